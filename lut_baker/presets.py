@@ -1,0 +1,119 @@
+"""Parameter presets: the paper's fitted layers (SPEC 5), skins from the literature, shades.
+
+Paper values are 16-bit pixel counts (red channel, applied to all three); they become albedo
+units through :func:`lut_baker.normalise.from_paper_counts`.  Literature skins are given
+directly in albedo units (1/sr) on the same scale.
+
+Functions
+---------
+- :func:`paper_layers` -- the four layers of SPEC 5 in counts.
+- :func:`paper` -- the paper's made-up skin (foundation "natural" on the bio-plate), normalised.
+- :func:`skin_layers` -- (surface reflection, dipole) of a named skin, albedo units.
+- :func:`made_up_skin` -- a named foundation on a named skin with coverage.
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+
+import numpy as np
+
+from .model import Dipole, ReflectionLayer, TransmissionLayer, dipole_total_reflectance
+from .normalise import MadeUpSkin, from_paper_counts
+
+__all__ = [
+    "PAPER_FILM_REFLECTION",
+    "PAPER_FILM_TRANSMISSION",
+    "PAPER_SKIN_REFLECTION",
+    "PAPER_SKIN_DIPOLE",
+    "FOUNDATIONS",
+    "SKINS",
+    "paper",
+    "paper_layers",
+    "skin_layers",
+    "made_up_skin",
+]
+
+# Baba, Mukaigawa, Yagi, section 4.1.1: liquid foundation ("natural"), reflection, 3 s shutter.
+PAPER_FILM_REFLECTION = ReflectionLayer(P_d=1.29e4, P_s=8.93e5, n=3.29e-2, eta=1.19)
+# Section 4.1.2: the same film, transmission, 10 s shutter.
+PAPER_FILM_TRANSMISSION = TransmissionLayer(P_d=2.64e4, P_t=1.08e4, n=3.46e-2, eta=1.19)
+# Section 4.2.1: skin substitute (white bio-plate), reflection, 3 s shutter.
+PAPER_SKIN_REFLECTION = ReflectionLayer(P_d=2.00e4, P_s=2.05e5, n=4.00e-2, eta=1.26)
+# Section 4.2.2: the bio-plate's dipole (1/mm); the paper gives no g, so g = 0 (SPEC 2.3).
+PAPER_SKIN_DIPOLE = Dipole(sigma_s=2.83, sigma_a=2.82e-2, g=0.0, eta=1.26)
+
+FOUNDATIONS: dict[str, dict] = {
+    # The paper's film, measured in red only; no absorption is known, so none is applied.
+    "paper_natural": {"absorption": (0.0, 0.0, 0.0), "label": "Paper (natural, as measured)"},
+    # Shades: the paper's film with pigment absorption per RGB channel (SPEC 4, "Absorption").
+    # Chosen by hand so the film's diffuse colour over white reads as the named shade.
+    "light_ivory": {"absorption": (0.04, 0.10, 0.22), "label": "Light ivory"},
+    "medium_beige": {"absorption": (0.10, 0.24, 0.42), "label": "Medium beige"},
+    "deep_mocha": {"absorption": (0.38, 0.56, 0.70), "label": "Deep mocha"},
+}
+
+
+@lru_cache(maxsize=1)
+def paper() -> MadeUpSkin:
+    """The paper's made-up skin: foundation "natural" on the bio-plate, coverage 1, albedo
+    units with K from SPEC 4."""
+    film, film_t, skin, dipole = paper_layers()
+    return from_paper_counts(film, film_t, skin, dipole, name="paper")
+
+
+def paper_layers():
+    """``(film reflection, film transmission, skin reflection, skin dipole)`` in counts."""
+    return PAPER_FILM_REFLECTION, PAPER_FILM_TRANSMISSION, PAPER_SKIN_REFLECTION, PAPER_SKIN_DIPOLE
+
+
+def _literature_skin(sigma_s_reduced, sigma_a, eta=1.3):
+    """Surface layer and dipole of a skin given by reduced scattering and absorption (1/mm).
+
+    Diffuse: ``P_d = Rd / pi`` (the dipole's closed-form total reflectance is the skin's diffuse
+    albedo, SPEC 4).  Gloss: Weyrich et al. 2006 (SIGGRAPH, "Analysis of human faces using a
+    measurement-based skin reflectance model") fit Beckmann roughness m ~ 0.35 to faces; the
+    Torrance-Sparrow lobe with the same 1/e half-width, atan(0.35) = 19.3 degrees, has
+    n = 0.052 / degree.  Its strength is the bio-plate's (normalised), as no TS fit in the
+    paper's form is published for real skin.
+    """
+    dipole = Dipole(sigma_s=sigma_s_reduced, sigma_a=sigma_a, g=0.0, eta=eta)
+    p_d = dipole_total_reflectance(dipole) / np.pi
+    bioplate = paper().skin
+    surface = ReflectionLayer(P_d=p_d, P_s=float(bioplate.P_s), n=1.0 / 19.3, eta=eta)
+    return surface, dipole
+
+
+SKINS: dict[str, dict] = {
+    "paper_bioplate": {"label": "Bio-plate (paper)"},
+    # Jensen, Marschner, Levoy, Hanrahan 2001, table of measured parameters: "Skin1",
+    # sigma_s' = (0.74, 0.88, 1.01) /mm, sigma_a = (0.032, 0.17, 0.48) /mm, eta = 1.3.
+    "jensen_skin1": {"label": "Skin 1 (Jensen 2001)",
+                     "sigma_s": (0.74, 0.88, 1.01), "sigma_a": (0.032, 0.17, 0.48)},
+    # Same table, "Skin2": sigma_s' = (1.09, 1.59, 1.79) /mm, sigma_a = (0.013, 0.070, 0.145).
+    "jensen_skin2": {"label": "Skin 2 (Jensen 2001)",
+                     "sigma_s": (1.09, 1.59, 1.79), "sigma_a": (0.013, 0.070, 0.145)},
+}
+
+
+def skin_layers(name: str):
+    """``(surface ReflectionLayer, Dipole)`` of a named skin, in albedo units."""
+    if name not in SKINS:
+        raise ValueError(f"skin must be one of {sorted(SKINS)}, got {name!r}")
+    if name == "paper_bioplate":
+        base = paper()
+        return base.skin, base.dipole
+    entry = SKINS[name]
+    return _literature_skin(entry["sigma_s"], entry["sigma_a"])
+
+
+def made_up_skin(foundation: str = "paper_natural", skin: str = "paper_bioplate", *,
+                 coverage: float = 1.0, absorption=None) -> MadeUpSkin:
+    """A named foundation on a named skin.  ``absorption`` (scalar or RGB in [0, 1]) overrides
+    the shade's own."""
+    if foundation not in FOUNDATIONS:
+        raise ValueError(f"foundation must be one of {sorted(FOUNDATIONS)}, got {foundation!r}")
+    surface, dipole = skin_layers(skin)
+    shade = FOUNDATIONS[foundation]["absorption"] if absorption is None else absorption
+    return paper().replace(skin=surface, dipole=dipole, coverage=coverage, absorption=shade,
+                           name=f"{foundation}+{skin}")
