@@ -22,6 +22,8 @@ Functions
   transmittance.
 - :func:`reflection_albedo` -- ``Int f_r(wi, wo) cos(theta_o) dwo`` of a reflecting layer.
 - :func:`layered_fourier_matrices` -- the per-order matrices of ``f_cs`` between two polar grids.
+- :func:`layer_fourier_kernel` -- cosine coefficients of one layer's kernel (the default
+  ``fourier`` of the matrix functions; a faster one with the same signature may be passed).
 """
 
 from __future__ import annotations
@@ -55,6 +57,7 @@ __all__ = [
     "layered_fourier_matrices",
     "grid_for",
     "inter_reflection_fourier_matrices",
+    "layer_fourier_kernel",
 ]
 
 POINT_CHUNK = 64
@@ -96,17 +99,28 @@ def reflection_kernel(layer: ReflectionLayer):
     return kernel
 
 
-def _inner_matrices(grid: HemisphereGrid, cosmetic, skin: ReflectionLayer) -> np.ndarray:
+def layer_fourier_kernel(layer, theta_a, theta_b, n_phi: int) -> np.ndarray:
+    """Cosine coefficients ``(orders, A, B, C)`` of a layer's kernel between polar angles
+    ``theta_a``, ``theta_b`` (radians): ``f_r(wa, wb)`` of a :class:`ReflectionLayer`,
+    ``f_t(wa, -wb)`` of a :class:`TransmissionLayer` (see :func:`quadrature.fourier_kernel`)."""
+    if isinstance(layer, ReflectionLayer):
+        return fourier_kernel(reflection_kernel(layer), theta_a, theta_b, n_phi)
+    return fourier_kernel(transmission_kernel(layer), theta_a, theta_b, n_phi)
+
+
+def _inner_matrices(grid: HemisphereGrid, cosmetic, skin: ReflectionLayer,
+                    fourier=layer_fourier_kernel) -> np.ndarray:
     """``c_m^2 W B_m W`` on the grid's polar nodes: shape ``(orders, N, N, C)``."""
-    b = fourier_kernel(reflection_kernel(skin), grid.theta, grid.theta, grid.n_phi)
+    b = fourier(skin, grid.theta, grid.theta, grid.n_phi)
     w = grid.weight
     factor = azimuth_convolution_factor(grid.orders) ** 2
     return factor[:, None, None, None] * w[None, :, None, None] * b * w[None, None, :, None]
 
 
-def _transmission_rows(theta, grid: HemisphereGrid, cosmetic) -> np.ndarray:
+def _transmission_rows(theta, grid: HemisphereGrid, cosmetic,
+                       fourier=layer_fourier_kernel) -> np.ndarray:
     """``T_m(theta, theta_u)`` for outer polar angles ``theta``: shape ``(orders, P, N, C)``."""
-    return fourier_kernel(transmission_kernel(cosmetic), theta, grid.theta, grid.n_phi)
+    return fourier(cosmetic, theta, grid.theta, grid.n_phi)
 
 
 def _batched_matmul(left: np.ndarray, right: np.ndarray) -> np.ndarray:
@@ -116,32 +130,35 @@ def _batched_matmul(left: np.ndarray, right: np.ndarray) -> np.ndarray:
     return np.moveaxis(left_c @ right_c, 1, -1)  # (M, P, Q, C)
 
 
-def layered_fourier_matrices(theta_i, theta_o, cosmetic, skin, grid: HemisphereGrid):
+def layered_fourier_matrices(theta_i, theta_o, cosmetic, skin, grid: HemisphereGrid, *,
+                             fourier=layer_fourier_kernel):
     """Fourier matrices ``F_m(theta_i, theta_o)`` of path 3: ``f_cs = sum_m F_m cos(m phi)``.
 
     ``theta_i``, ``theta_o``: polar angles (radians) of the outer directions; returns shape
     ``(orders, len(theta_i), len(theta_o), C)``.  Cost: one kernel table per layer and two
-    batched matrix products per order (SPEC 3).
+    batched matrix products per order (SPEC 3).  ``fourier``: the function giving each layer's
+    kernel coefficients (signature of :func:`layer_fourier_kernel`, e.g. a faster or cached one).
     """
-    inner = _inner_matrices(grid, cosmetic, skin)
-    rows = _transmission_rows(theta_i, grid, cosmetic)
-    cols = _transmission_rows(theta_o, grid, cosmetic)
+    inner = _inner_matrices(grid, cosmetic, skin, fourier)
+    rows = _transmission_rows(theta_i, grid, cosmetic, fourier)
+    cols = _transmission_rows(theta_o, grid, cosmetic, fourier)
     return _batched_matmul(_batched_matmul(rows, inner), np.swapaxes(cols, 1, 2))
 
 
-def inter_reflection_fourier_matrices(theta_i, theta_o, cosmetic, skin, grid, *, film_below=None):
+def inter_reflection_fourier_matrices(theta_i, theta_o, cosmetic, skin, grid, *, film_below=None,
+                                      fourier=layer_fourier_kernel):
     """Fourier matrices of all inter-reflections between film and skin (the adding equation).
 
     Path 3 is the first term of ``T (I - R_s R_f)^-1 R_s T``, where ``R_f`` is the film's
     underside reflecting like its top (``film_below``, a :class:`ReflectionLayer`; omit it for
-    path 3 alone).  Shapes as :func:`layered_fourier_matrices`.
+    path 3 alone).  Shapes and ``fourier`` as :func:`layered_fourier_matrices`.
     """
     if film_below is None:
-        return layered_fourier_matrices(theta_i, theta_o, cosmetic, skin, grid)
+        return layered_fourier_matrices(theta_i, theta_o, cosmetic, skin, grid, fourier=fourier)
     # S = c_m^2 W B_m W carries the two azimuth integrals around a skin bounce; each further
     # bounce off the film's underside adds R_f S, so the sum is S (I - R_f S)^-1 = (I - S R_f)^-1 S.
-    skin_m = _inner_matrices(grid, cosmetic, skin)
-    film_m = fourier_kernel(reflection_kernel(film_below), grid.theta, grid.theta, grid.n_phi)
+    skin_m = _inner_matrices(grid, cosmetic, skin, fourier)
+    film_m = fourier(film_below, grid.theta, grid.theta, grid.n_phi)
     channels = max(film_m.shape[-1], skin_m.shape[-1])
     skin_m = np.broadcast_to(skin_m, skin_m.shape[:3] + (channels,))
     film_m = np.broadcast_to(film_m, skin_m.shape)
@@ -151,8 +168,8 @@ def inter_reflection_fourier_matrices(theta_i, theta_o, cosmetic, skin, grid, *,
         for c in range(channels):
             s_m = skin_m[m, :, :, c]
             adding[m, :, :, c] = np.linalg.solve(eye - s_m @ film_m[m, :, :, c], s_m)
-    rows = _transmission_rows(theta_i, grid, cosmetic)
-    cols = _transmission_rows(theta_o, grid, cosmetic)
+    rows = _transmission_rows(theta_i, grid, cosmetic, fourier)
+    cols = _transmission_rows(theta_o, grid, cosmetic, fourier)
     return _batched_matmul(_batched_matmul(rows, adding), np.swapaxes(cols, 1, 2))
 
 
