@@ -244,14 +244,34 @@ def microfacet_distribution(angle_deg, n):
 
     ``angle_deg`` is alpha (or beta for transmission) in degrees, ``n`` in 1/degree.
     """
-    return np.exp(-np.square(np.asarray(angle_deg, dtype=float) * n))
+    angle = np.asarray(angle_deg, dtype=float)
+    n = np.asarray(n, dtype=float)
+    if not np.all(np.isfinite(angle)):
+        raise ValueError("angle_deg must be finite angles (degrees)")
+    if not np.all(np.isfinite(n)) or np.any(n <= 0.0):
+        raise ValueError(f"n must lie in (0, inf) (1/degree), got {n!r}")
+    return _distribution(angle, n)
+
+
+def _distribution(angle_deg: np.ndarray, n) -> np.ndarray:
+    """:func:`microfacet_distribution` without argument checks, for inner loops."""
+    return np.exp(-np.square(angle_deg * n))
 
 
 def geometric_attenuation(n_dot_h, n_dot_v, n_dot_l, v_dot_h):
     """Torrance-Sparrow shadowing/masking ``G = min(1, 2 NH NV / VH, 2 NH NL / VH)`` (eq. 2).
 
-    Where ``VH`` is 0 (an opposite horizontal pair) G is 0.
+    Arguments are cosines in [0, 1].  Where ``VH`` is 0 (an opposite horizontal pair) G is 0.
     """
+    cosines = np.broadcast_arrays(*(np.asarray(x, dtype=float)
+                                    for x in (n_dot_h, n_dot_v, n_dot_l, v_dot_h)))
+    if any(np.any(~((x >= 0.0) & (x <= 1.0 + UNIT_TOLERANCE))) for x in cosines):
+        raise ValueError("n_dot_h, n_dot_v, n_dot_l and v_dot_h must lie in [0, 1]")
+    return _attenuation(*cosines)
+
+
+def _attenuation(n_dot_h, n_dot_v, n_dot_l, v_dot_h) -> np.ndarray:
+    """:func:`geometric_attenuation` without argument checks, for inner loops."""
     n_dot_h, n_dot_v, n_dot_l, v_dot_h = np.broadcast_arrays(n_dot_h, n_dot_v, n_dot_l, v_dot_h)
     safe = v_dot_h > 1e-12
     ratio = 2.0 * n_dot_h * np.minimum(n_dot_v, n_dot_l) / np.where(safe, v_dot_h, 1.0)
@@ -277,8 +297,8 @@ def _ts_reflection(wi: np.ndarray, wo: np.ndarray, layer: ReflectionLayer) -> np
     n_dot_v = wo[..., 2]
     v_dot_h = np.clip(np.sum(wo * h, axis=-1), 0.0, 1.0)
     alpha = _angle_from_normal_deg(n_dot_h)
-    geometry = geometric_attenuation(n_dot_h, n_dot_v, n_dot_l, v_dot_h)
-    d = microfacet_distribution(_channel_axis(alpha, layer), layer.n)
+    geometry = _attenuation(n_dot_h, n_dot_v, n_dot_l, v_dot_h)
+    d = _distribution(_channel_axis(alpha, layer), layer.n)
     f = _fresnel(_channel_axis(v_dot_h, layer), layer.eta)
     value = layer.P_d + layer.P_s * d * _channel_axis(geometry, layer) * f
     upper = (n_dot_l >= 0.0) & (n_dot_v >= 0.0)
@@ -301,13 +321,14 @@ def ts_transmission(wi, wt, layer: TransmissionLayer):
 def _ts_transmission(wi: np.ndarray, wt: np.ndarray, layer: TransmissionLayer) -> np.ndarray:
     wi, wt = np.broadcast_arrays(wi, wt)
     crossing = wi[..., 2] * wt[..., 2] <= 0.0
-    flip = np.where(wi[..., 2:3] < 0.0, -1.0, 1.0)
+    # Upward crossing (``wi`` below, or on the horizon with ``wt`` above): mirror the pair.
+    flip = np.where(wi[..., 2:3] < wt[..., 2:3], -1.0, 1.0)
     top = wi * np.concatenate([np.ones_like(flip), np.ones_like(flip), flip], axis=-1)
     mirrored = wt * np.concatenate([np.ones_like(flip), np.ones_like(flip), -flip], axis=-1)
     h = _half_vector(top, mirrored)
     beta = _angle_from_normal_deg(h[..., 2])
     c = np.clip(np.sum(mirrored * h, axis=-1), 0.0, 1.0)
-    d = microfacet_distribution(_channel_axis(beta, layer), layer.n)
+    d = _distribution(_channel_axis(beta, layer), layer.n)
     f_t = 1.0 - _fresnel(_channel_axis(c, layer), layer.eta)
     value = layer.P_d + layer.P_t * d * f_t
     return np.where(_channel_axis(crossing, layer), value, 0.0)

@@ -1,0 +1,376 @@
+"""Single-layer functions (lut_baker.model, SPEC 2): known values, broadcasting, RGB channels,
+agreement with the independent reference (tests/reference_impl.py) in the paper's raw units,
+reciprocity, the dipole's closed form, input validation and hemisphere masking."""
+
+import math
+
+import numpy as np
+import pytest
+import reference_impl as ref
+from scipy.integrate import quad
+
+from lut_baker import model, presets
+from lut_baker.model import Dipole, ReflectionLayer, TransmissionLayer
+
+RTOL = 1e-10
+RAW_REFLECTION = {
+    "film": presets.PAPER_FILM_REFLECTION,
+    "skin": presets.PAPER_SKIN_REFLECTION,
+    "rgb": ReflectionLayer(P_d=(1.0e4, 2.0e4, 0.0), P_s=(9e5, 2e5, 5e4), n=(0.02, 0.04, 0.3),
+                           eta=(1.19, 1.26, 1.6)),
+}
+RAW_TRANSMISSION = {
+    "film": presets.PAPER_FILM_TRANSMISSION,
+    "rgb": TransmissionLayer(P_d=(2.64e4, 1e4, 0.0), P_t=(1.08e4, 3e4, 1e5), n=(0.0346, 0.1, 1.0),
+                             eta=(1.19, 1.5, 1.05)),
+}
+DIPOLES = {
+    "paper": presets.PAPER_SKIN_DIPOLE,
+    "jensen_skin1": Dipole(sigma_s=(0.74, 0.88, 1.01), sigma_a=(0.032, 0.17, 0.48), eta=1.3),
+    "jensen_skin2": Dipole(sigma_s=(1.09, 1.59, 1.79), sigma_a=(0.013, 0.070, 0.145), eta=1.3),
+    "tiny_sigma_a": Dipole(sigma_s=2.83, sigma_a=1e-9, eta=1.26),
+    "forward_g": Dipole(sigma_s=5.0, sigma_a=0.1, g=0.8, eta=1.44),
+}
+
+
+def _unit(v):
+    v = np.asarray(v, float)
+    return v / np.linalg.norm(v, axis=-1, keepdims=True)
+
+
+def _random_upper(rng, count):
+    """Directions uniform over the upper hemisphere (z >= 0)."""
+    v = _unit(rng.normal(size=(count, 3)))
+    v[:, 2] = np.abs(v[:, 2])
+    return v
+
+
+def _grazing_pairs():
+    """Pairs with one or both directions at 89.9 degrees or exactly on the horizon (z = 0)."""
+    s, c = math.sin(math.radians(89.9)), math.cos(math.radians(89.9))
+    near = [np.array([s * math.cos(p), s * math.sin(p), c]) for p in (0.0, 1.0, math.pi, 2.5)]
+    horizon = [np.array([math.cos(p), math.sin(p), 0.0]) for p in (0.0, 0.7, math.pi, 4.0)]
+    others = [np.array([0.0, 0.0, 1.0]), _unit([0.3, -0.2, 0.9]), _unit([-0.8, 0.1, 0.2])]
+    pool = near + horizon + others
+    return [(a, b) for a in pool for b in pool if (a[2] < 0.01 or b[2] < 0.01)]
+
+
+def _layer_args(layer, channel=None):
+    """The layer's fields as floats (one channel) for the reference functions."""
+    values = layer.as_dict()
+    return [float(v[channel] if isinstance(v, list) else v) for v in values.values()]
+
+
+# --- known values --------------------------------------------------------------------------
+@pytest.mark.parametrize("eta", [0.5, 1.0, 1.0001, 1.19, 1.26, 1.33, 1.5, 2.42, 10.0])
+def test_fresnel_normal_incidence(eta):
+    assert model.fresnel_reflectance(1.0, eta) == pytest.approx(((eta - 1) / (eta + 1)) ** 2,
+                                                                rel=1e-12, abs=1e-15)
+
+
+def test_fresnel_normal_incidence_rgb():
+    eta = np.array([1.19, 1.33, 1.5])
+    np.testing.assert_allclose(model.fresnel_reflectance(1.0, eta), ((eta - 1) / (eta + 1)) ** 2,
+                               rtol=1e-12)
+
+
+@pytest.mark.parametrize("eta", [0.6, 1.0, 1.0001, 1.19, 1.5, 3.0])
+def test_fresnel_grazing_is_one(eta):
+    assert model.fresnel_reflectance(0.0, eta) == pytest.approx(1.0, abs=1e-12)
+
+
+def test_fresnel_total_internal_reflection():
+    eta = 1.0 / 1.5
+    cos_critical = math.sqrt(1.0 - eta**2)
+    c = np.linspace(0.0, cos_critical * (1 - 1e-9), 50)
+    np.testing.assert_array_equal(model.fresnel_reflectance(c, eta), 1.0)
+    beyond = model.fresnel_reflectance(np.linspace(cos_critical * 1.01, 1.0, 50), eta)
+    assert np.all(beyond < 1.0) and np.all(np.diff(beyond) < 0)
+
+
+def test_fresnel_matches_reference():
+    c = np.linspace(0.0, 1.0, 101)
+    for eta in (0.7, 1.0, 1.19, 2.0):
+        expected = [ref.fresnel(x, eta) for x in c]
+        np.testing.assert_allclose(model.fresnel_reflectance(c, eta), expected, rtol=RTOL)
+
+
+@pytest.mark.parametrize("n", [1e-6, 3.29e-2, 0.04, 1.0, 50.0])
+def test_distribution_half_width(n):
+    """The lobe's 1/e half-width is 1/n degrees (SPEC 2.1)."""
+    assert model.microfacet_distribution(1.0 / n, n) == pytest.approx(math.exp(-1.0), rel=1e-12)
+    assert model.microfacet_distribution(0.0, n) == 1.0
+
+
+@pytest.mark.parametrize("nh, nv, nl, vh, expected", [
+    (1.0, 1.0, 1.0, 1.0, 1.0),  # mirror at normal incidence: unshadowed
+    (0.9, 0.3, 0.8, 0.7, 2 * 0.9 * 0.3 / 0.7),  # masking of the view
+    (0.9, 0.8, 0.2, 0.7, 2 * 0.9 * 0.2 / 0.7),  # shadowing of the light
+    (0.8, 0.0, 0.9, 0.5, 0.0),  # grazing view
+    (1.0, 0.0, 0.0, 0.0, 0.0),  # opposite horizontal pair: VH = 0
+])
+def test_geometric_attenuation_cases(nh, nv, nl, vh, expected):
+    assert model.geometric_attenuation(nh, nv, nl, vh) == pytest.approx(expected, rel=1e-12)
+
+
+def test_reflection_at_normal_mirror_known_value():
+    layer = presets.PAPER_SKIN_REFLECTION
+    z = np.array([0.0, 0.0, 1.0])
+    expected = 2.00e4 + 2.05e5 * 1.0 * 1.0 * ((1.26 - 1) / (1.26 + 1)) ** 2
+    assert model.ts_reflection(z, z, layer) == pytest.approx(expected, rel=1e-12)
+
+
+# --- broadcasting and channels -------------------------------------------------------------
+def test_nd_directions_broadcast():
+    rng = np.random.default_rng(1)
+    wi = _random_upper(rng, 20).reshape(4, 5, 3)
+    wo = _random_upper(rng, 20).reshape(4, 5, 3)
+    wt = -_random_upper(rng, 20).reshape(4, 5, 3)
+    for func, a, b, layer in [
+        (model.ts_reflection, wi, wo, RAW_REFLECTION["film"]),
+        (model.ts_transmission, wi, wt, RAW_TRANSMISSION["film"]),
+        (model.ts_reflection, wi, wo, RAW_REFLECTION["rgb"]),
+    ]:
+        whole = func(a, b, layer)
+        assert whole.shape == (4, 5) + layer.channels
+        flat = np.array([func(x, y, layer) for x, y in zip(a.reshape(-1, 3), b.reshape(-1, 3),
+                                                            strict=True)])
+        np.testing.assert_array_equal(whole.reshape(flat.shape), flat)
+    one = model.ts_reflection(wi[0, 0], wo, RAW_REFLECTION["film"])  # (3,) with (4, 5, 3)
+    np.testing.assert_array_equal(one, model.ts_reflection(
+        np.broadcast_to(wi[0, 0], wo.shape), wo, RAW_REFLECTION["film"]))
+    d = np.linspace(0, 3, 20).reshape(4, 5)
+    profile = model.dipole_profile(d, DIPOLES["jensen_skin1"])
+    assert profile.shape == (4, 5, 3)
+    np.testing.assert_array_equal(profile[1, 2], model.dipole_profile(d[1, 2],
+                                                                      DIPOLES["jensen_skin1"]))
+
+
+def test_rgb_layer_equals_scalar_layer_per_channel():
+    rng = np.random.default_rng(2)
+    wi, wo = _random_upper(rng, 50), _random_upper(rng, 50)
+    d = np.linspace(0.0, 5.0, 30)
+    cases = [
+        (model.ts_reflection, (wi, wo), RAW_REFLECTION["rgb"]),
+        (model.ts_transmission, (wi, -wo), RAW_TRANSMISSION["rgb"]),
+        (model.dipole_profile, (d,), DIPOLES["jensen_skin2"]),
+        (model.dipole_total_reflectance, (), DIPOLES["jensen_skin2"]),
+    ]
+    for func, args, layer in cases:
+        rgb = func(*args, layer)
+        assert rgb.shape[-1] == 3
+        for c in range(3):
+            scalar = func(*args, layer.channel(c))
+            assert np.shape(scalar) == rgb.shape[:-1]
+            np.testing.assert_allclose(rgb[..., c], scalar, rtol=1e-14)
+
+
+# --- agreement with the independent reference ----------------------------------------------
+@pytest.mark.parametrize("name", sorted(RAW_REFLECTION))
+def test_reflection_matches_reference(name):
+    layer = RAW_REFLECTION[name]
+    rng = np.random.default_rng(3)
+    pairs = list(zip(_random_upper(rng, 200), _random_upper(rng, 200), strict=True))
+    pairs += _grazing_pairs()
+    wi = np.array([p[0] for p in pairs])
+    wo = np.array([p[1] for p in pairs])
+    got = model.ts_reflection(wi, wo, layer)
+    for c in range(3) if layer.channels else [None]:
+        args = _layer_args(layer, c)
+        expected = np.array([ref.ts_reflection(a, b, *args) for a, b in pairs])
+        np.testing.assert_allclose(got if c is None else got[:, c], expected, rtol=RTOL)
+
+
+@pytest.mark.parametrize("name", sorted(RAW_TRANSMISSION))
+def test_transmission_matches_reference(name):
+    layer = RAW_TRANSMISSION[name]
+    rng = np.random.default_rng(4)
+    pairs = list(zip(_random_upper(rng, 200), -_random_upper(rng, 200), strict=True))
+    # Grazing pairs with the second direction moved below, and light crossing upward.
+    pairs += [(a, b * np.array([1, 1, -1])) for a, b in _grazing_pairs()]
+    pairs += [(b * np.array([1, 1, -1]), a) for a, b in _grazing_pairs()]
+    wi = np.array([p[0] for p in pairs])
+    wt = np.array([p[1] for p in pairs])
+    got = model.ts_transmission(wi, wt, layer)
+    for c in range(3) if layer.channels else [None]:
+        args = _layer_args(layer, c)
+        expected = np.array([ref.ts_transmission(a, b, *args) for a, b in pairs])
+        np.testing.assert_allclose(got if c is None else got[:, c], expected, rtol=RTOL)
+
+
+@pytest.mark.parametrize("name", sorted(DIPOLES))
+def test_dipole_profile_matches_reference(name):
+    dipole = DIPOLES[name]
+    d = np.concatenate([[0.0, 1e-9], np.geomspace(1e-4, 50.0, 60)])
+    got = model.dipole_profile(d, dipole)
+    for c in range(3) if dipole.channels else [None]:
+        expected = [ref.dipole_profile(x, *_layer_args(dipole, c)) for x in d]
+        np.testing.assert_allclose(got if c is None else got[:, c], expected, rtol=RTOL)
+
+
+# --- reciprocity and the transmission lobe -------------------------------------------------
+def test_reflection_reciprocity():
+    rng = np.random.default_rng(5)
+    wi, wo = _random_upper(rng, 500), _random_upper(rng, 500)
+    for layer in RAW_REFLECTION.values():
+        np.testing.assert_allclose(model.ts_reflection(wi, wo, layer),
+                                   model.ts_reflection(wo, wi, layer), rtol=1e-12)
+
+
+def test_transmission_reciprocity_and_mirror_symmetry():
+    rng = np.random.default_rng(6)
+    wi = _random_upper(rng, 500)
+    wt = -_random_upper(rng, 500)
+    pairs = _grazing_pairs()
+    wi = np.concatenate([wi, [a for a, _ in pairs]])
+    wt = np.concatenate([wt, [b * np.array([1, 1, -1]) for _, b in pairs]])
+    mirror = np.array([1.0, 1.0, -1.0])
+    for layer in RAW_TRANSMISSION.values():
+        forward = model.ts_transmission(wi, wt, layer)
+        np.testing.assert_allclose(model.ts_transmission(-wt, -wi, layer), forward, rtol=RTOL)
+        np.testing.assert_allclose(model.ts_transmission(wi * mirror, wt * mirror, layer),
+                                   forward, rtol=RTOL)
+
+
+def test_transmission_lobe_peaks_straight_through():
+    """D(beta) peaks at wt = -wi (SPEC 2.2): exactly so when F_t is flat (eta = 1), and at
+    normal incidence for any eta.  (With eta > 1 the factor F_t pulls the peak toward the
+    normal at oblique incidence; see the report.)"""
+    for eta, angles in ((1.0, (0.0, 30.0, 60.0, 85.0)), (1.19, (0.0,))):
+        layer = TransmissionLayer(P_d=10.0, P_t=100.0, n=0.0346, eta=eta)
+        for theta in angles:
+            wi = np.array([math.sin(math.radians(theta)), 0.0, math.cos(math.radians(theta))])
+            straight = model.ts_transmission(wi, -wi, layer)
+            assert straight == pytest.approx(10.0 + 100.0 * (1 - ref.fresnel(wi[2], eta)))
+            rng = np.random.default_rng(7)
+            around = -_unit(wi + 0.3 * rng.normal(size=(400, 3)))
+            around = around[around[:, 2] < 0]
+            assert np.all(model.ts_transmission(wi, around, layer) < straight)
+
+
+# --- dipole --------------------------------------------------------------------------------
+@pytest.mark.parametrize("name", sorted(DIPOLES))
+def test_dipole_integral_equals_closed_form(name):
+    dipole = DIPOLES[name]
+    closed = np.atleast_1d(model.dipole_total_reflectance(dipole))
+    for c in range(closed.size):
+        channel = dipole.channel(c) if dipole.channels else dipole
+
+        def integrand(d, channel=channel):
+            return 2.0 * math.pi * float(model.dipole_profile(d, channel)) * d
+
+        # Split at a few mean free paths: the profile is sharp near d = 0, slow in its tail.
+        z = 1.0 / float(channel.sigma_s * (1 - channel.g) + channel.sigma_a)
+        near, _ = quad(integrand, 0.0, 10 * z, limit=200, epsabs=1e-12, epsrel=1e-10)
+        far, _ = quad(integrand, 10 * z, np.inf, limit=200, epsabs=1e-12, epsrel=1e-10)
+        assert near + far == pytest.approx(closed[c], rel=1e-4)
+
+
+def test_dipole_finite_at_zero_distance():
+    for dipole in DIPOLES.values():
+        at_zero = np.atleast_1d(model.dipole_profile(0.0, dipole))
+        assert np.all(np.isfinite(at_zero)) and np.all(at_zero > 0)
+        np.testing.assert_allclose(at_zero, np.atleast_1d(model.dipole_profile(1e-9, dipole)),
+                                   rtol=1e-9)
+
+
+def test_dipole_lossless_reflects_everything():
+    """sigma_a = 0: nothing is absorbed, Rd = 1 (the closed form's limit)."""
+    assert model.dipole_total_reflectance(Dipole(sigma_s=1.0, sigma_a=0.0)) == pytest.approx(1.0)
+
+
+# --- validation ----------------------------------------------------------------------------
+@pytest.mark.parametrize("kind, field, value, message", [
+    (ReflectionLayer, "eta", 0.0, r"eta must lie in \(0, inf\)"),
+    (ReflectionLayer, "eta", -1.3, r"eta must lie in \(0, inf\)"),
+    (ReflectionLayer, "n", 0.0, r"n must lie in \(0, inf\)"),
+    (ReflectionLayer, "P_d", -1.0, r"P_d must lie in \[0, inf\)"),
+    (ReflectionLayer, "P_s", float("nan"), r"P_s must lie in \[0, inf\)"),
+    (ReflectionLayer, "P_s", (1.0, -2.0, 3.0), r"P_s must lie in \[0, inf\)"),
+    (ReflectionLayer, "n", float("inf"), r"n must lie in \(0, inf\)"),
+    (ReflectionLayer, "P_d", (1.0, 2.0), r"P_d must be a float or an RGB triple"),
+    (TransmissionLayer, "P_t", -0.5, r"P_t must lie in \[0, inf\)"),
+    (TransmissionLayer, "eta", (1.2, 0.0, 1.3), r"eta must lie in \(0, inf\)"),
+    (TransmissionLayer, "n", -3.0, r"n must lie in \(0, inf\)"),
+])
+def test_layer_validation(kind, field, value, message):
+    values = {"P_d": 1.0, "n": 0.04, "eta": 1.3}
+    values["P_s" if kind is ReflectionLayer else "P_t"] = 1.0
+    values[field] = value
+    with pytest.raises(ValueError, match=message):
+        kind(**values)
+
+
+@pytest.mark.parametrize("field, value, message", [
+    ("sigma_s", -1.0, r"sigma_s must lie in \[0, inf\)"),
+    ("sigma_a", -1e-3, r"sigma_a must lie in \[0, inf\)"),
+    ("sigma_a", float("nan"), r"sigma_a must lie in \[0, inf\)"),
+    ("g", 1.0, r"g must lie in \(-1, 1\)"),
+    ("eta", 0.9, r"eta must lie in \[1, inf\)"),
+    ("eta", 0.0, r"eta must lie in \[1, inf\)"),
+])
+def test_dipole_validation(field, value, message):
+    values = {"sigma_s": 1.0, "sigma_a": 0.1, "g": 0.0, "eta": 1.3}
+    values[field] = value
+    with pytest.raises(ValueError, match=message):
+        Dipole(**values)
+    with pytest.raises(ValueError, match=r"sigma_s \* \(1 - g\) \+ sigma_a must be > 0"):
+        Dipole(sigma_s=0.0, sigma_a=0.0)
+
+
+@pytest.mark.parametrize("bad, message", [
+    (np.array([0.0, 0.0]), r"wi must have shape \(\.\.\., 3\)"),
+    (np.array(1.0), r"wi must have shape \(\.\.\., 3\)"),
+    (np.array([0.0, 0.0, 1.1]), r"wi must be unit vectors \(\|w\| = 1 within 1e-6\)"),
+    (np.array([0.0, 0.0, 0.0]), r"wi must be unit vectors"),
+    (np.array([np.nan, 0.0, 1.0]), r"wi must be finite unit vectors"),
+])
+def test_direction_validation(bad, message):
+    z = np.array([0.0, 0.0, 1.0])
+    with pytest.raises(ValueError, match=message):
+        model.ts_reflection(bad, z, RAW_REFLECTION["film"])
+    with pytest.raises(ValueError, match=message):
+        model.ts_transmission(bad, -z, RAW_TRANSMISSION["film"])
+    with pytest.raises(ValueError, match=message.replace("wi must", "wo must")):
+        model.ts_reflection(z, bad, RAW_REFLECTION["film"])
+    with pytest.raises(ValueError, match=message.replace("wi must", "wt must")):
+        model.ts_transmission(z, bad, RAW_TRANSMISSION["film"])
+
+
+def test_function_argument_validation():
+    with pytest.raises(ValueError, match=r"eta must lie in \(0, inf\)"):
+        model.fresnel_reflectance(0.5, 0.0)
+    with pytest.raises(ValueError, match=r"eta must lie in \(0, inf\)"):
+        model.fresnel_reflectance(0.5, float("nan"))
+    with pytest.raises(ValueError, match=r"cos_theta must lie in \[0, 1\]"):
+        model.fresnel_reflectance(float("nan"), 1.3)
+    with pytest.raises(ValueError, match=r"cos_theta must lie in \[0, 1\]"):
+        model.fresnel_reflectance(1.5, 1.3)
+    with pytest.raises(ValueError, match=r"d_mm must be distances >= 0 \(mm\)"):
+        model.dipole_profile(-0.1, DIPOLES["paper"])
+    with pytest.raises(ValueError, match=r"d_mm must be distances >= 0 \(mm\)"):
+        model.dipole_profile([0.1, float("nan")], DIPOLES["paper"])
+    with pytest.raises(ValueError, match=r"n must lie in \(0, inf\)"):
+        model.microfacet_distribution(1.0, 0.0)
+    with pytest.raises(ValueError, match=r"angle_deg must be finite"):
+        model.microfacet_distribution(float("nan"), 0.04)
+    with pytest.raises(ValueError, match=r"must lie in \[0, 1\]"):
+        model.geometric_attenuation(float("nan"), 0.5, 0.5, 0.5)
+
+
+# --- hemispheres ---------------------------------------------------------------------------
+def test_outside_hemisphere_is_zero():
+    rng = np.random.default_rng(8)
+    up, up2 = _random_upper(rng, 100), _random_upper(rng, 100)
+    up[:, 2] += 1e-3  # strictly above the horizon
+    up, up2 = _unit(up), _unit(up2 + [0, 0, 1e-3])
+    for layer in RAW_REFLECTION.values():
+        assert np.all(model.ts_reflection(-up, up2, layer) == 0.0)
+        assert np.all(model.ts_reflection(up, -up2, layer) == 0.0)
+    for layer in RAW_TRANSMISSION.values():
+        assert np.all(model.ts_transmission(up, up2, layer) == 0.0)
+        assert np.all(model.ts_transmission(-up, -up2, layer) == 0.0)
+    # The same pairs inside the hemispheres are not 0 (the masks above are not vacuous).
+    assert np.all(model.ts_reflection(up, up2, RAW_REFLECTION["film"]) > 0.0)
+    assert np.all(model.ts_transmission(up, -up2, RAW_TRANSMISSION["film"]) > 0.0)
+    assert np.all(model.ts_transmission(-up, up2, RAW_TRANSMISSION["film"]) > 0.0)
