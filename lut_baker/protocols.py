@@ -15,6 +15,8 @@ Functions
 ---------
 - :func:`step_angles` -- the paper's signed sampling of alpha or beta (degrees).
 - :func:`in_plane_direction` -- unit vector at a signed in-plane angle (degrees).
+- :func:`reflection_geometry` -- directions of given samples alpha at relative angle psi.
+- :func:`transmission_geometry` -- directions of given samples theta_t at incidence theta_i.
 - :func:`reflection_sweep` -- geometry of a reflection experiment at relative angle psi.
 - :func:`transmission_sweep` -- geometry of a transmission experiment at incidence theta_i.
 - :func:`profile_distances` -- distances (mm) of a pencil-beam profile.
@@ -32,6 +34,8 @@ __all__ = [
     "in_plane_direction",
     "ReflectionSweep",
     "TransmissionSweep",
+    "reflection_geometry",
+    "transmission_geometry",
     "reflection_sweep",
     "transmission_sweep",
     "profile_distances",
@@ -86,20 +90,35 @@ class TransmissionSweep:
     wt: np.ndarray
 
 
+def reflection_geometry(relative_angle_deg: float, alpha_deg) -> ReflectionSweep:
+    """Directions of reflection samples at signed ``alpha_deg`` (degrees) with light and camera
+    ``relative_angle_deg`` apart: ``theta_i = alpha + psi/2``, ``theta_r = alpha - psi/2``."""
+    alpha = np.asarray(alpha_deg, float)
+    half = relative_angle_deg / 2.0
+    theta_i = alpha + half
+    theta_r = alpha - half
+    return ReflectionSweep(relative_angle_deg, alpha, theta_i, theta_r,
+                           in_plane_direction(theta_i), in_plane_direction(theta_r))
+
+
+def transmission_geometry(incidence_deg: float, theta_t_deg) -> TransmissionSweep:
+    """Directions of transmission samples at signed ``theta_t_deg`` (degrees, from -z) with the
+    light at ``incidence_deg``; in-plane, ``beta = (theta_t - theta_i) / 2``."""
+    theta_t = np.asarray(theta_t_deg, float)
+    beta = (theta_t - incidence_deg) / 2.0
+    wi = np.broadcast_to(in_plane_direction(incidence_deg), theta_t.shape + (3,))
+    return TransmissionSweep(incidence_deg, beta, theta_t, wi, -in_plane_direction(theta_t))
+
+
 def reflection_sweep(relative_angle_deg: float, max_angle_deg: float = 85.0) -> ReflectionSweep:
     """The sample rotated through alpha on the paper's steps while light and camera stay
     ``relative_angle_deg`` apart; samples where light or camera is beyond ``max_angle_deg``
     from the normal are left out."""
     if not 0.0 < relative_angle_deg < 180.0:
         raise ValueError(f"relative_angle_deg must lie in (0, 180), got {relative_angle_deg!r}")
-    half = relative_angle_deg / 2.0
-    alpha = step_angles(90.0 + half)
-    theta_i = alpha + half
-    theta_r = alpha - half
-    keep = (np.abs(theta_i) <= max_angle_deg) & (np.abs(theta_r) <= max_angle_deg)
-    alpha, theta_i, theta_r = alpha[keep], theta_i[keep], theta_r[keep]
-    return ReflectionSweep(relative_angle_deg, alpha, theta_i, theta_r,
-                           in_plane_direction(theta_i), in_plane_direction(theta_r))
+    full = reflection_geometry(relative_angle_deg, step_angles(90.0 + relative_angle_deg / 2.0))
+    keep = (np.abs(full.theta_i_deg) <= max_angle_deg) & (np.abs(full.theta_r_deg) <= max_angle_deg)
+    return reflection_geometry(relative_angle_deg, full.alpha_deg[keep])
 
 
 def transmission_sweep(incidence_deg: float, max_angle_deg: float = 85.0) -> TransmissionSweep:
@@ -108,13 +127,8 @@ def transmission_sweep(incidence_deg: float, max_angle_deg: float = 85.0) -> Tra
     if not 0.0 <= incidence_deg < 90.0:
         raise ValueError(f"incidence_deg must lie in [0, 90), got {incidence_deg!r}")
     # Straight through: theta_t = theta_i (wt = -wi); in-plane, beta = (theta_t - theta_i) / 2.
-    beta = step_angles(90.0)
-    theta_t = incidence_deg + 2.0 * beta
-    keep = np.abs(theta_t) <= max_angle_deg
-    beta, theta_t = beta[keep], theta_t[keep]
-    wi = np.broadcast_to(in_plane_direction(incidence_deg), theta_t.shape + (3,))
-    wt = -in_plane_direction(theta_t)
-    return TransmissionSweep(incidence_deg, beta, theta_t, wi, wt)
+    theta_t = incidence_deg + 2.0 * step_angles(90.0)
+    return transmission_geometry(incidence_deg, theta_t[np.abs(theta_t) <= max_angle_deg])
 
 
 def profile_distances(max_mm: float = 3.0, step_mm: float = 0.05) -> np.ndarray:

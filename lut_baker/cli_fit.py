@@ -1,0 +1,223 @@
+"""``python -m lut_baker fit``: fit the paper's layers to measurements, or synthesise some.
+
+    python -m lut_baker fit reflection FILE.csv [--eta ETA]
+    python -m lut_baker fit transmission FILE.csv [--eta ETA]
+    python -m lut_baker fit dipole FILE.csv [--g 0 --eta 1.26 --d-min 0.1 --free-scale]
+    python -m lut_baker fit synthesize --preset paper --out DIR [--noise 0.02 --seed 0]
+
+Fits print a TOML (or ``--format json``) block on stdout, or write it to ``--out FILE``: the
+fitted layer under its kind (``[reflection]``, ``[transmission]``, ``[dipole]``: pass it to the
+layer type as keywords), then ``[stderr]``, ``[relative_stderr]`` (eta: relative to eta - 1),
+``[derived]`` (the P ratio as [value, stderr]) and ``[fit]`` (samples, residual rms, Jacobian
+condition number, correlation matrix over ``free``, warnings).  Warnings (ill-conditioned or
+degenerate parameters, poor fit) also go to stderr, one per line.
+
+CSV columns (units in the names; ``#`` lines are comments; see lut_baker.measurements):
+  reflection    psi_deg, alpha_deg (or theta_r_deg), intensity_counts
+  transmission  incidence_deg, theta_t_deg, intensity_counts
+  dipole        distance_mm, ratio   (ratio to the lit pixel, modelled as R(d)/R(0))
+
+Exit codes: 0 done; 2 bad input (one line naming the problem); 3 the fit warned and --strict
+was given.  ``synthesize`` writes the paper's protocols (SPEC 6) from its parameters (SPEC 5)
+as CSV files plus ``truth.toml``, to try the round trip.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from .fit import D_MIN_MM, fit_dipole, fit_reflection, fit_transmission
+from .measurements import (
+    MAX_NOISE,
+    PAPER_INCIDENCES_DEG,
+    PAPER_RELATIVE_ANGLES_DEG,
+    ProfileData,
+    ReflectionData,
+    TransmissionData,
+    paper_protocols,
+    read_measurements,
+    write_measurements,
+)
+from .model import Dipole, ReflectionLayer
+from .presets import paper_layers
+
+__all__ = ["HELP", "STRICT_EXIT", "configure", "run", "result_document", "to_toml"]
+
+HELP = "fit reflection/transmission/dipole layers to CSV measurements, or synthesise them"
+STRICT_EXIT = 3
+"""Exit code of a fit that warned when ``--strict`` is given."""
+
+_FITS = {
+    "reflection": (ReflectionData, fit_reflection),
+    "transmission": (TransmissionData, fit_transmission),
+    "dipole": (ProfileData, fit_dipole),
+}
+
+
+def configure(parser) -> None:
+    """Add the ``fit`` sub-commands and their arguments."""
+    sub = parser.add_subparsers(dest="fit_kind", required=True, metavar="KIND")
+    helps = {
+        "reflection": "Torrance-Sparrow layer (eq. 2): P_d, P_s, n, eta",
+        "transmission": "thin-film layer (eq. 4): P_d, P_t, n, eta",
+        "dipole": "dipole (eq. 6): sigma_s, sigma_a with g and eta given",
+    }
+    for kind, text in helps.items():
+        command = sub.add_parser(kind, help=text, description=f"Fit a {text}.")
+        command.add_argument("csv", type=Path, help="measurements (CSV, see fit --help)")
+        if kind == "dipole":
+            command.add_argument("--g", type=float, default=0.0,
+                                 help="phase asymmetry, held fixed (default 0, SPEC 2.3)")
+            command.add_argument("--eta", type=float, default=1.26,
+                                 help="relative index, held fixed (default 1.26, the paper's "
+                                      "skin)")
+            command.add_argument("--d-min", type=float, default=D_MIN_MM, metavar="MM",
+                                 help=f"leave out samples closer than MM to the lit pixel "
+                                      f"(default {D_MIN_MM:g} mm)")
+            command.add_argument("--free-scale", action="store_true",
+                                 help="fit k R(d)/R(0) with a free k (lit pixel holding direct "
+                                      "light)")
+        else:
+            command.add_argument("--eta", type=float, default=None,
+                                 help="hold eta fixed at this value (default: fitted)")
+        command.add_argument("--out", type=Path, help="write the block here, not to stdout")
+        command.add_argument("--format", choices=("toml", "json"), default=None,
+                             help="output format (default: from --out's suffix, else toml)")
+        command.add_argument("--strict", action="store_true",
+                             help=f"exit {STRICT_EXIT} when the fit warns")
+    synth = sub.add_parser("synthesize", help="write the paper's protocols as CSV files",
+                           description="Synthesise the paper's experiments (SPEC 6) from its "
+                                       "parameters (SPEC 5) with multiplicative noise.")
+    synth.add_argument("--preset", choices=("paper",), default="paper")
+    synth.add_argument("--out", type=Path, required=True, help="output folder")
+    synth.add_argument("--noise", type=float, default=0.02,
+                       help=f"relative noise per sample, 0 to {MAX_NOISE:g} (default 0.02)")
+    synth.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+
+
+def run(args) -> int:
+    """Run ``fit KIND``; returns the exit code."""
+    if args.fit_kind == "synthesize":
+        return _synthesize(args)
+    data_type, fit = _FITS[args.fit_kind]
+    options = {"eta": args.eta}
+    if args.fit_kind == "dipole":
+        options.update(g=args.g, d_min_mm=args.d_min, free_scale=args.free_scale)
+    _check_options(options)
+    data = read_measurements(args.csv)
+    if not isinstance(data, data_type):
+        raise ValueError(f"{args.csv}: holds {data.KIND} columns ({','.join(data.COLUMNS)}), "
+                         f"not {data_type.KIND} ones ({','.join(data_type.COLUMNS)})")
+    try:
+        result = fit(data, **options)
+    except ValueError as error:
+        raise ValueError(f"{args.csv}: {error}") from None
+    document = result_document(result)
+    form = args.format or ("json" if args.out and args.out.suffix == ".json" else "toml")
+    header = (f"python -m lut_baker fit {args.fit_kind} {args.csv}",
+              f"{result.samples} samples, residual rms {100 * result.residual_rms:.3g}% "
+              f"(relative), Jacobian condition number {result.condition_number:.3g}")
+    text = json.dumps(document, indent=2) + "\n" if form == "json" else to_toml(document, header)
+    if args.out:
+        args.out.write_text(text, encoding="utf-8")
+        print(f"wrote {args.out}")
+    else:
+        sys.stdout.write(text)
+    for warning in result.warnings:
+        print(f"warning: {warning}", file=sys.stderr)
+    return STRICT_EXIT if (args.strict and result.warnings) else 0
+
+
+def _check_options(options: dict) -> None:
+    """Reject invalid fixed parameters before reading any file."""
+    try:
+        if "g" in options:
+            Dipole(sigma_s=1.0, sigma_a=0.1, g=options["g"], eta=options["eta"])
+        elif options["eta"] is not None:
+            ReflectionLayer(P_d=1.0, P_s=1.0, n=1.0, eta=options["eta"])
+    except ValueError as error:
+        raise ValueError(f"--{str(error).split()[0]}: {error}") from None
+    if options.get("d_min_mm", 0.0) < 0.0:
+        raise ValueError(f"--d-min must be >= 0 mm, got {options['d_min_mm']:g}")
+
+
+def result_document(result) -> dict:
+    """The output block of a :class:`~lut_baker.fit.FitResult` as nested plain data."""
+    data = result.as_dict()
+    return {
+        result.kind: data["params"],
+        "stderr": data["stderr"],
+        "relative_stderr": data["relative_stderr"],
+        "derived": data["derived"],
+        "fit": {key: data[key] for key in ("samples", "residual_rms", "condition_number",
+                                           "free", "fixed", "correlation", "warnings")},
+    }
+
+
+def _toml_value(value) -> str:
+    if isinstance(value, str):
+        return json.dumps(value)
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int | np.integer):
+        return str(int(value))
+    if isinstance(value, float | np.floating):
+        value = float(value)
+        return repr(value) if np.isfinite(value) else ("nan" if np.isnan(value) else
+                                                        ("inf" if value > 0 else "-inf"))
+    if isinstance(value, dict):
+        return "{" + ", ".join(f"{_toml_key(k)} = {_toml_value(v)}"
+                               for k, v in value.items()) + "}"
+    return "[" + ", ".join(_toml_value(v) for v in value) + "]"
+
+
+def _toml_key(key: str) -> str:
+    return key if key.replace("_", "").isalnum() else json.dumps(key)
+
+
+def to_toml(document: dict, comments=()) -> str:
+    """A two-level document (tables of scalars, lists, inline tables) as TOML text."""
+    lines = [f"# {comment}" for comment in comments]
+    for table, entries in document.items():
+        lines.append(f"\n[{_toml_key(table)}]")
+        lines += [f"{_toml_key(k)} = {_toml_value(v)}" for k, v in entries.items()]
+    return "\n".join(lines).lstrip("\n") + "\n"
+
+
+def _synthesize(args) -> int:
+    """Write the paper's four protocols and their true parameters to ``args.out``."""
+    out = args.out
+    if out.exists() and not out.is_dir():
+        raise ValueError(f"--out {out} exists and is not a folder")
+    datasets = paper_protocols(args.noise, args.seed)
+    out.mkdir(parents=True, exist_ok=True)
+    film, film_t, skin, dipole = paper_layers()
+    truth = {"film_reflection": film, "film_transmission": film_t,
+             "skin_reflection": skin, "skin_profile": dipole}
+    origin = (f"python -m lut_baker fit synthesize --preset {args.preset} "
+              f"--noise {args.noise:g} --seed {args.seed}")
+    notes = {
+        "film_reflection": f"paper 4.1.1: film reflection, counts at 3 s, psi "
+                           f"{', '.join(f'{a:g}' for a in PAPER_RELATIVE_ANGLES_DEG)} deg",
+        "film_transmission": f"paper 4.1.2: film transmission, counts at 10 s, incidence "
+                             f"{', '.join(f'{a:g}' for a in PAPER_INCIDENCES_DEG)} deg",
+        "skin_reflection": "paper 4.2.1: skin substitute reflection, counts at 3 s",
+        "skin_profile": "paper 4.2.2: skin substitute profile, ratio R(d)/R(0)",
+    }
+    commands = {"film_reflection": "reflection", "film_transmission": "transmission",
+                "skin_reflection": "reflection", "skin_profile": "dipole"}
+    for name, data in datasets.items():
+        path = write_measurements(out / f"{name}.csv", data,
+                                  (origin, notes[name], f"truth: {truth[name].as_dict()}"))
+        print(f"wrote {path}  (python -m lut_baker fit {commands[name]} {path})")
+    truth_path = out / "truth.toml"
+    truth_path.write_text(to_toml({name: {k: float(v) for k, v in layer.as_dict().items()}
+                                   for name, layer in truth.items()},
+                                  (origin, "the parameters the CSV files were made from")),
+                          encoding="utf-8")
+    print(f"wrote {truth_path}")
+    return 0
