@@ -198,7 +198,7 @@ def layered_reflection(wi, wo, cosmetic: TransmissionLayer, skin: ReflectionLaye
     theta_i = np.arccos(np.clip(wi[:, 2], 0.0, 1.0))
     theta_o = np.arccos(np.clip(wo[:, 2], 0.0, 1.0))
     phi = relative_azimuth(wi, wo)
-    out = np.empty((wi.shape[0], inner.shape[-1]))
+    out = np.empty((wi.shape[0], 3 if (cosmetic.channels or skin.channels) else 1))
     for start in range(0, wi.shape[0], POINT_CHUNK):
         s = slice(start, start + POINT_CHUNK)
         rows = _transmission_rows(theta_i[s], grid, cosmetic)  # (M, P, N, C)
