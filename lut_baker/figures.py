@@ -57,7 +57,15 @@ from .presets import (
     made_up_skin,
     paper,
 )
-from .protocols import in_plane_direction, profile_distances, reflection_sweep, transmission_sweep
+from .protocols import (
+    ReflectionSweep,
+    in_plane_direction,
+    profile_distances,
+    reflection_geometry,
+    reflection_sweep,
+    transmission_geometry,
+    transmission_sweep,
+)
 
 __all__ = [
     "DPI",
@@ -134,11 +142,11 @@ def _densified(samples_deg: np.ndarray, step_deg: float = CURVE_STEP_DEG) -> np.
     return np.union1d(samples_deg, grid)
 
 
-def _reflection_geometry(relative_angle_deg: float, step_deg: float = CURVE_STEP_DEG):
-    """``(theta_r_deg, wi, wo)`` of the reflection protocol at relative angle psi, densified:
-    the camera at theta_r, the light at ``theta_i = theta_r + psi`` in the same plane."""
-    theta_r = _densified(reflection_sweep(relative_angle_deg).theta_r_deg, step_deg)
-    return theta_r, in_plane_direction(theta_r + relative_angle_deg), in_plane_direction(theta_r)
+def _dense_reflection(relative_angle_deg: float,
+                      step_deg: float = CURVE_STEP_DEG) -> ReflectionSweep:
+    """The reflection protocol at relative angle psi with its samples of alpha densified."""
+    alpha = _densified(reflection_sweep(relative_angle_deg).alpha_deg, step_deg)
+    return reflection_geometry(relative_angle_deg, alpha)
 
 
 def reflection_curves(layer: ReflectionLayer = PAPER_FILM_REFLECTION,
@@ -149,13 +157,13 @@ def reflection_curves(layer: ReflectionLayer = PAPER_FILM_REFLECTION,
     at the protocol's samples (:func:`~lut_baker.protocols.reflection_sweep`) densified."""
     curves = {}
     for psi in relative_angles_deg:
-        theta_r, wi, wo = _reflection_geometry(psi)
-        brdf = _red(ts_reflection(wi, wo, layer))
+        sweep = _dense_reflection(psi)
+        brdf = _red(ts_reflection(sweep.wi, sweep.wo, layer))
         curves[float(psi)] = {
-            "theta_r_deg": theta_r,
-            "theta_i_deg": theta_r + psi,
+            "theta_r_deg": sweep.theta_r_deg,
+            "theta_i_deg": sweep.theta_i_deg,
             "brdf": brdf,
-            "intensity": brdf * wi[..., 2],
+            "intensity": brdf * sweep.wi[..., 2],
         }
     return curves
 
@@ -169,12 +177,12 @@ def transmission_curves(layer: TransmissionLayer = PAPER_FILM_TRANSMISSION,
     curves = {}
     for incidence in incidences_deg:
         theta_t = _densified(transmission_sweep(incidence).theta_t_deg)
-        wi = in_plane_direction(incidence)
-        btdf = _red(ts_transmission(wi, -in_plane_direction(theta_t), layer))
+        sweep = transmission_geometry(incidence, theta_t)
+        btdf = _red(ts_transmission(sweep.wi, sweep.wt, layer))
         curves[float(incidence)] = {
             "theta_t_deg": theta_t,
             "btdf": btdf,
-            "intensity": btdf * wi[2],
+            "intensity": btdf * sweep.wi[..., 2],
         }
     return curves
 
@@ -194,8 +202,8 @@ def made_up_reflection_curves(skin: MadeUpSkin | None = None, relative_angle_deg
     ``path3`` (through the film, off the skin surface, back through), ``bare`` (the skin alone)
     and ``sum`` {coverage: :func:`~lut_baker.normalise.made_up_reflection` at that coverage}."""
     skin = paper() if skin is None else skin
-    theta_r, wi, wo = _reflection_geometry(relative_angle_deg, MADE_UP_STEP_DEG)
-    cosine = wi[..., 2]
+    sweep = _dense_reflection(relative_angle_deg, MADE_UP_STEP_DEG)
+    wi, wo, cosine = sweep.wi, sweep.wo, sweep.wi[..., 2]
     path1 = _red(ts_reflection(wi, wo, film_reflection_layer(skin)))
     path3 = _red(layered_reflection(wi, wo, film_transmission_layer(skin), skin.skin))
     bare = _red(ts_reflection(wi, wo, skin.skin))
@@ -203,7 +211,7 @@ def made_up_reflection_curves(skin: MadeUpSkin | None = None, relative_angle_deg
              for w in coverages}
     return {
         "relative_angle_deg": float(relative_angle_deg),
-        "theta_r_deg": theta_r,
+        "theta_r_deg": sweep.theta_r_deg,
         "path1": path1 * cosine,
         "path3": path3 * cosine,
         "bare": bare * cosine,
