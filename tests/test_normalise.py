@@ -1,0 +1,206 @@
+"""SPEC 4: the normalisation constant K, coverage, absorption, and the white furnace test
+(the made-up skin's directional albedo, paths 1 + 3, is at most 1 everywhere)."""
+
+import math
+
+import numpy as np
+import pytest
+import reference_impl as ref
+
+from lut_baker import layers, model, normalise, presets
+from lut_baker.quadrature import direction
+
+THETA_DEG = np.arange(0.0, 90.0)  # 0, 1, ..., 89 degrees
+ABSORPTIONS = {"0": 0.0, "0.5": 0.5, "1": 1.0}
+COVERAGES = (0.0, 0.25, 0.5, 1.0)
+
+
+def _fields(layer):
+    return tuple(float(v) for v in layer.as_dict().values())
+
+
+def _film_per_second():
+    film = normalise.per_second(presets.PAPER_FILM_REFLECTION, normalise.REFLECTION_SHUTTER_S)
+    film_t = normalise.per_second(presets.PAPER_FILM_TRANSMISSION,
+                                  normalise.TRANSMISSION_SHUTTER_S)
+    return film, film_t
+
+
+# --- K -------------------------------------------------------------------------------------
+def test_k_is_the_films_brightest_total_albedo():
+    """A dense independent scan (0..89.5 degrees every 0.5, brute-force hemisphere sums of the
+    reference formulas, Richardson-extrapolated) finds the same maximum and where it is."""
+    film, film_t = _film_per_second()
+    k, theta_max = normalise.normalisation_constant(film, film_t)
+    assert presets.paper().K == k
+    theta = np.arange(0.0, 90.0, 0.5)
+    w = direction(np.radians(theta), 0.0)
+
+    def total(n):
+        reflection = ref.brute_force_albedo(
+            lambda a, u: ref.vector_reflection(a, u, *_fields(film)), w, n, 2 * n)
+        transmission = ref.brute_force_albedo(
+            lambda a, u: ref.vector_transmission_down(a, u, *_fields(film_t)), w, n, 2 * n)
+        return reflection + transmission
+
+    coarse, fine = total(32), total(64)
+    scan = fine + (fine - coarse) / 3
+    accuracy = float(np.max(np.abs(fine - coarse) / 3 / scan))
+    best = int(np.argmax(scan))
+    print(f"K = {k:.6g} counts/s at {theta_max:.3g} deg; independent scan {scan[best]:.6g} at "
+          f"{theta[best]:g} deg (brute-force accuracy {accuracy:.1e})")
+    assert k == pytest.approx(scan[best], rel=max(1e-4, accuracy))
+    assert abs(theta_max - theta[best]) <= 0.5
+    # K is a maximum: no incidence of the scan is brighter beyond the quadratures' accuracy.
+    assert np.all(scan <= k * (1 + max(1e-4, accuracy)))
+
+
+def test_film_albedo_is_at_most_one_and_one_at_k():
+    paper = presets.paper()
+    film = (layers.reflection_albedo(THETA_DEG, paper.film)
+            + layers.transmission_albedo(THETA_DEG, paper.film_transmission))
+    print(f"film albedo: max {film.max():.9f}, min {film.min():.4f}")
+    assert np.all(film <= 1.0 + 1e-12)
+    assert film.max() == pytest.approx(1.0, abs=1e-9)
+
+
+def test_paper_counts_become_albedo_units():
+    paper = presets.paper()
+    film, _ = _film_per_second()
+    np.testing.assert_allclose(paper.film.P_s, film.P_s / paper.K, rtol=1e-14)
+    np.testing.assert_allclose(paper.skin.P_d, 2.00e4 / 3.0 / paper.K, rtol=1e-14)
+    np.testing.assert_allclose(paper.film_transmission.P_t, 1.08e4 / 10.0 / paper.K, rtol=1e-14)
+
+
+# --- the white furnace test ----------------------------------------------------------------
+def _albedo(foundation, skin, coverage, absorption=None):
+    return normalise.directional_albedo(
+        THETA_DEG, presets.made_up_skin(foundation, skin, coverage=coverage,
+                                        absorption=absorption))
+
+
+@pytest.mark.parametrize("skin", sorted(presets.SKINS))
+def test_white_furnace(skin):
+    """directional_albedo <= 1 at 0..89 degrees, every channel, every foundation on ``skin``,
+    each foundation's own shade and absorption 0, 0.5 and 1, coverage 0, 0.25, 0.5, 1.
+
+    The albedo is affine in coverage (checked by test_albedo_linear_in_coverage), so coverages
+    0.25 and 0.5 are checked as mixes of the evaluated 0 and 1."""
+    bare = _albedo("paper_natural", skin, 0.0)
+    surface, _ = presets.skin_layers(skin)
+    assert np.all(bare <= 1.0)
+    np.testing.assert_allclose(bare, np.broadcast_to(np.reshape(
+        layers.reflection_albedo(THETA_DEG, surface), (90, -1)), bare.shape), rtol=1e-12)
+    worst = {"bare": float(bare.max())}
+    # Each foundation with its own shade; an explicit absorption replaces the shade, so with
+    # one every foundation is the same film: evaluated once.
+    cases = [(f, "own", None) for f in presets.FOUNDATIONS]
+    cases += [("any", label, a) for label, a in ABSORPTIONS.items()]
+    for foundation, label, absorption in cases:
+        name = "paper_natural" if foundation == "any" else foundation
+        full = _albedo(name, skin, 1.0, absorption)
+        for coverage in COVERAGES:
+            mixed = (1 - coverage) * bare + coverage * full
+            assert np.all(np.isfinite(mixed)) and np.all(mixed >= 0)
+            assert np.all(mixed <= 1.0), (foundation, label, coverage, mixed.max())
+        worst[f"{foundation}/{label}"] = float(full.max())
+    best = max(worst, key=worst.get)
+    print(f"{skin}: max albedo {worst[best]:.4f} ({best}); " + ", ".join(
+        f"{k} {v:.4f}" for k, v in worst.items()))
+
+
+def test_albedo_linear_in_coverage():
+    ends = [_albedo("medium_beige", "jensen_skin1", c) for c in (0.0, 1.0)]
+    for coverage in (0.25, 0.5):
+        np.testing.assert_allclose(_albedo("medium_beige", "jensen_skin1", coverage),
+                                   (1 - coverage) * ends[0] + coverage * ends[1], rtol=1e-12)
+
+
+def test_furnace_at_89_degrees_direct():
+    """Coverage 0.25 and 0.5 evaluated directly at grazing incidence for the paper pair."""
+    for coverage in COVERAGES:
+        for absorption in ABSORPTIONS.values():
+            value = normalise.directional_albedo(
+                89.0, presets.made_up_skin(coverage=coverage, absorption=absorption))
+            assert value.shape == (3,) and np.all(value <= 1.0) and np.all(value > 0.0)
+
+
+def test_bare_skin_albedo_against_brute_force():
+    """The skins' own albedos (coverage 0) are <= 1; checked with the independent reference."""
+    theta = np.array([0.0, 45.0, 75.0, 89.0])
+    w = direction(np.radians(theta), 0.0)
+    for name in presets.SKINS:
+        surface, _ = presets.skin_layers(name)
+        got = np.reshape(layers.reflection_albedo(theta, surface), (4, -1))
+        for c in range(got.shape[1]):
+            args = [float(np.broadcast_to(v, (3,))[c]) for v in surface.as_dict().values()]
+            brute = ref.brute_force_albedo(lambda a, u, args=args: ref.vector_reflection(
+                a, u, *args), w, 128, 256)
+            assert np.all(brute <= 1.0)
+            # Level 0 of the model's grid is coarse at grazing incidence (the G kink).
+            np.testing.assert_allclose(got[:, c], brute, rtol=3e-3)
+
+
+# --- coverage and absorption in the BRDF ---------------------------------------------------
+def _pairs(count, seed):
+    rng = np.random.default_rng(seed)
+    theta = np.radians(rng.uniform(0, 89, (2, count)))
+    return (direction(theta[0], rng.uniform(0, 2 * math.pi, count)),
+            direction(theta[1], rng.uniform(0, 2 * math.pi, count)))
+
+
+def test_coverage_zero_is_bare_skin_exactly():
+    wi, wo = _pairs(30, 1)
+    for name in presets.SKINS:
+        skin = presets.made_up_skin("deep_mocha", name, coverage=0.0)
+        bare = np.reshape(model.ts_reflection(wi, wo, skin.skin), (30, -1))
+        np.testing.assert_array_equal(normalise.made_up_reflection(wi, wo, skin),
+                                      np.broadcast_to(bare, (30, 3)))
+
+
+def test_made_up_reflection_linear_in_coverage():
+    wi, wo = _pairs(30, 2)
+    skin = presets.made_up_skin("light_ivory", "jensen_skin2")
+    ends = [normalise.made_up_reflection(wi, wo, skin.replace(coverage=c)) for c in (0.0, 1.0)]
+    for coverage in (0.1, 0.25, 0.5, 0.9):
+        np.testing.assert_allclose(
+            normalise.made_up_reflection(wi, wo, skin.replace(coverage=coverage)),
+            (1 - coverage) * ends[0] + coverage * ends[1], rtol=1e-12)
+
+
+def test_full_absorption_leaves_gloss_and_bare_skin():
+    """A = 1 absorbs the film's pigment: its diffuse reflection and everything it transmits
+    (path 3).  What remains is the film's gloss, plus bare skin where it is uncovered."""
+    wi, wo = _pairs(30, 3)
+    for coverage in (0.0, 0.4, 1.0):
+        skin = presets.made_up_skin("paper_natural", "jensen_skin1", coverage=coverage,
+                                    absorption=1.0)
+        film = presets.paper().film
+        gloss = np.array([ref.ts_reflection(a, b, 0.0, float(film.P_s),
+                                                         float(film.n), float(film.eta))
+                                       for a, b in zip(wi, wo, strict=True)])
+        bare = model.ts_reflection(wi, wo, skin.skin)
+        expected = (1 - coverage) * bare + coverage * gloss[:, None]
+        np.testing.assert_allclose(normalise.made_up_reflection(wi, wo, skin), expected,
+                                   rtol=1e-10)
+        assert np.all(gloss > 0)
+
+
+def test_absorption_lowers_albedo_per_channel():
+    wi, wo = _pairs(10, 4)
+    shade = presets.made_up_skin("deep_mocha")  # absorption rises from red to blue
+    clear = presets.made_up_skin("paper_natural")
+    shaded = normalise.made_up_reflection(wi, wo, shade)
+    assert np.all(shaded < normalise.made_up_reflection(wi, wo, clear))
+    assert np.all(shaded[:, 0] > shaded[:, 1]) and np.all(shaded[:, 1] > shaded[:, 2])
+
+
+@pytest.mark.parametrize("field, value, message", [
+    ("coverage", 1.5, r"coverage must lie in \[0, 1\]"),
+    ("coverage", float("nan"), r"coverage must lie in \[0, 1\]"),
+    ("absorption", (0.1, -0.1, 0.2), r"absorption must lie in \[0, 1\]"),
+    ("absorption", 2.0, r"absorption must lie in \[0, 1\]"),
+])
+def test_bundle_validation(field, value, message):
+    with pytest.raises(ValueError, match=message):
+        presets.paper().replace(**{field: value})
