@@ -58,6 +58,7 @@ def run(seeds: int, noise: float):
     records = defaultdict(lambda: defaultdict(list))
     timings = defaultdict(list)
     warnings = defaultdict(lambda: defaultdict(int))
+    correlations = defaultdict(list)
 
     def record(name, truth, fit, *args, **kwargs):
         start = time.perf_counter()
@@ -71,6 +72,7 @@ def run(seeds: int, noise: float):
                                                  flagged(result, parameter)))
         for text in result.warnings:
             warnings[name][text.split(":")[0]] += 1
+        correlations[name].append((result.free, result.correlation))
         return result
 
     for seed in range(seeds):
@@ -85,7 +87,16 @@ def run(seeds: int, noise: float):
                poor_start(skin))
         record("skin dipole (d >= 0.1 mm)", dipole, fit_dipole, data["skin_profile"],
                poor_start(dipole), g=float(dipole.g), eta=float(dipole.eta))
-    return records, timings, warnings
+    return records, timings, warnings, correlations
+
+
+def strongest_correlation(runs) -> str:
+    """The pair of free parameters with the largest median |correlation| over the seeds."""
+    names = runs[0][0]
+    median = np.median([c for _, c in runs], axis=0)
+    off = np.abs(median) - np.eye(len(names))
+    i, j = np.unravel_index(np.argmax(off), off.shape)
+    return f"{names[i]}-{names[j]} {median[i, j]:+.3f}"
 
 
 def main(argv=None) -> int:
@@ -94,7 +105,7 @@ def main(argv=None) -> int:
     parser.add_argument("--noise", type=float, default=0.02)
     args = parser.parse_args(argv)
     start = time.perf_counter()
-    records, timings, warnings = run(args.seeds, args.noise)
+    records, timings, warnings, correlations = run(args.seeds, args.noise)
     total = time.perf_counter() - start
 
     print(f"Round trip over {args.seeds} seeds, {100 * args.noise:g}% multiplicative noise, "
@@ -112,12 +123,13 @@ def main(argv=None) -> int:
             print(f"| {name} | {parameter} | {100 * target:g}% | {100 * np.median(err):.2f}% "
                   f"| {100 * err.max():.2f}% | {100 * np.median(se):.2f}% "
                   f"| {np.max(err / se):.2f} | {flags}/{len(rows)} | {inside}/{len(rows)} |")
-    print("\n| protocol | median time per fit | worst | warnings (fits) |")
-    print("| --- | --- | --- | --- |")
+    print("\n| protocol | median time per fit | worst | strongest correlation (median) "
+          "| warnings (fits) |")
+    print("| --- | --- | --- | --- | --- |")
     for name, times in timings.items():
         text = "; ".join(f"{w} ({c})" for w, c in warnings[name].items()) or "none"
         print(f"| {name} | {1000 * np.median(times):.0f} ms | {1000 * max(times):.0f} ms "
-              f"| {text} |")
+              f"| {strongest_correlation(correlations[name])} | {text} |")
     print(f"\ntotal {total:.1f} s for {sum(len(t) for t in timings.values())} fits")
     return 0
 
