@@ -34,6 +34,7 @@ Functions and types
 from __future__ import annotations
 
 from dataclasses import dataclass, field, fields, replace
+from types import SimpleNamespace
 
 import numpy as np
 from scipy.optimize import least_squares, nnls
@@ -339,7 +340,7 @@ def _linear_starts(problem: _Problem, lobe: str, n_grid, eta: float) -> list[tup
                     np.ones_like(weight))
         p = np.clip(p, low, high)
         cost = float(np.sum(np.log((p[0] * diffuse + p[1] * lobe_basis) * weight) ** 2))
-        values = _Values({"P_d": p[0], lobe: p[1], "n": n, "eta": eta})
+        values = SimpleNamespace(**{"P_d": p[0], lobe: p[1], "n": n, "eta": eta})
         starts.append((_x_of(problem, values), cost))
     return starts
 
@@ -350,20 +351,13 @@ def _dipole_starts(problem: _Problem) -> list[tuple]:
     starts = []
     for sigma_s in SIGMA_S_GRID_PER_MM:
         for sigma_a in SIGMA_A_GRID_PER_MM:
-            x = _x_of(problem, _Values({"sigma_s": sigma_s, "sigma_a": sigma_a}))
+            x = _x_of(problem, SimpleNamespace(sigma_s=sigma_s, sigma_a=sigma_a))
             r = problem.residuals(x)
             if problem.scale_free:
                 x[-1] = -float(np.mean(r))
                 r = r + x[-1]
             starts.append((x, float(np.sum(r * r))))
     return starts
-
-
-class _Values:
-    """Attribute access to a dict, so grid points pass through :func:`_x_of` like layers."""
-
-    def __init__(self, values: dict):
-        self.__dict__.update(values)
 
 
 def _scored(problem: _Problem, x: np.ndarray) -> tuple[np.ndarray, float]:
