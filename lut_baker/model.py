@@ -362,13 +362,20 @@ def dipole_profile(d_mm, skin: Dipole):
     d = np.asarray(d_mm, dtype=float)
     if np.any(np.isnan(d)) or np.any(d < 0.0):
         raise ValueError("d_mm must be distances >= 0 (mm)")
-    albedo, sigma_tr, z_r, z_v, _ = _dipole_terms(skin)
-    d = _channel_axis(d, skin)
-    d_r = np.sqrt(d * d + z_r * z_r)
-    d_v = np.sqrt(d * d + z_v * z_v)
-    real = z_r * (sigma_tr + 1.0 / d_r) * np.exp(-sigma_tr * d_r) / (d_r * d_r)
-    virtual = z_v * (sigma_tr + 1.0 / d_v) * np.exp(-sigma_tr * d_v) / (d_v * d_v)
-    return albedo / (4.0 * np.pi) * (real + virtual)
+    albedo, _, _, _, a = _dipole_terms(skin)
+    # Lengths in reduced mean free paths 1/s' (s' = sigma_t' in 1/mm): z_r s' = 1, z_v s' =
+    # 1 + 4A/3, s_tr / s' = k, so R = a' s'^2 / (4 pi) sum z (k + 1/r) e^(-k r) / r^2 with
+    # dimensionless r = hypot(d s', z): no overflow as s' -> 0 (z_r -> inf).
+    sigma_t_reduced = skin.sigma_s * (1.0 - skin.g) + skin.sigma_a
+    k = np.sqrt(3.0 * skin.sigma_a / sigma_t_reduced)
+    x = _channel_axis(d, skin) * sigma_t_reduced
+    total = 0.0
+    for z in (1.0, 1.0 + 4.0 * a / 3.0):
+        r = np.hypot(x, z)
+        with np.errstate(invalid="ignore"):  # k = 0 with r = inf: no decay
+            decay = np.exp(-np.where(k > 0.0, k * r, 0.0))
+        total = total + z / (r * r) * (k + 1.0 / r) * decay
+    return albedo * sigma_t_reduced**2 / (4.0 * np.pi) * total
 
 
 def dipole_total_reflectance(skin: Dipole):
