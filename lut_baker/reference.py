@@ -1,0 +1,257 @@
+"""Reference images of the exact model: a sphere under a distant light (issue 5, item 1).
+
+The scene: a sphere of radius ``radius_mm`` seen by an orthographic camera looking down -z
+(every view direction is +z), one distant light from direction ``light`` with irradiance
+``irradiance`` (radiance units per 1/sr, e.g. W/m^2), black surroundings.  Per pixel centre the
+radiance of paths 1 + 3 (SPEC 3, eq. 9) is evaluated exactly.  With ``spread=True`` the skin's
+diffuse part of path 3 -- ``w (1 - A)^2 P_d,s T(wi) T(wo) E cos(theta_i)`` -- is not returned
+where it entered but spread over the lit surface by the dipole's normalised profile
+``R(d) / Rd`` (SPEC 4), with the chord distance between surface points.
+
+Functions
+---------
+- :func:`sphere_points` -- pixel centres on the sphere: positions (mm), normals, mask.
+- :func:`local_directions` -- world directions into each point's tangent frame.
+- :func:`fibonacci_sphere` -- near-uniform surface samples with equal areas (mm^2).
+- :func:`local_radiance` -- radiance of paths 1 + 3 at each point (nothing spread).
+- :func:`local_diffuse` -- the skin-diffuse part of paths 1 + 3 where it entered.
+- :func:`spread_diffuse` -- the same part spread by the dipole profile (k-d tree over samples).
+- :func:`default_samples` -- entry samples fine enough for the profile's depth scale.
+- :func:`sphere_image` -- the whole image, ``(n, n, 3)``.
+- :func:`spread_convergence` -- relative change of the spread image when samples double.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from .layers import film_transmittance
+from .model import dipole_profile, dipole_total_reflectance
+from .normalise import MadeUpSkin, film_transmission_layer, made_up_reflection
+from .quadrature import direction
+
+__all__ = [
+    "sphere_points",
+    "local_directions",
+    "fibonacci_sphere",
+    "local_radiance",
+    "local_diffuse",
+    "default_samples",
+    "light_direction",
+    "spread_diffuse",
+    "sphere_image",
+    "spread_convergence",
+    "profile_cutoff_mm",
+]
+
+VIEW = np.array([0.0, 0.0, 1.0])
+"""Direction toward the orthographic camera, world frame."""
+
+
+def light_direction(angle_from_view_deg: float) -> np.ndarray:
+    """Unit vector toward a light ``angle_from_view_deg`` (degrees) from the view, in x-z."""
+    a = np.radians(angle_from_view_deg)
+    return np.array([np.sin(a), 0.0, np.cos(a)])
+
+
+def sphere_points(resolution: int, radius_mm: float):
+    """Pixel centres of a ``resolution`` x ``resolution`` image spanning the sphere's disk.
+
+    Returns ``(positions_mm (n, n, 3), normals (n, n, 3), mask (n, n))``; rows run top-down
+    (+y first) as images do.  Outside the disk positions and normals are 0.
+    """
+    if resolution < 1 or not radius_mm > 0:
+        raise ValueError("resolution must be >= 1 and radius_mm > 0 (mm)")
+    centres = (np.arange(resolution) + 0.5) / resolution * 2.0 - 1.0
+    x, y = np.meshgrid(centres, -centres)
+    r2 = x * x + y * y
+    mask = r2 < 1.0
+    z = np.sqrt(np.clip(1.0 - r2, 0.0, None))
+    normals = np.where(mask[..., None], np.stack([x, y, z], axis=-1), 0.0)
+    return normals * radius_mm, normals, mask
+
+
+def _tangent_frame(normals: np.ndarray):
+    """An orthonormal tangent and bitangent per normal (any: the model is isotropic)."""
+    helper = np.where(np.abs(normals[..., 2:3]) < 0.9, [0.0, 0.0, 1.0], [1.0, 0.0, 0.0])
+    tangent = np.cross(helper, normals)
+    tangent /= np.linalg.norm(tangent, axis=-1, keepdims=True)
+    return tangent, np.cross(normals, tangent)
+
+
+def local_directions(world: np.ndarray, normals: np.ndarray) -> np.ndarray:
+    """Express world unit vectors ``(..., 3)`` in each normal's local frame (normal = +z)."""
+    tangent, bitangent = _tangent_frame(normals)
+    local = np.stack([np.sum(world * tangent, -1), np.sum(world * bitangent, -1),
+                      np.sum(world * normals, -1)], axis=-1)
+    return local / np.linalg.norm(local, axis=-1, keepdims=True)
+
+
+def fibonacci_sphere(count: int, radius_mm: float):
+    """``count`` near-uniform points on the sphere: ``(positions_mm, normals, area_mm2)``."""
+    i = np.arange(count) + 0.5
+    z = 1.0 - 2.0 * i / count
+    phi = np.pi * (1.0 + 5.0**0.5) * i
+    r = np.sqrt(1.0 - z * z)
+    normals = np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=-1)
+    return normals * radius_mm, normals, 4.0 * np.pi * radius_mm**2 / count
+
+
+def local_radiance(normals: np.ndarray, light: np.ndarray, skin: MadeUpSkin,
+                   irradiance: float = 1.0, *, level: int = 0) -> np.ndarray:
+    """Radiance of paths 1 + 3 at points with ``normals`` (P, 3): ``E f(wi, wo) cos(theta_i)``
+    with the exact evaluator; 0 where the light is below the horizon.  Shape (P, 3)."""
+    wi = local_directions(np.broadcast_to(light, normals.shape), normals)
+    wo = local_directions(np.broadcast_to(VIEW, normals.shape), normals)
+    lit = (wi[:, 2] > 0.0) & (wo[:, 2] > 0.0)
+    out = np.zeros(normals.shape[:-1] + (3,))
+    if np.any(lit):
+        f = made_up_reflection(wi[lit], wo[lit], skin, level=level)
+        out[lit] = irradiance * f * wi[lit, 2:3]
+    return out
+
+
+EXIT_CHUNK = 64
+"""Exit points whose neighbour lists are held at once (bounds memory)."""
+
+
+def profile_cutoff_mm(skin: MadeUpSkin, lost_fraction: float = 1e-3) -> float:
+    """Distance (mm) within which the dipole profile holds all but ``lost_fraction`` of its
+    total ``Rd = 2 pi Int R(d) d dd`` in every channel."""
+    d = np.concatenate([[0.0], np.geomspace(1e-4, 1e4, 4000)])
+    profile = np.reshape(dipole_profile(d, skin.dipole), (d.size, -1))
+    ring = 0.5 * (profile[1:] * d[1:, None] + profile[:-1] * d[:-1, None]) * np.diff(d)[:, None]
+    captured = 2.0 * np.pi * np.cumsum(ring, axis=0)
+    rd = np.reshape(dipole_total_reflectance(skin.dipole), (1, -1))
+    inside = np.all(captured >= (1.0 - lost_fraction) * rd, axis=1)
+    return float(d[1:][np.argmax(inside)]) if np.any(inside) else float(d[-1])
+
+
+TRANSMITTANCE_NODES = 1025
+"""Polar nodes (0..90 degrees) on which ``T`` is tabulated once and interpolated: T is smooth,
+so the interpolation error (< 1e-7 relative) stays far below the reference's tolerance."""
+
+
+def _film_transmittance_rgb(local: np.ndarray, skin: MadeUpSkin) -> np.ndarray:
+    """``(1 - A) T(w)`` per point for local directions (P, 3): the film crossed once, RGB."""
+    film_t = film_transmission_layer(skin)
+    theta = np.linspace(0.0, np.pi / 2, TRANSMITTANCE_NODES)
+    nodes = np.reshape(film_transmittance(direction(theta, 0.0), film_t), (theta.size, -1))
+    polar = np.arccos(np.clip(local[:, 2], 0.0, 1.0))
+    t = np.stack([np.interp(polar, theta, nodes[:, c % nodes.shape[1]]) for c in range(3)], -1)
+    return np.where(local[:, 2:3] > 0.0, t, 0.0)
+
+
+def local_diffuse(normals: np.ndarray, light: np.ndarray, skin: MadeUpSkin,
+                  irradiance: float = 1.0) -> np.ndarray:
+    """The skin-diffuse part of paths 1 + 3 where it entered (SPEC 4), radiance (P, 3):
+    ``P_d,s [w T_A(wi) T_A(wo) + (1 - w)] E cos(theta_i)`` with ``T_A = (1 - A) T``."""
+    wi = local_directions(np.broadcast_to(light, normals.shape), normals)
+    wo = local_directions(np.broadcast_to(VIEW, normals.shape), normals)
+    through = _film_transmittance_rgb(wi, skin) * _film_transmittance_rgb(wo, skin)
+    lit = ((wi[:, 2] > 0.0) & (wo[:, 2] > 0.0))[:, None]
+    w = skin.coverage
+    p_d = np.asarray(skin.skin.P_d) * np.ones(3)
+    return np.where(lit, p_d * (w * through + (1.0 - w)) * irradiance * wi[:, 2:3], 0.0)
+
+
+def spread_diffuse(exit_normals: np.ndarray, light: np.ndarray, skin: MadeUpSkin, *,
+                   radius_mm: float, samples: int, irradiance: float = 1.0) -> np.ndarray:
+    """The skin-diffuse part after spreading under the surface (SPEC 4), radiance (P, 3)::
+
+        L(x_o) = P_d,s sum_i E cos(theta_i) [w T_A(wi) T_A(wo) + (1 - w)] R(|x_i - x_o|)/Rd dA
+
+    over ``samples`` Fibonacci entry points on the lit sphere within the profile's cutoff,
+    found with a k-d tree (chord distances, mm).  Entry and exit through the film and through
+    bare skin are summed apart, so the coverage mix is the one of :func:`local_diffuse`.
+    """
+    entry_pos, entry_normals, area = fibonacci_sphere(samples, radius_mm)
+    cos_i = entry_normals @ light
+    lit = cos_i > 0.0
+    entry_pos, entry_normals, cos_i = entry_pos[lit], entry_normals[lit], cos_i[lit]
+    power = (irradiance * cos_i * area)[:, None]  # (I, 1)
+    entry_film = _film_transmittance_rgb(
+        local_directions(np.broadcast_to(light, entry_normals.shape), entry_normals), skin)
+    exit_local = local_directions(np.broadcast_to(VIEW, exit_normals.shape), exit_normals)
+    exit_film = _film_transmittance_rgb(exit_local, skin)
+    rd = np.atleast_1d(dipole_total_reflectance(skin.dipole)) * np.ones(3)
+    tree = cKDTree(entry_pos)
+    exit_pos = exit_normals * radius_mm
+    cutoff = profile_cutoff_mm(skin)
+    through = np.zeros((exit_pos.shape[0], 3))
+    bare = np.zeros((exit_pos.shape[0], 3))
+    for start in range(0, exit_pos.shape[0], EXIT_CHUNK):
+        chunk = slice(start, start + EXIT_CHUNK)
+        owner, neighbours = _pairs_within(tree, entry_pos, exit_pos[chunk], cutoff)
+        if owner.size == 0:
+            continue
+        d = np.linalg.norm(entry_pos[neighbours] - exit_pos[chunk][owner], axis=-1)
+        kernel = np.reshape(dipole_profile(d, skin.dipole), (d.size, -1)) / rd
+        kernel = kernel * power[neighbours]
+        rows = exit_pos[chunk].shape[0]
+        for c in range(3):
+            k = kernel[:, c % kernel.shape[1]]
+            bare[chunk, c] = np.bincount(owner, k, rows)
+            through[chunk, c] = np.bincount(owner, k * entry_film[neighbours, c], rows)
+    w = skin.coverage
+    p_d = np.asarray(skin.skin.P_d) * np.ones(3)
+    out = p_d * (w * exit_film * through + (1.0 - w) * bare)
+    return np.where(exit_local[:, 2:3] > 0.0, out, 0.0)
+
+
+def _pairs_within(tree: cKDTree, entry_pos: np.ndarray, exit_pos: np.ndarray, cutoff: float):
+    """Index pairs ``(exit, entry)`` closer than ``cutoff`` (mm).  The k-d tree prunes when
+    the cutoff is small against the sphere; when it would return most points anyway, a dense
+    chunked distance test is faster than building Python lists."""
+    if cutoff**2 < 0.05 * tree.maxes.max() ** 2:  # the cutoff disk covers < ~5% of the box
+        lists = tree.query_ball_point(exit_pos, r=cutoff, return_sorted=False)
+        counts = np.array([len(n) for n in lists], dtype=np.intp)
+        owner = np.repeat(np.arange(counts.size), counts)
+        neighbours = np.fromiter((i for n in lists for i in n), np.intp, counts.sum())
+        return owner, neighbours
+    d2 = np.sum((exit_pos[:, None, :] - entry_pos[None, :, :]) ** 2, axis=-1)
+    return np.nonzero(d2 < cutoff * cutoff)
+
+
+def default_samples(skin: MadeUpSkin, radius_mm: float, per_mean_free_path: float = 3.0) -> int:
+    """Entry samples so that their spacing is ``z_r / per_mean_free_path`` (z_r = 1/sigma_t',
+    the dipole's real-source depth in mm, of the channel that scatters the shortest)."""
+    reduced = skin.dipole.sigma_s * (1.0 - skin.dipole.g) + skin.dipole.sigma_a
+    spacing = 1.0 / float(np.max(reduced)) / per_mean_free_path
+    return int(np.ceil(4.0 * np.pi * radius_mm**2 / spacing**2))
+
+
+def sphere_image(skin: MadeUpSkin, *, resolution: int = 64, radius_mm: float = 50.0,
+                 light_angle_deg: float = 45.0, irradiance: float = 1.0,
+                 spread: bool = False, samples: int | None = None, level: int = 0):
+    """Reference image ``(n, n, 3)`` of a made-up sphere (see the module docstring).
+
+    ``spread=False``: every path returns where it entered (the local BRDF).  ``spread=True``:
+    the skin-diffuse part is replaced by its spread over the surface with ``samples`` entry
+    points (default :func:`default_samples`)."""
+    _, normals, mask = sphere_points(resolution, radius_mm)
+    light = light_direction(light_angle_deg)
+    image = np.zeros((resolution, resolution, 3))
+    points = normals[mask]
+    radiance = local_radiance(points, light, skin, irradiance, level=level)
+    if spread:
+        samples = samples or default_samples(skin, radius_mm)
+        radiance = (radiance - local_diffuse(points, light, skin, irradiance)
+                    + spread_diffuse(points, light, skin, radius_mm=radius_mm, samples=samples,
+                                     irradiance=irradiance))
+    image[mask] = radiance
+    return image
+
+
+def spread_convergence(skin: MadeUpSkin, *, resolution: int = 32, radius_mm: float = 10.0,
+                       light_angle_deg: float = 45.0, samples: int | None = None) -> float:
+    """Relative RMS change of the spread image over the sphere when entry samples double: the
+    reference's own convergence check."""
+    samples = samples or default_samples(skin, radius_mm)
+    _, normals, mask = sphere_points(resolution, radius_mm)
+    light = light_direction(light_angle_deg)
+    points = normals[mask]
+    coarse = spread_diffuse(points, light, skin, radius_mm=radius_mm, samples=samples)
+    fine = spread_diffuse(points, light, skin, radius_mm=radius_mm, samples=2 * samples)
+    return float(np.sqrt(np.mean((coarse - fine) ** 2)) / np.sqrt(np.mean(fine**2)))
