@@ -226,13 +226,17 @@ def fresnel_reflectance(cos_theta, eta):
 
 def _fresnel(c: np.ndarray, eta: np.ndarray) -> np.ndarray:
     """:func:`fresnel_reflectance` without argument checks, for inner loops."""
-    g2 = eta * eta + c * c - 1.0
-    g = np.sqrt(np.maximum(g2, 0.0))
+    # g^2 = (eta^2 - 1) + c^2, with eta^2 - 1 = (eta - 1)(eta + 1): no cancellation near
+    # eta = 1 (where g -> c and F -> 0), and no underflow of c^2 for eta >= 1 (hypot).
+    excess = (eta - 1.0) * (eta + 1.0)
+    g2 = excess + c * c
+    g = np.where(excess >= 0.0, np.hypot(np.sqrt(np.maximum(excess, 0.0)), c),
+                 np.sqrt(np.maximum(g2, 0.0)))
     gpc = g + c
     gmc = g - c
     with np.errstate(divide="ignore", invalid="ignore"):
-        first = 0.5 * (gmc * gmc) / (gpc * gpc)
-        second = 1.0 + (c * gpc - 1.0) ** 2 / (c * gmc + 1.0) ** 2
+        first = 0.5 * (gmc / gpc) ** 2
+        second = 1.0 + ((c * gpc - 1.0) / (c * gmc + 1.0)) ** 2
         f = first * second
     # g + c = 0 only at eta = 1 and grazing (limit 1); g2 < 0 is total internal reflection.
     f = np.where((gpc <= 0.0) | (g2 < 0.0), 1.0, f)

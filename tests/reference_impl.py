@@ -59,8 +59,9 @@ def _angle_deg(cos_value):
 
 
 def fresnel(c, eta):
-    """Unpolarised Fresnel reflectance, SPEC 2.1: ``g = sqrt(eta^2 + c^2 - 1)``."""
-    g2 = eta * eta + c * c - 1.0
+    """Unpolarised Fresnel reflectance, SPEC 2.1: ``g = sqrt(eta^2 + c^2 - 1)``, with
+    ``eta^2 - 1`` written ``(eta - 1)(eta + 1)`` so that eta = 1 gives g = c exactly."""
+    g2 = (eta - 1.0) * (eta + 1.0) + c * c
     if g2 < 0.0:
         return 1.0  # total internal reflection
     g = math.sqrt(g2)
@@ -128,7 +129,7 @@ def dipole_profile(d, sigma_s, sigma_a, g, eta):
 # ------------------------------------------------------------------------------------------
 def vector_fresnel(c, eta):
     """:func:`fresnel` on arrays (``c`` in [0, 1])."""
-    g2 = eta * eta + c * c - 1.0
+    g2 = (eta - 1.0) * (eta + 1.0) + c * c
     g = np.sqrt(np.maximum(g2, 0.0))
     with np.errstate(divide="ignore", invalid="ignore"):
         value = 0.5 * (g - c) ** 2 / (g + c) ** 2 * (

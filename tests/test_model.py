@@ -79,6 +79,16 @@ def test_fresnel_grazing_is_one(eta):
     assert model.fresnel_reflectance(0.0, eta) == pytest.approx(1.0, abs=1e-12)
 
 
+def test_fresnel_index_matched_is_zero():
+    """eta = 1: no interface, no reflection at any incidence short of exactly grazing, and the
+    values next to eta = 1 approach it continuously."""
+    c = np.array([1e-300, 1e-200, 1e-12, 1e-8, 1e-4, 0.3, 1.0])
+    np.testing.assert_array_equal(model.fresnel_reflectance(c, 1.0), 0.0)
+    # Beyond the grazing zone cos < sqrt(2 |eta - 1|) ~ 1.4e-6 the values are near 0.
+    near = model.fresnel_reflectance(c[4:], np.array([[1.0 - 1e-12], [1.0 + 1e-12]]))
+    assert np.all(near < 1e-8)
+
+
 def test_fresnel_total_internal_reflection():
     eta = 1.0 / 1.5
     cos_critical = math.sqrt(1.0 - eta**2)
