@@ -14,6 +14,47 @@ the surface with the dipole's normalised profile ``profile = R(d) / Rd`` (SPEC 4
 Angular tables are indexed ``[theta_i, theta_o, phi]`` on the grids ``theta_deg`` (degrees
 from the normal) and ``phi_deg`` (relative azimuth, degrees, 0..180 by symmetry); radial ones by
 ``radius_mm``.
+
+Grids and lookup
+----------------
+Grids are closed-form so that a shader can find a table coordinate without searching; the
+fractional index ``x`` of a value (grid node ``k`` has ``x = k``) is:
+
+- ``theta_spacing = "grazing"`` (the default): node density proportional to
+  ``1 / (cos theta + mu0)`` (``mu0 = theta_offset``), even in theta at the normal (where the
+  BRDF has terms linear in theta) and geometric in ``cos theta`` towards grazing (where the
+  gloss lobes depend on the ratio of the two cosines)::
+
+      x = atanh(q tan(theta / 2)) / atanh(q tan(theta_max / 2)) (n - 1),
+      q = sqrt((1 - mu0) / (1 + mu0)),   atanh(y) = ln((1 + y) / (1 - y)) / 2
+
+  with ``theta_max = theta_deg[-1]`` (nodes: ``theta = 2 atan(tanh(s X) / q)``).
+  ``"uniform_cos"``: ``x = (1 - cos theta) / (1 - cos theta_max) (n - 1)``;
+  ``"uniform_theta"``: ``x = theta / theta_max (n - 1)``.
+- ``phi_spacing = "half_vector"`` (the default): the azimuth axis is warped so that the
+  surface gloss lobes stay smooth up to grazing.  With ``alpha`` the polar angle of the half
+  vector ``normalize(wi + wo)`` and ``alpha_max = (theta_i + theta_o) / 2``,
+  ``alpha_min = |theta_i - theta_o| / 2`` (its values at relative azimuth 0 and 180), the
+  coordinate is ``c = 180 (alpha_max - alpha) / (alpha_max - alpha_min)`` degrees and
+  ``x = c / 180 (n_phi - 1)``; ``phi_deg`` holds the nodes of ``c``.  ``c`` is 0 at azimuth 0 and
+  180 at azimuth 180 and increases with the azimuth between (0 where theta_i or theta_o is 0,
+  where nothing depends on azimuth).  ``"uniform"``: ``c`` is the relative azimuth itself,
+  folded into [0, 180] degrees.  (At theta = 89 degrees the film's gloss lobe is about 1 degree
+  wide in azimuth: a uniform azimuth grid of 361 nodes still errs by 2% there.)
+- ``radius_spacing = "quadratic"``: ``x = sqrt(d / d_max) (n - 1)``; ``"uniform"``:
+  ``x = d / d_max (n - 1)`` (``d_max = radius_mm[-1]``).
+
+``x`` is clamped to ``[0, n - 1]`` (beyond the last node a table holds its edge value) and the
+table is interpolated linearly in each index: trilinear for angular tables, the interpolation an
+image texture with linear filtering gives.  :meth:`Tables.made_up_reflection` is that lookup; the
+bake's error study measures it against the exact evaluator.
+
+Contents
+--------
+- :class:`Tables` -- the arrays, with the lookups ``angular``, ``directional``, ``radial``,
+  ``made_up_reflection`` and ``directional_albedo``.
+- :func:`theta_nodes`, :func:`theta_index`, :func:`radius_nodes`, :func:`radius_index`,
+  :func:`phi_index`, :func:`node_cos_azimuths` -- the closed-form grids and their inverse.
 """
 
 from __future__ import annotations
@@ -22,7 +63,24 @@ from dataclasses import dataclass, field, fields
 
 import numpy as np
 
-__all__ = ["FORMAT_VERSION", "Tables", "ANGULAR", "DIRECTIONAL", "CONSTANT", "RADIAL"]
+__all__ = [
+    "FORMAT_VERSION",
+    "Tables",
+    "ANGULAR",
+    "DIRECTIONAL",
+    "CONSTANT",
+    "RADIAL",
+    "THETA_SPACINGS",
+    "RADIUS_SPACINGS",
+    "theta_nodes",
+    "theta_index",
+    "phi_index",
+    "node_cos_azimuths",
+    "THETA_OFFSET",
+    "PHI_SPACINGS",
+    "radius_nodes",
+    "radius_index",
+]
 
 FORMAT_VERSION = 1
 
@@ -36,20 +94,173 @@ DIRECTIONAL = (
     "skin_gloss_albedo",
 )
 """Tables of shape ``(n_theta, 3)``, dimensionless (transmittances and albedos)."""
-CONSTANT = ("film_diffuse", "skin_diffuse", "total_reflectance")
-"""Per-channel constants of shape ``(3,)``: the two P_d (1/sr) and the dipole's Rd."""
+CONSTANT = ("film_diffuse", "skin_diffuse", "total_reflectance", "film_transmittance_integral")
+"""Per-channel constants of shape ``(3,)``: the two P_d (1/sr), the dipole's Rd, and
+``Int T(w) cos(theta) dw`` over the hemisphere (sr; at most pi), which turns the skin's diffuse
+part of path 3 into its albedo ``skin_diffuse T(theta_i) film_transmittance_integral``."""
 RADIAL = ("profile",)
 """Tables of shape ``(n_radius, 3)``: ``R(d) / Rd`` in 1/mm^2."""
+
+THETA_SPACINGS = ("grazing", "uniform_cos", "uniform_theta")
+THETA_OFFSET = 0.03
+"""Default ``mu0`` of the ``grazing`` spacing (chosen by the convergence study)."""
+PHI_SPACINGS = ("half_vector", "uniform")
+RADIUS_SPACINGS = ("quadratic", "uniform")
+GRID_TOLERANCE_DEG = 1e-9
+"""How far a stored grid node may lie from its closed form (degrees or mm)."""
+
+
+# --------------------------------------------------------------------------------------------
+# Closed-form grids
+# --------------------------------------------------------------------------------------------
+def _check_spacing(spacing: str, allowed: tuple[str, ...], name: str) -> None:
+    if spacing not in allowed:
+        raise ValueError(f"{name} must be one of {list(allowed)}, got {spacing!r}")
+
+
+def _grazing(theta_deg, offset: float):
+    """``(q, atanh(q tan(theta / 2)))`` of the ``grazing`` spacing."""
+    if not 0.0 < offset < 1.0:
+        raise ValueError(f"theta_offset must lie in (0, 1), got {offset!r}")
+    q = np.sqrt((1.0 - offset) / (1.0 + offset))
+    return q, np.arctanh(q * np.tan(np.radians(theta_deg) / 2.0))
+
+
+def theta_nodes(n: int, spacing: str, theta_max_deg: float,
+                offset: float = THETA_OFFSET) -> np.ndarray:
+    """``n`` polar nodes (degrees) from 0 to ``theta_max_deg`` with the given spacing
+    (``offset``: ``mu0`` of the ``grazing`` spacing)."""
+    _check_spacing(spacing, THETA_SPACINGS, "theta_spacing")
+    if n < 2 or not 0.0 < theta_max_deg <= 90.0:
+        raise ValueError(f"need n >= 2 and 0 < theta_max_deg <= 90, got {n}, {theta_max_deg}")
+    s = np.linspace(0.0, 1.0, n)
+    if spacing == "uniform_theta":
+        nodes = s * theta_max_deg
+    elif spacing == "uniform_cos":
+        nodes = np.degrees(np.arccos(1.0 - s * (1.0 - np.cos(np.radians(theta_max_deg)))))
+    else:
+        q, top = _grazing(theta_max_deg, offset)
+        nodes = np.degrees(2.0 * np.arctan(np.tanh(s * top) / q))
+    nodes[-1] = theta_max_deg
+    return nodes
+
+
+def theta_index(theta_deg, n: int, spacing: str, theta_max_deg: float,
+                offset: float = THETA_OFFSET) -> np.ndarray:
+    """Fractional index (unclamped) of polar angles ``theta_deg`` on :func:`theta_nodes`."""
+    _check_spacing(spacing, THETA_SPACINGS, "theta_spacing")
+    theta = np.clip(np.asarray(theta_deg, float), 0.0, 90.0)
+    if spacing == "uniform_theta":
+        return theta / theta_max_deg * (n - 1)
+    if spacing == "uniform_cos":
+        mu_max = np.cos(np.radians(theta_max_deg))
+        return (1.0 - np.cos(np.radians(theta))) / (1.0 - mu_max) * (n - 1)
+    _, top = _grazing(theta_max_deg, offset)
+    _, x = _grazing(theta, offset)
+    return x / top * (n - 1)
+
+
+def _folded_azimuth_deg(wi: np.ndarray, wo: np.ndarray) -> np.ndarray:
+    """Relative azimuth of ``wi`` and ``wo`` folded into [0, 180] degrees."""
+    phi = np.arctan2(wi[..., 1], wi[..., 0]) - np.arctan2(wo[..., 1], wo[..., 0])
+    return np.abs(np.mod(np.degrees(phi) + 180.0, 360.0) - 180.0)
+
+
+def phi_index(wi, wo, n: int, spacing: str = "half_vector") -> np.ndarray:
+    """Fractional index of the azimuth coordinate of unit directions ``wi``, ``wo``
+    ``(..., 3)`` on ``n`` nodes over [0, 180] (module docstring)."""
+    _check_spacing(spacing, PHI_SPACINGS, "phi_spacing")
+    wi, wo = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
+    if spacing == "uniform":
+        return _folded_azimuth_deg(wi, wo) / 180.0 * (n - 1)
+    theta_i, theta_o = _polar_deg(wi), _polar_deg(wo)
+    h = wi + wo
+    length = np.linalg.norm(h, axis=-1)
+    alpha = _polar_deg(h / np.where(length > 1e-12, length, 1.0)[..., None])
+    span = np.minimum(theta_i, theta_o)
+    fraction = (0.5 * (theta_i + theta_o) - alpha) / np.where(span > 1e-9, span, 1.0)
+    return np.where(span > 1e-9, np.clip(fraction, 0.0, 1.0), 0.0) * (n - 1)
+
+
+def node_cos_azimuths(theta_i_deg, theta_o_deg, phi_deg,
+                      spacing: str = "half_vector") -> np.ndarray:
+    """Cosine of the relative azimuth of angular nodes at polar angles ``theta_i_deg``,
+    ``theta_o_deg`` (broadcasting, e.g. ``(I, 1)`` and ``(1, O)`` or paired ``(P,)``) and
+    azimuth coordinates ``phi_deg`` ``(n_phi,)``: shape ``broadcast + (n_phi,)``; the inverse
+    of :func:`phi_index`."""
+    _check_spacing(spacing, PHI_SPACINGS, "phi_spacing")
+    a = np.radians(np.asarray(theta_i_deg, float))[..., None]
+    b = np.radians(np.asarray(theta_o_deg, float))[..., None]
+    c = np.asarray(phi_deg, float)
+    if spacing == "uniform":
+        return np.broadcast_to(np.cos(np.radians(c)), np.broadcast(a, b, c).shape).copy()
+    alpha = 0.5 * (a + b) - c / 180.0 * np.minimum(a, b)
+    cos_a, cos_b = np.cos(a), np.cos(b)
+    dot = 0.5 * ((cos_a + cos_b) / np.cos(alpha)) ** 2 - 1.0  # |wi + wo|^2 = 2 + 2 wi.wo
+    sines = np.sin(a) * np.sin(b)
+    cos_phi = np.where(sines > 1e-12, (dot - cos_a * cos_b) / np.where(sines > 1e-12, sines, 1.0),
+                       1.0)
+    return np.clip(cos_phi, -1.0, 1.0)
+
+
+def radius_nodes(n: int, spacing: str, radius_max_mm: float) -> np.ndarray:
+    """``n`` radial nodes (mm) from 0 to ``radius_max_mm``."""
+    _check_spacing(spacing, RADIUS_SPACINGS, "radius_spacing")
+    if n < 2 or not radius_max_mm > 0.0:
+        raise ValueError(f"need n >= 2 and radius_max_mm > 0, got {n}, {radius_max_mm}")
+    s = np.linspace(0.0, 1.0, n)
+    return radius_max_mm * (s * s if spacing == "quadratic" else s)
+
+
+def radius_index(d_mm, n: int, spacing: str, radius_max_mm: float) -> np.ndarray:
+    """Fractional index (unclamped) of distances ``d_mm`` on :func:`radius_nodes`."""
+    _check_spacing(spacing, RADIUS_SPACINGS, "radius_spacing")
+    s = np.asarray(d_mm, float) / radius_max_mm
+    return (np.sqrt(np.maximum(s, 0.0)) if spacing == "quadratic" else s) * (n - 1)
+
+
+def _corners(x: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Lower node and weight of the upper node for fractional indices ``x`` (clamped)."""
+    x = np.clip(x, 0.0, n - 1.0)
+    low = np.minimum(np.floor(x).astype(np.intp), max(n - 2, 0))
+    return low, x - low
+
+
+def _linear(table: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """Linear interpolation of ``table[k, ...]`` at fractional indices ``x`` (any shape)."""
+    low, t = _corners(x, table.shape[0])
+    t = t[..., None]
+    return (1.0 - t) * table[low] + t * table[low + 1]
+
+
+def _trilinear(table: np.ndarray, xi: np.ndarray, xo: np.ndarray, xp: np.ndarray) -> np.ndarray:
+    """Trilinear interpolation of ``table[i, j, k, c]`` at fractional indices (same shape)."""
+    i, ti = _corners(xi, table.shape[0])
+    j, tj = _corners(xo, table.shape[1])
+    k, tk = _corners(xp, table.shape[2])
+    out = 0.0
+    for di, wi in ((0, 1.0 - ti), (1, ti)):
+        for dj, wj in ((0, 1.0 - tj), (1, tj)):
+            for dk, wk in ((0, 1.0 - tk), (1, tk)):
+                out = out + (wi * wj * wk)[..., None] * table[i + di, j + dj, k + dk]
+    return out
+
+
+def _polar_deg(w: np.ndarray) -> np.ndarray:
+    return np.degrees(np.arccos(np.clip(w[..., 2], -1.0, 1.0)))
 
 
 @dataclass(frozen=True, eq=False)
 class Tables:
     """Baked tables of one made-up skin (see the module docstring for the formula).
 
-    Grids: ``theta_deg`` (n_theta,), ``phi_deg`` (n_phi,), ``radius_mm`` (n_radius,).
-    ``parameters``: the MadeUpSkin as plain data (``MadeUpSkin`` fields via ``as_dict``),
-    including ``K``, ``coverage`` and ``absorption`` it was baked for.  ``inter_reflection``:
-    optional angular table, the full adding-equation sum minus path 3 (1/sr), or None.
+    Grids: ``theta_deg`` (n_theta,), ``phi_deg`` (n_phi,), ``radius_mm`` (n_radius,), laid out
+    as ``theta_spacing``, ``phi_spacing`` and ``radius_spacing`` say (closed forms in the module
+    docstring).  ``parameters``: the MadeUpSkin as plain data (``MadeUpSkin`` fields via
+    ``as_dict``), including ``K``, ``coverage`` and ``absorption`` it was baked for.
+    ``inter_reflection``: optional angular table, the full adding-equation sum minus path 3
+    (1/sr), or None; unlike the other tables it holds the film's absorption as baked
+    (``parameters["absorption"]``).
     """
 
     theta_deg: np.ndarray
@@ -66,9 +277,14 @@ class Tables:
     film_diffuse: np.ndarray
     skin_diffuse: np.ndarray
     total_reflectance: np.ndarray
+    film_transmittance_integral: np.ndarray
     profile: np.ndarray
     parameters: dict = field(default_factory=dict)
     inter_reflection: np.ndarray | None = None
+    theta_spacing: str = "grazing"
+    phi_spacing: str = "half_vector"
+    radius_spacing: str = "quadratic"
+    theta_offset: float = THETA_OFFSET
 
     def __post_init__(self):
         n_theta, n_phi, n_radius = self.theta_deg.size, self.phi_deg.size, self.radius_mm.size
@@ -82,8 +298,22 @@ class Tables:
             value = np.asarray(getattr(self, name))
             if value.shape != shape:
                 raise ValueError(f"table {name!r} must have shape {shape}, got {value.shape}")
-            if not np.all(np.isfinite(value)):
+            if value.ndim and value.strides[-1] == 0:  # a broadcast over channels
+                value = value[..., :1]
+            if not np.isfinite(np.sum(value)) and not np.all(np.isfinite(value)):
                 raise ValueError(f"table {name!r} holds NaN or Inf")
+        _check_spacing(self.phi_spacing, PHI_SPACINGS, "phi_spacing")
+        self._check_grid("theta_deg", theta_nodes(n_theta, self.theta_spacing,
+                                                  float(self.theta_deg[-1]), self.theta_offset))
+        self._check_grid("phi_deg", np.linspace(0.0, 180.0, n_phi))
+        self._check_grid("radius_mm", radius_nodes(n_radius, self.radius_spacing,
+                                                   float(self.radius_mm[-1])))
+
+    def _check_grid(self, name: str, nodes: np.ndarray) -> None:
+        grid = np.asarray(getattr(self, name), float)
+        if grid.shape != nodes.shape or np.max(np.abs(grid - nodes)) > GRID_TOLERANCE_DEG * max(
+                1.0, float(np.max(np.abs(nodes)))):
+            raise ValueError(f"grid {name!r} does not follow its closed form (module docstring)")
 
     @property
     def arrays(self) -> dict[str, np.ndarray]:
@@ -91,5 +321,104 @@ class Tables:
         return {
             f.name: getattr(self, f.name)
             for f in fields(self)
-            if f.name != "parameters" and getattr(self, f.name) is not None
+            if f.name != "parameters" and isinstance(getattr(self, f.name), np.ndarray)
         }
+
+    @property
+    def spacings(self) -> dict:
+        """How the grids are laid out: ``theta_spacing``, ``theta_offset``, ``phi_spacing``,
+        ``radius_spacing`` (module docstring)."""
+        return {name: getattr(self, name)
+                for name in ("theta_spacing", "theta_offset", "phi_spacing", "radius_spacing")}
+
+    # ----------------------------------------------------------------------------------------
+    # Lookups (the linear interpolation a shader does)
+    # ----------------------------------------------------------------------------------------
+    def theta_index(self, theta_deg) -> np.ndarray:
+        """Fractional table index of polar angles (degrees), unclamped."""
+        return theta_index(theta_deg, self.theta_deg.size, self.theta_spacing,
+                           float(self.theta_deg[-1]), self.theta_offset)
+
+    def radius_index(self, d_mm) -> np.ndarray:
+        """Fractional table index of distances (mm), unclamped."""
+        return radius_index(d_mm, self.radius_mm.size, self.radius_spacing,
+                            float(self.radius_mm[-1]))
+
+    def node_azimuths(self) -> np.ndarray:
+        """Relative azimuth (degrees) of every angular node, ``(n_theta, n_theta, n_phi)``."""
+        return np.degrees(np.arccos(node_cos_azimuths(
+            self.theta_deg[:, None], self.theta_deg[None, :], self.phi_deg, self.phi_spacing)))
+
+    def angular(self, name: str, wi, wo) -> np.ndarray:
+        """Angular table ``name`` interpolated trilinearly at unit directions ``(..., 3)``;
+        shape ``(..., 3)``."""
+        wi, wo = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
+        return _trilinear(np.asarray(getattr(self, name)), self.theta_index(_polar_deg(wi)),
+                          self.theta_index(_polar_deg(wo)),
+                          phi_index(wi, wo, self.phi_deg.size, self.phi_spacing))
+
+    def directional(self, name: str, theta_deg) -> np.ndarray:
+        """Directional table ``name`` interpolated at polar angles (degrees); ``(..., 3)``."""
+        return _linear(np.asarray(getattr(self, name)), self.theta_index(theta_deg))
+
+    def radial(self, d_mm) -> np.ndarray:
+        """The normalised profile ``R(d) / Rd`` (1/mm^2) at distances (mm); 0 beyond the grid."""
+        d = np.asarray(d_mm, float)
+        value = _linear(np.asarray(self.profile), self.radius_index(d))
+        return np.where((d <= self.radius_mm[-1])[..., None], value, 0.0)
+
+    def _mix(self, coverage, absorption) -> tuple[float, np.ndarray]:
+        w = self.parameters.get("coverage", 1.0) if coverage is None else coverage
+        a = self.parameters.get("absorption", 0.0) if absorption is None else absorption
+        return float(w), np.broadcast_to(np.asarray(a, float), (3,))
+
+    def _combine(self, parts: dict, t_i, t_o, coverage, absorption) -> np.ndarray:
+        """The module docstring's formula from angular ``parts`` (by table name) and the film
+        transmittances ``t_i``, ``t_o``; the inter-reflection part, baked at one absorption,
+        is scaled by ``((1 - A) / (1 - A_baked))^2``."""
+        w, a = self._mix(coverage, absorption)
+        through = 1.0 - a
+        path3 = parts["path3_gloss"] + self.skin_diffuse * t_i * t_o
+        film = parts["film_gloss"] + through * self.film_diffuse + through**2 * path3
+        if self.inter_reflection is not None:
+            baked = 1.0 - np.broadcast_to(np.asarray(self.parameters.get("absorption", 0.0)),
+                                          (3,))
+            ratio = np.where(baked > 0.0, through / np.where(baked > 0.0, baked, 1.0), 0.0)
+            film = film + parts["inter_reflection"] * ratio**2
+        return w * film + (1.0 - w) * (parts["skin_gloss"] + self.skin_diffuse)
+
+    def _angular_names(self) -> tuple[str, ...]:
+        return ANGULAR + (("inter_reflection",) if self.inter_reflection is not None else ())
+
+    def made_up_reflection(self, wi, wo, coverage=None, absorption=None) -> np.ndarray:
+        """Made-up skin BRDF (1/sr, ``(..., 3)``) interpolated from the tables: the module
+        docstring's formula, plus the inter-reflection table if baked (exact at the baked
+        absorption only).  ``coverage``, ``absorption`` default to the baked ones; 0 where
+        ``wi`` or ``wo`` is below the surface."""
+        wi, wo = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
+        parts = {name: self.angular(name, wi, wo) for name in self._angular_names()}
+        t_i = self.directional("film_transmittance", _polar_deg(wi))
+        t_o = self.directional("film_transmittance", _polar_deg(wo))
+        value = self._combine(parts, t_i, t_o, coverage, absorption)
+        upper = (wi[..., 2] >= 0.0) & (wo[..., 2] >= 0.0)
+        return np.where(upper[..., None], value, 0.0)
+
+    def node_values(self, coverage=None, absorption=None) -> np.ndarray:
+        """:meth:`made_up_reflection` at the angular nodes, ``(n_theta, n_theta, n_phi, 3)``
+        (no interpolation: the directions of :meth:`node_azimuths`)."""
+        parts = {name: np.asarray(getattr(self, name)) for name in self._angular_names()}
+        t = np.asarray(self.film_transmittance)
+        return self._combine(parts, t[:, None, None], t[None, :, None], coverage, absorption)
+
+    def directional_albedo(self, theta_deg, coverage=None, absorption=None) -> np.ndarray:
+        """``Int f(wi, wo) cos(theta_o) dwo`` (paths 1 + 3, no inter-reflection) at incidence
+        ``theta_deg`` (degrees) from the albedo tables; shape ``(..., 3)``."""
+        w, a = self._mix(coverage, absorption)
+        through = 1.0 - a
+        path3 = (self.directional("path3_gloss_albedo", theta_deg) + self.skin_diffuse
+                 * self.directional("film_transmittance", theta_deg)
+                 * self.film_transmittance_integral)
+        film = (self.directional("film_gloss_albedo", theta_deg)
+                + through * np.pi * self.film_diffuse + through**2 * path3)
+        bare = self.directional("skin_gloss_albedo", theta_deg) + np.pi * self.skin_diffuse
+        return w * film + (1.0 - w) * bare

@@ -1,0 +1,604 @@
+"""Bake a made-up skin into lookup tables (:class:`lut_baker.tables.Tables`), fast.
+
+Path 3 is a product of matrices per azimuthal Fourier order (SPEC 3): the bake evaluates
+:func:`lut_baker.layers.layered_fourier_matrices` with the table's polar grid as the outer
+angles and sums the cosine series on the table's azimuth grid.  What makes it fast:
+
+- the layers' kernels are evaluated from cosines alone (no direction vectors), at the
+  ``n_phi // 2 + 1`` distinct azimuths of an even kernel, once per unordered pair of polar
+  angles (both kernels are symmetric), and turned into cosine coefficients by one BLAS product
+  (:func:`fourier_coefficients`, equal to :func:`lut_baker.layers.layer_fourier_kernel`);
+- every kernel table is computed once per bake (:class:`KernelCache`);
+- the bake's quadrature (:func:`bake_quadrature`) is coarser than the exact evaluator's, as
+  coarse as the convergence study (``bench/bake.py --study``, docs/baking.md) allows.
+
+Functions and types
+-------------------
+- :func:`bake` -- the tables of one :class:`~lut_baker.normalise.MadeUpSkin`.
+- :class:`Resolution`, :data:`RESOLUTIONS`, :func:`resolution` -- grid sizes per name.
+- :func:`bake_quadrature` -- Gauss-Legendre panels in polar angle, odd azimuth count.
+- :func:`fourier_coefficients` -- cosine coefficients of a layer's kernel, fast.
+- :class:`KernelCache` -- memoises :func:`fourier_coefficients` within one bake.
+- :func:`gloss_tables` -- Torrance-Sparrow specular parts (eq. 2) on the table grid.
+- :func:`gloss_albedos` -- their directional albedos (order 0, azimuths adapted to the lobe).
+- :func:`profile_radius` -- where the dipole's R(d) falls to a fraction of its peak (mm).
+- :func:`error_samples` -- random points (grazing included) and the exact values there.
+- :func:`table_error` -- the interpolated tables against the exact evaluator.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from functools import lru_cache
+
+import numpy as np
+
+from .layers import (
+    inter_reflection_fourier_matrices,
+    layered_fourier_matrices,
+    transmission_factor,
+)
+from .model import (
+    Dipole,
+    ReflectionLayer,
+    TransmissionLayer,
+    _attenuation,
+    _distribution,
+    _fresnel,
+    dipole_profile,
+    dipole_total_reflectance,
+)
+from .normalise import (
+    MadeUpSkin,
+    directional_albedo,
+    film_reflection_layer,
+    film_transmission_layer,
+    made_up_reflection,
+)
+from .params_file import skin_to_dict
+from .quadrature import HemisphereGrid, direction
+from .tables import THETA_OFFSET, Tables, node_cos_azimuths, radius_nodes, theta_nodes
+
+__all__ = [
+    "Resolution",
+    "RESOLUTIONS",
+    "resolution",
+    "bake",
+    "bake_quadrature",
+    "fourier_coefficients",
+    "KernelCache",
+    "gloss_tables",
+    "gloss_albedos",
+    "profile_radius",
+    "table_error",
+    "error_samples",
+    "ErrorSamples",
+    "PROFILE_FLOOR",
+    "REFERENCE_LOBE_DEG",
+]
+
+PROFILE_FLOOR = 1e-4
+"""The radial table ends where R(d) falls below this fraction of R(0) (in every channel)."""
+REFERENCE_LOBE_DEG = 19.3
+"""The narrowest lobe (1/e half-width, 1/n degrees) among the presets the resolutions were
+chosen for (the Jensen skins' gloss).  Narrower lobes scale the angular grids up
+(:meth:`Resolution.for_lobe`), up to 4x."""
+
+
+@dataclass(frozen=True)
+class Resolution:
+    """Grid sizes of one bake.
+
+    Table grids: ``n_theta`` polar nodes (theta_i and theta_o) on [0, ``theta_max_deg``] with
+    ``theta_spacing``, ``n_phi`` azimuth coordinates on [0, 180] degrees with ``phi_spacing``,
+    ``n_radius`` distances with ``radius_spacing`` (closed forms in :mod:`lut_baker.tables`).
+    Quadrature of the path-3 integrals: ``quad_panels`` Gauss-Legendre panels of
+    ``quad_points`` nodes in polar angle, ``quad_phi`` (odd) azimuth samples; the gloss
+    albedos use ``albedo_azimuths`` azimuths concentrated at the mirror direction
+    (:func:`gloss_albedos`).
+    """
+
+    name: str
+    n_theta: int
+    n_phi: int
+    n_radius: int
+    quad_panels: int
+    quad_points: int
+    quad_phi: int
+    albedo_azimuths: int = 16
+    theta_spacing: str = "grazing"
+    theta_offset: float = THETA_OFFSET
+    phi_spacing: str = "half_vector"
+    radius_spacing: str = "quadratic"
+    theta_max_deg: float = 89.0
+
+    def for_lobe(self, width_deg: float) -> Resolution:
+        """This resolution scaled for a lobe of 1/e half-width ``width_deg`` (degrees)."""
+        scale = float(np.clip(REFERENCE_LOBE_DEG / width_deg, 1.0, 4.0))
+        if scale == 1.0:
+            return self
+        return replace(
+            self,
+            n_theta=int(np.ceil((self.n_theta - 1) * scale)) + 1,
+            n_phi=int(np.ceil((self.n_phi - 1) * scale)) + 1,
+            quad_panels=int(np.ceil(self.quad_panels * scale)),
+            quad_phi=2 * int(np.ceil((self.quad_phi // 2) * scale)) + 1,
+        )
+
+
+RESOLUTIONS = {
+    "preview": Resolution("preview", n_theta=16, n_phi=10, n_radius=32,
+                          quad_panels=2, quad_points=6, quad_phi=17),
+    "default": Resolution("default", n_theta=48, n_phi=25, n_radius=96,
+                          quad_panels=3, quad_points=8, quad_phi=33),
+    "high": Resolution("high", n_theta=96, n_phi=49, n_radius=192,
+                       quad_panels=4, quad_points=8, quad_phi=49),
+}
+"""Named resolutions, chosen by the convergence study in docs/baking.md."""
+
+
+def resolution(name_or_resolution) -> Resolution:
+    """A :class:`Resolution` from its name (``preview``, ``default``, ``high``) or itself."""
+    if isinstance(name_or_resolution, Resolution):
+        return name_or_resolution
+    if name_or_resolution not in RESOLUTIONS:
+        raise ValueError(f"resolution must be one of {list(RESOLUTIONS)}, "
+                         f"got {name_or_resolution!r}")
+    return RESOLUTIONS[name_or_resolution]
+
+
+@lru_cache(maxsize=16)
+def bake_quadrature(panels: int, points: int, n_phi: int) -> HemisphereGrid:
+    """Quadrature over the upper hemisphere (projected solid angle): ``panels`` equal
+    Gauss-Legendre panels of ``points`` nodes over [0, 90] degrees, ``n_phi`` (odd) azimuths."""
+    if panels < 1 or points < 1 or n_phi < 3 or n_phi % 2 == 0:
+        raise ValueError(f"need panels, points >= 1 and odd n_phi >= 3, got "
+                         f"{panels}, {points}, {n_phi}")
+    x, w = np.polynomial.legendre.leggauss(points)
+    half = np.pi / 4.0 / panels
+    mid = half * (2.0 * np.arange(panels) + 1.0)
+    theta = (mid[:, None] + half * x[None, :]).ravel()
+    weight = np.cos(theta) * np.sin(theta) * np.tile(half * w, panels)
+    return HemisphereGrid(theta=theta, weight=weight, n_phi=n_phi)
+
+
+# --------------------------------------------------------------------------------------------
+# Kernels from cosines
+# --------------------------------------------------------------------------------------------
+def _half_vector_cosines(cos_a, sin_a, cos_b, sin_b, cos_phi):
+    """``(N.H, V.H)`` of ``wa`` and ``wb`` at relative azimuth ``phi`` (eq. 2's half vector):
+    ``|wa + wb|^2 = 2 + 2 wa.wb``, ``N.H = (cos_a + cos_b) / |wa + wb|``, ``V.H = |wa + wb| / 2``;
+    the normal where ``wa + wb`` vanishes (as :func:`lut_baker.model.ts_reflection`)."""
+    dot = cos_a * cos_b + sin_a * sin_b * cos_phi
+    length = np.sqrt(np.maximum(2.0 + 2.0 * dot, 0.0))
+    safe = length > 1e-12
+    n_dot_h = np.where(safe, (cos_a + cos_b) / np.where(safe, length, 1.0), 1.0)
+    v_dot_h = np.where(safe, 0.5 * length, np.broadcast_to(cos_b, length.shape))
+    return np.clip(n_dot_h, 0.0, 1.0), np.clip(v_dot_h, 0.0, 1.0)
+
+
+def _reflection_values(layer: ReflectionLayer, cos_a, cos_b, n_dot_h, v_dot_h):
+    """``P_d + P_s D(alpha) G F_r(V.H)`` (eq. 2) with a trailing channel axis (1 or 3)."""
+    alpha = np.degrees(np.arccos(n_dot_h))[..., None]
+    geometry = _attenuation(n_dot_h, cos_b, cos_a, v_dot_h)[..., None]
+    lobe = _distribution(alpha, layer.n) * geometry * _fresnel(v_dot_h[..., None], layer.eta)
+    return layer.P_d + layer.P_s * lobe
+
+
+def _transmission_values(layer: TransmissionLayer, n_dot_h, v_dot_h):
+    """``P_d + P_t D(beta) (1 - F_r(V.H))`` (eq. 4) with a trailing channel axis."""
+    beta = np.degrees(np.arccos(n_dot_h))[..., None]
+    through = 1.0 - _fresnel(v_dot_h[..., None], layer.eta)
+    return layer.P_d + layer.P_t * _distribution(beta, layer.n) * through
+
+
+def _kernel_values(layer, theta_a, theta_b, cos_phi):
+    """The layer's kernel at polar angles ``theta_a``, ``theta_b`` (radians, broadcasting)
+    and relative azimuths with cosine ``cos_phi``: ``f_r(wa, wb)`` for a reflecting layer,
+    ``f_t(wa, -wb)`` for the film (whose lobe is the mirror image: azimuth ``phi + pi``)."""
+    cos_a, sin_a, cos_b, sin_b = np.cos(theta_a), np.sin(theta_a), np.cos(theta_b), np.sin(theta_b)
+    if isinstance(layer, ReflectionLayer):
+        n_dot_h, v_dot_h = _half_vector_cosines(cos_a, sin_a, cos_b, sin_b, cos_phi)
+        return _reflection_values(layer, cos_a, cos_b, n_dot_h, v_dot_h)
+    n_dot_h, v_dot_h = _half_vector_cosines(cos_a, sin_a, cos_b, sin_b, -cos_phi)
+    return _transmission_values(layer, n_dot_h, v_dot_h)
+
+
+@lru_cache(maxsize=16)
+def _cosine_matrix(n_phi: int) -> np.ndarray:
+    """``(orders, n_phi // 2 + 1)``: cosine coefficients from the distinct samples of an even
+    sequence on ``n_phi`` uniform azimuths (the real FFT of :func:`quadrature.fourier_kernel`)."""
+    k = np.arange(n_phi // 2 + 1)
+    m = k[:, None]
+    multiplicity = np.where((k == 0) | (2 * k == n_phi), 1.0, 2.0)
+    matrix = multiplicity * np.cos(2.0 * np.pi * m * k / n_phi) / n_phi
+    matrix[1:] *= 2.0
+    return matrix
+
+
+def fourier_coefficients(layer, theta_a, theta_b, n_phi: int) -> np.ndarray:
+    """Cosine coefficients ``(orders, A, B, C)`` of a layer's kernel (the signature and result
+    of :func:`lut_baker.layers.layer_fourier_kernel`, to rounding), evaluated at the distinct
+    azimuths only, and once per unordered pair when ``theta_a`` equals ``theta_b``."""
+    theta_a = np.atleast_1d(np.asarray(theta_a, float))
+    theta_b = np.atleast_1d(np.asarray(theta_b, float))
+    matrix = _cosine_matrix(n_phi)
+    cos_phi = np.cos(2.0 * np.pi * np.arange(matrix.shape[1]) / n_phi)
+    if theta_a.shape == theta_b.shape and np.array_equal(theta_a, theta_b):
+        upper = np.triu_indices(theta_a.size)
+        values = _kernel_values(layer, theta_a[upper[0], None], theta_b[upper[1], None], cos_phi)
+        pairs = np.tensordot(matrix, values, axes=([1], [1]))  # (M, pairs, C)
+        out = np.empty((matrix.shape[0], theta_a.size, theta_a.size, pairs.shape[-1]))
+        out[:, upper[0], upper[1]] = pairs
+        out[:, upper[1], upper[0]] = pairs
+        return out
+    values = _kernel_values(layer, theta_a[:, None, None], theta_b[None, :, None], cos_phi)
+    return np.tensordot(matrix, values, axes=([1], [2]))
+
+
+class KernelCache:
+    """:func:`fourier_coefficients` memoised by (layer, grids): pass as ``fourier=`` to the
+    matrix functions of :mod:`lut_baker.layers` so that one bake evaluates each kernel once."""
+
+    def __init__(self):
+        self._store: dict = {}
+
+    def __call__(self, layer, theta_a, theta_b, n_phi: int) -> np.ndarray:
+        theta_a = np.atleast_1d(np.asarray(theta_a, float))
+        theta_b = np.atleast_1d(np.asarray(theta_b, float))
+        key = (id(layer), theta_a.tobytes(), theta_b.tobytes(), n_phi)
+        if key not in self._store:  # the layer is kept alive so that its id stays unique
+            self._store[key] = (layer, fourier_coefficients(layer, theta_a, theta_b, n_phi))
+        return self._store[key][1]
+
+
+# --------------------------------------------------------------------------------------------
+# Tables
+# --------------------------------------------------------------------------------------------
+def _gloss_layer(layer: ReflectionLayer) -> ReflectionLayer:
+    """The Torrance-Sparrow specular part of a layer (``P_d`` = 0)."""
+    if not np.any(layer.P_d):
+        return layer
+    return ReflectionLayer(P_d=0.0, P_s=layer.P_s, n=layer.n, eta=layer.eta)
+
+
+def _rgb(values: np.ndarray) -> np.ndarray:
+    """A trailing channel axis of 1 or 3 as 3 (a read-only broadcast view, no copy)."""
+    return np.broadcast_to(values, values.shape[:-1] + (3,))
+
+
+CHUNK_ELEMENTS = 1 << 15
+"""Node values computed together (temporaries of a few hundred kB stay in the CPU cache)."""
+
+
+class _NodePairs:
+    """The angular nodes with ``theta_i <= theta_o`` (tables are symmetric under the swap):
+    ``upper`` indices into ``(n_theta, n_theta)``, their cosines and the cosine of each node's
+    relative azimuth ``cos_phi`` ``(P, n_phi)``; :meth:`tables` evaluates functions on them in
+    cache-sized chunks and fills the symmetric tables."""
+
+    def __init__(self, theta_deg, phi_deg, phi_spacing: str):
+        theta_deg = np.asarray(theta_deg, float)
+        self.n, self.n_phi = theta_deg.size, np.size(phi_deg)
+        self.upper = np.triu_indices(self.n)
+        a, b = np.radians(theta_deg[self.upper[0]]), np.radians(theta_deg[self.upper[1]])
+        self.cos_a, self.sin_a = np.cos(a)[:, None], np.sin(a)[:, None]
+        self.cos_b, self.sin_b = np.cos(b)[:, None], np.sin(b)[:, None]
+        self.chunks = [slice(start, start + max(1, CHUNK_ELEMENTS // self.n_phi))
+                       for start in range(0, a.size, max(1, CHUNK_ELEMENTS // self.n_phi))]
+        self.cos_phi = np.empty((a.size, self.n_phi))
+        for chunk in self.chunks:
+            self.cos_phi[chunk] = node_cos_azimuths(theta_deg[self.upper[0][chunk]],
+                                                    theta_deg[self.upper[1][chunk]],
+                                                    phi_deg, phi_spacing)
+
+    def tables(self, function, channels) -> list[np.ndarray]:
+        """``function(chunk)`` -> a list of ``(len(chunk), n_phi, C_k)`` arrays for slices of
+        the pairs; returns the full ``(n_theta, n_theta, n_phi, 3)`` tables (read-only
+        broadcasts where ``C_k`` = 1).  ``channels``: the ``C_k``."""
+        out = [np.empty((self.n, self.n, self.n_phi, c)) for c in channels]
+        for chunk in self.chunks:
+            i, j = self.upper[0][chunk], self.upper[1][chunk]
+            for table, values in zip(out, function(chunk), strict=True):
+                table[i, j] = values
+                table[j, i] = values
+        return [_rgb(table) for table in out]
+
+
+def _channel_count(*layers) -> int:
+    return 3 if any(layer.channels for layer in layers) else 1
+
+
+def gloss_tables(layers, theta_deg, phi_deg, phi_spacing: str = "half_vector",
+                 *, pairs: _NodePairs | None = None) -> list[np.ndarray]:
+    """Specular parts ``P_s D G F_r`` (eq. 2, 1/sr) of each reflecting layer on the table grid
+    (grids and spacing as :class:`lut_baker.tables.Tables`): ``(n_theta, n_theta, n_phi, 3)``
+    each, evaluated once per unordered (theta_i, theta_o)."""
+    pairs = pairs or _NodePairs(theta_deg, phi_deg, phi_spacing)
+    layers = [_gloss_layer(layer) for layer in layers]
+
+    def values(chunk):
+        cos_a, cos_b = pairs.cos_a[chunk], pairs.cos_b[chunk]
+        n_dot_h, v_dot_h = _half_vector_cosines(cos_a, pairs.sin_a[chunk], cos_b,
+                                                pairs.sin_b[chunk], pairs.cos_phi[chunk])
+        return [_reflection_values(layer, cos_a, cos_b, n_dot_h, v_dot_h) for layer in layers]
+
+    return pairs.tables(values, [_channel_count(layer) for layer in layers])
+
+
+AZIMUTH_POWER = 3
+"""Exponent of the azimuth substitution of :func:`gloss_albedos`."""
+
+
+@lru_cache(maxsize=8)
+def _mirror_weighted_azimuths(count: int) -> tuple[np.ndarray, np.ndarray]:
+    """``(cos(phi_k), w_k)`` with ``Int_0^{2 pi} f(phi) dphi ~ sum_k w_k f(phi_k)`` for even
+    ``f``: Gauss-Legendre in ``s`` after ``phi = pi (1 - s^p)``, dense at the mirror azimuth."""
+    x, w = np.polynomial.legendre.leggauss(count)
+    s = 0.5 * (x + 1.0)
+    weight = 2.0 * np.pi * AZIMUTH_POWER * s ** (AZIMUTH_POWER - 1) * 0.5 * w
+    return np.cos(np.pi * (1.0 - s**AZIMUTH_POWER)), weight
+
+
+def gloss_albedos(layers, theta_deg, grid: HemisphereGrid, azimuths: int) -> list[np.ndarray]:
+    """Directional albedos ``Int P_s D G F_r cos(theta_o) dwo`` (eq. 2's specular part
+    integrated) of each reflecting layer at incidences ``theta_deg``: ``(n_theta, 3)`` each.
+
+    Only the azimuth integral (order 0) is needed, so instead of uniform azimuths it uses
+    ``azimuths`` Gauss-Legendre nodes in ``s`` with ``phi = pi (1 - s^3)``: towards grazing the
+    gloss lobe narrows in azimuth like ``cos(theta_i) + cos(theta_o)`` (about 1 degree wide at 89
+    degrees), and the substitution resolves every width at once (polar nodes from ``grid``)."""
+    layers = [_gloss_layer(layer) for layer in layers]
+    cos_phi, weight = _mirror_weighted_azimuths(int(azimuths))
+    theta = np.radians(np.asarray(theta_deg, float))[:, None, None]
+    cos_a, sin_a = np.cos(theta), np.sin(theta)
+    cos_b, sin_b = np.cos(grid.theta)[:, None], np.sin(grid.theta)[:, None]
+    n_dot_h, v_dot_h = _half_vector_cosines(cos_a, sin_a, cos_b, sin_b, cos_phi)
+    out = []
+    for layer in layers:
+        values = _reflection_values(layer, cos_a, cos_b, n_dot_h, v_dot_h)  # (T, N, S, C)
+        out.append(_rgb(np.einsum("tnsc,s,n->tc", values, weight, grid.weight)))
+    return out
+
+
+def _cosine_series(matrices: np.ndarray, pairs: _NodePairs) -> np.ndarray:
+    """``sum_m F_m(theta_i, theta_o) cos(m phi)`` at the nodes: ``(M, I, I, C)`` ->
+    ``(I, I, P, 3)``, clipped at 0 (cos(m phi) by Chebyshev's recurrence)."""
+    f = matrices[:, pairs.upper[0], pairs.upper[1], None, :]  # (M, P, 1, C)
+
+    def values(chunk):
+        x = pairs.cos_phi[chunk][..., None]  # (p, n_phi, 1)
+        previous, current = np.ones_like(x), x
+        series = f[0, chunk] + f[1, chunk] * x
+        for m in range(2, f.shape[0]):
+            previous, current = current, 2.0 * x * current - previous
+            series += f[m, chunk] * current
+        return [np.maximum(series, 0.0)]
+
+    return pairs.tables(values, [matrices.shape[-1]])[0]
+
+
+def _order0_integral(matrix0: np.ndarray, grid: HemisphereGrid, weight=None) -> np.ndarray:
+    """``2 pi sum_u K_0(theta, theta_u) weight_u W_u``: an order-0 kernel integrated over the
+    hemisphere (projected solid angle).  ``matrix0``: ``(P, N, C)`` -> ``(P, C)``."""
+    w = grid.weight[:, None] if weight is None else grid.weight[:, None] * weight
+    return 2.0 * np.pi * np.sum(matrix0 * w[None], axis=1)
+
+
+def profile_radius(dipole: Dipole, floor: float = PROFILE_FLOOR) -> float:
+    """Distance (mm) beyond which the dipole's ``R(d)`` stays below ``floor`` times ``R(0)`` in
+    every channel (R decreases with d): bracketed on geometric grids refined three times
+    (relative precision ~1e-9)."""
+    def above(d):  # d (K,) -> (K,): R(d) > floor R(0) in some channel
+        values = np.reshape(dipole_profile(d, dipole), (np.size(d), -1))
+        return np.any(values > limit, axis=1)
+
+    limit = floor * np.reshape(dipole_profile(0.0, dipole), (1, -1))
+    high = 1.0
+    while above(np.array([high]))[0]:
+        high *= 2.0
+    low = 1e-6 * high
+    for _ in range(3):
+        grid = np.geomspace(low, high, 1000)
+        last = int(np.max(np.nonzero(above(grid))[0], initial=0))
+        low, high = grid[last], grid[min(last + 1, grid.size - 1)]
+    return float(high)
+
+
+def _stage(progress, fraction: float, message: str) -> None:
+    if progress is not None:
+        progress(fraction, message)
+
+
+def bake(skin: MadeUpSkin, resolution_name="default", *, inter_reflection: bool = False,
+         progress=None) -> Tables:
+    """Bake the tables of one made-up skin (see :mod:`lut_baker.tables` for their meaning).
+
+    ``resolution_name``: ``"preview"``, ``"default"``, ``"high"`` or a :class:`Resolution`;
+    it is scaled up for lobes narrower than the presets' (:meth:`Resolution.for_lobe`).
+    ``inter_reflection``: also bake the film-skin inter-reflections beyond path 3 (the adding
+    equation, film underside reflecting like its top, at the skin's absorption).
+    ``progress(fraction, message)``: called as the bake advances (fraction 0..1).
+    """
+    if not isinstance(skin, MadeUpSkin):
+        raise ValueError(f"skin must be a MadeUpSkin, got {type(skin).__name__}")
+    widths = [1.0 / float(np.max(layer.n)) for layer in (skin.film, skin.film_transmission,
+                                                          skin.skin)]
+    res = resolution(resolution_name).for_lobe(min(widths))
+    _stage(progress, 0.0, f"grids ({res.name})")
+    theta_deg = theta_nodes(res.n_theta, res.theta_spacing, res.theta_max_deg, res.theta_offset)
+    phi_deg = np.linspace(0.0, 180.0, res.n_phi)
+    pairs = _NodePairs(theta_deg, phi_deg, res.phi_spacing)
+    theta = np.radians(theta_deg)
+    grid = bake_quadrature(res.quad_panels, res.quad_points, res.quad_phi)
+    kernels = KernelCache()
+    film_t = skin.film_transmission  # absorption 0: the tables apply it afterwards
+    film_gloss_layer, skin_gloss = _gloss_layer(skin.film), _gloss_layer(skin.skin)
+
+    _stage(progress, 0.05, "path 3 (Fourier matrices)")
+    outer = np.concatenate([theta, grid.theta])
+    path3_m = layered_fourier_matrices(theta, outer, film_t, skin_gloss, grid, fourier=kernels)
+    path3 = _cosine_series(path3_m[:, :, :theta.size], pairs)
+    path3_albedo = _order0_integral(path3_m[0, :, theta.size:], grid)
+
+    _stage(progress, 0.45, "transmittances and albedos")
+    rows0 = kernels(film_t, theta, grid.theta, grid.n_phi)[0]
+    fresnel_t = 1.0 - _fresnel(np.cos(grid.theta)[:, None], np.atleast_1d(skin.dipole.eta))
+    inner_t = _order0_integral(kernels(film_t, grid.theta, grid.theta, grid.n_phi)[0], grid)
+    albedos = gloss_albedos((film_gloss_layer, skin_gloss), theta_deg, grid,
+                            res.albedo_azimuths)
+
+    _stage(progress, 0.55, "surface gloss")
+    film_gloss, skin_gloss_table = gloss_tables((film_gloss_layer, skin_gloss), theta_deg,
+                                                  phi_deg, pairs=pairs)
+
+    extra = None
+    if inter_reflection:
+        _stage(progress, 0.7, "inter-reflections (adding equation)")
+        film_t_a = film_transmission_layer(skin)
+        full = inter_reflection_fourier_matrices(
+            theta, theta, film_t_a, skin.skin, grid, film_below=film_reflection_layer(skin),
+            fourier=kernels)
+        first = layered_fourier_matrices(theta, theta, film_t_a, skin.skin, grid, fourier=kernels)
+        extra = _cosine_series(full - first, pairs)
+
+    _stage(progress, 0.9, "radial profile")
+    radius_mm = radius_nodes(res.n_radius, res.radius_spacing, profile_radius(skin.dipole))
+    total = np.atleast_1d(dipole_total_reflectance(skin.dipole))
+    profile = np.atleast_2d(dipole_profile(radius_mm, skin.dipole).T).T / total
+
+    tables = Tables(
+        theta_deg=theta_deg,
+        phi_deg=phi_deg,
+        radius_mm=radius_mm,
+        film_gloss=film_gloss,
+        path3_gloss=path3,
+        skin_gloss=skin_gloss_table,
+        film_transmittance=_rgb(_order0_integral(rows0, grid)),
+        transmission_factor=_rgb(_order0_integral(rows0, grid, fresnel_t)),
+        film_gloss_albedo=albedos[0],
+        path3_gloss_albedo=_rgb(path3_albedo),
+        skin_gloss_albedo=albedos[1],
+        film_diffuse=_rgb(np.atleast_1d(skin.film.P_d)),
+        skin_diffuse=_rgb(np.atleast_1d(skin.skin.P_d)),
+        total_reflectance=_rgb(total),
+        film_transmittance_integral=_rgb(_order0_integral(inner_t[None], grid)[0]),
+        profile=_rgb(profile),
+        parameters=skin_to_dict(skin),
+        inter_reflection=extra,
+        theta_spacing=res.theta_spacing,
+        theta_offset=res.theta_offset,
+        phi_spacing=res.phi_spacing,
+        radius_spacing=res.radius_spacing,
+    )
+    _stage(progress, 1.0, "done")
+    return tables
+
+
+# --------------------------------------------------------------------------------------------
+# Error against the exact evaluator
+# --------------------------------------------------------------------------------------------
+def _sample_directions(n_points: int, rng: np.random.Generator, theta_max_deg: float):
+    """Random (wi, wo): 60% with both polar angles uniform on [0, theta_max], 20% with wi and
+    20% with both on the grazing rows [80, theta_max] degrees; azimuths uniform."""
+    grazing = min(80.0, theta_max_deg)
+    n_one = n_points // 5
+    low_i = np.zeros(n_points)
+    low_o = np.zeros(n_points)
+    low_i[n_points - 2 * n_one:] = grazing
+    low_o[n_points - n_one:] = grazing
+    theta_i = rng.uniform(low_i, theta_max_deg)
+    theta_o = rng.uniform(low_o, theta_max_deg)
+    phi_i, phi_o = rng.uniform(0.0, 2.0 * np.pi, (2, n_points))
+    return direction(np.radians(theta_i), phi_i), direction(np.radians(theta_o), phi_o)
+
+
+@dataclass(frozen=True, eq=False)
+class ErrorSamples:
+    """Random points and the exact evaluator's values there (see :func:`error_samples`)."""
+
+    skin: MadeUpSkin
+    wi: np.ndarray
+    wo: np.ndarray
+    reflection: np.ndarray
+    theta_deg: np.ndarray
+    albedo: np.ndarray
+    transmission: np.ndarray
+    d_mm: np.ndarray
+    profile: np.ndarray
+
+
+def error_samples(skin: MadeUpSkin, n_points: int = 500, seed: int = 0, *, level: int = 0,
+                  albedo_level: int | None = None, theta_max_deg: float = 89.0) -> ErrorSamples:
+    """``n_points`` random points (grazing rows included, polar angles up to
+    ``theta_max_deg``) and the exact evaluator there: paths 1 + 3
+    (:func:`lut_baker.normalise.made_up_reflection`) and path 4's factor at ``level``, the
+    directional albedo at ``albedo_level`` (default ``level + 1``: at level 0 the film gloss's
+    albedo is 3% low at 89 degrees, its lobe being ~1 degree wide in azimuth there, which moves
+    the total by 1.3e-3), and R(d)/Rd on [0, :func:`profile_radius`] (denser near 0)."""
+    albedo_level = level + 1 if albedo_level is None else albedo_level
+    rng = np.random.default_rng(seed)
+    wi, wo = _sample_directions(n_points, rng, theta_max_deg)
+    theta = rng.uniform(0.0, theta_max_deg, n_points)
+    transmission = transmission_factor(direction(np.radians(theta), 0.0), skin.film_transmission,
+                                       skin.dipole, level=level)
+    d = profile_radius(skin.dipole) * rng.uniform(0.0, 1.0, n_points) ** 2
+    profile = np.reshape(dipole_profile(d, skin.dipole), (n_points, -1)) / np.atleast_1d(
+        dipole_total_reflectance(skin.dipole))
+    return ErrorSamples(
+        skin=skin, wi=wi, wo=wo, reflection=made_up_reflection(wi, wo, skin, level=level),
+        theta_deg=theta, albedo=directional_albedo(theta, skin, level=albedo_level),
+        transmission=_rgb(np.reshape(transmission, (n_points, -1))), d_mm=d,
+        profile=_rgb(profile))
+
+
+def _normalised_error(approx, exact, peak) -> np.ndarray:
+    """``|approx - exact| / max(|exact|, 0.1 peak)``: <= 1e-3 is the goal's "1e-3 relative or
+    1e-4 of the peak, whichever is larger"."""
+    return np.abs(approx - exact) / np.maximum(np.abs(exact), 0.1 * np.asarray(peak))
+
+
+def table_error(tables: Tables, skin: MadeUpSkin | None = None, n_points: int = 500,
+                seed: int = 0, *, level: int = 0, samples: ErrorSamples | None = None) -> dict:
+    """Interpolated tables against the exact evaluator at random points.
+
+    Errors are normalised as ``|table - exact| / max(|exact|, 0.1 peak)`` per channel (peak: the
+    largest value of the quantity on the table's nodes), so a value <= 1e-3 meets "1e-3 relative
+    or 1e-4 of the peak, whichever is larger".  The points come from :func:`error_samples`
+    (``skin``, ``n_points``, ``seed``, ``level``) unless ``samples`` are given.  Returns a dict
+    of maxima: ``reflection`` (paths 1 + 3 by :meth:`Tables.made_up_reflection`, without
+    inter-reflection), ``albedo`` (directional), ``transmission`` (path 4's factor),
+    ``profile`` (R(d)/Rd), ``max`` (of those four); ``worst`` (theta_i, theta_o, relative
+    azimuth in degrees of the worst reflection point) and ``peak`` (1/sr per channel).
+    """
+    if samples is None:
+        if skin is None:
+            raise ValueError("table_error needs the skin or precomputed samples")
+        samples = error_samples(skin, n_points, seed, level=level)
+    skin = samples.skin
+    plain = replace(tables, inter_reflection=None)
+    w, a = skin.coverage, skin.absorption
+    peak = plain.node_values(w, a).reshape(-1, 3).max(axis=0)
+    reflection = _normalised_error(plain.made_up_reflection(samples.wi, samples.wo, w, a),
+                                   samples.reflection, peak)
+    albedo = _normalised_error(plain.directional_albedo(samples.theta_deg, w, a), samples.albedo,
+                               plain.directional_albedo(tables.theta_deg, w, a).max(axis=0))
+    transmission = _normalised_error(tables.directional("transmission_factor", samples.theta_deg),
+                                     samples.transmission, tables.transmission_factor.max(axis=0))
+    profile = _normalised_error(tables.radial(samples.d_mm), samples.profile,
+                                tables.profile.max(axis=0))
+    worst = int(np.argmax(reflection.max(axis=-1)))
+    wi, wo = samples.wi[worst], samples.wo[worst]
+    azimuth = np.degrees(np.arctan2(wi[1], wi[0]) - np.arctan2(wo[1], wo[0]))
+    result = {
+        "reflection": float(reflection.max()),
+        "albedo": float(albedo.max()),
+        "transmission": float(transmission.max()),
+        "profile": float(profile.max()),
+        "peak": peak.tolist(),
+        "worst": [float(np.degrees(np.arccos(np.clip(wi[2], -1.0, 1.0)))),
+                  float(np.degrees(np.arccos(np.clip(wo[2], -1.0, 1.0)))),
+                  float(abs((azimuth + 180.0) % 360.0 - 180.0))],
+    }
+    result["max"] = max(result[k] for k in ("reflection", "albedo", "transmission", "profile"))
+    return result

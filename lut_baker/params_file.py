@@ -1,0 +1,144 @@
+"""Made-up skin parameters as plain data and as TOML files a user writes (docs/baking.md).
+
+A parameter file starts from presets and overrides what it names::
+
+    name = "beige on skin 1"
+    foundation = "medium_beige"      # lut_baker.presets.FOUNDATIONS (default paper_natural)
+    skin = "jensen_skin1"            # lut_baker.presets.SKINS (default paper_bioplate)
+    coverage = 0.8                   # [0, 1]
+    absorption = [0.1, 0.24, 0.42]   # [0, 1], one number or R G B
+
+    [film]                 # film top reflection (paper eq. 2): P_d, P_s in 1/sr, n in 1/degree, eta
+    n = 0.04
+    [film_transmission]    # film transmission (eq. 4): P_d, P_t in 1/sr, n, eta
+    [skin]                 # skin surface reflection (eq. 2): P_d, P_s, n, eta
+    [dipole]               # skin subsurface (eq. 6): sigma_s, sigma_a in 1/mm, g, eta
+
+Values are albedo units (1/sr, SPEC 4) unless ``units = "counts"``: then ``[film]``,
+``[film_transmission]`` and ``[skin]`` must each be complete and are the paper's pixel counts
+(reflection at 3 s, transmission at 10 s, or ``reflection_shutter_s``/``transmission_shutter_s``),
+normalised with the K they imply (:func:`lut_baker.normalise.from_paper_counts`).
+
+Functions
+---------
+- :func:`skin_to_dict` -- a :class:`~lut_baker.normalise.MadeUpSkin` as JSON-ready data.
+- :func:`skin_from_dict` -- the inverse.
+- :func:`load_params` -- read and validate a TOML parameter file into a MadeUpSkin.
+- :func:`params_from_mapping` -- the same from an already parsed mapping.
+"""
+
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+
+import numpy as np
+
+from .model import Dipole, ReflectionLayer, TransmissionLayer
+from .normalise import MadeUpSkin, from_paper_counts
+from .presets import FOUNDATIONS, SKINS, made_up_skin
+
+__all__ = ["skin_to_dict", "skin_from_dict", "load_params", "params_from_mapping", "LAYERS"]
+
+LAYERS = {
+    "film": ReflectionLayer,
+    "film_transmission": TransmissionLayer,
+    "skin": ReflectionLayer,
+    "dipole": Dipole,
+}
+"""Sections of a parameter file (and keys of :func:`skin_to_dict`) and their types."""
+TOP_LEVEL = {"name", "foundation", "skin", "coverage", "absorption", "units",
+             "reflection_shutter_s", "transmission_shutter_s", "format"}
+
+
+def skin_to_dict(skin: MadeUpSkin) -> dict:
+    """Plain data (floats, lists, str) of a made-up skin, for metadata and sidecars."""
+    data = {name: getattr(skin, name).as_dict() for name in LAYERS}
+    data.update(coverage=float(skin.coverage), absorption=np.asarray(skin.absorption).tolist(),
+                K=None if skin.K is None else float(skin.K), name=skin.name)
+    return data
+
+
+def skin_from_dict(data: dict) -> MadeUpSkin:
+    """Rebuild a :class:`MadeUpSkin` from :func:`skin_to_dict` data (validated)."""
+    try:
+        layers = {name: kind(**data[name]) for name, kind in LAYERS.items()}
+        return MadeUpSkin(**layers, coverage=data["coverage"], absorption=data["absorption"],
+                          K=data.get("K"), name=data.get("name", "custom"))
+    except (KeyError, TypeError) as error:
+        raise ValueError(f"incomplete made-up skin parameters: {error}") from None
+
+
+def _section(mapping: dict, name: str) -> dict:
+    section = mapping.get(name, {})
+    if not isinstance(section, dict):
+        raise ValueError(f"[{name}] must be a table of fields")
+    kind = LAYERS[name]
+    allowed = set(kind.__dataclass_fields__)
+    unknown = sorted(set(section) - allowed)
+    if unknown:
+        raise ValueError(f"[{name}] has unknown field(s) {unknown}; allowed: {sorted(allowed)}")
+    return section
+
+
+def _layer(kind, name: str, fields: dict):
+    try:
+        return kind(**fields)
+    except ValueError as error:
+        raise ValueError(f"[{name}] {error}") from None
+    except TypeError:
+        missing = sorted(set(kind.__dataclass_fields__) - set(fields))
+        raise ValueError(f"[{name}] is missing field(s) {missing}") from None
+
+
+def params_from_mapping(mapping: dict) -> MadeUpSkin:
+    """A :class:`MadeUpSkin` from a parsed parameter file (see the module docstring)."""
+    unknown = sorted(set(mapping) - TOP_LEVEL - set(LAYERS))
+    if unknown:
+        raise ValueError(f"unknown key(s) {unknown}; allowed: {sorted(TOP_LEVEL | set(LAYERS))}")
+    foundation = mapping.get("foundation", "paper_natural")
+    skin_name = mapping.get("skin", "paper_bioplate")
+    if foundation not in FOUNDATIONS:
+        raise ValueError(f"foundation must be one of {sorted(FOUNDATIONS)}, got {foundation!r}")
+    if skin_name not in SKINS:
+        raise ValueError(f"skin must be one of {sorted(SKINS)}, got {skin_name!r}")
+    base = made_up_skin(foundation, skin_name)
+    units = mapping.get("units", "albedo")
+    sections = {name: _section(mapping, name) for name in LAYERS}
+    if units == "counts":
+        layers = [_layer(LAYERS[name], name, sections[name])
+                  for name in ("film", "film_transmission", "skin")]
+        dipole = _layer(Dipole, "dipole", {**base.dipole.as_dict(), **sections["dipole"]})
+        shutters = {key: mapping[key] for key in ("reflection_shutter_s", "transmission_shutter_s")
+                    if key in mapping}
+        base = from_paper_counts(*layers, dipole, **shutters, name=base.name,
+                                 absorption=base.absorption)
+    elif units == "albedo":
+        changed = {name: _layer(LAYERS[name], name,
+                                {**getattr(base, name).as_dict(), **sections[name]})
+                   for name in LAYERS if sections[name]}
+        base = base.replace(**changed)
+    else:
+        raise ValueError(f"units must be 'albedo' or 'counts', got {units!r}")
+    changes = {key: mapping[key] for key in ("coverage", "absorption", "name") if key in mapping}
+    try:
+        return base.replace(**changes)
+    except (ValueError, TypeError) as error:
+        raise ValueError(str(error)) from None
+
+
+def load_params(path) -> MadeUpSkin:
+    """Read a TOML parameter file; ``ValueError`` naming the file and the problem if it is
+    missing, not TOML, or holds an invalid value."""
+    path = Path(path)
+    try:
+        with path.open("rb") as stream:
+            mapping = tomllib.load(stream)
+    except FileNotFoundError:
+        raise ValueError(f"parameter file {str(path)!r} does not exist") from None
+    except (OSError, tomllib.TOMLDecodeError, UnicodeDecodeError) as error:
+        raise ValueError(f"parameter file {str(path)!r} is not valid TOML: {error}") from None
+    try:
+        return params_from_mapping(mapping)
+    except ValueError as error:
+        raise ValueError(f"parameter file {str(path)!r}: {error}") from None
