@@ -1,0 +1,723 @@
+"""Fitting Blender closure parameters to baked tables, and each tier's error against them.
+
+A Cycles shader sees the view direction but not the light's, so the add-on's tiers are
+closures (replicated in :mod:`lut_baker.cycles_closures`) whose parameters are fitted here to the
+tables of :mod:`lut_baker.tables`, with weights that may depend on the view angle through 1-D
+lookup images.  Everything is numpy only (it runs inside Blender, which ships no scipy).
+
+Tiers
+-----
+``PRINCIPLED``: one Principled BSDF.  Coat = the film's gloss (Coat Weight = coverage, Coat
+Roughness and Coat IOR fitted); specular = the skin's gloss, bare or through the film
+(Roughness and Specular IOR Level fitted per case, mixed by coverage); base colour = the
+diffuse albedo (film diffuse + skin seen through the film, or bare skin), divided by the mean
+attenuation of the layers above it; Subsurface Weight = the skin's share of it.
+``LAYERED``: closures added with view-dependent weights: film gloss, path-3 gloss and skin gloss
+(Glossy GGX, roughness fitted, weight = table albedo / closure albedo read from a 1-D image by
+``cos(theta_o)``), film diffuse (Diffuse), the skin through the film and bare (Subsurface, colour
+``(1 - A)^2 skin_diffuse pi T_mean T(theta_o)`` and ``skin_diffuse pi``), mixed by coverage.
+
+Errors
+------
+On the tables' own grid, with ``f`` the BRDF and ``L = f cos(theta_i)`` the radiance under a
+unit-irradiance light: relative RMS of ``L`` with weights ``sin(theta_i)`` (light directions
+uniform over the hemisphere) times ``cos(theta_o) sin(theta_o)`` (the area a sphere's image
+gives each view angle) times the azimuth step; and the largest relative error of the view
+albedo ``Int f cos(theta_i) dw_i``.
+
+Functions and types
+-------------------
+- :func:`node_directions`, :func:`angular_weights` -- the tables' nodes as directions, and
+  quadrature weights on them.
+- :func:`relative_rms`, :func:`albedo_error`, :func:`view_albedo` -- the error measures.
+- :func:`golden_minimum` -- 1-D bounded minimisation (golden section).
+- :func:`fit_coat`, :func:`fit_specular`, :func:`fit_glossy` -- GGX lobes fitted to a table.
+- :func:`fit_profile`, :func:`fit_profiles` -- Subsurface Radius per channel for a Blender
+  subsurface method, fitted to the radial profile.
+- :func:`lut_nodes`, :func:`sample_lut` -- the 1-D image's texel centres and its sampling.
+- :class:`LobeFit`, :class:`ProfileFit`, :class:`TierError`, :class:`ClosureFit`.
+- :func:`fit_closures` -- every fit of one set of tables.
+- :func:`principled_inputs`, :func:`principled_tier_reflection` -- the PRINCIPLED tier at a
+  coverage and absorption; :func:`layered_weights`, :func:`layered_tier_reflection` -- the
+  LAYERED tier; :func:`tier_errors` -- both against the tables.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+
+from . import cycles_closures as cc
+from .tables import Tables
+
+__all__ = [
+    "TIERS",
+    "LUT_ROWS",
+    "DEFAULT_LUT_SIZE",
+    "node_directions",
+    "angular_weights",
+    "relative_rms",
+    "view_albedo",
+    "albedo_error",
+    "golden_minimum",
+    "lut_nodes",
+    "sample_lut",
+    "LobeFit",
+    "ProfileFit",
+    "TierError",
+    "ClosureFit",
+    "fit_coat",
+    "fit_specular",
+    "fit_glossy",
+    "fit_profile",
+    "fit_profiles",
+    "fit_closures",
+    "diffuse_albedo",
+    "principled_inputs",
+    "principled_tier_reflection",
+    "layered_weights",
+    "layered_tier_reflection",
+    "tier_errors",
+]
+
+TIERS = ("PRINCIPLED", "LAYERED")
+"""The node group's tiers, cheapest first."""
+LUT_ROWS = ("film_gloss", "path3_gloss", "skin_gloss", "film_transmittance")
+"""Rows of the LAYERED tier's view-angle image: three Glossy weights and the film's
+transmittance ``T(theta_o)``."""
+DEFAULT_LUT_SIZE = 64
+"""Texels per row of the view-angle image (linear filtering between texel centres)."""
+ROUGHNESS_RANGE = (0.2, 1.0)
+"""Roughness (Blender's socket, alpha = roughness^2) searched by the fits.  The lower end
+(alpha = 0.04, a lobe about 2 degrees wide) is below any lobe the tables resolve: the
+narrowest Torrance-Sparrow lobe the bake resolves is 5 degrees wide (alpha ~ 0.11)."""
+COAT_IOR_RANGE = (1.01, 4.0)
+"""Coat IOR searched (the socket's range in Blender)."""
+SPECULAR_LEVEL_RANGE = (0.0, 8.0)
+"""Specular IOR Level searched (0.5 leaves IOR 1.5 as it is; F0 = 0.04 * 2 level)."""
+SPECULAR_IOR = 1.5
+"""The Principled IOR the specular fits assume (Specular IOR Level scales its F0)."""
+FIT_TOLERANCE = 1e-3
+"""Relative bracket width at which the golden-section searches stop."""
+NO_LOBE_ERROR = 0.9
+"""A specular fit erring more than this (relative RMS; leaving the lobe out errs 1.0) is
+dropped and its albedo moved to the base colour."""
+FIT_POINTS = 5000
+"""The fits use a subsample of the angular nodes of about this size (the error report uses
+them all)."""
+
+
+# --------------------------------------------------------------------------------------------
+# Grid, weights and error measures
+# --------------------------------------------------------------------------------------------
+def node_directions(tables: Tables):
+    """``(wi, wo)`` unit vectors ``(n_theta, n_theta, n_phi, 3)`` of the angular nodes:
+    ``wo`` at azimuth 0, ``wi`` at the node's relative azimuth (:meth:`Tables.node_azimuths`)."""
+    theta = np.radians(np.asarray(tables.theta_deg, float))
+    phi = np.radians(tables.node_azimuths())
+    n = theta.size
+    ti = np.broadcast_to(theta[:, None, None], phi.shape)
+    to = np.broadcast_to(theta[None, :, None], phi.shape)
+    wi = np.stack([np.sin(ti) * np.cos(phi), np.sin(ti) * np.sin(phi), np.cos(ti)], axis=-1)
+    wo = np.stack([np.sin(to), np.zeros_like(to), np.cos(to)], axis=-1)
+    assert wi.shape == (n, n, phi.shape[-1], 3)
+    return wi, wo
+
+
+def _trapezoid_weights(x: np.ndarray, axis: int = -1) -> np.ndarray:
+    """Trapezoid-rule weights of nodes ``x`` along ``axis`` (any monotonic spacing)."""
+    x = np.moveaxis(np.asarray(x, float), axis, -1)
+    dx = np.diff(x, axis=-1)
+    w = np.zeros_like(x)
+    w[..., :-1] += 0.5 * dx
+    w[..., 1:] += 0.5 * dx
+    return np.moveaxis(w, -1, axis)
+
+
+def _azimuth_weights(tables: Tables, theta_index, phi_index) -> np.ndarray:
+    """Trapezoid weights of the nodes' actual (warped) azimuths, ``(n, n, p)``, doubled for the
+    other half turn.  Where ``theta_i`` or ``theta_o`` is 0 nothing depends on azimuth and the
+    nodes collapse to one azimuth: they share the full turn evenly."""
+    azimuth = np.radians(tables.node_azimuths())[np.ix_(theta_index, theta_index, phi_index)]
+    weights = 2.0 * _trapezoid_weights(azimuth, axis=-1)
+    even = 2.0 * _trapezoid_weights(np.linspace(0.0, np.pi, len(phi_index)))
+    theta = np.asarray(tables.theta_deg, float)[theta_index]
+    flat = (theta[:, None] == 0.0) | (theta[None, :] == 0.0)
+    return np.where(flat[..., None], even, weights)
+
+
+def angular_weights(tables: Tables, theta_index=None, phi_index=None) -> np.ndarray:
+    """Quadrature weights ``(n_theta, n_theta, n_phi)`` of the angular nodes:
+    ``sin(theta_i) dtheta_i`` x ``cos(theta_o) sin(theta_o) dtheta_o`` x ``2 dphi`` (azimuth on
+    [0, 180] degrees counted twice), trapezoid rule on the actual (warped) azimuths.
+    ``theta_index``, ``phi_index``: integer arrays picking a sub-grid (its own weights)."""
+    theta_index = np.arange(tables.theta_deg.size) if theta_index is None else theta_index
+    phi_index = np.arange(tables.phi_deg.size) if phi_index is None else phi_index
+    theta = np.radians(np.asarray(tables.theta_deg, float))[theta_index]
+    dtheta = _trapezoid_weights(theta)
+    w_i = np.sin(theta) * dtheta
+    w_o = np.cos(theta) * np.sin(theta) * dtheta
+    return w_i[:, None, None] * w_o[None, :, None] * _azimuth_weights(tables, theta_index,
+                                                                       phi_index)
+
+
+def relative_rms(f_fit, f_ref, tables: Tables, weights=None) -> float:
+    """Relative RMS of the radiance ``f cos(theta_i)`` over the angular nodes (module
+    docstring), all channels pooled.  ``f_*``: ``(n_theta, n_theta, n_phi[, 3])``."""
+    weights = angular_weights(tables) if weights is None else weights
+    cos_i = np.cos(np.radians(np.asarray(tables.theta_deg, float)))[:, None, None]
+    f_fit, f_ref = np.asarray(f_fit, float), np.asarray(f_ref, float)
+    if f_ref.ndim == 4:
+        cos_i, weights = cos_i[..., None], weights[..., None]
+    num = np.sum(weights * np.square((f_fit - f_ref) * cos_i))
+    den = np.sum(weights * np.square(f_ref * cos_i))
+    return float(np.sqrt(num / den)) if den > 0 else float(np.sqrt(num))
+
+
+def view_albedo(f, tables: Tables) -> np.ndarray:
+    """``Int f cos(theta_i) dw_i`` per view angle ``theta_o`` of the nodes: ``(n_theta[, 3])``
+    (trapezoid rule on the tables' grid)."""
+    theta = np.radians(np.asarray(tables.theta_deg, float))
+    w_i = np.cos(theta) * np.sin(theta) * _trapezoid_weights(theta)
+    every_theta, every_phi = np.arange(theta.size), np.arange(tables.phi_deg.size)
+    weights = w_i[:, None, None] * _azimuth_weights(tables, every_theta, every_phi)
+    f = np.asarray(f, float)
+    if f.ndim == 4:
+        weights = weights[..., None]
+    return np.sum(f * weights, axis=(0, 2))
+
+
+def albedo_error(f_fit, f_ref, tables: Tables) -> float:
+    """Largest relative error of :func:`view_albedo` over view angles and channels."""
+    fit, ref = view_albedo(f_fit, tables), view_albedo(f_ref, tables)
+    return float(np.max(np.abs(fit - ref) / np.maximum(np.abs(ref), 1e-12)))
+
+
+def golden_minimum(function, low: float, high: float, *, tol: float = 1e-4,
+                   coarse: int = 9) -> tuple[float, float]:
+    """``(x, f(x))`` minimising a 1-D ``function`` on ``[low, high]``: the best of ``coarse``
+    evenly spaced samples, then golden-section search in the bracket around it."""
+    xs = np.linspace(low, high, coarse)
+    values = [function(x) for x in xs]
+    k = int(np.argmin(values))
+    a, b = xs[max(k - 1, 0)], xs[min(k + 1, coarse - 1)]
+    ratio = (np.sqrt(5.0) - 1.0) / 2.0
+    c, d = b - ratio * (b - a), a + ratio * (b - a)
+    fc, fd = function(c), function(d)
+    while b - a > tol * max(1.0, abs(a) + abs(b)):
+        if fc < fd:
+            b, d, fd = d, c, fc
+            c = b - ratio * (b - a)
+            fc = function(c)
+        else:
+            a, c, fc = c, d, fd
+            d = a + ratio * (b - a)
+            fd = function(d)
+    best = min([(values[k], xs[k]), (fc, c), (fd, d)])
+    return float(best[1]), float(best[0])
+
+
+def lut_nodes(size: int = DEFAULT_LUT_SIZE) -> np.ndarray:
+    """``cos(theta_o)`` at the texel centres ``(i + 0.5) / size`` of a view-angle image."""
+    return (np.arange(size) + 0.5) / size
+
+
+def sample_lut(lut, cos_view) -> np.ndarray:
+    """What Blender's Image Texture (Linear, EXTEND) returns for a row ``lut`` ``(size[, C])``
+    at ``u = cos_view``: linear between texel centres, the edge texel beyond them."""
+    lut = np.asarray(lut, float)
+    nodes = lut_nodes(lut.shape[0])
+    cos_view = np.asarray(cos_view, float)
+    if lut.ndim == 1:
+        return np.interp(cos_view, nodes, lut)
+    return np.stack([np.interp(cos_view, nodes, lut[:, c]) for c in range(lut.shape[1])], -1)
+
+
+# --------------------------------------------------------------------------------------------
+# Lobe fits
+# --------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class LobeFit:
+    """A GGX lobe fitted to an angular table.
+
+    ``roughness``: Blender's Roughness; ``ior``: Coat IOR (coat) or the IOR whose F0 the
+    Specular IOR Level sets (specular), None for a Glossy BSDF; ``level``: Specular IOR Level
+    (specular only; 0 when no lobe beats leaving the gloss out); ``lut``: the Glossy weight per
+    view-angle texel, ``(size, 3)`` (Glossy only); ``distribution``: ``GGX``, ``BECKMANN`` or
+    ``ASHIKHMIN_SHIRLEY`` (Glossy only; the Principled BSDF is GGX); ``error``: relative RMS
+    of this lobe against its table (module docstring).
+    """
+
+    roughness: float
+    error: float
+    ior: float | None = None
+    level: float | None = None
+    lut: np.ndarray | None = None
+    distribution: str = "GGX"
+
+
+class _Grid:
+    """Node directions, weights and the cosines the GGX fits reuse (optionally subsampled)."""
+
+    def __init__(self, tables: Tables, max_points: int | None = None):
+        wi, wo = node_directions(tables)
+        n, p = tables.theta_deg.size, tables.phi_deg.size
+        m_theta, m_phi = n, p
+        while max_points is not None and m_theta * m_theta * m_phi > max_points:
+            if m_theta * m_theta >= 4 * m_phi:
+                m_theta -= 1
+            else:
+                m_phi -= 1
+        # Evenly spread node indices, both ends kept (normal and grazing, azimuth 0 and 180).
+        it = np.unique(np.round(np.linspace(0, n - 1, m_theta)).astype(int))
+        ip = np.unique(np.round(np.linspace(0, p - 1, m_phi)).astype(int))
+        pick = np.ix_(it, it, ip)
+        self.pick = pick
+        self.wi, self.wo = wi[pick], wo[pick]
+        self.weights = angular_weights(tables, it, ip)
+        self.cos_i = self.wi[..., 2]
+        self.cos_o = self.wo[..., 2]
+        h = self.wi + self.wo
+        h = h / np.maximum(np.linalg.norm(h, axis=-1, keepdims=True), 1e-12)
+        self.cos_h = h[..., 2]
+        self.cos_hi = np.clip(np.sum(h * self.wi, axis=-1), 0.0, 1.0)
+
+    def lobe(self, roughness: float, distribution: str = "GGX") -> np.ndarray:
+        """A microfacet lobe without Fresnel on the grid."""
+        return cc.microfacet_reflection(self.wi, self.wo, roughness, distribution=distribution)
+
+    def error(self, f_fit, f_ref) -> float:
+        """Relative RMS of ``f cos(theta_i)`` on this grid, channels pooled."""
+        diff = (f_fit - f_ref) * self.cos_i[..., None]
+        ref = f_ref * self.cos_i[..., None]
+        w = self.weights[..., None]
+        return float(np.sqrt(np.sum(w * diff * diff) / max(np.sum(w * ref * ref), 1e-300)))
+
+
+def _rgb(values: np.ndarray) -> np.ndarray:
+    """Give per-node values a trailing RGB axis."""
+    values = np.asarray(values, float)
+    return values if values.shape[-1:] == (3,) and values.ndim == 4 else values[..., None]
+
+
+def _fit_roughness_and(grid: _Grid, target: np.ndarray, fresnel, second_range, scale=1.0):
+    """``(roughness, second, error)``: a GGX lobe with Fresnel ``fresnel(cos_hi, second)``
+    fitted to ``target`` (channels averaged) by nested golden-section searches, the second
+    parameter inside.  ``scale``: a factor per node applied to the lobe."""
+    target = np.mean(np.asarray(target, float), axis=-1, keepdims=True)
+
+    def error_for(roughness):
+        base = grid.lobe(roughness)[..., None] * scale
+
+        def inner(second):
+            return grid.error(base * fresnel(grid.cos_hi, second)[..., None], target)
+
+        return golden_minimum(inner, *second_range, tol=FIT_TOLERANCE)
+
+    roughness, _ = golden_minimum(lambda r: error_for(r)[1], *ROUGHNESS_RANGE,
+                                  tol=FIT_TOLERANCE)
+    return (roughness, *error_for(roughness))
+
+
+def fit_coat(grid: _Grid, target: np.ndarray) -> LobeFit:
+    """Coat Roughness and Coat IOR of a GGX coat (weight 1, dielectric Fresnel) fitted to
+    ``target`` (the film's gloss, ``(n, n, p, 3)`` on ``grid``; its channels averaged)."""
+    roughness, ior, error = _fit_roughness_and(grid, target, cc.dielectric_fresnel,
+                                               COAT_IOR_RANGE)
+    return LobeFit(roughness=roughness, ior=ior, error=error)
+
+
+def _specular_fresnel(cos_hi, level):
+    """The Principled specular's Fresnel at IOR :data:`SPECULAR_IOR` and a Specular IOR
+    Level."""
+    f0 = float(cc.f0_from_ior(SPECULAR_IOR)) * 2.0 * level
+    eta = float(cc.ior_from_f0(f0)) if level != 0.5 else SPECULAR_IOR
+    return cc.schlick_ior_fresnel(cos_hi, eta, f0)
+
+
+def fit_specular(grid: _Grid, target: np.ndarray, attenuation=None) -> LobeFit:
+    """Roughness and Specular IOR Level (at IOR :data:`SPECULAR_IOR`) of the Principled
+    specular fitted to ``target`` ``(n, n, p, 3)`` (channels averaged).  ``attenuation``: the
+    factor the layers above apply to it per view node (the coat's ``1 - E_coat``), or None."""
+    scale = 1.0 if attenuation is None else np.asarray(attenuation, float)[..., None]
+    roughness, level, error = _fit_roughness_and(grid, target, _specular_fresnel,
+                                                 SPECULAR_LEVEL_RANGE, scale)
+    if error >= NO_LOBE_ERROR:  # no lobe does much better than none: leave it to the diffuse
+        return LobeFit(roughness=roughness, ior=SPECULAR_IOR, level=0.0, error=1.0)
+    return LobeFit(roughness=roughness, ior=SPECULAR_IOR, level=level, error=error)
+
+
+def _glossy_lut(roughness: float, distribution: str, albedo_table: np.ndarray,
+                theta_deg: np.ndarray, size: int) -> np.ndarray:
+    """Glossy weights per texel: table albedo / closure albedo at ``cos(theta_o)`` nodes."""
+    mu = lut_nodes(size)
+    theta = np.degrees(np.arccos(mu))
+    table = np.stack([np.interp(theta, theta_deg, albedo_table[:, c]) for c in range(3)], -1)
+    closure = cc.microfacet_albedo(mu, roughness, distribution=distribution)
+    return table / np.maximum(closure, 1e-6)[:, None]
+
+
+def fit_glossy(grid: _Grid, target: np.ndarray, albedo_table: np.ndarray,
+               theta_deg: np.ndarray, size: int = DEFAULT_LUT_SIZE) -> LobeFit:
+    """Distribution (:data:`cycles_closures.GLOSSY_DISTRIBUTIONS`) and roughness of a Glossy
+    BSDF whose view-dependent weight (table albedo / closure albedo, read from a
+    ``size``-texel image by ``cos(theta_o)``) best reproduces ``target`` ``(n, n, p, 3)``;
+    ``albedo_table`` ``(n_theta, 3)`` on ``theta_deg``."""
+    target = _rgb(target) * np.ones(3)
+    best = None
+    for distribution in cc.GLOSSY_DISTRIBUTIONS:
+        def lobe(roughness, distribution=distribution):
+            lut = _glossy_lut(roughness, distribution, albedo_table, theta_deg, size)
+            value = grid.lobe(roughness, distribution)[..., None] * sample_lut(lut, grid.cos_o)
+            return value, lut
+
+        roughness, error = golden_minimum(lambda r, lobe=lobe: grid.error(lobe(r)[0], target),
+                                          *ROUGHNESS_RANGE, tol=FIT_TOLERANCE)
+        if best is None or error < best.error:
+            best = LobeFit(roughness=roughness, error=error, lut=lobe(roughness)[1],
+                           distribution=distribution)
+    return best
+
+
+# --------------------------------------------------------------------------------------------
+# Radial profile fits
+# --------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class ProfileFit:
+    """Subsurface Radius (x Scale, in mm, per channel) of one Blender subsurface method fitted
+    to the tables' normalised profile ``R(d)/Rd``; ``error`` per channel: relative L2 error of
+    the radial energy density ``2 pi r P(r)``; ``albedo``: the colour assumed (random walk)."""
+
+    method: str
+    radius_mm: np.ndarray
+    error: np.ndarray
+    albedo: np.ndarray | None = None
+
+    @property
+    def worst_error(self) -> float:
+        return float(np.max(self.error))
+
+
+def _profile_error(r_mm: np.ndarray, model: np.ndarray, reference: np.ndarray) -> float:
+    """Relative L2 error of ``2 pi r P(r)`` over ``r_mm`` (trapezoid rule)."""
+    w = _trapezoid_weights(r_mm)
+    a, b = 2 * np.pi * r_mm * model, 2 * np.pi * r_mm * reference
+    return float(np.sqrt(np.sum(w * (a - b) ** 2) / max(np.sum(w * b * b), 1e-300)))
+
+
+def _method_profile(method: str, r_mm, radius: float, albedo: float, ior: float):
+    if method == "BURLEY":
+        return cc.burley_profile(r_mm, radius)
+    return cc.random_walk_profile(r_mm, radius, albedo, method=method, ior=ior)
+
+
+def fit_profile(tables: Tables, method: str, *, albedo=None, ior: float = 1.4) -> ProfileFit:
+    """Fit the Subsurface Radius (mm, per channel) of ``method`` (``BURLEY``, ``RANDOM_WALK``,
+    ``RANDOM_WALK_SKIN``) to the tables' profile.  ``albedo`` (per channel): the colour the
+    random walk sees, default the skin's diffuse albedo ``pi skin_diffuse``; ``ior``: the
+    Subsurface IOR (random walk)."""
+    if method not in cc.SUBSURFACE_METHODS:
+        raise ValueError(f"method must be one of {cc.SUBSURFACE_METHODS}, got {method!r}")
+    r = np.asarray(tables.radius_mm, float)
+    profile = np.asarray(tables.profile, float)
+    albedo = np.clip(np.pi * np.asarray(tables.skin_diffuse, float) if albedo is None
+                     else np.broadcast_to(np.asarray(albedo, float), (3,)), 0.0, 1.0)
+    radii, errors, done = [], [], {}
+    # The mean distance of the reference sets the search window (log radius).
+    w = _trapezoid_weights(r)
+    for c in range(3):
+        key = (profile[:, c].tobytes(), float(albedo[c]))
+        if key in done:
+            radii.append(radii[done[key]])
+            errors.append(errors[done[key]])
+            continue
+        done[key] = c
+        mean_r = np.sum(w * 2 * np.pi * r * r * profile[:, c]) / np.sum(
+            w * 2 * np.pi * r * profile[:, c])
+
+        def err(log_radius, c=c):
+            model = _method_profile(method, r, float(np.exp(log_radius)), albedo[c], ior)
+            return _profile_error(r, model, profile[:, c])
+
+        centre = np.log(max(mean_r, 1e-6))
+        log_radius, error = golden_minimum(err, centre - 3.0, centre + 5.0, tol=1e-4, coarse=17)
+        radii.append(np.exp(log_radius))
+        errors.append(error)
+    return ProfileFit(method=method, radius_mm=np.array(radii), error=np.array(errors),
+                      albedo=None if method == "BURLEY" else albedo)
+
+
+def fit_profiles(tables: Tables, **options) -> dict[str, ProfileFit]:
+    """:func:`fit_profile` for every Blender subsurface method, by method name."""
+    return {method: fit_profile(tables, method, **options) for method in cc.SUBSURFACE_METHODS}
+
+
+# --------------------------------------------------------------------------------------------
+# All fits of one set of tables
+# --------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class TierError:
+    """A tier's error against the tables at one coverage and absorption: ``rms`` (relative RMS
+    of ``f cos(theta_i)``) and ``albedo`` (largest relative view-albedo error)."""
+
+    tier: str
+    coverage: float
+    absorption: tuple
+    rms: float
+    albedo: float
+
+
+@dataclass(frozen=True, eq=False)
+class ClosureFit:
+    """Everything the node group needs from one set of tables (absorption 0).
+
+    PRINCIPLED: ``coat`` (film gloss), ``specular_bare`` (skin gloss), ``specular_film`` (path-3
+    gloss under the coat), ``coat_albedo_mean``, ``specular_albedo_mean`` (bare, film): the
+    cosine-weighted mean layering albedos; ``gloss_to_diffuse`` (RGB): the path-3 gloss albedo
+    the base colour carries when no specular lobe fits it (else 0).  LAYERED: ``glossy``
+    (film_gloss, path3_gloss, skin_gloss: Glossy lobes with their weight rows).  Both:
+    ``transmittance_mean`` (RGB, the cosine-weighted mean of T), ``film_albedo`` and
+    ``skin_albedo`` (RGB, ``pi P_d``), ``profiles`` (by method) and ``subsurface_method``
+    (the best-fitting one), ``lut`` (``(len(LUT_ROWS), size, 3)``: the view-angle image),
+    ``errors`` at the coverage and absorption the tables were baked for.
+    """
+
+    coat: LobeFit
+    specular_bare: LobeFit
+    specular_film: LobeFit
+    coat_albedo_mean: float
+    specular_albedo_mean: tuple
+    gloss_to_diffuse: np.ndarray
+    glossy: dict
+    transmittance_mean: np.ndarray
+    film_albedo: np.ndarray
+    skin_albedo: np.ndarray
+    profiles: dict
+    subsurface_method: str
+    lut: np.ndarray
+    errors: dict = field(default_factory=dict)
+
+    @property
+    def subsurface_radius_mm(self) -> np.ndarray:
+        """The chosen method's Subsurface Radius x Scale per channel, mm."""
+        return self.profiles[self.subsurface_method].radius_mm
+
+    def summary(self) -> dict:
+        """Plain data (floats and lists) for metadata, the panel and the docs."""
+        return {
+            "coat": {"roughness": self.coat.roughness, "ior": self.coat.ior,
+                     "error": self.coat.error},
+            "specular_bare": {"roughness": self.specular_bare.roughness,
+                              "level": self.specular_bare.level,
+                              "error": self.specular_bare.error},
+            "specular_film": {"roughness": self.specular_film.roughness,
+                              "level": self.specular_film.level,
+                              "error": self.specular_film.error},
+            "glossy": {name: {"roughness": lobe.roughness, "error": lobe.error,
+                              "distribution": lobe.distribution}
+                       for name, lobe in self.glossy.items()},
+            "subsurface_method": self.subsurface_method,
+            "profiles": {name: {"radius_mm": p.radius_mm.tolist(), "error": p.error.tolist()}
+                         for name, p in self.profiles.items()},
+            "errors": {name: asdict(e) for name, e in self.errors.items()},
+        }
+
+
+def _cosine_mean(values: np.ndarray, theta_deg: np.ndarray) -> np.ndarray:
+    """``2 Int v(mu) mu dmu`` of a directional table ``(n_theta[, C])`` (its hemispherical
+    cosine-weighted mean), trapezoid in ``mu``, held at its last value beyond ``theta_max``."""
+    mu = np.cos(np.radians(np.asarray(theta_deg, float)))[::-1]
+    values = np.asarray(values, float)[::-1]
+    mu = np.concatenate([[0.0], mu])
+    values = np.concatenate([values[:1], values])
+    w = _trapezoid_weights(mu)
+    return 2.0 * np.tensordot(w * mu, values, axes=(0, 0))
+
+
+def _layering_mean(roughness: float, ior: float, f0=None) -> float:
+    """Cosine-weighted mean over view angles of :func:`cycles_closures.layering_albedo`."""
+    mu = np.linspace(0.0, 1.0, 33)
+    albedo = np.max(np.atleast_2d(cc.layering_albedo(mu, roughness, ior, f0).T).T, axis=-1)
+    return float(2.0 * np.sum(_trapezoid_weights(mu) * mu * albedo))
+
+
+def fit_closures(tables: Tables, *, lut_size: int = DEFAULT_LUT_SIZE,
+                 subsurface_method: str | None = None,
+                 max_points: int | None = FIT_POINTS) -> ClosureFit:
+    """Fit both tiers to ``tables`` and measure their errors at the baked coverage and
+    absorption.  ``subsurface_method``: force one (default: the best-fitting of Burley and
+    Random Walk (Skin); plain Random Walk is fitted and reported too)."""
+    grid = _Grid(tables, max_points)
+    pick = grid.pick
+    film_gloss = np.asarray(tables.film_gloss, float)[pick]
+    path3 = np.asarray(tables.path3_gloss, float)[pick]
+    skin_gloss = np.asarray(tables.skin_gloss, float)[pick]
+
+    coat = fit_coat(grid, film_gloss)
+    e_coat = cc._view_table(grid.cos_o, lambda c: cc.layering_albedo(c, coat.roughness,
+                                                                        coat.ior))
+    specular_bare = fit_specular(grid, skin_gloss)
+    specular_film = fit_specular(grid, path3, attenuation=1.0 - e_coat)
+
+    theta_deg = np.asarray(tables.theta_deg, float)
+    glossy = {name: fit_glossy(grid, table, np.asarray(getattr(tables, name + "_albedo")),
+                               theta_deg, lut_size)
+              for name, table in (("film_gloss", film_gloss), ("path3_gloss", path3),
+                                  ("skin_gloss", skin_gloss))}
+    transmittance = np.asarray(tables.film_transmittance, float)
+    mu = lut_nodes(lut_size)
+    t_rows = np.stack([np.interp(np.degrees(np.arccos(mu)), theta_deg, transmittance[:, c])
+                       for c in range(3)], -1)
+    lut = np.stack([glossy[name].lut for name in LUT_ROWS[:3]] + [t_rows])
+
+    profiles = fit_profiles(tables)
+    if subsurface_method is None:
+        subsurface_method = min(("BURLEY", "RANDOM_WALK_SKIN"),
+                                key=lambda m: profiles[m].worst_error)
+    elif subsurface_method not in cc.SUBSURFACE_METHODS:
+        raise ValueError(f"subsurface_method must be one of {cc.SUBSURFACE_METHODS}, "
+                         f"got {subsurface_method!r}")
+
+    def specular_mean(lobe):
+        if lobe.level == 0.0:
+            return 0.0
+        f0 = float(cc.f0_from_ior(SPECULAR_IOR)) * 2.0 * lobe.level
+        return _layering_mean(lobe.roughness, float(cc.ior_from_f0(f0)), f0)
+
+    fit = ClosureFit(
+        coat=coat,
+        specular_bare=specular_bare,
+        specular_film=specular_film,
+        coat_albedo_mean=_layering_mean(coat.roughness, coat.ior),
+        specular_albedo_mean=(specular_mean(specular_bare), specular_mean(specular_film)),
+        gloss_to_diffuse=(_cosine_mean(np.asarray(tables.path3_gloss_albedo), theta_deg)
+                          if specular_film.level == 0.0 else np.zeros(3)),
+        glossy=glossy,
+        transmittance_mean=_cosine_mean(transmittance, theta_deg),
+        film_albedo=np.pi * np.asarray(tables.film_diffuse, float),
+        skin_albedo=np.pi * np.asarray(tables.skin_diffuse, float),
+        profiles=profiles,
+        subsurface_method=subsurface_method,
+        lut=lut,
+    )
+    coverage = float(tables.parameters.get("coverage", 1.0))
+    absorption = tables.parameters.get("absorption", 0.0)
+    return _with_errors(fit, tier_errors(fit, tables, coverage, absorption))
+
+
+def _with_errors(fit: ClosureFit, errors: dict) -> ClosureFit:
+    values = {name: getattr(fit, name) for name in fit.__dataclass_fields__}
+    values["errors"] = errors
+    return ClosureFit(**values)
+
+
+# --------------------------------------------------------------------------------------------
+# The tiers at a coverage and absorption (the node group's formulas)
+# --------------------------------------------------------------------------------------------
+def _absorption(absorption) -> np.ndarray:
+    return np.broadcast_to(np.asarray(absorption, float), (3,)).copy()
+
+
+def diffuse_albedo(fit: ClosureFit, coverage: float, absorption) -> tuple[np.ndarray, np.ndarray]:
+    """``(total, skin part)`` of the diffuse albedo per channel at coverage ``w`` and
+    absorption ``A``: ``(1 - w) pi P_d,s + w [(1 - A) pi P_d,f + (1 - A)^2 pi P_d,s T_mean^2]``
+    and its skin terms (which the subsurface closure carries)."""
+    through = 1.0 - _absorption(absorption)
+    skin_through = through**2 * fit.skin_albedo * fit.transmittance_mean**2
+    skin = (1.0 - coverage) * fit.skin_albedo + coverage * skin_through
+    return skin + coverage * through * fit.film_albedo, skin
+
+
+def principled_inputs(fit: ClosureFit, coverage: float, absorption):
+    """``(PrincipledInputs, subsurface_weight)`` of the PRINCIPLED tier (the node group's math):
+
+    - Coat Weight ``w``, Coat Roughness/IOR fitted;
+    - Roughness ``mix(r_bare, r_film, w)``, Specular IOR Level
+      ``(1 - w) l_bare + w l_film mean((1 - A)^2)``;
+    - Base Color = (:func:`diffuse_albedo` + ``w (1 - A)^2 gloss_to_diffuse``) /
+      ``((1 - w E_coat) (1 - E_spec(w)))`` with the mean layering albedos,
+      ``E_spec(w) = mix(E_bare, E_film, w)``;
+    - Subsurface Weight = the skin's share of the diffuse albedo (channel mean).
+    """
+    w = float(coverage)
+    through2 = float(np.mean((1.0 - _absorption(absorption)) ** 2))
+    total, skin = diffuse_albedo(fit, w, absorption)
+    total = total + w * (1.0 - _absorption(absorption)) ** 2 * fit.gloss_to_diffuse
+    e_spec = (1.0 - w) * fit.specular_albedo_mean[0] + w * fit.specular_albedo_mean[1]
+    base = total / ((1.0 - w * fit.coat_albedo_mean) * (1.0 - e_spec))
+    level = (1.0 - w) * fit.specular_bare.level + w * fit.specular_film.level * through2
+    inputs = cc.PrincipledInputs(
+        base_color=tuple(np.clip(base, 0.0, 1.0)),
+        roughness=(1.0 - w) * fit.specular_bare.roughness + w * fit.specular_film.roughness,
+        ior=SPECULAR_IOR,
+        specular_ior_level=level,
+        coat_weight=w,
+        coat_roughness=fit.coat.roughness,
+        coat_ior=fit.coat.ior,
+    )
+    weight = float(np.mean(skin / np.maximum(total, 1e-12)))
+    return inputs, weight
+
+
+def principled_tier_reflection(fit: ClosureFit, tables: Tables, coverage: float, absorption):
+    """The PRINCIPLED tier's BRDF at the angular nodes, ``(n, n, p, 3)``."""
+    wi, wo = node_directions(tables)
+    inputs, _ = principled_inputs(fit, coverage, absorption)
+    return cc.principled_reflection(wi, wo, inputs)
+
+
+def layered_weights(fit: ClosureFit, coverage: float, absorption) -> dict:
+    """The LAYERED tier's constant weights (RGB) at coverage ``w`` and absorption ``A``;
+    view-dependent factors come from the image rows :data:`LUT_ROWS`:
+
+    - ``film_gloss``: ``w``; ``path3_gloss``: ``w (1 - A)^2``; ``skin_gloss``: ``1 - w``
+      (each times its row);
+    - ``film_diffuse``: ``w (1 - A) pi P_d,f`` (Diffuse);
+    - ``skin_through``: ``w (1 - A)^2 pi P_d,s T_mean`` (times row ``T``); ``skin_bare``:
+      ``(1 - w) pi P_d,s`` (Subsurface).
+    """
+    w = float(coverage)
+    through = 1.0 - _absorption(absorption)
+    one = np.ones(3)
+    return {
+        "film_gloss": w * one,
+        "path3_gloss": w * through**2,
+        "skin_gloss": (1.0 - w) * one,
+        "film_diffuse": w * through * fit.film_albedo,
+        "skin_through": w * through**2 * fit.skin_albedo * fit.transmittance_mean,
+        "skin_bare": (1.0 - w) * fit.skin_albedo,
+    }
+
+
+def layered_tier_reflection(fit: ClosureFit, tables: Tables, coverage: float, absorption):
+    """The LAYERED tier's BRDF at the angular nodes, ``(n, n, p, 3)``: every closure added with
+    its weight and image row (linear texel interpolation, as Blender samples it)."""
+    wi, wo = node_directions(tables)
+    cos_o = wo[..., 2]
+    weights = layered_weights(fit, coverage, absorption)
+    rows = dict(zip(LUT_ROWS, fit.lut, strict=True))
+    value = 0.0
+    for name in LUT_ROWS[:3]:
+        glossy = fit.glossy[name]
+        lobe = cc.microfacet_reflection(wi, wo, glossy.roughness,
+                                        distribution=glossy.distribution)[..., None]
+        value = value + lobe * weights[name] * sample_lut(rows[name], cos_o)
+    diffuse = (weights["film_diffuse"] + weights["skin_bare"]
+               + weights["skin_through"] * sample_lut(rows["film_transmittance"], cos_o))
+    return value + cc.lambert_reflection(diffuse)
+
+
+def tier_errors(fit: ClosureFit, tables: Tables, coverage: float, absorption) -> dict:
+    """:class:`TierError` of every tier against the tables at one coverage and absorption."""
+    reference = tables.node_values(coverage, absorption)
+    weights = angular_weights(tables)
+    out = {}
+    for tier, replica in (("PRINCIPLED", principled_tier_reflection),
+                          ("LAYERED", layered_tier_reflection)):
+        f = replica(fit, tables, coverage, absorption)
+        out[tier] = TierError(tier=tier, coverage=float(coverage),
+                              absorption=tuple(_absorption(absorption).tolist()),
+                              rms=relative_rms(f, reference, tables, weights),
+                              albedo=albedo_error(f, reference, tables))
+    return out

@@ -1,0 +1,494 @@
+"""Numpy replicas of the Cycles closures the add-on fits to the tables (Blender 4.2 - 5.0).
+
+The replicas follow Cycles' kernel (``intern/cycles/kernel/closure/bsdf_microfacet.h``,
+``bssrdf.h``, ``svm/closure.h``); each function names what it copies.  Directions are unit
+vectors ``(..., 3)`` in the local frame (normal +z); ``wi`` points to the light, ``wo`` to the
+viewer, as in the rest of ``lut_baker``.  BRDF values are without the cosine, in 1/sr.  Radii
+are in millimetres: the caller converts them to scene units.
+
+Functions
+---------
+- :func:`ggx_distribution`, :func:`beckmann_distribution` -- normal distributions ``D(h)``
+  (``alpha = roughness^2``, as Blender maps its Roughness socket).
+- :func:`ggx_lambda`, :func:`beckmann_lambda` -- their Smith ``Lambda`` (Beckmann: Cycles'
+  rational approximation).
+- :func:`ashikhmin_shirley_reflection` -- Cycles' Ashikhmin-Shirley Glossy lobe.
+- :func:`microfacet_shadowing` -- height-correlated ``G2 = 1 / (1 + Lambda_i + Lambda_o)``.
+- :func:`microfacet_reflection` -- microfacet BRDF ``D G2 F / (4 cos_i cos_o)`` with a Fresnel
+  callable (Glossy BSDF: none; coat: dielectric; Principled specular: generalised Schlick).
+- :func:`dielectric_fresnel`, :func:`schlick_ior_fresnel` -- the Fresnel terms Cycles uses.
+- :func:`directional_albedo` -- ``Int f cos(theta_i) dwi`` of any BRDF at view angles.
+- :func:`microfacet_albedo` -- the same for a microfacet lobe, by quadrature over normals.
+- :func:`layering_albedo` -- Cycles' albedo estimate that attenuates the layers below a coat or
+  a specular layer (``bsdf_microfacet_estimate_albedo``).
+- :func:`lambert_reflection` -- ``albedo / pi``.
+- :func:`principled_reflection` -- the Principled BSDF's coat, specular and diffuse layers
+  (``svm_node_closure_bsdf``), for the inputs in :class:`PrincipledInputs`.
+- :func:`burley_profile` -- Christensen-Burley radial profile as Cycles scales it.
+- :func:`burley_radius_for_length` -- the Subsurface Radius giving a Burley shape length ``d``.
+- :func:`random_walk_albedo` -- Cycles' surface-to-single-scattering albedo remap (g = 0).
+- :func:`skin_alpha_prime` -- Cycles' dipole inversion used by Random Walk (Skin).
+- :func:`random_walk_dipole` -- the diffusion dipole a random walk of given radius and colour
+  approximates (``Random Walk`` or ``Random Walk (Skin)``).
+- :func:`random_walk_profile` -- that dipole's profile, normalised to unit area.
+
+References
+----------
+Walter et al. 2007 (GGX); Heitz 2014 (height-correlated Smith); Christensen, Burley 2015
+("Approximate Reflectance Profiles for Efficient Subsurface Scattering"); Chiang, Kutz, Burley
+2016 (random-walk albedo remap); Jensen et al. 2001 (dipole).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import lru_cache
+
+import numpy as np
+
+from .model import Dipole, _fresnel, dipole_profile, dipole_total_reflectance
+from .quadrature import direction, hemisphere_grid
+
+__all__ = [
+    "DISTRIBUTIONS",
+    "ggx_distribution",
+    "beckmann_distribution",
+    "ggx_lambda",
+    "beckmann_lambda",
+    "GLOSSY_DISTRIBUTIONS",
+    "ashikhmin_shirley_exponent",
+    "ashikhmin_shirley_reflection",
+    "microfacet_shadowing",
+    "microfacet_reflection",
+    "dielectric_fresnel",
+    "schlick_ior_fresnel",
+    "directional_albedo",
+    "microfacet_albedo",
+    "layering_albedo",
+    "lambert_reflection",
+    "PrincipledInputs",
+    "principled_reflection",
+    "burley_profile",
+    "burley_radius_for_length",
+    "BURLEY_MFP_SCALE",
+    "random_walk_albedo",
+    "skin_alpha_prime",
+    "random_walk_dipole",
+    "random_walk_profile",
+    "SUBSURFACE_METHODS",
+]
+
+BURLEY_MFP_SCALE = 0.25 / np.pi
+"""Cycles multiplies Subsurface Radius x Scale by ``1/(4 pi)`` before using it as the Burley
+shape length ``d`` and as the Random Walk mean free path (``bssrdf_setup_radius``)."""
+BURLEY_TRUNCATE = 16.0
+"""Cycles cuts the Burley profile at ``16 d``."""
+SUBSURFACE_METHODS = ("BURLEY", "RANDOM_WALK", "RANDOM_WALK_SKIN")
+"""Blender's ``subsurface_method`` identifiers."""
+ROUGHNESS_EPS = 1e-3
+"""Roughness below this is a mirror Cycles cannot evaluate; the replicas clamp to it."""
+
+
+# --------------------------------------------------------------------------------------------
+# GGX microfacet model (bsdf_microfacet.h)
+# --------------------------------------------------------------------------------------------
+def ggx_distribution(cos_h, alpha):
+    """GGX ``D = alpha^2 / (pi ((1 - c^2) + alpha^2 c^2)^2)`` at ``c = N.H`` (Walter 2007)."""
+    c2 = np.minimum(np.square(np.asarray(cos_h, float)), 1.0)
+    a2 = np.square(alpha)
+    return a2 / (np.pi * np.square((1.0 - c2) + a2 * c2))
+
+
+def beckmann_distribution(cos_h, alpha):
+    """Beckmann ``D = exp(-tan^2 / alpha^2) / (pi alpha^2 c^4)`` at ``c = N.H``."""
+    c2 = np.clip(np.square(np.asarray(cos_h, float)), 1e-300, 1.0)
+    a2 = np.square(alpha)
+    with np.errstate(over="ignore"):
+        return np.exp(-(1.0 - c2) / (c2 * a2)) / (np.pi * a2 * c2 * c2)
+
+
+def _alpha_tan2(cos_theta, alpha):
+    c2 = np.square(np.asarray(cos_theta, float))
+    return np.square(alpha) * np.maximum(1.0 / np.maximum(c2, 1e-300) - 1.0, 0.0)
+
+
+def ggx_lambda(cos_theta, alpha):
+    """Smith ``Lambda = (sqrt(1 + alpha^2 tan^2) - 1) / 2`` of GGX (Heitz 2014, eq. 72)."""
+    return 0.5 * (np.sqrt(1.0 + _alpha_tan2(cos_theta, alpha)) - 1.0)
+
+
+def beckmann_lambda(cos_theta, alpha):
+    """Smith ``Lambda`` of Beckmann, the rational approximation Cycles uses (0 where
+    ``alpha^2 tan^2 < 0.39``)."""
+    t2 = _alpha_tan2(cos_theta, alpha)
+    a = 1.0 / np.sqrt(np.maximum(t2, 1e-300))
+    value = ((0.396 * a - 1.259) * a + 1.0) / ((2.181 * a + 3.535) * a)
+    return np.where(t2 < 0.39, 0.0, value)
+
+
+DISTRIBUTIONS = {"GGX": (ggx_distribution, ggx_lambda),
+                 "BECKMANN": (beckmann_distribution, beckmann_lambda)}
+"""Blender's microfacet distributions replicated: ``(D, Lambda)`` by identifier."""
+GLOSSY_DISTRIBUTIONS = ("GGX", "BECKMANN", "ASHIKHMIN_SHIRLEY")
+"""The Glossy BSDF's distributions the replicas cover (Multiscatter GGX is left out)."""
+
+
+def ashikhmin_shirley_exponent(roughness):
+    """Phong exponent ``2 / alpha^2 - 2`` of Cycles' Ashikhmin-Shirley lobe, ``alpha =
+    roughness^2`` clamped to [1e-4, 1] (``bsdf_ashikhmin_shirley_roughness_to_exponent``)."""
+    alpha = np.clip(np.square(roughness), 1e-4, 1.0)
+    return 2.0 / (alpha * alpha) - 2.0
+
+
+def ashikhmin_shirley_reflection(wi, wo, roughness):
+    """Isotropic Ashikhmin-Shirley lobe without Fresnel (Cycles ``bsdf_ashikhmin_shirley_eval``):
+    ``(e + 1) / (8 pi) (N.H)^e / ((H.wi) max(cos_i, cos_o))``, no cosine; 0 below the surface."""
+    wi, wo = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
+    e = ashikhmin_shirley_exponent(roughness)
+    h = wi + wo
+    h = h / np.maximum(np.sqrt(np.sum(h * h, axis=-1, keepdims=True)), 1e-12)
+    h_dot_i = np.maximum(np.abs(np.sum(h * wi, axis=-1)), 1e-6)
+    h_dot_n = np.maximum(h[..., 2], 1e-6)
+    upper = (wi[..., 2] > 0.0) & (wo[..., 2] > 0.0)
+    pump = 1.0 / np.maximum(1e-6, h_dot_i * np.maximum(np.maximum(wi[..., 2], wo[..., 2]),
+                                                           1e-6))
+    return np.where(upper, (e + 1.0) / (8.0 * np.pi) * h_dot_n**e * pump, 0.0)
+
+
+def microfacet_shadowing(cos_i, cos_o, alpha, distribution: str = "GGX"):
+    """Height-correlated masking-shadowing ``G2 = 1 / (1 + Lambda_i + Lambda_o)``
+    (Cycles ``bsdf_G``)."""
+    lam = DISTRIBUTIONS[distribution][1]
+    return 1.0 / (1.0 + lam(cos_i, alpha) + lam(cos_o, alpha))
+
+
+def dielectric_fresnel(cos_theta, eta):
+    """Unpolarised dielectric Fresnel reflectance (Cycles ``fresnel_dielectric_cos``); the same
+    formula as the paper's ``F_r`` (:func:`lut_baker.model.fresnel_reflectance`)."""
+    return _fresnel(np.clip(np.asarray(cos_theta, float), 0.0, 1.0), np.asarray(eta, float))
+
+
+def f0_from_ior(eta):
+    """Normal-incidence reflectance ``((eta - 1) / (eta + 1))^2``."""
+    return np.square((np.asarray(eta, float) - 1.0) / (np.asarray(eta, float) + 1.0))
+
+
+def ior_from_f0(f0):
+    """Inverse of :func:`f0_from_ior` (Cycles ``ior_from_F0``), for ``f0`` in [0, 1)."""
+    root = np.sqrt(np.clip(f0, 0.0, 0.999999))
+    return (1.0 + root) / (1.0 - root)
+
+
+def schlick_ior_fresnel(cos_theta, eta, f0):
+    """The Principled specular's Fresnel: generalised Schlick with a negative exponent, i.e.
+    ``mix(f0, 1, s)`` with ``s = (F(c, eta) - F0(eta)) / (1 - F0(eta))`` from the real curve.
+    ``f0`` may be RGB (Specular Tint); the result then has a trailing channel axis."""
+    real0 = f0_from_ior(eta)
+    s = np.clip((dielectric_fresnel(cos_theta, eta) - real0) / (1.0 - real0), 0.0, 1.0)
+    f0 = np.asarray(f0, float)
+    if f0.ndim:
+        s = s[..., None]
+    return f0 + (1.0 - f0) * s
+
+
+def microfacet_reflection(wi, wo, roughness, fresnel=None, distribution: str = "GGX"):
+    """Microfacet reflection ``F(H.wi) D G2 / (4 cos_i cos_o)`` (Cycles
+    ``bsdf_microfacet_eval``).
+
+    ``roughness``: Blender's Roughness socket (``alpha = roughness^2``, clamped to
+    :data:`ROUGHNESS_EPS`); ``fresnel``: ``None`` (Glossy BSDF: F = 1) or a callable of
+    ``cos(H, wi)`` returning the Fresnel factor (any trailing channel axis is kept);
+    ``distribution``: ``GGX``, ``BECKMANN`` or ``ASHIKHMIN_SHIRLEY`` (which takes no Fresnel).
+    0 where either direction is below the surface.
+    """
+    if distribution == "ASHIKHMIN_SHIRLEY":
+        if fresnel is not None:
+            raise ValueError("the Ashikhmin-Shirley lobe takes no Fresnel in Cycles")
+        return ashikhmin_shirley_reflection(wi, wo, roughness)
+    wi, wo = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
+    alpha = np.square(max(float(roughness), ROUGHNESS_EPS))
+    d_function = DISTRIBUTIONS[distribution][0]
+    cos_i = wi[..., 2]
+    cos_o = wo[..., 2]
+    h = wi + wo
+    h = h / np.maximum(np.sqrt(np.sum(h * h, axis=-1, keepdims=True)), 1e-12)
+    upper = (cos_i > 0.0) & (cos_o > 0.0)
+    safe_i = np.where(upper, cos_i, 1.0)
+    safe_o = np.where(upper, cos_o, 1.0)
+    value = (d_function(h[..., 2], alpha) * microfacet_shadowing(safe_i, safe_o, alpha,
+                                                                 distribution)
+             / (4.0 * safe_i * safe_o))
+    value = np.where(upper, value, 0.0)
+    if fresnel is None:
+        return value
+    f = np.asarray(fresnel(np.clip(np.sum(h * wi, axis=-1), 0.0, 1.0)))
+    return (value[..., None] if f.ndim > value.ndim else value) * f
+
+
+def lambert_reflection(albedo):
+    """Lambertian BRDF ``albedo / pi`` (Diffuse BSDF at roughness 0)."""
+    return np.asarray(albedo, float) / np.pi
+
+
+def directional_albedo(brdf, cos_theta, *, lobe_width_deg: float = 20.0, level: int = 0):
+    """``Int brdf(w, v) cos(theta_w) dw`` for view directions ``v`` at ``cos_theta`` (any
+    shape), by the hemisphere quadrature of :mod:`lut_baker.quadrature`.
+
+    ``brdf(w, v)`` takes direction arrays ``(..., 3)`` and returns ``(...)`` or ``(..., C)``.
+    """
+    cos_theta = np.asarray(cos_theta, float)
+    grid = hemisphere_grid(lobe_width_deg, level)
+    phi = 2.0 * np.pi * np.arange(grid.n_phi) / grid.n_phi
+    w = direction(grid.theta[:, None], phi[None, :])  # (N, P, 3)
+    theta_v = np.arccos(np.clip(cos_theta.ravel(), 0.0, 1.0))
+    v = direction(theta_v, 0.0)[:, None, None, :]  # (V, 1, 1, 3)
+    values = np.asarray(brdf(w[None], v))
+    weights = grid.weight[None, :, None] * (2.0 * np.pi / grid.n_phi)
+    if values.ndim == 4:
+        total = np.einsum("vnpc,vnp->vc", values, np.broadcast_to(weights, values.shape[:3]))
+        return total.reshape(cos_theta.shape + (values.shape[-1],))
+    return np.sum(values * weights, axis=(1, 2)).reshape(cos_theta.shape)
+
+
+@lru_cache(maxsize=8)
+def _unit_gauss_legendre(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss-Legendre nodes and weights on (0, 1)."""
+    x, w = np.polynomial.legendre.leggauss(n)
+    return 0.5 * (x + 1.0), 0.5 * w
+
+
+def microfacet_albedo(cos_view, roughness, fresnel=None, distribution: str = "GGX", *,
+                      n_u: int = 48, n_phi: int = 32):
+    """Albedo ``Int f cos(theta_i) dwi`` of :func:`microfacet_reflection` at view cosines
+    ``cos_view`` (any shape; a ``fresnel`` returning RGB adds a channel axis).
+
+    Integrated over microfacet normals: with ``dwi = 4 (h.wo) dwh`` the albedo is
+    ``Int D(h) cos(theta_h) [G2 F (h.wo) / (cos_o cos(theta_h))] dwh``; the map
+    ``tan^2 theta_h = alpha^2 u / (1 - u)`` (GGX) or ``-alpha^2 log(1 - u)`` (Beckmann) turns
+    ``D cos dwh`` into ``du dphi / 2 pi``, so Gauss-Legendre nodes in ``u`` (``n_u``) and
+    midpoints in azimuth (``n_phi`` over [0, pi]) resolve a lobe of any roughness.
+    Ashikhmin-Shirley: ``h`` has density ``(e + 1) / (2 pi) cos^e`` (``cos = u^(1/(e+1))``) and
+    the albedo is the mean of ``cos_i / max(cos_i, cos_o)``.
+    """
+    cos_view = np.asarray(cos_view, float)
+    alpha = np.square(max(float(roughness), ROUGHNESS_EPS))
+    u, w_u = _unit_gauss_legendre(n_u)
+    if distribution == "GGX":
+        tan2 = alpha * alpha * u / (1.0 - u)
+    elif distribution == "BECKMANN":
+        tan2 = -alpha * alpha * np.log1p(-u)
+    elif distribution == "ASHIKHMIN_SHIRLEY":
+        c = u ** (1.0 / (ashikhmin_shirley_exponent(roughness) + 1.0))
+        tan2 = (1.0 - c * c) / np.maximum(c * c, 1e-300)
+    else:
+        raise ValueError(f"distribution must be one of {list(DISTRIBUTIONS)}, got "
+                         f"{distribution!r}")
+    cos_h = 1.0 / np.sqrt(1.0 + tan2)
+    sin_h = np.sqrt(tan2) * cos_h
+    phi = (np.arange(n_phi) + 0.5) * np.pi / n_phi
+    mu_o = np.clip(cos_view.ravel(), 1e-6, 1.0)[:, None, None]
+    sin_o = np.sqrt(1.0 - mu_o * mu_o)
+    hx = sin_h[None, :, None] * np.cos(phi)[None, None, :]
+    hz = cos_h[None, :, None]
+    h_dot_o = hx * sin_o + hz * mu_o
+    mu_i = 2.0 * h_dot_o * hz - mu_o
+    valid = (h_dot_o > 0.0) & (mu_i > 0.0)
+    if distribution == "ASHIKHMIN_SHIRLEY":
+        value = np.where(valid, mu_i / np.maximum(mu_i, mu_o), 0.0)
+    else:
+        g2 = microfacet_shadowing(np.where(valid, mu_i, 1.0), mu_o, alpha, distribution)
+        value = np.where(valid, g2 * h_dot_o / (mu_o * hz), 0.0)
+    weights = w_u[None, :, None] / n_phi
+    if fresnel is None:
+        total = np.sum(value * weights, axis=(1, 2))
+        return total.reshape(cos_view.shape)
+    f = np.asarray(fresnel(np.clip(h_dot_o, 0.0, 1.0)))
+    if f.ndim > value.ndim:
+        total = np.einsum("vup,vupc->vc", value * weights, f)
+        return total.reshape(cos_view.shape + (f.shape[-1],))
+    return np.sum(value * weights * f, axis=(1, 2)).reshape(cos_view.shape)
+
+
+def layering_albedo(cos_view, roughness, eta, f0=None):
+    """The albedo Cycles attributes to a dielectric GGX layer seen at ``cos_view`` when it
+    attenuates the layers below (``bsdf_microfacet_estimate_albedo``): ``mix(f0, 1, s)``.
+
+    Cycles reads ``s`` from a 16^3 table that normalises by the Fresnel-free GGX albedo
+    (its comment: the table "assumes energy preservation"); this replica computes the same
+    ratio ``E_F / E_1`` by quadrature (:func:`microfacet_albedo`), with ``E_F`` the albedo under the
+    real Fresnel at ``eta``.  ``f0`` (default ``F0(eta)``, RGB allowed) rescales the start as
+    Specular IOR Level and Specular Tint do.
+    """
+    cos_view = np.asarray(cos_view, float)
+    e_f = microfacet_albedo(cos_view, roughness, lambda c: dielectric_fresnel(c, eta))
+    e_1 = microfacet_albedo(cos_view, roughness)
+    real0 = f0_from_ior(eta)
+    s = np.clip((e_f / np.maximum(e_1, 1e-12) - real0) / (1.0 - real0), 0.0, 1.0)
+    f0 = real0 if f0 is None else np.asarray(f0, float)
+    if np.ndim(f0):
+        s = s[..., None]
+    return f0 + (1.0 - f0) * s
+
+
+# --------------------------------------------------------------------------------------------
+# Principled BSDF (svm_node_closure_bsdf, CLOSURE_BSDF_PRINCIPLED_ID, distribution GGX)
+# --------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class PrincipledInputs:
+    """The Principled BSDF sockets the replica uses (others at their defaults: metallic 0,
+    transmission 0, sheen 0, coat tint white, diffuse roughness 0, distribution GGX).
+
+    ``base_color``: RGB; ``roughness``, ``ior``, ``specular_ior_level`` (0.5 = IOR as given),
+    ``specular_tint`` RGB; ``coat_weight``, ``coat_roughness``, ``coat_ior``.
+    """
+
+    base_color: tuple = (0.8, 0.8, 0.8)
+    roughness: float = 0.5
+    ior: float = 1.5
+    specular_ior_level: float = 0.5
+    specular_tint: tuple = (1.0, 1.0, 1.0)
+    coat_weight: float = 0.0
+    coat_roughness: float = 0.03
+    coat_ior: float = 1.5
+    extra: dict = field(default_factory=dict)
+
+    def specular_eta_f0(self):
+        """``(eta', f0 per channel)`` after Specular IOR Level and Tint (Cycles' "IOR
+        adjustment"): ``f0 = F0(ior) 2 level``, ``eta' = ior_from_F0(f0)``."""
+        f0 = float(f0_from_ior(self.ior))
+        eta = self.ior
+        if self.specular_ior_level != 0.5:
+            f0 *= 2.0 * self.specular_ior_level
+            eta = float(ior_from_f0(f0))
+        return eta, f0 * np.asarray(self.specular_tint, float)
+
+
+def principled_reflection(wi, wo, inputs: PrincipledInputs):
+    """The Principled BSDF's reflection (no cosine), RGB ``(..., 3)``, as Cycles layers it:
+
+    ``w_c coat(wi, wo) + a_c(wo) [spec(wi, wo) + a_s(wo) base / pi]``
+
+    with ``a_c = 1 - w_c E_coat(wo)`` and ``a_s = 1 - max_c E_spec(wo)`` from
+    :func:`layering_albedo` (``closure_layering_weight``): the attenuation depends on the view
+    only, so the model is not reciprocal, like Cycles.  Subsurface counts as its albedo in
+    ``base_color`` leaving Lambertian-like (its spread is separate, see the profiles).
+    """
+    wi, wo = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
+    cos_o = np.clip(wo[..., 2], 0.0, 1.0)
+    eta, f0 = inputs.specular_eta_f0()
+    spec = microfacet_reflection(wi, wo, inputs.roughness,
+                                 lambda c: schlick_ior_fresnel(c, eta, f0))
+    a_s = 1.0 - np.max(_view_table(cos_o, lambda c: layering_albedo(
+        c, inputs.roughness, eta, f0)), axis=-1)
+    base = lambert_reflection(np.minimum(np.maximum(inputs.base_color, 0.0), 1.0))
+    lower = spec + a_s[..., None] * base
+    if inputs.coat_weight <= 0.0:
+        return lower
+    coat = microfacet_reflection(wi, wo, inputs.coat_roughness,
+                          lambda c: dielectric_fresnel(c, inputs.coat_ior))
+    e_c = _view_table(cos_o, lambda c: layering_albedo(
+        c, inputs.coat_roughness, inputs.coat_ior))
+    a_c = np.clip(1.0 - inputs.coat_weight * e_c, 0.0, 1.0)
+    return inputs.coat_weight * coat[..., None] + a_c[..., None] * lower
+
+
+def _view_table(cos_view: np.ndarray, function, size: int = 64) -> np.ndarray:
+    """``function`` of the view cosine, tabulated on ``size`` nodes and interpolated linearly
+    (the layering albedos are smooth; tabulating keeps a replica of a large grid cheap)."""
+    nodes = np.linspace(0.0, 1.0, size)
+    table = np.asarray(function(nodes))
+    if table.ndim == 1:
+        return np.interp(cos_view, nodes, table)
+    return np.stack([np.interp(cos_view, nodes, table[:, c]) for c in range(table.shape[1])],
+                    axis=-1)
+
+
+# --------------------------------------------------------------------------------------------
+# Subsurface radial profiles (bssrdf.h, subsurface_random_walk.h)
+# --------------------------------------------------------------------------------------------
+def burley_profile(r_mm, radius_mm):
+    """Christensen-Burley profile as Cycles evaluates it, normalised to ``Int P 2 pi r dr = 1``
+    (1/mm^2): ``P = (exp(-r/d) + exp(-r/(3d))) / (8 pi d r)`` with ``d = radius / (4 pi)``
+    (``bssrdf_setup_radius``; ``radius`` = Subsurface Radius x Scale), cut at ``16 d`` and
+    renormalised as ``bssrdf_burley_pdf`` does.  ``radius_mm`` scalar or RGB (trailing axis)."""
+    r = np.asarray(r_mm, float)
+    d = np.asarray(radius_mm, float) * BURLEY_MFP_SCALE
+    if d.ndim:
+        r = r[..., None]
+    r_safe = np.maximum(r, 1e-12)
+    value = (np.exp(-r_safe / d) + np.exp(-r_safe / (3.0 * d))) / (8.0 * np.pi * d * r_safe)
+    cdf = 1.0 - 0.25 * np.exp(-BURLEY_TRUNCATE) - 0.75 * np.exp(-BURLEY_TRUNCATE / 3.0)
+    return np.where(r < BURLEY_TRUNCATE * d, value / cdf, 0.0)
+
+
+def burley_radius_for_length(d_mm):
+    """The Subsurface Radius x Scale (mm) whose Burley shape length is ``d_mm``."""
+    return np.asarray(d_mm, float) / BURLEY_MFP_SCALE
+
+
+def random_walk_albedo(surface_albedo):
+    """Single-scattering albedo a random walk uses for a surface (multiple-scattering) albedo
+    (``subsurface_random_walk_remap`` at anisotropy 0; Chiang et al. 2016, eq. 3's fit)."""
+    a = np.clip(np.asarray(surface_albedo, float), 0.0, 1.0)
+    blend = a**0.25
+    alpha = ((1.0 - blend) * 1.8260523782 * np.arctan(4.98511194385 * a) ** 1.09686102424
+             + blend * 0.496310210422 * np.arctan(4.23190299701 * a) ** 2.40602999408)
+    return np.clip(alpha, 0.0, 0.999999)
+
+
+def _dipole_rd(alpha_prime, four_thirds_a):
+    """Cycles ``bssrdf_dipole_compute_Rd``: the dipole's total reflectance at reduced albedo."""
+    s = np.sqrt(3.0 * (1.0 - alpha_prime))
+    return 0.5 * alpha_prime * (1.0 + np.exp(-four_thirds_a * s)) * np.exp(-s)
+
+
+def skin_alpha_prime(surface_albedo, ior):
+    """Reduced albedo whose dipole reflectance is ``surface_albedo`` (Cycles
+    ``bssrdf_dipole_compute_alpha_prime``: 12 bisections; the IOR clamped to [1.01, 3.8])."""
+    ior = float(np.clip(ior, 1.01, 3.8))
+    inv = 1.0 / ior
+    f_dr = inv * (-1.440 * inv + 0.710) + 0.668 + 0.0636 * ior
+    four_thirds_a = (4.0 / 3.0) * (1.0 + f_dr) / (1.0 - f_dr)
+    rd = np.asarray(surface_albedo, float)
+    low, high = np.zeros_like(rd), np.ones_like(rd)
+    mid = 0.5 * (low + high)
+    for _ in range(12):
+        mid = 0.5 * (low + high)
+        below = _dipole_rd(mid, four_thirds_a) < rd
+        low = np.where(below, mid, low)
+        high = np.where(below, high, mid)
+    return np.where(rd < 1e-4, 0.0, np.where(rd >= 0.995, 0.999999, mid))
+
+
+def random_walk_dipole(radius_mm, surface_albedo, *, method: str = "RANDOM_WALK_SKIN",
+                       ior: float = 1.4) -> Dipole:
+    """The diffusion dipole (g = 0) that a Cycles random walk of this radius (Subsurface Radius
+    x Scale, mm) and colour approximates.
+
+    The walk's medium: single-scattering albedo :func:`random_walk_albedo` and extinction
+    ``1/r'`` with ``r' = radius / (4 pi)`` (``RANDOM_WALK``) or
+    ``r' = radius sqrt(3 (1 - alpha'))`` (``RANDOM_WALK_SKIN``, ``alpha'`` from
+    :func:`skin_alpha_prime`; the diffusion coefficient ``sigma_tr`` then lies between about
+    1.2 and 2.4 / radius for colours 0.1 to 0.9, as the two albedo inversions differ).
+    The dipole's boundary uses ``ior`` (the Subsurface IOR).  An approximation: the walk itself
+    is a Monte Carlo simulation, which the renders of issue 5 compare with.
+    """
+    if method not in ("RANDOM_WALK", "RANDOM_WALK_SKIN"):
+        raise ValueError(f"method must be RANDOM_WALK or RANDOM_WALK_SKIN, got {method!r}")
+    radius = np.asarray(radius_mm, float)
+    if method == "RANDOM_WALK":
+        length = radius * BURLEY_MFP_SCALE
+    else:
+        length = radius * np.sqrt(3.0 * (1.0 - skin_alpha_prime(surface_albedo, ior)))
+    sigma_t = 1.0 / np.maximum(length, 1e-12)
+    alpha = random_walk_albedo(surface_albedo)
+    return Dipole(sigma_s=alpha * sigma_t, sigma_a=np.maximum((1.0 - alpha) * sigma_t, 1e-9),
+                  g=0.0, eta=float(np.clip(ior, 1.0, 3.8)))
+
+
+def random_walk_profile(r_mm, radius_mm, surface_albedo, *, method: str = "RANDOM_WALK_SKIN",
+                        ior: float = 1.4):
+    """The profile of :func:`random_walk_dipole`, normalised to ``Int P 2 pi r dr = 1``
+    (1/mm^2)."""
+    dipole = random_walk_dipole(radius_mm, surface_albedo, method=method, ior=ior)
+    return dipole_profile(r_mm, dipole) / dipole_total_reflectance(dipole)

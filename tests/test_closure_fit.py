@@ -1,0 +1,218 @@
+"""Cycles closure replicas (lut_baker.cycles_closures) and the closure fits (lut_baker.closure_fit).
+
+The replicas are checked against independent quadratures and closed forms; the fits by round
+trips: tables synthesised from a known closure must give that closure's parameters back.
+"""
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from lut_baker import bake, closure_fit, presets
+from lut_baker import cycles_closures as cc
+from lut_baker.quadrature import direction
+
+
+@pytest.fixture(scope="module")
+def paper_tables():
+    return bake.bake(presets.paper(), "preview")
+
+
+@pytest.fixture(scope="module")
+def paper_fit(paper_tables):
+    return closure_fit.fit_closures(paper_tables)
+
+
+# ---------------------------------------------------------------------------------------------
+# Replicas
+# ---------------------------------------------------------------------------------------------
+@pytest.mark.parametrize("distribution", cc.GLOSSY_DISTRIBUTIONS)
+@pytest.mark.parametrize("roughness", [0.3, 0.6, 0.95])
+def test_lobe_albedo_matches_brute_quadrature(distribution, roughness):
+    mu = np.array([1.0, 0.7, 0.3, 0.1])
+    fast = cc.microfacet_albedo(mu, roughness, distribution=distribution)
+    brute = cc.directional_albedo(
+        lambda w, v: cc.microfacet_reflection(w, v, roughness, distribution=distribution), mu,
+        lobe_width_deg=5.0, level=1)
+    np.testing.assert_allclose(fast, brute, rtol=5e-3, atol=2e-3)
+    assert np.all(fast <= 1.0 + 1e-9)
+
+
+def test_ggx_distribution_is_normalised():
+    # Int D(h) cos(theta_h) dw_h = 1 for any alpha.
+    theta = np.linspace(0.0, np.pi / 2, 200001)
+    for alpha in (0.05, 0.3, 1.0):
+        integrand = cc.ggx_distribution(np.cos(theta), alpha) * np.cos(theta) * np.sin(theta)
+        assert np.trapz(integrand, theta) * 2 * np.pi == pytest.approx(1.0, rel=1e-3)
+
+
+def test_schlick_ior_fresnel_is_the_real_curve_at_its_own_f0():
+    c = np.linspace(0.0, 1.0, 11)
+    eta = 1.45
+    np.testing.assert_allclose(cc.schlick_ior_fresnel(c, eta, cc.f0_from_ior(eta)),
+                               cc.dielectric_fresnel(c, eta), atol=1e-12)
+    assert float(cc.dielectric_fresnel(1.0, 1.5)) == pytest.approx(0.04)
+
+
+def test_principled_without_coat_and_specular_is_lambert():
+    inputs = cc.PrincipledInputs(base_color=(0.2, 0.5, 0.8), specular_ior_level=0.0)
+    wi = direction(np.radians([10.0, 40.0]), 1.0)
+    wo = direction(np.radians([60.0, 5.0]), 0.0)
+    np.testing.assert_allclose(cc.principled_reflection(wi, wo, inputs),
+                               np.broadcast_to(np.array([0.2, 0.5, 0.8]) / np.pi, (2, 3)),
+                               rtol=1e-12)
+
+
+def test_coat_attenuates_the_base_by_its_albedo():
+    wi = direction(np.radians(30.0), 2.0)
+    wo = direction(np.radians(50.0), 0.0)
+    plain = cc.PrincipledInputs(base_color=(0.5, 0.5, 0.5), specular_ior_level=0.0)
+    coated = dataclasses.replace(plain, coat_weight=1.0, coat_roughness=0.5, coat_ior=1.8)
+    coat_only = cc.microfacet_reflection(wi, wo, 0.5, lambda c: cc.dielectric_fresnel(c, 1.8))
+    e_coat = cc.layering_albedo(np.cos(np.radians(50.0)), 0.5, 1.8)
+    expected = coat_only + (1.0 - e_coat) * 0.5 / np.pi
+    np.testing.assert_allclose(cc.principled_reflection(wi, wo, coated), [expected] * 3,
+                               rtol=2e-3)
+    assert 0.0 < e_coat < 1.0
+
+
+def _radial_integral(profile, r):
+    return float(np.trapz(2 * np.pi * r * profile, r))
+
+
+def test_subsurface_profiles_have_unit_area():
+    r = np.concatenate([np.geomspace(1e-6, 200.0, 200000)])
+    assert _radial_integral(cc.burley_profile(r, 5.0), r) == pytest.approx(1.0, rel=2e-3)
+    for method in ("RANDOM_WALK", "RANDOM_WALK_SKIN"):
+        value = cc.random_walk_profile(r, 5.0, 0.7, method=method, ior=1.3)
+        assert _radial_integral(value, r) == pytest.approx(1.0, rel=2e-3)
+
+
+@pytest.mark.parametrize("method", cc.SUBSURFACE_METHODS)
+def test_subsurface_radius_scales_the_profile(method):
+    # P(r; k radius) = P(r / k; radius) / k^2 at a fixed colour: Subsurface Scale is a length.
+    r = np.linspace(0.1, 10.0, 41)
+    k = 2.5
+    if method == "BURLEY":
+        scaled, base = cc.burley_profile(r, 2.0 * k), cc.burley_profile(r / k, 2.0)
+    else:
+        scaled = cc.random_walk_profile(r, 2.0 * k, 0.6, method=method)
+        base = cc.random_walk_profile(r / k, 2.0, 0.6, method=method)
+    np.testing.assert_allclose(scaled, base / k**2, rtol=1e-9)
+
+
+def test_skin_alpha_prime_inverts_the_dipole_reflectance():
+    # Jensen's F_dr at eta = 1.4, written out: A = (1 + F_dr) / (1 - F_dr).
+    eta = 1.4
+    f_dr = -1.440 / eta**2 + 0.710 / eta + 0.668 + 0.0636 * eta
+    four_thirds_a = 4.0 / 3.0 * (1 + f_dr) / (1 - f_dr)
+    rd = np.array([0.05, 0.3, 0.7, 0.9])
+    alpha = cc.skin_alpha_prime(rd, eta)
+    # Cycles bisects 12 times on [0, 1]: alpha' is within 2^-12 of the exact inverse.
+    fine = np.linspace(0.0, 1.0, 2**20 + 1)
+    exact = np.interp(rd, cc._dipole_rd(fine, four_thirds_a), fine)
+    np.testing.assert_allclose(alpha, exact, atol=2.0**-12)
+
+
+# ---------------------------------------------------------------------------------------------
+# Fits: round trips
+# ---------------------------------------------------------------------------------------------
+def test_relative_rms_is_zero_against_itself_and_scales(paper_tables):
+    f = paper_tables.node_values(1.0, 0.0)
+    assert closure_fit.relative_rms(f, f, paper_tables) == 0.0
+    assert closure_fit.relative_rms(1.1 * f, f, paper_tables) == pytest.approx(0.1)
+    assert closure_fit.albedo_error(1.1 * f, f, paper_tables) == pytest.approx(0.1)
+
+
+def test_view_albedo_matches_the_albedo_tables(paper_tables):
+    # The trapezoid rule on the (coarse, preview) table grid against the bake's own albedos.
+    albedo = closure_fit.view_albedo(np.asarray(paper_tables.skin_gloss), paper_tables)
+    np.testing.assert_allclose(albedo[:-2], np.asarray(paper_tables.skin_gloss_albedo)[:-2],
+                               rtol=0.1)
+
+
+def test_fit_coat_recovers_a_known_coat(paper_tables):
+    grid = closure_fit._Grid(paper_tables, closure_fit.FIT_POINTS)
+    synthetic = cc.microfacet_reflection(grid.wi, grid.wo, 0.45,
+                                         lambda c: cc.dielectric_fresnel(c, 1.8))
+    fit = closure_fit.fit_coat(grid, np.repeat(synthetic[..., None], 3, axis=-1))
+    assert fit.roughness == pytest.approx(0.45, abs=0.01)
+    assert fit.ior == pytest.approx(1.8, abs=0.02)
+    assert fit.error < 0.01
+
+
+def test_fit_glossy_recovers_distribution_and_roughness(paper_tables):
+    grid = closure_fit._Grid(paper_tables, None)
+    wi, wo = closure_fit.node_directions(paper_tables)
+    lobe = cc.microfacet_reflection(wi, wo, 0.5, distribution="BECKMANN")
+    mu = np.cos(np.radians(paper_tables.theta_deg))
+    albedo = cc.microfacet_albedo(mu, 0.5, distribution="BECKMANN")[:, None] * np.ones(3)
+    fit = closure_fit.fit_glossy(grid, lobe[..., None] * np.ones(3), albedo,
+                                 np.asarray(paper_tables.theta_deg))
+    assert fit.distribution == "BECKMANN"
+    assert fit.roughness == pytest.approx(0.5, abs=0.01)
+    assert fit.error < 0.02
+    # The weight row is table albedo / closure albedo: 1 for the lobe itself.
+    np.testing.assert_allclose(fit.lut, 1.0, atol=0.02)
+
+
+@pytest.mark.parametrize("method", ["BURLEY", "RANDOM_WALK_SKIN"])
+def test_fit_profile_recovers_a_known_radius(paper_tables, method):
+    r = np.asarray(paper_tables.radius_mm)
+    radius = np.array([3.0, 1.5, 0.8])
+    if method == "BURLEY":
+        profile = cc.burley_profile(r, radius)
+    else:
+        profile = np.stack([cc.random_walk_profile(r, radius[c], 0.6, method=method, ior=1.3)
+                            for c in range(3)], -1)
+    tables = dataclasses.replace(paper_tables, profile=profile)
+    fit = closure_fit.fit_profile(tables, method, albedo=0.6, ior=1.3)
+    np.testing.assert_allclose(fit.radius_mm, radius, rtol=0.01)
+    assert fit.worst_error < 0.01
+
+
+# ---------------------------------------------------------------------------------------------
+# The tiers on the paper's tables
+# ---------------------------------------------------------------------------------------------
+def test_paper_fit_parameters_are_in_blender_ranges(paper_fit):
+    assert closure_fit.ROUGHNESS_RANGE[0] <= paper_fit.coat.roughness <= 1.0
+    assert 1.0 < paper_fit.coat.ior <= closure_fit.COAT_IOR_RANGE[1]
+    for lobe in paper_fit.glossy.values():
+        assert lobe.distribution in cc.GLOSSY_DISTRIBUTIONS
+        assert np.all(np.isfinite(lobe.lut)) and np.all(lobe.lut >= 0.0)
+    assert paper_fit.lut.shape == (len(closure_fit.LUT_ROWS), closure_fit.DEFAULT_LUT_SIZE, 3)
+    assert np.all(paper_fit.subsurface_radius_mm > 0.0)
+    assert paper_fit.subsurface_method in ("BURLEY", "RANDOM_WALK_SKIN")
+
+
+def test_layered_tier_keeps_the_albedo(paper_tables, paper_fit):
+    # Glossy weights are albedo ratios, so the tier's view albedo follows the tables'.
+    for coverage in (0.0, 0.5, 1.0):
+        errors = closure_fit.tier_errors(paper_fit, paper_tables, coverage, (0.1, 0.2, 0.4))
+        assert errors["LAYERED"].albedo < 0.03
+        assert errors["LAYERED"].rms < 0.12
+        assert np.isfinite(errors["PRINCIPLED"].rms)
+
+
+def test_layered_beats_principled_on_bare_skin(paper_tables, paper_fit):
+    errors = closure_fit.tier_errors(paper_fit, paper_tables, 0.0, 0.0)
+    assert errors["LAYERED"].rms < errors["PRINCIPLED"].rms
+
+
+def test_principled_inputs_follow_coverage(paper_fit):
+    bare, weight_bare = closure_fit.principled_inputs(paper_fit, 0.0, 0.0)
+    full, weight_full = closure_fit.principled_inputs(paper_fit, 1.0, (0.3, 0.3, 0.3))
+    assert bare.coat_weight == 0.0 and full.coat_weight == 1.0
+    assert weight_bare == pytest.approx(1.0)  # bare skin: all diffuse light is the skin's
+    assert 0.0 < weight_full < 1.0
+    # Absorption darkens the film's diffuse light: the base colour drops.
+    darker, _ = closure_fit.principled_inputs(paper_fit, 1.0, (0.6, 0.6, 0.6))
+    assert np.all(np.array(darker.base_color) < np.array(full.base_color))
+
+
+def test_summary_is_plain_data(paper_fit):
+    import json
+
+    text = json.dumps(paper_fit.summary())
+    assert "PRINCIPLED" in text and "subsurface_method" in text
