@@ -237,7 +237,9 @@ def transmission_factor(w, cosmetic: TransmissionLayer, skin: Dipole, *, level: 
     reciprocity).  ``w``: unit vectors ``(..., 3)``, 0 below the surface."""
     w = check_directions("w", w)
     grid = grid_for(cosmetic, level=level)
-    fresnel_t = 1.0 - _fresnel(_channels(np.cos(grid.theta), skin), skin.eta)  # (N, C)
+    # (N, C): the dipole may be RGB through its coefficients with a scalar eta.
+    fresnel_t = 1.0 - _fresnel(np.cos(grid.theta)[:, None], np.atleast_1d(skin.eta))
+    fresnel_t = np.broadcast_to(fresnel_t, (grid.theta.size, 3 if skin.channels else 1))
     return _hemisphere_factor(w, grid, cosmetic, fresnel_t, skin)
 
 
