@@ -176,19 +176,22 @@ def test_rgb_layer_equals_scalar_layer_per_channel():
 
 
 # --- agreement with the independent reference ----------------------------------------------
+def _assert_matches_reference(function, reference, pairs, layer):
+    """``function(wi, wo, layer)`` on all pairs at once == the scalar reference, per channel."""
+    got = function(np.array([p[0] for p in pairs]), np.array([p[1] for p in pairs]), layer)
+    for c in range(3) if layer.channels else [None]:
+        args = _layer_args(layer, c)
+        expected = np.array([reference(a, b, *args) for a, b in pairs])
+        np.testing.assert_allclose(got if c is None else got[:, c], expected, rtol=RTOL)
+
+
 @pytest.mark.parametrize("name", sorted(RAW_REFLECTION))
 def test_reflection_matches_reference(name):
     layer = RAW_REFLECTION[name]
     rng = np.random.default_rng(3)
     pairs = list(zip(_random_upper(rng, 200), _random_upper(rng, 200), strict=True))
     pairs += _grazing_pairs()
-    wi = np.array([p[0] for p in pairs])
-    wo = np.array([p[1] for p in pairs])
-    got = model.ts_reflection(wi, wo, layer)
-    for c in range(3) if layer.channels else [None]:
-        args = _layer_args(layer, c)
-        expected = np.array([ref.ts_reflection(a, b, *args) for a, b in pairs])
-        np.testing.assert_allclose(got if c is None else got[:, c], expected, rtol=RTOL)
+    _assert_matches_reference(model.ts_reflection, ref.ts_reflection, pairs, layer)
 
 
 @pytest.mark.parametrize("name", sorted(RAW_TRANSMISSION))
@@ -199,13 +202,7 @@ def test_transmission_matches_reference(name):
     # Grazing pairs with the second direction moved below, and light crossing upward.
     pairs += [(a, b * np.array([1, 1, -1])) for a, b in _grazing_pairs()]
     pairs += [(b * np.array([1, 1, -1]), a) for a, b in _grazing_pairs()]
-    wi = np.array([p[0] for p in pairs])
-    wt = np.array([p[1] for p in pairs])
-    got = model.ts_transmission(wi, wt, layer)
-    for c in range(3) if layer.channels else [None]:
-        args = _layer_args(layer, c)
-        expected = np.array([ref.ts_transmission(a, b, *args) for a, b in pairs])
-        np.testing.assert_allclose(got if c is None else got[:, c], expected, rtol=RTOL)
+    _assert_matches_reference(model.ts_transmission, ref.ts_transmission, pairs, layer)
 
 
 @pytest.mark.parametrize("name", sorted(DIPOLES))
