@@ -21,6 +21,7 @@ Functions and types
 - :class:`KernelCache` -- memoises :func:`fourier_coefficients` within one bake.
 - :func:`gloss_tables` -- Torrance-Sparrow specular parts (eq. 2) on the table grid.
 - :func:`gloss_albedos` -- their directional albedos (order 0, azimuths adapted to the lobe).
+- :func:`inter_reflection_albedo` -- what the inter-reflections add to the albedo.
 - :func:`profile_radius` -- where the dipole's R(d) falls to a fraction of its peak (mm).
 - :func:`error_samples` -- random points (grazing included) and the exact values there.
 - :func:`table_error` -- the interpolated tables against the exact evaluator.
@@ -71,6 +72,7 @@ __all__ = [
     "gloss_albedos",
     "profile_radius",
     "table_error",
+    "inter_reflection_albedo",
     "error_samples",
     "ErrorSamples",
     "PROFILE_FLOOR",
@@ -127,12 +129,12 @@ class Resolution:
 
 
 RESOLUTIONS = {
-    "preview": Resolution("preview", n_theta=16, n_phi=10, n_radius=32,
-                          quad_panels=2, quad_points=6, quad_phi=17),
-    "default": Resolution("default", n_theta=48, n_phi=25, n_radius=96,
-                          quad_panels=3, quad_points=8, quad_phi=33),
-    "high": Resolution("high", n_theta=96, n_phi=49, n_radius=192,
-                       quad_panels=4, quad_points=8, quad_phi=49),
+    "preview": Resolution("preview", n_theta=48, n_phi=33, n_radius=128,
+                          quad_panels=2, quad_points=6, quad_phi=17, albedo_azimuths=12),
+    "default": Resolution("default", n_theta=96, n_phi=65, n_radius=320,
+                          quad_panels=3, quad_points=10, quad_phi=33, albedo_azimuths=16),
+    "high": Resolution("high", n_theta=112, n_phi=97, n_radius=512,
+                       quad_panels=4, quad_points=10, quad_phi=65, albedo_azimuths=24),
 }
 """Named resolutions, chosen by the convergence study in docs/baking.md."""
 
@@ -495,6 +497,22 @@ def bake(skin: MadeUpSkin, resolution_name="default", *, inter_reflection: bool 
     return tables
 
 
+def inter_reflection_albedo(skin: MadeUpSkin, theta_deg, resolution_name="default"):
+    """Directional albedo ``Int f_extra(wi, wo) cos(theta_o) dwo`` of the inter-reflections
+    beyond path 3 (the adding equation's further terms, as in :func:`bake`'s
+    ``inter_reflection`` table), at the skin's absorption, before coverage: ``(n, 3)``."""
+    res = resolution(resolution_name)
+    grid = bake_quadrature(res.quad_panels, res.quad_points, res.quad_phi)
+    theta = np.radians(np.atleast_1d(np.asarray(theta_deg, float)))
+    film_t = film_transmission_layer(skin)
+    kernels = KernelCache()
+    full = inter_reflection_fourier_matrices(theta, grid.theta, film_t, skin.skin, grid,
+                                             film_below=film_reflection_layer(skin),
+                                             fourier=kernels)
+    first = layered_fourier_matrices(theta, grid.theta, film_t, skin.skin, grid, fourier=kernels)
+    return _rgb(_order0_integral(full[0] - first[0], grid))
+
+
 # --------------------------------------------------------------------------------------------
 # Error against the exact evaluator
 # --------------------------------------------------------------------------------------------
@@ -522,6 +540,7 @@ class ErrorSamples:
     wo: np.ndarray
     reflection: np.ndarray
     theta_deg: np.ndarray
+    albedo_theta_deg: np.ndarray
     albedo: np.ndarray
     transmission: np.ndarray
     d_mm: np.ndarray
@@ -529,17 +548,20 @@ class ErrorSamples:
 
 
 def error_samples(skin: MadeUpSkin, n_points: int = 500, seed: int = 0, *, level: int = 0,
-                  albedo_level: int | None = None, theta_max_deg: float = 89.0) -> ErrorSamples:
+                  albedo_level: int | None = None, albedo_points: int | None = None,
+                  theta_max_deg: float = 89.0) -> ErrorSamples:
     """``n_points`` random points (grazing rows included, polar angles up to
     ``theta_max_deg``) and the exact evaluator there: paths 1 + 3
     (:func:`lut_baker.normalise.made_up_reflection`) and path 4's factor at ``level``, the
     directional albedo at ``albedo_level`` (default ``level + 1``: at level 0 the film gloss's
     albedo is 3% low at 89 degrees, its lobe being ~1 degree wide in azimuth there, which moves
-    the total by 1.3e-3), and R(d)/Rd on [0, :func:`profile_radius`] (denser near 0)."""
+    the total by 1.3e-3; ``albedo_points`` of them, default all, as level 1 is slow), and
+    R(d)/Rd on [0, :func:`profile_radius`] (denser near 0)."""
     albedo_level = level + 1 if albedo_level is None else albedo_level
     rng = np.random.default_rng(seed)
     wi, wo = _sample_directions(n_points, rng, theta_max_deg)
     theta = rng.uniform(0.0, theta_max_deg, n_points)
+    albedo_theta = theta[:n_points if albedo_points is None else albedo_points]
     transmission = transmission_factor(direction(np.radians(theta), 0.0), skin.film_transmission,
                                        skin.dipole, level=level)
     d = profile_radius(skin.dipole) * rng.uniform(0.0, 1.0, n_points) ** 2
@@ -547,7 +569,8 @@ def error_samples(skin: MadeUpSkin, n_points: int = 500, seed: int = 0, *, level
         dipole_total_reflectance(skin.dipole))
     return ErrorSamples(
         skin=skin, wi=wi, wo=wo, reflection=made_up_reflection(wi, wo, skin, level=level),
-        theta_deg=theta, albedo=directional_albedo(theta, skin, level=albedo_level),
+        theta_deg=theta, albedo_theta_deg=albedo_theta,
+        albedo=directional_albedo(albedo_theta, skin, level=albedo_level),
         transmission=_rgb(np.reshape(transmission, (n_points, -1))), d_mm=d,
         profile=_rgb(profile))
 
@@ -581,7 +604,8 @@ def table_error(tables: Tables, skin: MadeUpSkin | None = None, n_points: int = 
     peak = plain.node_values(w, a).reshape(-1, 3).max(axis=0)
     reflection = _normalised_error(plain.made_up_reflection(samples.wi, samples.wo, w, a),
                                    samples.reflection, peak)
-    albedo = _normalised_error(plain.directional_albedo(samples.theta_deg, w, a), samples.albedo,
+    albedo = _normalised_error(plain.directional_albedo(samples.albedo_theta_deg, w, a),
+                               samples.albedo,
                                plain.directional_albedo(tables.theta_deg, w, a).max(axis=0))
     transmission = _normalised_error(tables.directional("transmission_factor", samples.theta_deg),
                                      samples.transmission, tables.transmission_factor.max(axis=0))

@@ -11,11 +11,11 @@ A parameter file starts from presets and overrides what it names::
     [film]                 # film top reflection (paper eq. 2): P_d, P_s in 1/sr, n in 1/degree, eta
     n = 0.04
     [film_transmission]    # film transmission (eq. 4): P_d, P_t in 1/sr, n, eta
-    [skin]                 # skin surface reflection (eq. 2): P_d, P_s, n, eta
+    [skin_surface]         # skin surface reflection (eq. 2): P_d, P_s, n, eta
     [dipole]               # skin subsurface (eq. 6): sigma_s, sigma_a in 1/mm, g, eta
 
 Values are albedo units (1/sr, SPEC 4) unless ``units = "counts"``: then ``[film]``,
-``[film_transmission]`` and ``[skin]`` must each be complete and are the paper's pixel counts
+``[film_transmission]`` and ``[skin_surface]`` must each be complete and are the paper's counts
 (reflection at 3 s, transmission at 10 s, or ``reflection_shutter_s``/``transmission_shutter_s``),
 normalised with the K they imply (:func:`lut_baker.normalise.from_paper_counts`).
 
@@ -24,7 +24,8 @@ Functions
 - :func:`skin_to_dict` -- a :class:`~lut_baker.normalise.MadeUpSkin` as JSON-ready data.
 - :func:`skin_from_dict` -- the inverse.
 - :func:`load_params` -- read and validate a TOML parameter file into a MadeUpSkin.
-- :func:`params_from_mapping` -- the same from an already parsed mapping.
+- :func:`read_mapping` -- read a TOML parameter file without interpreting it.
+- :func:`params_from_mapping` -- a MadeUpSkin from a parsed mapping (presets when empty).
 """
 
 from __future__ import annotations
@@ -36,9 +37,10 @@ import numpy as np
 
 from .model import Dipole, ReflectionLayer, TransmissionLayer
 from .normalise import MadeUpSkin, from_paper_counts
-from .presets import FOUNDATIONS, SKINS, made_up_skin
+from .presets import FOUNDATIONS, SKINS, made_up_skin, paper
 
-__all__ = ["skin_to_dict", "skin_from_dict", "load_params", "params_from_mapping", "LAYERS"]
+__all__ = ["skin_to_dict", "skin_from_dict", "load_params", "read_mapping",
+           "params_from_mapping", "LAYERS", "SECTIONS"]
 
 LAYERS = {
     "film": ReflectionLayer,
@@ -46,7 +48,10 @@ LAYERS = {
     "skin": ReflectionLayer,
     "dipole": Dipole,
 }
-"""Sections of a parameter file (and keys of :func:`skin_to_dict`) and their types."""
+"""The layers of a made-up skin (keys of :func:`skin_to_dict`) and their types."""
+SECTIONS = {"film": "film", "film_transmission": "film_transmission", "skin_surface": "skin",
+            "dipole": "dipole"}
+"""Tables of a parameter file -> the layer they set (``skin`` names the skin preset)."""
 TOP_LEVEL = {"name", "foundation", "skin", "coverage", "absorption", "units",
              "reflection_shutter_s", "transmission_shutter_s", "format"}
 
@@ -73,7 +78,7 @@ def _section(mapping: dict, name: str) -> dict:
     section = mapping.get(name, {})
     if not isinstance(section, dict):
         raise ValueError(f"[{name}] must be a table of fields")
-    kind = LAYERS[name]
+    kind = LAYERS[SECTIONS[name]]
     allowed = set(kind.__dataclass_fields__)
     unknown = sorted(set(section) - allowed)
     if unknown:
@@ -92,31 +97,33 @@ def _layer(kind, name: str, fields: dict):
 
 
 def params_from_mapping(mapping: dict) -> MadeUpSkin:
-    """A :class:`MadeUpSkin` from a parsed parameter file (see the module docstring)."""
-    unknown = sorted(set(mapping) - TOP_LEVEL - set(LAYERS))
+    """A :class:`MadeUpSkin` from a parsed parameter file (see the module docstring); with
+    neither ``foundation`` nor ``skin`` the base is the paper's preset (named ``paper``)."""
+    unknown = sorted(set(mapping) - TOP_LEVEL - set(SECTIONS))
     if unknown:
-        raise ValueError(f"unknown key(s) {unknown}; allowed: {sorted(TOP_LEVEL | set(LAYERS))}")
+        raise ValueError(f"unknown key(s) {unknown}; allowed: "
+                         f"{sorted(TOP_LEVEL | set(SECTIONS))}")
     foundation = mapping.get("foundation", "paper_natural")
     skin_name = mapping.get("skin", "paper_bioplate")
-    if foundation not in FOUNDATIONS:
+    if not isinstance(foundation, str) or foundation not in FOUNDATIONS:
         raise ValueError(f"foundation must be one of {sorted(FOUNDATIONS)}, got {foundation!r}")
-    if skin_name not in SKINS:
+    if not isinstance(skin_name, str) or skin_name not in SKINS:
         raise ValueError(f"skin must be one of {sorted(SKINS)}, got {skin_name!r}")
-    base = made_up_skin(foundation, skin_name)
+    named = "foundation" in mapping or "skin" in mapping
+    base = made_up_skin(foundation, skin_name) if named else paper()
     units = mapping.get("units", "albedo")
-    sections = {name: _section(mapping, name) for name in LAYERS}
+    sections = {SECTIONS[name]: (name, _section(mapping, name)) for name in SECTIONS}
     if units == "counts":
-        layers = [_layer(LAYERS[name], name, sections[name])
-                  for name in ("film", "film_transmission", "skin")]
-        dipole = _layer(Dipole, "dipole", {**base.dipole.as_dict(), **sections["dipole"]})
+        layers = [_layer(LAYERS[field], *sections[field])
+                  for field in ("film", "film_transmission", "skin")]
+        dipole = _layer(Dipole, "dipole", {**base.dipole.as_dict(), **sections["dipole"][1]})
         shutters = {key: mapping[key] for key in ("reflection_shutter_s", "transmission_shutter_s")
                     if key in mapping}
         base = from_paper_counts(*layers, dipole, **shutters, name=base.name,
                                  absorption=base.absorption)
     elif units == "albedo":
-        changed = {name: _layer(LAYERS[name], name,
-                                {**getattr(base, name).as_dict(), **sections[name]})
-                   for name in LAYERS if sections[name]}
+        changed = {field: _layer(LAYERS[field], name, {**getattr(base, field).as_dict(), **values})
+                   for field, (name, values) in sections.items() if values}
         base = base.replace(**changed)
     else:
         raise ValueError(f"units must be 'albedo' or 'counts', got {units!r}")
@@ -127,17 +134,23 @@ def params_from_mapping(mapping: dict) -> MadeUpSkin:
         raise ValueError(str(error)) from None
 
 
-def load_params(path) -> MadeUpSkin:
-    """Read a TOML parameter file; ``ValueError`` naming the file and the problem if it is
-    missing, not TOML, or holds an invalid value."""
+def read_mapping(path) -> dict:
+    """The parsed TOML of a parameter file; ``ValueError`` naming the file if it is missing or
+    not TOML."""
     path = Path(path)
     try:
         with path.open("rb") as stream:
-            mapping = tomllib.load(stream)
+            return tomllib.load(stream)
     except FileNotFoundError:
         raise ValueError(f"parameter file {str(path)!r} does not exist") from None
     except (OSError, tomllib.TOMLDecodeError, UnicodeDecodeError) as error:
         raise ValueError(f"parameter file {str(path)!r} is not valid TOML: {error}") from None
+
+
+def load_params(path) -> MadeUpSkin:
+    """Read a TOML parameter file; ``ValueError`` naming the file and the problem if it is
+    missing, not TOML, or holds an invalid value."""
+    mapping = read_mapping(path)
     try:
         return params_from_mapping(mapping)
     except ValueError as error:

@@ -1,0 +1,150 @@
+"""Bake a made-up skin's lookup tables to a float32 OpenEXR atlas and its JSON sidecar.
+
+Parameters come from a preset (the paper's film on the paper's skin substitute unless
+--foundation/--skin name others), then a TOML parameter file (--params, schema in
+docs/baking.md), then --coverage/--absorption, each overriding the one before.  Writes
+OUT/NAME.exr and OUT/NAME.json (atomically) and prints one line with the result.
+
+examples:
+  python -m lut_baker bake --preset paper --out out
+  python -m lut_baker bake --foundation medium_beige --skin jensen_skin1 --coverage 0.8
+  python -m lut_baker bake --params examples/beige_on_skin1.toml --resolution high
+
+"""
+
+from __future__ import annotations
+
+import argparse
+import re
+import sys
+import time
+import types
+from pathlib import Path
+
+__all__ = ["HELP", "configure", "run", "skin_from_args"]
+
+HELP = "bake a made-up skin's lookup tables to an OpenEXR atlas + JSON sidecar"
+PRESETS = ("paper",)
+BAR_WIDTH = 30
+
+
+def _fraction(name: str):
+    """argparse type: a float in [0, 1] (the message names the range and the value)."""
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{name} must be a number in [0, 1], "
+                                             f"got {text!r}") from None
+        if not 0.0 <= value <= 1.0:
+            raise argparse.ArgumentTypeError(f"{name} must lie in [0, 1], got {text}")
+        return value
+
+    parse.__name__ = name
+    return parse
+
+
+def _one_line_error(parser, message: str):
+    """argparse's error without the usage block: one line, exit code 2."""
+    parser.exit(2, f"{parser.prog}: error: {message}\n")
+
+
+def configure(parser: argparse.ArgumentParser) -> None:
+    from .bake import RESOLUTIONS
+    from .presets import FOUNDATIONS, SKINS
+
+    parser.error = types.MethodType(_one_line_error, parser)
+    parser.add_argument("--preset", choices=PRESETS, default="paper",
+                        help="base parameters: the paper's film ('natural' liquid foundation) "
+                             "on its skin substitute, in albedo units (1/sr) normalised by K "
+                             "(default: %(default)s)")
+    parser.add_argument("--foundation", choices=sorted(FOUNDATIONS), metavar="NAME",
+                        help="foundation preset (the paper's film with a shade's per-channel "
+                             f"absorption): {', '.join(sorted(FOUNDATIONS))}")
+    parser.add_argument("--skin", choices=sorted(SKINS), metavar="NAME",
+                        help=f"skin preset (surface gloss and dipole): {', '.join(sorted(SKINS))}")
+    parser.add_argument("--params", type=Path, metavar="FILE.toml",
+                        help="TOML parameter file overriding the preset (schema: docs/baking.md, "
+                             "example: examples/beige_on_skin1.toml)")
+    parser.add_argument("--coverage", type=_fraction("coverage"), metavar="W",
+                        help="film coverage, dimensionless in [0, 1]: 0 bare skin, 1 the full "
+                             "two-layer model, an areal mix between (default: 1, or the file's)")
+    parser.add_argument("--absorption", type=_fraction("absorption"), nargs=3,
+                        metavar=("R", "G", "B"),
+                        help="fraction of the light crossing the film's pigment that it absorbs, "
+                             "per RGB channel, each in [0, 1] (default: the foundation's)")
+    parser.add_argument("--resolution", choices=list(RESOLUTIONS), default="default",
+                        help="table grids: preview (fast, error < 1%%, for live sliders), "
+                             "default (error ~1e-3, docs/baking.md), high (default: %(default)s)")
+    parser.add_argument("--inter-reflection", action="store_true",
+                        help="also bake the inter-reflections between the film's underside and "
+                             "the skin beyond the paper's path 3 (the adding equation)")
+    parser.add_argument("--out", type=Path, default=Path("out"), metavar="DIR",
+                        help="output folder, created if missing (default: %(default)s)")
+    parser.add_argument("--name", metavar="STEM",
+                        help="file name stem of OUT/STEM.exr and OUT/STEM.json (default: the "
+                             "parameter set's name, e.g. 'paper')")
+
+
+def skin_from_args(args):
+    """The :class:`~lut_baker.normalise.MadeUpSkin` the options describe (``ValueError``
+    naming the option on bad input)."""
+    from .params_file import params_from_mapping, read_mapping
+
+    mapping = {}
+    if args.params is not None:
+        try:
+            mapping = read_mapping(args.params)
+        except ValueError as error:
+            raise ValueError(f"argument --params: {error}") from None
+    for key in ("foundation", "skin", "coverage"):
+        if getattr(args, key) is not None:
+            mapping[key] = getattr(args, key)
+    if args.absorption is not None:
+        mapping["absorption"] = list(args.absorption)
+    try:
+        return params_from_mapping(mapping)
+    except ValueError as error:
+        where = f"--params {str(args.params)!r}" if args.params is not None else "parameters"
+        raise ValueError(f"argument {where}: {error}") from None
+
+
+class _Progress:
+    """A progress bar on a terminal (stderr), nothing otherwise."""
+
+    def __init__(self, stream=sys.stderr):
+        self.stream = stream
+        self.enabled = stream.isatty()
+
+    def __call__(self, fraction: float, message: str) -> None:
+        if self.enabled:
+            filled = int(round(BAR_WIDTH * fraction))
+            bar = "#" * filled + "." * (BAR_WIDTH - filled)
+            self.stream.write(f"\r[{bar}] {100 * fraction:3.0f}% {message:<40}")
+            self.stream.flush()
+
+    def close(self) -> None:
+        if self.enabled:
+            self.stream.write("\n")
+            self.stream.flush()
+
+
+def run(args) -> int:
+    from .bake import bake
+    from .io import content_hash, save_tables
+
+    skin = skin_from_args(args)
+    stem = args.name or re.sub(r"[^A-Za-z0-9._+-]", "_", skin.name)
+    progress = _Progress()
+    start = time.perf_counter()
+    try:
+        tables = bake(skin, args.resolution, inter_reflection=args.inter_reflection,
+                      progress=progress)
+    finally:
+        progress.close()
+    seconds = time.perf_counter() - start
+    path = save_tables(tables, args.out / f"{stem}.exr")
+    shape = "x".join(str(n) for n in tables.film_gloss.shape[:3])
+    print(f"baked {skin.name} ({args.resolution}, angular {shape}) in {seconds:.2f} s -> "
+          f"{path} + {path.with_suffix('.json').name}, sha256 {content_hash(tables)[:16]}")
+    return 0

@@ -1,0 +1,293 @@
+"""Baked tables on disk: one float32 OpenEXR atlas plus a JSON sidecar (docs/baking.md).
+
+The atlas is one RGB image holding every table, so a shader needs one image texture (linear
+interpolation, extension EXTEND, colour space Non-Color).  Rows are counted from the bottom,
+as Blender's pixel rows are (the EXR file stores them top-down: row ``r`` is the file's
+scanline ``height - 1 - r``); pixel ``(x, y)`` has its centre at texture coordinates
+``((x + 0.5) / width, (y + 0.5) / height)``.  Blocks, bottom-up:
+
+- each angular table (``film_gloss``, ``path3_gloss``, ``skin_gloss``, then
+  ``inter_reflection`` if baked): ``n_theta`` rows; pixel ``(j n_phi + k, row + i)`` holds
+  ``table[theta_i = i, theta_o = j, phi = k]``.  Within a block a bilinear fetch interpolates
+  ``theta_i`` and the azimuth coordinate; ``theta_o`` takes two fetches (columns ``j`` and
+  ``j + 1``) mixed by its fraction;
+- one row per directional table (``DIRECTIONAL`` order): pixel ``(i, row)`` = ``table[i]``;
+- one row for ``profile``: pixel ``(r, row)``;
+- one row of constants (``CONSTANT`` order): pixel ``(c, row)``.
+
+The sidecar (same name, ``.json``) holds the format version, the layout (first row and row
+count of each block), the grids and their closed forms, units, the made-up skin's parameters
+(with K) and ``sha256``, the hash of the atlas's float32 pixels in the row order above (C order,
+little-endian).  The EXR header repeats version and hash (``makeup_skin:format_version``,
+``makeup_skin:sha256``) so that an image and a sidecar from different bakes are caught.
+
+Writing is atomic: both files go to temporaries in the target folder, are flushed to disk and
+renamed into place (image first); a crash never leaves a partial file under the final name.
+
+Functions
+---------
+- :func:`save_tables`, :func:`load_tables` -- write and read (validated) tables.
+- :func:`atlas`, :func:`content_hash` -- the atlas pixels and their hash (no file involved).
+- :class:`TableFileError` -- a corrupt, truncated, mismatched or unsupported table file.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+
+from .tables import ANGULAR, CONSTANT, DIRECTIONAL, FORMAT_VERSION, RADIAL, Tables
+
+__all__ = ["save_tables", "load_tables", "atlas", "content_hash", "sidecar_path",
+           "TableFileError", "FORMAT_NAME"]
+
+FORMAT_NAME = "makeup-skin-tables"
+UNITS = {
+    "theta_deg": "degrees from the normal",
+    "phi_deg": "degrees (azimuth coordinate, see phi_spacing)",
+    "radius_mm": "mm",
+    "angular tables": "1/sr",
+    "film_transmittance, transmission_factor, albedos": "dimensionless",
+    "film_diffuse, skin_diffuse": "1/sr",
+    "total_reflectance": "dimensionless",
+    "film_transmittance_integral": "sr",
+    "profile": "1/mm^2",
+    "K": "counts per second per unit albedo",
+}
+
+
+class TableFileError(ValueError):
+    """A table file that cannot be used: missing, corrupt, truncated, from another bake or
+    of an unsupported format version.  The message says which file and what is wrong."""
+
+
+def _one_line(message: str) -> str:
+    """OpenImageIO's (multi-line) error text as one line."""
+    return " ".join(str(message).split())[:400]
+
+
+def _oiio():
+    try:
+        import OpenImageIO
+    except ImportError as error:  # pragma: no cover - the test venv has it
+        raise ImportError(
+            "lut_baker.io needs OpenImageIO to read and write .exr tables "
+            "(pip install OpenImageIO; Blender ships it as the OpenImageIO module)"
+        ) from error
+    return OpenImageIO
+
+
+def sidecar_path(path) -> Path:
+    """The JSON sidecar of an atlas path (same name, ``.json``)."""
+    return Path(path).with_suffix(".json")
+
+
+def _angular_names(tables: Tables) -> tuple[str, ...]:
+    return ANGULAR + (("inter_reflection",) if tables.inter_reflection is not None else ())
+
+
+def _layout(n_theta: int, n_phi: int, n_radius: int, angular: tuple[str, ...]) -> dict:
+    """First row and row count of each block (rows from the bottom), and the image size."""
+    blocks, row = {}, 0
+    for name in angular:
+        blocks[name] = {"row": row, "rows": n_theta, "columns": n_theta * n_phi,
+                        "pixel": "(theta_o * n_phi + phi, row + theta_i)"}
+        row += n_theta
+    for name in DIRECTIONAL:
+        blocks[name] = {"row": row, "rows": 1, "columns": n_theta, "pixel": "(theta, row)"}
+        row += 1
+    for name in RADIAL:
+        blocks[name] = {"row": row, "rows": 1, "columns": n_radius, "pixel": "(radius, row)"}
+        row += 1
+    blocks["constants"] = {"row": row, "rows": 1, "columns": len(CONSTANT),
+                           "pixel": "(index in order, row)", "order": list(CONSTANT)}
+    row += 1
+    width = max(n_theta * n_phi, n_theta, n_radius, len(CONSTANT))
+    return {"width": width, "height": row, "blocks": blocks}
+
+
+def atlas(tables: Tables) -> tuple[np.ndarray, dict]:
+    """``(pixels, layout)``: the float32 atlas ``(height, width, 3)`` with row 0 at the
+    bottom, and its layout (see the module docstring)."""
+    n_theta, n_phi = tables.theta_deg.size, tables.phi_deg.size
+    layout = _layout(n_theta, n_phi, tables.radius_mm.size, _angular_names(tables))
+    pixels = np.zeros((layout["height"], layout["width"], 3), np.float32)
+    blocks = layout["blocks"]
+    for name in _angular_names(tables):
+        row = blocks[name]["row"]
+        pixels[row:row + n_theta, :n_theta * n_phi] = np.reshape(
+            np.asarray(getattr(tables, name)), (n_theta, n_theta * n_phi, 3))
+    for name in DIRECTIONAL + RADIAL:
+        values = np.asarray(getattr(tables, name))
+        pixels[blocks[name]["row"], :values.shape[0]] = values
+    pixels[blocks["constants"]["row"], :len(CONSTANT)] = [getattr(tables, name)
+                                                          for name in CONSTANT]
+    return pixels, layout
+
+
+def content_hash(tables: Tables) -> str:
+    """sha256 (hex) of the float32 atlas of ``tables``: equal hashes, equal stored tables."""
+    return _hash(atlas(tables)[0])
+
+
+def _hash(pixels: np.ndarray) -> str:
+    return hashlib.sha256(np.ascontiguousarray(pixels, "<f4").tobytes()).hexdigest()
+
+
+def _sidecar(tables: Tables, layout: dict, digest: str, image_name: str) -> dict:
+    return {
+        "format": FORMAT_NAME,
+        "format_version": FORMAT_VERSION,
+        "image": image_name,
+        "width": layout["width"],
+        "height": layout["height"],
+        "channels": ["R", "G", "B"],
+        "rows": "counted from the bottom (Blender); the EXR stores them top-down",
+        "texel_centre": "(x + 0.5) / width, (y + 0.5) / height",
+        "sha256": digest,
+        "layout": layout["blocks"],
+        "grids": {
+            "theta_deg": tables.theta_deg.tolist(),
+            "phi_deg": tables.phi_deg.tolist(),
+            "radius_mm": tables.radius_mm.tolist(),
+            **tables.spacings,
+        },
+        "units": UNITS,
+        "parameters": tables.parameters,
+        "K": tables.parameters.get("K"),
+    }
+
+
+def _fsync(path: Path) -> None:
+    fd = os.open(path, os.O_RDONLY)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
+
+
+def save_tables(tables: Tables, path) -> Path:
+    """Write ``tables`` to ``path`` (an ``.exr``) and its sidecar ``path.json``, atomically.
+    Returns the image path."""
+    oiio = _oiio()
+    path = Path(path)
+    if path.suffix.lower() != ".exr":
+        raise ValueError(f"table image must end in .exr, got {str(path)!r}")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    pixels, layout = atlas(tables)
+    digest = _hash(pixels)
+    tag = f".{path.stem}.{os.getpid()}.tmp"
+    image_tmp = path.with_name(tag + ".exr")
+    json_tmp = path.with_name(tag + ".json")
+    try:
+        spec = oiio.ImageSpec(layout["width"], layout["height"], 3, oiio.FLOAT)
+        spec.attribute("compression", "zip")
+        spec.attribute("makeup_skin:format_version", FORMAT_VERSION)
+        spec.attribute("makeup_skin:sha256", digest)
+        out = oiio.ImageOutput.create(str(image_tmp))
+        if out is None or not out.open(str(image_tmp), spec):
+            raise OSError(f"cannot write {str(path)!r}: {_one_line(oiio.geterror())}")
+        ok = out.write_image(np.ascontiguousarray(pixels[::-1]))
+        error = out.geterror()
+        out.close()
+        if not ok:
+            raise OSError(f"cannot write {str(path)!r}: {_one_line(error)}")
+        json_tmp.write_text(json.dumps(_sidecar(tables, layout, digest, path.name), indent=1))
+        for tmp in (image_tmp, json_tmp):
+            _fsync(tmp)
+        os.replace(image_tmp, path)
+        os.replace(json_tmp, sidecar_path(path))
+        _fsync(path.parent)
+    finally:
+        for tmp in (image_tmp, json_tmp):
+            tmp.unlink(missing_ok=True)
+    return path
+
+
+def _read_sidecar(path: Path) -> dict:
+    side = sidecar_path(path)
+    try:
+        meta = json.loads(side.read_text())
+    except FileNotFoundError:
+        raise TableFileError(f"{str(side)!r}: the sidecar of {path.name!r} is missing; "
+                             "re-bake the tables") from None
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as error:
+        raise TableFileError(f"{str(side)!r} is not a readable sidecar: {error}") from None
+    if not isinstance(meta, dict) or meta.get("format") != FORMAT_NAME:
+        raise TableFileError(f"{str(side)!r} is not a {FORMAT_NAME} sidecar")
+    if meta.get("format_version") != FORMAT_VERSION:
+        raise TableFileError(f"{str(side)!r} has format version {meta.get('format_version')!r}; "
+                             f"this lut_baker reads version {FORMAT_VERSION}: re-bake the tables")
+    return meta
+
+
+def _read_pixels(path: Path, meta: dict) -> np.ndarray:
+    oiio = _oiio()
+    image = oiio.ImageInput.open(str(path))
+    if image is None:
+        raise TableFileError(f"{str(path)!r} cannot be read as an image: "
+                             f"{_one_line(oiio.geterror())}")
+    try:
+        spec = image.spec()
+        shape = (spec.height, spec.width, spec.nchannels)
+        if spec.getattribute("makeup_skin:sha256") != meta["sha256"]:
+            raise TableFileError(f"{str(path)!r} and its sidecar come from different bakes "
+                                 "(their hashes differ); re-bake the tables")
+        if shape != (meta["height"], meta["width"], 3):
+            raise TableFileError(f"{str(path)!r} is {shape[1]} x {shape[0]} x {shape[2]}, its "
+                                 f"sidecar says {meta['width']} x {meta['height']} x 3")
+        pixels = image.read_image(oiio.FLOAT)
+        if pixels is None or image.has_error:
+            raise TableFileError(f"{str(path)!r} is truncated or corrupt: "
+                                 f"{_one_line(image.geterror())}")
+    finally:
+        image.close()
+    pixels = np.asarray(pixels, np.float32).reshape(shape)[::-1]
+    if _hash(pixels) != meta["sha256"]:
+        raise TableFileError(f"{str(path)!r} is corrupt: its pixels do not match the sidecar's "
+                             "sha256; re-bake the tables")
+    return pixels
+
+
+def load_tables(path) -> Tables:
+    """Read tables written by :func:`save_tables` (the ``.exr`` or its ``.json``).
+
+    Validates format version, image size, layout, grids and the content hash; raises
+    :class:`TableFileError` naming the file and the problem otherwise.  Values are the stored
+    float32 numbers (as float64 arrays)."""
+    path = Path(path)
+    path = path.with_suffix(".exr") if path.suffix.lower() == ".json" else path
+    if not path.is_file():
+        raise TableFileError(f"{str(path)!r} does not exist")
+    meta = _read_sidecar(path)
+    try:
+        grids = meta["grids"]
+        theta, phi, radius = (np.asarray(grids[k], float)
+                              for k in ("theta_deg", "phi_deg", "radius_mm"))
+        angular = tuple(name for name in ANGULAR + ("inter_reflection",)
+                        if name in meta["layout"])
+        expected = _layout(theta.size, phi.size, radius.size, angular)
+        if expected["blocks"] != meta["layout"] or (expected["width"], expected["height"]) != (
+                meta["width"], meta["height"]):
+            raise TableFileError(f"{str(sidecar_path(path))!r}: layout does not match its grids")
+        pixels = _read_pixels(path, meta).astype(float)
+        blocks = meta["layout"]
+        n, p = theta.size, phi.size
+        arrays = {name: pixels[blocks[name]["row"]:blocks[name]["row"] + n, :n * p].reshape(
+            n, n, p, 3) for name in angular}
+        arrays.update({name: pixels[blocks[name]["row"], :blocks[name]["columns"]]
+                       for name in DIRECTIONAL + RADIAL})
+        constants = pixels[blocks["constants"]["row"], :len(CONSTANT)]
+        arrays.update({name: constants[i] for i, name in enumerate(CONSTANT)})
+        spacing = {k: grids[k] for k in ("theta_spacing", "theta_offset", "phi_spacing",
+                                         "radius_spacing")}
+        return Tables(theta_deg=theta, phi_deg=phi, radius_mm=radius, **arrays,
+                      parameters=meta["parameters"], **spacing)
+    except TableFileError:
+        raise
+    except (KeyError, TypeError, ValueError) as error:
+        raise TableFileError(f"{str(sidecar_path(path))!r} is inconsistent: {error}") from None

@@ -1,0 +1,186 @@
+"""Tables on disk (lut_baker.io): float32 OpenEXR atlas + JSON sidecar."""
+
+import json
+import os
+
+import numpy as np
+import pytest
+
+from lut_baker import bake, io, presets
+from lut_baker.tables import ANGULAR, CONSTANT, DIRECTIONAL
+
+oiio = pytest.importorskip("OpenImageIO")
+
+
+@pytest.fixture(scope="module")
+def baked():
+    skin = presets.made_up_skin("medium_beige", "jensen_skin1", coverage=0.7)
+    return bake.bake(skin, "preview", inter_reflection=True)
+
+
+@pytest.fixture
+def saved(baked, tmp_path):
+    return io.save_tables(baked, tmp_path / "skin.exr")
+
+
+def test_round_trip_is_float32_exact(baked, saved):
+    loaded = io.load_tables(saved)
+    for name, value in baked.arrays.items():
+        stored = np.asarray(getattr(loaded, name))
+        if name in ("theta_deg", "phi_deg", "radius_mm"):
+            np.testing.assert_array_equal(stored, value)  # grids: exact float64 in the sidecar
+        else:
+            np.testing.assert_array_equal(stored, np.asarray(value, np.float32), err_msg=name)
+    assert loaded.parameters == baked.parameters
+    assert loaded.spacings == baked.spacings
+    assert io.content_hash(loaded) == io.content_hash(baked)
+    # float32 storage moves values by at most half an ulp: ~6e-8 relative
+    relative = np.abs(loaded.film_gloss - baked.film_gloss) / np.maximum(baked.film_gloss, 1e-30)
+    assert relative.max() < 6e-8
+
+
+def test_sidecar_describes_the_file(baked, saved):
+    meta = json.loads(saved.with_suffix(".json").read_text())
+    assert meta["format_version"] == 1 and meta["image"] == "skin.exr"
+    assert meta["K"] == pytest.approx(presets.paper().K)
+    assert meta["parameters"]["coverage"] == 0.7
+    assert meta["grids"]["phi_spacing"] == "half_vector"
+    assert {"theta_deg", "radius_mm", "profile"} <= set(meta["units"]) | set(meta["layout"])
+    assert meta["sha256"] == io.content_hash(baked)
+
+
+def test_atlas_layout_as_documented(baked, saved):
+    """Pixel (j n_phi + k, row + i) of an angular block is table[i, j, k]; rows count from the
+    bottom, so Blender's row r is the EXR's scanline height - 1 - r."""
+    meta = json.loads(saved.with_suffix(".json").read_text())
+    image = oiio.ImageInput.open(str(saved))
+    pixels = image.read_image(oiio.FLOAT)
+    image.close()
+    height, n_phi = meta["height"], baked.phi_deg.size
+    i, j, k = 5, 7, 11
+    for name in ANGULAR + ("inter_reflection",):
+        row = meta["layout"][name]["row"] + i
+        np.testing.assert_array_equal(pixels[height - 1 - row, j * n_phi + k],
+                                      np.asarray(getattr(baked, name), np.float32)[i, j, k])
+    for name in DIRECTIONAL:
+        row = meta["layout"][name]["row"]
+        np.testing.assert_array_equal(pixels[height - 1 - row, 3],
+                                      np.asarray(getattr(baked, name), np.float32)[3])
+    row = meta["layout"]["constants"]["row"]
+    assert meta["layout"]["constants"]["order"] == list(CONSTANT)
+    np.testing.assert_array_equal(pixels[height - 1 - row, 1],
+                                  np.asarray(baked.skin_diffuse, np.float32))
+    assert pixels.shape == (height, meta["width"], 3)
+
+
+def test_atlas_of_plain_tables_has_no_inter_reflection_block(baked):
+    from dataclasses import replace
+
+    _, layout = io.atlas(replace(baked, inter_reflection=None))
+    assert "inter_reflection" not in layout["blocks"]
+
+
+def _flip_byte(path, offset):
+    data = bytearray(path.read_bytes())
+    data[offset] ^= 0xFF
+    path.write_bytes(bytes(data))
+
+
+@pytest.mark.parametrize("where", [0.05, 0.5, 0.95])
+def test_corrupt_byte_is_reported(saved, where):
+    _flip_byte(saved, int(where * saved.stat().st_size))
+    with pytest.raises(io.TableFileError, match="skin.exr"):
+        io.load_tables(saved)
+
+
+@pytest.mark.parametrize("keep", [0.0, 0.5, 0.99])
+def test_truncated_file_is_reported(saved, keep):
+    data = saved.read_bytes()
+    saved.write_bytes(data[:int(keep * len(data))])
+    with pytest.raises(io.TableFileError, match="skin.exr"):
+        io.load_tables(saved)
+
+
+def test_wrong_version_is_reported(saved):
+    side = saved.with_suffix(".json")
+    meta = json.loads(side.read_text())
+    meta["format_version"] = 99
+    side.write_text(json.dumps(meta))
+    with pytest.raises(io.TableFileError, match="version 99"):
+        io.load_tables(saved)
+
+
+def test_missing_sidecar_is_reported(saved):
+    saved.with_suffix(".json").unlink()
+    with pytest.raises(io.TableFileError, match="sidecar.*missing"):
+        io.load_tables(saved)
+
+
+def test_missing_image_is_reported(tmp_path):
+    with pytest.raises(io.TableFileError, match="does not exist"):
+        io.load_tables(tmp_path / "none.exr")
+
+
+def test_image_and_sidecar_of_different_bakes_are_reported(baked, saved, tmp_path):
+    other = io.save_tables(bake.bake(presets.paper(), "preview", inter_reflection=True),
+                           tmp_path / "other.exr")
+    saved.with_suffix(".json").write_text(other.with_suffix(".json").read_text())
+    with pytest.raises(io.TableFileError):
+        io.load_tables(saved)
+
+
+def test_edited_sidecar_values_are_reported(saved):
+    side = saved.with_suffix(".json")
+    meta = json.loads(side.read_text())
+    meta["grids"]["theta_deg"] = meta["grids"]["theta_deg"][:-1]
+    side.write_text(json.dumps(meta))
+    with pytest.raises(io.TableFileError, match="layout|grid"):
+        io.load_tables(saved)
+    side.write_text("{ not json")
+    with pytest.raises(io.TableFileError, match="not a readable sidecar"):
+        io.load_tables(saved)
+
+
+def test_a_crash_mid_write_leaves_the_old_files_intact(baked, saved, monkeypatch):
+    before = {p.name: p.read_bytes() for p in saved.parent.iterdir()}
+    real_replace = os.replace
+    calls = []
+
+    def crash_on_second(src, dst):  # the image is in place, the sidecar not yet
+        calls.append(dst)
+        if len(calls) == 1:
+            raise OSError("simulated crash")
+        real_replace(src, dst)
+
+    monkeypatch.setattr(io.os, "replace", crash_on_second)
+    with pytest.raises(OSError, match="simulated"):
+        io.save_tables(bake.bake(presets.paper(), "preview"), saved)
+    after = {p.name: p.read_bytes() for p in saved.parent.iterdir()}
+    assert after == before  # no temporary left, nothing half-written under the final names
+    assert io.content_hash(io.load_tables(saved)) == io.content_hash(baked)
+
+
+def test_a_crash_between_the_renames_is_detected(baked, saved, monkeypatch):
+    """Image replaced, sidecar not: the pair no longer matches and loading says so."""
+    real_replace = os.replace
+
+    def crash_before_sidecar(src, dst):
+        if str(dst).endswith(".json"):
+            raise OSError("simulated crash")
+        real_replace(src, dst)
+
+    monkeypatch.setattr(io.os, "replace", crash_before_sidecar)
+    with pytest.raises(OSError):
+        io.save_tables(bake.bake(presets.paper(), "preview"), saved)
+    with pytest.raises(io.TableFileError, match="different bakes"):
+        io.load_tables(saved)
+    assert sorted(p.name for p in saved.parent.iterdir()) == ["skin.exr", "skin.json"]
+
+
+def test_only_exr_paths_are_written(baked, tmp_path):
+    with pytest.raises(ValueError, match=".exr"):
+        io.save_tables(baked, tmp_path / "skin.png")
+
+
+def test_load_accepts_the_sidecar_path(baked, saved):
+    assert io.content_hash(io.load_tables(saved.with_suffix(".json"))) == io.content_hash(baked)
