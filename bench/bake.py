@@ -205,7 +205,7 @@ def study(runs: int) -> str:
 
     # 2. angular sizes
     rows = []
-    for n_theta in (16, 24, 32, 48, 64, 96, 128):
+    for n_theta in (16, 24, 32, 48, 64, 96, 112, 128):
         for n_phi in (9, 17, 33, 49, 65, 97):
             if n_theta >= 96 and n_phi < 33 or n_theta <= 24 and n_phi > 49:
                 continue

@@ -260,7 +260,8 @@ class Tables:
     ``as_dict``), including ``K``, ``coverage`` and ``absorption`` it was baked for.
     ``inter_reflection``: optional angular table, the full adding-equation sum minus path 3
     (1/sr), or None; unlike the other tables it holds the film's absorption as baked
-    (``parameters["absorption"]``).
+    (``parameters["absorption"]``).  Arrays may be read-only (the bake broadcasts a channel
+    axis of 1 to 3 without copying): copy before writing into them.
     """
 
     theta_deg: np.ndarray
