@@ -44,7 +44,7 @@ Functions and types
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 
 import numpy as np
 
@@ -72,6 +72,7 @@ __all__ = [
     "fit_glossy",
     "fit_profile",
     "fit_profiles",
+    "subsurface_ior",
     "fit_closures",
     "diffuse_albedo",
     "principled_inputs",
@@ -98,7 +99,7 @@ SPECULAR_LEVEL_RANGE = (0.0, 8.0)
 """Specular IOR Level searched (0.5 leaves IOR 1.5 as it is; F0 = 0.04 * 2 level)."""
 SPECULAR_IOR = 1.5
 """The Principled IOR the specular fits assume (Specular IOR Level scales its F0)."""
-FIT_TOLERANCE = 1e-3
+FIT_TOLERANCE = 2e-3
 """Relative bracket width at which the golden-section searches stop."""
 NO_LOBE_ERROR = 0.9
 """A specular fit erring more than this (relative RMS; leaving the lobe out errs 1.0) is
@@ -313,10 +314,10 @@ def _fit_roughness_and(grid: _Grid, target: np.ndarray, fresnel, second_range, s
         def inner(second):
             return grid.error(base * fresnel(grid.cos_hi, second)[..., None], target)
 
-        return golden_minimum(inner, *second_range, tol=FIT_TOLERANCE)
+        return golden_minimum(inner, *second_range, tol=2 * FIT_TOLERANCE, coarse=7)
 
     roughness, _ = golden_minimum(lambda r: error_for(r)[1], *ROUGHNESS_RANGE,
-                                  tol=FIT_TOLERANCE)
+                                  tol=FIT_TOLERANCE, coarse=7)
     return (roughness, *error_for(roughness))
 
 
@@ -348,13 +349,23 @@ def fit_specular(grid: _Grid, target: np.ndarray, attenuation=None) -> LobeFit:
     return LobeFit(roughness=roughness, ior=SPECULAR_IOR, level=level, error=error)
 
 
+SEARCH_QUADRATURE = {"n_u": 24, "n_phi": 12, "n_mu": 17}
+"""Closure-albedo quadrature while searching (within 2%, at 17 view cosines interpolated to the
+texels); the final weights use :data:`FINAL_QUADRATURE` (within 0.1%, at every texel)."""
+FINAL_QUADRATURE = {"n_u": 96, "n_phi": 64, "n_mu": None}
+
+
 def _glossy_lut(roughness: float, distribution: str, albedo_table: np.ndarray,
-                theta_deg: np.ndarray, size: int) -> np.ndarray:
+                theta_deg: np.ndarray, size: int, quadrature=FINAL_QUADRATURE) -> np.ndarray:
     """Glossy weights per texel: table albedo / closure albedo at ``cos(theta_o)`` nodes."""
     mu = lut_nodes(size)
     theta = np.degrees(np.arccos(mu))
     table = np.stack([np.interp(theta, theta_deg, albedo_table[:, c]) for c in range(3)], -1)
-    closure = cc.microfacet_albedo(mu, roughness, distribution=distribution)
+    n_mu = quadrature["n_mu"]
+    nodes = mu if n_mu is None else np.linspace(mu[0], mu[-1], n_mu)
+    closure = cc.microfacet_albedo(nodes, roughness, distribution=distribution,
+                                   n_u=quadrature["n_u"], n_phi=quadrature["n_phi"])
+    closure = closure if n_mu is None else np.interp(mu, nodes, closure)
     return table / np.maximum(closure, 1e-6)[:, None]
 
 
@@ -367,15 +378,17 @@ def fit_glossy(grid: _Grid, target: np.ndarray, albedo_table: np.ndarray,
     target = _rgb(target) * np.ones(3)
     best = None
     for distribution in cc.GLOSSY_DISTRIBUTIONS:
-        def lobe(roughness, distribution=distribution):
-            lut = _glossy_lut(roughness, distribution, albedo_table, theta_deg, size)
+        def lobe(roughness, distribution=distribution, quadrature=SEARCH_QUADRATURE):
+            lut = _glossy_lut(roughness, distribution, albedo_table, theta_deg, size,
+                              quadrature)
             value = grid.lobe(roughness, distribution)[..., None] * sample_lut(lut, grid.cos_o)
             return value, lut
 
         roughness, error = golden_minimum(lambda r, lobe=lobe: grid.error(lobe(r)[0], target),
-                                          *ROUGHNESS_RANGE, tol=FIT_TOLERANCE)
+                                          *ROUGHNESS_RANGE, tol=FIT_TOLERANCE, coarse=7)
         if best is None or error < best.error:
-            best = LobeFit(roughness=roughness, error=error, lut=lobe(roughness)[1],
+            value, lut = lobe(roughness, quadrature=FINAL_QUADRATURE)
+            best = LobeFit(roughness=roughness, error=grid.error(value, target), lut=lut,
                            distribution=distribution)
     return best
 
@@ -479,7 +492,8 @@ class ClosureFit:
     (film_gloss, path3_gloss, skin_gloss: Glossy lobes with their weight rows).  Both:
     ``transmittance_mean`` (RGB, the cosine-weighted mean of T), ``film_albedo`` and
     ``skin_albedo`` (RGB, ``pi P_d``), ``profiles`` (by method) and ``subsurface_method``
-    (the best-fitting one), ``lut`` (``(len(LUT_ROWS), size, 3)``: the view-angle image),
+    (the best-fitting one), ``subsurface_ior`` (the dipole's index, for the random walk and
+    the profile fits), ``lut`` (``(len(LUT_ROWS), size, 3)``: the view-angle image),
     ``errors`` at the coverage and absorption the tables were baked for.
     """
 
@@ -495,6 +509,7 @@ class ClosureFit:
     skin_albedo: np.ndarray
     profiles: dict
     subsurface_method: str
+    subsurface_ior: float
     lut: np.ndarray
     errors: dict = field(default_factory=dict)
 
@@ -518,6 +533,7 @@ class ClosureFit:
                               "distribution": lobe.distribution}
                        for name, lobe in self.glossy.items()},
             "subsurface_method": self.subsurface_method,
+            "subsurface_ior": self.subsurface_ior,
             "profiles": {name: {"radius_mm": p.radius_mm.tolist(), "error": p.error.tolist()}
                          for name, p in self.profiles.items()},
             "errors": {name: asdict(e) for name, e in self.errors.items()},
@@ -542,12 +558,21 @@ def _layering_mean(roughness: float, ior: float, f0=None) -> float:
     return float(2.0 * np.sum(_trapezoid_weights(mu) * mu * albedo))
 
 
+def subsurface_ior(parameters: dict) -> float:
+    """The skin dipole's relative index (the Subsurface IOR) from tables' ``parameters``;
+    1.4 (Blender's default) if they do not say.  Clamped to Cycles' [1.01, 3.8]."""
+    dipole = parameters.get("dipole", {}) if isinstance(parameters, dict) else {}
+    eta = float(np.mean(dipole.get("eta", 1.4)))
+    return float(np.clip(eta, 1.01, 3.8))
+
+
 def fit_closures(tables: Tables, *, lut_size: int = DEFAULT_LUT_SIZE,
                  subsurface_method: str | None = None,
-                 max_points: int | None = FIT_POINTS) -> ClosureFit:
-    """Fit both tiers to ``tables`` and measure their errors at the baked coverage and
-    absorption.  ``subsurface_method``: force one (default: the best-fitting of Burley and
-    Random Walk (Skin); plain Random Walk is fitted and reported too)."""
+                 max_points: int | None = FIT_POINTS, errors_at=None) -> ClosureFit:
+    """Fit both tiers to ``tables`` and measure their errors at ``errors_at`` = ``(coverage,
+    absorption)`` (default: those the tables were baked for).  ``subsurface_method``: force
+    one (default: the best-fitting of Burley and Random Walk (Skin); plain Random Walk is
+    fitted and reported too)."""
     grid = _Grid(tables, max_points)
     pick = grid.pick
     film_gloss = np.asarray(tables.film_gloss, float)[pick]
@@ -571,7 +596,8 @@ def fit_closures(tables: Tables, *, lut_size: int = DEFAULT_LUT_SIZE,
                        for c in range(3)], -1)
     lut = np.stack([glossy[name].lut for name in LUT_ROWS[:3]] + [t_rows])
 
-    profiles = fit_profiles(tables)
+    ior = subsurface_ior(tables.parameters)
+    profiles = fit_profiles(tables, ior=ior)
     if subsurface_method is None:
         subsurface_method = min(("BURLEY", "RANDOM_WALK_SKIN"),
                                 key=lambda m: profiles[m].worst_error)
@@ -599,17 +625,13 @@ def fit_closures(tables: Tables, *, lut_size: int = DEFAULT_LUT_SIZE,
         skin_albedo=np.pi * np.asarray(tables.skin_diffuse, float),
         profiles=profiles,
         subsurface_method=subsurface_method,
+        subsurface_ior=ior,
         lut=lut,
     )
-    coverage = float(tables.parameters.get("coverage", 1.0))
-    absorption = tables.parameters.get("absorption", 0.0)
-    return _with_errors(fit, tier_errors(fit, tables, coverage, absorption))
-
-
-def _with_errors(fit: ClosureFit, errors: dict) -> ClosureFit:
-    values = {name: getattr(fit, name) for name in fit.__dataclass_fields__}
-    values["errors"] = errors
-    return ClosureFit(**values)
+    if errors_at is None:
+        errors_at = (float(tables.parameters.get("coverage", 1.0)),
+                     tables.parameters.get("absorption", 0.0))
+    return replace(fit, errors=tier_errors(fit, tables, *errors_at))
 
 
 # --------------------------------------------------------------------------------------------

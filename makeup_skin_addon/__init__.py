@@ -9,11 +9,11 @@ panels as new submodules and append them to :data:`modules`.
     from .. import lut_baker
 """
 
-from . import preferences
+from . import live, operators, preferences, properties, ui
 
 __all__ = ["modules", "register", "unregister"]
 
-modules = (preferences,)
+modules = (preferences, properties, operators, ui, live)
 
 
 def register():

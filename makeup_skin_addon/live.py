@@ -1,0 +1,99 @@
+"""Live update while sliders move.
+
+Socket-level settings (coverage, absorption, tint, subsurface scale) go straight to the
+material's group node.  Settings that change the tables (skin, film overrides, tier) mark the
+material dirty and start one debounce timer; when it fires, every dirty material is re-baked at
+preview resolution and its group rebuilt in place (copied first if other materials share it).
+Without an event loop (headless) timers never fire: :func:`flush` does the same work at once.
+:func:`unregister` removes the timer, so none is left behind (bpy 4.5 hangs at exit otherwise).
+"""
+
+from __future__ import annotations
+
+import bpy
+
+__all__ = ["DEBOUNCE_S", "sockets_changed", "tables_changed", "flush", "pending", "register",
+           "unregister"]
+
+DEBOUNCE_S = 0.3
+"""Seconds without a further change before a preview re-bake runs."""
+PREVIEW = "preview"
+
+_dirty: set[str] = set()
+_messages: list[str] = []
+
+
+def _material_of(settings):
+    material = settings.id_data
+    return material if isinstance(material, bpy.types.Material) else None
+
+
+def sockets_changed(settings) -> None:
+    """Coverage, absorption, tint or scale moved: set the group node's sockets."""
+    from .material import update_sockets
+
+    material = _material_of(settings)
+    if material is not None and settings.is_made_up:
+        update_sockets(material)
+
+
+def tables_changed(settings) -> None:
+    """A setting the tables depend on moved: schedule a preview re-bake (debounced)."""
+    material = _material_of(settings)
+    if material is None or not settings.is_made_up or not settings.live_update:
+        return
+    _dirty.add(material.name)
+    if bpy.app.background:
+        return  # no event loop: flush() runs the re-bake when asked
+    if bpy.app.timers.is_registered(_timer):
+        bpy.app.timers.unregister(_timer)
+    bpy.app.timers.register(_timer, first_interval=DEBOUNCE_S)
+
+
+def pending() -> set[str]:
+    """Names of materials waiting for a preview re-bake."""
+    return set(_dirty)
+
+
+def _timer():
+    flush()
+    return None  # one shot
+
+
+def flush(context=None) -> list[str]:
+    """Re-bake every dirty material at preview resolution now; returns report messages."""
+    from . import material as made_up
+
+    context = context or bpy.context
+    messages = []
+    while _dirty:
+        material = bpy.data.materials.get(_dirty.pop())
+        if material is None or not material.makeup_skin.is_made_up:
+            continue
+        node = made_up.group_of(material)
+        group = node.node_tree if node is not None else None
+        if group is not None and group.users > 1:
+            group = group.copy()  # others keep their look; this material gets its own
+        settings = material.makeup_skin
+        try:
+            group, _, _ = made_up.ensure_group(
+                made_up.skin_from_settings(settings), made_up.resolve_tier(settings,
+                                                                           context.scene),
+                PREVIEW, messages=messages, group=group)
+        except (ValueError, RuntimeError) as error:
+            messages.append(f"Made-up Skin: preview of {material.name!r} failed: {error}")
+            continue
+        made_up.setup_material(material, group, context.scene)
+    _messages.extend(messages)
+    return messages
+
+
+def register():
+    _dirty.clear()
+
+
+def unregister():
+    if bpy.app.timers.is_registered(_timer):
+        bpy.app.timers.unregister(_timer)
+    _dirty.clear()
+    _messages.clear()

@@ -1,0 +1,319 @@
+"""The "Made-up Skin" node groups: closures fitted to baked tables (lut_baker.closure_fit).
+
+Both tiers share one interface, so a material keeps its links when the tier changes:
+
+- inputs: ``Coverage`` (0..1, paintable with a texture), ``Foundation Absorption`` (colour:
+  the fraction of light the film's pigment absorbs per channel), ``Skin Tint`` (multiplies the
+  skin's diffuse albedo), ``Subsurface Scale`` (artist multiplier of the fitted radius),
+  ``Units per mm`` (scene units in one millimetre; the add-on sets it from the scene's unit
+  scale);
+- output: ``Shader``.
+
+PRINCIPLED: one Principled BSDF (GGX, coat = the film, specular and base/subsurface = the skin)
+whose inputs follow :func:`lut_baker.closure_fit.principled_inputs` in math nodes.
+LAYERED: Glossy, Diffuse and Subsurface closures weighted as
+:func:`lut_baker.closure_fit.layered_weights`, view-dependent factors read from one float image
+(rows :data:`lut_baker.closure_fit.LUT_ROWS`) at ``u = cos(theta_o)``, and a Mix Shader by
+Coverage between bare skin and made-up skin: an areal mix of closures, so a painted coverage
+fades out without fringe or halo.
+
+- :func:`group_name` -- name of a group from tier and tables key.
+- :func:`build_group` -- create or rebuild (in place) a group from a fit and its tables.
+- :func:`set_inputs` -- socket values on a group node from the panel's settings.
+"""
+
+from __future__ import annotations
+
+import json
+
+import bpy
+import numpy as np
+
+from . import storage
+from .package import lut_baker
+
+__all__ = ["INPUTS", "GROUP_PREFIX", "FIT_KEY", "TABLES_REF", "group_name", "build_group",
+           "set_inputs", "socket"]
+
+GROUP_PREFIX = "Made-up Skin"
+FIT_KEY = "makeup_skin_fit"
+"""Custom property of a group: its tables key, tier and the fit's summary (JSON)."""
+TABLES_REF = "makeup_skin_tables"
+"""Custom property of a group holding its tables image (keeps it saved with the file)."""
+
+INPUTS = (
+    # name, socket type, default, min, max, subtype, description
+    ("Coverage", "NodeSocketFloat", 1.0, 0.0, 1.0, "FACTOR",
+     "Foundation coverage: 0 bare skin, 1 full film (paint it with a texture)"),
+    ("Foundation Absorption", "NodeSocketColor", (0.0, 0.0, 0.0, 1.0), None, None, None,
+     "Fraction of the light crossing the film's pigment that it absorbs, per channel"),
+    ("Skin Tint", "NodeSocketColor", (1.0, 1.0, 1.0, 1.0), None, None, None,
+     "Multiplies the skin's diffuse albedo"),
+    ("Subsurface Scale", "NodeSocketFloat", 1.0, 0.0, 100.0, "NONE",
+     "Multiplies the subsurface radius fitted to the skin's profile"),
+    ("Units per mm", "NodeSocketFloat", 0.001, 0.0, 1e6, "NONE",
+     "Scene units in one millimetre (set from the scene's unit scale on Apply)"),
+)
+
+
+def group_name(tier: str, key: str) -> str:
+    return f"{GROUP_PREFIX} {tier.title()} {key[:8]}"
+
+
+def socket(sockets, identifier: str):
+    """A node socket by identifier (display names differ between Blender versions)."""
+    for item in sockets:
+        if item.identifier == identifier:
+            return item
+    raise KeyError(identifier)
+
+
+class _Builder:
+    """Adds nodes to a tree and links them; values may be sockets or constants."""
+
+    def __init__(self, tree):
+        self.tree = tree
+        self.count = 0
+
+    def node(self, kind: str, label: str = "", **props):
+        node = self.tree.nodes.new(kind)
+        node.location = (200 * (self.count // 10) - 400, -160 * (self.count % 10))
+        self.count += 1
+        if label:
+            node.label = label
+        for name, value in props.items():
+            setattr(node, name, value)
+        return node
+
+    def feed(self, target, value):
+        """Link a socket into ``target`` or set its default value."""
+        if isinstance(value, bpy.types.NodeSocket):
+            self.tree.links.new(value, target)
+        elif target.type in ("VECTOR", "RGBA") and np.ndim(value) == 0:
+            n = len(target.default_value)
+            target.default_value = (float(value),) * n
+        elif target.type == "RGBA" and len(value) == 3:
+            target.default_value = (*map(float, value), 1.0)
+        else:
+            target.default_value = value if np.ndim(value) == 0 else tuple(map(float, value))
+
+    def math(self, operation: str, a, b=0.0, label: str = ""):
+        node = self.node("ShaderNodeMath", label, operation=operation)
+        self.feed(node.inputs[0], a)
+        self.feed(node.inputs[1], b)
+        return node.outputs[0]
+
+    def vector(self, operation: str, a, b=(0.0, 0.0, 0.0), label: str = ""):
+        node = self.node("ShaderNodeVectorMath", label, operation=operation)
+        self.feed(socket(node.inputs, "Vector"), a)
+        self.feed(socket(node.inputs, "Vector_001"), b)
+        return node.outputs["Value" if operation == "DOT_PRODUCT" else "Vector"]
+
+    def scale(self, vector, factor, label: str = ""):
+        """``vector * factor`` (a float)."""
+        node = self.node("ShaderNodeVectorMath", label, operation="SCALE")
+        self.feed(socket(node.inputs, "Vector"), vector)
+        self.feed(socket(node.inputs, "Scale"), factor)
+        return node.outputs["Vector"]
+
+    def mix_float(self, factor, a, b, label: str = ""):
+        """``a + factor (b - a)``, factor unclamped."""
+        return self._mix("FLOAT", factor, a, b, label)
+
+    def mix_vector(self, factor, a, b, label: str = ""):
+        return self._mix("VECTOR", factor, a, b, label)
+
+    def _mix(self, data_type: str, factor, a, b, label: str):
+        node = self.node("ShaderNodeMix", label, data_type=data_type)
+        node.clamp_factor = False
+        suffix = "Float" if data_type == "FLOAT" else "Vector"
+        self.feed(socket(node.inputs, "Factor_Float"), factor)
+        self.feed(socket(node.inputs, "A_" + suffix), a)
+        self.feed(socket(node.inputs, "B_" + suffix), b)
+        return socket(node.outputs, "Result_" + suffix)
+
+
+def _interface(group) -> None:
+    """Create the group's sockets if missing (existing ones keep their links and values)."""
+    existing = {item.name for item in group.interface.items_tree
+                if getattr(item, "item_type", "SOCKET") == "SOCKET"}
+    for name, kind, default, low, high, subtype, description in INPUTS:
+        if name in existing:
+            continue
+        item = group.interface.new_socket(name=name, in_out="INPUT", socket_type=kind)
+        item.default_value = default
+        item.description = description
+        if low is not None:
+            item.min_value, item.max_value = low, high
+        if subtype and hasattr(item, "subtype"):
+            item.subtype = subtype
+    if "Shader" not in existing:
+        group.interface.new_socket(name="Shader", in_out="OUTPUT", socket_type="NodeSocketShader")
+
+
+def _common(build: _Builder, fit):
+    """Group input/output nodes and the terms both tiers use."""
+    inputs = build.node("NodeGroupInput")
+    output = build.node("NodeGroupOutput")
+    w = inputs.outputs["Coverage"]
+    through = build.vector("SUBTRACT", (1.0, 1.0, 1.0), inputs.outputs["Foundation Absorption"],
+                           label="1 - A")
+    through2 = build.vector("MULTIPLY", through, through, label="(1 - A)^2")
+    skin = build.vector("MULTIPLY", inputs.outputs["Skin Tint"], tuple(fit.skin_albedo),
+                        label="skin albedo")
+    scale = build.math("MULTIPLY", inputs.outputs["Subsurface Scale"],
+                       inputs.outputs["Units per mm"], label="subsurface scale")
+    return inputs, output, w, through, through2, skin, scale
+
+
+def _build_principled(build: _Builder, fit, method: str, radius_mm, ior: float):
+    cf = lut_baker("closure_fit")
+    inputs, output, w, through, through2, skin, scale = _common(build, fit)
+    made_skin = build.vector("MULTIPLY", build.vector("MULTIPLY", through2, skin),
+                             tuple(fit.transmittance_mean**2), label="skin through film")
+    made_total = build.vector("ADD", build.vector("MULTIPLY", through, tuple(fit.film_albedo)),
+                              build.vector("ADD", made_skin, build.vector(
+                                  "MULTIPLY", through2, tuple(fit.gloss_to_diffuse))))
+    total = build.mix_vector(w, skin, made_total, label="diffuse albedo")
+    skin_part = build.mix_vector(w, skin, made_skin, label="skin part")
+    e_spec = build.mix_float(w, fit.specular_albedo_mean[0], fit.specular_albedo_mean[1])
+    attenuation = build.math("MULTIPLY",
+                             build.math("SUBTRACT", 1.0, build.math("MULTIPLY", w,
+                                                                     fit.coat_albedo_mean)),
+                             build.math("SUBTRACT", 1.0, e_spec), label="layer attenuation")
+    base = build.scale(total, build.math("DIVIDE", 1.0, attenuation), label="base colour")
+    share = build.vector("DOT_PRODUCT", build.vector("DIVIDE", skin_part, total),
+                         (1 / 3, 1 / 3, 1 / 3), label="subsurface weight")
+    mean_through2 = build.vector("DOT_PRODUCT", through2, (1 / 3, 1 / 3, 1 / 3))
+    level = build.mix_float(w, fit.specular_bare.level,
+                            build.math("MULTIPLY", mean_through2, fit.specular_film.level),
+                            label="specular level")
+    roughness = build.mix_float(w, fit.specular_bare.roughness, fit.specular_film.roughness)
+
+    bsdf = build.node("ShaderNodeBsdfPrincipled", "Made-up skin", distribution="GGX",
+                      subsurface_method=method)
+    values = {
+        "Base Color": base, "Roughness": roughness, "IOR": cf.SPECULAR_IOR,
+        "Specular IOR Level": level, "Coat Weight": w, "Coat Roughness": fit.coat.roughness,
+        "Coat IOR": fit.coat.ior, "Subsurface Weight": share,
+        "Subsurface Radius": tuple(map(float, radius_mm)), "Subsurface Scale": scale,
+        "Subsurface IOR": ior,
+    }
+    for name, value in values.items():
+        build.feed(bsdf.inputs[name], value)
+    build.tree.links.new(bsdf.outputs[0], output.inputs["Shader"])
+
+
+def _build_layered(build: _Builder, fit, lut, method: str, radius_mm, ior: float):
+    cf = lut_baker("closure_fit")
+    inputs, output, w, through, through2, skin, scale = _common(build, fit)
+    geometry = build.node("ShaderNodeNewGeometry")
+    cos_o = build.math("MAXIMUM", build.vector("DOT_PRODUCT", geometry.outputs["Incoming"],
+                                               geometry.outputs["Normal"]), 0.0,
+                       label="cos theta_o")
+    rows = {}
+    for j, name in enumerate(cf.LUT_ROWS):
+        coordinate = build.node("ShaderNodeCombineXYZ", f"u = cos, row {name}")
+        build.feed(coordinate.inputs["X"], cos_o)
+        build.feed(coordinate.inputs["Y"], (j + 0.5) / len(cf.LUT_ROWS))
+        texture = build.node("ShaderNodeTexImage", name, image=lut, interpolation="Linear",
+                             extension="EXTEND")
+        build.tree.links.new(coordinate.outputs[0], texture.inputs["Vector"])
+        rows[name] = texture.outputs["Color"]
+
+    def glossy(name, colour):
+        lobe = fit.glossy[name]
+        node = build.node("ShaderNodeBsdfGlossy", name.replace("_", " "),
+                          distribution=lobe.distribution)
+        build.feed(node.inputs["Color"], colour)
+        build.feed(node.inputs["Roughness"], lobe.roughness)
+        return node.outputs[0]
+
+    def subsurface(colour, label):
+        node = build.node("ShaderNodeSubsurfaceScattering", label, falloff=method)
+        build.feed(node.inputs["Color"], colour)
+        build.feed(node.inputs["Radius"], tuple(map(float, radius_mm)))
+        build.feed(node.inputs["Scale"], scale)
+        build.feed(node.inputs["IOR"], ior)
+        return node.outputs[0]
+
+    def add(a, b):
+        node = build.node("ShaderNodeAddShader")
+        build.tree.links.new(a, node.inputs[0])
+        build.tree.links.new(b, node.inputs[1])
+        return node.outputs[0]
+
+    film_diffuse = build.node("ShaderNodeBsdfDiffuse", "film diffuse")
+    build.feed(film_diffuse.inputs["Color"],
+               build.vector("MULTIPLY", through, tuple(fit.film_albedo)))
+    # The skin seen through the film: the medium keeps the skin's own (bright) colour, tinted
+    # by the film's absorption relative to its weakest channel, and the film's transmittances
+    # scale the closure as a whole.  A dark colour instead would make the random walk both
+    # noisy (14% against 1% at 32 samples) and wrongly short.
+    separate = build.node("ShaderNodeSeparateXYZ", "absorption channels")
+    build.feed(separate.inputs[0], through2)
+    strongest = build.math("MAXIMUM", separate.outputs[0],
+                           build.math("MAXIMUM", separate.outputs[1], separate.outputs[2]))
+    through_colour = build.scale(build.vector("MULTIPLY", through2, skin),
+                                 build.math("DIVIDE", 1.0, build.math("MAXIMUM", strongest,
+                                                                      1e-6)),
+                                 label="skin through film colour")
+    transmit = build.vector("DOT_PRODUCT", rows["film_transmittance"],
+                            tuple(fit.transmittance_mean / 3.0))
+    through_weight = build.math("MULTIPLY", transmit, strongest,
+                                label="(1 - A)^2 T(theta_o) T_mean")
+    weighted = build.node("ShaderNodeMixShader", "skin through film (weight)")
+    build.feed(socket(weighted.inputs, "Fac"), through_weight)
+    build.tree.links.new(subsurface(through_colour, "skin through film"),
+                         socket(weighted.inputs, "Shader_001"))
+    made_up = add(add(glossy("film_gloss", rows["film_gloss"]), film_diffuse.outputs[0]),
+                  add(glossy("path3_gloss", build.vector("MULTIPLY", rows["path3_gloss"],
+                                                         through2)),
+                      weighted.outputs[0]))
+    bare = add(glossy("skin_gloss", rows["skin_gloss"]), subsurface(skin, "bare skin"))
+    mix = build.node("ShaderNodeMixShader", "coverage (areal mix)")
+    build.feed(socket(mix.inputs, "Fac"), w)
+    build.tree.links.new(bare, socket(mix.inputs, "Shader"))
+    build.tree.links.new(made_up, socket(mix.inputs, "Shader_001"))
+    build.tree.links.new(mix.outputs[0], output.inputs["Shader"])
+
+
+def build_group(tier: str, key: str, fit, tables_image, group=None, *, lut_size=None):
+    """Create (or, given ``group``, rebuild in place) the node group of ``tier`` for the tables
+    stored in ``tables_image`` (key ``key``) and their :class:`ClosureFit` ``fit``."""
+    cf = lut_baker("closure_fit")
+    if tier not in cf.TIERS:
+        raise ValueError(f"tier must be one of {cf.TIERS}, got {tier!r}")
+    name = group_name(tier, key)
+    if group is None:
+        group = bpy.data.node_groups.get(name) or bpy.data.node_groups.new(name,
+                                                                           "ShaderNodeTree")
+    elif group.name != name and bpy.data.node_groups.get(name) is None:
+        group.name = name
+    _interface(group)
+    group.nodes.clear()
+    build = _Builder(group)
+    method = fit.subsurface_method
+    radius = fit.profiles[method].radius_mm
+    ior = fit.subsurface_ior
+    if tier == "PRINCIPLED":
+        _build_principled(build, fit, method, radius, ior)
+    else:
+        lut = storage.lut_image(storage.lut_image_name(key), fit.lut)
+        _build_layered(build, fit, lut, method, radius, ior)
+    group[FIT_KEY] = json.dumps({"key": key, "tier": tier, "tables": tables_image.name,
+                                 **fit.summary()}, default=float)
+    # An ID property holding the image counts as a user: the tables are saved with the group.
+    group[TABLES_REF] = tables_image
+    return group
+
+
+def set_inputs(node, values: dict) -> None:
+    """Set a group node's input socket values by name (unknown names are ignored)."""
+    for name, value in values.items():
+        target = node.inputs.get(name)
+        if target is None or target.is_linked:
+            continue
+        if target.type == "RGBA" and len(value) == 3:
+            value = (*value, 1.0)
+        target.default_value = value

@@ -1,0 +1,108 @@
+"""Operators: Apply, Check Tables, and the preset menu's add/remove operator."""
+
+from __future__ import annotations
+
+import bpy
+from bl_operators.presets import AddPresetBase
+
+from . import material as made_up
+from .package import lut_baker
+
+__all__ = ["MAKEUPSKIN_OT_apply", "MAKEUPSKIN_OT_check_tables", "MAKEUPSKIN_OT_add_preset",
+           "MAKEUPSKIN_MT_presets", "PRESET_SUBDIR", "register", "unregister"]
+
+PRESET_SUBDIR = "makeup_skin"
+"""Folder under Blender's ``presets`` where parameter sets are saved."""
+
+
+class _ObjectPoll:
+    @classmethod
+    def poll(cls, context):
+        obj = context.active_object
+        return obj is not None and obj.type in {"MESH", "CURVE", "SURFACE", "META", "FONT"}
+
+
+class MAKEUPSKIN_OT_apply(_ObjectPoll, bpy.types.Operator):
+    """Bake the tables, pack them into the file, build or reuse the Made-up Skin node group
+    and give the active object the material"""
+
+    bl_idname = "makeup_skin.apply"
+    bl_label = "Apply Made-up Skin"
+    bl_options = {"REGISTER", "UNDO"}
+
+    resolution: bpy.props.EnumProperty(
+        name="Resolution", items=(("SETTINGS", "From Settings", "The material's bake resolution"),
+                                  ("preview", "Preview", ""), ("default", "Default", ""),
+                                  ("high", "High", "")),
+        default="SETTINGS", options={"SKIP_SAVE"})
+
+    def execute(self, context):
+        obj = context.active_object
+        resolution = None if self.resolution == "SETTINGS" else self.resolution
+        try:
+            material, messages = made_up.apply_to_object(context, obj, resolution=resolution)
+        except (ValueError, RuntimeError) as error:
+            self.report({"ERROR"}, f"Made-up Skin: {error}")
+            return {"CANCELLED"}
+        for message in messages:
+            self.report({"WARNING"}, message)
+        self.report({"INFO"}, f"Made-up Skin: {material.name!r} applied to {obj.name!r}")
+        return {"FINISHED"}
+
+
+class MAKEUPSKIN_OT_check_tables(bpy.types.Operator):
+    """Check the tables packed for every Made-up Skin material; re-bake missing or broken ones"""
+
+    bl_idname = "makeup_skin.check_tables"
+    bl_label = "Check Made-up Skin Tables"
+    bl_options = {"REGISTER", "UNDO"}
+
+    def execute(self, context):
+        messages = []
+        for material in list(bpy.data.materials):
+            if material.makeup_skin.is_made_up:
+                try:
+                    messages += made_up.check_material(context, material)
+                except (ValueError, RuntimeError) as error:
+                    messages.append(f"Made-up Skin: {material.name!r} could not be re-baked: "
+                                    f"{error}")
+        for message in messages:
+            self.report({"WARNING"}, message)
+        if not messages:
+            self.report({"INFO"}, "Made-up Skin: all tables intact")
+        return {"FINISHED"}
+
+
+class MAKEUPSKIN_MT_presets(bpy.types.Menu):
+    bl_label = "Made-up Skin Presets"
+    preset_subdir = PRESET_SUBDIR
+    preset_operator = "script.execute_preset"
+    draw = bpy.types.Menu.draw_preset
+
+
+class MAKEUPSKIN_OT_add_preset(AddPresetBase, bpy.types.Operator):
+    """Save or remove a Made-up Skin parameter set"""
+
+    bl_idname = "makeup_skin.add_preset"
+    bl_label = "Add Made-up Skin Preset"
+    preset_menu = "MAKEUPSKIN_MT_presets"
+    preset_subdir = PRESET_SUBDIR
+    preset_defines = ["settings = bpy.context.material.makeup_skin"]
+    preset_values = [
+        "settings.foundation", "settings.skin", "settings.coverage", "settings.absorption_mode",
+        "settings.absorption", "settings.foundation_colour", "settings.skin_tint",
+        "settings.subsurface_scale", "settings.override_film", "settings.film_lobe_width",
+        "settings.film_ior", "settings.tier", "settings.resolution",
+    ]
+
+
+classes = (MAKEUPSKIN_OT_apply, MAKEUPSKIN_OT_check_tables, MAKEUPSKIN_MT_presets,
+           MAKEUPSKIN_OT_add_preset)
+
+
+_register, unregister = bpy.utils.register_classes_factory(classes)
+
+
+def register():
+    lut_baker()  # fail early (and clearly) if the bundled lut_baker cannot be imported
+    _register()

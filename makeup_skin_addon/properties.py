@@ -1,0 +1,171 @@
+"""The panel's settings: one :class:`MakeupSkinSettings` per material (``material.makeup_skin``).
+
+Coverage, absorption, skin tint and subsurface scale are socket values of the material's group
+node: moving them updates the material at once.  Foundation and skin presets, film overrides,
+tier and resolution change the tables: with live update on, moving them schedules a preview
+re-bake (:mod:`.live`); Apply bakes at full resolution.
+"""
+
+from __future__ import annotations
+
+import math
+
+import bpy
+
+from .package import lut_baker
+
+__all__ = ["MakeupSkinSettings", "register", "unregister", "TIER_ITEMS", "socket_values"]
+
+TIER_ITEMS = (
+    ("AUTO", "Auto", "Layered for Cycles, Principled otherwise (issue 5 makes this scene-aware)"),
+    ("PRINCIPLED", "Principled", "One Principled BSDF: coat = film, subsurface = skin; cheapest, "
+                                 "no images"),
+    ("LAYERED", "Layered", "Glossy, Diffuse and Subsurface closures with view-angle weights "
+                           "from a lookup image; closest to the tables in Cycles"),
+)
+RESOLUTION_ITEMS = (
+    ("preview", "Preview", "Coarse tables (fast bake, under 1% error)"),
+    ("default", "Default", "The bake's default resolution"),
+    ("high", "High", "Finer tables (slower bake)"),
+)
+
+
+def _foundation_items(self, context):
+    presets = lut_baker("presets")
+    return [(key, value["label"], f"Foundation shade {value['label']}")
+            for key, value in presets.FOUNDATIONS.items()]
+
+
+def _skin_items(self, context):
+    presets = lut_baker("presets")
+    return [(key, value["label"], f"Skin {value['label']}") for key, value in
+            presets.SKINS.items()]
+
+
+# Enum items must stay referenced while Blender shows them.
+_ITEMS_CACHE: dict[str, list] = {}
+
+
+def _cached(name, function):
+    def items(self, context):
+        _ITEMS_CACHE[name] = function(self, context)
+        return _ITEMS_CACHE[name]
+
+    return items
+
+
+def socket_values(settings) -> dict:
+    """Group-node socket values of the settings (by socket name)."""
+    return {
+        "Coverage": settings.coverage,
+        "Foundation Absorption": tuple(settings.effective_absorption()),
+        "Skin Tint": tuple(settings.skin_tint),
+        "Subsurface Scale": settings.subsurface_scale,
+    }
+
+
+def _update_sockets(self, context):
+    from . import live
+
+    live.sockets_changed(self)
+
+
+def _update_tables(self, context):
+    from . import live
+
+    live.tables_changed(self)
+
+
+def _update_foundation(self, context):
+    presets = lut_baker("presets")
+    entry = presets.FOUNDATIONS.get(self.foundation)
+    if entry is not None:
+        # Assigning runs _update_sockets once more: the shade reaches the material at once.
+        self.absorption = entry["absorption"]
+        self.foundation_colour = [1.0 - a for a in entry["absorption"]]
+
+
+class MakeupSkinSettings(bpy.types.PropertyGroup):
+    """Made-up skin parameters of one material."""
+
+    is_made_up: bpy.props.BoolProperty(
+        name="Made-up Skin Material", default=False,
+        description="This material's node tree was made by Apply (internal)")
+    foundation: bpy.props.EnumProperty(
+        name="Foundation", items=_cached("foundation", _foundation_items),
+        description="Foundation preset: the paper's measured film and its shades",
+        update=_update_foundation)
+    skin: bpy.props.EnumProperty(
+        name="Skin", items=_cached("skin", _skin_items),
+        description="Skin under the film: the paper's bio-plate or measured human skin",
+        update=_update_tables)
+    coverage: bpy.props.FloatProperty(
+        name="Coverage", default=1.0, min=0.0, max=1.0, subtype="FACTOR",
+        description="Fraction of the surface the film covers (0 bare skin, 1 full film); link "
+                    "a texture to the group's Coverage socket to paint it",
+        update=_update_sockets)
+    absorption_mode: bpy.props.EnumProperty(
+        name="Shade By", items=(("ABSORPTION", "Absorption", "Pigment absorption per channel"),
+                                ("COLOUR", "Colour", "Colour the pigment passes (1 - absorption)")),
+        default="ABSORPTION", update=_update_sockets)
+    absorption: bpy.props.FloatVectorProperty(
+        name="Absorption", size=3, default=(0.0, 0.0, 0.0), min=0.0, max=1.0, subtype="NONE",
+        description="Fraction of the light crossing the film's pigment absorbed, per R, G, B "
+                    "(the foundation's shade)", update=_update_sockets)
+    foundation_colour: bpy.props.FloatVectorProperty(
+        name="Foundation Colour", size=3, default=(1.0, 1.0, 1.0), min=0.0, max=1.0,
+        subtype="COLOR", description="Colour the pigment lets through (1 - absorption)",
+        update=_update_sockets)
+    skin_tint: bpy.props.FloatVectorProperty(
+        name="Skin Tint", size=3, default=(1.0, 1.0, 1.0), min=0.0, max=2.0, subtype="COLOR",
+        description="Multiplies the skin's diffuse albedo", update=_update_sockets)
+    subsurface_scale: bpy.props.FloatProperty(
+        name="Subsurface Scale", default=1.0, min=0.0, soft_max=4.0, max=100.0,
+        description="Multiplies the subsurface radius fitted to the skin's measured profile "
+                    "(1 = as measured, in millimetres converted by the scene's unit scale)",
+        update=_update_sockets)
+    override_film: bpy.props.BoolProperty(
+        name="Override Film", default=False,
+        description="Replace the film's measured roughness and index of refraction",
+        update=_update_tables)
+    film_lobe_width: bpy.props.FloatProperty(
+        name="Film Roughness", default=math.radians(30.4), min=math.radians(5.0),
+        max=math.radians(60.0), subtype="ANGLE", unit="ROTATION",
+        description="Width of the film's gloss lobe (1/n of the paper's Torrance-Sparrow "
+                    "lobe; measured 30.4 degrees; the transmission lobe scales with it)",
+        update=_update_tables)
+    film_ior: bpy.props.FloatProperty(
+        name="Film IOR", default=1.19, min=1.01, max=2.5,
+        description="Film index of refraction (measured 1.19)", update=_update_tables)
+    tier: bpy.props.EnumProperty(
+        name="Tier", items=TIER_ITEMS, default="AUTO",
+        description="Node group tier (cost against accuracy)", update=_update_tables)
+    resolution: bpy.props.EnumProperty(
+        name="Bake Resolution", items=RESOLUTION_ITEMS, default="default",
+        description="Resolution of the tables Apply bakes")
+    live_update: bpy.props.BoolProperty(
+        name="Live Update", default=True,
+        description="Re-bake at preview resolution while sliders move (Apply bakes in full)")
+
+    def effective_absorption(self):
+        """Absorption per channel, from the absorption or the colour field."""
+        if self.absorption_mode == "COLOUR":
+            return [1.0 - c for c in self.foundation_colour]
+        return list(self.absorption)
+
+
+classes = (MakeupSkinSettings,)
+
+
+_register_classes, _unregister_classes = bpy.utils.register_classes_factory(classes)
+
+
+def register():
+    _register_classes()
+    bpy.types.Material.makeup_skin = bpy.props.PointerProperty(type=MakeupSkinSettings)
+
+
+def unregister():
+    del bpy.types.Material.makeup_skin
+    _unregister_classes()
+    _ITEMS_CACHE.clear()

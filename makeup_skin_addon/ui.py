@@ -1,0 +1,124 @@
+"""Panels: Material properties and the shader editor's sidebar (tab "Made-up Skin")."""
+
+from __future__ import annotations
+
+import json
+
+import bpy
+
+from . import material as made_up
+from . import nodes
+from .operators import MAKEUPSKIN_MT_presets, MAKEUPSKIN_OT_add_preset
+
+__all__ = ["MAKEUPSKIN_PT_material", "MAKEUPSKIN_PT_node_editor", "draw_settings", "register",
+           "unregister"]
+
+
+def _errors_text(material) -> list[str]:
+    lines = []
+    try:
+        errors = json.loads(material.get(made_up.ERRORS_KEY, "{}"))
+    except ValueError:
+        errors = {}
+    for tier, error in errors.items():
+        lines.append(f"{tier.title()}: {100 * error['rms']:.1f}% RMS, "
+                     f"albedo {100 * error['albedo']:.1f}%")
+    return lines
+
+
+def draw_settings(layout, context) -> None:
+    """The panel body, shared by both panels."""
+    material = context.material
+    row = layout.row(align=True)
+    row.menu(MAKEUPSKIN_MT_presets.__name__, text=MAKEUPSKIN_MT_presets.bl_label)
+    row.operator(MAKEUPSKIN_OT_add_preset.bl_idname, text="", icon="ADD")
+    row.operator(MAKEUPSKIN_OT_add_preset.bl_idname, text="", icon="REMOVE").remove_active = True
+    if material is None:
+        layout.label(text="No material: Apply creates one")
+        layout.operator("makeup_skin.apply", icon="MATERIAL")
+        return
+    settings = material.makeup_skin
+    layout.use_property_split = True
+    layout.use_property_decorate = False
+    col = layout.column()
+    col.prop(settings, "foundation")
+    col.prop(settings, "coverage", slider=True)
+    col.prop(settings, "absorption_mode", expand=True)
+    if settings.absorption_mode == "COLOUR":
+        col.prop(settings, "foundation_colour")
+    else:
+        col.prop(settings, "absorption", text="Absorption RGB")
+    col.separator()
+    col.prop(settings, "skin")
+    col.prop(settings, "skin_tint")
+    col.prop(settings, "subsurface_scale")
+    col.separator()
+    col.prop(settings, "override_film")
+    sub = col.column()
+    sub.active = settings.override_film
+    sub.prop(settings, "film_lobe_width")
+    sub.prop(settings, "film_ior")
+    col.separator()
+    col.prop(settings, "tier")
+    if settings.tier == "AUTO":
+        col.label(text=f"Auto: {made_up.resolve_tier(settings, context.scene).title()}",
+                  icon="INFO")
+    col.prop(settings, "resolution")
+    col.prop(settings, "live_update")
+    layout.operator("makeup_skin.apply", icon="MATERIAL")
+    node = made_up.group_of(material)
+    if node is not None and node.node_tree is not None:
+        box = layout.box()
+        box.label(text=f"Group: {node.node_tree.name}", icon="NODETREE")
+        try:
+            meta = json.loads(node.node_tree.get(nodes.FIT_KEY, "{}"))
+        except ValueError:
+            meta = {}
+        if meta:
+            radius = meta.get("profiles", {}).get(meta.get("subsurface_method"), {})
+            radius = radius.get("radius_mm", [])
+            box.label(text=f"Subsurface: {meta.get('subsurface_method', '?').title()}, radius "
+                           + " ".join(f"{r:.2f}" for r in radius) + " mm")
+        lines = _errors_text(material)
+        if lines:
+            box.label(text="Angular error against the tables:")
+            for line in lines:
+                box.label(text=line)
+        box.operator("makeup_skin.check_tables", icon="CHECKMARK")
+
+
+class _SettingsPanel:
+    """Shared body: :func:`draw_settings`."""
+
+    bl_label = "Made-up Skin"
+
+    def draw(self, context):
+        draw_settings(self.layout, context)
+
+
+class MAKEUPSKIN_PT_material(_SettingsPanel, bpy.types.Panel):
+    bl_idname = "MAKEUPSKIN_PT_material"
+    bl_space_type = "PROPERTIES"
+    bl_region_type = "WINDOW"
+    bl_context = "material"
+
+    @classmethod
+    def poll(cls, context):
+        return context.active_object is not None
+
+
+class MAKEUPSKIN_PT_node_editor(_SettingsPanel, bpy.types.Panel):
+    bl_idname = "MAKEUPSKIN_PT_node_editor"
+    bl_space_type = "NODE_EDITOR"
+    bl_region_type = "UI"
+    bl_category = "Made-up Skin"
+
+    @classmethod
+    def poll(cls, context):
+        space = context.space_data
+        return (space is not None and getattr(space, "tree_type", "") == "ShaderNodeTree"
+                and context.active_object is not None)
+
+
+classes = (MAKEUPSKIN_PT_material, MAKEUPSKIN_PT_node_editor)
+register, unregister = bpy.utils.register_classes_factory(classes)

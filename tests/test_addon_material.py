@@ -1,0 +1,260 @@
+"""The add-on from the source tree, headless: Apply, render, reuse, save/reload, repair, live.
+
+Renders are Cycles CPU, 64x64 px, 16 samples (about 0.3 s each).  The add-on is registered
+from this checkout (``makeup_skin_addon`` as a top-level package) for the module and always
+unregistered after it: bpy 4.5 hangs at exit while an add-on's classes stay registered.
+"""
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+SIZE = 64
+
+
+@pytest.fixture(scope="module")
+def addon(bpy_factory):
+    import makeup_skin_addon
+
+    makeup_skin_addon.register()
+    yield makeup_skin_addon
+    makeup_skin_addon.unregister()
+
+
+@pytest.fixture
+def sphere(addon, blank_scene):
+    """A smooth sphere (radius 3 cm), an orthographic camera, a sun 60 degrees off the view
+    from +x, black world, Cycles CPU at 16 samples."""
+    import bpy
+
+    scene = blank_scene
+    bpy.ops.mesh.primitive_uv_sphere_add(segments=48, ring_count=24, radius=0.03)
+    obj = bpy.context.active_object
+    bpy.ops.object.shade_smooth()
+    camera = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
+    scene.collection.objects.link(camera)
+    camera.data.type = "ORTHO"
+    camera.data.ortho_scale = 0.066
+    camera.location = (0.0, -0.3, 0.0)
+    camera.rotation_euler = (math.pi / 2, 0.0, 0.0)
+    scene.camera = camera
+    sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
+    scene.collection.objects.link(sun)
+    sun.data.energy = math.pi
+    sun.data.angle = 0.0
+    sun.rotation_euler = (math.pi / 2, 0.0, math.radians(60.0))
+    scene.world = bpy.data.worlds.new("Black")
+    scene.world.color = (0.0, 0.0, 0.0)
+    for node in (scene.world.node_tree.nodes if scene.world.node_tree else ()):
+        if node.type == "BACKGROUND":
+            node.inputs["Strength"].default_value = 0.0
+    scene.render.engine = "CYCLES"
+    scene.cycles.device = "CPU"
+    scene.cycles.samples = 16
+    scene.cycles.seed = 0
+    scene.cycles.use_denoising = False
+    scene.render.resolution_x = scene.render.resolution_y = SIZE
+    scene.render.resolution_percentage = 100
+    return obj
+
+
+def _render(tmp_path, name="render"):
+    """Render the scene to a float EXR and return its RGB pixels (rows bottom-up)."""
+    import bpy
+
+    scene = bpy.context.scene
+    scene.render.image_settings.file_format = "OPEN_EXR"
+    scene.render.image_settings.color_depth = "32"
+    scene.render.filepath = str(tmp_path / f"{name}.exr")
+    bpy.ops.render.render(write_still=True)
+    image = bpy.data.images.load(scene.render.filepath)
+    pixels = np.array(image.pixels[:], dtype=np.float32).reshape(SIZE, SIZE, 4)[..., :3]
+    bpy.data.images.remove(image)
+    return pixels
+
+
+def _apply(obj, tier="PRINCIPLED", resolution="preview", **settings):
+    """Apply through the operator; returns the material.  The operator's reports go to the
+    returned material's ``last_messages`` list (warnings only)."""
+    import bpy
+
+    from makeup_skin_addon import material as made_up
+
+    if obj.active_material is None:
+        obj.data.materials.append(bpy.data.materials.new("Skin"))
+    values = obj.active_material.makeup_skin
+    values.tier = tier
+    values.resolution = resolution
+    for name, value in settings.items():
+        setattr(values, name, value)
+    material, messages = made_up.apply_to_object(bpy.context, obj)
+    _apply.messages = messages
+    return material
+
+
+def _counts():
+    import bpy
+
+    return (len(bpy.data.node_groups), len(bpy.data.images), len(bpy.data.materials))
+
+
+@pytest.mark.parametrize("tier", ["PRINCIPLED", "LAYERED"])
+def test_apply_and_render(sphere, tmp_path, tier):
+    material = _apply(sphere, tier)
+    assert material.makeup_skin.is_made_up
+    group = material.node_tree.nodes["Made-up Skin"].node_tree
+    assert group.name.startswith(f"Made-up Skin {tier.title()}")
+    meta = json.loads(group["makeup_skin_fit"])
+    assert meta["tier"] == tier and meta["subsurface_method"] in ("BURLEY", "RANDOM_WALK_SKIN")
+    errors = json.loads(material["makeup_skin_errors"])
+    assert set(errors) == {"PRINCIPLED", "LAYERED"}
+    pixels = _render(tmp_path)
+    assert np.all(np.isfinite(pixels)) and pixels.min() >= 0.0
+    disc = pixels.mean(axis=-1) > 1e-4
+    assert 0.4 < disc.mean() < 0.9  # the sphere fills the middle of the frame
+    # Plausible brightness: a sun of irradiance pi on a surface of albedo ~0.7.
+    assert 0.05 < pixels[disc].mean() < 0.8
+    # The sun is 60 degrees towards +x: the right half is brighter than the left.
+    left, right = pixels[:, : SIZE // 2][disc[:, : SIZE // 2]], pixels[:, SIZE // 2:][
+        disc[:, SIZE // 2:]]
+    assert right.mean() > 1.5 * left.mean()
+
+
+def test_apply_operator_and_twice_creates_no_duplicates(sphere):
+    import bpy
+
+    sphere.data.materials.append(bpy.data.materials.new("Skin"))
+    sphere.active_material.makeup_skin.tier = "LAYERED"
+    sphere.active_material.makeup_skin.resolution = "preview"
+    assert bpy.ops.makeup_skin.apply() == {"FINISHED"}
+    before = _counts()
+    material = _apply(sphere, "LAYERED")
+    assert _apply.messages == []  # the stored tables were found intact
+    assert _counts() == before
+    assert sphere.active_material == material
+    assert len(sphere.material_slots) == 1
+
+
+def test_coverage_and_absorption_are_sockets(sphere):
+    material = _apply(sphere, "PRINCIPLED")
+    node = material.node_tree.nodes["Made-up Skin"]
+    groups = _counts()[0]
+    material.makeup_skin.coverage = 0.25
+    material.makeup_skin.absorption = (0.1, 0.3, 0.5)
+    assert node.inputs["Coverage"].default_value == pytest.approx(0.25)
+    assert tuple(node.inputs["Foundation Absorption"].default_value)[:3] == pytest.approx(
+        (0.1, 0.3, 0.5))
+    material.makeup_skin.foundation = "deep_mocha"  # sets the shade's absorption
+    from lut_baker.presets import FOUNDATIONS
+
+    assert tuple(node.inputs["Foundation Absorption"].default_value)[:3] == pytest.approx(
+        FOUNDATIONS["deep_mocha"]["absorption"])
+    assert _counts()[0] == groups  # no re-bake for socket-level settings
+
+
+def test_scene_unit_scale_sets_the_blur(sphere):
+    import bpy
+
+    bpy.context.scene.unit_settings.scale_length = 0.01  # modelled in centimetres
+    material = _apply(sphere, "PRINCIPLED")
+    node = material.node_tree.nodes["Made-up Skin"]
+    assert node.inputs["Units per mm"].default_value == pytest.approx(0.1)
+
+
+def test_save_reload_renders_the_same_and_keeps_tables_packed(sphere, tmp_path):
+    import bpy
+
+    from makeup_skin_addon import storage
+
+    _apply(sphere, "LAYERED")
+    first = _render(tmp_path, "first")
+    path = tmp_path / "made_up.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(path))
+    bpy.ops.wm.open_mainfile(filepath=str(path), load_ui=False)
+    tables = [image for image in bpy.data.images if image.name.startswith("MakeupSkin Tables")]
+    luts = [image for image in bpy.data.images if image.name.startswith("MakeupSkin LUT")]
+    assert len(tables) == 1 and len(luts) == 1
+    assert tables[0].packed_file is not None and luts[0].packed_file is not None
+    storage.unpack_tables(tables[0])  # intact after the round trip
+    second = _render(tmp_path, "second")
+    np.testing.assert_array_equal(first, second)
+
+
+def _tables_image():
+    import bpy
+
+    return next(image for image in bpy.data.images if image.name.startswith("MakeupSkin Tables"))
+
+
+def test_broken_tables_are_reported_and_rebaked(sphere):
+    import bpy
+
+    from makeup_skin_addon import material as made_up
+    from makeup_skin_addon import storage
+
+    material = _apply(sphere, "PRINCIPLED")
+    image = _tables_image()
+    pixels = np.zeros(len(image.pixels), np.float32)
+    image.pixels.foreach_get(pixels)
+    pixels[:100] += 1.0
+    image.pixels.foreach_set(pixels)  # altered in memory: the checksum no longer matches
+    with pytest.raises(storage.StorageError, match="altered"):
+        storage.unpack_tables(image)
+    messages = made_up.check_material(bpy.context, material)
+    assert messages and "altered" in messages[0] and "re-baking" in messages[0]
+    storage.unpack_tables(_tables_image())  # re-baked and intact
+    assert made_up.check_material(bpy.context, material) == []
+    # Deleted tables: the operator reports and re-bakes, never raises.
+    bpy.data.images.remove(_tables_image())
+    assert bpy.ops.makeup_skin.check_tables() == {"FINISHED"}
+    storage.unpack_tables(_tables_image())
+
+
+def test_apply_reports_broken_tables_and_replaces_them(sphere):
+    from makeup_skin_addon import storage
+
+    _apply(sphere, "PRINCIPLED")
+    image = _tables_image()
+    image["makeup_skin_tables"] = "{not json"
+    _apply(sphere, "PRINCIPLED")  # must not raise
+    assert len(_apply.messages) == 1 and "unreadable description" in _apply.messages[0]
+    storage.unpack_tables(_tables_image())
+
+
+def test_live_update_rebakes_at_preview_resolution(sphere):
+    import bpy
+
+    from makeup_skin_addon import live
+
+    material = _apply(sphere, "PRINCIPLED", resolution="preview")
+    node = material.node_tree.nodes["Made-up Skin"]
+    before = node.node_tree["makeup_skin_fit"]
+    material.makeup_skin.skin = "jensen_skin2"  # changes the tables
+    assert material.name in live.pending()
+    assert live.flush(bpy.context) == []
+    assert not live.pending()
+    after = node.node_tree["makeup_skin_fit"]
+    assert json.loads(after)["key"] != json.loads(before)["key"]
+    assert not bpy.app.timers.is_registered(live._timer)
+
+
+def test_unregister_leaves_nothing(addon, bpy_factory):
+    import bpy
+
+    from makeup_skin_addon import live
+
+    def ours():
+        # Panels and menus by class name; operators by bl_idname (MAKEUP_SKIN_OT_apply).
+        return [name for name in dir(bpy.types) if name.startswith(("MAKEUPSKIN", "MAKEUP_SKIN"))]
+
+    assert len(ours()) == 6 and hasattr(bpy.types.Material, "makeup_skin")
+    addon.unregister()
+    try:
+        assert not hasattr(bpy.types.Material, "makeup_skin")
+        assert ours() == []
+        assert not bpy.app.timers.is_registered(live._timer)
+        assert live.pending() == set()
+    finally:
+        addon.register()

@@ -1,0 +1,212 @@
+"""Render a reference sphere with the Made-up Skin node group (Cycles, CPU, bpy as a module).
+
+Usage::
+
+    python tools/render_sphere.py --tables out/ --out out/sphere.png [--tier LAYERED]
+    python tools/render_sphere.py --foundation medium_beige --skin jensen_skin1 --out x.png
+
+``--tables`` takes a folder (its one ``*.exr`` written by ``python -m lut_baker bake``) or the
+``.exr`` itself; without it the tables are baked from ``--foundation``/``--skin``.  Writes the
+PNG (view transform Standard) and a float32 OpenEXR beside it (same stem), then prints one line
+with the render time.  Run it with the venv's python (``$(tools/venv.sh)/bin/python``).
+
+Scene: a smooth UV sphere of ``--radius-mm`` millimetres (scene in metres), an orthographic
+camera looking at it, one sun (angle 0, irradiance ``pi`` W/m^2, so a white Lambertian surface
+facing it is 1.0) ``--light-deg`` degrees from the view direction towards +x, black world, no
+denoiser, film exposure 1.
+
+Functions (for other scripts, e.g. the benchmarks of issue 5):
+
+- :func:`build_scene` -- the sphere, camera, sun and render settings in the current file.
+- :func:`addon_registered` -- the add-on from this checkout, registered for a ``with`` block.
+- :func:`made_up_material` -- a material with the group for given tables and tier.
+- :func:`render` -- render to PNG and EXR; returns seconds.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import math
+import os
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+REPO_ROOT = Path(__file__).resolve().parent.parent
+if str(REPO_ROOT) not in sys.path:
+    sys.path.insert(0, str(REPO_ROOT))
+
+__all__ = ["build_scene", "addon_registered", "made_up_material", "render", "load_or_bake",
+           "main"]
+
+IRRADIANCE = math.pi
+"""Sun strength (W/m^2): a white Lambertian surface facing the sun renders as 1.0."""
+
+
+def load_or_bake(tables_path=None, foundation="paper_natural", skin="paper_bioplate",
+                 resolution="default"):
+    """Tables from a file or folder written by ``python -m lut_baker bake``, else baked."""
+    from lut_baker import bake, io, presets
+
+    if tables_path is not None:
+        path = Path(tables_path)
+        if path.is_dir():
+            found = sorted(path.glob("*.exr"))
+            if len(found) != 1:
+                raise SystemExit(f"render_sphere: expected one .exr in {path}, found "
+                                 f"{len(found)}; pass the file itself")
+            path = found[0]
+        try:
+            return io.load_tables(path)
+        except io.TableFileError as error:
+            raise SystemExit(f"render_sphere: {error}") from None
+    return bake.bake(presets.made_up_skin(foundation, skin), resolution)
+
+
+def build_scene(*, size=128, samples=64, radius_mm=30.0, light_deg=45.0, seed=0):
+    """Sphere, camera, sun and Cycles settings in a fresh file; returns the sphere object."""
+    import bpy
+
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    scene = bpy.context.scene
+    scene.unit_settings.system = "METRIC"
+    scene.unit_settings.scale_length = 1.0
+    radius = radius_mm * 1e-3
+    bpy.ops.mesh.primitive_uv_sphere_add(segments=128, ring_count=64, radius=radius)
+    sphere = bpy.context.active_object
+    bpy.ops.object.shade_smooth()
+    camera = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
+    scene.collection.objects.link(camera)
+    camera.data.type = "ORTHO"
+    camera.data.ortho_scale = 2.2 * radius
+    camera.location = (0.0, -10.0 * radius, 0.0)
+    camera.rotation_euler = (math.pi / 2, 0.0, 0.0)
+    scene.camera = camera
+    sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
+    scene.collection.objects.link(sun)
+    sun.data.energy = IRRADIANCE
+    sun.data.angle = 0.0
+    # The sun shines along -Z of its object; turn it to come from the camera side, rotated
+    # light_deg towards +x about the vertical axis.
+    sun.rotation_euler = (math.pi / 2, 0.0, math.radians(light_deg))
+    world = bpy.data.worlds.new("Black")
+    world.color = (0.0, 0.0, 0.0)
+    for node in (world.node_tree.nodes if world.node_tree is not None else ()):
+        if node.type == "BACKGROUND":  # 5.0 gives new worlds a node tree
+            node.inputs["Strength"].default_value = 0.0
+    scene.world = world
+    scene.render.engine = "CYCLES"
+    scene.cycles.device = "CPU"
+    scene.cycles.samples = samples
+    scene.cycles.seed = seed
+    scene.cycles.use_denoising = False
+    scene.cycles.film_exposure = 1.0
+    scene.render.resolution_x = scene.render.resolution_y = size
+    scene.render.resolution_percentage = 100
+    scene.view_settings.view_transform = "Standard"
+    scene.view_settings.look = "None"
+    return sphere
+
+
+@contextlib.contextmanager
+def addon_registered():
+    """The add-on from this checkout registered for the duration (bpy 4.5 hangs at exit while
+    an add-on's classes stay registered, so always leave through here)."""
+    import bpy
+
+    import makeup_skin_addon
+
+    if hasattr(bpy.types.Material, "makeup_skin"):
+        yield
+        return
+    makeup_skin_addon.register()
+    try:
+        yield
+    finally:
+        makeup_skin_addon.unregister()
+
+
+def made_up_material(obj, tables, tier="LAYERED", *, coverage=None, absorption=None):
+    """Give ``obj`` a material with the Made-up Skin group for ``tables`` (the add-on must be
+    registered: :func:`addon_registered`).  Coverage and absorption default to the tables'."""
+    import bpy
+
+    from makeup_skin_addon import material as made_up
+
+    material = bpy.data.materials.new(made_up.MATERIAL_NAME)
+    obj.data.materials.append(material)
+    settings = material.makeup_skin
+    settings.is_made_up = True
+    settings.live_update = False
+    settings.tier = tier
+    settings.coverage = tables.parameters.get("coverage", 1.0) if coverage is None else coverage
+    absorption = tables.parameters.get("absorption", 0.0) if absorption is None else absorption
+    settings.absorption = [absorption] * 3 if isinstance(absorption, float) else absorption
+    group, _ = made_up.group_for_tables(tables, tier, errors_at=(settings.coverage,
+                                                                 list(settings.absorption)))
+    made_up.setup_material(material, group, bpy.context.scene)
+    return material
+
+
+def render(png_path) -> float:
+    """Render the current scene; write ``png_path`` and the float EXR beside it; seconds."""
+    import bpy
+
+    scene = bpy.context.scene
+    png_path = Path(png_path)
+    png_path.parent.mkdir(parents=True, exist_ok=True)
+    start = time.perf_counter()
+    bpy.ops.render.render()
+    seconds = time.perf_counter() - start
+    result = bpy.data.images["Render Result"]
+    settings = scene.render.image_settings
+    settings.file_format = "PNG"
+    settings.color_mode = "RGBA"
+    settings.color_depth = "8"
+    result.save_render(str(png_path), scene=scene)
+    settings.file_format = "OPEN_EXR"
+    settings.color_depth = "32"
+    settings.exr_codec = "ZIP"
+    result.save_render(str(png_path.with_suffix(".exr")), scene=scene)
+    return seconds
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--tables", metavar="PATH",
+                        help="tables folder or .exr from 'python -m lut_baker bake'")
+    parser.add_argument("--foundation", default="paper_natural",
+                        help="foundation preset when baking here (default paper_natural)")
+    parser.add_argument("--skin", default="paper_bioplate",
+                        help="skin preset when baking here (default paper_bioplate)")
+    parser.add_argument("--out", required=True, metavar="PNG", help="output PNG (EXR beside)")
+    parser.add_argument("--tier", default="LAYERED", choices=("PRINCIPLED", "LAYERED"))
+    parser.add_argument("--coverage", type=float, help="0..1 (default: the tables')")
+    parser.add_argument("--absorption", type=float, nargs=3, metavar=("R", "G", "B"),
+                        help="per-channel absorption 0..1 (default: the tables')")
+    parser.add_argument("--size", type=int, default=128, help="pixels (square), default 128")
+    parser.add_argument("--samples", type=int, default=64, help="Cycles samples, default 64")
+    parser.add_argument("--radius-mm", type=float, default=30.0,
+                        help="sphere radius in millimetres, default 30")
+    parser.add_argument("--light-deg", type=float, default=45.0,
+                        help="angle between light and view direction, degrees, default 45")
+    parser.add_argument("--seed", type=int, default=0, help="Cycles seed")
+    args = parser.parse_args(argv)
+    os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="render_sphere_"))
+    tables = load_or_bake(args.tables, args.foundation, args.skin)
+    sphere = build_scene(size=args.size, samples=args.samples, radius_mm=args.radius_mm,
+                         light_deg=args.light_deg, seed=args.seed)
+    with addon_registered():
+        made_up_material(sphere, tables, args.tier, coverage=args.coverage,
+                         absorption=args.absorption)
+        seconds = render(args.out)
+    print(f"render_sphere: {args.tier} {args.size}x{args.size} px, {args.samples} samples, "
+          f"light {args.light_deg:g} deg: {seconds:.2f} s -> {args.out} + "
+          f"{Path(args.out).with_suffix('.exr').name}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
