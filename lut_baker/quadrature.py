@@ -26,11 +26,14 @@ __all__ = [
     "fourier_kernel",
     "azimuth_convolution_factor",
     "relative_azimuth",
+    "grazing_azimuth_width_deg",
 ]
 
 GAUSS_POINTS_PER_PANEL = 8
 WIDEST_PANEL_DEG = 22.5
 """Panels are never wider than this, so the G kink of broad lobes still converges."""
+GRAZING_DEG = 89.0
+"""The most grazing direction the evaluator promises to resolve (issue 2: to 89 degrees)."""
 NARROWEST_LOBE_DEG = 5.0
 """Lobes narrower than this (n > 0.2 / degree) are not resolved further: the grid would cost
 O(width^-4).  The exact evaluator reports them as not converged rather than guess."""
@@ -64,7 +67,9 @@ def hemisphere_grid(lobe_width_deg: float = 90.0, level: int = 0) -> HemisphereG
 
     Polar angle: ``[0, 90]`` degrees cut into panels no wider than 1.5 lobe widths (and
     22.5 degrees), each with 8 Gauss-Legendre nodes; azimuth: at least 4 samples per lobe width
-    at the horizon, where a lobe is narrowest in azimuth.  Each ``level`` doubles both.  Widths
+    and at least one per the lobe's azimuthal width at 89 degrees
+    (:func:`grazing_azimuth_width_deg`), where two grazing directions make a lobe narrowest
+    in azimuth.  Each ``level`` doubles both.  Widths
     below ``NARROWEST_LOBE_DEG`` are clamped to it.
     """
     if not np.isfinite(lobe_width_deg) or lobe_width_deg <= 0:
@@ -80,9 +85,24 @@ def hemisphere_grid(lobe_width_deg: float = 90.0, level: int = 0) -> HemisphereG
     theta = (mid[:, None] + half[:, None] * x[None, :]).ravel()
     dtheta = (half[:, None] * w[None, :]).ravel()
     weight = np.cos(theta) * np.sin(theta) * dtheta
-    samples_per_turn = max(64, int(np.ceil(4 * 360.0 / width)))
+    samples_per_turn = max(64, int(np.ceil(4 * 360.0 / width)),
+                           int(np.ceil(360.0 / grazing_azimuth_width_deg(width))))
+    samples_per_turn += samples_per_turn % 2  # even, so n_phi is odd (no Nyquist order)
     n_phi = samples_per_turn * 2**level + 1
     return HemisphereGrid(theta=theta, weight=weight, n_phi=n_phi)
+
+
+def grazing_azimuth_width_deg(lobe_width_deg: float, theta_deg: float = GRAZING_DEG) -> float:
+    """Azimuthal width (degrees) of a lobe of half-vector width ``lobe_width_deg`` around the
+    mirror (or straight-through) direction when both directions lie at ``theta_deg``.
+
+    Both near the horizon, ``h ~ (sin t * dphi, 2 cos t)`` so the lobe spans only
+    ``dphi ~ 2 cos(t) tan(width)``: far narrower than ``width`` itself (0.35 degrees for a
+    10 degree lobe at 89 degrees).  Widths beyond 45 degrees are taken as 45 (such lobes cover
+    the hemisphere anyway).
+    """
+    width = np.radians(min(float(lobe_width_deg), 45.0))
+    return float(np.degrees(2.0 * np.cos(np.radians(theta_deg)) * np.tan(width)))
 
 
 def direction(theta, phi) -> np.ndarray:
