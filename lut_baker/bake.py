@@ -585,11 +585,9 @@ def error_samples(skin: MadeUpSkin, n_points: int = 500, seed: int = 0, *, level
     """``n_points`` random points (grazing rows included, polar angles up to
     ``theta_max_deg``) and the exact evaluator there: paths 1 + 3
     (:func:`lut_baker.normalise.made_up_reflection`) and path 4's factor at ``level``, the
-    directional albedo at ``albedo_level`` (default ``level + 1``: at level 0 the film gloss's
-    albedo is 3% low at 89 degrees, its lobe being ~1 degree wide in azimuth there, which moves
-    the total by 1.3e-3; ``albedo_points`` of them, default all, as level 1 is slow), and
-    R(d)/Rd on [0, :func:`profile_radius`] (denser near 0)."""
-    albedo_level = level + 1 if albedo_level is None else albedo_level
+    directional albedo at ``albedo_level`` (default ``level``) on the first ``albedo_points``
+    of them (default all), and R(d)/Rd on [0, :func:`profile_radius`] (denser near 0)."""
+    albedo_level = level if albedo_level is None else albedo_level
     rng = np.random.default_rng(seed)
     wi, wo = _sample_directions(n_points, rng, theta_max_deg)
     theta = rng.uniform(0.0, theta_max_deg, n_points)

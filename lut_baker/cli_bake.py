@@ -131,9 +131,14 @@ class _Progress:
 
 def run(args) -> int:
     from .bake import bake
-    from .io import content_hash, save_tables
+    from .io import _oiio, content_hash, save_tables
 
     skin = skin_from_args(args)
+    try:
+        _oiio()  # before the bake: without it nothing can be written
+    except ImportError as error:
+        print(f"python -m lut_baker bake: error: {error}", file=sys.stderr)
+        return 1
     stem = args.name or re.sub(r"[^A-Za-z0-9._+-]", "_", skin.name)
     progress = _Progress()
     start = time.perf_counter()

@@ -8,7 +8,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from lut_baker import bake, layers, model, normalise, presets, quadrature, tables
+from lut_baker import bake, layers, model, normalise, presets, tables
 from lut_baker.quadrature import direction
 
 
@@ -19,8 +19,9 @@ def paper():
 
 @pytest.fixture(scope="module")
 def samples(paper):
-    # reflection at level 0, albedo at level 1 (level 0 is 1.3e-3 off at 89 degrees)
-    return bake.error_samples(paper, n_points=500, seed=0)
+    # the exact evaluator at level 0 (within 1e-4 of level 2 for the film gloss's albedo at
+    # 89 degrees); the albedo, the slow part, on 100 of the 500 points
+    return bake.error_samples(paper, n_points=500, seed=0, albedo_points=100)
 
 
 @pytest.fixture(scope="module")
@@ -69,8 +70,8 @@ def test_layered_matrices_with_fast_kernels_equal_the_default(paper):
 def test_skin_diffuse_part_of_path3_is_pd_times_both_transmittances(paper):
     """Int Int f_t P_d f_t cos cos = P_d T(wi) T(wo): the split the tables rely on."""
     rng = np.random.default_rng(3)
-    wi = direction(np.radians(rng.uniform(0, 89, 40)), rng.uniform(0, 2 * np.pi, 40))
-    wo = direction(np.radians(rng.uniform(0, 89, 40)), rng.uniform(0, 2 * np.pi, 40))
+    wi = direction(np.radians(rng.uniform(0, 89, 20)), rng.uniform(0, 2 * np.pi, 20))
+    wo = direction(np.radians(rng.uniform(0, 89, 20)), rng.uniform(0, 2 * np.pi, 20))
     diffuse_only = paper.skin.scaled(P_s=0.0)
     path3 = layers.layered_reflection(wi, wo, paper.film_transmission, diffuse_only)
     t_i = layers.film_transmittance(wi, paper.film_transmission)
@@ -214,8 +215,8 @@ def test_rgb_skin_bakes_per_channel():
     t = bake.bake(skin, "preview")
     assert t.skin_diffuse.shape == (3,) and len(set(t.skin_diffuse.tolist())) == 3
     assert len(set(t.profile[1].tolist())) == 3
-    error = bake.table_error(t, samples=bake.error_samples(skin, n_points=100, seed=2,
-                                                           albedo_level=0))
+    error = bake.table_error(t, samples=bake.error_samples(skin, n_points=60, seed=2,
+                                                           albedo_points=10))
     assert error["max"] < 1e-2, error
 
 
@@ -340,9 +341,3 @@ def test_lookups_are_reciprocal(default_tables):
     wo = direction(np.radians(rng.uniform(0, 89, 50)), rng.uniform(0, 2 * np.pi, 50))
     np.testing.assert_allclose(default_tables.made_up_reflection(wi, wo),
                                default_tables.made_up_reflection(wo, wi), rtol=1e-12)
-
-
-def test_quadrature_module_is_untouched_by_the_bake():
-    """The bake's coarse grid is its own; the exact evaluator's grid is unchanged."""
-    grid = quadrature.hemisphere_grid(25.0, 0)
-    assert grid.theta.size == 32 and grid.n_phi == 65

@@ -121,6 +121,14 @@ def test_invalid_parameter_files_exit_2_naming_params(capsys, text, message, tmp
     assert not (tmp_path / "out").exists()
 
 
+def test_missing_openimageio_is_one_clear_line(capsys, monkeypatch, tmp_path):
+    monkeypatch.setitem(sys.modules, "OpenImageIO", None)  # import fails
+    assert cli.main(["bake", "--resolution", "preview", "--out", str(tmp_path)]) == 1
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "needs OpenImageIO" in err and "pip install" in err
+    assert not any(tmp_path.iterdir())
+
+
 def test_help_explains_every_option_with_units():
     result = run_cli("--help")
     assert result.returncode == 0
