@@ -32,8 +32,9 @@ Functions and types
 - :func:`relative_rms`, :func:`albedo_error`, :func:`view_albedo` -- the error measures.
 - :func:`golden_minimum` -- 1-D bounded minimisation (golden section).
 - :func:`fit_coat`, :func:`fit_specular`, :func:`fit_glossy` -- GGX lobes fitted to a table.
+- :func:`edge_response` -- a radial profile's response to a straight shadow edge.
 - :func:`fit_profile`, :func:`fit_profiles` -- Subsurface Radius per channel for a Blender
-  subsurface method, fitted to the radial profile.
+  subsurface method, fitted to the radial profile's edge response.
 - :func:`lut_nodes`, :func:`sample_lut` -- the 1-D image's texel centres and its sampling.
 - :class:`LobeFit`, :class:`ProfileFit`, :class:`TierError`, :class:`ClosureFit`.
 - :func:`fit_closures` -- every fit of one set of tables.
@@ -70,6 +71,7 @@ __all__ = [
     "fit_coat",
     "fit_specular",
     "fit_glossy",
+    "edge_response",
     "fit_profile",
     "fit_profiles",
     "subsurface_ior",
@@ -99,6 +101,11 @@ SPECULAR_LEVEL_RANGE = (0.0, 8.0)
 """Specular IOR Level searched (0.5 leaves IOR 1.5 as it is; F0 = 0.04 * 2 level)."""
 SPECULAR_IOR = 1.5
 """The Principled IOR the specular fits assume (Specular IOR Level scales its F0)."""
+REPLICA_EDGE_ERROR = {"BURLEY": 0.0035, "RANDOM_WALK": 0.0068, "RANDOM_WALK_SKIN": 0.0067}
+"""RMS difference (fraction of the lit level) between a rendered edge response and the
+replica's at albedo 0.8 (tools/calibrate_subsurface.py, Cycles 5.0.1 and 4.5.15, 256 samples):
+Burley's is the Monte Carlo noise; the random walks add the mismatch of their Burley-shaped
+replica (0.6-1.3% over albedos 0.2-0.95)."""
 FIT_TOLERANCE = 2e-3
 """Relative bracket width at which the golden-section searches stop."""
 NO_LOBE_ERROR = 0.9
@@ -399,12 +406,15 @@ def fit_glossy(grid: _Grid, target: np.ndarray, albedo_table: np.ndarray,
 @dataclass(frozen=True)
 class ProfileFit:
     """Subsurface Radius (x Scale, in mm, per channel) of one Blender subsurface method fitted
-    to the tables' normalised profile ``R(d)/Rd``; ``error`` per channel: relative L2 error of
-    the radial energy density ``2 pi r P(r)``; ``albedo``: the colour assumed (random walk)."""
+    to the tables' normalised profile ``R(d)/Rd``.  ``error`` and ``max_error`` per channel: RMS
+    and largest difference of the edge response (:func:`edge_response`, a fraction of the lit
+    level) over distances up to the tables' last radius; ``albedo``: the colour assumed (the
+    random walks' spread depends on it)."""
 
     method: str
     radius_mm: np.ndarray
     error: np.ndarray
+    max_error: np.ndarray
     albedo: np.ndarray | None = None
 
     @property
@@ -412,53 +422,60 @@ class ProfileFit:
         return float(np.max(self.error))
 
 
-def _profile_error(r_mm: np.ndarray, model: np.ndarray, reference: np.ndarray) -> float:
-    """Relative L2 error of ``2 pi r P(r)`` over ``r_mm`` (trapezoid rule)."""
-    w = _trapezoid_weights(r_mm)
-    a, b = 2 * np.pi * r_mm * model, 2 * np.pi * r_mm * reference
-    return float(np.sqrt(np.sum(w * (a - b) ** 2) / max(np.sum(w * b * b), 1e-300)))
+def edge_response(r_mm, profile, s_mm) -> np.ndarray:
+    """The light a point ``s_mm`` inside a straight shadow edge receives from the lit
+    half-plane, as a fraction of the lit level, for a radial profile ``profile`` (unit area,
+    1/mm^2) sampled at ``r_mm``: ``ESF(s) = Int_s^inf P(r) 2 r arccos(s / r) dr`` (0.5 at the
+    edge).  What a subsurface profile looks like in a render: the blur of a shadow edge.
+    ``profile``: ``(n_r)`` or ``(n_r, C)``; the result ``(n_s)`` or ``(n_s, C)``."""
+    r = np.asarray(r_mm, float)
+    s = np.asarray(s_mm, float)[:, None]
+    arc = np.where(r > s, 2.0 * np.arccos(np.clip(s / np.maximum(r, 1e-300), -1.0, 1.0)), 0.0)
+    return (arc * (r * _trapezoid_weights(r))) @ np.asarray(profile, float)
 
 
-def _method_profile(method: str, r_mm, radius: float, albedo: float, ior: float):
-    if method == "BURLEY":
-        return cc.burley_profile(r_mm, radius)
-    return cc.random_walk_profile(r_mm, radius, albedo, method=method, ior=ior)
+def _profile_grid(r_max: float) -> np.ndarray:
+    """Integration radii (mm) for :func:`edge_response`: geometric, to 40 x the table's end."""
+    return np.concatenate([[0.0], np.geomspace(1e-5 * r_max, 40.0 * r_max, 1200)])
 
 
-def fit_profile(tables: Tables, method: str, *, albedo=None, ior: float = 1.4) -> ProfileFit:
+def fit_profile(tables: Tables, method: str, *, albedo=None) -> ProfileFit:
     """Fit the Subsurface Radius (mm, per channel) of ``method`` (``BURLEY``, ``RANDOM_WALK``,
-    ``RANDOM_WALK_SKIN``) to the tables' profile.  ``albedo`` (per channel): the colour the
-    random walk sees, default the skin's diffuse albedo ``pi skin_diffuse``; ``ior``: the
-    Subsurface IOR (random walk)."""
+    ``RANDOM_WALK_SKIN``) so that its edge response matches the tables' profile's (RMS over
+    distances up to the tables' last radius).  ``albedo`` (per channel): the colour the random
+    walk sees, default the skin's diffuse albedo ``pi skin_diffuse``."""
     if method not in cc.SUBSURFACE_METHODS:
         raise ValueError(f"method must be one of {cc.SUBSURFACE_METHODS}, got {method!r}")
-    r = np.asarray(tables.radius_mm, float)
-    profile = np.asarray(tables.profile, float)
     albedo = np.clip(np.pi * np.asarray(tables.skin_diffuse, float) if albedo is None
                      else np.broadcast_to(np.asarray(albedo, float), (3,)), 0.0, 1.0)
-    radii, errors, done = [], [], {}
-    # The mean distance of the reference sets the search window (log radius).
-    w = _trapezoid_weights(r)
+    r_max = float(tables.radius_mm[-1])
+    r = _profile_grid(r_max)
+    s = np.linspace(0.0, r_max, 48)
+    reference = edge_response(r, tables.radial(r), s)  # (48, 3)
+    radii, errors, worst, done = [], [], [], {}
     for c in range(3):
-        key = (profile[:, c].tobytes(), float(albedo[c]))
+        key = (reference[:, c].tobytes(), float(albedo[c]))
         if key in done:
-            radii.append(radii[done[key]])
-            errors.append(errors[done[key]])
+            for values in (radii, errors, worst):
+                values.append(values[done[key]])
             continue
         done[key] = c
-        mean_r = np.sum(w * 2 * np.pi * r * r * profile[:, c]) / np.sum(
-            w * 2 * np.pi * r * profile[:, c])
 
-        def err(log_radius, c=c):
-            model = _method_profile(method, r, float(np.exp(log_radius)), albedo[c], ior)
-            return _profile_error(r, model, profile[:, c])
+        def difference(log_radius, c=c):
+            model = cc.subsurface_profile(r, float(np.exp(log_radius)), albedo[c], method)
+            return edge_response(r, model, s) - reference[:, c]
 
-        centre = np.log(max(mean_r, 1e-6))
-        log_radius, error = golden_minimum(err, centre - 3.0, centre + 5.0, tol=1e-4, coarse=17)
-        radii.append(np.exp(log_radius))
+        def rms(log_radius):
+            return float(np.sqrt(np.mean(np.square(difference(log_radius)))))
+
+        # Half the reference's mean spread (mm) centres the search window (log radius).
+        centre = np.log(max(float(np.mean(reference[:, c]) * r_max), 1e-6))
+        log_radius, error = golden_minimum(rms, centre - 3.0, centre + 5.0, tol=1e-4, coarse=17)
+        radii.append(float(np.exp(log_radius)))
         errors.append(error)
+        worst.append(float(np.max(np.abs(difference(log_radius)))))
     return ProfileFit(method=method, radius_mm=np.array(radii), error=np.array(errors),
-                      albedo=None if method == "BURLEY" else albedo)
+                      max_error=np.array(worst), albedo=None if method == "BURLEY" else albedo)
 
 
 def fit_profiles(tables: Tables, **options) -> dict[str, ProfileFit]:
@@ -534,7 +551,8 @@ class ClosureFit:
                        for name, lobe in self.glossy.items()},
             "subsurface_method": self.subsurface_method,
             "subsurface_ior": self.subsurface_ior,
-            "profiles": {name: {"radius_mm": p.radius_mm.tolist(), "error": p.error.tolist()}
+            "profiles": {name: {"radius_mm": p.radius_mm.tolist(), "error": p.error.tolist(),
+                                "max_error": p.max_error.tolist()}
                          for name, p in self.profiles.items()},
             "errors": {name: asdict(e) for name, e in self.errors.items()},
         }
@@ -571,8 +589,8 @@ def fit_closures(tables: Tables, *, lut_size: int = DEFAULT_LUT_SIZE,
                  max_points: int | None = FIT_POINTS, errors_at=None) -> ClosureFit:
     """Fit both tiers to ``tables`` and measure their errors at ``errors_at`` = ``(coverage,
     absorption)`` (default: those the tables were baked for).  ``subsurface_method``: force
-    one (default: the best-fitting of Burley and Random Walk (Skin); plain Random Walk is
-    fitted and reported too)."""
+    one (default: the method whose edge response, fitted error and replica error combined,
+    is closest to the tables'; all three are fitted and reported)."""
     grid = _Grid(tables, max_points)
     pick = grid.pick
     film_gloss = np.asarray(tables.film_gloss, float)[pick]
@@ -597,10 +615,10 @@ def fit_closures(tables: Tables, *, lut_size: int = DEFAULT_LUT_SIZE,
     lut = np.stack([glossy[name].lut for name in LUT_ROWS[:3]] + [t_rows])
 
     ior = subsurface_ior(tables.parameters)
-    profiles = fit_profiles(tables, ior=ior)
+    profiles = fit_profiles(tables)
     if subsurface_method is None:
-        subsurface_method = min(("BURLEY", "RANDOM_WALK_SKIN"),
-                                key=lambda m: profiles[m].worst_error)
+        subsurface_method = min(cc.SUBSURFACE_METHODS, key=lambda m: np.hypot(
+            profiles[m].worst_error, REPLICA_EDGE_ERROR[m]))
     elif subsurface_method not in cc.SUBSURFACE_METHODS:
         raise ValueError(f"subsurface_method must be one of {cc.SUBSURFACE_METHODS}, "
                          f"got {subsurface_method!r}")

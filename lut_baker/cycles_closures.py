@@ -26,17 +26,15 @@ Functions
   (``svm_node_closure_bsdf``), for the inputs in :class:`PrincipledInputs`.
 - :func:`burley_profile` -- Christensen-Burley radial profile as Cycles scales it.
 - :func:`burley_radius_for_length` -- the Subsurface Radius giving a Burley shape length ``d``.
-- :func:`random_walk_albedo` -- Cycles' surface-to-single-scattering albedo remap (g = 0).
-- :func:`skin_alpha_prime` -- Cycles' dipole inversion used by Random Walk (Skin).
-- :func:`random_walk_dipole` -- the diffusion dipole a random walk of given radius and colour
-  approximates (``Random Walk`` or ``Random Walk (Skin)``).
-- :func:`random_walk_profile` -- that dipole's profile, normalised to unit area.
+- :func:`random_walk_scale` -- the measured radius factor that makes a Burley profile match a
+  random walk's (Cycles' random walk is a Monte Carlo simulation with no closed form).
+- :func:`subsurface_profile` -- the profile of any of Blender's three methods.
 
 References
 ----------
 Walter et al. 2007 (GGX); Heitz 2014 (height-correlated Smith); Christensen, Burley 2015
 ("Approximate Reflectance Profiles for Efficient Subsurface Scattering"); Chiang, Kutz, Burley
-2016 (random-walk albedo remap); Jensen et al. 2001 (dipole).
+2016 (random walk).
 """
 
 from __future__ import annotations
@@ -46,7 +44,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from .model import Dipole, _fresnel, dipole_profile, dipole_total_reflectance
+from .model import _fresnel
 from .quadrature import direction, hemisphere_grid
 
 __all__ = [
@@ -71,10 +69,9 @@ __all__ = [
     "burley_profile",
     "burley_radius_for_length",
     "BURLEY_MFP_SCALE",
-    "random_walk_albedo",
-    "skin_alpha_prime",
-    "random_walk_dipole",
-    "random_walk_profile",
+    "RANDOM_WALK_BURLEY_SCALE",
+    "random_walk_scale",
+    "subsurface_profile",
     "SUBSURFACE_METHODS",
 ]
 
@@ -426,69 +423,33 @@ def burley_radius_for_length(d_mm):
     return np.asarray(d_mm, float) / BURLEY_MFP_SCALE
 
 
-def random_walk_albedo(surface_albedo):
-    """Single-scattering albedo a random walk uses for a surface (multiple-scattering) albedo
-    (``subsurface_random_walk_remap`` at anisotropy 0; Chiang et al. 2016, eq. 3's fit)."""
-    a = np.clip(np.asarray(surface_albedo, float), 0.0, 1.0)
-    blend = a**0.25
-    alpha = ((1.0 - blend) * 1.8260523782 * np.arctan(4.98511194385 * a) ** 1.09686102424
-             + blend * 0.496310210422 * np.arctan(4.23190299701 * a) ** 2.40602999408)
-    return np.clip(alpha, 0.0, 0.999999)
+RANDOM_WALK_BURLEY_SCALE = {
+    # surface albedo -> k, measured on Cycles 5.0.1 (4.5.15 agrees at 0.8) by
+    # tools/calibrate_subsurface.py: a slab lit up to a straight shadow edge, the rendered edge
+    # response (256 samples, rows averaged) against the Burley replica's, k on a 1.08-ratio grid.
+    "RANDOM_WALK": ((0.2, 0.325), (0.5, 0.562), (0.8, 1.05), (0.95, 1.33)),
+    "RANDOM_WALK_SKIN": ((0.2, 3.13), (0.5, 1.81), (0.8, 0.898), (0.95, 0.445)),
+}
+"""Random walks replicated as a Burley profile of radius ``k(albedo) x radius``: the
+rendered edge responses match that shape within 0.6-1.3% of the lit level (the Burley closure
+itself within 0.3-0.4%, the Monte Carlo noise); ``k`` is interpolated linearly in albedo and
+held beyond the measured range."""
 
 
-def _dipole_rd(alpha_prime, four_thirds_a):
-    """Cycles ``bssrdf_dipole_compute_Rd``: the dipole's total reflectance at reduced albedo."""
-    s = np.sqrt(3.0 * (1.0 - alpha_prime))
-    return 0.5 * alpha_prime * (1.0 + np.exp(-four_thirds_a * s)) * np.exp(-s)
+def random_walk_scale(surface_albedo, method: str = "RANDOM_WALK_SKIN"):
+    """The measured ``k`` of :data:`RANDOM_WALK_BURLEY_SCALE` at a surface albedo (colour)."""
+    if method not in RANDOM_WALK_BURLEY_SCALE:
+        raise ValueError(f"method must be one of {list(RANDOM_WALK_BURLEY_SCALE)}, "
+                         f"got {method!r}")
+    albedo, scale = np.array(RANDOM_WALK_BURLEY_SCALE[method]).T
+    return np.interp(np.asarray(surface_albedo, float), albedo, scale)
 
 
-def skin_alpha_prime(surface_albedo, ior):
-    """Reduced albedo whose dipole reflectance is ``surface_albedo`` (Cycles
-    ``bssrdf_dipole_compute_alpha_prime``: 12 bisections; the IOR clamped to [1.01, 3.8])."""
-    ior = float(np.clip(ior, 1.01, 3.8))
-    inv = 1.0 / ior
-    f_dr = inv * (-1.440 * inv + 0.710) + 0.668 + 0.0636 * ior
-    four_thirds_a = (4.0 / 3.0) * (1.0 + f_dr) / (1.0 - f_dr)
-    rd = np.asarray(surface_albedo, float)
-    low, high = np.zeros_like(rd), np.ones_like(rd)
-    mid = 0.5 * (low + high)
-    for _ in range(12):
-        mid = 0.5 * (low + high)
-        below = _dipole_rd(mid, four_thirds_a) < rd
-        low = np.where(below, mid, low)
-        high = np.where(below, high, mid)
-    return np.where(rd < 1e-4, 0.0, np.where(rd >= 0.995, 0.999999, mid))
-
-
-def random_walk_dipole(radius_mm, surface_albedo, *, method: str = "RANDOM_WALK_SKIN",
-                       ior: float = 1.4) -> Dipole:
-    """The diffusion dipole (g = 0) that a Cycles random walk of this radius (Subsurface Radius
-    x Scale, mm) and colour approximates.
-
-    The walk's medium: single-scattering albedo :func:`random_walk_albedo` and extinction
-    ``1/r'`` with ``r' = radius / (4 pi)`` (``RANDOM_WALK``) or
-    ``r' = radius sqrt(3 (1 - alpha'))`` (``RANDOM_WALK_SKIN``, ``alpha'`` from
-    :func:`skin_alpha_prime`; the diffusion coefficient ``sigma_tr`` then lies between about
-    1.2 and 2.4 / radius for colours 0.1 to 0.9, as the two albedo inversions differ).
-    The dipole's boundary uses ``ior`` (the Subsurface IOR).  An approximation: the walk itself
-    is a Monte Carlo simulation, which the renders of issue 5 compare with.
-    """
-    if method not in ("RANDOM_WALK", "RANDOM_WALK_SKIN"):
-        raise ValueError(f"method must be RANDOM_WALK or RANDOM_WALK_SKIN, got {method!r}")
-    radius = np.asarray(radius_mm, float)
-    if method == "RANDOM_WALK":
-        length = radius * BURLEY_MFP_SCALE
-    else:
-        length = radius * np.sqrt(3.0 * (1.0 - skin_alpha_prime(surface_albedo, ior)))
-    sigma_t = 1.0 / np.maximum(length, 1e-12)
-    alpha = random_walk_albedo(surface_albedo)
-    return Dipole(sigma_s=alpha * sigma_t, sigma_a=np.maximum((1.0 - alpha) * sigma_t, 1e-9),
-                  g=0.0, eta=float(np.clip(ior, 1.0, 3.8)))
-
-
-def random_walk_profile(r_mm, radius_mm, surface_albedo, *, method: str = "RANDOM_WALK_SKIN",
-                        ior: float = 1.4):
-    """The profile of :func:`random_walk_dipole`, normalised to ``Int P 2 pi r dr = 1``
-    (1/mm^2)."""
-    dipole = random_walk_dipole(radius_mm, surface_albedo, method=method, ior=ior)
-    return dipole_profile(r_mm, dipole) / dipole_total_reflectance(dipole)
+def subsurface_profile(r_mm, radius_mm, surface_albedo=0.8, method: str = "BURLEY"):
+    """Radial profile (1/mm^2, unit area) of a Blender subsurface method at Subsurface Radius x
+    Scale ``radius_mm`` (scalar or RGB) and colour ``surface_albedo``: :func:`burley_profile`,
+    for the random walks with the measured scale :func:`random_walk_scale`."""
+    if method == "BURLEY":
+        return burley_profile(r_mm, radius_mm)
+    return burley_profile(r_mm, np.asarray(radius_mm, float)
+                          * random_walk_scale(surface_albedo, method))

@@ -79,7 +79,8 @@ def flush(context=None) -> list[str]:
             group, _, _ = made_up.ensure_group(
                 made_up.skin_from_settings(settings), made_up.resolve_tier(settings,
                                                                            context.scene),
-                PREVIEW, messages=messages, group=group)
+                PREVIEW, messages=messages, group=group,
+                method=made_up.forced_method(settings))
         except (ValueError, RuntimeError) as error:
             messages.append(f"Made-up Skin: preview of {material.name!r} failed: {error}")
             continue

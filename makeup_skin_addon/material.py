@@ -30,6 +30,7 @@ __all__ = [
     "skin_from_settings",
     "resolve_tier",
     "units_per_mm",
+    "forced_method",
     "group_for_tables",
     "ensure_group",
     "group_of",
@@ -70,6 +71,11 @@ def resolve_tier(settings, scene) -> str:
     return "LAYERED" if scene.render.engine == "CYCLES" else "PRINCIPLED"
 
 
+def forced_method(settings):
+    """The subsurface method the settings force, or None (Auto: the fit's best)."""
+    return None if settings.subsurface_method == "AUTO" else settings.subsurface_method
+
+
 def units_per_mm(scene) -> float:
     """Scene units in one millimetre: ``0.001 / unit_settings.scale_length`` (a scene in
     metres gives 0.001, one modelled in centimetres with scale 0.01 gives 0.1)."""
@@ -106,25 +112,27 @@ def _intact(image) -> tuple[bool, str]:
         return False, str(error)
 
 
-def _group_matches(group, key: str, tier: str) -> bool:
+def _group_matches(group, key: str, tier: str, method) -> bool:
     try:
         meta = json.loads(group.get(nodes.FIT_KEY, "{}"))
     except ValueError:
         return False
-    if meta.get("key") != key or meta.get("tier") != tier:
+    if (meta.get("key"), meta.get("tier"), meta.get("forced_method")) != (key, tier, method):
         return False
     if tier == "LAYERED":
         return bpy.data.images.get(storage.lut_image_name(key)) is not None
     return True
 
 
-def group_for_tables(tables, tier: str, *, messages=None, group=None, errors_at=None):
+def group_for_tables(tables, tier: str, *, messages=None, group=None, errors_at=None,
+                     method=None):
     """``(group, fit or None)`` of ``tier`` for baked ``tables``.
 
     The tables are packed under their content hash; a group already built from the same
-    tables and tier is reused (no fit) unless ``group`` is given, which is then rebuilt in
-    place.  Stored tables of that hash that fail their checks are reported in ``messages``
-    and replaced.  ``errors_at``: ``(coverage, absorption)`` at which to measure the tiers'
+    tables, tier and ``method`` (a forced subsurface method, or None for the fit's choice) is
+    reused (no fit) unless ``group`` is given, which is then rebuilt in place.  Stored tables
+    of that hash that fail their checks are reported in ``messages`` and replaced.
+    ``errors_at``: ``(coverage, absorption)`` at which to measure the tiers'
     errors when fitting (default: the bake's).
     """
     messages = [] if messages is None else messages
@@ -137,13 +145,13 @@ def group_for_tables(tables, tier: str, *, messages=None, group=None, errors_at=
             messages.append(f"Made-up Skin: stored tables {image.name!r} were broken "
                             f"({problem}); re-baked them")
     image = storage.pack_tables(tables, key)
-    existing = bpy.data.node_groups.get(nodes.group_name(tier, key))
-    if group is None and existing is not None and stored_ok and _group_matches(existing, key,
-                                                                                 tier):
+    existing = bpy.data.node_groups.get(nodes.group_name(tier, key, method))
+    if group is None and existing is not None and stored_ok and _group_matches(
+            existing, key, tier, method):
         return existing, None
     fit = _fit(tables, key, errors_at)
     target = group if group is not None else existing
-    return nodes.build_group(tier, key, fit, image, target), fit
+    return nodes.build_group(tier, key, fit, image, target, method=method), fit
 
 
 _FITS: OrderedDict = OrderedDict()
@@ -260,7 +268,8 @@ def apply_to_object(context, obj, *, settings=None, resolution=None) -> tuple:
     with _Progress(context) as progress:
         group, tables, fit = ensure_group(
             skin_from_settings(settings), tier, resolution or settings.resolution,
-            progress=progress, messages=messages, errors_at=(settings.coverage, absorption))
+            progress=progress, messages=messages, errors_at=(settings.coverage, absorption),
+            method=forced_method(settings))
     if fit is not None:
         material[ERRORS_KEY] = json.dumps({name: {"rms": e.rms, "albedo": e.albedo,
                                                   "coverage": e.coverage,
@@ -292,6 +301,7 @@ def check_material(context, material) -> list[str]:
     group = node.node_tree if node is not None else None
     with _Progress(context) as progress:
         group, _, _ = ensure_group(skin_from_settings(settings), tier, settings.resolution,
-                                   progress=progress, messages=messages, group=group)
+                                   progress=progress, messages=messages, group=group,
+                                   method=forced_method(settings))
     setup_material(material, group, context.scene)
     return messages

@@ -17,7 +17,7 @@ LAYERED: Glossy, Diffuse and Subsurface closures weighted as
 Coverage between bare skin and made-up skin: an areal mix of closures, so a painted coverage
 fades out without fringe or halo.
 
-- :func:`group_name` -- name of a group from tier and tables key.
+- :func:`group_name` -- name of a group from tier, tables key and a forced subsurface method.
 - :func:`build_group` -- create or rebuild (in place) a group from a fit and its tables.
 - :func:`set_inputs` -- socket values on a group node from the panel's settings.
 """
@@ -56,8 +56,13 @@ INPUTS = (
 )
 
 
-def group_name(tier: str, key: str) -> str:
-    return f"{GROUP_PREFIX} {tier.title()} {key[:8]}"
+METHOD_LABELS = {"BURLEY": "Burley", "RANDOM_WALK": "RW", "RANDOM_WALK_SKIN": "RW Skin"}
+
+
+def group_name(tier: str, key: str, method: str | None = None) -> str:
+    """``Made-up Skin <Tier> [<method>] <key>``; no method: the fit's own choice."""
+    label = f" {METHOD_LABELS[method]}" if method else ""
+    return f"{GROUP_PREFIX} {tier.title()}{label} {key[:8]}"
 
 
 def socket(sockets, identifier: str):
@@ -200,7 +205,8 @@ def _build_principled(build: _Builder, fit, method: str, radius_mm, ior: float):
         "Subsurface IOR": ior,
     }
     for name, value in values.items():
-        build.feed(bsdf.inputs[name], value)
+        # By identifier: a socket the method leaves unavailable is not found by name in 5.0.
+        build.feed(socket(bsdf.inputs, name), value)
     build.tree.links.new(bsdf.outputs[0], output.inputs["Shader"])
 
 
@@ -231,10 +237,10 @@ def _build_layered(build: _Builder, fit, lut, method: str, radius_mm, ior: float
 
     def subsurface(colour, label):
         node = build.node("ShaderNodeSubsurfaceScattering", label, falloff=method)
-        build.feed(node.inputs["Color"], colour)
-        build.feed(node.inputs["Radius"], tuple(map(float, radius_mm)))
-        build.feed(node.inputs["Scale"], scale)
-        build.feed(node.inputs["IOR"], ior)
+        build.feed(socket(node.inputs, "Color"), colour)
+        build.feed(socket(node.inputs, "Radius"), tuple(map(float, radius_mm)))
+        build.feed(socket(node.inputs, "Scale"), scale)
+        build.feed(socket(node.inputs, "IOR"), ior)
         return node.outputs[0]
 
     def add(a, b):
@@ -278,13 +284,14 @@ def _build_layered(build: _Builder, fit, lut, method: str, radius_mm, ior: float
     build.tree.links.new(mix.outputs[0], output.inputs["Shader"])
 
 
-def build_group(tier: str, key: str, fit, tables_image, group=None, *, lut_size=None):
+def build_group(tier: str, key: str, fit, tables_image, group=None, *, method=None):
     """Create (or, given ``group``, rebuild in place) the node group of ``tier`` for the tables
-    stored in ``tables_image`` (key ``key``) and their :class:`ClosureFit` ``fit``."""
+    stored in ``tables_image`` (key ``key``) and their :class:`ClosureFit` ``fit``.
+    ``method``: a subsurface method forced by the user, else the fit's choice."""
     cf = lut_baker("closure_fit")
     if tier not in cf.TIERS:
         raise ValueError(f"tier must be one of {cf.TIERS}, got {tier!r}")
-    name = group_name(tier, key)
+    name = group_name(tier, key, method)
     if group is None:
         group = bpy.data.node_groups.get(name) or bpy.data.node_groups.new(name,
                                                                            "ShaderNodeTree")
@@ -293,7 +300,8 @@ def build_group(tier: str, key: str, fit, tables_image, group=None, *, lut_size=
     _interface(group)
     group.nodes.clear()
     build = _Builder(group)
-    method = fit.subsurface_method
+    forced = method
+    method = method or fit.subsurface_method
     radius = fit.profiles[method].radius_mm
     ior = fit.subsurface_ior
     if tier == "PRINCIPLED":
@@ -302,7 +310,8 @@ def build_group(tier: str, key: str, fit, tables_image, group=None, *, lut_size=
         lut = storage.lut_image(storage.lut_image_name(key), fit.lut)
         _build_layered(build, fit, lut, method, radius, ior)
     group[FIT_KEY] = json.dumps({"key": key, "tier": tier, "tables": tables_image.name,
-                                 **fit.summary()}, default=float)
+                                 "forced_method": forced, **fit.summary(),
+                                 "subsurface_method": method}, default=float)
     # An ID property holding the image counts as a user: the tables are saved with the group.
     group[TABLES_REF] = tables_image
     return group

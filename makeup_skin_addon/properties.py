@@ -23,6 +23,13 @@ TIER_ITEMS = (
     ("LAYERED", "Layered", "Glossy, Diffuse and Subsurface closures with view-angle weights "
                            "from a lookup image; closest to the tables in Cycles"),
 )
+SUBSURFACE_ITEMS = (
+    ("AUTO", "Auto", "The method whose shadow-edge blur is closest to the skin's (Burley)"),
+    ("BURLEY", "Christensen-Burley", "Burley's profile: Cycles and EEVEE, fitted exactly"),
+    ("RANDOM_WALK", "Random Walk", "Cycles' volume random walk (radius = mean free path)"),
+    ("RANDOM_WALK_SKIN", "Random Walk (Skin)", "Cycles' random walk with radius adjusted by "
+                                               "colour, as Principled skin presets use"),
+)
 RESOLUTION_ITEMS = (
     ("preview", "Preview", "Coarse tables (fast bake, under 1% error)"),
     ("default", "Default", "The bake's default resolution"),
@@ -137,6 +144,10 @@ class MakeupSkinSettings(bpy.types.PropertyGroup):
     film_ior: bpy.props.FloatProperty(
         name="Film IOR", default=1.19, min=1.01, max=2.5,
         description="Film index of refraction (measured 1.19)", update=_update_tables)
+    subsurface_method: bpy.props.EnumProperty(
+        name="Subsurface", items=SUBSURFACE_ITEMS, default="AUTO",
+        description="Blender subsurface method (its radius is fitted to the skin's profile)",
+        update=_update_tables)
     tier: bpy.props.EnumProperty(
         name="Tier", items=TIER_ITEMS, default="AUTO",
         description="Node group tier (cost against accuracy)", update=_update_tables)

@@ -258,3 +258,17 @@ def test_unregister_leaves_nothing(addon, bpy_factory):
         assert live.pending() == set()
     finally:
         addon.register()
+
+
+def test_forced_subsurface_method_gets_its_own_group(sphere):
+    material = _apply(sphere, "PRINCIPLED")
+    auto = material.node_tree.nodes["Made-up Skin"].node_tree
+    material = _apply(sphere, "PRINCIPLED", subsurface_method="RANDOM_WALK_SKIN")
+    group = material.node_tree.nodes["Made-up Skin"].node_tree
+    assert group != auto and " RW Skin " in group.name
+    principled = next(n for n in group.nodes if n.type == "BSDF_PRINCIPLED")
+    assert principled.subsurface_method == "RANDOM_WALK_SKIN"
+    meta = json.loads(group["makeup_skin_fit"])
+    radius = meta["profiles"]["RANDOM_WALK_SKIN"]["radius_mm"]
+    assert tuple(next(s for s in principled.inputs if s.identifier == "Subsurface Radius")
+                 .default_value) == pytest.approx(radius)

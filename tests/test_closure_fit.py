@@ -12,6 +12,7 @@ import pytest
 from lut_baker import bake, closure_fit, presets
 from lut_baker import cycles_closures as cc
 from lut_baker.quadrature import direction
+from lut_baker.tables import radius_nodes
 
 
 @pytest.fixture(scope="module")
@@ -81,12 +82,27 @@ def _radial_integral(profile, r):
     return float(np.trapz(2 * np.pi * r * profile, r))
 
 
-def test_subsurface_profiles_have_unit_area():
-    r = np.concatenate([np.geomspace(1e-6, 200.0, 200000)])
-    assert _radial_integral(cc.burley_profile(r, 5.0), r) == pytest.approx(1.0, rel=2e-3)
-    for method in ("RANDOM_WALK", "RANDOM_WALK_SKIN"):
-        value = cc.random_walk_profile(r, 5.0, 0.7, method=method, ior=1.3)
-        assert _radial_integral(value, r) == pytest.approx(1.0, rel=2e-3)
+@pytest.mark.parametrize("method", cc.SUBSURFACE_METHODS)
+def test_subsurface_profiles_have_unit_area(method):
+    r = np.geomspace(1e-7, 400.0, 400000)
+    value = cc.subsurface_profile(r, 5.0, 0.7, method)
+    assert _radial_integral(value, r) == pytest.approx(1.0, rel=2e-3)
+
+
+def test_burley_length_is_radius_over_four_pi():
+    # Cycles: d = radius / (4 pi), cut at T = 16 d and renormalised.  The mean distance is
+    # [d^2 g(T/d) + 9 d^2 g(T/3d)] / (4 d cdf), with Int_0^T r exp(-r/a) dr = a^2 g(T/a) and
+    # g(x) = 1 - exp(-x) (1 + x).
+    d = 8.0 / (4 * np.pi)
+
+    def g(x):
+        return 1 - np.exp(-x) * (1 + x)
+
+    cdf = 1 - 0.25 * np.exp(-16) - 0.75 * np.exp(-16 / 3)
+    expected = (d * d * g(16) + 9 * d * d * g(16 / 3)) / (4 * d * cdf)
+    r = np.geomspace(1e-7, 400.0, 400000)
+    mean = np.trapz(2 * np.pi * r * r * cc.burley_profile(r, 8.0), r)
+    assert mean == pytest.approx(expected, rel=1e-3)
 
 
 @pytest.mark.parametrize("method", cc.SUBSURFACE_METHODS)
@@ -94,25 +110,29 @@ def test_subsurface_radius_scales_the_profile(method):
     # P(r; k radius) = P(r / k; radius) / k^2 at a fixed colour: Subsurface Scale is a length.
     r = np.linspace(0.1, 10.0, 41)
     k = 2.5
-    if method == "BURLEY":
-        scaled, base = cc.burley_profile(r, 2.0 * k), cc.burley_profile(r / k, 2.0)
-    else:
-        scaled = cc.random_walk_profile(r, 2.0 * k, 0.6, method=method)
-        base = cc.random_walk_profile(r / k, 2.0, 0.6, method=method)
+    scaled = cc.subsurface_profile(r, 2.0 * k, 0.6, method)
+    base = cc.subsurface_profile(r / k, 2.0, 0.6, method)
     np.testing.assert_allclose(scaled, base / k**2, rtol=1e-9)
 
 
-def test_skin_alpha_prime_inverts_the_dipole_reflectance():
-    # Jensen's F_dr at eta = 1.4, written out: A = (1 + F_dr) / (1 - F_dr).
-    eta = 1.4
-    f_dr = -1.440 / eta**2 + 0.710 / eta + 0.668 + 0.0636 * eta
-    four_thirds_a = 4.0 / 3.0 * (1 + f_dr) / (1 - f_dr)
-    rd = np.array([0.05, 0.3, 0.7, 0.9])
-    alpha = cc.skin_alpha_prime(rd, eta)
-    # Cycles bisects 12 times on [0, 1]: alpha' is within 2^-12 of the exact inverse.
-    fine = np.linspace(0.0, 1.0, 2**20 + 1)
-    exact = np.interp(rd, cc._dipole_rd(fine, four_thirds_a), fine)
-    np.testing.assert_allclose(alpha, exact, atol=2.0**-12)
+def test_random_walk_scale_interpolates_the_measurements():
+    table = dict(cc.RANDOM_WALK_BURLEY_SCALE["RANDOM_WALK"])
+    assert cc.random_walk_scale(0.5, "RANDOM_WALK") == pytest.approx(table[0.5])
+    assert cc.random_walk_scale(0.65, "RANDOM_WALK") == pytest.approx(
+        0.5 * (table[0.5] + table[0.8]))
+    assert cc.random_walk_scale(0.0, "RANDOM_WALK") == pytest.approx(table[0.2])  # held
+    with pytest.raises(ValueError, match="method"):
+        cc.random_walk_scale(0.5, "BURLEY")
+
+
+def test_edge_response_of_a_uniform_disc():
+    # P = 1 / (pi a^2) inside r < a: ESF(s) = (a^2 acos(s/a) - s sqrt(a^2 - s^2)) / (pi a^2).
+    a = 2.0
+    r = np.linspace(0.0, 3.0, 300001)
+    disc = np.where(r < a, 1.0 / (np.pi * a * a), 0.0)
+    s = np.array([0.0, 0.5, 1.0, 1.9])
+    expected = (a * a * np.arccos(s / a) - s * np.sqrt(a * a - s * s)) / (np.pi * a * a)
+    np.testing.assert_allclose(closure_fit.edge_response(r, disc, s), expected, atol=1e-4)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -157,19 +177,17 @@ def test_fit_glossy_recovers_distribution_and_roughness(paper_tables):
     np.testing.assert_allclose(fit.lut, 1.0, atol=0.02)
 
 
-@pytest.mark.parametrize("method", ["BURLEY", "RANDOM_WALK_SKIN"])
+@pytest.mark.parametrize("method", cc.SUBSURFACE_METHODS)
 def test_fit_profile_recovers_a_known_radius(paper_tables, method):
-    r = np.asarray(paper_tables.radius_mm)
+    # A fine quadratic radius grid: Burley's profile is singular (1/r) at 0.
+    r = radius_nodes(2000, "quadratic", 20.0)
     radius = np.array([3.0, 1.5, 0.8])
-    if method == "BURLEY":
-        profile = cc.burley_profile(r, radius)
-    else:
-        profile = np.stack([cc.random_walk_profile(r, radius[c], 0.6, method=method, ior=1.3)
-                            for c in range(3)], -1)
-    tables = dataclasses.replace(paper_tables, profile=profile)
-    fit = closure_fit.fit_profile(tables, method, albedo=0.6, ior=1.3)
-    np.testing.assert_allclose(fit.radius_mm, radius, rtol=0.01)
-    assert fit.worst_error < 0.01
+    profile = np.stack([cc.subsurface_profile(np.maximum(r, r[1] / 2), radius[c], 0.6, method)
+                        for c in range(3)], -1)
+    tables = dataclasses.replace(paper_tables, radius_mm=r, profile=profile)
+    fit = closure_fit.fit_profile(tables, method, albedo=0.6)
+    np.testing.assert_allclose(fit.radius_mm, radius, rtol=0.02)
+    assert fit.worst_error < 0.005
 
 
 # ---------------------------------------------------------------------------------------------
@@ -183,7 +201,9 @@ def test_paper_fit_parameters_are_in_blender_ranges(paper_fit):
         assert np.all(np.isfinite(lobe.lut)) and np.all(lobe.lut >= 0.0)
     assert paper_fit.lut.shape == (len(closure_fit.LUT_ROWS), closure_fit.DEFAULT_LUT_SIZE, 3)
     assert np.all(paper_fit.subsurface_radius_mm > 0.0)
-    assert paper_fit.subsurface_method in ("BURLEY", "RANDOM_WALK_SKIN")
+    assert paper_fit.subsurface_method in cc.SUBSURFACE_METHODS
+    # Burley's edge response follows the dipole's within 1% RMS of the lit level.
+    assert paper_fit.profiles["BURLEY"].worst_error < 0.01
 
 
 def test_layered_tier_keeps_the_albedo(paper_tables, paper_fit):
