@@ -50,6 +50,7 @@ from dataclasses import asdict, dataclass, field, replace
 import numpy as np
 
 from . import cycles_closures as cc
+from .optimise import golden_minimum
 from .tables import Tables
 
 __all__ = [
@@ -200,30 +201,6 @@ def albedo_error(f_fit, f_ref, tables: Tables) -> float:
     """Largest relative error of :func:`view_albedo` over view angles and channels."""
     fit, ref = view_albedo(f_fit, tables), view_albedo(f_ref, tables)
     return float(np.max(np.abs(fit - ref) / np.maximum(np.abs(ref), 1e-12)))
-
-
-def golden_minimum(function, low: float, high: float, *, tol: float = 1e-4,
-                   coarse: int = 9) -> tuple[float, float]:
-    """``(x, f(x))`` minimising a 1-D ``function`` on ``[low, high]``: the best of ``coarse``
-    evenly spaced samples, then golden-section search in the bracket around it."""
-    xs = np.linspace(low, high, coarse)
-    values = [function(x) for x in xs]
-    k = int(np.argmin(values))
-    a, b = xs[max(k - 1, 0)], xs[min(k + 1, coarse - 1)]
-    ratio = (np.sqrt(5.0) - 1.0) / 2.0
-    c, d = b - ratio * (b - a), a + ratio * (b - a)
-    fc, fd = function(c), function(d)
-    while b - a > tol * max(1.0, abs(a) + abs(b)):
-        if fc < fd:
-            b, d, fd = d, c, fc
-            c = b - ratio * (b - a)
-            fc = function(c)
-        else:
-            a, c, fc = c, d, fd
-            d = a + ratio * (b - a)
-            fd = function(d)
-    best = min([(values[k], xs[k]), (fc, c), (fd, d)])
-    return float(best[1]), float(best[0])
 
 
 def lut_nodes(size: int = DEFAULT_LUT_SIZE) -> np.ndarray:
@@ -602,6 +579,12 @@ def fit_closures(tables: Tables, *, lut_size: int = DEFAULT_LUT_SIZE,
                                                                         coat.ior))
     specular_bare = fit_specular(grid, skin_gloss)
     specular_film = fit_specular(grid, path3, attenuation=1.0 - e_coat)
+    # The node group mixes the two roughnesses by coverage: a dropped lobe (level 0) takes the
+    # other's, so that mixing never sharpens the remaining lobe.
+    if specular_film.level == 0.0:
+        specular_film = replace(specular_film, roughness=specular_bare.roughness)
+    elif specular_bare.level == 0.0:
+        specular_bare = replace(specular_bare, roughness=specular_film.roughness)
 
     theta_deg = np.asarray(tables.theta_deg, float)
     glossy = {name: fit_glossy(grid, table, np.asarray(getattr(tables, name + "_albedo")),

@@ -22,7 +22,6 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import minimize_scalar
 
 from .layers import (
     grid_for,
@@ -39,6 +38,7 @@ from .model import (
     _ts_reflection,
     check_directions,
 )
+from .optimise import golden_minimum
 
 __all__ = [
     "REFLECTION_SHUTTER_S",
@@ -82,15 +82,8 @@ def normalisation_constant(film_reflection: ReflectionLayer,
         )
         return float(np.max(value))
 
-    coarse = np.linspace(0.0, 89.9, 91)
-    values = [total(t) for t in coarse]
-    best = int(np.argmax(values))
-    low, high = coarse[max(best - 1, 0)], coarse[min(best + 1, coarse.size - 1)]
-    found = minimize_scalar(lambda t: -total(t), bounds=(low, high), method="bounded",
-                            options={"xatol": 1e-3})
-    if -found.fun >= values[best]:
-        return float(-found.fun), float(found.x)
-    return float(values[best]), float(coarse[best])
+    theta, value = golden_minimum(lambda t: -total(t), 0.0, 89.9, tol=1e-5, coarse=91)
+    return float(-value), float(theta)
 
 
 @dataclass(frozen=True, eq=False)
