@@ -83,11 +83,17 @@ class MAKEUPSKIN_MT_presets(bpy.types.Menu):
 class MAKEUPSKIN_OT_add_preset(AddPresetBase, bpy.types.Operator):
     """Save or remove a Made-up Skin parameter set"""
 
+    @classmethod
+    def poll(cls, context):
+        obj = context.object
+        return obj is not None and obj.active_material is not None
+
     bl_idname = "makeup_skin.add_preset"
     bl_label = "Add Made-up Skin Preset"
     preset_menu = "MAKEUPSKIN_MT_presets"
     preset_subdir = PRESET_SUBDIR
-    preset_defines = ["settings = bpy.context.material.makeup_skin"]
+    # The active object's material: also defined in the shader editor, unlike context.material.
+    preset_defines = ["settings = bpy.context.object.active_material.makeup_skin"]
     preset_values = [
         "settings.foundation", "settings.skin", "settings.coverage", "settings.absorption_mode",
         "settings.absorption", "settings.foundation_colour", "settings.skin_tint",

@@ -27,8 +27,9 @@ def _errors_text(material) -> list[str]:
 
 
 def draw_settings(layout, context) -> None:
-    """The panel body, shared by both panels."""
-    material = context.material
+    """The panel body, shared by both panels (the active object's material)."""
+    obj = context.active_object
+    material = obj.active_material if obj is not None else None
     row = layout.row(align=True)
     row.menu(MAKEUPSKIN_MT_presets.__name__, text=MAKEUPSKIN_MT_presets.bl_label)
     row.operator(MAKEUPSKIN_OT_add_preset.bl_idname, text="", icon="ADD")

@@ -272,3 +272,27 @@ def test_forced_subsurface_method_gets_its_own_group(sphere):
     radius = meta["profiles"]["RANDOM_WALK_SKIN"]["radius_mm"]
     assert tuple(next(s for s in principled.inputs if s.identifier == "Subsurface Radius")
                  .default_value) == pytest.approx(radius)
+
+
+def test_presets_save_and_load_a_parameter_set(sphere):
+    import bpy
+
+    from makeup_skin_addon.operators import PRESET_SUBDIR
+
+    material = _apply(sphere, "PRINCIPLED")
+    settings = material.makeup_skin
+    settings.foundation = "deep_mocha"
+    settings.coverage = 0.35
+    settings.subsurface_scale = 2.5
+    assert bpy.ops.makeup_skin.add_preset(name="Test Shade") == {"FINISHED"}
+    folder = bpy.utils.user_resource("SCRIPTS", path=f"presets/{PRESET_SUBDIR}")
+    path = f"{folder}/Test_Shade.py"  # Blender's file name for the preset "Test Shade"
+    settings.foundation = "light_ivory"
+    settings.coverage = 1.0
+    settings.subsurface_scale = 1.0
+    assert bpy.ops.script.execute_preset(filepath=path,
+                                         menu_idname="MAKEUPSKIN_MT_presets") == {"FINISHED"}
+    assert (settings.foundation, settings.coverage, settings.subsurface_scale) == (
+        "deep_mocha", pytest.approx(0.35), pytest.approx(2.5))
+    node = material.node_tree.nodes["Made-up Skin"]
+    assert node.inputs["Coverage"].default_value == pytest.approx(0.35)  # live to the socket

@@ -236,3 +236,13 @@ def test_summary_is_plain_data(paper_fit):
 
     text = json.dumps(paper_fit.summary())
     assert "PRINCIPLED" in text and "subsurface_method" in text
+
+
+def test_principled_error_does_not_peak_between_coverages(paper_tables, paper_fit):
+    # The node group mixes roughness and level by coverage: a half-covered surface must not
+    # err much more than the worse of bare and fully covered skin.
+    ends = [closure_fit.tier_errors(paper_fit, paper_tables, w, 0.0)["PRINCIPLED"].rms
+            for w in (0.0, 1.0)]
+    for coverage in (0.25, 0.5, 0.75):
+        middle = closure_fit.tier_errors(paper_fit, paper_tables, coverage, 0.0)["PRINCIPLED"]
+        assert middle.rms < 1.2 * max(ends)

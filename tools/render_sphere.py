@@ -20,6 +20,7 @@ Functions (for other scripts, e.g. the benchmarks of issue 5):
 - :func:`build_scene` -- the sphere, camera, sun and render settings in the current file.
 - :func:`addon_registered` -- the add-on from this checkout, registered for a ``with`` block.
 - :func:`made_up_material` -- a material with the group for given tables and tier.
+- :func:`coverage_ramp` -- coverage painted as a left-to-right ramp.
 - :func:`render` -- render to PNG and EXR; returns seconds.
 """
 
@@ -38,8 +39,8 @@ REPO_ROOT = Path(__file__).resolve().parent.parent
 if str(REPO_ROOT) not in sys.path:
     sys.path.insert(0, str(REPO_ROOT))
 
-__all__ = ["build_scene", "addon_registered", "made_up_material", "render", "load_or_bake",
-           "main"]
+__all__ = ["build_scene", "addon_registered", "made_up_material", "coverage_ramp", "render",
+           "load_or_bake", "main"]
 
 IRRADIANCE = math.pi
 """Sun strength (W/m^2): a white Lambertian surface facing the sun renders as 1.0."""
@@ -150,6 +151,24 @@ def made_up_material(obj, tables, tier="LAYERED", *, coverage=None, absorption=N
     return material
 
 
+def coverage_ramp(material, obj) -> None:
+    """Link a left-to-right ramp (coverage 0 at the sphere's left edge, 1 at its right) into
+    the group's Coverage socket: what a painted coverage texture does."""
+    from makeup_skin_addon import material as made_up
+
+    tree = material.node_tree
+    coordinates = tree.nodes.new("ShaderNodeTexCoord")
+    separate = tree.nodes.new("ShaderNodeSeparateXYZ")
+    tree.links.new(coordinates.outputs["Object"], separate.inputs[0])
+    ramp = tree.nodes.new("ShaderNodeMapRange")
+    ramp.clamp = True
+    tree.links.new(separate.outputs["X"], ramp.inputs["Value"])
+    radius = max(obj.dimensions) / 2
+    ramp.inputs["From Min"].default_value = -radius
+    ramp.inputs["From Max"].default_value = radius
+    tree.links.new(ramp.outputs["Result"], made_up.group_of(material).inputs["Coverage"])
+
+
 def render(png_path) -> float:
     """Render the current scene; write ``png_path`` and the float EXR beside it; seconds."""
     import bpy
@@ -193,14 +212,18 @@ def main(argv=None) -> int:
     parser.add_argument("--light-deg", type=float, default=45.0,
                         help="angle between light and view direction, degrees, default 45")
     parser.add_argument("--seed", type=int, default=0, help="Cycles seed")
+    parser.add_argument("--coverage-ramp", action="store_true",
+                        help="coverage from 0 (left) to 1 (right), as a painted texture would")
     args = parser.parse_args(argv)
     os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="render_sphere_"))
     tables = load_or_bake(args.tables, args.foundation, args.skin)
     sphere = build_scene(size=args.size, samples=args.samples, radius_mm=args.radius_mm,
                          light_deg=args.light_deg, seed=args.seed)
     with addon_registered():
-        made_up_material(sphere, tables, args.tier, coverage=args.coverage,
-                         absorption=args.absorption)
+        material = made_up_material(sphere, tables, args.tier, coverage=args.coverage,
+                                    absorption=args.absorption)
+        if args.coverage_ramp:
+            coverage_ramp(material, sphere)
         seconds = render(args.out)
     print(f"render_sphere: {args.tier} {args.size}x{args.size} px, {args.samples} samples, "
           f"light {args.light_deg:g} deg: {seconds:.2f} s -> {args.out} + "
