@@ -94,7 +94,10 @@ def register():
 
 
 def unregister():
+    from .material import clear_cache
+
     if bpy.app.timers.is_registered(_timer):
         bpy.app.timers.unregister(_timer)
     _dirty.clear()
     _messages.clear()
+    clear_cache()

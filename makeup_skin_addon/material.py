@@ -37,6 +37,7 @@ __all__ = [
     "apply_to_object",
     "setup_material",
     "check_material",
+    "clear_cache",
     "update_sockets",
 ]
 
@@ -157,6 +158,11 @@ def group_for_tables(tables, tier: str, *, messages=None, group=None, errors_at=
 _FITS: OrderedDict = OrderedDict()
 FIT_CACHE_SIZE = 8
 """Closure fits kept per tables key in this session (a fit takes seconds, a bake 0.2 s)."""
+
+
+def clear_cache() -> None:
+    """Forget the session's fits (the add-on's unregister calls it)."""
+    _FITS.clear()
 
 
 def _fit(tables, key: str, errors_at):
@@ -291,6 +297,9 @@ def check_material(context, material) -> list[str]:
             meta = json.loads(node.node_tree.get(nodes.FIT_KEY, "{}"))
             image = bpy.data.images.get(meta.get("tables", ""))
             storage.unpack_tables(image)
+            if meta.get("tier") == "LAYERED" and bpy.data.images.get(
+                    storage.lut_image_name(meta.get("key", ""))) is None:
+                problem = "its view-angle lookup image is missing"
         except (ValueError, storage.StorageError) as error:
             problem = str(error)
     if problem is None:

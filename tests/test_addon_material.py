@@ -212,6 +212,21 @@ def test_broken_tables_are_reported_and_rebaked(sphere):
     storage.unpack_tables(_tables_image())
 
 
+def test_missing_lookup_image_is_rebuilt(sphere):
+    import bpy
+
+    from makeup_skin_addon import material as made_up
+
+    material = _apply(sphere, "LAYERED")
+    lut = next(image for image in bpy.data.images if image.name.startswith("MakeupSkin LUT"))
+    bpy.data.images.remove(lut)
+    messages = made_up.check_material(bpy.context, material)
+    assert messages and "lookup image is missing" in messages[0]
+    group = material.node_tree.nodes["Made-up Skin"].node_tree
+    textures = [n for n in group.nodes if n.type == "TEX_IMAGE"]
+    assert textures and all(n.image is not None for n in textures)
+
+
 def test_apply_reports_broken_tables_and_replaces_them(sphere):
     from makeup_skin_addon import storage
 
