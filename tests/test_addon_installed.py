@@ -7,16 +7,17 @@ Builds the zip with tools/build_extension.py and installs it into a temporary US
 
 import contextlib
 import importlib.util
-import math
 import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-pytestmark = pytest.mark.bpy
-
 REPO_ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(REPO_ROOT / "tools"))  # the tools are scripts, not a package
+import render_sphere  # noqa: E402
+
+pytestmark = pytest.mark.bpy
 REPO_MODULE = "makeup_skin_apply_repo"
 
 
@@ -85,21 +86,8 @@ def test_apply_from_the_installed_extension(installed, tmp_path):
     assert Path(storage.__file__).is_relative_to(installed["repo_dir"])
     storage.unpack_tables(group["makeup_skin_tables"])
 
-    camera = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
-    scene.collection.objects.link(camera)
-    camera.data.type = "ORTHO"
-    camera.data.ortho_scale = 0.066
-    camera.location = (0.0, -0.3, 0.0)
-    camera.rotation_euler = (math.pi / 2, 0.0, 0.0)
-    scene.camera = camera
-    sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
-    scene.collection.objects.link(sun)
-    sun.data.energy = math.pi
-    sun.rotation_euler = (math.pi / 2, 0.0, 0.0)
-    scene.render.engine = "CYCLES"
-    scene.cycles.device = "CPU"
-    scene.cycles.samples = 8
-    scene.render.resolution_x = scene.render.resolution_y = 32
+    render_sphere.light_and_camera(scene, 0.03, light_deg=0.0)
+    render_sphere.cycles_settings(scene, size=32, samples=8)
     scene.render.image_settings.file_format = "OPEN_EXR"
     scene.render.filepath = str(tmp_path / "installed.exr")
     bpy.ops.render.render(write_still=True)

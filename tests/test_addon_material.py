@@ -6,10 +6,14 @@ unregistered after it: bpy 4.5 hangs at exit while an add-on's classes stay regi
 """
 
 import json
-import math
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tools"))  # scripts, no package
+import render_sphere  # noqa: E402
 
 SIZE = 64
 
@@ -25,38 +29,17 @@ def addon(bpy_factory):
 
 @pytest.fixture
 def sphere(addon, blank_scene):
-    """A smooth sphere (radius 3 cm), an orthographic camera, a sun 60 degrees off the view
-    from +x, black world, Cycles CPU at 16 samples."""
+    """A smooth sphere (radius 3 cm), tools/render_sphere.py's camera and sun (60 degrees off
+    the view towards +x), black world, Cycles CPU at 16 samples."""
     import bpy
 
     scene = blank_scene
     bpy.ops.mesh.primitive_uv_sphere_add(segments=48, ring_count=24, radius=0.03)
     obj = bpy.context.active_object
     bpy.ops.object.shade_smooth()
-    camera = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
-    scene.collection.objects.link(camera)
-    camera.data.type = "ORTHO"
-    camera.data.ortho_scale = 0.066
-    camera.location = (0.0, -0.3, 0.0)
-    camera.rotation_euler = (math.pi / 2, 0.0, 0.0)
-    scene.camera = camera
-    sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
-    scene.collection.objects.link(sun)
-    sun.data.energy = math.pi
-    sun.data.angle = 0.0
-    sun.rotation_euler = (math.pi / 2, 0.0, math.radians(60.0))
-    scene.world = bpy.data.worlds.new("Black")
-    scene.world.color = (0.0, 0.0, 0.0)
-    for node in (scene.world.node_tree.nodes if scene.world.node_tree else ()):
-        if node.type == "BACKGROUND":
-            node.inputs["Strength"].default_value = 0.0
-    scene.render.engine = "CYCLES"
-    scene.cycles.device = "CPU"
-    scene.cycles.samples = 16
-    scene.cycles.seed = 0
-    scene.cycles.use_denoising = False
-    scene.render.resolution_x = scene.render.resolution_y = SIZE
-    scene.render.resolution_percentage = 100
+    render_sphere.light_and_camera(scene, 0.03, light_deg=60.0)
+    render_sphere.black_world(scene)
+    render_sphere.cycles_settings(scene, size=SIZE, samples=16)
     return obj
 
 

@@ -1,21 +1,14 @@
 """Cycles' subsurface blur against the replicas the radius fit relies on (one render each,
 256 x 8 px at 64 samples, via tools/calibrate_subsurface.py)."""
 
-import importlib.util
+import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-REPO_ROOT = Path(__file__).resolve().parent.parent
-
-
-def _calibration():
-    spec = importlib.util.spec_from_file_location(
-        "calibrate_subsurface", REPO_ROOT / "tools" / "calibrate_subsurface.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tools"))  # scripts, no package
+import calibrate_subsurface as calibration  # noqa: E402
 
 
 @pytest.mark.parametrize(("method", "albedo", "bound"), [
@@ -23,7 +16,6 @@ def _calibration():
     ("RANDOM_WALK_SKIN", 0.8, 0.011),  # measured Burley-shaped replica (0.7%)
 ])
 def test_rendered_edge_matches_the_replica(bpy_factory, tmp_path, method, albedo, bound):
-    calibration = _calibration()
     x, measured = calibration.render_edge(method, albedo, samples=64, folder=tmp_path)
     near = np.abs(x) < 3 * calibration.RADIUS_M * 1e3
     assert np.all(np.isfinite(measured))

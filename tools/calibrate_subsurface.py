@@ -29,8 +29,11 @@ from pathlib import Path
 import numpy as np
 
 REPO_ROOT = Path(__file__).resolve().parent.parent
-if str(REPO_ROOT) not in sys.path:
-    sys.path.insert(0, str(REPO_ROOT))
+for folder in (REPO_ROOT, REPO_ROOT / "tools"):
+    if str(folder) not in sys.path:
+        sys.path.insert(0, str(folder))
+
+from render_sphere import black_world, cycles_settings  # noqa: E402
 
 __all__ = ["RADIUS_M", "edge_scene", "render_edge", "replica_edge", "main"]
 
@@ -88,19 +91,10 @@ def edge_scene(method: str, albedo: float, samples: int) -> None:
     scene.collection.objects.link(sun)
     sun.data.energy = math.pi
     sun.data.angle = 0.0
-    scene.world = bpy.data.worlds.new("Black")
-    scene.world.color = (0.0, 0.0, 0.0)
-    for node in (scene.world.node_tree.nodes if scene.world.node_tree else ()):
-        if node.type == "BACKGROUND":
-            node.inputs["Strength"].default_value = 0.0
-    scene.render.engine = "CYCLES"
-    scene.cycles.device = "CPU"
-    scene.cycles.samples = samples
-    scene.cycles.use_denoising = False
+    black_world(scene)
+    cycles_settings(scene, size=WIDTH, height=HEIGHT, samples=samples)
     scene.cycles.max_bounces = 1
     scene.cycles.diffuse_bounces = 0
-    scene.render.resolution_x, scene.render.resolution_y = WIDTH, HEIGHT
-    scene.render.resolution_percentage = 100
     scene.render.filter_size = 0.01
 
 

@@ -17,7 +17,9 @@ denoiser, film exposure 1.
 
 Functions (for other scripts, e.g. the benchmarks of issue 5):
 
-- :func:`build_scene` -- the sphere, camera, sun and render settings in the current file.
+- :func:`build_scene` -- the sphere, camera, sun and render settings in a fresh file, from
+  :func:`light_and_camera`, :func:`black_world` and :func:`cycles_settings` (also used alone
+  by the tests and tools/calibrate_subsurface.py).
 - :func:`addon_registered` -- the add-on from this checkout, registered for a ``with`` block.
 - :func:`made_up_material` -- a material with the group for given tables and tier.
 - :func:`coverage_ramp` -- coverage painted as a left-to-right ramp.
@@ -39,7 +41,8 @@ REPO_ROOT = Path(__file__).resolve().parent.parent
 if str(REPO_ROOT) not in sys.path:
     sys.path.insert(0, str(REPO_ROOT))
 
-__all__ = ["build_scene", "addon_registered", "made_up_material", "coverage_ramp", "render",
+__all__ = ["build_scene", "light_and_camera", "black_world", "cycles_settings",
+           "addon_registered", "made_up_material", "coverage_ramp", "render",
            "load_or_bake", "main"]
 
 IRRADIANCE = math.pi
@@ -66,6 +69,54 @@ def load_or_bake(tables_path=None, foundation="paper_natural", skin="paper_biopl
     return bake.bake(presets.made_up_skin(foundation, skin), resolution)
 
 
+def light_and_camera(scene, radius: float, light_deg: float = 45.0) -> None:
+    """An orthographic camera on -y looking at a sphere of ``radius`` (scene units) at the
+    origin, framing it with 10% margin, and a sun (angle 0, irradiance :data:`IRRADIANCE`)
+    from the camera's side, turned ``light_deg`` degrees towards +x about the vertical."""
+    import bpy
+
+    camera = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
+    scene.collection.objects.link(camera)
+    camera.data.type = "ORTHO"
+    camera.data.ortho_scale = 2.2 * radius
+    camera.location = (0.0, -10.0 * radius, 0.0)
+    camera.rotation_euler = (math.pi / 2, 0.0, 0.0)
+    scene.camera = camera
+    sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
+    scene.collection.objects.link(sun)
+    sun.data.energy = IRRADIANCE
+    sun.data.angle = 0.0
+    sun.rotation_euler = (math.pi / 2, 0.0, math.radians(light_deg))  # shines along its -Z
+
+
+def black_world(scene) -> None:
+    """A black world (5.0 gives new worlds a Background node, 4.5 uses the world colour)."""
+    import bpy
+
+    world = bpy.data.worlds.new("Black")
+    world.color = (0.0, 0.0, 0.0)
+    for node in (world.node_tree.nodes if world.node_tree is not None else ()):
+        if node.type == "BACKGROUND":
+            node.inputs["Strength"].default_value = 0.0
+    scene.world = world
+
+
+def cycles_settings(scene, *, size: int, samples: int, seed: int = 0,
+                    height: int | None = None) -> None:
+    """Cycles on the CPU, no denoiser, film exposure 1, view transform Standard."""
+    scene.render.engine = "CYCLES"
+    scene.cycles.device = "CPU"
+    scene.cycles.samples = samples
+    scene.cycles.seed = seed
+    scene.cycles.use_denoising = False
+    scene.cycles.film_exposure = 1.0
+    scene.render.resolution_x = size
+    scene.render.resolution_y = size if height is None else height
+    scene.render.resolution_percentage = 100
+    scene.view_settings.view_transform = "Standard"
+    scene.view_settings.look = "None"
+
+
 def build_scene(*, size=128, samples=64, radius_mm=30.0, light_deg=45.0, seed=0):
     """Sphere, camera, sun and Cycles settings in a fresh file; returns the sphere object."""
     import bpy
@@ -78,36 +129,9 @@ def build_scene(*, size=128, samples=64, radius_mm=30.0, light_deg=45.0, seed=0)
     bpy.ops.mesh.primitive_uv_sphere_add(segments=128, ring_count=64, radius=radius)
     sphere = bpy.context.active_object
     bpy.ops.object.shade_smooth()
-    camera = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
-    scene.collection.objects.link(camera)
-    camera.data.type = "ORTHO"
-    camera.data.ortho_scale = 2.2 * radius
-    camera.location = (0.0, -10.0 * radius, 0.0)
-    camera.rotation_euler = (math.pi / 2, 0.0, 0.0)
-    scene.camera = camera
-    sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
-    scene.collection.objects.link(sun)
-    sun.data.energy = IRRADIANCE
-    sun.data.angle = 0.0
-    # The sun shines along -Z of its object; turn it to come from the camera side, rotated
-    # light_deg towards +x about the vertical axis.
-    sun.rotation_euler = (math.pi / 2, 0.0, math.radians(light_deg))
-    world = bpy.data.worlds.new("Black")
-    world.color = (0.0, 0.0, 0.0)
-    for node in (world.node_tree.nodes if world.node_tree is not None else ()):
-        if node.type == "BACKGROUND":  # 5.0 gives new worlds a node tree
-            node.inputs["Strength"].default_value = 0.0
-    scene.world = world
-    scene.render.engine = "CYCLES"
-    scene.cycles.device = "CPU"
-    scene.cycles.samples = samples
-    scene.cycles.seed = seed
-    scene.cycles.use_denoising = False
-    scene.cycles.film_exposure = 1.0
-    scene.render.resolution_x = scene.render.resolution_y = size
-    scene.render.resolution_percentage = 100
-    scene.view_settings.view_transform = "Standard"
-    scene.view_settings.look = "None"
+    light_and_camera(scene, radius, light_deg)
+    black_world(scene)
+    cycles_settings(scene, size=size, samples=samples, seed=seed)
     return sphere
 
 
