@@ -5,10 +5,11 @@ Usage::
     python tools/render_sphere.py --tables out/ --out out/sphere.png [--tier LAYERED]
     python tools/render_sphere.py --foundation medium_beige --skin jensen_skin1 --out x.png
 
-``--tables`` takes a folder (its one ``*.exr`` written by ``python -m lut_baker bake``) or the
-``.exr`` itself; without it the tables are baked from ``--foundation``/``--skin``.  Writes the
-PNG (view transform Standard) and a float32 OpenEXR beside it (same stem), then prints one line
-with the render time.  Run it with the venv's python (``$(tools/venv.sh)/bin/python``).
+``--tables`` takes a folder (its one ``*.exr`` + ``*.json`` pair written by ``python -m
+lut_baker bake``) or the ``.exr`` itself; without it the tables are baked from
+``--foundation``/``--skin``.  Writes the PNG (view transform Standard) and a float32 OpenEXR
+beside it (same stem), then prints one line with the render time.  Run it with the venv's
+python (``$(tools/venv.sh)/bin/python``).
 
 Scene: a smooth UV sphere of ``--radius-mm`` millimetres (scene in metres), an orthographic
 camera looking at it, one sun (angle 0, irradiance ``pi`` W/m^2, so a white Lambertian surface
@@ -56,11 +57,12 @@ def load_or_bake(tables_path=None, foundation="paper_natural", skin="paper_biopl
 
     if tables_path is not None:
         path = Path(tables_path)
-        if path.is_dir():
-            found = sorted(path.glob("*.exr"))
+        if path.is_dir():  # the tables are the .exr files with a .json sidecar
+            found = sorted(p.with_suffix(".exr") for p in path.glob("*.json")
+                           if p.with_suffix(".exr").is_file())
             if len(found) != 1:
-                raise SystemExit(f"render_sphere: expected one .exr in {path}, found "
-                                 f"{len(found)}; pass the file itself")
+                raise SystemExit(f"render_sphere: expected one baked table (.exr + .json) in "
+                                 f"{path}, found {len(found)}; pass the .exr itself")
             path = found[0]
         try:
             return io.load_tables(path)

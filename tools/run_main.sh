@@ -8,5 +8,5 @@ cd "$repo"
 venv="$(tools/venv.sh 5.0 | tail -n 1)"
 mkdir -p out
 "$venv/bin/python" -m lut_baker bake --preset paper --out out/
-"$venv/bin/python" tools/render_sphere.py --tables out/ --out out/sphere.png
+"$venv/bin/python" tools/render_sphere.py --tables out/paper.exr --out out/sphere.png
 echo "wrote $repo/out/sphere.png"
