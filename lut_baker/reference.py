@@ -133,11 +133,22 @@ TRANSMITTANCE_NODES = 1025
 so the interpolation error (< 1e-7 relative) stays far below the reference's tolerance."""
 
 
+_TRANSMITTANCE_CACHE: dict = {}
+"""``T`` on the polar nodes per film layer (keyed by its parameters, at most 8 kept): the
+tabulation takes seconds and one spread image needs it four times."""
+
+
 def _film_transmittance_rgb(local: np.ndarray, skin: MadeUpSkin) -> np.ndarray:
     """``(1 - A) T(w)`` per point for local directions (P, 3): the film crossed once, RGB."""
     film_t = film_transmission_layer(skin)
     theta = np.linspace(0.0, np.pi / 2, TRANSMITTANCE_NODES)
-    nodes = np.reshape(film_transmittance(direction(theta, 0.0), film_t), (theta.size, -1))
+    key = repr(film_t.as_dict())
+    nodes = _TRANSMITTANCE_CACHE.get(key)
+    if nodes is None:
+        nodes = np.reshape(film_transmittance(direction(theta, 0.0), film_t), (theta.size, -1))
+        while len(_TRANSMITTANCE_CACHE) >= 8:
+            _TRANSMITTANCE_CACHE.pop(next(iter(_TRANSMITTANCE_CACHE)))
+        _TRANSMITTANCE_CACHE[key] = nodes
     polar = np.arccos(np.clip(local[:, 2], 0.0, 1.0))
     t = np.stack([np.interp(polar, theta, nodes[:, c % nodes.shape[1]]) for c in range(3)], -1)
     return np.where(local[:, 2:3] > 0.0, t, 0.0)
