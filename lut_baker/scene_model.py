@@ -1,0 +1,616 @@
+"""The Auto tier (issue 5, item 5): model no more than the scene needs.
+
+From a description of the scene (camera, resolution, the object's size in mm, its distance or
+pixel footprint, the lights, the engine, the samples) this module predicts, for every
+:class:`Candidate` way of shading made-up skin, its error against the exact model and its
+render cost, and picks the cheapest one whose error is within a tolerance of the best.
+
+Error of a candidate (relative RMS over the object's pixels, one render against the converged
+exact image)::
+
+    E = sqrt(e_angle^2 + e_subsurface^2 + e_gloss^2 + noise^2)
+
+- ``e_angle``: the tier's angular error against the tables (:func:`closure_fit.tier_errors`,
+  relative RMS of ``f cos(theta_i)``);
+- ``e_subsurface``: without the subsurface closure, the light the skin spreads under the
+  surface stays where it entered; how much that changes the image is the pixel-footprint blur
+  argument, computed by :func:`subsurface_omission_error` (the profile's blur of a sphere's
+  shading, averaged over each pixel).  A spread under half a pixel changes no pixel by much.
+  With the closure, what is left is the closure's profile mismatch times that;
+- ``e_gloss``: without gloss lobes, the gloss's share of the image
+  (:func:`gloss_and_skin_shares`);
+- ``noise``: the Monte Carlo noise of one render, ``k / sqrt(samples)`` with ``k`` measured
+  per candidate (:data:`NOISE_K`); 0 with a denoiser (its bias is not modelled) and in EEVEE.
+
+So a film gloss below the noise of the fullest tier costs nothing to leave out, a subsurface
+radius under half a pixel leaves ``e_subsurface`` near 0, and EEVEE admits only the tiers that
+run there (:data:`ENGINE_TIERS`).  :func:`choose` takes the cheapest candidate (costs:
+:data:`RELATIVE_COST`, measured) whose ``E`` is at most ``min E + tolerance`` (default 2%).
+
+Functions and types
+-------------------
+- :class:`Candidate`, :data:`CANDIDATES`, :data:`FULLEST`, :data:`ENGINE_TIERS`.
+- :class:`SceneDescription` -- what the model needs to know of a scene.
+- :func:`pixel_footprint_mm` -- millimetres of the object per pixel (ortho or perspective).
+- :class:`MaterialTraits`, :func:`paper_traits`, :func:`traits_from_tables` -- what it needs
+  to know of the material.
+- :func:`profile_mean_radius_mm` -- the mean distance light travels under the skin.
+- :func:`gloss_and_skin_shares` -- shares of the gloss and of the spreading skin light in a
+  sphere's image.
+- :func:`profile_mismatch` -- how far a fitted closure's edge response is from the tables'.
+- :func:`blur_kernel`, :func:`subsurface_omission_error` -- the pixel-footprint blur argument.
+- :func:`noise`, :func:`predict`, :class:`Prediction`, :func:`needs_subsurface`,
+  :func:`choose`, :class:`Choice`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from functools import lru_cache
+
+import numpy as np
+
+from .quadrature import direction
+
+__all__ = [
+    "Candidate",
+    "CANDIDATES",
+    "FULLEST",
+    "ENGINES",
+    "ENGINE_TIERS",
+    "RELATIVE_COST",
+    "NOISE_K",
+    "DEFAULT_TOLERANCE",
+    "SceneDescription",
+    "pixel_footprint_mm",
+    "MaterialTraits",
+    "paper_traits",
+    "PAPER_TIER_ERRORS",
+    "PAPER_SKIN_SHARE",
+    "PAPER_GLOSS_SHARE",
+    "PAPER_MISMATCH",
+    "traits_from_tables",
+    "profile_mean_radius_mm",
+    "gloss_and_skin_shares",
+    "profile_mismatch",
+    "blur_kernel",
+    "subsurface_omission_error",
+    "noise",
+    "Prediction",
+    "predict",
+    "Choice",
+    "needs_subsurface",
+    "choose",
+    "TRAITS_COMMAND",
+    "COST_COMMAND",
+]
+
+
+# --------------------------------------------------------------------------------------------
+# Candidates, their costs and noise
+# --------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Candidate:
+    """One way to shade made-up skin: an add-on ``tier`` (``PRINCIPLED`` or ``LAYERED``) with
+    or without its subsurface closure and its gloss lobes.  The add-on realises
+    ``subsurface=False`` with Subsurface Scale 0 (Cycles then turns subsurface closures into
+    diffuse ones); it builds no gloss-free group, so ``gloss=False`` candidates are modelled
+    (and measured, bench/stability_sweep.py) but not :attr:`realisable`."""
+
+    tier: str
+    subsurface: bool = True
+    gloss: bool = True
+
+    @property
+    def name(self) -> str:
+        parts = [self.tier.title()]
+        if not self.subsurface:
+            parts.append("no subsurface")
+        if not self.gloss:
+            parts.append("no gloss")
+        return ", ".join(parts)
+
+    @property
+    def realisable(self) -> bool:
+        """Whether the add-on can build it (every gloss lobe kept)."""
+        return self.gloss
+
+
+CANDIDATES = tuple(Candidate(tier, subsurface, gloss) for tier in ("LAYERED", "PRINCIPLED")
+                   for gloss in (True, False) for subsurface in (True, False))
+"""Every candidate, the fullest first."""
+FULLEST = CANDIDATES[0]
+"""The LAYERED tier with subsurface and gloss: the most accurate, the costliest."""
+ENGINES = ("CYCLES", "EEVEE")
+ENGINE_TIERS = {"CYCLES": ("LAYERED", "PRINCIPLED"), "EEVEE": ("PRINCIPLED",)}
+"""Tiers per engine.  EEVEE gets the PRINCIPLED tier only: its Glossy BSDF has no Beckmann or
+Ashikhmin-Shirley distribution (the LAYERED fits may choose them), its subsurface is a
+screen-space Burley with no random walk, and it is optimised for the Principled BSDF."""
+DEFAULT_TOLERANCE = 0.02
+"""Error a cheaper candidate may add to the best one's (relative RMS)."""
+
+COST_COMMAND = "python bench/stability_sweep.py --costs --repeats 3"
+RELATIVE_COST = {
+    Candidate("LAYERED", True, True): 1.000,
+    Candidate("LAYERED", False, True): 0.606,
+    Candidate("LAYERED", True, False): 0.995,
+    Candidate("LAYERED", False, False): 0.362,
+    Candidate("PRINCIPLED", True, True): 0.535,
+    Candidate("PRINCIPLED", False, True): 0.383,
+    Candidate("PRINCIPLED", True, False): 0.613,
+    Candidate("PRINCIPLED", False, False): 0.302,
+}
+"""Render time per sample relative to :data:`FULLEST` (Cycles CPU 2 threads, 64 px sphere of
+30 mm, paper preset, sun at 45 degrees; the slope between 16 and 144 samples, fastest of 3
+interleaved runs), measured by :data:`COST_COMMAND` on bpy 5.0.1 (the fullest took 16.9 ms per
+sample).  Runs on this shared machine vary by 10-20%: ``PRINCIPLED, no gloss`` measured dearer
+than ``PRINCIPLED``, which is noise; only differences above ~15% are real.  EEVEE uses the same
+order (its render time here is shader compilation on software OpenGL)."""
+NOISE_K = {
+    Candidate("LAYERED", True, True): 0.279,
+    Candidate("LAYERED", False, True): 0.0019,
+    Candidate("LAYERED", True, False): 0.296,
+    Candidate("LAYERED", False, False): 0.0022,
+    Candidate("PRINCIPLED", True, True): 0.290,
+    Candidate("PRINCIPLED", False, True): 0.0019,
+    Candidate("PRINCIPLED", True, False): 0.296,
+    Candidate("PRINCIPLED", False, False): 0.0022,
+}
+"""Noise coefficient ``k``: one render's relative RMS deviation from the converged image is
+``k / sqrt(samples)`` (same command, two seeds at 144 samples).  The subsurface closure is the
+noisy part (3.5% at 64 samples); a sun light of angle 0 adds almost none.  Area lights and
+environments add noise to every candidate alike, so these values understate the noise there
+and the choice leans towards the fullest tier."""
+
+
+def noise(candidate: Candidate, samples: int, *, engine: str = "CYCLES",
+          denoise: bool = False) -> float:
+    """One render's Monte Carlo noise (relative RMS): ``k / sqrt(samples)`` (Cycles without a
+    denoiser), else 0."""
+    if engine != "CYCLES" or denoise:
+        return 0.0
+    return NOISE_K[candidate] / math.sqrt(max(int(samples), 1))
+
+
+# --------------------------------------------------------------------------------------------
+# The scene
+# --------------------------------------------------------------------------------------------
+def pixel_footprint_mm(camera: str, resolution_px: int, *, ortho_scale_mm: float | None = None,
+                       distance_mm: float | None = None, sensor_mm: float = 36.0,
+                       focal_mm: float = 50.0) -> float:
+    """Millimetres of the object one pixel covers.  ``camera`` ``"ORTHO"``: ``ortho_scale_mm``
+    (the view's width) over ``resolution_px`` (the larger image side); ``"PERSP"``: at
+    ``distance_mm`` from the camera, ``distance sensor / (focal resolution)`` (pinhole)."""
+    if resolution_px < 1:
+        raise ValueError(f"resolution_px must be >= 1, got {resolution_px}")
+    if camera == "ORTHO":
+        if not (ortho_scale_mm and ortho_scale_mm > 0):
+            raise ValueError("an orthographic camera needs ortho_scale_mm > 0")
+        return float(ortho_scale_mm) / resolution_px
+    if camera == "PERSP":
+        if not (distance_mm and distance_mm > 0) or not (focal_mm > 0 and sensor_mm > 0):
+            raise ValueError("a perspective camera needs distance_mm, focal_mm, sensor_mm > 0")
+        return float(distance_mm) * sensor_mm / (focal_mm * resolution_px)
+    raise ValueError(f"camera must be 'ORTHO' or 'PERSP', got {camera!r}")
+
+
+@dataclass(frozen=True)
+class SceneDescription:
+    """What the Auto tier needs of a scene.
+
+    ``object_size_mm``: the object's largest dimension (mm); ``footprint_mm``: mm per pixel at
+    the object (:func:`pixel_footprint_mm`); ``lights_deg``: each light's angle from the view
+    direction at the object (degrees; an environment counts as 45); ``engine``: ``CYCLES`` or
+    ``EEVEE``; ``samples`` per pixel; ``denoise``: a denoiser is on.
+    """
+
+    object_size_mm: float
+    footprint_mm: float
+    lights_deg: tuple = (45.0,)
+    engine: str = "CYCLES"
+    samples: int = 128
+    denoise: bool = False
+
+    def __post_init__(self):
+        if not (self.object_size_mm > 0 and self.footprint_mm > 0):
+            raise ValueError("object_size_mm and footprint_mm must be > 0 (mm)")
+        if self.engine not in ENGINES:
+            raise ValueError(f"engine must be one of {ENGINES}, got {self.engine!r}")
+        if not self.lights_deg:
+            raise ValueError("lights_deg needs at least one light angle (degrees)")
+
+    @property
+    def object_pixels(self) -> float:
+        """The object's size in pixels."""
+        return self.object_size_mm / self.footprint_mm
+
+
+# --------------------------------------------------------------------------------------------
+# The material
+# --------------------------------------------------------------------------------------------
+@dataclass(frozen=True, eq=False)
+class MaterialTraits:
+    """What the Auto tier needs of a made-up material at its coverage and absorption.
+
+    ``tier_errors``: angular relative RMS per tier (:func:`closure_fit.tier_errors`);
+    ``radius_mm``, ``profile``: the normalised radial profile ``R(d)/Rd`` (1/mm^2, ``(n, 3)``)
+    on distances (mm), the tables' ``radius_mm`` and ``profile``; ``profile_mismatch``: the
+    fitted closure's relative edge-response error (:func:`profile_mismatch`);
+    ``skin_share``, ``gloss_share``: per light angle (degrees), the share of the image that
+    spreads under the skin and that the gloss lobes make (:func:`gloss_and_skin_shares`).
+    """
+
+    tier_errors: dict
+    radius_mm: np.ndarray
+    profile: np.ndarray
+    profile_mismatch: float
+    skin_share: dict
+    gloss_share: dict
+    subsurface_scale: float = 1.0
+
+    def share(self, name: str, light_deg: float) -> float:
+        """``skin_share`` or ``gloss_share`` at a light angle (linear between the stored
+        angles, held beyond them)."""
+        table = getattr(self, name)
+        angles = sorted(table)
+        return float(np.interp(light_deg, angles, [table[a] for a in angles]))
+
+    def scaled(self, subsurface_scale: float) -> MaterialTraits:
+        """The same material with the artist's Subsurface Scale (distances multiplied)."""
+        return MaterialTraits(self.tier_errors, self.radius_mm, self.profile,
+                              self.profile_mismatch, self.skin_share, self.gloss_share,
+                              float(subsurface_scale))
+
+    @property
+    def mean_radius_mm(self) -> float:
+        """:func:`profile_mean_radius_mm` with the Subsurface Scale applied."""
+        return self.subsurface_scale * profile_mean_radius_mm(self.radius_mm, self.profile)
+
+
+def _trapezoid(y: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """Trapezoid rule along the first axis."""
+    dx = np.diff(x)
+    return np.tensordot(dx, 0.5 * (y[1:] + y[:-1]), axes=(0, 0))
+
+
+def profile_mean_radius_mm(radius_mm, profile) -> float:
+    """Mean distance (mm) between where light enters and leaves: ``Int d P(d) 2 pi d dd`` of
+    the normalised profile ``P = R/Rd`` (largest over channels)."""
+    d = np.asarray(radius_mm, float)
+    p = np.reshape(np.asarray(profile, float), (d.size, -1))
+    mass = _trapezoid(p * (2.0 * np.pi * d)[:, None], d)
+    mean = _trapezoid(p * (2.0 * np.pi * d * d)[:, None], d)
+    return float(np.max(mean / np.maximum(mass, 1e-300)))
+
+
+def _sphere_directions(resolution: int, light_deg: float):
+    """Local ``(wi, wo)`` at the lit pixel centres of a unit sphere seen orthographically from
+    +z (the reference's framing) with a distant light ``light_deg`` from the view in x-z.  The
+    model is isotropic, so only the polar angles and the relative azimuth are built (numpy
+    only: this runs inside Blender)."""
+    centres = (np.arange(resolution) + 0.5) / resolution * 2.0 - 1.0
+    x, y = np.meshgrid(centres, -centres)
+    inside = x * x + y * y < 1.0
+    x, y = x[inside], y[inside]
+    z = np.sqrt(1.0 - x * x - y * y)
+    a = math.radians(light_deg)
+    cos_i = x * math.sin(a) + z * math.cos(a)
+    lit = cos_i > 0.0
+    cos_i, cos_o = cos_i[lit], z[lit]
+    sin_i = np.sqrt(np.clip(1.0 - cos_i**2, 0.0, None))
+    sin_o = np.sqrt(np.clip(1.0 - cos_o**2, 0.0, None))
+    # l.v = cos(a) = cos_i cos_o + sin_i sin_o cos(phi)
+    cos_phi = np.where(sin_i * sin_o > 1e-12,
+                       (math.cos(a) - cos_i * cos_o) / np.maximum(sin_i * sin_o, 1e-12), 1.0)
+    phi = np.arccos(np.clip(cos_phi, -1.0, 1.0))
+    return (direction(np.arccos(np.clip(cos_i, -1.0, 1.0)), phi),
+            direction(np.arccos(np.clip(cos_o, -1.0, 1.0)), np.zeros_like(phi)))
+
+
+def gloss_and_skin_shares(tables, light_deg: float, coverage=None, absorption=None, *,
+                          resolution: int = 48) -> tuple[float, float]:
+    """``(gloss share, skin share)`` of a sphere's image under one distant light
+    ``light_deg`` from the view (orthographic, the reference's framing): relative RMS over
+    the lit pixels of the gloss lobes' radiance (film, path-3 and skin gloss at the coverage
+    and absorption) and of the skin's diffuse part (what spreads), against the total radiance
+    ``f cos(theta_i)`` from the tables."""
+    wi, wo = _sphere_directions(resolution, light_deg)
+    w, a = tables._mix(coverage, absorption)
+    through = 1.0 - a
+    cos_i = wi[:, 2:3]
+    total = tables.made_up_reflection(wi, wo, w, a) * cos_i
+    gloss = (w * tables.angular("film_gloss", wi, wo)
+             + w * through**2 * tables.angular("path3_gloss", wi, wo)
+             + (1.0 - w) * tables.angular("skin_gloss", wi, wo)) * cos_i
+    t_i = tables.directional("film_transmittance", np.degrees(np.arccos(wi[:, 2])))
+    t_o = tables.directional("film_transmittance", np.degrees(np.arccos(wo[:, 2])))
+    skin = tables.skin_diffuse * (w * through**2 * t_i * t_o + (1.0 - w)) * cos_i
+    norm = np.sqrt(np.mean(total**2))
+    if not norm > 0:
+        return 0.0, 0.0
+    return float(np.sqrt(np.mean(gloss**2)) / norm), float(np.sqrt(np.mean(skin**2)) / norm)
+
+
+def profile_mismatch(tables, fit_error) -> float:
+    """Relative error of a fitted subsurface closure's blur: ``fit_error`` (per channel, the
+    RMS difference of its edge response and the tables', a fraction of the lit level:
+    :class:`closure_fit.ProfileFit` ``error``) over the RMS of the tables' edge response's
+    departure from a sharp edge, largest over channels."""
+    from .closure_fit import _profile_grid, edge_response
+
+    r_max = float(tables.radius_mm[-1])
+    r = _profile_grid(r_max)
+    s = np.linspace(0.0, r_max, 48)
+    reference = edge_response(r, tables.radial(r), s)
+    departure = np.sqrt(np.mean(reference**2, axis=0))  # the sharp edge is 0 inside
+    return float(np.max(np.asarray(fit_error, float) / np.maximum(departure, 1e-12)))
+
+
+SHARE_LIGHTS_DEG = (0.0, 45.0, 75.0, 89.0)
+"""Light angles (degrees from the view) at which :func:`traits_from_tables` measures the
+shares."""
+
+
+def traits_from_tables(tables, fit, coverage=None, absorption=None, *,
+                       lights_deg=SHARE_LIGHTS_DEG, method: str | None = None
+                       ) -> MaterialTraits:
+    """:class:`MaterialTraits` of baked ``tables`` and their :class:`closure_fit.ClosureFit`
+    ``fit`` at a coverage and absorption (default: the tables')."""
+    from .closure_fit import tier_errors
+
+    w, a = tables._mix(coverage, absorption)
+    errors = tier_errors(fit, tables, w, a)
+    shares = {float(angle): gloss_and_skin_shares(tables, angle, w, a) for angle in lights_deg}
+    return MaterialTraits(
+        tier_errors={tier: float(e.rms) for tier, e in errors.items()},
+        radius_mm=np.asarray(tables.radius_mm, float),
+        profile=np.asarray(tables.profile, float),
+        profile_mismatch=profile_mismatch(
+            tables, fit.profiles[method or fit.subsurface_method].error),
+        skin_share={angle: value[1] for angle, value in shares.items()},
+        gloss_share={angle: value[0] for angle, value in shares.items()},
+    )
+
+
+TRAITS_COMMAND = "python bench/stability_sweep.py --traits"
+PAPER_TIER_ERRORS = {"PRINCIPLED": 0.0778, "LAYERED": 0.0524}
+PAPER_MISMATCH = 0.0474
+PAPER_SKIN_SHARE = {0.0: 0.1361, 45.0: 0.1327, 75.0: 0.1233, 89.0: 0.1141}
+PAPER_GLOSS_SHARE = {0.0: 0.1825, 45.0: 0.1904, 75.0: 0.2274, 89.0: 0.2758}
+"""The paper preset's traits (foundation paper_natural on paper_bioplate, coverage 1,
+absorption 0, default bake, closure fit with Burley) as :data:`TRAITS_COMMAND` prints them:
+what the Auto tier assumes of a material it has no tables for yet."""
+
+
+def _paper_traits() -> MaterialTraits:
+    """The constants above with the paper dipole's profile on the bake's
+    radial grid (exact and cheap to recompute)."""
+    from .bake import RESOLUTIONS, profile_radius
+    from .model import dipole_profile, dipole_total_reflectance
+    from .presets import made_up_skin
+    from .tables import radius_nodes
+
+    dipole = made_up_skin("paper_natural", "paper_bioplate").dipole
+    res = RESOLUTIONS["default"]
+    radius = radius_nodes(res.n_radius, res.radius_spacing, profile_radius(dipole))
+    profile = np.reshape(dipole_profile(radius, dipole), (radius.size, -1))
+    profile = profile / np.atleast_1d(dipole_total_reflectance(dipole)) * np.ones(3)
+    return MaterialTraits(tier_errors=dict(PAPER_TIER_ERRORS), radius_mm=radius,
+                          profile=profile, profile_mismatch=PAPER_MISMATCH,
+                          skin_share=dict(PAPER_SKIN_SHARE), gloss_share=dict(PAPER_GLOSS_SHARE))
+
+
+@lru_cache(maxsize=1)
+def paper_traits() -> MaterialTraits:
+    """The paper preset's :class:`MaterialTraits` (the constants above; built once)."""
+    return _paper_traits()
+
+
+# --------------------------------------------------------------------------------------------
+# The pixel-footprint blur argument
+# --------------------------------------------------------------------------------------------
+SUPERSAMPLE = 4
+"""Cells per pixel side in :func:`subsurface_omission_error`."""
+MAX_CELLS = 384
+"""Largest grid side (cells) of :func:`subsurface_omission_error`: bigger objects are modelled
+with coarser cells (never coarser than a pixel of the real image when it fits)."""
+KERNEL_SUBSAMPLES = 4
+"""Sub-samples per cell side when integrating the profile over a kernel cell."""
+
+
+def blur_kernel(cell_mm: float, radius_mm, profile) -> np.ndarray:
+    """The normalised profile integrated over square cells of ``cell_mm``: ``(2h+1, 2h+1, C)``
+    weights summing to 1 per channel, ``h`` cells reaching the profile's last distance.  The
+    centre cell takes what the others leave (the profile's peak at 0 is integrable but not
+    sampleable)."""
+    d = np.asarray(radius_mm, float)
+    p = np.reshape(np.asarray(profile, float), (d.size, -1))
+    h = int(min(math.ceil(d[-1] / cell_mm), MAX_CELLS))
+    offsets = (np.arange(KERNEL_SUBSAMPLES) + 0.5) / KERNEL_SUBSAMPLES - 0.5
+    centres = np.arange(-h, h + 1, dtype=float)
+    x = (centres[:, None] + offsets[None, :]).ravel() * cell_mm
+    r = np.hypot(x[:, None], x[None, :])
+    values = np.stack([np.interp(r, d, p[:, c], right=0.0) for c in range(p.shape[1])], -1)
+    n = 2 * h + 1
+    cells = values.reshape(n, KERNEL_SUBSAMPLES, n, KERNEL_SUBSAMPLES, -1).mean(axis=(1, 3))
+    cells *= cell_mm**2
+    cells[h, h] = 0.0
+    cells = np.minimum(cells, 1.0)
+    total = cells.sum(axis=(0, 1))
+    scale = np.where(total > 1.0, 1.0 / np.maximum(total, 1e-300), 1.0)
+    cells = cells * scale
+    cells[h, h] = 1.0 - cells.sum(axis=(0, 1))
+    return cells
+
+
+def _convolve(image: np.ndarray, kernel: np.ndarray) -> np.ndarray:
+    """``image`` (m, m) convolved with ``kernel`` (k, k), same size, zero outside (FFT)."""
+    m, k = image.shape[0], kernel.shape[0]
+    size = m + k - 1
+    spectrum = np.fft.rfft2(image, (size, size)) * np.fft.rfft2(kernel, (size, size))
+    full = np.fft.irfft2(spectrum, (size, size))
+    h = k // 2
+    return full[h:h + m, h:h + m]
+
+
+def subsurface_omission_error(footprint_mm: float, object_size_mm: float, light_deg: float,
+                              radius_mm, profile, skin_share: float = 1.0) -> float:
+    """Relative RMS change of a sphere's image (diameter ``object_size_mm``, pixels of
+    ``footprint_mm``, one distant light ``light_deg`` from the view) when the part of its
+    radiance that spreads under the skin (``skin_share`` of it) stays where it entered
+    instead of spreading with the normalised ``profile`` on ``radius_mm`` (mm).
+
+    The shading is Lambertian (``max(0, N.L)``) on cells of a pixel / :data:`SUPERSAMPLE`
+    (coarser for objects over :data:`MAX_CELLS` cells), blurred in the image plane with
+    :func:`blur_kernel` renormalised to the object's disk (light stays on the surface), both
+    images averaged over each pixel (the pixel footprint) before they are compared.  A
+    spread under half a pixel mostly stays inside the pixel it entered."""
+    radius_obj = 0.5 * float(object_size_mm)
+    cell = max(footprint_mm / SUPERSAMPLE, object_size_mm / MAX_CELLS)
+    per_pixel = max(int(round(footprint_mm / cell)), 1)
+    pixels = max(int(math.ceil(object_size_mm / (cell * per_pixel))), 1)
+    m = pixels * per_pixel
+    centres = ((np.arange(m) + 0.5) / m * 2.0 - 1.0) * (0.5 * m * cell / radius_obj)
+    x, y = np.meshgrid(centres, -centres)
+    r2 = x * x + y * y
+    disk = (r2 < 1.0).astype(float)
+    z = np.sqrt(np.clip(1.0 - r2, 0.0, None))
+    a = math.radians(light_deg)
+    shading = np.clip(x * math.sin(a) + z * math.cos(a), 0.0, None) * disk
+    if not np.any(shading > 0):
+        return 0.0
+    kernel = blur_kernel(cell, radius_mm, profile)
+
+    def pixel_mean(image):
+        return image.reshape(pixels, per_pixel, pixels, per_pixel).mean(axis=(1, 3))
+
+    seen = pixel_mean(disk) > 0.0
+    sharp = pixel_mean(shading)
+    errors = []
+    for c in range(kernel.shape[-1]):
+        spread = _convolve(shading, kernel[..., c])
+        reach = _convolve(disk, kernel[..., c])
+        blurred = np.where(disk > 0, spread / np.maximum(reach, 1e-12), 0.0)
+        errors.append(pixel_mean(blurred)[seen] - sharp[seen])
+    difference = np.stack(errors)
+    return float(skin_share * np.sqrt(np.mean(difference**2)) / np.sqrt(np.mean(sharp[seen]**2)))
+
+
+# --------------------------------------------------------------------------------------------
+# Prediction and choice
+# --------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Prediction:
+    """A candidate's predicted error in a scene: ``error`` (total, relative RMS), its parts
+    ``angle``, ``subsurface``, ``gloss``, ``noise`` (see the module docstring), and ``cost``
+    (render time relative to :data:`FULLEST`)."""
+
+    candidate: Candidate
+    error: float
+    angle: float
+    subsurface: float
+    gloss: float
+    noise: float
+    cost: float
+
+
+def _omission(scene: SceneDescription, traits: MaterialTraits) -> float:
+    """The largest :func:`subsurface_omission_error` over the scene's lights."""
+    return max(_omission_cached(scene.footprint_mm, scene.object_size_mm, float(light),
+                                traits)
+               for light in scene.lights_deg)
+
+
+@lru_cache(maxsize=256)
+def _omission_cached(footprint_mm, object_size_mm, light_deg, traits):
+    scale = traits.subsurface_scale
+    return subsurface_omission_error(footprint_mm, object_size_mm, light_deg,
+                                     scale * traits.radius_mm, traits.profile / scale**2,
+                                     traits.share("skin_share", light_deg))
+
+
+def predict(candidate: Candidate, scene: SceneDescription, traits: MaterialTraits,
+            omission: float | None = None) -> Prediction:
+    """:class:`Prediction` of ``candidate`` in ``scene`` for a material of ``traits``
+    (``omission``: :func:`subsurface_omission_error` if already known)."""
+    angle = float(traits.tier_errors[candidate.tier])
+    if traits.subsurface_scale <= 0.0:
+        omission = 0.0
+    elif omission is None:
+        omission = _omission(scene, traits)
+    subsurface = omission * (min(traits.profile_mismatch, 1.0) if candidate.subsurface else 1.0)
+    gloss = 0.0 if candidate.gloss else max(traits.share("gloss_share", light)
+                                            for light in scene.lights_deg)
+    grain = noise(candidate, scene.samples, engine=scene.engine, denoise=scene.denoise)
+    error = math.sqrt(angle**2 + subsurface**2 + gloss**2 + grain**2)
+    return Prediction(candidate=candidate, error=error, angle=angle, subsurface=subsurface,
+                      gloss=gloss, noise=grain, cost=RELATIVE_COST[candidate])
+
+
+@dataclass(frozen=True)
+class Choice:
+    """The Auto tier's decision: ``chosen`` (a :class:`Prediction`), ``predictions`` of every
+    candidate considered (cheapest first), ``tolerance``, ``best_error`` and ``reasons``
+    (lines for a report)."""
+
+    chosen: Prediction
+    predictions: tuple
+    tolerance: float
+    best_error: float
+    reasons: tuple = field(default_factory=tuple)
+
+    @property
+    def candidate(self) -> Candidate:
+        return self.chosen.candidate
+
+    def prediction(self, candidate: Candidate) -> Prediction | None:
+        """The prediction of ``candidate``, if it was considered."""
+        return next((p for p in self.predictions if p.candidate == candidate), None)
+
+
+def needs_subsurface(scene: SceneDescription, traits: MaterialTraits) -> bool:
+    """Whether the scene resolves the skin's subsurface spread: its mean radius
+    (:attr:`MaterialTraits.mean_radius_mm`, the Subsurface Scale applied) is at least half a
+    pixel.  Below that a shadow edge, where subsurface scattering shows most, moves by less
+    than half a pixel.  (The sphere images of :func:`subsurface_omission_error` have no
+    shadow edge, so their small error alone would drop the closure at any distance.)"""
+    return traits.subsurface_scale > 0.0 and traits.mean_radius_mm >= 0.5 * scene.footprint_mm
+
+
+def choose(scene: SceneDescription, traits: MaterialTraits | None = None, *,
+           tolerance: float = DEFAULT_TOLERANCE, candidates=None) -> Choice:
+    """The cheapest candidate whose predicted error is within ``tolerance`` of the best one's,
+    among ``candidates`` (default: the add-on's realisable ones) that run in the scene's
+    engine, keep the subsurface closure if :func:`needs_subsurface` (and drop it when the
+    Subsurface Scale is 0: Cycles then shades no spread anyway).  ``traits`` default to the
+    paper preset's (:func:`paper_traits`)."""
+    if not tolerance >= 0:
+        raise ValueError(f"tolerance must be >= 0, got {tolerance}")
+    traits = paper_traits() if traits is None else traits
+    needed = needs_subsurface(scene, traits)
+    pool = [c for c in (candidates or [c for c in CANDIDATES if c.realisable])
+            if c.tier in ENGINE_TIERS[scene.engine]
+            and not (needed and not c.subsurface)
+            and not (traits.subsurface_scale <= 0.0 and c.subsurface)]
+    if not pool:
+        raise ValueError(f"no candidate runs in {scene.engine} with what the scene needs")
+    omission = 0.0 if traits.subsurface_scale <= 0.0 else _omission(scene, traits)
+    predictions = sorted((predict(c, scene, traits, omission) for c in pool),
+                         key=lambda p: (p.cost, p.error))
+    best = min(p.error for p in predictions)
+    chosen = next(p for p in predictions if p.error <= best + tolerance)
+    radius = traits.mean_radius_mm
+    grain = noise(FULLEST, scene.samples, engine=scene.engine, denoise=scene.denoise)
+    reasons = (
+        f"object {scene.object_pixels:.0f} px across at {scene.footprint_mm:.3g} mm per px",
+        f"subsurface mean radius {radius:.3g} mm = {radius / scene.footprint_mm:.2g} px: "
+        + ("needed (half a pixel or more)" if needed else
+           f"not needed (under half a pixel; leaving it out errs {100 * omission:.2f}%)"),
+        f"noise of the fullest tier at {scene.samples} samples: {100 * grain:.1f}%",
+        f"{chosen.candidate.name}: predicted error {100 * chosen.error:.1f}% (best "
+        f"{100 * best:.1f}% + tolerance {100 * tolerance:.0f}%), cost {chosen.cost:.2f} of "
+        f"the fullest tier's",
+    )
+    return Choice(chosen=chosen, predictions=tuple(predictions), tolerance=tolerance,
+                  best_error=best, reasons=reasons)
