@@ -131,17 +131,20 @@ def _batched_matmul(left: np.ndarray, right: np.ndarray) -> np.ndarray:
 
 
 def layered_fourier_matrices(theta_i, theta_o, cosmetic, skin, grid: HemisphereGrid, *,
-                             fourier=layer_fourier_kernel):
+                             fourier=layer_fourier_kernel, orders: int | None = None):
     """Fourier matrices ``F_m(theta_i, theta_o)`` of path 3: ``f_cs = sum_m F_m cos(m phi)``.
 
     ``theta_i``, ``theta_o``: polar angles (radians) of the outer directions; returns shape
     ``(orders, len(theta_i), len(theta_o), C)``.  Cost: one kernel table per layer and two
     batched matrix products per order (SPEC 3).  ``fourier``: the function giving each layer's
     kernel coefficients (signature of :func:`layer_fourier_kernel`, e.g. a faster or cached one).
+    ``orders``: keep only the first orders (1 for azimuth-integrated quantities such as albedos:
+    the kernels are still sampled at every azimuth, but the products run once).
     """
-    inner = _inner_matrices(grid, cosmetic, skin, fourier)
-    rows = _transmission_rows(theta_i, grid, cosmetic, fourier)
-    cols = _transmission_rows(theta_o, grid, cosmetic, fourier)
+    keep = slice(None, orders)
+    inner = _inner_matrices(grid, cosmetic, skin, fourier)[keep]
+    rows = _transmission_rows(theta_i, grid, cosmetic, fourier)[keep]
+    cols = _transmission_rows(theta_o, grid, cosmetic, fourier)[keep]
     return _batched_matmul(_batched_matmul(rows, inner), np.swapaxes(cols, 1, 2))
 
 

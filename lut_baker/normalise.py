@@ -187,7 +187,8 @@ def directional_albedo(theta_i_deg, skin: MadeUpSkin, *, level: int = 0) -> np.n
     theta = np.radians(np.atleast_1d(np.asarray(theta_i_deg, float)))
     film_t = film_transmission_layer(skin)
     grid = grid_for(film_t, skin.skin, skin.film, level=level)
-    path3 = layered_fourier_matrices(theta, grid.theta, film_t, skin.skin, grid)[0]  # (P, N, C)
+    path3 = layered_fourier_matrices(theta, grid.theta, film_t, skin.skin, grid,
+                                     orders=1)[0]  # (P, N, C)
     path3 = 2.0 * np.pi * np.einsum("pnc,n->pc", path3, grid.weight)
     path3 = path3 if (film_t.channels or skin.skin.channels) else path3[..., 0]
     film = film_reflection_layer(skin)
