@@ -83,6 +83,7 @@ __all__ = [
     "needs_subsurface",
     "choose",
     "TRAITS_COMMAND",
+    "SHARE_LIGHTS_DEG",
     "COST_COMMAND",
 ]
 

@@ -20,7 +20,7 @@ from collections import OrderedDict
 
 import bpy
 
-from . import nodes, storage
+from . import nodes, scene_fit, storage
 from .package import lut_baker
 from .properties import socket_values
 
@@ -69,7 +69,7 @@ def resolve_tier(settings, scene) -> str:
     elsewhere (EEVEE has no angular lookup advantage to offer; issue 5 refines Auto)."""
     if settings.tier != "AUTO":
         return settings.tier
-    return "LAYERED" if scene.render.engine == "CYCLES" else "PRINCIPLED"
+    return scene_fit.auto_tier(settings, scene)
 
 
 def forced_method(settings):

@@ -247,7 +247,7 @@ def test_unregister_leaves_nothing(addon, bpy_factory):
         # Panels and menus by class name; operators by bl_idname (MAKEUP_SKIN_OT_apply).
         return [name for name in dir(bpy.types) if name.startswith(("MAKEUPSKIN", "MAKEUP_SKIN"))]
 
-    assert len(ours()) == 6 and hasattr(bpy.types.Material, "makeup_skin")
+    assert len(ours()) == 7 and hasattr(bpy.types.Material, "makeup_skin")  # + Fit to Scene
     addon.unregister()
     try:
         assert not hasattr(bpy.types.Material, "makeup_skin")

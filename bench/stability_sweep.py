@@ -1,0 +1,305 @@
+"""Stability where the methods fail, and the costs the Auto tier uses (a benchmark).
+
+    python bench/stability_sweep.py [--out docs/stability.md] [--no-render]
+    python bench/stability_sweep.py --costs [--repeats 3]
+
+The first form runs :func:`lut_baker.stability.sweep` (the exact model, the bake, the closure
+fits and the reference images in every regime of issue 5, item 4) and, unless
+``--no-render``, renders each tier in the same regimes with Cycles (:func:`render_regimes`):
+no NaN, Inf or negative pixel, the white furnace (world colour 1, no light) and the error
+against the reference image.  It prints the table of docs/stability.md (``--out`` rewrites the
+part of that file between its ``<!-- sweep -->`` markers).
+
+``--costs`` measures what :mod:`lut_baker.scene_model` stores: per-sample render time of every
+candidate relative to the fullest (the slope between two sample counts, so that scene set-up
+does not count) and its Monte Carlo noise coefficient (relative RMS between two seeds).
+
+bpy helpers on top of bench/blender_scene.py (the reference's scene; also used by
+tests/test_addon_stability.py and tests/test_scene_model.py):
+
+- :class:`Stage` -- one scene built once, changed between renders (radius, light, seed,
+  white furnace: no light, world colour 1).
+- :func:`candidate_material` -- the made-up material of a scene-model candidate.
+- :func:`furnace_rings` -- a furnace image averaged over rings of the view angle.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+for _path in (ROOT, ROOT / "tools", ROOT / "bench"):
+    if str(_path) not in sys.path:
+        sys.path.insert(0, str(_path))
+
+import blender_scene  # noqa: E402  (bench/blender_scene.py)
+import render_sphere  # noqa: E402  (tools/render_sphere.py)
+
+from lut_baker import compare  # noqa: E402
+
+__all__ = ["Stage", "candidate_material", "furnace_rings", "measure_costs",
+           "render_regimes", "main"]
+
+
+class Stage:
+    """One :func:`blender_scene.sphere_scene` built once (it takes 10-15 s on this machine:
+    the 256-segment sphere) and changed between renders: sphere radius (the mesh rescaled,
+    camera reframed as sphere_scene frames it), light angle, seed, samples, white furnace."""
+
+    def __init__(self, *, size=32, samples=128, radius_mm=10.0):
+        import bpy
+
+        self.sphere = blender_scene.sphere_scene(size=size, samples=samples,
+                                                 radius_mm=radius_mm)
+        self.scene = bpy.context.scene
+        self.radius_mm = radius_mm
+        self.sun = self.scene.objects["Sun"]
+        self.background = next((n for n in (self.scene.world.node_tree.nodes
+                                             if self.scene.world.node_tree else ())
+                                if n.type == "BACKGROUND"), None)
+
+    def frame(self, radius_mm: float) -> None:
+        """Rescale the sphere to ``radius_mm`` and reframe the camera (ortho 2R at -10R)."""
+        from mathutils import Matrix
+
+        if radius_mm != self.radius_mm:
+            self.sphere.data.transform(Matrix.Scale(radius_mm / self.radius_mm, 4))
+            self.sphere.data.update()
+            self.radius_mm = radius_mm
+        radius = radius_mm * 1e-3
+        camera = self.scene.camera
+        camera.location = (0.0, -10.0 * radius, 0.0)
+        camera.data.ortho_scale = 2.0 * radius
+        camera.data.clip_start = radius
+        camera.data.clip_end = 100.0 * radius
+
+    def light(self, light_deg: float) -> None:
+        """The sun ``light_deg`` from the view towards +x (as tools/render_sphere.py)."""
+        self.sun.rotation_euler = (math.pi / 2, 0.0, math.radians(light_deg))
+
+    def furnace(self, on: bool) -> None:
+        """White furnace (no light, world colour 1) or the sun in a black world."""
+        self.sun.hide_render = on
+        value = 1.0 if on else 0.0
+        self.scene.world.color = (value,) * 3
+        if self.background is not None:
+            self.background.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
+            self.background.inputs["Strength"].default_value = value
+
+    def render(self, tables, candidate, *, seed=0, samples=None):
+        """Render ``candidate`` (:func:`candidate_material`): ``(seconds, image)``."""
+        blender_scene.set_samples(self.scene, samples or self.scene.cycles.samples, seed)
+        candidate_material(self.sphere, tables, candidate)
+        return blender_scene.render_image()
+
+
+def _drop_gloss(group):
+    """A copy of ``group`` without its gloss (bench only: Glossy closures at colour 0, the
+    Principled BSDF's coat weight and specular level at 0)."""
+    copy = group.copy()
+    for node in copy.nodes:
+        if node.type == "BSDF_GLOSSY":
+            for link in list(node.inputs["Color"].links):
+                copy.links.remove(link)
+            node.inputs["Color"].default_value = (0.0, 0.0, 0.0, 1.0)
+        elif node.type == "BSDF_PRINCIPLED":
+            for name in ("Coat Weight", "Specular IOR Level"):
+                for link in list(node.inputs[name].links):
+                    copy.links.remove(link)
+                node.inputs[name].default_value = 0.0
+    return copy
+
+
+def candidate_material(sphere, tables, candidate):
+    """The made-up material of a :class:`lut_baker.scene_model.Candidate` on ``sphere`` (the
+    add-on registered): its tier; ``subsurface=False`` sets Subsurface Scale 0 as the Fit to
+    Scene operator does (Cycles then shades the subsurface closures as diffuse ones);
+    ``gloss=False`` swaps in :func:`_drop_gloss` (no add-on tier does that)."""
+    material = blender_scene.tier_material(sphere, tables, candidate.tier)
+    node = material.node_tree.nodes["Made-up Skin"]
+    if not candidate.subsurface:
+        material.makeup_skin.subsurface_scale = 0.0
+        node.inputs["Subsurface Scale"].default_value = 0.0
+    if not candidate.gloss:
+        node.node_tree = _drop_gloss(node.node_tree)
+    return material
+
+
+FURNACE_RINGS = 8
+"""Rings of equal width in ``cos(theta_o)`` over which :func:`furnace_rings` averages."""
+
+
+def furnace_rings(image, rings: int = FURNACE_RINGS):
+    """``(cos_view centres, ring means (rings, 3), ring standard errors (rings, 3))`` of a
+    white-furnace image over rings of the view cosine (pixel centres of the sphere)."""
+    size = image.shape[0]
+    centres = (np.arange(size) + 0.5) / size * 2.0 - 1.0
+    x, y = np.meshgrid(centres, -centres)
+    r2 = x * x + y * y
+    mask = r2 < 1.0
+    cos_view = np.sqrt(np.clip(1.0 - r2, 0.0, None))[mask]
+    values = np.asarray(image, float)[mask]
+    ring = np.minimum((cos_view * rings).astype(int), rings - 1)
+    means = np.stack([values[ring == k].mean(axis=0) for k in range(rings)])
+    errors = np.stack([values[ring == k].std(axis=0) / np.sqrt(max((ring == k).sum(), 1))
+                       for k in range(rings)])
+    return (np.arange(rings) + 0.5) / rings, means, errors
+
+
+# --------------------------------------------------------------------------------------------
+# Costs and noise of the candidates (lut_baker.scene_model's constants)
+# --------------------------------------------------------------------------------------------
+def measure_costs(*, size=64, samples=(16, 144), repeats=3, radius_mm=30.0):
+    """Per-sample render time (relative to the fullest candidate) and noise coefficient
+    ``k`` (one render's relative RMS deviation = k / sqrt(samples)) of every candidate of
+    :data:`lut_baker.scene_model.CANDIDATES`, Cycles CPU, paper preset, sun at 45 degrees.
+
+    Times: the slope ``(t(high) - t(low)) / (high - low)`` (scene set-up does not count), the
+    fastest of ``repeats`` interleaved runs.  Noise: :func:`lut_baker.compare.noise_floor` of
+    two seeds at the higher count, times ``sqrt(samples)``."""
+    from lut_baker import bake, presets, scene_model
+
+    tables = bake.bake(presets.made_up_skin("paper_natural", "paper_bioplate"), "preview")
+    low, high = samples
+    times = {c: {low: [], high: []} for c in scene_model.CANDIDATES}
+    noise = {}
+
+    with render_sphere.addon_registered():
+        stage = Stage(size=size, samples=high, radius_mm=radius_mm)
+        for _ in range(repeats):
+            for candidate in scene_model.CANDIDATES:
+                for count in (low, high):
+                    times[candidate][count].append(
+                        stage.render(tables, candidate, samples=count)[0])
+        for candidate in scene_model.CANDIDATES:
+            a = stage.render(tables, candidate, seed=0)[1]
+            b = stage.render(tables, candidate, seed=1)[1]
+            noise[candidate] = compare.noise_floor(a, b, 0.5 * (a + b)) * math.sqrt(high)
+    slope = {c: (min(t[high]) - min(t[low])) / (high - low) for c, t in times.items()}
+    fullest = slope[scene_model.FULLEST]
+    return {c: {"relative_cost": slope[c] / fullest, "seconds_per_sample": slope[c],
+                "noise_k": noise[c]} for c in scene_model.CANDIDATES}
+
+
+# --------------------------------------------------------------------------------------------
+# Each tier in each regime
+# --------------------------------------------------------------------------------------------
+
+
+def _furnace_reference(tables, size):
+    """The exact model's white-furnace image: at each pixel the directional albedo at its
+    view angle (reciprocity; uniform light spreads nothing)."""
+    centres = (np.arange(size) + 0.5) / size * 2.0 - 1.0
+    x, y = np.meshgrid(centres, -centres)
+    r2 = x * x + y * y
+    theta = np.degrees(np.arccos(np.sqrt(np.clip(1.0 - r2, 0.0, 1.0))))
+    image = np.asarray(tables.directional_albedo(theta), float)
+    return np.where((r2 < 1.0)[..., None], image, 0.0)
+
+
+def render_regime(stage, item, candidates, *, seeds=(0, 1), furnace=True, tables=None):
+    """Render every candidate in one :class:`lut_baker.stability.Regime` on ``stage`` (a
+    :class:`Stage`; the add-on registered): per candidate name ``{"lit", "furnace",
+    "spread"}``.  Lit (each of the regime's lights, the worst kept): finite, min, max,
+    ``error`` against :func:`lut_baker.compare.reference_image` (from the tables; spread where
+    the reference affords it), ``noise`` (two seeds) and ``bias``.  Furnace: finite, min, max
+    pixel, the largest ring mean of :func:`furnace_rings` and its standard error, the exact
+    albedo's largest value and the error against the exact furnace image."""
+    from lut_baker import bake, reference, stability
+
+    skin = stability.regime_skin(item)
+    tables = tables or bake.bake(skin, "preview")
+    size = stage.scene.render.resolution_x
+    affordable = reference.default_samples(skin, item.radius_mm) <= stability.MAX_SPREAD_SAMPLES
+    references = {light: compare.reference_image(
+        skin, tables=tables, resolution=size, radius_mm=item.radius_mm, light_angle_deg=light,
+        irradiance=blender_scene.IRRADIANCE, spread=affordable) for light in item.lights_deg}
+    furnace_ref = _furnace_reference(tables, size)
+    mask = compare.sphere_mask(size)
+    stage.frame(item.radius_mm)
+    out = {}
+    for candidate in candidates:
+        lit = []
+        stage.furnace(False)
+        for light in item.lights_deg:
+            stage.light(light)
+            images = [stage.render(tables, candidate, seed=seed)[1] for seed in seeds]
+            ref = references[light]
+            error = compare.relative_rms(images[0], ref)
+            floor = compare.noise_floor(images[0], images[-1], ref) if len(images) > 1 else 0.0
+            lit.append({"light_deg": light, **stability.summary(np.stack(images)),
+                        "error": error, "noise": floor, "bias": compare.bias(error, floor)})
+        result = {"lit": dict(max(lit, key=lambda r: r["error"])), "spread": affordable}
+        result["lit"]["finite"] = all(r["finite"] for r in lit)
+        result["lit"]["min"] = min(r["min"] for r in lit)
+        if furnace:
+            stage.furnace(True)
+            image = stage.render(tables, candidate)[1]
+            stage.furnace(False)
+            _, means, errors = furnace_rings(image)
+            k = np.unravel_index(np.argmax(means), means.shape)
+            result["furnace"] = {**stability.summary(image[mask]),
+                                 "ring_max": float(means[k]), "ring_se": float(errors[k]),
+                                 "albedo_max": float(furnace_ref[mask].max()),
+                                 "error": compare.relative_rms(image, furnace_ref)}
+        out[candidate.name] = result
+    return out
+
+
+def render_regimes(regimes=None, **options) -> dict:
+    """:func:`render_regime` of both add-on tiers (and the Auto tier's choice where it is
+    another candidate) over ``regimes`` (default all), by regime key."""
+    from lut_baker import scene_model, stability
+
+    regimes = stability.REGIMES if regimes is None else regimes
+    out = {}
+    with render_sphere.addon_registered():
+        stage = Stage(**{k: options.pop(k) for k in ("size", "samples") if k in options})
+        for item in regimes:
+            candidates = [scene_model.Candidate("PRINCIPLED"), scene_model.Candidate("LAYERED")]
+            auto = stability.auto_choice(item).candidate
+            if auto not in candidates:
+                candidates.append(auto)
+            start = time.perf_counter()
+            out[item.key] = render_regime(stage, item, candidates, **options)
+            print(f"# rendered {item.key}: {time.perf_counter() - start:.0f} s", flush=True)
+    return out
+
+
+def _print_costs(costs, args) -> None:
+    print(f"# python bench/stability_sweep.py --costs --repeats {args.repeats} "
+          f"(Cycles CPU, {args.size} px, samples {args.samples[0]}/{args.samples[1]})")
+    for candidate, value in costs.items():
+        print(f"{candidate.name:34s} relative cost {value['relative_cost']:.3f}  "
+              f"({1e3 * value['seconds_per_sample']:.2f} ms/sample)  "
+              f"noise k {value['noise_k']:.4f}")
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--costs", action="store_true",
+                        help="measure the candidates' relative costs and noise")
+    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--size", type=int, default=64)
+    parser.add_argument("--samples", type=int, nargs=2, default=(16, 144))
+    parser.add_argument("--out", type=Path, help="rewrite the table in this markdown file")
+    parser.add_argument("--no-render", action="store_true", help="pure sweep only")
+    args = parser.parse_args(argv)
+    os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="stability_"))
+    if args.costs:
+        _print_costs(measure_costs(size=args.size, samples=tuple(args.samples),
+                                   repeats=args.repeats), args)
+        return 0
+    raise SystemExit("the sweep is not written yet")
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,363 @@
+"""Fit to Scene: the Auto tier chosen from the scene (issue 5, item 5).
+
+What the scene looks like to the model (:class:`lut_baker.scene_model.SceneDescription`) comes
+from the active camera, the render resolution, the objects wearing the material (the nearest
+one: the largest on screen), the lights and the render engine; what the material is
+(:class:`lut_baker.scene_model.MaterialTraits`) from its stored tables and the tiers' errors of
+its last Apply.  :func:`lut_baker.scene_model.choose` then picks the cheapest candidate within
+the tolerance.
+
+- :func:`auto_tier` -- the tier for ``Tier = Auto`` (called by
+  :func:`makeup_skin_addon.material.resolve_tier`; quick, never raises).
+- :func:`describe_scene` -- the scene as the model sees it (None without a camera or object).
+- :func:`material_traits` -- the material as the model sees it (cached per tables).
+- :func:`choose_for` -- the choice for a material in a scene.
+- :class:`MAKEUPSKIN_OT_fit_to_scene` (``makeup_skin.fit_to_scene``) -- choose, report the
+  choice and the predicted error, and apply it: the tier, and Subsurface Scale 0 when the
+  scene does not resolve the subsurface (the value before is kept and given back when a later
+  fit needs it).
+- :func:`draw_fit` -- the panels' button and the last choice (appended to both panels).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections import OrderedDict
+
+import bpy
+
+from .package import lut_baker
+
+__all__ = ["CHOICE_KEY", "SAVED_SCALE_KEY", "ENVIRONMENT_LIGHT_DEG", "auto_tier",
+           "describe_scene", "material_traits", "choose_for", "MAKEUPSKIN_OT_fit_to_scene",
+           "draw_fit", "register", "unregister"]
+
+CHOICE_KEY = "makeup_skin_scene_fit"
+"""Material custom property: the last Fit to Scene choice (JSON), shown in the panel."""
+SAVED_SCALE_KEY = "makeup_skin_saved_subsurface_scale"
+"""Material custom property: the Subsurface Scale before Fit to Scene set it to 0."""
+ENVIRONMENT_LIGHT_DEG = 45.0
+"""Light angle (degrees from the view) assumed when the scene has no lamp (world light)."""
+UNKNOWN_SCENE = {"object_size_mm": 100.0, "footprint_mm": 0.01}
+"""Without a camera or an object wearing the material: a close-up (everything resolved)."""
+
+
+def _engine(scene) -> str:
+    return "CYCLES" if scene.render.engine == "CYCLES" else "EEVEE"
+
+
+def _samples(scene) -> tuple[int, bool]:
+    if scene.render.engine == "CYCLES":
+        return int(scene.cycles.samples), bool(scene.cycles.use_denoising)
+    return int(getattr(scene.eevee, "taa_render_samples", 64)), False
+
+
+def _wearers(material, scene) -> list:
+    return [obj for obj in scene.objects
+            if obj.type == "MESH" and any(slot.material == material
+                                          for slot in obj.material_slots)]
+
+
+def _centre(obj):
+    from mathutils import Vector
+
+    corners = [obj.matrix_world @ Vector(corner) for corner in obj.bound_box]
+    return sum(corners, Vector()) / 8.0
+
+
+def _footprint_mm(scene, obj, mm_per_unit: float):
+    """``(mm per pixel at the object, unit vector from the object to the camera)``."""
+    sm = lut_baker("scene_model")
+    camera = scene.camera
+    data = camera.data
+    scale = scene.render.resolution_percentage / 100.0
+    res_x, res_y = scene.render.resolution_x * scale, scene.render.resolution_y * scale
+    fit = data.sensor_fit
+    if fit == "AUTO":
+        resolution, sensor = max(res_x, res_y), data.sensor_width
+    elif fit == "HORIZONTAL":
+        resolution, sensor = res_x, data.sensor_width
+    else:
+        resolution, sensor = res_y, data.sensor_height
+    axis = camera.matrix_world.to_3x3().col[2].normalized()  # the camera looks along -Z
+    centre = _centre(obj)
+    if data.type == "ORTHO":
+        footprint = sm.pixel_footprint_mm("ORTHO", max(int(resolution), 1),
+                                          ortho_scale_mm=data.ortho_scale * mm_per_unit)
+        return footprint, axis
+    offset = camera.matrix_world.translation - centre
+    depth = max(offset.dot(axis), 1e-9)
+    footprint = sm.pixel_footprint_mm("PERSP", max(int(resolution), 1),
+                                      distance_mm=depth * mm_per_unit, sensor_mm=sensor,
+                                      focal_mm=data.lens)
+    return footprint, offset.normalized()
+
+
+def _light_angles(scene, obj, toward_camera) -> tuple:
+    centre = _centre(obj)
+    angles = []
+    for light in scene.objects:
+        if light.type != "LIGHT" or light.hide_render or light.data.energy <= 0.0:
+            continue
+        if light.data.type == "SUN":
+            toward = light.matrix_world.to_3x3().col[2].normalized()  # shines along -Z
+        else:
+            toward = (light.matrix_world.translation - centre).normalized()
+        cosine = max(-1.0, min(1.0, toward.dot(toward_camera)))
+        angles.append(round(math.degrees(math.acos(cosine)), 1))
+    return tuple(sorted(set(angles))) or (ENVIRONMENT_LIGHT_DEG,)
+
+
+def describe_scene(scene, material=None, obj=None):
+    """The :class:`lut_baker.scene_model.SceneDescription` of ``scene`` for ``obj`` (default:
+    the nearest object wearing ``material``), or None without a camera or an object."""
+    sm = lut_baker("scene_model")
+    from .material import units_per_mm
+
+    samples, denoise = _samples(scene)
+    objects = [obj] if obj is not None else (_wearers(material, scene) if material else [])
+    if scene.camera is None or not objects:
+        return None
+    mm_per_unit = 1.0 / units_per_mm(scene)
+    best = None
+    for item in objects:
+        size = max(item.dimensions) * mm_per_unit
+        if not size > 0:
+            continue
+        footprint, toward_camera = _footprint_mm(scene, item, mm_per_unit)
+        if best is None or footprint < best[1]:
+            best = (item, footprint, size, toward_camera)
+    if best is None:
+        return None
+    item, footprint, size, toward_camera = best
+    return sm.SceneDescription(object_size_mm=size, footprint_mm=footprint,
+                               lights_deg=_light_angles(scene, item, toward_camera),
+                               engine=_engine(scene), samples=samples, denoise=denoise)
+
+
+_TRAITS: OrderedDict = OrderedDict()
+TRAITS_CACHE_SIZE = 16
+
+
+def _stored_errors(material, coverage, absorption):
+    """Tier errors (rms) of the last Apply if measured at this coverage and absorption."""
+    from .material import ERRORS_KEY
+
+    try:
+        errors = json.loads(material.get(ERRORS_KEY, "{}"))
+    except ValueError:
+        return None
+    if not errors:
+        return None
+    first = next(iter(errors.values()))
+    same = (math.isclose(first.get("coverage", -1.0), coverage, abs_tol=1e-6)
+            and all(math.isclose(a, b, abs_tol=1e-6)
+                    for a, b in zip(first.get("absorption", []), absorption, strict=False)))
+    return {tier: float(e["rms"]) for tier, e in errors.items()} if same else None
+
+
+def _tables_and_meta(material):
+    from . import nodes, storage
+    from .material import group_of
+
+    node = group_of(material)
+    if node is None or node.node_tree is None:
+        return None, {}
+    try:
+        meta = json.loads(node.node_tree.get(nodes.FIT_KEY, "{}"))
+        image = bpy.data.images.get(meta.get("tables", ""))
+        return storage.unpack_tables(image), meta
+    except (ValueError, storage.StorageError):
+        return None, {}
+
+
+def material_traits(material, *, refit: bool = False):
+    """The :class:`lut_baker.scene_model.MaterialTraits` of a made-up material at its coverage
+    and absorption, the Subsurface Scale applied (the value Fit to Scene saved if it set the
+    scale to 0).  From its stored tables: the profile, the shares of gloss and skin light, the
+    profile mismatch of the group's subsurface method; the tier errors of the last Apply, or
+    (``refit``, or none stored for this coverage and absorption) of a new closure fit (a few
+    seconds).  Without tables: the paper preset's traits."""
+    sm = lut_baker("scene_model")
+    settings = material.makeup_skin
+    coverage = float(settings.coverage)
+    absorption = [float(a) for a in settings.effective_absorption()]
+    scale = float(settings.subsurface_scale)
+    if scale <= 0.0 and SAVED_SCALE_KEY in material:
+        scale = float(material[SAVED_SCALE_KEY])
+    tables, meta = _tables_and_meta(material)
+    if tables is None:
+        return sm.paper_traits().scaled(scale) if scale != 1.0 else sm.paper_traits()
+    errors = None if refit else _stored_errors(material, coverage, absorption)
+    key = (meta.get("key"), meta.get("subsurface_method"), coverage, tuple(absorption),
+           None if errors is None else tuple(sorted(errors.items())), scale)
+    traits = _TRAITS.pop(key, None)
+    if traits is None:
+        if errors is None:
+            fit = lut_baker("closure_fit").fit_closures(tables,
+                                                        errors_at=(coverage, absorption))
+            errors = {tier: float(e.rms) for tier, e in fit.errors.items()}
+        method = meta.get("subsurface_method")
+        profile_error = meta.get("profiles", {}).get(method, {}).get("error", [0.0])
+        shares = {angle: sm.gloss_and_skin_shares(tables, angle, coverage, absorption)
+                  for angle in sm.SHARE_LIGHTS_DEG}
+        traits = sm.MaterialTraits(
+            tier_errors=errors, radius_mm=tables.radius_mm, profile=tables.profile,
+            profile_mismatch=sm.profile_mismatch(tables, profile_error),
+            skin_share={a: v[1] for a, v in shares.items()},
+            gloss_share={a: v[0] for a, v in shares.items()}, subsurface_scale=scale)
+    _TRAITS[key] = traits
+    while len(_TRAITS) > TRAITS_CACHE_SIZE:
+        _TRAITS.popitem(last=False)
+    return traits
+
+
+def choose_for(material, scene, *, obj=None, tolerance=None, refit=False):
+    """``(Choice, SceneDescription or None)`` for ``material`` in ``scene`` (an unknown scene
+    counts as a close-up: :data:`UNKNOWN_SCENE`)."""
+    sm = lut_baker("scene_model")
+    description = describe_scene(scene, material, obj)
+    chosen_scene = description
+    if chosen_scene is None:
+        samples, denoise = _samples(scene)
+        chosen_scene = sm.SceneDescription(engine=_engine(scene), samples=samples,
+                                           denoise=denoise, **UNKNOWN_SCENE)
+    tolerance = sm.DEFAULT_TOLERANCE if tolerance is None else tolerance
+    choice = sm.choose(chosen_scene, material_traits(material, refit=refit),
+                       tolerance=tolerance)
+    return choice, description
+
+
+def auto_tier(settings, scene) -> str:
+    """The add-on tier of the Auto choice for the material of ``settings`` in ``scene``
+    (:func:`choose_for`); on any failure the former rule: Layered in Cycles, else
+    Principled."""
+    material = settings.id_data
+    try:
+        return choose_for(material, scene)[0].candidate.tier
+    except Exception:  # the panel calls this while drawing: never fail there
+        return "LAYERED" if scene.render.engine == "CYCLES" else "PRINCIPLED"
+
+
+def _apply_choice(context, obj, material, candidate) -> list[str]:
+    """Set the tier and the Subsurface Scale of the choice, then Apply.  Returns what
+    changed, for the report."""
+    from . import material as made_up
+
+    settings = material.makeup_skin
+    changes = []
+    live = settings.live_update
+    settings.live_update = False  # a tier change would otherwise schedule a preview re-bake
+    try:
+        if settings.tier != candidate.tier:
+            changes.append(f"tier {settings.tier.title()} -> {candidate.tier.title()}")
+            settings.tier = candidate.tier
+    finally:
+        settings.live_update = live
+    if not candidate.subsurface and settings.subsurface_scale > 0.0:
+        material[SAVED_SCALE_KEY] = float(settings.subsurface_scale)
+        changes.append(f"Subsurface Scale {settings.subsurface_scale:g} -> 0")
+        settings.subsurface_scale = 0.0
+    elif candidate.subsurface and settings.subsurface_scale <= 0.0 and SAVED_SCALE_KEY in material:
+        settings.subsurface_scale = float(material[SAVED_SCALE_KEY])
+        del material[SAVED_SCALE_KEY]
+        changes.append(f"Subsurface Scale 0 -> {settings.subsurface_scale:g}")
+    made_up.apply_to_object(context, obj)
+    return changes
+
+
+class MAKEUPSKIN_OT_fit_to_scene(bpy.types.Operator):
+    """Choose the cheapest Made-up Skin tier that stays within the tolerance in this scene
+    (camera, resolution, object size, lights, engine, samples), report it with its predicted
+    error, and apply it"""
+
+    bl_idname = "makeup_skin.fit_to_scene"
+    bl_label = "Fit to Scene"
+    bl_options = {"REGISTER", "UNDO"}
+
+    tolerance: bpy.props.FloatProperty(
+        name="Tolerance", default=0.02, min=0.0, max=1.0, subtype="FACTOR",
+        description="Error a cheaper tier may add to the best tier's (relative RMS)")
+    apply: bpy.props.BoolProperty(
+        name="Apply", default=True,
+        description="Set the chosen tier and subsurface on the material (else only report)")
+
+    @classmethod
+    def poll(cls, context):
+        obj = context.active_object
+        return obj is not None and obj.type == "MESH"
+
+    def execute(self, context):
+        from . import material as made_up
+
+        obj = context.active_object
+        material = obj.active_material
+        context.view_layer.update()  # object matrices follow moves only after an update
+        try:
+            if material is None or not material.makeup_skin.is_made_up:
+                material, _ = made_up.apply_to_object(context, obj)
+            choice, description = choose_for(material, context.scene, obj=obj,
+                                             tolerance=self.tolerance)
+            changes = (_apply_choice(context, obj, material, choice.candidate)
+                       if self.apply else [])
+        except (ValueError, RuntimeError) as error:
+            self.report({"ERROR"}, f"Made-up Skin: Fit to Scene failed: {error}")
+            return {"CANCELLED"}
+        chosen = choice.chosen
+        material[CHOICE_KEY] = json.dumps({
+            "candidate": chosen.candidate.name, "tier": chosen.candidate.tier,
+            "subsurface": chosen.candidate.subsurface, "error": chosen.error,
+            "best_error": choice.best_error, "cost": chosen.cost,
+            "tolerance": choice.tolerance, "reasons": list(choice.reasons),
+            "known_scene": description is not None})
+        if description is None:
+            self.report({"WARNING"}, "Made-up Skin: no camera or object in the scene: assumed "
+                                     "a close-up")
+        self.report({"INFO"}, f"Made-up Skin: Fit to Scene chose {chosen.candidate.name}: "
+                              f"predicted error {100 * chosen.error:.1f}% (best "
+                              f"{100 * choice.best_error:.1f}% + {100 * choice.tolerance:.0f}%)"
+                              f", cost {chosen.cost:.2f} of the fullest tier"
+                              + (f"; {', '.join(changes)}" if changes else ""))
+        for line in choice.reasons[:2]:
+            self.report({"INFO"}, f"Made-up Skin: {line}")
+        return {"FINISHED"}
+
+
+def draw_fit(self, context) -> None:
+    """Appended to the Made-up Skin panels: the Fit to Scene button and the last choice."""
+    layout = self.layout
+    layout.operator(MAKEUPSKIN_OT_fit_to_scene.bl_idname, icon="SCENE_DATA")
+    material = context.material
+    if material is None or CHOICE_KEY not in material:
+        return
+    try:
+        last = json.loads(material[CHOICE_KEY])
+    except ValueError:
+        return
+    box = layout.box()
+    box.label(text=f"Fit to Scene: {last['candidate']}", icon="INFO")
+    box.label(text=f"Predicted error {100 * last['error']:.1f}%, cost {last['cost']:.2f}")
+
+
+classes = (MAKEUPSKIN_OT_fit_to_scene,)
+_register, _unregister = bpy.utils.register_classes_factory(classes)
+
+
+def _panels():
+    from . import ui
+
+    return (ui.MAKEUPSKIN_PT_material, ui.MAKEUPSKIN_PT_node_editor)
+
+
+def register():
+    _register()
+    for panel in _panels():
+        panel.append(draw_fit)
+
+
+def unregister():
+    for panel in _panels():
+        panel.remove(draw_fit)
+    _unregister()
+    _TRAITS.clear()
