@@ -1,0 +1,349 @@
+"""Render time against error for the Made-up Skin tiers and the baseline (issue 5, item 3).
+
+A benchmark, not a test::
+
+    python bench/speed_accuracy.py            # docs/speed_accuracy.csv, .png, the table in .md
+    python bench/speed_accuracy.py --quick    # 16 and 64 samples, no bake axis (smoke run)
+    python bench/speed_accuracy.py --replot   # redraw the PNG from the CSV
+
+Scene (``bench/blender_scene.py``): the paper preset on a sphere of 10 mm radius, 48 x 48 px,
+Cycles CPU, light 0, 45 and 75 degrees from the view.  Each of PRINCIPLED, LAYERED (the add-on's
+node group, "default" tables) and BASELINE (a stock Principled BSDF set up by the rule of
+:func:`lut_baker.compare.baseline_inputs`) renders at 16, 64, 256 and 1024 samples with seeds
+0 and 1, configurations interleaved so that the load of a shared machine falls on all alike.
+Against the reference (:func:`lut_baker.compare.reference_image`, paths 1 + 3 from "high"
+tables, the skin's diffuse part spread by the dipole profile): relative RMS error over the
+sphere's pixels (mean of the two seeds), the noise floor ``rms(a - b) / sqrt(2)`` and the time
+per render (mean of the two).  The bake axis: per bake resolution, the tables' size, bake time
+(median of 3), table error (:func:`lut_baker.bake.table_error`, 500 points) and the LAYERED
+tier's render error at 256 samples, light 45 degrees, seed 0.  48 px keeps the whole run near
+8 minutes on 2 cores (the 1024-sample renders take most of it; 64 px would take ~14).
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import importlib
+import os
+import re
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+for _path in (ROOT, ROOT / "bench", ROOT / "tools"):
+    if str(_path) not in sys.path:
+        sys.path.insert(0, str(_path))
+
+from lut_baker import bake, compare, presets, reference  # noqa: E402
+
+DOCS = ROOT / "docs"
+BEGIN, END = "<!-- results:begin -->", "<!-- results:end -->"
+CONFIGS = ("PRINCIPLED", "LAYERED", "BASELINE")
+LABELS = {"PRINCIPLED": "Principled tier", "LAYERED": "Layered tier",
+          "BASELINE": "baseline (stock Principled)"}
+COLOURS = {"PRINCIPLED": "tab:blue", "LAYERED": "tab:orange", "BASELINE": "tab:grey"}
+RADIUS_MM = 10.0
+SEEDS = (0, 1)
+SPREAD_PER_MEAN_FREE_PATH = 1.5
+"""The reference's spread with half its default sample spacing: within 2.5e-5 of the default
+at 48 px, 10 mm (measured), four times faster."""
+GOAL_SAMPLES = 256
+GOAL_EXCESS = 0.03
+GOAL_BASELINE_RATIO = 1.0 / 3.0
+GOAL_TIME_RATIO = 1.2
+FIELDS = ("axis", "config", "light_deg", "samples", "size_px", "seconds", "error",
+          "noise_floor", "bias", "excess", "pareto", "resolution", "table_entries", "table_mb",
+          "bake_ms", "table_error")
+
+
+def _bake_bench():
+    """bench/bake.py (its ``timed``, ``entries`` and ``megabytes``)."""
+    return importlib.import_module("bake")
+
+
+def references(skin, size: int, lights) -> dict:
+    """Reference image per light (degrees)."""
+    import blender_scene
+
+    tables = bake.bake(skin, "high")
+    samples = reference.default_samples(skin, RADIUS_MM, SPREAD_PER_MEAN_FREE_PATH)
+    return {light: compare.reference_image(skin, tables=tables, resolution=size,
+                                           radius_mm=RADIUS_MM, light_angle_deg=light,
+                                           irradiance=blender_scene.IRRADIANCE, samples=samples)
+            for light in lights}
+
+
+def _row(**values) -> dict:
+    return {name: values.get(name, "") for name in FIELDS}
+
+
+def render_rows(skin, tables, refs: dict, size: int, sample_counts, bake_tables=None):
+    """Render every configuration at every light and sample count; the rows of the CSV.
+    ``bake_tables``: ``{resolution: tables}`` whose LAYERED render error at
+    :data:`GOAL_SAMPLES` samples, light 45, seed 0 is returned as ``{resolution: error}``."""
+    import blender_scene as scene_module
+    import bpy
+    import render_sphere
+
+    rows, bake_errors = [], {}
+    baseline = compare.baseline_inputs(skin, compare.made_up_diffuse_albedo(tables))
+    for light, ref in refs.items():
+        sphere = scene_module.sphere_scene(size=size, samples=16, radius_mm=RADIUS_MM,
+                                           light_deg=light)
+        scene = bpy.context.scene
+        with render_sphere.addon_registered():
+            materials = {name: scene_module.tier_material(sphere, tables, name)
+                         for name in CONFIGS[:2]}
+            materials["BASELINE"] = scene_module.baseline_material(baseline, scene)
+            scene_module.set_samples(scene, 1)
+            scene_module.render_image()  # warm-up: kernels and images load once
+            results = {}
+            for samples in sample_counts:
+                for seed in SEEDS:
+                    for name in CONFIGS:
+                        scene_module.set_material(sphere, materials[name])
+                        scene_module.set_samples(scene, samples, seed)
+                        seconds, image = scene_module.render_image()
+                        results.setdefault((name, samples), []).append((seconds, image))
+                        print(f"  light {light:g}, {name}, {samples} samples, seed {seed}: "
+                              f"{seconds:.2f} s, error {compare.relative_rms(image, ref):.4f}",
+                              flush=True)
+            if bake_tables and light == 45.0:
+                for resolution, other in bake_tables.items():
+                    scene_module.tier_material(sphere, other, "LAYERED")
+                    scene_module.set_samples(scene, GOAL_SAMPLES, 0)
+                    _, image = scene_module.render_image()
+                    bake_errors[resolution] = compare.relative_rms(image, ref)
+        for (name, samples), runs in results.items():
+            (t0, a), (t1, b) = runs
+            error = 0.5 * (compare.relative_rms(a, ref) + compare.relative_rms(b, ref))
+            floor = compare.noise_floor(a, b, ref)
+            rows.append(_row(axis="render", config=name, light_deg=light, samples=samples,
+                             size_px=size, seconds=0.5 * (t0 + t1), error=error,
+                             noise_floor=floor, bias=compare.bias(error, floor),
+                             excess=error - floor))
+    for light in refs:
+        mine = [row for row in rows if row["light_deg"] == light]
+        front = compare.pareto_front([r["seconds"] for r in mine], [r["error"] for r in mine])
+        for row, on in zip(mine, front, strict=True):
+            row["pareto"] = bool(on)
+    return rows, bake_errors
+
+
+def bake_rows(skin, runs: int = 3):
+    """Per bake resolution: tables, and a row without the render error yet."""
+    bench = _bake_bench()
+    samples = bake.error_samples(skin, albedo_points=100)
+    tables, rows = {}, {}
+    for name, resolution in bake.RESOLUTIONS.items():
+        median, _, baked = bench.timed(lambda r=resolution: bake.bake(skin, r), runs)
+        tables[name] = baked
+        rows[name] = _row(axis="bake", config="LAYERED", light_deg=45.0, samples=GOAL_SAMPLES,
+                          resolution=name, table_entries=bench.entries(resolution),
+                          table_mb=bench.megabytes(baked), bake_ms=1e3 * median,
+                          table_error=bake.table_error(baked, samples=samples)["max"])
+    return tables, rows
+
+
+def goals(rows) -> list[dict]:
+    """Issue 5's goals at :data:`GOAL_SAMPLES` samples, per light: the best tier's excess
+    over its noise floor, its error against the baseline's, its time against the baseline's."""
+    out = []
+    for light in sorted({r["light_deg"] for r in rows if r["axis"] == "render"}):
+        at = {r["config"]: r for r in rows if r["axis"] == "render" and r["light_deg"] == light
+              and r["samples"] == GOAL_SAMPLES}
+        if not at:
+            continue
+        best = min(CONFIGS[:2], key=lambda name: at[name]["error"])
+        tier, base = at[best], at["BASELINE"]
+        out.append({
+            "light_deg": light, "best": best, "error": tier["error"],
+            "floor": tier["noise_floor"], "excess": tier["excess"],
+            "baseline_error": base["error"], "error_ratio": tier["error"] / base["error"],
+            "time_ratio": tier["seconds"] / base["seconds"],
+            "met": (tier["excess"] < GOAL_EXCESS
+                    and tier["error"] < GOAL_BASELINE_RATIO * base["error"]
+                    and tier["seconds"] <= GOAL_TIME_RATIO * base["seconds"]),
+        })
+    return out
+
+
+def write_csv(rows, path: Path) -> None:
+    def cell(value):
+        return f"{value:.6g}" if isinstance(value, float) else value
+
+    with open(path, "w", newline="") as handle:
+        writer = csv.DictWriter(handle, fieldnames=FIELDS)
+        writer.writeheader()
+        for row in rows:
+            writer.writerow({k: cell(v) for k, v in row.items()})
+
+
+def read_csv(path: Path) -> list[dict]:
+    """Rows of a CSV written by :func:`write_csv`, numbers and flags converted back."""
+    def value(text):
+        if text in ("True", "False"):
+            return text == "True"
+        try:
+            number = float(text)
+        except ValueError:
+            return text
+        return int(number) if number.is_integer() and "." not in text else number
+
+    with open(path, newline="") as handle:
+        return [{k: value(v) for k, v in row.items()} for row in csv.DictReader(handle)]
+
+
+def chart(rows, path: Path) -> None:
+    """Time against error per light (log-log; Pareto front ringed and joined), and the bake
+    axis (table size against table and render error, bake time labelled)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import matplotlib.ticker
+
+    lights = sorted({r["light_deg"] for r in rows if r["axis"] == "render"})
+    baked = [r for r in rows if r["axis"] == "bake"]
+    panels = len(lights) + (1 if baked else 0)
+    fig, axes = plt.subplots(1, panels, figsize=(4.2 * panels, 4.2), squeeze=False)
+    for ax, light in zip(axes[0], lights, strict=False):
+        mine = [r for r in rows if r["axis"] == "render" and r["light_deg"] == light]
+        for name in CONFIGS:
+            points = sorted((r for r in mine if r["config"] == name), key=lambda r: r["samples"])
+            x = [r["seconds"] for r in points]
+            ax.plot(x, [r["error"] for r in points], "o-", color=COLOURS[name],
+                    label=LABELS[name])
+            ax.plot(x, [r["noise_floor"] for r in points], ":", color=COLOURS[name], lw=1)
+            for r in points:
+                ax.annotate(str(r["samples"]), (r["seconds"], r["error"]), fontsize=7,
+                            xytext=(3, 3), textcoords="offset points")
+        front = sorted((r for r in mine if r["pareto"]), key=lambda r: r["seconds"])
+        ax.plot([r["seconds"] for r in front], [r["error"] for r in front], "k--", lw=0.8)
+        ax.scatter([r["seconds"] for r in front], [r["error"] for r in front], s=90,
+                   facecolors="none", edgecolors="k", label="Pareto front", zorder=3)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+        ax.set_xlabel("render time per image (s)")
+        ax.set_ylabel("relative RMS error vs reference")
+        ax.set_title(f"light {light:g} deg from the view")
+        ax.grid(True, which="both", alpha=0.3)
+    axes[0][0].legend(fontsize=7, title="dotted: noise floor; labels: samples",
+                      title_fontsize=7)
+    if baked:
+        ax = axes[0][-1]
+        size = [r["table_mb"] for r in baked]
+        ax.plot(size, [r["table_error"] for r in baked], "s-", color="tab:green",
+                label="table error (max, 500 points)")
+        ax.plot(size, [r["error"] for r in baked], "o-", color=COLOURS["LAYERED"],
+                label=f"Layered render error ({GOAL_SAMPLES} samples, 45 deg)")
+        for r in baked:
+            ax.annotate(f"{r['resolution']}\n{r['bake_ms']:.0f} ms bake",
+                        (r["table_mb"], r["table_error"]), fontsize=7, xytext=(3, 3),
+                        textcoords="offset points")
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+        ax.set_xlabel("tables, MB (float32)")
+        ax.set_ylabel("relative error")
+        ax.set_title("bake resolution")
+        ax.legend(fontsize=7)
+        ax.grid(True, which="both", alpha=0.3)
+    fig.suptitle("Made-up Skin, paper preset, 10 mm sphere, 48 px, Cycles CPU", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def _percent(x: float) -> str:
+    return f"{100 * x:.2f}%"
+
+
+def markdown(rows, goal_rows, seconds: float) -> str:
+    lines = [f"Measured by `python bench/speed_accuracy.py` in {seconds / 60:.1f} min "
+             "(2 cores, shared).", "",
+             "| light | config | samples | s per render | error | noise floor | bias | "
+             "Pareto |", "|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        if r["axis"] != "render":
+            continue
+        lines.append(f"| {r['light_deg']:g} | {r['config']} | {r['samples']} | "
+                     f"{r['seconds']:.2f} | {_percent(r['error'])} | "
+                     f"{_percent(r['noise_floor'])} | {_percent(r['bias'])} | "
+                     f"{'yes' if r['pareto'] else ''} |")
+    baked = [r for r in rows if r["axis"] == "bake"]
+    if baked:
+        lines += ["", "| bake resolution | angular entries | MB | bake ms | table error | "
+                  f"Layered render error ({GOAL_SAMPLES} samples, 45 deg, seed 0) |",
+                  "|---|---|---|---|---|---|"]
+        lines += [f"| {r['resolution']} | {r['table_entries']} | {r['table_mb']:.1f} | "
+                  f"{r['bake_ms']:.0f} | {r['table_error']:.1e} | {_percent(r['error'])} |"
+                  for r in baked]
+    lines += ["", f"Goals at {GOAL_SAMPLES} samples (best tier: lower error):", "",
+              "| light | best tier | error | floor | error - floor (< 3%) | baseline error | "
+              "tier / baseline error (< 1/3) | tier / baseline time (<= 1.2) | met |",
+              "|---|---|---|---|---|---|---|---|---|"]
+    lines += [f"| {g['light_deg']:g} | {g['best']} | {_percent(g['error'])} | "
+              f"{_percent(g['floor'])} | {_percent(g['excess'])} | "
+              f"{_percent(g['baseline_error'])} | {g['error_ratio']:.2f} | "
+              f"{g['time_ratio']:.2f} | {'yes' if g['met'] else 'NO'} |" for g in goal_rows]
+    return "\n".join(lines)
+
+
+def write_docs(text: str, path: Path) -> None:
+    doc = path.read_text()
+    if BEGIN not in doc or END not in doc:
+        raise SystemExit(f"{path} has no {BEGIN} ... {END} block")
+    block = f"{BEGIN}\n{text}\n{END}"
+    path.write_text(re.sub(re.escape(BEGIN) + ".*?" + re.escape(END), lambda _: block, doc,
+                           flags=re.S))
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--size", type=int, default=48, help="pixels (square), default 48")
+    parser.add_argument("--samples", type=int, nargs="+", default=[16, 64, 256, 1024])
+    parser.add_argument("--lights", type=float, nargs="+", default=[0.0, 45.0, 75.0],
+                        help="light angles from the view, degrees")
+    parser.add_argument("--quick", action="store_true",
+                        help="16 and 64 samples, no bake axis, nothing written to docs/")
+    parser.add_argument("--out", type=Path, default=DOCS, help="folder for the CSV and PNG")
+    parser.add_argument("--replot", action="store_true",
+                        help="only redraw the PNG from the CSV in --out (no rendering)")
+    args = parser.parse_args(argv)
+    if args.replot:
+        chart(read_csv(args.out / "speed_accuracy.csv"), args.out / "speed_accuracy.png")
+        return 0
+    if args.quick:
+        args.samples = [16, 64]
+    os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="speed_accuracy_"))
+    start = time.perf_counter()
+    skin = presets.paper()
+    tables = bake.bake(skin, "default")
+    print("reference images ...", flush=True)
+    refs = references(skin, args.size, args.lights)
+    bake_tables, baked = ({}, {}) if args.quick else bake_rows(skin)
+    rows, bake_errors = render_rows(skin, tables, refs, args.size, args.samples, bake_tables)
+    for name, row in baked.items():
+        row["error"] = bake_errors.get(name, float("nan"))
+        rows.append(row)
+    goal_rows = goals(rows)
+    seconds = time.perf_counter() - start
+    text = markdown(rows, goal_rows, seconds)
+    print(text)
+    args.out.mkdir(parents=True, exist_ok=True)
+    suffix = "_quick" if args.quick else ""
+    write_csv(rows, args.out / f"speed_accuracy{suffix}.csv")
+    chart(rows, args.out / f"speed_accuracy{suffix}.png")
+    if not args.quick and args.out == DOCS:
+        write_docs(text, DOCS / "speed_accuracy.md")
+    print(f"speed_accuracy: {seconds / 60:.1f} min -> {args.out}/speed_accuracy{suffix}.csv, .png")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
