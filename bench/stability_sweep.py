@@ -1,7 +1,8 @@
 """Stability where the methods fail, and the costs the Auto tier uses (a benchmark).
 
-    python bench/stability_sweep.py [--out docs/stability.md] [--no-render]
+    python bench/stability_sweep.py [--out docs/stability.md] [--no-render] [--regimes K ...]
     python bench/stability_sweep.py --costs [--repeats 3]
+    python bench/stability_sweep.py --traits
 
 The first form runs :func:`lut_baker.stability.sweep` (the exact model, the bake, the closure
 fits and the reference images in every regime of issue 5, item 4) and, unless
@@ -12,7 +13,8 @@ part of that file between its ``<!-- sweep -->`` markers).
 
 ``--costs`` measures what :mod:`lut_baker.scene_model` stores: per-sample render time of every
 candidate relative to the fullest (the slope between two sample counts, so that scene set-up
-does not count) and its Monte Carlo noise coefficient (relative RMS between two seeds).
+does not count) and its Monte Carlo noise coefficient (relative RMS between two seeds);
+``--traits`` prints the paper preset's traits it assumes without tables.
 
 bpy helpers on top of bench/blender_scene.py (the reference's scene; also used by
 tests/test_addon_stability.py and tests/test_scene_model.py):
@@ -157,17 +159,19 @@ def furnace_rings(image, rings: int = FURNACE_RINGS):
 # --------------------------------------------------------------------------------------------
 # Costs and noise of the candidates (lut_baker.scene_model's constants)
 # --------------------------------------------------------------------------------------------
-def measure_costs(*, size=64, samples=(16, 144), repeats=3, radius_mm=30.0):
+def measure_costs(*, size=96, samples=(16, 272), repeats=3, radius_mm=30.0, coverage=1.0):
     """Per-sample render time (relative to the fullest candidate) and noise coefficient
     ``k`` (one render's relative RMS deviation = k / sqrt(samples)) of every candidate of
-    :data:`lut_baker.scene_model.CANDIDATES`, Cycles CPU, paper preset, sun at 45 degrees.
+    :data:`lut_baker.scene_model.CANDIDATES`, Cycles CPU, paper preset at ``coverage``, sun at
+    45 degrees.
 
     Times: the slope ``(t(high) - t(low)) / (high - low)`` (scene set-up does not count), the
     fastest of ``repeats`` interleaved runs.  Noise: :func:`lut_baker.compare.noise_floor` of
     two seeds at the higher count, times ``sqrt(samples)``."""
     from lut_baker import bake, presets, scene_model
 
-    tables = bake.bake(presets.made_up_skin("paper_natural", "paper_bioplate"), "preview")
+    tables = bake.bake(presets.made_up_skin("paper_natural", "paper_bioplate",
+                                            coverage=coverage), "preview")
     low, high = samples
     times = {c: {low: [], high: []} for c in scene_model.CANDIDATES}
     noise = {}
@@ -218,7 +222,10 @@ def render_regime(stage, item, candidates, *, seeds=(0, 1), furnace=True, tables
     skin = stability.regime_skin(item)
     tables = tables or bake.bake(skin, "preview")
     size = stage.scene.render.resolution_x
-    affordable = reference.default_samples(skin, item.radius_mm) <= stability.MAX_SPREAD_SAMPLES
+    # The spread needs the film's exact transmittance: for sharp lobes it does not fit in
+    # memory (4.5 GB at 5 degrees); there the reference is local.
+    affordable = (item.exact_affordable and reference.default_samples(skin, item.radius_mm)
+                  <= stability.MAX_SPREAD_SAMPLES)
     references = {light: compare.reference_image(
         skin, tables=tables, resolution=size, radius_mm=item.radius_mm, light_angle_deg=light,
         irradiance=blender_scene.IRRADIANCE, spread=affordable) for light in item.lights_deg}
@@ -274,31 +281,158 @@ def render_regimes(regimes=None, **options) -> dict:
     return out
 
 
-def _print_costs(costs, args) -> None:
-    print(f"# python bench/stability_sweep.py --costs --repeats {args.repeats} "
-          f"(Cycles CPU, {args.size} px, samples {args.samples[0]}/{args.samples[1]})")
+def _print_costs(costs, args, coverage) -> None:
+    print(f"# python bench/stability_sweep.py --costs --repeats {args.repeats} --size "
+          f"{args.size} --samples {args.samples[0]} {args.samples[1]}: coverage {coverage:g}")
     for candidate, value in costs.items():
         print(f"{candidate.name:34s} relative cost {value['relative_cost']:.3f}  "
               f"({1e3 * value['seconds_per_sample']:.2f} ms/sample)  "
               f"noise k {value['noise_k']:.4f}")
 
 
+def _print_traits() -> None:
+    """The paper preset's traits as lut_baker.scene_model stores them."""
+    from lut_baker import bake, closure_fit, presets, scene_model
+
+    tables = bake.bake(presets.made_up_skin("paper_natural", "paper_bioplate"), "default")
+    traits = scene_model.traits_from_tables(tables, closure_fit.fit_closures(tables))
+    print(f"# {scene_model.TRAITS_COMMAND}")
+    print("PAPER_TIER_ERRORS =", {k: round(v, 4) for k, v in traits.tier_errors.items()})
+    print("PAPER_MISMATCH =", round(traits.profile_mismatch, 4))
+    print("PAPER_SKIN_SHARE =", {k: round(v, 4) for k, v in traits.skin_share.items()})
+    print("PAPER_GLOSS_SHARE =", {k: round(v, 4) for k, v in traits.gloss_share.items()})
+    print(f"# mean radius {traits.mean_radius_mm:.3f} mm")
+
+
+# --------------------------------------------------------------------------------------------
+# The docs' tables
+# --------------------------------------------------------------------------------------------
+TEST_SAMPLES = 64
+"""Samples of tests/test_addon_stability.py's renders: the bounds allow for their noise."""
+MARKERS = ("<!-- sweep: begin (python bench/stability_sweep.py --out docs/stability.md) -->",
+           "<!-- sweep: end -->")
+
+
+def bound(bias: float, noise: float, samples: int, test_samples: int = TEST_SAMPLES) -> float:
+    """The error bound a render at ``test_samples`` keeps: the measured ``bias`` and the
+    ``noise`` scaled to those samples in quadrature, plus a quarter and 0.5%, rounded up to
+    0.5%."""
+    expected = math.hypot(bias, noise * math.sqrt(samples / test_samples))
+    return math.ceil((1.25 * expected + 0.005) / 0.005) * 0.005
+
+
+def _pct(value, digits=1) -> str:
+    return f"{100 * value:.{digits}f}%"
+
+
+def pure_table(results) -> str:
+    """Markdown: the methods without Blender in every regime."""
+    lines = ["| regime | model: finite, min, albedo max | bake: min, albedo max, error | "
+             "reference: finite, min, spread (light kept) | fits: Principled / Layered "
+             "(RMS, albedo) | Auto |",
+             "| --- | --- | --- | --- | --- | --- |"]
+    for r in results:
+        model = r["model"]["reflection"]
+        albedo = r["model"].get("albedo")
+        model_text = (f"{'yes' if model['finite'] else 'NO'}, {model['min']:.2g}, "
+                      + (f"{albedo['max']:.3f}" if albedo else
+                         f"{r['model']['pairs']} pairs only (~8 s, 2.4 GB each)"))
+        baked = r["bake"]
+        error = baked.get("error", {})
+        bake_text = (f"{baked['min']:.2g}, {baked['albedo']['max']:.3f}, "
+                     + (_pct(error["reflection"], 2) if error else "-"))
+        ref = r["reference"]
+        if ref is None:
+            ref_text = "not drawn (exact evaluator unaffordable)"
+        else:
+            kept = (f"yes ({_pct(ref['spread_over_local'])})" if ref["spread"] else
+                    f"no ({ref['entry_samples']:.1e} entry samples)")
+            image = ref["image"]
+            ref_text = f"{'yes' if image['finite'] else 'NO'}, {image['min']:.2g}, {kept}"
+        tiers = r.get("tiers", {})
+        fits = " / ".join(f"{_pct(tiers[t]['rms'])}, {_pct(tiers[t]['albedo'])}"
+                          for t in ("PRINCIPLED", "LAYERED") if t in tiers) or "-"
+        lines.append(f"| `{r['key']}` {r['name']} | {model_text} | {bake_text} | {ref_text} | "
+                     f"{fits} | {r['auto']['choice']} |")
+    return "\n".join(lines)
+
+
+def render_table(renders, samples) -> str:
+    """Markdown: each tier rendered in every regime (the test's bounds in the last but one
+    column)."""
+    lines = ["| regime | tier | finite, min | error | noise | bias | bound at "
+             f"{TEST_SAMPLES} samples | furnace: brightest ring (se) / exact albedo max |",
+             "| --- | --- | --- | --- | --- | --- | --- | --- |"]
+    for key, by_tier in renders.items():
+        for name, r in by_tier.items():
+            lit, furnace = r["lit"], r.get("furnace")
+            furnace_text = (f"{furnace['ring_max']:.3f} ({furnace['ring_se']:.3f}) / "
+                            f"{furnace['albedo_max']:.3f}" if furnace else "-")
+            lines.append(
+                f"| `{key}` | {name} | {'yes' if lit['finite'] else 'NO'}, {lit['min']:.2g} | "
+                f"{_pct(lit['error'])} | {_pct(lit['noise'])} | {_pct(lit['bias'])} | "
+                f"{_pct(bound(lit['bias'], lit['noise'], samples))} | {furnace_text} |")
+    return "\n".join(lines)
+
+
+def write_docs(path: Path, text: str) -> None:
+    """Replace what lies between :data:`MARKERS` in ``path`` with ``text``."""
+    content = path.read_text()
+    begin, end = content.index(MARKERS[0]), content.index(MARKERS[1])
+    path.write_text(content[:begin + len(MARKERS[0])] + "\n" + text + "\n" + content[end:])
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--costs", action="store_true",
                         help="measure the candidates' relative costs and noise")
+    parser.add_argument("--traits", action="store_true",
+                        help="print the paper preset's traits (lut_baker.scene_model)")
     parser.add_argument("--repeats", type=int, default=3)
-    parser.add_argument("--size", type=int, default=64)
-    parser.add_argument("--samples", type=int, nargs=2, default=(16, 144))
-    parser.add_argument("--out", type=Path, help="rewrite the table in this markdown file")
+    parser.add_argument("--size", type=int, default=None,
+                        help="render size, px (default 96 for --costs, 32 for the sweep)")
+    parser.add_argument("--samples", type=int, nargs="+", default=None,
+                        help="--costs: two sample counts (16 272); sweep: one (128)")
+    parser.add_argument("--regimes", nargs="+", help="regime keys (default all)")
+    parser.add_argument("--out", type=Path, help="rewrite the tables in this markdown file")
     parser.add_argument("--no-render", action="store_true", help="pure sweep only")
     args = parser.parse_args(argv)
     os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="stability_"))
-    if args.costs:
-        _print_costs(measure_costs(size=args.size, samples=tuple(args.samples),
-                                   repeats=args.repeats), args)
+    if args.traits:
+        _print_traits()
         return 0
-    raise SystemExit("the sweep is not written yet")
+    if args.costs:
+        args.size = args.size or 96
+        args.samples = args.samples or [16, 272]
+        for coverage in (1.0, 0.0):
+            _print_costs(measure_costs(size=args.size, samples=tuple(args.samples[:2]),
+                                       repeats=args.repeats, coverage=coverage), args, coverage)
+        return 0
+    from lut_baker import stability
+
+    regimes = ([stability.regime(k) for k in args.regimes] if args.regimes
+               else list(stability.REGIMES))
+    size, samples = args.size or 32, (args.samples or [128])[0]
+    start = time.perf_counter()
+    results = []
+    for item in regimes:
+        results.append(stability.check_regime(item, error_points=60, model_points=24,
+                                              fit=True))
+        print(f"# checked {item.key}: {time.perf_counter() - start:.0f} s", flush=True)
+    text = ("Methods without Blender (`lut_baker.stability.check_regime`: exact model at 24 "
+            "direction pairs, preview bake, its error at 60 random points, reference images "
+            "16 px):\n\n" + pure_table(results))
+    if not args.no_render:
+        renders = render_regimes(regimes, size=size, samples=samples)
+        text += (f"\n\nEach tier in Cycles (`render_regimes`: {size} px, {samples} samples, "
+                 "seeds 0 and 1, against `lut_baker.compare.reference_image` from the preview "
+                 "tables, spread where affordable; white furnace: world colour 1, no light, "
+                 "rings of equal width in cos(theta_o)):\n\n" + render_table(renders, samples))
+    print(text)
+    print(f"# stability sweep: {time.perf_counter() - start:.0f} s")
+    if args.out:
+        write_docs(args.out, text)
+    return 0
 
 
 if __name__ == "__main__":

@@ -20,12 +20,14 @@ exact image)::
 - ``e_gloss``: without gloss lobes, the gloss's share of the image
   (:func:`gloss_and_skin_shares`);
 - ``noise``: the Monte Carlo noise of one render, ``k / sqrt(samples)`` with ``k`` measured
-  per candidate (:data:`NOISE_K`); 0 with a denoiser (its bias is not modelled) and in EEVEE.
+  per candidate and coverage (:data:`NOISE_K`); 0 with a denoiser (its bias is not
+  modelled) and in EEVEE.
 
 So a film gloss below the noise of the fullest tier costs nothing to leave out, a subsurface
 radius under half a pixel leaves ``e_subsurface`` near 0, and EEVEE admits only the tiers that
 run there (:data:`ENGINE_TIERS`).  :func:`choose` takes the cheapest candidate (costs:
-:data:`RELATIVE_COST`, measured) whose ``E`` is at most ``min E + tolerance`` (default 2%).
+:data:`RELATIVE_COST`, measured at coverage 1 and 0 and interpolated by the material's share
+of skin light) whose ``E`` is at most ``min E + tolerance`` (default 2%).
 
 Functions and types
 -------------------
@@ -39,8 +41,8 @@ Functions and types
   sphere's image.
 - :func:`profile_mismatch` -- how far a fitted closure's edge response is from the tables'.
 - :func:`blur_kernel`, :func:`subsurface_omission_error` -- the pixel-footprint blur argument.
-- :func:`noise`, :func:`predict`, :class:`Prediction`, :func:`needs_subsurface`,
-  :func:`choose`, :class:`Choice`.
+- :func:`relative_cost`, :func:`noise`, :func:`predict`, :class:`Prediction`,
+  :func:`needs_subsurface`, :func:`choose`, :class:`Choice`.
 """
 
 from __future__ import annotations
@@ -61,6 +63,8 @@ __all__ = [
     "ENGINE_TIERS",
     "RELATIVE_COST",
     "NOISE_K",
+    "COST_SKIN_SHARE",
+    "relative_cost",
     "DEFAULT_TOLERANCE",
     "SceneDescription",
     "pixel_footprint_mm",
@@ -131,47 +135,63 @@ screen-space Burley with no random walk, and it is optimised for the Principled 
 DEFAULT_TOLERANCE = 0.02
 """Error a cheaper candidate may add to the best one's (relative RMS)."""
 
-COST_COMMAND = "python bench/stability_sweep.py --costs --repeats 3"
+COST_COMMAND = ("python bench/stability_sweep.py --costs --repeats 3 --size 96 "
+                "--samples 16 272")
+_ORDER = CANDIDATES  # the tables below list CANDIDATES in this order
 RELATIVE_COST = {
-    Candidate("LAYERED", True, True): 1.000,
-    Candidate("LAYERED", False, True): 0.606,
-    Candidate("LAYERED", True, False): 0.995,
-    Candidate("LAYERED", False, False): 0.362,
-    Candidate("PRINCIPLED", True, True): 0.535,
-    Candidate("PRINCIPLED", False, True): 0.383,
-    Candidate("PRINCIPLED", True, False): 0.613,
-    Candidate("PRINCIPLED", False, False): 0.302,
+    1.0: dict(zip(_ORDER, (1.000, 0.875, 0.843, 0.711, 0.823, 0.615, 0.723, 0.509),
+                  strict=True)),
+    0.0: dict(zip(_ORDER, (1.000, 0.657, 0.716, 0.499, 0.904, 0.534, 0.726, 0.452),
+                  strict=True)),
 }
-"""Render time per sample relative to :data:`FULLEST` (Cycles CPU 2 threads, 64 px sphere of
-30 mm, paper preset, sun at 45 degrees; the slope between 16 and 144 samples, fastest of 3
-interleaved runs), measured by :data:`COST_COMMAND` on bpy 5.0.1 (the fullest took 16.9 ms per
-sample).  Runs on this shared machine vary by 10-20%: ``PRINCIPLED, no gloss`` measured dearer
-than ``PRINCIPLED``, which is noise; only differences above ~15% are real.  EEVEE uses the same
-order (its render time here is shader compilation on software OpenGL)."""
+"""Render time per sample relative to :data:`FULLEST`, by coverage (1: the paper's film, 0:
+bare skin), then by candidate: Cycles CPU on 2 threads, 96 px sphere of 30 mm, paper preset,
+sun at 45 degrees, the slope between 16 and 272 samples, the fastest of 3 interleaved runs,
+measured by :data:`COST_COMMAND` on bpy 5.0.1 at a load of ~1.5 (the fullest: 15-16 ms per
+sample).  Two other runs at coverage 1 gave 0.94 and 0.97 for ``LAYERED, no subsurface``:
+differences under ~10% are not resolved.  Under the film the subsurface closure carries
+little weight (Cycles rarely samples it), so leaving it out saves little time there but all
+of its noise (:data:`NOISE_K`); on bare skin it saves a third.  A first run on a loaded
+machine (load ~4) gave other ratios (0.61 for ``LAYERED, no subsurface``): contention does
+not stretch every shader alike.  EEVEE uses the same order (its render time here is shader
+compilation on software OpenGL: 9-96 s a render, not a cost)."""
 NOISE_K = {
-    Candidate("LAYERED", True, True): 0.279,
-    Candidate("LAYERED", False, True): 0.0019,
-    Candidate("LAYERED", True, False): 0.296,
-    Candidate("LAYERED", False, False): 0.0022,
-    Candidate("PRINCIPLED", True, True): 0.290,
-    Candidate("PRINCIPLED", False, True): 0.0019,
-    Candidate("PRINCIPLED", True, False): 0.296,
-    Candidate("PRINCIPLED", False, False): 0.0022,
+    1.0: dict(zip(_ORDER, (0.2474, 0.0006, 0.2595, 0.0007, 0.2414, 0.0006, 0.2580, 0.0007),
+                  strict=True)),
+    0.0: dict(zip(_ORDER, (0.1698, 0.0007, 0.0363, 0.0007, 0.1777, 0.0007, 0.0363, 0.0007),
+                  strict=True)),
 }
-"""Noise coefficient ``k``: one render's relative RMS deviation from the converged image is
-``k / sqrt(samples)`` (same command, two seeds at 144 samples).  The subsurface closure is the
-noisy part (3.5% at 64 samples); a sun light of angle 0 adds almost none.  Area lights and
-environments add noise to every candidate alike, so these values understate the noise there
-and the choice leans towards the fullest tier."""
+"""Noise coefficient ``k`` by coverage and candidate: one render's relative RMS deviation from
+the converged image is ``k / sqrt(samples)`` (same command, two seeds at 272 samples).  The
+subsurface closure is the noisy part (1.5% at 272 samples, 3.1% at 64); a sun of angle 0 adds
+almost none.  Area lights and environments add noise to every candidate alike, so these
+understate the noise there and the choice leans towards the fullest tier."""
+COST_SKIN_SHARE = {1.0: 0.1327, 0.0: 0.9591}
+"""The paper preset's skin share (:func:`gloss_and_skin_shares`, light 45 degrees) at the
+coverages the costs were measured at: a material's costs are interpolated by its share."""
+
+
+def _by_share(table: dict, candidate: Candidate, skin_share: float) -> float:
+    """Interpolate a per-coverage table of :data:`RELATIVE_COST` or :data:`NOISE_K` to a
+    skin share (held beyond the measured ones)."""
+    shares = [COST_SKIN_SHARE[c] for c in (1.0, 0.0)]
+    values = [table[c][candidate] for c in (1.0, 0.0)]
+    return float(np.interp(skin_share, shares, values))
+
+
+def relative_cost(candidate: Candidate, skin_share: float = COST_SKIN_SHARE[1.0]) -> float:
+    """:data:`RELATIVE_COST` of ``candidate`` for a material whose skin share is
+    ``skin_share`` (default: the paper's film)."""
+    return _by_share(RELATIVE_COST, candidate, skin_share)
 
 
 def noise(candidate: Candidate, samples: int, *, engine: str = "CYCLES",
-          denoise: bool = False) -> float:
+          denoise: bool = False, skin_share: float = COST_SKIN_SHARE[1.0]) -> float:
     """One render's Monte Carlo noise (relative RMS): ``k / sqrt(samples)`` (Cycles without a
-    denoiser), else 0."""
+    denoiser; ``k`` of :data:`NOISE_K` at the material's ``skin_share``), else 0."""
     if engine != "CYCLES" or denoise:
         return 0.0
-    return NOISE_K[candidate] / math.sqrt(max(int(samples), 1))
+    return _by_share(NOISE_K, candidate, skin_share) / math.sqrt(max(int(samples), 1))
 
 
 # --------------------------------------------------------------------------------------------
@@ -543,10 +563,17 @@ def predict(candidate: Candidate, scene: SceneDescription, traits: MaterialTrait
     subsurface = omission * (min(traits.profile_mismatch, 1.0) if candidate.subsurface else 1.0)
     gloss = 0.0 if candidate.gloss else max(traits.share("gloss_share", light)
                                             for light in scene.lights_deg)
-    grain = noise(candidate, scene.samples, engine=scene.engine, denoise=scene.denoise)
+    share = _skin_share(scene, traits)
+    grain = noise(candidate, scene.samples, engine=scene.engine, denoise=scene.denoise,
+                  skin_share=share)
     error = math.sqrt(angle**2 + subsurface**2 + gloss**2 + grain**2)
     return Prediction(candidate=candidate, error=error, angle=angle, subsurface=subsurface,
-                      gloss=gloss, noise=grain, cost=RELATIVE_COST[candidate])
+                      gloss=gloss, noise=grain, cost=relative_cost(candidate, share))
+
+
+def _skin_share(scene: SceneDescription, traits: MaterialTraits) -> float:
+    """The material's skin share, averaged over the scene's lights."""
+    return float(np.mean([traits.share("skin_share", light) for light in scene.lights_deg]))
 
 
 @dataclass(frozen=True)
@@ -602,7 +629,8 @@ def choose(scene: SceneDescription, traits: MaterialTraits | None = None, *,
     best = min(p.error for p in predictions)
     chosen = next(p for p in predictions if p.error <= best + tolerance)
     radius = traits.mean_radius_mm
-    grain = noise(FULLEST, scene.samples, engine=scene.engine, denoise=scene.denoise)
+    grain = noise(FULLEST, scene.samples, engine=scene.engine, denoise=scene.denoise,
+                  skin_share=_skin_share(scene, traits))
     reasons = (
         f"object {scene.object_pixels:.0f} px across at {scene.footprint_mm:.3g} mm per px",
         f"subsurface mean radius {radius:.3g} mm = {radius / scene.footprint_mm:.2g} px: "

@@ -197,7 +197,8 @@ def _model(item: Regime, skin: MadeUpSkin, points: int | None, albedo: bool) -> 
     chunk = MODEL_CHUNK if item.exact_affordable else 1
     values = np.concatenate([made_up_reflection(wi[i:i + chunk], wo[i:i + chunk], skin)
                              for i in range(0, wi.shape[0], chunk)])
-    out = {"reflection": summary(values), "pairs": int(wi.shape[0]), "_values": (wi, wo, values)}
+    out = {"reflection": summary(values), "pairs": int(wi.shape[0]),
+           "_values": (wi, wo, values)}
     if albedo and item.exact_affordable:
         theta = np.array(sorted(set(item.incidence_deg) & {0.0, 45.0, 89.0, 89.9}) or [0.0])
         out["albedo"] = summary(directional_albedo(theta, skin))
@@ -219,15 +220,15 @@ def _bake(item: Regime, skin: MadeUpSkin, resolution: str, error_points: int):
     return tables, out
 
 
-def _reference(item: Regime, skin: MadeUpSkin) -> dict:
+def _reference(item: Regime, skin: MadeUpSkin, resolution: int, spread: bool) -> dict:
     samples = default_samples(skin, item.radius_mm)
-    spread = samples <= MAX_SPREAD_SAMPLES
-    images = [sphere_image(skin, resolution=item.resolution, radius_mm=item.radius_mm,
+    spread = spread and samples <= MAX_SPREAD_SAMPLES
+    images = [sphere_image(skin, resolution=resolution, radius_mm=item.radius_mm,
                            light_angle_deg=light, spread=spread, samples=samples)
               for light in item.lights_deg]
     out = {"image": summary(np.stack(images)), "spread": spread, "entry_samples": int(samples)}
     if spread:
-        out["spread_over_local"] = spread_energy_ratio(skin, item.radius_mm, item.resolution,
+        out["spread_over_local"] = spread_energy_ratio(skin, item.radius_mm, resolution,
                                                        samples)
     return out
 
@@ -276,20 +277,26 @@ def _auto(item: Regime) -> dict:
 
 def check_regime(item: Regime, *, bake_resolution: str = "preview", error_points: int = 0,
                  model_points: int | None = None, model_albedo: bool = True,
-                 fit: bool = False) -> dict:
+                 fit: bool = False, resolution: int | None = None,
+                 spread: bool = True) -> dict:
     """Measurements of every method in one regime (module docstring), as plain data.
 
     ``model_points``: direction pairs of :func:`regime_directions` given to the exact evaluator
-    (evenly picked; None: all; where it is not :attr:`Regime.exact_affordable`, 2);
+    (evenly picked; None: all; where it is not :attr:`Regime.exact_affordable`, at most 2;
+    0: none, ``model`` is then None);
     ``model_albedo``: also its directional albedo (affordable regimes only);
+    ``resolution``: of the reference images (default the regime's); ``spread``: spread
+    their skin light where the entry samples are affordable (the first spread for a film
+    layer tabulates its transmittance: 4-7 s);
     ``error_points``: random points of :func:`bake.table_error` (0 or unaffordable: skipped);
     ``fit``: also the closure fits' tier errors (a few seconds)."""
     skin = regime_skin(item)
     affordable = item.exact_affordable
     tables, baked = _bake(item, skin, bake_resolution, error_points if affordable else 0)
-    model = _model(item, skin, model_points if affordable else 2, model_albedo)
-    wi, wo, exact = model.pop("_values")
-    if not affordable:  # the bake's error at the few pairs the exact evaluator could afford
+    points = model_points if affordable or model_points == 0 else min(model_points or 2, 2)
+    model = _model(item, skin, points, model_albedo) if points != 0 else None
+    wi, wo, exact = model.pop("_values") if model is not None else (None, None, None)
+    if model is not None and not affordable:  # the bake's error at the pairs afforded
         peak = tables.node_values().reshape(-1, 3).max(axis=0)
         error = np.abs(tables.made_up_reflection(wi, wo) - exact) / np.maximum(
             np.abs(exact), 0.1 * peak)
@@ -297,7 +304,8 @@ def check_regime(item: Regime, *, bake_resolution: str = "preview", error_points
     out = {"key": item.key, "name": item.name,
            "model": model,
            "bake": baked,
-           "reference": _reference(item, skin) if affordable else None,
+           "reference": (_reference(item, skin, resolution or item.resolution, spread)
+                         if affordable else None),
            "auto": _auto(item)}
     if fit:
         out["tiers"] = _tiers(item, tables)

@@ -157,28 +157,39 @@ def _stored_errors(material, coverage, absorption):
     return {tier: float(e["rms"]) for tier, e in errors.items()} if same else None
 
 
-def _tables_and_meta(material):
-    from . import nodes, storage
+def _meta(material) -> dict:
+    """The material's group's fit metadata (its tables key and image, subsurface method,
+    profile fits), or {}."""
+    from . import nodes
     from .material import group_of
 
     node = group_of(material)
     if node is None or node.node_tree is None:
-        return None, {}
+        return {}
     try:
-        meta = json.loads(node.node_tree.get(nodes.FIT_KEY, "{}"))
-        image = bpy.data.images.get(meta.get("tables", ""))
-        return storage.unpack_tables(image), meta
+        return json.loads(node.node_tree.get(nodes.FIT_KEY, "{}"))
+    except ValueError:
+        return {}
+
+
+def _tables(meta):
+    """The tables stored in the image the metadata names, or None."""
+    from . import storage
+
+    try:
+        return storage.unpack_tables(bpy.data.images.get(meta.get("tables", "")))
     except (ValueError, storage.StorageError):
-        return None, {}
+        return None
 
 
-def material_traits(material, *, refit: bool = False):
+def material_traits(material, *, refit: bool = False, may_fit: bool = True):
     """The :class:`lut_baker.scene_model.MaterialTraits` of a made-up material at its coverage
     and absorption, the Subsurface Scale applied (the value Fit to Scene saved if it set the
     scale to 0).  From its stored tables: the profile, the shares of gloss and skin light, the
     profile mismatch of the group's subsurface method; the tier errors of the last Apply, or
     (``refit``, or none stored for this coverage and absorption) of a new closure fit (a few
-    seconds).  Without tables: the paper preset's traits."""
+    seconds; without ``may_fit``, as when a panel draws, the paper preset's tier errors
+    instead).  Without tables: the paper preset's traits."""
     sm = lut_baker("scene_model")
     settings = material.makeup_skin
     coverage = float(settings.coverage)
@@ -186,18 +197,21 @@ def material_traits(material, *, refit: bool = False):
     scale = float(settings.subsurface_scale)
     if scale <= 0.0 and SAVED_SCALE_KEY in material:
         scale = float(material[SAVED_SCALE_KEY])
-    tables, meta = _tables_and_meta(material)
-    if tables is None:
-        return sm.paper_traits().scaled(scale) if scale != 1.0 else sm.paper_traits()
+    meta = _meta(material)
     errors = None if refit else _stored_errors(material, coverage, absorption)
     key = (meta.get("key"), meta.get("subsurface_method"), coverage, tuple(absorption),
-           None if errors is None else tuple(sorted(errors.items())), scale)
+           None if errors is None else tuple(sorted(errors.items())), scale, may_fit)
     traits = _TRAITS.pop(key, None)
-    if traits is None:
-        if errors is None:
+    tables = _tables(meta) if traits is None and meta else None
+    if traits is None and tables is None:
+        traits = sm.paper_traits().scaled(scale) if scale != 1.0 else sm.paper_traits()
+    elif traits is None:
+        if errors is None and may_fit:
             fit = lut_baker("closure_fit").fit_closures(tables,
                                                         errors_at=(coverage, absorption))
             errors = {tier: float(e.rms) for tier, e in fit.errors.items()}
+        elif errors is None:
+            errors = dict(sm.PAPER_TIER_ERRORS)
         method = meta.get("subsurface_method")
         profile_error = meta.get("profiles", {}).get(method, {}).get("error", [0.0])
         shares = {angle: sm.gloss_and_skin_shares(tables, angle, coverage, absorption)
@@ -213,9 +227,10 @@ def material_traits(material, *, refit: bool = False):
     return traits
 
 
-def choose_for(material, scene, *, obj=None, tolerance=None, refit=False):
+def choose_for(material, scene, *, obj=None, tolerance=None, refit=False, may_fit=True):
     """``(Choice, SceneDescription or None)`` for ``material`` in ``scene`` (an unknown scene
-    counts as a close-up: :data:`UNKNOWN_SCENE`)."""
+    counts as a close-up: :data:`UNKNOWN_SCENE`); ``refit``, ``may_fit``: as
+    :func:`material_traits`."""
     sm = lut_baker("scene_model")
     description = describe_scene(scene, material, obj)
     chosen_scene = description
@@ -224,7 +239,7 @@ def choose_for(material, scene, *, obj=None, tolerance=None, refit=False):
         chosen_scene = sm.SceneDescription(engine=_engine(scene), samples=samples,
                                            denoise=denoise, **UNKNOWN_SCENE)
     tolerance = sm.DEFAULT_TOLERANCE if tolerance is None else tolerance
-    choice = sm.choose(chosen_scene, material_traits(material, refit=refit),
+    choice = sm.choose(chosen_scene, material_traits(material, refit=refit, may_fit=may_fit),
                        tolerance=tolerance)
     return choice, description
 
@@ -235,7 +250,7 @@ def auto_tier(settings, scene) -> str:
     Principled."""
     material = settings.id_data
     try:
-        return choose_for(material, scene)[0].candidate.tier
+        return choose_for(material, scene, may_fit=False)[0].candidate.tier
     except Exception:  # the panel calls this while drawing: never fail there
         return "LAYERED" if scene.render.engine == "CYCLES" else "PRINCIPLED"
 

@@ -1,0 +1,139 @@
+"""The add-on's tiers where the methods fail (issue 5, item 4), rendered.
+
+Cycles CPU, 32 px, 64 samples, one scene built once (bench/stability_sweep.py's ``Stage``):
+
+- white furnace (world colour 1, no light): the made-up sphere is never brighter than the
+  environment.  Margin for Monte Carlo noise: a ring of the view angle (1/8 of cos(theta_o),
+  >= 20 pixels) may exceed 1 by 3 standard errors of its mean, a pixel by 0.1 (the largest
+  pixel excursion measured at 128 samples is ~0.05 over its ring's mean);
+- lit by a sun in the regimes (the most grazing of their lights): no NaN, Inf or negative
+  pixel, and the error against lut_baker's reference within the bound docs/stability.md lists
+  for that regime and tier (the bench measured bias and noise at 128 samples; the bound allows
+  for the noise at 64).  The reference's subsurface spread uses a quarter of its default entry
+  samples (spacing 0.24 mm, under the skin's mean free path; ~4x faster).
+"""
+
+import importlib.util
+import re
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from lut_baker import bake, compare, reference, scene_model, stability
+
+ROOT = Path(__file__).resolve().parent.parent
+SIZE, SAMPLES = 32, 64
+RING_STANDARD_ERRORS = 3.0
+PIXEL_MARGIN = 0.1
+TIERS = (scene_model.Candidate("PRINCIPLED"), scene_model.Candidate("LAYERED"))
+ROW = re.compile(r"^\| `(\w+)` \| ([^|]+?) \|(?: [^|]+ \|){4} ([\d.]+)% \|")
+
+
+def _bench(name):
+    spec = importlib.util.spec_from_file_location(name, ROOT / "bench" / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def documented_bounds() -> dict:
+    """``{(regime key, candidate name): bound}`` from docs/stability.md's render table."""
+    bounds = {}
+    for line in (ROOT / "docs" / "stability.md").read_text().splitlines():
+        match = ROW.match(line)
+        if match:
+            bounds[(match[1], match[2].strip())] = float(match[3]) / 100.0
+    return bounds
+
+
+def test_docs_list_a_bound_for_every_regime_and_tier():
+    bounds = documented_bounds()
+    for item in stability.REGIMES:
+        for tier in TIERS:
+            assert 0.0 < bounds[(item.key, tier.name)] < 1.0
+
+
+@pytest.fixture(scope="module")
+def stage(bpy_factory):
+    sweep = _bench("stability_sweep")
+    import render_sphere
+
+    with render_sphere.addon_registered():
+        yield sweep, sweep.Stage(size=SIZE, samples=SAMPLES)
+
+
+_TABLES = {}
+
+
+def _tables(item):
+    if item.key not in _TABLES:
+        _TABLES[item.key] = bake.bake(stability.regime_skin(item), "preview")
+    return _TABLES[item.key]
+
+
+BEYOND_THE_PANEL = pytest.mark.xfail(
+    strict=True, reason="film lobe 90 deg (the panel stops at 60): the Layered tier's "
+                        "Ashikhmin-Shirley film lobe renders brighter than its replica; "
+                        "brightest ring 1.08 (docs/stability.md)")
+FURNACE_CASES = [(key, tier) for key in ("coverage1", "coverage0", "rough", "eta1")
+                 for tier in TIERS] + [pytest.param("rougher", TIERS[1],
+                                                    marks=BEYOND_THE_PANEL)]
+
+
+def test_the_panel_stops_where_the_furnace_holds(stage):
+    """The film lobe width the panel offers ends at 60 degrees: beyond it (90 degrees) the
+    Layered tier fails the white furnace (test_white_furnace[rougher-LAYERED])."""
+    import math
+
+    import bpy
+
+    settings = bpy.types.Material.bl_rna.properties["makeup_skin"].fixed_type
+    assert settings.properties["film_lobe_width"].hard_max <= math.radians(60.0) + 1e-6
+
+
+@pytest.mark.parametrize(("key", "tier"), FURNACE_CASES,
+                         ids=lambda v: v if isinstance(v, str) else v.tier)
+def test_white_furnace(stage, key, tier):
+    sweep, scene = stage
+    item = stability.regime(key)
+    scene.frame(item.radius_mm)
+    scene.furnace(True)
+    try:
+        _, image = scene.render(_tables(item), tier)
+    finally:
+        scene.furnace(False)
+    mask = compare.sphere_mask(SIZE)
+    pixels = image[mask]
+    assert np.all(np.isfinite(pixels)) and pixels.min() >= 0.0
+    assert pixels.max() <= 1.0 + PIXEL_MARGIN
+    _, means, errors = sweep.furnace_rings(image)
+    assert np.all(means <= 1.0 + RING_STANDARD_ERRORS * errors)
+    # Not trivially dark: the sphere reflects most of the light (exact albedo 0.6-0.9).
+    assert means.min() > 0.4
+
+
+LIT = ("grazing", "silhouette", "tiny", "coverage0", "absorbed", "eta1")
+
+
+@pytest.mark.parametrize("key", LIT)
+def test_lit_regimes_within_documented_bounds(stage, key):
+    _, scene = stage
+    item = stability.regime(key)
+    item = replace(item, lights_deg=item.lights_deg[-1:])
+    skin = stability.regime_skin(item)
+    tables = _tables(item)
+    samples = reference.default_samples(skin, item.radius_mm)
+    spread = item.exact_affordable and samples <= stability.MAX_SPREAD_SAMPLES
+    ref = compare.reference_image(skin, tables=tables, resolution=SIZE, radius_mm=item.radius_mm,
+                                  light_angle_deg=item.lights_deg[0], irradiance=np.pi,
+                                  spread=spread, samples=max(samples // 4, 1))
+    bounds = documented_bounds()
+    scene.frame(item.radius_mm)
+    scene.light(item.lights_deg[0])
+    for tier in TIERS:
+        _, image = scene.render(tables, tier)
+        assert np.all(np.isfinite(image)) and image.min() >= 0.0
+        error = compare.relative_rms(image, ref)
+        assert error <= bounds[(key, tier.name)], f"{tier.name}: {error:.4f}"
