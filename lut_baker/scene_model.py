@@ -151,10 +151,12 @@ measured by :data:`COST_COMMAND` on bpy 5.0.1 at a load of ~1.5 (the fullest: 15
 sample).  Two other runs at coverage 1 gave 0.94 and 0.97 for ``LAYERED, no subsurface``:
 differences under ~10% are not resolved.  Under the film the subsurface closure carries
 little weight (Cycles rarely samples it), so leaving it out saves little time there but all
-of its noise (:data:`NOISE_K`); on bare skin it saves a third.  A first run on a loaded
-machine (load ~4) gave other ratios (0.61 for ``LAYERED, no subsurface``): contention does
-not stretch every shader alike.  EEVEE uses the same order (its render time here is shader
-compilation on software OpenGL: 9-96 s a render, not a cost)."""
+of its noise (:data:`NOISE_K`); on bare skin it saves a third.  Adaptive sampling is off in
+these measurements (every pixel takes every sample); with Blender's default (adaptive, noise
+threshold 0.01) a first run gave 0.61 for ``LAYERED, no subsurface`` on the film: noise-free
+candidates stop sooner, so the savings are then larger than modelled.  EEVEE uses the same
+order (its render time here is shader compilation on software OpenGL: 9-96 s a render, not a
+cost)."""
 NOISE_K = {
     1.0: dict(zip(_ORDER, (0.2474, 0.0006, 0.2595, 0.0007, 0.2414, 0.0006, 0.2580, 0.0007),
                   strict=True)),
