@@ -25,7 +25,8 @@ Functions
 - :func:`sphere_scene` -- the scene in a fresh file; returns the sphere.
 - :func:`set_material` -- give the sphere one material.
 - :func:`shader_material` -- a material of one BSDF node with given inputs.
-- :func:`lambert_material`, :func:`baseline_material` -- the check's and the baseline's.
+- :func:`lambert_material`, :func:`baseline_material` -- the check's and the baseline's
+  (a stock Principled BSDF with :mod:`lut_baker.baseline`'s fitted sockets).
 - :func:`tier_material` -- the add-on's node group of a tier (register the add-on around it:
   :func:`render_sphere.addon_registered`).
 - :func:`set_samples` -- samples and seed of the engine in use.
@@ -110,8 +111,11 @@ def set_material(obj, material) -> None:
 
 def shader_material(name: str, node_type: str, inputs: dict, **properties):
     """A material whose output is one shader node of ``node_type`` with socket values
-    ``inputs`` (by name; 3-tuples to colour sockets get alpha 1) and node ``properties``."""
+    ``inputs`` (by socket identifier; 3-tuples to colour sockets get alpha 1) and node
+    ``properties``."""
     import bpy
+
+    from makeup_skin_addon.nodes import socket
 
     material = bpy.data.materials.new(name)
     if material.node_tree is None and bpy.app.version < (5, 0, 0):
@@ -122,10 +126,11 @@ def shader_material(name: str, node_type: str, inputs: dict, **properties):
     for key, value in properties.items():
         setattr(shader, key, value)
     for key, value in inputs.items():
-        socket = shader.inputs[key]
-        if socket.type == "RGBA" and len(value) == 3:
+        # By identifier: a socket its method leaves unavailable is not found by name in 5.0.
+        target = socket(shader.inputs, key)
+        if target.type == "RGBA" and len(value) == 3:
             value = (*value, 1.0)
-        socket.default_value = value
+        target.default_value = value
     output = tree.nodes.new("ShaderNodeOutputMaterial")
     tree.links.new(shader.outputs[0], output.inputs["Surface"])
     return material
@@ -137,13 +142,16 @@ def lambert_material(albedo: float = 0.8):
                            {"Color": (albedo,) * 3, "Roughness": 0.0})
 
 
-def baseline_material(values: dict, scene):
-    """Principled BSDF with :func:`lut_baker.compare.baseline_inputs` ``values`` (radius in
-    mm); Subsurface Scale = the scene's units per mm."""
+def baseline_material(baseline, scene):
+    """A stock Principled BSDF with the sockets of a :class:`lut_baker.baseline.Baseline`
+    (its subsurface method; distribution GGX, which the fit's replica models: the default
+    Multiscatter GGX would add ~1% to its specular; Subsurface Scale = the scene's units per
+    mm)."""
     from makeup_skin_addon.material import units_per_mm
 
-    inputs = dict(values, **{"Subsurface Scale": units_per_mm(scene)})
-    return shader_material("Baseline", "ShaderNodeBsdfPrincipled", inputs)
+    inputs = dict(baseline.socket_values(), **{"Subsurface Scale": units_per_mm(scene)})
+    return shader_material("Baseline", "ShaderNodeBsdfPrincipled", inputs,
+                           subsurface_method=baseline.subsurface_method, distribution="GGX")
 
 
 def tier_material(obj, tables, tier: str):

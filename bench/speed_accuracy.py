@@ -8,9 +8,10 @@ A benchmark, not a test::
 
 Scene (``bench/blender_scene.py``): the paper preset on a sphere of 10 mm radius, 48 x 48 px,
 Cycles CPU, light 0, 45 and 75 degrees from the view.  Each of PRINCIPLED, LAYERED (the add-on's
-node group, "default" tables) and BASELINE (a stock Principled BSDF set up by the rule of
-:func:`lut_baker.compare.baseline_inputs`) renders at 16, 64, 256 and 1024 samples with seeds
-0 and 1, configurations interleaved so that the load of a shared machine falls on all alike.
+node group, "default" tables) and BASELINE (a stock Principled BSDF whose sockets
+:func:`lut_baker.baseline.fit_baseline` fitted to the same tables) renders at 16, 64, 256 and
+1024 samples with seeds 0 and 1, configurations interleaved so that the load of a shared
+machine falls on all alike.
 Against the reference (:func:`lut_baker.compare.reference_image`, paths 1 + 3 from "high"
 tables, the skin's diffuse part spread by the dipole profile): relative RMS error over the
 sphere's pixels (mean of the two seeds), the noise floor ``rms(a - b) / sqrt(2)`` and the time
@@ -38,6 +39,7 @@ for _path in (ROOT, ROOT / "bench", ROOT / "tools"):
         sys.path.insert(0, str(_path))
 
 from lut_baker import bake, compare, presets, reference  # noqa: E402
+from lut_baker.baseline import fit_baseline  # noqa: E402
 
 DOCS = ROOT / "docs"
 BEGIN, END = "<!-- results:begin -->", "<!-- results:end -->"
@@ -80,8 +82,10 @@ def _row(**values) -> dict:
     return {name: values.get(name, "") for name in FIELDS}
 
 
-def render_rows(skin, tables, refs: dict, size: int, sample_counts, bake_tables=None):
+def render_rows(skin, tables, baseline, refs: dict, size: int, sample_counts,
+                bake_tables=None):
     """Render every configuration at every light and sample count; the rows of the CSV.
+    ``baseline``: the :class:`lut_baker.baseline.Baseline` of ``tables``.
     ``bake_tables``: ``{resolution: tables}`` whose LAYERED render error at
     :data:`GOAL_SAMPLES` samples, light 45, seed 0 is returned as ``{resolution: error}``."""
     import blender_scene as scene_module
@@ -89,7 +93,6 @@ def render_rows(skin, tables, refs: dict, size: int, sample_counts, bake_tables=
     import render_sphere
 
     rows, bake_errors = [], {}
-    baseline = compare.baseline_inputs(skin, compare.made_up_diffuse_albedo(tables))
     for light, ref in refs.items():
         sphere = scene_module.sphere_scene(size=size, samples=16, radius_mm=RADIUS_MM,
                                            light_deg=light)
@@ -294,6 +297,27 @@ def markdown(rows, goal_rows, seconds: float) -> str:
     return "\n".join(lines)
 
 
+def baseline_text(baseline, seconds: float) -> str:
+    """The baseline's fitted sockets and its fit's image errors, as Markdown."""
+    def number(value):
+        if isinstance(value, tuple):
+            return "(" + ", ".join(f"{v:.3f}" for v in value) + ")"
+        return f"{value:.3f}"
+
+    lights = sorted(baseline.error)
+    lines = [f"The baseline, fitted by `lut_baker.baseline.fit_baseline` in {seconds:.1f} s "
+             f"({baseline.evaluations} evaluations; subsurface method "
+             f"{baseline.subsurface_method}):", "",
+             "| " + " | ".join(baseline.socket_values()) + " |",
+             "|" + "---|" * len(baseline.socket_values()),
+             "| " + " | ".join(number(v) for v in baseline.socket_values().values()) + " |", "",
+             "Its local image error (replicas, no spread), at the start (the Principled tier's "
+             "values) and fitted: " + "; ".join(
+                 f"light {light:g}: {_percent(baseline.start_error[light])} -> "
+                 f"{_percent(baseline.error[light])}" for light in lights) + "."]
+    return "\n".join(lines)
+
+
 def write_docs(text: str, path: Path) -> None:
     doc = path.read_text()
     if BEGIN not in doc or END not in doc:
@@ -327,13 +351,18 @@ def main(argv=None) -> int:
     print("reference images ...", flush=True)
     refs = references(skin, args.size, args.lights)
     bake_tables, baked = ({}, {}) if args.quick else bake_rows(skin)
-    rows, bake_errors = render_rows(skin, tables, refs, args.size, args.samples, bake_tables)
+    started = time.perf_counter()
+    baseline = fit_baseline(skin, tables)
+    fitted = baseline_text(baseline, time.perf_counter() - started)
+    print(fitted, flush=True)
+    rows, bake_errors = render_rows(skin, tables, baseline, refs, args.size, args.samples,
+                                    bake_tables)
     for name, row in baked.items():
         row["error"] = bake_errors.get(name, float("nan"))
         rows.append(row)
     goal_rows = goals(rows)
     seconds = time.perf_counter() - start
-    text = markdown(rows, goal_rows, seconds)
+    text = markdown(rows, goal_rows, seconds) + "\n\n" + fitted
     print(text)
     args.out.mkdir(parents=True, exist_ok=True)
     suffix = "_quick" if args.quick else ""

@@ -286,17 +286,22 @@ def _rgb(values: np.ndarray) -> np.ndarray:
     return values if values.shape[-1:] == (3,) and values.ndim == 4 else values[..., None]
 
 
-def _fit_roughness_and(grid: _Grid, target: np.ndarray, fresnel, second_range, scale=1.0):
+def _fit_roughness_and(grid: _Grid, target: np.ndarray, fresnel, second_range, scale=1.0,
+                       view_factor=None):
     """``(roughness, second, error)``: a GGX lobe with Fresnel ``fresnel(cos_hi, second)``
     fitted to ``target`` (channels averaged) by nested golden-section searches, the second
-    parameter inside.  ``scale``: a factor per node applied to the lobe."""
+    parameter inside.  ``scale``: a factor per node applied to the lobe; ``view_factor``:
+    ``(roughness, second) -> factor per view node`` (the coat's energy compensation)."""
     target = np.mean(np.asarray(target, float), axis=-1, keepdims=True)
 
     def error_for(roughness):
         base = grid.lobe(roughness)[..., None] * scale
 
         def inner(second):
-            return grid.error(base * fresnel(grid.cos_hi, second)[..., None], target)
+            lobe = base * fresnel(grid.cos_hi, second)[..., None]
+            if view_factor is not None:
+                lobe = lobe * view_factor(roughness, second)[..., None]
+            return grid.error(lobe, target)
 
         return golden_minimum(inner, *second_range, tol=2 * FIT_TOLERANCE, coarse=7)
 
@@ -306,10 +311,15 @@ def _fit_roughness_and(grid: _Grid, target: np.ndarray, fresnel, second_range, s
 
 
 def fit_coat(grid: _Grid, target: np.ndarray) -> LobeFit:
-    """Coat Roughness and Coat IOR of a GGX coat (weight 1, dielectric Fresnel) fitted to
-    ``target`` (the film's gloss, ``(n, n, p, 3)`` on ``grid``; its channels averaged)."""
+    """Coat Roughness and Coat IOR of a GGX coat (weight 1, dielectric Fresnel, Cycles'
+    energy compensation) fitted to ``target`` (the film's gloss, ``(n, n, p, 3)`` on ``grid``;
+    its channels averaged)."""
+    def compensation(roughness, ior):
+        return cc._view_table(grid.cos_o, lambda c: cc.ggx_energy_compensation(
+            c, roughness, float(cc.dielectric_fss(ior)))[0], size=17)
+
     roughness, ior, error = _fit_roughness_and(grid, target, cc.dielectric_fresnel,
-                                               COAT_IOR_RANGE)
+                                               COAT_IOR_RANGE, view_factor=compensation)
     return LobeFit(roughness=roughness, ior=ior, error=error)
 
 
@@ -546,6 +556,14 @@ def _cosine_mean(values: np.ndarray, theta_deg: np.ndarray) -> np.ndarray:
     return 2.0 * np.tensordot(w * mu, values, axes=(0, 0))
 
 
+def _coat_layering_mean(roughness: float, ior: float) -> float:
+    """Cosine-weighted mean over view angles of the coat's layering albedo
+    (:func:`cycles_closures.coat_view_terms`)."""
+    mu = np.linspace(0.0, 1.0, 33)
+    return float(2.0 * np.sum(_trapezoid_weights(mu) * mu
+                              * cc.coat_view_terms(mu, roughness, ior)[1]))
+
+
 def _layering_mean(roughness: float, ior: float, f0=None) -> float:
     """Cosine-weighted mean over view angles of :func:`cycles_closures.layering_albedo`."""
     mu = np.linspace(0.0, 1.0, 33)
@@ -575,8 +593,8 @@ def fit_closures(tables: Tables, *, lut_size: int = DEFAULT_LUT_SIZE,
     skin_gloss = np.asarray(tables.skin_gloss, float)[pick]
 
     coat = fit_coat(grid, film_gloss)
-    e_coat = cc._view_table(grid.cos_o, lambda c: cc.layering_albedo(c, coat.roughness,
-                                                                        coat.ior))
+    e_coat = cc._view_table(grid.cos_o, lambda c: cc.coat_view_terms(c, coat.roughness,
+                                                                      coat.ior)[1])
     specular_bare = fit_specular(grid, skin_gloss)
     specular_film = fit_specular(grid, path3, attenuation=1.0 - e_coat)
     # The node group mixes the two roughnesses by coverage: a dropped lobe (level 0) takes the
@@ -616,7 +634,7 @@ def fit_closures(tables: Tables, *, lut_size: int = DEFAULT_LUT_SIZE,
         coat=coat,
         specular_bare=specular_bare,
         specular_film=specular_film,
-        coat_albedo_mean=_layering_mean(coat.roughness, coat.ior),
+        coat_albedo_mean=_coat_layering_mean(coat.roughness, coat.ior),
         specular_albedo_mean=(specular_mean(specular_bare), specular_mean(specular_film)),
         gloss_to_diffuse=(_cosine_mean(np.asarray(tables.path3_gloss_albedo), theta_deg)
                           if specular_film.level == 0.0 else np.zeros(3)),

@@ -21,10 +21,8 @@ Functions
 - :func:`lambert_image` -- the analytic image of a Lambertian sphere, ``E a / pi max(0, N.L)``.
 - :func:`reference_image` -- the made-up sphere's reference, exact or with paths 1 + 3 read
   from baked tables (same geometry and spread as :func:`lut_baker.reference.sphere_image`).
-- :func:`made_up_diffuse_albedo` -- the diffuse colour of the made-up skin from its tables.
-- :func:`diffuse_mean_free_path_mm` -- the dipole's ``1 / sigma_tr`` per channel.
-- :func:`ts_roughness` -- the Blender Roughness of a Torrance-Sparrow lobe by a simple rule.
-- :func:`baseline_inputs` -- the stock Principled BSDF a user would set up without the add-on.
+- :func:`local_image` -- the image of any local reflection function (no spread);
+  :func:`sphere_directions` -- its pixels' local light and view directions.
 - :func:`pareto_front` -- the points no other point beats in both cost and error.
 """
 
@@ -33,7 +31,6 @@ from __future__ import annotations
 import numpy as np
 
 from . import reference
-from .model import Dipole
 from .normalise import MadeUpSkin
 
 __all__ = [
@@ -44,10 +41,8 @@ __all__ = [
     "bias",
     "lambert_image",
     "reference_image",
-    "made_up_diffuse_albedo",
-    "diffuse_mean_free_path_mm",
-    "ts_roughness",
-    "baseline_inputs",
+    "local_image",
+    "sphere_directions",
     "pareto_front",
 ]
 
@@ -133,91 +128,45 @@ def reference_image(skin: MadeUpSkin, *, tables=None, resolution: int = 64,
         return reference.sphere_image(skin, resolution=resolution, radius_mm=radius_mm,
                                       light_angle_deg=light_angle_deg, irradiance=irradiance,
                                       spread=spread, samples=samples)
-    _, normals, mask = reference.sphere_points(resolution, radius_mm)
+    image = local_image(lambda wi, wo: tables.made_up_reflection(wi, wo, skin.coverage,
+                                                                 skin.absorption),
+                        resolution, light_angle_deg, irradiance)
+    if spread:
+        _, normals, mask = reference.sphere_points(resolution, radius_mm)
+        light = reference.light_direction(light_angle_deg)
+        points = normals[mask]
+        samples = samples or reference.default_samples(skin, radius_mm)
+        image[mask] += (reference.spread_diffuse(points, light, skin, radius_mm=radius_mm,
+                                                 samples=samples, irradiance=irradiance)
+                        - reference.local_diffuse(points, light, skin, irradiance))
+    return image
+
+
+def local_image(reflection, resolution: int, light_angle_deg: float,
+                irradiance: float = 1.0) -> np.ndarray:
+    """The sphere's image ``(n, n, 3)`` under one distant light when every point reflects
+    locally: ``E f(wi, wo) cos(theta_i)`` per pixel centre, ``reflection(wi, wo) -> (P, 3)``
+    taking local unit directions ``(P, 3)`` of the lit, visible points (normal = +z).  The
+    sphere's size does not enter (no spread)."""
+    lit, wi, wo = sphere_directions(resolution, light_angle_deg)
+    image = np.zeros((resolution, resolution, 3))
+    image[lit] = irradiance * np.asarray(reflection(wi, wo)) * wi[:, 2:3]
+    return image
+
+
+def sphere_directions(resolution: int, light_angle_deg: float):
+    """``(lit (n, n) booleans, wi (P, 3), wo (P, 3))``: the pixels whose centre sees a lit
+    point of the sphere, and at those points (row-major order) the local unit directions to
+    the light and to the camera (normal = +z)."""
+    _, normals, mask = reference.sphere_points(resolution, 1.0)
     light = reference.light_direction(light_angle_deg)
     points = normals[mask]
     wi = reference.local_directions(np.broadcast_to(light, points.shape), points)
     wo = reference.local_directions(np.broadcast_to(reference.VIEW, points.shape), points)
-    lit = (wi[:, 2] > 0.0) & (wo[:, 2] > 0.0)
-    radiance = np.zeros(points.shape)
-    f = tables.made_up_reflection(wi[lit], wo[lit], skin.coverage, skin.absorption)
-    radiance[lit] = irradiance * f * wi[lit, 2:3]
-    if spread:
-        samples = samples or reference.default_samples(skin, radius_mm)
-        radiance = (radiance - reference.local_diffuse(points, light, skin, irradiance)
-                    + reference.spread_diffuse(points, light, skin, radius_mm=radius_mm,
-                                               samples=samples, irradiance=irradiance))
-    image = np.zeros((resolution, resolution, 3))
-    image[mask] = radiance
-    return image
-
-
-def made_up_diffuse_albedo(tables, coverage=None, absorption=None,
-                           theta_deg: float = 0.0) -> np.ndarray:
-    """The diffuse albedo (RGB) of the made-up skin lit from ``theta_deg`` (degrees; default
-    head-on, the colour a user would measure), from baked ``tables`` (:mod:`lut_baker.tables`)::
-
-        w [(1 - A) pi P_d,f + (1 - A)^2 P_d,s T(theta) Int T cos dw] + (1 - w) pi P_d,s
-
-    ``coverage`` ``w`` and ``absorption`` ``A`` default to the tables'."""
-    w = float(tables.parameters.get("coverage", 1.0) if coverage is None else coverage)
-    a = tables.parameters.get("absorption", 0.0) if absorption is None else absorption
-    through = 1.0 - np.broadcast_to(np.asarray(a, float), (3,))
-    film = np.pi * np.asarray(tables.film_diffuse, float)
-    skin = np.asarray(tables.skin_diffuse, float)
-    crossing = tables.directional("film_transmittance", theta_deg) * np.asarray(
-        tables.film_transmittance_integral, float)
-    return w * (through * film + through**2 * skin * crossing) + (1.0 - w) * np.pi * skin
-
-
-def diffuse_mean_free_path_mm(dipole: Dipole) -> np.ndarray:
-    """``1 / sigma_tr`` (mm) per channel, ``sigma_tr = sqrt(3 sigma_a sigma_t')``,
-    ``sigma_t' = sigma_s (1 - g) + sigma_a`` (Jensen et al. 2001): the length over which the
-    dipole's profile falls by ``e`` far from the light (SPEC 2.3)."""
-    reduced = np.asarray(dipole.sigma_s) * (1.0 - np.asarray(dipole.g)) + np.asarray(
-        dipole.sigma_a)
-    sigma_tr = np.sqrt(3.0 * np.asarray(dipole.sigma_a) * reduced)
-    return np.broadcast_to(1.0 / sigma_tr, (3,)).astype(float)
-
-
-def ts_roughness(n_per_deg) -> float:
-    """Blender Roughness for a Torrance-Sparrow lobe ``D = exp(-(alpha n)^2)`` (alpha in
-    degrees, SPEC 2.1), by the rule a user would apply: near the peak a Beckmann lobe is
-    ``exp(-tan^2(alpha) / m^2) ~ exp(-(alpha / m)^2)`` with ``alpha`` in radians, so the slope
-    ``m`` is the lobe's 1/e half-width ``1/n`` degrees in radians; GGX alpha = m, and Blender's
-    Roughness is ``sqrt(alpha)``.  Clamped to [0, 1]; channels averaged."""
-    width_rad = np.radians(1.0 / float(np.mean(n_per_deg)))
-    return float(np.clip(np.sqrt(width_rad), 0.0, 1.0))
-
-
-def baseline_inputs(skin: MadeUpSkin, diffuse_albedo) -> dict:
-    """The stock Principled BSDF a user would set up for ``skin`` without the add-on (socket
-    name -> value; ``Subsurface Radius`` in mm, the caller sets ``Subsurface Scale`` to scene
-    units per mm).  The rule, one line per socket:
-
-    - Base Color = ``diffuse_albedo`` (RGB): the made-up skin's diffuse colour
-      (:func:`made_up_diffuse_albedo`: film diffuse + skin seen through the film + bare skin by
-      coverage), clamped to [0, 1];
-    - Roughness, IOR = the skin gloss's :func:`ts_roughness` and ``eta``; Specular IOR Level
-      0.5 (F0 from the IOR, the Torrance-Sparrow ``P_s`` has no socket);
-    - Coat Weight = coverage ``w``; Coat Roughness, Coat IOR = the film's :func:`ts_roughness`
-      and ``eta``;
-    - Subsurface Weight 1, Subsurface Radius = :func:`diffuse_mean_free_path_mm` of the skin's
-      dipole; the Principled's default method (Random Walk, whose index is the IOR above:
-      Subsurface IOR is a socket of Random Walk Skin only).
-    """
-    albedo = np.clip(np.broadcast_to(np.asarray(diffuse_albedo, float), (3,)), 0.0, 1.0)
-    return {
-        "Base Color": tuple(float(a) for a in albedo),
-        "Roughness": ts_roughness(skin.skin.n),
-        "IOR": float(np.mean(skin.skin.eta)),
-        "Specular IOR Level": 0.5,
-        "Coat Weight": float(skin.coverage),
-        "Coat Roughness": ts_roughness(skin.film.n),
-        "Coat IOR": float(np.mean(skin.film.eta)),
-        "Subsurface Weight": 1.0,
-        "Subsurface Radius": tuple(float(r) for r in diffuse_mean_free_path_mm(skin.dipole)),
-    }
+    seen = (wi[:, 2] > 0.0) & (wo[:, 2] > 0.0)
+    lit = np.zeros_like(mask)
+    lit[mask] = seen
+    return lit, wi[seen], wo[seen]
 
 
 def pareto_front(cost, error) -> np.ndarray:

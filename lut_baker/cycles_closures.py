@@ -21,6 +21,8 @@ Functions
 - :func:`microfacet_albedo` -- the same for a microfacet lobe, by quadrature over normals.
 - :func:`layering_albedo` -- Cycles' albedo estimate that attenuates the layers below a coat or
   a specular layer (``bsdf_microfacet_estimate_albedo``).
+- :func:`dielectric_fss`, :func:`ggx_energy_compensation`, :func:`coat_view_terms` -- the
+  multiple-scattering compensation Cycles gives the Principled coat.
 - :func:`lambert_reflection` -- ``albedo / pi``.
 - :func:`principled_reflection` -- the Principled BSDF's coat, specular and diffuse layers
   (``svm_node_closure_bsdf``), for the inputs in :class:`PrincipledInputs`.
@@ -58,6 +60,9 @@ __all__ = [
     "ashikhmin_shirley_reflection",
     "microfacet_shadowing",
     "microfacet_reflection",
+    "dielectric_fss",
+    "ggx_energy_compensation",
+    "coat_view_terms",
     "dielectric_fresnel",
     "schlick_ior_fresnel",
     "directional_albedo",
@@ -327,6 +332,50 @@ def layering_albedo(cos_view, roughness, eta, f0=None):
     return f0 + (1.0 - f0) * s
 
 
+def dielectric_fss(eta):
+    """Cycles' average single-scattering dielectric Fresnel ``Int 2 mu F(mu) dmu`` at ``eta``
+    (``fresnel_dielectric_Fss``: Kulla and Conty's fit; exact to ~1e-3)."""
+    eta = np.asarray(eta, float)
+    below = 0.997118 + eta * (0.1014 - eta * (0.965241 + eta * 0.130607))
+    return np.where(eta < 1.0, below, (eta - 1.0) / (4.08567 + 1.00071 * eta))
+
+
+def ggx_energy_compensation(cos_view, roughness, fss):
+    """``(scale, darkening)`` Cycles applies to a GGX lobe with Fresnel (the Principled coat:
+    ``microfacet_ggx_preserve_energy``), at view cosines ``cos_view``.
+
+    With ``E`` the Fresnel-free single-scattering albedo at the view (:func:`microfacet_albedo`;
+    Cycles reads a 32^2 table of it) and ``E_avg`` its cosine-weighted mean: the lobe's value is
+    multiplied by ``scale = 1 + F_ms (1 - E) / E`` with ``F_ms = F_ss E_avg / (1 - F_ss (1 -
+    E_avg))``, of which ``darkening = scale E`` sits in the closure's weight (so in the albedo
+    that attenuates the layers below) and ``1 / E`` in its evaluation.
+    """
+    cos_view = np.asarray(cos_view, float)
+    e = microfacet_albedo(cos_view, roughness)
+    e_avg = _ggx_average_albedo(float(roughness))
+    missing = (1.0 - e) / np.maximum(e, 1e-6)
+    f_ms = fss * e_avg / (1.0 - fss * (1.0 - e_avg))
+    scale = 1.0 + f_ms * missing
+    return scale, scale / (1.0 + missing)
+
+
+def coat_view_terms(cos_view, roughness, ior):
+    """``(scale, layering albedo)`` of the Principled coat at view cosines ``cos_view``: the
+    factor :func:`ggx_energy_compensation` puts on its lobe, and the albedo by which it
+    attenuates the layers below, ``darkening * layering_albedo`` (Cycles' ``bsdf_albedo``
+    reads the closure's weight, which holds the darkening)."""
+    scale, darkening = ggx_energy_compensation(cos_view, roughness,
+                                               float(dielectric_fss(ior)))
+    return scale, darkening * layering_albedo(cos_view, roughness, ior)
+
+
+@lru_cache(maxsize=64)
+def _ggx_average_albedo(roughness: float) -> float:
+    """``2 Int E(mu) mu dmu`` of the Fresnel-free GGX albedo (Cycles' ``ggx_Eavg``)."""
+    mu, w = _unit_gauss_legendre(32)
+    return float(2.0 * np.sum(w * mu * microfacet_albedo(mu, roughness)))
+
+
 # --------------------------------------------------------------------------------------------
 # Principled BSDF (svm_node_closure_bsdf, CLOSURE_BSDF_PRINCIPLED_ID, distribution GGX)
 # --------------------------------------------------------------------------------------------
@@ -363,9 +412,11 @@ class PrincipledInputs:
 def principled_reflection(wi, wo, inputs: PrincipledInputs):
     """The Principled BSDF's reflection (no cosine), RGB ``(..., 3)``, as Cycles layers it:
 
-    ``w_c coat(wi, wo) + a_c(wo) [spec(wi, wo) + a_s(wo) base / pi]``
+    ``w_c k(wo) coat(wi, wo) + a_c(wo) [spec(wi, wo) + a_s(wo) base / pi]``
 
-    with ``a_c = 1 - w_c E_coat(wo)`` and ``a_s = 1 - max_c E_spec(wo)`` from
+    with the coat's multiple-scattering compensation ``k`` (:func:`ggx_energy_compensation`:
+    Cycles applies it to the coat whatever the distribution), ``a_c = 1 - w_c d(wo)
+    E_coat(wo)`` (``d`` its darkening) and ``a_s = 1 - max_c E_spec(wo)`` from
     :func:`layering_albedo` (``closure_layering_weight``): the attenuation depends on the view
     only, so the model is not reciprocal, like Cycles.  Subsurface counts as its albedo in
     ``base_color`` leaving Lambertian-like (its spread is separate, see the profiles).
@@ -373,20 +424,24 @@ def principled_reflection(wi, wo, inputs: PrincipledInputs):
     wi, wo = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
     cos_o = np.clip(wo[..., 2], 0.0, 1.0)
     eta, f0 = inputs.specular_eta_f0()
-    spec = microfacet_reflection(wi, wo, inputs.roughness,
-                                 lambda c: schlick_ior_fresnel(c, eta, f0))
-    a_s = 1.0 - np.max(_view_table(cos_o, lambda c: layering_albedo(
-        c, inputs.roughness, eta, f0)), axis=-1)
     base = lambert_reflection(np.minimum(np.maximum(inputs.base_color, 0.0), 1.0))
-    lower = spec + a_s[..., None] * base
+    if eta == 1.0:  # Specular IOR Level 0: Cycles allocates no specular closure
+        lower = base * np.ones(cos_o.shape + (1,))
+    else:
+        spec = microfacet_reflection(wi, wo, inputs.roughness,
+                                     lambda c: schlick_ior_fresnel(c, eta, f0))
+        a_s = 1.0 - np.max(_view_table(cos_o, lambda c: layering_albedo(
+            c, inputs.roughness, eta, f0)), axis=-1)
+        lower = spec + a_s[..., None] * base
     if inputs.coat_weight <= 0.0:
         return lower
     coat = microfacet_reflection(wi, wo, inputs.coat_roughness,
-                          lambda c: dielectric_fresnel(c, inputs.coat_ior))
-    e_c = _view_table(cos_o, lambda c: layering_albedo(
-        c, inputs.coat_roughness, inputs.coat_ior))
-    a_c = np.clip(1.0 - inputs.coat_weight * e_c, 0.0, 1.0)
-    return inputs.coat_weight * coat[..., None] + a_c[..., None] * lower
+                                 lambda c: dielectric_fresnel(c, inputs.coat_ior))
+    terms = _view_table(cos_o, lambda c: np.stack(
+        coat_view_terms(c, inputs.coat_roughness, inputs.coat_ior), axis=-1))
+    a_c = np.clip(1.0 - inputs.coat_weight * terms[..., 1], 0.0, 1.0)
+    return (inputs.coat_weight * (coat * terms[..., 0])[..., None]
+            + a_c[..., None] * lower)
 
 
 def _view_table(cos_view: np.ndarray, function, size: int = 64) -> np.ndarray:

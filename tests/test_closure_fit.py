@@ -71,11 +71,31 @@ def test_coat_attenuates_the_base_by_its_albedo():
     plain = cc.PrincipledInputs(base_color=(0.5, 0.5, 0.5), specular_ior_level=0.0)
     coated = dataclasses.replace(plain, coat_weight=1.0, coat_roughness=0.5, coat_ior=1.8)
     coat_only = cc.microfacet_reflection(wi, wo, 0.5, lambda c: cc.dielectric_fresnel(c, 1.8))
-    e_coat = cc.layering_albedo(np.cos(np.radians(50.0)), 0.5, 1.8)
-    expected = coat_only + (1.0 - e_coat) * 0.5 / np.pi
+    scale, e_coat = cc.coat_view_terms(np.cos(np.radians(50.0)), 0.5, 1.8)
+    expected = scale * coat_only + (1.0 - e_coat) * 0.5 / np.pi
     np.testing.assert_allclose(cc.principled_reflection(wi, wo, coated), [expected] * 3,
                                rtol=2e-3)
-    assert 0.0 < e_coat < 1.0
+    assert 0.0 < e_coat < cc.layering_albedo(np.cos(np.radians(50.0)), 0.5, 1.8) < 1.0
+    assert 1.0 < scale < 1.1
+
+
+@pytest.mark.parametrize("roughness", [0.2, 0.5, 0.9])
+def test_coat_energy_compensation(roughness):
+    """Cycles' multiple-scattering compensation: with a white Fresnel (F_ss = 1) the lobe's
+    albedo becomes exactly 1 (the white furnace), the darkening 1; with a dielectric one the
+    lobe gains less than the missing energy and the darkening is below 1; a smooth lobe
+    (nothing missing) keeps its value."""
+    mu = np.array([1.0, 0.6, 0.2])
+    e = cc.microfacet_albedo(mu, roughness)
+    scale, darkening = cc.ggx_energy_compensation(mu, roughness, 1.0)
+    np.testing.assert_allclose(e * scale, 1.0, rtol=1e-9)
+    np.testing.assert_allclose(darkening, 1.0, rtol=1e-9)
+    fss = float(cc.dielectric_fss(1.5))
+    assert fss == pytest.approx(0.0918, rel=0.03)  # 2 Int F mu dmu = 0.0918 at eta 1.5 (a fit)
+    scale, darkening = cc.ggx_energy_compensation(mu, roughness, fss)
+    assert np.all((scale > 1.0) & (scale < 1.0 / e)) and np.all(darkening < 1.0)
+    smooth, _ = cc.ggx_energy_compensation(mu[:2], 0.05, fss)
+    np.testing.assert_allclose(smooth, 1.0, atol=1e-3)
 
 
 def _radial_integral(profile, r):

@@ -2,13 +2,16 @@
 
 The comparison itself (pure numpy, :mod:`lut_baker.compare`) is tested first; then the scene of
 ``bench/blender_scene.py`` (Cycles CPU, 48 x 48 px, a sphere of 10 mm, the paper preset, light
-45 degrees from the view) renders a Lambert sphere, the two tiers and the baseline, each twice
-(seeds 0 and 1, 32 samples).  The bounds are measured (docs/speed_accuracy.md, "Bounds of the
-tests"), with margin for the noise of one seed pair and a busy machine.  Blender-side tests
-use the ``bpy_factory`` fixture (marked ``bpy``); they take ~40 s per Blender line, the EEVEE
-check (marked ``slow``) another 40-100 s of shader compilation on software OpenGL.
+45 degrees from the view) renders a Lambert sphere, the two tiers and the baseline (a stock
+Principled BSDF fitted by :mod:`lut_baker.baseline`), each twice (seeds 0 and 1, 32 samples),
+and the baseline without subsurface at 256 samples against its replica. The bounds are measured
+(docs/speed_accuracy.md, "Bounds of the tests"), with margin for the noise of one seed pair and
+a busy machine. Blender-side tests use the ``bpy_factory`` fixture (marked ``bpy``); they take
+~40 s per Blender line, the EEVEE check (marked ``slow``) another 40-100 s of shader compilation
+on software OpenGL.
 """
 
+import dataclasses
 import math
 import sys
 from pathlib import Path
@@ -16,7 +19,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from lut_baker import bake, compare, presets, reference
+from lut_baker import bake, baseline, compare, presets, reference
 
 SIZE = 48
 SAMPLES = 32
@@ -34,9 +37,15 @@ LAMBERT_BOUND = 1e-3
 BIAS_BOUND = {"PRINCIPLED": 0.08, "LAYERED": 0.035}
 """Error not explained by noise, sqrt(e^2 - floor^2): measured PRINCIPLED 5.3-5.6%, LAYERED
 1.3-2.2%."""
-BASELINE_BIAS_LOW = 0.12
-"""The baseline's bias is at least this (measured 21-22%): the comparison must see the film's
-gloss that the baseline lacks, or it measures nothing."""
+BEATS_BASELINE = 0.75
+"""The best tier's bias is below this share of the baseline's (measured 1.5% against 3.1%, 0.49,
+with the baseline fitted to convergence; the test's shorter fit leaves it a little worse)."""
+BASELINE_EVALUATIONS = 12
+"""The test's baseline fit stops here (the benchmark's runs to convergence, ~54)."""
+REPLICA_BOUND = 0.01
+"""The Principled replica (no subsurface) against Cycles at 256 samples: measured 0.2-0.3%
+(noise included); without the coat's energy compensation it was 4.7%."""
+REPLICA_SAMPLES = 256
 EEVEE_BOUND = 0.05
 """EEVEE (16 samples) against Cycles (1024 samples), PRINCIPLED tier: measured 2.8% (5.0.1)."""
 
@@ -98,31 +107,6 @@ def test_reference_from_tables_matches_the_exact_reference():
     assert compare.relative_rms(fast, 1.01 * exact) > 5e-3  # the check can fail
 
 
-def test_made_up_diffuse_albedo_limits():
-    tables = bake.bake(presets.paper(), "preview")
-    bare = np.pi * tables.skin_diffuse
-    assert np.allclose(compare.made_up_diffuse_albedo(tables, 0.0, 0.0), bare)
-    film_only = compare.made_up_diffuse_albedo(tables, 1.0, 1.0)
-    assert np.allclose(film_only, 0.0)
-    made_up = compare.made_up_diffuse_albedo(tables, 1.0, 0.0)
-    assert np.all(made_up > np.pi * tables.film_diffuse) and np.all(made_up < 1.0)
-    half = compare.made_up_diffuse_albedo(tables, 0.5, 0.0)
-    assert np.allclose(half, 0.5 * (bare + made_up))
-
-
-def test_baseline_rule_for_the_paper_preset():
-    skin = presets.paper()
-    values = compare.baseline_inputs(skin, [0.5, 0.6, 0.7])
-    # 1/sigma_tr = 1/sqrt(3 * 0.0282 * (2.83 + 0.0282)) mm
-    assert values["Subsurface Radius"] == pytest.approx((2.0336,) * 3, rel=1e-4)
-    # The film's lobe is 1/0.0329 = 30.4 degrees wide: sqrt(0.5305 rad)
-    assert values["Coat Roughness"] == pytest.approx(0.7284, abs=1e-4)
-    assert values["Roughness"] == pytest.approx(math.sqrt(math.radians(25.0)))
-    assert values["Coat IOR"] == pytest.approx(1.19) and values["IOR"] == pytest.approx(1.26)
-    assert values["Base Color"] == (0.5, 0.6, 0.7)
-    assert values["Coat Weight"] == skin.coverage
-
-
 # --------------------------------------------------------------------------------------------
 # Renders (bpy)
 # --------------------------------------------------------------------------------------------
@@ -162,11 +146,11 @@ def renders(bpy_factory, made_up):
     with render_sphere.addon_registered():
         scene_module.set_material(sphere, scene_module.lambert_material(0.8))
         out["LAMBERT"] = scene_module.render_image()
-        baseline = compare.baseline_inputs(skin, compare.made_up_diffuse_albedo(tables))
+        fitted = baseline.fit_baseline(skin, tables, max_evaluations=BASELINE_EVALUATIONS)
+        out["FITTED"] = fitted
         for name in NAMES:
             if name == "BASELINE":
-                scene_module.set_material(sphere, scene_module.baseline_material(baseline,
-                                                                                  scene))
+                scene_module.set_material(sphere, scene_module.baseline_material(fitted, scene))
             else:
                 scene_module.tier_material(sphere, tables, name)
             images, seconds = [], 0.0
@@ -176,6 +160,10 @@ def renders(bpy_factory, made_up):
                 images.append(image)
                 seconds += took
             out[name] = (seconds / len(SEEDS), images)
+        local = dataclasses.replace(fitted, subsurface_weight=0.0)
+        scene_module.set_material(sphere, scene_module.baseline_material(local, scene))
+        scene_module.set_samples(scene, REPLICA_SAMPLES, 0)
+        out["REPLICA"] = scene_module.render_image()
         yield out
 
 
@@ -223,9 +211,22 @@ def test_best_tier_beats_the_baseline(renders, made_up):
     errors = {name: _measures(renders, made_up, name) for name in NAMES}
     print({name: f"error {e[0]:.4f} floor {e[1]:.4f} bias {e[2]:.4f} {e[3]:.2f} s"
            for name, e in errors.items()})
-    best = min(errors[name][0] for name in ("PRINCIPLED", "LAYERED"))
-    assert errors["BASELINE"][2] > BASELINE_BIAS_LOW
-    assert best < errors["BASELINE"][0] / 3.0
+    best = min(errors[name][2] for name in ("PRINCIPLED", "LAYERED"))
+    assert best < BEATS_BASELINE * errors["BASELINE"][2]
+
+
+def test_principled_replica_matches_cycles(renders):
+    """The replica every Principled fit relies on (coat with Cycles' energy compensation,
+    specular, layering, diffuse) against a render of the fitted baseline without subsurface."""
+    inputs = renders["FITTED"].inputs
+    _, image = renders["REPLICA"]
+    predicted = baseline.principled_image(inputs, SIZE, LIGHT_DEG, _bench().IRRADIANCE)
+    mask = compare.sphere_mask(SIZE)
+    error = compare.relative_rms(image, predicted)
+    print(f"replica against Cycles: relative RMS {error:.4f}, mean ratio "
+          f"{image[mask].mean() / predicted[mask].mean():.4f}")
+    assert error < REPLICA_BOUND
+    assert image[mask].mean() / predicted[mask].mean() == pytest.approx(1.0, abs=0.005)
 
 
 @pytest.mark.slow
