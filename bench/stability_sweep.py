@@ -103,35 +103,20 @@ class Stage:
         return blender_scene.render_image()
 
 
-def _drop_gloss(group):
-    """A copy of ``group`` without its gloss (bench only: Glossy closures at colour 0, the
-    Principled BSDF's coat weight and specular level at 0)."""
-    copy = group.copy()
-    for node in copy.nodes:
-        if node.type == "BSDF_GLOSSY":
-            for link in list(node.inputs["Color"].links):
-                copy.links.remove(link)
-            node.inputs["Color"].default_value = (0.0, 0.0, 0.0, 1.0)
-        elif node.type == "BSDF_PRINCIPLED":
-            for name in ("Coat Weight", "Specular IOR Level"):
-                for link in list(node.inputs[name].links):
-                    copy.links.remove(link)
-                node.inputs[name].default_value = 0.0
-    return copy
-
-
 def candidate_material(sphere, tables, candidate):
     """The made-up material of a :class:`lut_baker.scene_model.Candidate` on ``sphere`` (the
-    add-on registered): its tier; ``subsurface=False`` sets Subsurface Scale 0 as the Fit to
-    Scene operator does (Cycles then shades the subsurface closures as diffuse ones);
-    ``gloss=False`` swaps in :func:`_drop_gloss` (no add-on tier does that)."""
+    add-on registered), as Fit to Scene realises it: its tier; ``subsurface=False`` sets
+    Subsurface Scale 0 (Cycles then shades the subsurface closures as diffuse ones);
+    ``gloss=False`` sets the group's Gloss input to 0 (Cycles then allocates no gloss
+    closure)."""
     material = blender_scene.tier_material(sphere, tables, candidate.tier)
     node = material.node_tree.nodes["Made-up Skin"]
     if not candidate.subsurface:
         material.makeup_skin.subsurface_scale = 0.0
         node.inputs["Subsurface Scale"].default_value = 0.0
     if not candidate.gloss:
-        node.node_tree = _drop_gloss(node.node_tree)
+        material.makeup_skin.gloss = 0.0
+        node.inputs["Gloss"].default_value = 0.0
     return material
 
 
@@ -166,14 +151,18 @@ def measure_costs(*, size=96, samples=(16, 272), repeats=3, radius_mm=30.0, cove
     45 degrees.
 
     Times: the slope ``(t(high) - t(low)) / (high - low)`` (scene set-up does not count), the
-    fastest of ``repeats`` interleaved runs.  Noise: :func:`lut_baker.compare.noise_floor` of
-    two seeds at the higher count, times ``sqrt(samples)``."""
+    fastest of ``repeats`` interleaved runs, in wall-clock seconds (``relative_cost``) and in
+    the process's CPU seconds (``relative_cpu``: all of Cycles' threads; on a shared machine
+    other processes slow the wall clock but not this).  Noise:
+    :func:`lut_baker.compare.noise_floor` of two seeds at the higher count, times
+    ``sqrt(samples)``."""
     from lut_baker import bake, presets, scene_model
 
     tables = bake.bake(presets.made_up_skin("paper_natural", "paper_bioplate",
                                             coverage=coverage), "preview")
     low, high = samples
     times = {c: {low: [], high: []} for c in scene_model.CANDIDATES}
+    cpu = {c: {low: [], high: []} for c in scene_model.CANDIDATES}
     noise = {}
 
     with render_sphere.addon_registered():
@@ -181,15 +170,22 @@ def measure_costs(*, size=96, samples=(16, 272), repeats=3, radius_mm=30.0, cove
         for _ in range(repeats):
             for candidate in scene_model.CANDIDATES:
                 for count in (low, high):
+                    start = time.process_time()
                     times[candidate][count].append(
                         stage.render(tables, candidate, samples=count)[0])
+                    cpu[candidate][count].append(time.process_time() - start)
         for candidate in scene_model.CANDIDATES:
             a = stage.render(tables, candidate, seed=0)[1]
             b = stage.render(tables, candidate, seed=1)[1]
             noise[candidate] = compare.noise_floor(a, b, 0.5 * (a + b)) * math.sqrt(high)
-    slope = {c: (min(t[high]) - min(t[low])) / (high - low) for c, t in times.items()}
-    fullest = slope[scene_model.FULLEST]
-    return {c: {"relative_cost": slope[c] / fullest, "seconds_per_sample": slope[c],
+    def slope(table):
+        return {c: (min(t[high]) - min(t[low])) / (high - low) for c, t in table.items()}
+
+    wall, busy = slope(times), slope(cpu)
+    return {c: {"relative_cost": wall[c] / wall[scene_model.FULLEST],
+                "seconds_per_sample": wall[c],
+                "relative_cpu": busy[c] / busy[scene_model.FULLEST],
+                "cpu_seconds_per_sample": busy[c],
                 "noise_k": noise[c]} for c in scene_model.CANDIDATES}
 
 
@@ -285,9 +281,15 @@ def _print_costs(costs, args, coverage) -> None:
     print(f"# python bench/stability_sweep.py --costs --repeats {args.repeats} --size "
           f"{args.size} --samples {args.samples[0]} {args.samples[1]}: coverage {coverage:g}")
     for candidate, value in costs.items():
-        print(f"{candidate.name:34s} relative cost {value['relative_cost']:.3f}  "
-              f"({1e3 * value['seconds_per_sample']:.2f} ms/sample)  "
-              f"noise k {value['noise_k']:.4f}")
+        print(f"{candidate.name:35s} relative cost {value['relative_cost']:.3f}  "
+              f"({1e3 * value['seconds_per_sample']:.2f} ms/sample)  cpu "
+              f"{value['relative_cpu']:.3f} ({1e3 * value['cpu_seconds_per_sample']:.2f} "
+              f"ms/sample)  noise k {value['noise_k']:.4f}")
+    for key in ("relative_cost", "relative_cpu"):
+        print(f"# coverage {coverage:g}, {key} in CANDIDATES order:",
+              tuple(round(v[key], 3) for v in costs.values()))
+    print(f"# coverage {coverage:g}, noise k in CANDIDATES order:",
+          tuple(round(v["noise_k"], 4) for v in costs.values()))
 
 
 def _print_traits() -> None:
@@ -301,6 +303,8 @@ def _print_traits() -> None:
     print("PAPER_MISMATCH =", round(traits.profile_mismatch, 4))
     print("PAPER_SKIN_SHARE =", {k: round(v, 4) for k, v in traits.skin_share.items()})
     print("PAPER_GLOSS_SHARE =", {k: round(v, 4) for k, v in traits.gloss_share.items()})
+    print("PAPER_GLOSS_OMISSION =", {tier: {k: round(v, 4) for k, v in by_light.items()}
+                                     for tier, by_light in traits.gloss_omission.items()})
     print(f"# mean radius {traits.mean_radius_mm:.3f} mm")
 
 

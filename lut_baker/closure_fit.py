@@ -16,6 +16,10 @@ attenuation of the layers above it; Subsurface Weight = the skin's share of it.
 (Glossy GGX, roughness fitted, weight = table albedo / closure albedo read from a 1-D image by
 ``cos(theta_o)``), film diffuse (Diffuse), the skin through the film and bare (Subsurface, colour
 ``(1 - A)^2 skin_diffuse pi T_mean T(theta_o)`` and ``skin_diffuse pi``), mixed by coverage.
+Both take the group's Gloss input ``g`` (0..1): it scales the gloss lobes (coat weight and
+specular level; the Glossy colours), and at 0 Cycles allocates none of them.  The replicas
+below take it as ``gloss``, so the Auto tier predicts a gloss-free candidate from the same
+formulas as the node group (:func:`lut_baker.scene_model.gloss_omission_error`).
 
 Errors
 ------
@@ -39,8 +43,9 @@ Functions and types
 - :class:`LobeFit`, :class:`ProfileFit`, :class:`TierError`, :class:`ClosureFit`.
 - :func:`fit_closures` -- every fit of one set of tables.
 - :func:`principled_inputs`, :func:`principled_tier_reflection` -- the PRINCIPLED tier at a
-  coverage and absorption; :func:`layered_weights`, :func:`layered_tier_reflection` -- the
-  LAYERED tier; :func:`tier_errors` -- both against the tables.
+  coverage, absorption and Gloss; :func:`layered_weights`, :func:`layered_tier_reflection` --
+  the LAYERED tier; :data:`TIER_REPLICAS` -- both by name; :func:`tier_errors` -- both
+  against the tables.
 """
 
 from __future__ import annotations
@@ -82,6 +87,7 @@ __all__ = [
     "principled_tier_reflection",
     "layered_weights",
     "layered_tier_reflection",
+    "TIER_REPLICAS",
     "tier_errors",
 ]
 
@@ -670,30 +676,37 @@ def diffuse_albedo(fit: ClosureFit, coverage: float, absorption) -> tuple[np.nda
     return skin + coverage * through * fit.film_albedo, skin
 
 
-def principled_inputs(fit: ClosureFit, coverage: float, absorption):
+def principled_inputs(fit: ClosureFit, coverage: float, absorption, gloss: float = 1.0):
     """``(PrincipledInputs, subsurface_weight)`` of the PRINCIPLED tier (the node group's math):
 
-    - Coat Weight ``w``, Coat Roughness/IOR fitted;
+    - Coat Weight ``g w``, Coat Roughness/IOR fitted;
     - Roughness ``mix(r_bare, r_film, w)``, Specular IOR Level
-      ``(1 - w) l_bare + w l_film mean((1 - A)^2)``;
-    - Base Color = (:func:`diffuse_albedo` + ``w (1 - A)^2 gloss_to_diffuse``) /
-      ``((1 - w E_coat) (1 - E_spec(w)))`` with the mean layering albedos,
+      ``g [(1 - w) l_bare + w l_film mean((1 - A)^2)]``;
+    - Base Color = (:func:`diffuse_albedo` + ``g w (1 - A)^2 gloss_to_diffuse``) /
+      ``((1 - g w E_coat) (1 - g E_spec(w)))`` with the mean layering albedos,
       ``E_spec(w) = mix(E_bare, E_film, w)``;
     - Subsurface Weight = the skin's share of the diffuse albedo (channel mean).
+
+    ``gloss`` (the group's Gloss input, 0..1) scales the gloss lobes: at 0 the coat weight
+    and the specular level are 0, so Cycles allocates neither closure (``coat_weight >
+    CLOSURE_WEIGHT_CUTOFF`` and ``eta != 1`` guard them in ``svm_node_closure_bsdf``), and the
+    base colour is the diffuse albedo alone.  Between 0 and 1 the layer attenuation is taken
+    linear in ``g`` (exact at both ends).
     """
     w = float(coverage)
+    g = float(gloss)
     through2 = float(np.mean((1.0 - _absorption(absorption)) ** 2))
     total, skin = diffuse_albedo(fit, w, absorption)
-    total = total + w * (1.0 - _absorption(absorption)) ** 2 * fit.gloss_to_diffuse
+    total = total + g * w * (1.0 - _absorption(absorption)) ** 2 * fit.gloss_to_diffuse
     e_spec = (1.0 - w) * fit.specular_albedo_mean[0] + w * fit.specular_albedo_mean[1]
-    base = total / ((1.0 - w * fit.coat_albedo_mean) * (1.0 - e_spec))
-    level = (1.0 - w) * fit.specular_bare.level + w * fit.specular_film.level * through2
+    base = total / ((1.0 - g * w * fit.coat_albedo_mean) * (1.0 - g * e_spec))
+    level = g * ((1.0 - w) * fit.specular_bare.level + w * fit.specular_film.level * through2)
     inputs = cc.PrincipledInputs(
         base_color=tuple(np.clip(base, 0.0, 1.0)),
         roughness=(1.0 - w) * fit.specular_bare.roughness + w * fit.specular_film.roughness,
         ior=SPECULAR_IOR,
         specular_ior_level=level,
-        coat_weight=w,
+        coat_weight=g * w,
         coat_roughness=fit.coat.roughness,
         coat_ior=fit.coat.ior,
     )
@@ -701,45 +714,53 @@ def principled_inputs(fit: ClosureFit, coverage: float, absorption):
     return inputs, weight
 
 
-def principled_tier_reflection(fit: ClosureFit, tables: Tables, coverage: float, absorption):
-    """The PRINCIPLED tier's BRDF at the angular nodes, ``(n, n, p, 3)``."""
-    wi, wo = node_directions(tables)
-    inputs, _ = principled_inputs(fit, coverage, absorption)
+def principled_tier_reflection(fit: ClosureFit, tables: Tables, coverage: float, absorption,
+                               gloss: float = 1.0, directions=None):
+    """The PRINCIPLED tier's BRDF, ``(..., 3)``: at the angular nodes, or at ``directions``
+    ``(wi, wo)`` (local unit vectors); ``gloss``: the group's Gloss input."""
+    wi, wo = node_directions(tables) if directions is None else directions
+    inputs, _ = principled_inputs(fit, coverage, absorption, gloss)
     return cc.principled_reflection(wi, wo, inputs)
 
 
-def layered_weights(fit: ClosureFit, coverage: float, absorption) -> dict:
+def layered_weights(fit: ClosureFit, coverage: float, absorption, gloss: float = 1.0) -> dict:
     """The LAYERED tier's constant weights (RGB) at coverage ``w`` and absorption ``A``;
     view-dependent factors come from the image rows :data:`LUT_ROWS`:
 
-    - ``film_gloss``: ``w``; ``path3_gloss``: ``w (1 - A)^2``; ``skin_gloss``: ``1 - w``
-      (each times its row);
+    - ``film_gloss``: ``g w``; ``path3_gloss``: ``g w (1 - A)^2``; ``skin_gloss``: ``g (1 - w)``
+      (each times its row; ``g`` the group's Gloss input: at 0 the Glossy colours are 0 and
+      Cycles allocates no Glossy closure, ``bsdf_alloc``'s weight cutoff);
     - ``film_diffuse``: ``w (1 - A) pi P_d,f`` (Diffuse);
     - ``skin_through``: ``w (1 - A)^2 pi P_d,s T_mean`` (times row ``T``); ``skin_bare``:
       ``(1 - w) pi P_d,s`` (Subsurface).
     """
     w = float(coverage)
+    g = float(gloss)
     through = 1.0 - _absorption(absorption)
     one = np.ones(3)
     return {
-        "film_gloss": w * one,
-        "path3_gloss": w * through**2,
-        "skin_gloss": (1.0 - w) * one,
+        "film_gloss": g * w * one,
+        "path3_gloss": g * w * through**2,
+        "skin_gloss": g * (1.0 - w) * one,
         "film_diffuse": w * through * fit.film_albedo,
         "skin_through": w * through**2 * fit.skin_albedo * fit.transmittance_mean,
         "skin_bare": (1.0 - w) * fit.skin_albedo,
     }
 
 
-def layered_tier_reflection(fit: ClosureFit, tables: Tables, coverage: float, absorption):
-    """The LAYERED tier's BRDF at the angular nodes, ``(n, n, p, 3)``: every closure added with
-    its weight and image row (linear texel interpolation, as Blender samples it)."""
-    wi, wo = node_directions(tables)
+def layered_tier_reflection(fit: ClosureFit, tables: Tables, coverage: float, absorption,
+                            gloss: float = 1.0, directions=None):
+    """The LAYERED tier's BRDF, ``(..., 3)``, at the angular nodes or at ``directions``
+    ``(wi, wo)``: every closure added with its weight and image row (linear texel
+    interpolation, as Blender samples it); ``gloss``: the group's Gloss input."""
+    wi, wo = node_directions(tables) if directions is None else directions
     cos_o = wo[..., 2]
-    weights = layered_weights(fit, coverage, absorption)
+    weights = layered_weights(fit, coverage, absorption, gloss)
     rows = dict(zip(LUT_ROWS, fit.lut, strict=True))
     value = 0.0
     for name in LUT_ROWS[:3]:
+        if not np.any(weights[name]):
+            continue  # Cycles allocates no closure of weight 0
         glossy = fit.glossy[name]
         lobe = cc.microfacet_reflection(wi, wo, glossy.roughness,
                                         distribution=glossy.distribution)[..., None]
@@ -749,14 +770,19 @@ def layered_tier_reflection(fit: ClosureFit, tables: Tables, coverage: float, ab
     return value + cc.lambert_reflection(diffuse)
 
 
-def tier_errors(fit: ClosureFit, tables: Tables, coverage: float, absorption) -> dict:
-    """:class:`TierError` of every tier against the tables at one coverage and absorption."""
+TIER_REPLICAS = {"PRINCIPLED": principled_tier_reflection, "LAYERED": layered_tier_reflection}
+"""Each tier's replica, ``(fit, tables, coverage, absorption, gloss=1, directions=None)``."""
+
+
+def tier_errors(fit: ClosureFit, tables: Tables, coverage: float, absorption,
+                gloss: float = 1.0) -> dict:
+    """:class:`TierError` of every tier against the tables at one coverage and absorption
+    (``gloss``: the group's Gloss input; at 0 the error includes all of the gloss left out)."""
     reference = tables.node_values(coverage, absorption)
     weights = angular_weights(tables)
     out = {}
-    for tier, replica in (("PRINCIPLED", principled_tier_reflection),
-                          ("LAYERED", layered_tier_reflection)):
-        f = replica(fit, tables, coverage, absorption)
+    for tier, replica in TIER_REPLICAS.items():
+        f = replica(fit, tables, coverage, absorption, gloss)
         out[tier] = TierError(tier=tier, coverage=float(coverage),
                               absorption=tuple(_absorption(absorption).tolist()),
                               rms=relative_rms(f, reference, tables, weights),

@@ -17,13 +17,15 @@ exact image)::
   argument, computed by :func:`subsurface_omission_error` (the profile's blur of a sphere's
   shading, averaged over each pixel).  A spread under half a pixel changes no pixel by much.
   With the closure, what is left is the closure's profile mismatch times that;
-- ``e_gloss``: without gloss lobes, the gloss's share of the image
-  (:func:`gloss_and_skin_shares`);
+- ``e_gloss``: without gloss lobes (the group's Gloss input at 0), the change of a sphere's
+  image under the scene's lights, from the tier's own replica with and without them
+  (:func:`gloss_omission_error`; without a closure fit, the tables' gloss share of
+  :func:`gloss_and_skin_shares`);
 - ``noise``: the Monte Carlo noise of one render, ``k / sqrt(samples)`` with ``k`` measured
   per candidate and coverage (:data:`NOISE_K`); 0 with a denoiser (its bias is not
   modelled) and in EEVEE.
 
-So a film gloss below the noise of the fullest tier costs nothing to leave out, a subsurface
+So a gloss below the noise of the fullest tier costs little to leave out, a subsurface
 radius under half a pixel leaves ``e_subsurface`` near 0, and EEVEE admits only the tiers that
 run there (:data:`ENGINE_TIERS`).  :func:`choose` takes the cheapest candidate (costs:
 :data:`RELATIVE_COST`, measured at coverage 1 and 0 and interpolated by the material's share
@@ -39,6 +41,8 @@ Functions and types
 - :func:`profile_mean_radius_mm` -- the mean distance light travels under the skin.
 - :func:`gloss_and_skin_shares` -- shares of the gloss and of the spreading skin light in a
   sphere's image.
+- :func:`gloss_omission_error`, :func:`gloss_omissions` -- what the tiers' Gloss input at 0
+  changes in a sphere's image (their replicas in :mod:`lut_baker.closure_fit`).
 - :func:`profile_mismatch` -- how far a fitted closure's edge response is from the tables'.
 - :func:`blur_kernel`, :func:`subsurface_omission_error` -- the pixel-footprint blur argument.
 - :func:`relative_cost`, :func:`noise`, :func:`predict`, :class:`Prediction`,
@@ -48,7 +52,7 @@ Functions and types
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import lru_cache
 
 import numpy as np
@@ -77,6 +81,9 @@ __all__ = [
     "traits_from_tables",
     "profile_mean_radius_mm",
     "gloss_and_skin_shares",
+    "gloss_omission_error",
+    "gloss_omissions",
+    "PAPER_GLOSS_OMISSION",
     "profile_mismatch",
     "blur_kernel",
     "subsurface_omission_error",
@@ -100,8 +107,8 @@ class Candidate:
     """One way to shade made-up skin: an add-on ``tier`` (``PRINCIPLED`` or ``LAYERED``) with
     or without its subsurface closure and its gloss lobes.  The add-on realises
     ``subsurface=False`` with Subsurface Scale 0 (Cycles then turns subsurface closures into
-    diffuse ones); it builds no gloss-free group, so ``gloss=False`` candidates are modelled
-    (and measured, bench/stability_sweep.py) but not :attr:`realisable`."""
+    diffuse ones) and ``gloss=False`` with the group's Gloss input at 0 (Cycles then
+    allocates no Glossy closure, coat or specular: their weights are 0)."""
 
     tier: str
     subsurface: bool = True
@@ -115,11 +122,6 @@ class Candidate:
         if not self.gloss:
             parts.append("no gloss")
         return ", ".join(parts)
-
-    @property
-    def realisable(self) -> bool:
-        """Whether the add-on can build it (every gloss lobe kept)."""
-        return self.gloss
 
 
 CANDIDATES = tuple(Candidate(tier, subsurface, gloss) for tier in ("LAYERED", "PRINCIPLED")
@@ -139,35 +141,42 @@ COST_COMMAND = ("python bench/stability_sweep.py --costs --repeats 3 --size 96 "
                 "--samples 16 272")
 _ORDER = CANDIDATES  # the tables below list CANDIDATES in this order
 RELATIVE_COST = {
-    1.0: dict(zip(_ORDER, (1.000, 0.875, 0.843, 0.711, 0.823, 0.615, 0.723, 0.509),
+    1.0: dict(zip(_ORDER, (1.000, 0.889, 0.868, 0.695, 0.793, 0.595, 0.761, 0.522),
                   strict=True)),
-    0.0: dict(zip(_ORDER, (1.000, 0.657, 0.716, 0.499, 0.904, 0.534, 0.726, 0.452),
+    0.0: dict(zip(_ORDER, (1.000, 0.652, 0.728, 0.522, 0.914, 0.554, 0.772, 0.505),
                   strict=True)),
 }
 """Render time per sample relative to :data:`FULLEST`, by coverage (1: the paper's film, 0:
 bare skin), then by candidate: Cycles CPU on 2 threads, 96 px sphere of 30 mm, paper preset,
 sun at 45 degrees, the slope between 16 and 272 samples, the fastest of 3 interleaved runs,
-measured by :data:`COST_COMMAND` on bpy 5.0.1 at a load of ~1.5 (the fullest: 15-16 ms per
-sample).  Two other runs at coverage 1 gave 0.94 and 0.97 for ``LAYERED, no subsurface``:
-differences under ~10% are not resolved.  Under the film the subsurface closure carries
-little weight (Cycles rarely samples it), so leaving it out saves little time there but all
-of its noise (:data:`NOISE_K`); on bare skin it saves a third.  Adaptive sampling is off in
-these measurements (every pixel takes every sample); with Blender's default (adaptive, noise
-threshold 0.01) a first run gave 0.61 for ``LAYERED, no subsurface`` on the film: noise-free
-candidates stop sooner, so the savings are then larger than modelled.  EEVEE uses the same
-order (its render time here is shader compilation on software OpenGL: 9-96 s a render, not a
-cost)."""
+measured by :data:`COST_COMMAND` on bpy 5.0.1; gloss-free candidates with the group's Gloss
+input at 0, as Fit to Scene sets it.  Each value is the median of three runs of the command
+(the runs whose fullest candidate took within 15% of the quietest run's time per sample, 15.3
+ms on the film and 16.0 ms on bare skin; runs beside another process's load were left out):
+the runs spread by up to 0.15 (``PRINCIPLED`` 0.73-0.88 on the film), so differences under
+~10% are not resolved.  Under the film the subsurface closure carries little weight (Cycles
+rarely samples it), so leaving it out saves little time there but all of its noise
+(:data:`NOISE_K`); on bare skin it saves a third.  Gloss 0 with the subsurface kept saves
+0.03 (``PRINCIPLED`` on the film, whose specular is already off) to 0.27 (``LAYERED`` on bare
+skin) of the fullest's time; with both left out a candidate costs 0.5-0.7 of it.  Adaptive
+sampling is off in these measurements (every pixel takes every sample); with Blender's default
+(adaptive, noise threshold 0.01) a first run gave 0.61 for ``LAYERED, no subsurface`` on the
+film: noise-free candidates stop sooner, so the savings are then larger than modelled.  EEVEE
+uses the same order (its render time here is shader compilation on software OpenGL: 9-96 s a
+render, not a cost)."""
 NOISE_K = {
-    1.0: dict(zip(_ORDER, (0.2474, 0.0006, 0.2595, 0.0007, 0.2414, 0.0006, 0.2580, 0.0007),
+    1.0: dict(zip(_ORDER, (0.2474, 0.0006, 0.2595, 0.0007, 0.2413, 0.0006, 0.2594, 0.0007),
                   strict=True)),
     0.0: dict(zip(_ORDER, (0.1698, 0.0007, 0.0363, 0.0007, 0.1777, 0.0007, 0.0363, 0.0007),
                   strict=True)),
 }
 """Noise coefficient ``k`` by coverage and candidate: one render's relative RMS deviation from
-the converged image is ``k / sqrt(samples)`` (same command, two seeds at 272 samples).  The
-subsurface closure is the noisy part (1.5% at 272 samples, 3.1% at 64); a sun of angle 0 adds
-almost none.  Area lights and environments add noise to every candidate alike, so these
-understate the noise there and the choice leans towards the fullest tier."""
+the converged image is ``k / sqrt(samples)`` (same command, two seeds at 272 samples; the
+same in every run: the seeds fix the images).  The subsurface closure is the noisy part (1.5%
+at 272 samples, 3.1% at 64); on bare skin the skin's gloss lobe makes most of it (0.170 with
+the lobe, 0.036 without); a sun of angle 0 adds almost none.  Area lights and environments
+add noise to every candidate alike, so these understate the noise there and the choice leans
+towards the fullest tier."""
 COST_SKIN_SHARE = {1.0: 0.1327, 0.0: 0.9591}
 """The paper preset's skin share (:func:`gloss_and_skin_shares`, light 45 degrees) at the
 coverages the costs were measured at: a material's costs are interpolated by its share."""
@@ -261,7 +270,10 @@ class MaterialTraits:
     on distances (mm), the tables' ``radius_mm`` and ``profile``; ``profile_mismatch``: the
     fitted closure's relative edge-response error (:func:`profile_mismatch`);
     ``skin_share``, ``gloss_share``: per light angle (degrees), the share of the image that
-    spreads under the skin and that the gloss lobes make (:func:`gloss_and_skin_shares`).
+    spreads under the skin and that the gloss lobes make (:func:`gloss_and_skin_shares`);
+    ``subsurface_scale``, ``gloss_scale``: the artist's Subsurface Scale and Gloss (the
+    group's inputs); ``gloss_omission``: per tier, per light angle, what Gloss 0 changes in
+    a sphere's image (:func:`gloss_omissions`; None: ``gloss_share`` stands in for it).
     """
 
     tier_errors: dict
@@ -271,24 +283,39 @@ class MaterialTraits:
     skin_share: dict
     gloss_share: dict
     subsurface_scale: float = 1.0
+    gloss_omission: dict | None = None
+    gloss_scale: float = 1.0
 
     def share(self, name: str, light_deg: float) -> float:
         """``skin_share`` or ``gloss_share`` at a light angle (linear between the stored
         angles, held beyond them)."""
-        table = getattr(self, name)
-        angles = sorted(table)
-        return float(np.interp(light_deg, angles, [table[a] for a in angles]))
+        return _at_angle(getattr(self, name), light_deg)
 
-    def scaled(self, subsurface_scale: float) -> MaterialTraits:
-        """The same material with the artist's Subsurface Scale (distances multiplied)."""
-        return MaterialTraits(self.tier_errors, self.radius_mm, self.profile,
-                              self.profile_mismatch, self.skin_share, self.gloss_share,
-                              float(subsurface_scale))
+    def gloss_error(self, tier: str, light_deg: float) -> float:
+        """What leaving out the gloss lobes changes in a sphere's image lit ``light_deg`` from
+        the view: ``gloss_omission`` of ``tier`` if known, else ``gloss_share``."""
+        if self.gloss_omission and tier in self.gloss_omission:
+            return _at_angle(self.gloss_omission[tier], light_deg)
+        return self.share("gloss_share", light_deg)
+
+    def scaled(self, subsurface_scale: float, gloss_scale: float | None = None
+               ) -> MaterialTraits:
+        """The same material with the artist's Subsurface Scale (distances multiplied) and
+        Gloss (default: unchanged)."""
+        return replace(self, subsurface_scale=float(subsurface_scale),
+                       gloss_scale=self.gloss_scale if gloss_scale is None
+                       else float(gloss_scale))
 
     @property
     def mean_radius_mm(self) -> float:
         """:func:`profile_mean_radius_mm` with the Subsurface Scale applied."""
         return self.subsurface_scale * profile_mean_radius_mm(self.radius_mm, self.profile)
+
+
+def _at_angle(table: dict, light_deg: float) -> float:
+    """A per-light-angle table at ``light_deg`` (linear between its angles, held beyond)."""
+    angles = sorted(table)
+    return float(np.interp(light_deg, angles, [table[a] for a in angles]))
 
 
 def _trapezoid(y: np.ndarray, x: np.ndarray) -> np.ndarray:
@@ -355,6 +382,38 @@ def gloss_and_skin_shares(tables, light_deg: float, coverage=None, absorption=No
     return float(np.sqrt(np.mean(gloss**2)) / norm), float(np.sqrt(np.mean(skin**2)) / norm)
 
 
+def gloss_omission_error(tables, fit, tier: str, light_deg: float, coverage=None,
+                         absorption=None, *, resolution: int = 48) -> float:
+    """Relative RMS change of a sphere's image (orthographic, one distant light ``light_deg``
+    from the view, the lit pixels) when ``tier``'s Gloss input goes from 1 to 0: the tier's
+    replica (:data:`lut_baker.closure_fit.TIER_REPLICAS` with the closure fit ``fit``) with
+    and without its gloss lobes, over the RMS of the tables' radiance ``f cos(theta_i)``, at
+    the coverage and absorption (default: the tables')."""
+    from .closure_fit import TIER_REPLICAS
+
+    wi, wo = _sphere_directions(resolution, light_deg)
+    w, a = tables._mix(coverage, absorption)
+    cos_i = wi[:, 2:3]
+    norm = np.sqrt(np.mean((tables.made_up_reflection(wi, wo, w, a) * cos_i) ** 2))
+    if not norm > 0:
+        return 0.0
+    replica = TIER_REPLICAS[tier]
+    kept, left_out = (replica(fit, tables, w, a, gloss, (wi, wo)) for gloss in (1.0, 0.0))
+    return float(np.sqrt(np.mean(((kept - left_out) * cos_i) ** 2)) / norm)
+
+
+def gloss_omissions(tables, fit, coverage=None, absorption=None, *,
+                    lights_deg=None) -> dict:
+    """:func:`gloss_omission_error` of every tier at ``lights_deg`` (default
+    :data:`SHARE_LIGHTS_DEG`): ``{tier: {light angle: error}}``."""
+    from .closure_fit import TIERS
+
+    lights = SHARE_LIGHTS_DEG if lights_deg is None else lights_deg
+    return {tier: {float(light): gloss_omission_error(tables, fit, tier, light, coverage,
+                                                      absorption)
+                   for light in lights} for tier in TIERS}
+
+
 def profile_mismatch(tables, fit_error) -> float:
     """Relative error of a fitted subsurface closure's blur: ``fit_error`` (per channel, the
     RMS difference of its edge response and the tables', a fraction of the lit level:
@@ -393,14 +452,17 @@ def traits_from_tables(tables, fit, coverage=None, absorption=None, *,
             tables, fit.profiles[method or fit.subsurface_method].error),
         skin_share={angle: value[1] for angle, value in shares.items()},
         gloss_share={angle: value[0] for angle, value in shares.items()},
+        gloss_omission=gloss_omissions(tables, fit, w, a, lights_deg=lights_deg),
     )
 
 
 TRAITS_COMMAND = "python bench/stability_sweep.py --traits"
-PAPER_TIER_ERRORS = {"PRINCIPLED": 0.0778, "LAYERED": 0.0524}
+PAPER_TIER_ERRORS = {"PRINCIPLED": 0.0758, "LAYERED": 0.0524}
 PAPER_MISMATCH = 0.0474
 PAPER_SKIN_SHARE = {0.0: 0.1361, 45.0: 0.1327, 75.0: 0.1233, 89.0: 0.1141}
 PAPER_GLOSS_SHARE = {0.0: 0.1825, 45.0: 0.1904, 75.0: 0.2274, 89.0: 0.2758}
+PAPER_GLOSS_OMISSION = {"PRINCIPLED": {0.0: 0.1586, 45.0: 0.1858, 75.0: 0.2511, 89.0: 0.3051},
+                        "LAYERED": {0.0: 0.1746, 45.0: 0.1914, 75.0: 0.2564, 89.0: 0.3167}}
 """The paper preset's traits (foundation paper_natural on paper_bioplate, coverage 1,
 absorption 0, default bake, closure fit with Burley) as :data:`TRAITS_COMMAND` prints them:
 what the Auto tier assumes of a material it has no tables for yet."""
@@ -421,7 +483,9 @@ def _paper_traits() -> MaterialTraits:
     profile = profile / np.atleast_1d(dipole_total_reflectance(dipole)) * np.ones(3)
     return MaterialTraits(tier_errors=dict(PAPER_TIER_ERRORS), radius_mm=radius,
                           profile=profile, profile_mismatch=PAPER_MISMATCH,
-                          skin_share=dict(PAPER_SKIN_SHARE), gloss_share=dict(PAPER_GLOSS_SHARE))
+                          skin_share=dict(PAPER_SKIN_SHARE), gloss_share=dict(PAPER_GLOSS_SHARE),
+                          gloss_omission={tier: dict(by_light) for tier, by_light
+                                          in PAPER_GLOSS_OMISSION.items()})
 
 
 @lru_cache(maxsize=1)
@@ -563,8 +627,10 @@ def predict(candidate: Candidate, scene: SceneDescription, traits: MaterialTrait
     elif omission is None:
         omission = _omission(scene, traits)
     subsurface = omission * (min(traits.profile_mismatch, 1.0) if candidate.subsurface else 1.0)
-    gloss = 0.0 if candidate.gloss else max(traits.share("gloss_share", light)
-                                            for light in scene.lights_deg)
+    # Gloss kept: only what the artist's Gloss under 1 already leaves out.
+    kept = traits.gloss_scale if candidate.gloss else 0.0
+    gloss = (1.0 - min(max(kept, 0.0), 1.0)) * max(
+        traits.gloss_error(candidate.tier, light) for light in scene.lights_deg)
     share = _skin_share(scene, traits)
     grain = noise(candidate, scene.samples, engine=scene.engine, denoise=scene.denoise,
                   skin_share=share)
@@ -611,18 +677,19 @@ def needs_subsurface(scene: SceneDescription, traits: MaterialTraits) -> bool:
 def choose(scene: SceneDescription, traits: MaterialTraits | None = None, *,
            tolerance: float = DEFAULT_TOLERANCE, candidates=None) -> Choice:
     """The cheapest candidate whose predicted error is within ``tolerance`` of the best one's,
-    among ``candidates`` (default: the add-on's realisable ones) that run in the scene's
-    engine, keep the subsurface closure if :func:`needs_subsurface` (and drop it when the
-    Subsurface Scale is 0: Cycles then shades no spread anyway).  ``traits`` default to the
-    paper preset's (:func:`paper_traits`)."""
+    among ``candidates`` (default: :data:`CANDIDATES`) that run in the scene's engine, keep
+    the subsurface closure if :func:`needs_subsurface` (and drop it when the Subsurface
+    Scale is 0: Cycles then shades no spread anyway; likewise the gloss lobes when the
+    artist's Gloss is 0).  ``traits`` default to the paper preset's (:func:`paper_traits`)."""
     if not tolerance >= 0:
         raise ValueError(f"tolerance must be >= 0, got {tolerance}")
     traits = paper_traits() if traits is None else traits
     needed = needs_subsurface(scene, traits)
-    pool = [c for c in (candidates or [c for c in CANDIDATES if c.realisable])
+    pool = [c for c in (candidates or CANDIDATES)
             if c.tier in ENGINE_TIERS[scene.engine]
             and not (needed and not c.subsurface)
-            and not (traits.subsurface_scale <= 0.0 and c.subsurface)]
+            and not (traits.subsurface_scale <= 0.0 and c.subsurface)
+            and not (traits.gloss_scale <= 0.0 and c.gloss)]
     if not pool:
         raise ValueError(f"no candidate runs in {scene.engine} with what the scene needs")
     omission = 0.0 if traits.subsurface_scale <= 0.0 else _omission(scene, traits)
@@ -633,12 +700,16 @@ def choose(scene: SceneDescription, traits: MaterialTraits | None = None, *,
     radius = traits.mean_radius_mm
     grain = noise(FULLEST, scene.samples, engine=scene.engine, denoise=scene.denoise,
                   skin_share=_skin_share(scene, traits))
+    tier = chosen.candidate.tier
+    gloss = max(traits.gloss_error(tier, light) for light in scene.lights_deg)
     reasons = (
         f"object {scene.object_pixels:.0f} px across at {scene.footprint_mm:.3g} mm per px",
         f"subsurface mean radius {radius:.3g} mm = {radius / scene.footprint_mm:.2g} px: "
         + ("needed (half a pixel or more)" if needed else
            f"not needed (under half a pixel; leaving it out errs {100 * omission:.2f}%)"),
-        f"noise of the fullest tier at {scene.samples} samples: {100 * grain:.1f}%",
+        f"gloss lobes {100 * gloss:.1f}% of the image ({tier.title()}), noise of the fullest "
+        f"tier at {scene.samples} samples {100 * grain:.1f}%: "
+        + ("kept" if chosen.candidate.gloss else "left out (Gloss 0)"),
         f"{chosen.candidate.name}: predicted error {100 * chosen.error:.1f}% (best "
         f"{100 * best:.1f}% + tolerance {100 * tolerance:.0f}%), cost {chosen.cost:.2f} of "
         f"the fullest tier's",

@@ -45,7 +45,10 @@ GROUP_NODE = "Made-up Skin"
 """Name of the group node in a made-up material's node tree."""
 MATERIAL_NAME = "Made-up Skin"
 ERRORS_KEY = "makeup_skin_errors"
-"""Material custom property: the tiers' errors at the settings of the last Apply (JSON)."""
+"""Material custom property: the tiers' errors at the settings of the last Apply (JSON): per
+tier its angular ``rms`` and ``albedo`` errors, ``gloss_omission`` (per light angle, what
+Gloss 0 changes in a sphere's image, :func:`lut_baker.scene_model.gloss_omissions`), the
+``coverage``, ``absorption`` and tables ``key`` they were measured for."""
 
 
 def skin_from_settings(settings):
@@ -119,6 +122,8 @@ def _group_matches(group, key: str, tier: str, method) -> bool:
     except ValueError:
         return False
     if (meta.get("key"), meta.get("tier"), meta.get("forced_method")) != (key, tier, method):
+        return False
+    if not nodes.has_interface(group):  # built before a socket existed (Gloss): rebuild
         return False
     if tier == "LAYERED":
         return bpy.data.images.get(storage.lut_image_name(key)) is not None
@@ -277,9 +282,14 @@ def apply_to_object(context, obj, *, settings=None, resolution=None) -> tuple:
             progress=progress, messages=messages, errors_at=(settings.coverage, absorption),
             method=forced_method(settings))
     if fit is not None:
+        omission = lut_baker("scene_model").gloss_omissions(tables, fit, settings.coverage,
+                                                            absorption)
+        key = storage.tables_key(tables)
         material[ERRORS_KEY] = json.dumps({name: {"rms": e.rms, "albedo": e.albedo,
                                                   "coverage": e.coverage,
-                                                  "absorption": list(e.absorption)}
+                                                  "absorption": list(e.absorption),
+                                                  "gloss_omission": omission[name],
+                                                  "key": key}
                                            for name, e in fit.errors.items()})
     setup_material(material, group, scene)
     return material, messages

@@ -5,14 +5,18 @@ Both tiers share one interface, so a material keeps its links when the tier chan
 - inputs: ``Coverage`` (0..1, paintable with a texture), ``Foundation Absorption`` (colour:
   the fraction of light the film's pigment absorbs per channel), ``Skin Tint`` (multiplies the
   skin's diffuse albedo), ``Subsurface Scale`` (artist multiplier of the fitted radius),
-  ``Units per mm`` (scene units in one millimetre; the add-on sets it from the scene's unit
-  scale);
+  ``Gloss`` (0..1, multiplies the gloss lobes: at 0 Cycles allocates none of them, which the
+  Auto tier uses when the gloss is below the noise), ``Units per mm`` (scene units in one
+  millimetre; the add-on sets it from the scene's unit scale);
 - output: ``Shader``.
 
 PRINCIPLED: one Principled BSDF (GGX, coat = the film, specular and base/subsurface = the skin)
-whose inputs follow :func:`lut_baker.closure_fit.principled_inputs` in math nodes.
+whose inputs follow :func:`lut_baker.closure_fit.principled_inputs` in math nodes (Gloss
+scales Coat Weight and Specular IOR Level: at 0 ``svm_node_closure_bsdf`` skips the coat,
+``coat_weight > CLOSURE_WEIGHT_CUTOFF``, and the specular, ``eta != 1``).
 LAYERED: Glossy, Diffuse and Subsurface closures weighted as
-:func:`lut_baker.closure_fit.layered_weights`, view-dependent factors read from one float image
+:func:`lut_baker.closure_fit.layered_weights` (Gloss scales the three Glossy colours: a closure
+of weight 0 is never allocated, ``bsdf_alloc``), view-dependent factors read from one float image
 (rows :data:`lut_baker.closure_fit.LUT_ROWS`) at ``u = cos(theta_o)``, and a Mix Shader by
 Coverage between bare skin and made-up skin: an areal mix of closures, so a painted coverage
 fades out without fringe or halo.
@@ -33,7 +37,7 @@ from . import storage
 from .package import lut_baker
 
 __all__ = ["INPUTS", "GROUP_PREFIX", "FIT_KEY", "TABLES_REF", "group_name", "build_group",
-           "set_inputs", "socket"]
+           "set_inputs", "socket", "has_interface"]
 
 GROUP_PREFIX = "Made-up Skin"
 FIT_KEY = "makeup_skin_fit"
@@ -51,6 +55,10 @@ INPUTS = (
      "Multiplies the skin's diffuse albedo"),
     ("Subsurface Scale", "NodeSocketFloat", 1.0, 0.0, 100.0, "NONE",
      "Multiplies the subsurface radius fitted to the skin's profile"),
+    ("Gloss", "NodeSocketFloat", 1.0, 0.0, 1.0, "FACTOR",
+     "Multiplies the gloss lobes (film, skin through the film, bare skin): 0 leaves them out "
+     "and Cycles then allocates none (cheaper; Fit to Scene does it when the gloss is below "
+     "the noise)"),
     ("Units per mm", "NodeSocketFloat", 0.001, 0.0, 1e6, "NONE",
      "Scene units in one millimetre (set from the scene's unit scale on Apply)"),
 )
@@ -139,10 +147,11 @@ class _Builder:
 
 
 def _interface(group) -> None:
-    """Create the group's sockets if missing (existing ones keep their links and values)."""
+    """Create the group's sockets if missing (existing ones keep their links and values); a
+    socket added to a group built before it existed is moved to its place in :data:`INPUTS`."""
     existing = {item.name for item in group.interface.items_tree
                 if getattr(item, "item_type", "SOCKET") == "SOCKET"}
-    for name, kind, default, low, high, subtype, description in INPUTS:
+    for position, (name, kind, default, low, high, subtype, description) in enumerate(INPUTS):
         if name in existing:
             continue
         item = group.interface.new_socket(name=name, in_out="INPUT", socket_type=kind)
@@ -152,8 +161,22 @@ def _interface(group) -> None:
             item.min_value, item.max_value = low, high
         if subtype and hasattr(item, "subtype"):
             item.subtype = subtype
+        if existing and position:  # after its predecessor (outputs may come first)
+            items = list(group.interface.items_tree)
+            before = next(i for i, other in enumerate(items)
+                          if other.name == INPUTS[position - 1][0])
+            group.interface.move(item, before + 1)
     if "Shader" not in existing:
         group.interface.new_socket(name="Shader", in_out="OUTPUT", socket_type="NodeSocketShader")
+
+
+def has_interface(group) -> bool:
+    """Whether ``group`` has every input of :data:`INPUTS` (a group built by an older version
+    of the add-on may lack one, e.g. Gloss, and is then rebuilt)."""
+    names = {item.name for item in group.interface.items_tree
+             if getattr(item, "item_type", "SOCKET") == "SOCKET"
+             and getattr(item, "in_out", "INPUT") == "INPUT"}
+    return all(name in names for name, *_ in INPUTS)
 
 
 def _common(build: _Builder, fit):
@@ -168,38 +191,42 @@ def _common(build: _Builder, fit):
                         label="skin albedo")
     scale = build.math("MULTIPLY", inputs.outputs["Subsurface Scale"],
                        inputs.outputs["Units per mm"], label="subsurface scale")
-    return inputs, output, w, through, through2, skin, scale
+    return inputs, output, w, through, through2, skin, scale, inputs.outputs["Gloss"]
 
 
 def _build_principled(build: _Builder, fit, method: str, radius_mm, ior: float):
     cf = lut_baker("closure_fit")
-    inputs, output, w, through, through2, skin, scale = _common(build, fit)
+    inputs, output, w, through, through2, skin, scale, gloss = _common(build, fit)
+    coat_weight = build.math("MULTIPLY", w, gloss, label="coat weight")
     made_skin = build.vector("MULTIPLY", build.vector("MULTIPLY", through2, skin),
                              tuple(fit.transmittance_mean**2), label="skin through film")
     made_total = build.vector("ADD", build.vector("MULTIPLY", through, tuple(fit.film_albedo)),
-                              build.vector("ADD", made_skin, build.vector(
-                                  "MULTIPLY", through2, tuple(fit.gloss_to_diffuse))))
+                              build.vector("ADD", made_skin, build.scale(build.vector(
+                                  "MULTIPLY", through2, tuple(fit.gloss_to_diffuse)), gloss)))
     total = build.mix_vector(w, skin, made_total, label="diffuse albedo")
     skin_part = build.mix_vector(w, skin, made_skin, label="skin part")
     e_spec = build.mix_float(w, fit.specular_albedo_mean[0], fit.specular_albedo_mean[1])
     attenuation = build.math("MULTIPLY",
-                             build.math("SUBTRACT", 1.0, build.math("MULTIPLY", w,
+                             build.math("SUBTRACT", 1.0, build.math("MULTIPLY", coat_weight,
                                                                      fit.coat_albedo_mean)),
-                             build.math("SUBTRACT", 1.0, e_spec), label="layer attenuation")
+                             build.math("SUBTRACT", 1.0, build.math("MULTIPLY", e_spec, gloss)),
+                             label="layer attenuation")
     base = build.scale(total, build.math("DIVIDE", 1.0, attenuation), label="base colour")
     share = build.vector("DOT_PRODUCT", build.vector("DIVIDE", skin_part, total),
                          (1 / 3, 1 / 3, 1 / 3), label="subsurface weight")
     mean_through2 = build.vector("DOT_PRODUCT", through2, (1 / 3, 1 / 3, 1 / 3))
-    level = build.mix_float(w, fit.specular_bare.level,
-                            build.math("MULTIPLY", mean_through2, fit.specular_film.level),
-                            label="specular level")
+    level = build.math("MULTIPLY", build.mix_float(
+        w, fit.specular_bare.level, build.math("MULTIPLY", mean_through2,
+                                               fit.specular_film.level)), gloss,
+        label="specular level")
     roughness = build.mix_float(w, fit.specular_bare.roughness, fit.specular_film.roughness)
 
     bsdf = build.node("ShaderNodeBsdfPrincipled", "Made-up skin", distribution="GGX",
                       subsurface_method=method)
     values = {
         "Base Color": base, "Roughness": roughness, "IOR": cf.SPECULAR_IOR,
-        "Specular IOR Level": level, "Coat Weight": w, "Coat Roughness": fit.coat.roughness,
+        "Specular IOR Level": level, "Coat Weight": coat_weight,
+        "Coat Roughness": fit.coat.roughness,
         "Coat IOR": fit.coat.ior, "Subsurface Weight": share,
         "Subsurface Radius": tuple(map(float, radius_mm)), "Subsurface Scale": scale,
         "Subsurface IOR": ior,
@@ -212,7 +239,7 @@ def _build_principled(build: _Builder, fit, method: str, radius_mm, ior: float):
 
 def _build_layered(build: _Builder, fit, lut, method: str, radius_mm, ior: float):
     cf = lut_baker("closure_fit")
-    inputs, output, w, through, through2, skin, scale = _common(build, fit)
+    inputs, output, w, through, through2, skin, scale, gloss = _common(build, fit)
     geometry = build.node("ShaderNodeNewGeometry")
     cos_o = build.math("MAXIMUM", build.vector("DOT_PRODUCT", geometry.outputs["Incoming"],
                                                geometry.outputs["Normal"]), 0.0,
@@ -231,7 +258,8 @@ def _build_layered(build: _Builder, fit, lut, method: str, radius_mm, ior: float
         lobe = fit.glossy[name]
         node = build.node("ShaderNodeBsdfGlossy", name.replace("_", " "),
                           distribution=lobe.distribution)
-        build.feed(node.inputs["Color"], colour)
+        # Gloss 0: colour 0, a closure Cycles does not allocate (bsdf_alloc's weight cutoff).
+        build.feed(node.inputs["Color"], build.scale(colour, gloss, label=f"{name} x Gloss"))
         build.feed(node.inputs["Roughness"], lobe.roughness)
         return node.outputs[0]
 

@@ -97,8 +97,9 @@ class MAKEUPSKIN_OT_add_preset(AddPresetBase, bpy.types.Operator):
     preset_values = [
         "settings.foundation", "settings.skin", "settings.coverage", "settings.absorption_mode",
         "settings.absorption", "settings.foundation_colour", "settings.skin_tint",
-        "settings.subsurface_scale", "settings.subsurface_method", "settings.override_film",
-        "settings.film_lobe_width", "settings.film_ior", "settings.tier", "settings.resolution",
+        "settings.subsurface_scale", "settings.gloss", "settings.subsurface_method",
+        "settings.override_film", "settings.film_lobe_width", "settings.film_ior",
+        "settings.tier", "settings.resolution",
     ]
 
 

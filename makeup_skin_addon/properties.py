@@ -1,7 +1,7 @@
 """The panel's settings: one :class:`MakeupSkinSettings` per material (``material.makeup_skin``).
 
-Coverage, absorption, skin tint and subsurface scale are socket values of the material's group
-node: moving them updates the material at once.  Foundation and skin presets, film overrides,
+Coverage, absorption, skin tint, subsurface scale and gloss are socket values of the material's
+group node: moving them updates the material at once.  Foundation and skin presets, film overrides,
 tier and resolution change the tables: with live update on, moving them schedules a preview
 re-bake (:mod:`.live`); Apply bakes at full resolution.
 """
@@ -17,7 +17,9 @@ from .package import lut_baker
 __all__ = ["MakeupSkinSettings", "register", "unregister", "TIER_ITEMS", "socket_values"]
 
 TIER_ITEMS = (
-    ("AUTO", "Auto", "Layered for Cycles, Principled otherwise (issue 5 makes this scene-aware)"),
+    ("AUTO", "Auto", "The cheapest tier within 2% of the best one's error in this scene (camera, "
+                     "resolution, object size, lights, engine, samples); Fit to Scene also "
+                     "drops the subsurface and gloss the scene does not need"),
     ("PRINCIPLED", "Principled", "One Principled BSDF: coat = film, subsurface = skin; cheapest, "
                                  "no images"),
     ("LAYERED", "Layered", "Glossy, Diffuse and Subsurface closures with view-angle weights "
@@ -68,6 +70,7 @@ def socket_values(settings) -> dict:
         "Foundation Absorption": tuple(settings.effective_absorption()),
         "Skin Tint": tuple(settings.skin_tint),
         "Subsurface Scale": settings.subsurface_scale,
+        "Gloss": settings.gloss,
     }
 
 
@@ -130,6 +133,12 @@ class MakeupSkinSettings(bpy.types.PropertyGroup):
         name="Subsurface Scale", default=1.0, min=0.0, soft_max=4.0, max=100.0,
         description="Multiplies the subsurface radius fitted to the skin's measured profile "
                     "(1 = as measured, in millimetres converted by the scene's unit scale)",
+        update=_update_sockets)
+    gloss: bpy.props.FloatProperty(
+        name="Gloss", default=1.0, min=0.0, max=1.0, subtype="FACTOR",
+        description="Multiplies the gloss lobes (film, skin through the film, bare skin): 1 = "
+                    "as measured, 0 leaves them out and Cycles allocates none (cheaper; Fit "
+                    "to Scene sets 0 when the gloss is below the noise)",
         update=_update_sockets)
     override_film: bpy.props.BoolProperty(
         name="Override Film", default=False,

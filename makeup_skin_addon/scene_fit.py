@@ -13,9 +13,10 @@ the tolerance.
 - :func:`material_traits` -- the material as the model sees it (cached per tables).
 - :func:`choose_for` -- the choice for a material in a scene.
 - :class:`MAKEUPSKIN_OT_fit_to_scene` (``makeup_skin.fit_to_scene``) -- choose, report the
-  choice and the predicted error, and apply it: the tier, and Subsurface Scale 0 when the
-  scene does not resolve the subsurface (the value before is kept and given back when a later
-  fit needs it).
+  choice and the predicted error, and apply it: the tier, Subsurface Scale 0 when the scene
+  does not resolve the subsurface, Gloss 0 when the gloss lobes change the image by less
+  than the tolerance allows (below the noise); the values before are kept and given back
+  when a later fit needs them.
 - :func:`draw_fit` -- the panels' button and the last choice (appended to both panels).
 """
 
@@ -29,7 +30,8 @@ import bpy
 
 from .package import lut_baker
 
-__all__ = ["CHOICE_KEY", "SAVED_SCALE_KEY", "ENVIRONMENT_LIGHT_DEG", "auto_tier",
+__all__ = ["CHOICE_KEY", "SAVED_SCALE_KEY", "SAVED_GLOSS_KEY", "ENVIRONMENT_LIGHT_DEG",
+           "auto_tier",
            "describe_scene", "material_traits", "choose_for", "MAKEUPSKIN_OT_fit_to_scene",
            "draw_fit", "register", "unregister"]
 
@@ -37,6 +39,8 @@ CHOICE_KEY = "makeup_skin_scene_fit"
 """Material custom property: the last Fit to Scene choice (JSON), shown in the panel."""
 SAVED_SCALE_KEY = "makeup_skin_saved_subsurface_scale"
 """Material custom property: the Subsurface Scale before Fit to Scene set it to 0."""
+SAVED_GLOSS_KEY = "makeup_skin_saved_gloss"
+"""Material custom property: the Gloss before Fit to Scene set it to 0."""
 ENVIRONMENT_LIGHT_DEG = 45.0
 """Light angle (degrees from the view) assumed when the scene has no lamp (world light)."""
 UNKNOWN_SCENE = {"object_size_mm": 100.0, "footprint_mm": 0.01}
@@ -140,21 +144,30 @@ _TRAITS: OrderedDict = OrderedDict()
 TRAITS_CACHE_SIZE = 16
 
 
-def _stored_errors(material, coverage, absorption):
-    """Tier errors (rms) of the last Apply if measured at this coverage and absorption."""
+def _stored_errors(material, coverage, absorption, key=None):
+    """``(tier errors (rms), gloss omissions or None)`` of the last Apply if measured at this
+    coverage and absorption (and, when stored, for the tables ``key``: a preview re-bake
+    since then changed the tables), else ``(None, None)``."""
     from .material import ERRORS_KEY
 
     try:
         errors = json.loads(material.get(ERRORS_KEY, "{}"))
     except ValueError:
-        return None
+        return None, None
     if not errors:
-        return None
+        return None, None
     first = next(iter(errors.values()))
-    same = (math.isclose(first.get("coverage", -1.0), coverage, abs_tol=1e-6)
+    same = (first.get("key", key) == key
+            and math.isclose(first.get("coverage", -1.0), coverage, abs_tol=1e-6)
             and all(math.isclose(a, b, abs_tol=1e-6)
                     for a, b in zip(first.get("absorption", []), absorption, strict=False)))
-    return {tier: float(e["rms"]) for tier, e in errors.items()} if same else None
+    if not same:
+        return None, None
+    omission = {tier: {float(angle): float(value)
+                       for angle, value in e["gloss_omission"].items()}
+                for tier, e in errors.items() if "gloss_omission" in e}
+    return ({tier: float(e["rms"]) for tier, e in errors.items()},
+            omission if len(omission) == len(errors) else None)
 
 
 def _meta(material) -> dict:
@@ -184,12 +197,13 @@ def _tables(meta):
 
 def material_traits(material, *, refit: bool = False, may_fit: bool = True):
     """The :class:`lut_baker.scene_model.MaterialTraits` of a made-up material at its coverage
-    and absorption, the Subsurface Scale applied (the value Fit to Scene saved if it set the
-    scale to 0).  From its stored tables: the profile, the shares of gloss and skin light, the
-    profile mismatch of the group's subsurface method; the tier errors of the last Apply, or
-    (``refit``, or none stored for this coverage and absorption) of a new closure fit (a few
-    seconds; without ``may_fit``, as when a panel draws, the paper preset's tier errors
-    instead).  Without tables: the paper preset's traits."""
+    and absorption, the Subsurface Scale and Gloss applied (the values Fit to Scene saved if
+    it set them to 0).  From its stored tables: the profile, the shares of gloss and skin
+    light, the profile mismatch of the group's subsurface method; the tier errors and gloss
+    omissions of the last Apply, or (``refit``, or none stored for this coverage and
+    absorption) of a new closure fit (a few seconds; without ``may_fit``, as when a panel
+    draws, the paper preset's tier errors and the tables' gloss share instead).  Without
+    tables: the paper preset's traits."""
     sm = lut_baker("scene_model")
     settings = material.makeup_skin
     coverage = float(settings.coverage)
@@ -197,19 +211,26 @@ def material_traits(material, *, refit: bool = False, may_fit: bool = True):
     scale = float(settings.subsurface_scale)
     if scale <= 0.0 and SAVED_SCALE_KEY in material:
         scale = float(material[SAVED_SCALE_KEY])
+    gloss = float(settings.gloss)
+    if gloss <= 0.0 and SAVED_GLOSS_KEY in material:
+        gloss = float(material[SAVED_GLOSS_KEY])
     meta = _meta(material)
-    errors = None if refit else _stored_errors(material, coverage, absorption)
+    errors, omission = (None, None) if refit else _stored_errors(material, coverage,
+                                                                 absorption, meta.get("key"))
     key = (meta.get("key"), meta.get("subsurface_method"), coverage, tuple(absorption),
-           None if errors is None else tuple(sorted(errors.items())), scale, may_fit)
+           None if errors is None else tuple(sorted(errors.items())), omission is not None,
+           scale, gloss, may_fit)
     traits = _TRAITS.pop(key, None)
     tables = _tables(meta) if traits is None and meta else None
     if traits is None and tables is None:
-        traits = sm.paper_traits().scaled(scale) if scale != 1.0 else sm.paper_traits()
+        traits = (sm.paper_traits() if (scale, gloss) == (1.0, 1.0)
+                  else sm.paper_traits().scaled(scale, gloss))
     elif traits is None:
         if errors is None and may_fit:
             fit = lut_baker("closure_fit").fit_closures(tables,
                                                         errors_at=(coverage, absorption))
             errors = {tier: float(e.rms) for tier, e in fit.errors.items()}
+            omission = sm.gloss_omissions(tables, fit, coverage, absorption)
         elif errors is None:
             errors = dict(sm.PAPER_TIER_ERRORS)
         method = meta.get("subsurface_method")
@@ -220,7 +241,8 @@ def material_traits(material, *, refit: bool = False, may_fit: bool = True):
             tier_errors=errors, radius_mm=tables.radius_mm, profile=tables.profile,
             profile_mismatch=sm.profile_mismatch(tables, profile_error),
             skin_share={a: v[1] for a, v in shares.items()},
-            gloss_share={a: v[0] for a, v in shares.items()}, subsurface_scale=scale)
+            gloss_share={a: v[0] for a, v in shares.items()}, subsurface_scale=scale,
+            gloss_omission=omission, gloss_scale=gloss)
     _TRAITS[key] = traits
     while len(_TRAITS) > TRAITS_CACHE_SIZE:
         _TRAITS.popitem(last=False)
@@ -256,8 +278,8 @@ def auto_tier(settings, scene) -> str:
 
 
 def _apply_choice(context, obj, material, candidate) -> list[str]:
-    """Set the tier and the Subsurface Scale of the choice, then Apply.  Returns what
-    changed, for the report."""
+    """Set the tier, the Subsurface Scale and the Gloss of the choice, then Apply.  Returns
+    what changed, for the report."""
     from . import material as made_up
 
     settings = material.makeup_skin
@@ -278,6 +300,14 @@ def _apply_choice(context, obj, material, candidate) -> list[str]:
         settings.subsurface_scale = float(material[SAVED_SCALE_KEY])
         del material[SAVED_SCALE_KEY]
         changes.append(f"Subsurface Scale 0 -> {settings.subsurface_scale:g}")
+    if not candidate.gloss and settings.gloss > 0.0:
+        material[SAVED_GLOSS_KEY] = float(settings.gloss)
+        changes.append(f"Gloss {settings.gloss:g} -> 0")
+        settings.gloss = 0.0
+    elif candidate.gloss and settings.gloss <= 0.0 and SAVED_GLOSS_KEY in material:
+        settings.gloss = float(material[SAVED_GLOSS_KEY])
+        del material[SAVED_GLOSS_KEY]
+        changes.append(f"Gloss 0 -> {settings.gloss:g}")
     made_up.apply_to_object(context, obj)
     return changes
 
@@ -304,6 +334,7 @@ class MAKEUPSKIN_OT_fit_to_scene(bpy.types.Operator):
         return obj is not None and obj.type == "MESH"
 
     def execute(self, context):
+        from . import live
         from . import material as made_up
 
         obj = context.active_object
@@ -312,6 +343,8 @@ class MAKEUPSKIN_OT_fit_to_scene(bpy.types.Operator):
         try:
             if material is None or not material.makeup_skin.is_made_up:
                 material, _ = made_up.apply_to_object(context, obj)
+            elif material.name in live.pending():
+                live.flush(context)  # judge the tables the settings describe now
             choice, description = choose_for(material, context.scene, obj=obj,
                                              tolerance=self.tolerance)
             changes = (_apply_choice(context, obj, material, choice.candidate)
@@ -322,7 +355,8 @@ class MAKEUPSKIN_OT_fit_to_scene(bpy.types.Operator):
         chosen = choice.chosen
         material[CHOICE_KEY] = json.dumps({
             "candidate": chosen.candidate.name, "tier": chosen.candidate.tier,
-            "subsurface": chosen.candidate.subsurface, "error": chosen.error,
+            "subsurface": chosen.candidate.subsurface, "gloss": chosen.candidate.gloss,
+            "error": chosen.error,
             "best_error": choice.best_error, "cost": chosen.cost,
             "tolerance": choice.tolerance, "reasons": list(choice.reasons),
             "known_scene": description is not None})
@@ -334,7 +368,7 @@ class MAKEUPSKIN_OT_fit_to_scene(bpy.types.Operator):
                               f"{100 * choice.best_error:.1f}% + {100 * choice.tolerance:.0f}%)"
                               f", cost {chosen.cost:.2f} of the fullest tier"
                               + (f"; {', '.join(changes)}" if changes else ""))
-        for line in choice.reasons[:2]:
+        for line in choice.reasons[:3]:
             self.report({"INFO"}, f"Made-up Skin: {line}")
         return {"FINISHED"}
 

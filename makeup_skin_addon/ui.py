@@ -53,6 +53,7 @@ def draw_settings(layout, context) -> None:
     col.prop(settings, "skin")
     col.prop(settings, "skin_tint")
     col.prop(settings, "subsurface_scale")
+    col.prop(settings, "gloss", slider=True)
     col.prop(settings, "subsurface_method")
     col.separator()
     col.prop(settings, "override_film")

@@ -266,3 +266,51 @@ def test_principled_error_does_not_peak_between_coverages(paper_tables, paper_fi
     for coverage in (0.25, 0.5, 0.75):
         middle = closure_fit.tier_errors(paper_fit, paper_tables, coverage, 0.0)["PRINCIPLED"]
         assert middle.rms < 1.2 * max(ends)
+
+
+def test_gloss_zero_leaves_only_the_diffuse_closures(paper_tables, paper_fit):
+    """The group's Gloss input at 0: the Principled tier has coat weight 0 and specular level
+    0 (eta 1: Cycles allocates neither closure) and its base colour is the diffuse albedo
+    itself; the Layered tier's Glossy weights are 0 and it is linear in Gloss.  Without its
+    gloss, each tier misses the tables' gloss."""
+    w, a = 0.5, (0.1, 0.2, 0.4)
+    inputs, weight = closure_fit.principled_inputs(paper_fit, w, a, gloss=0.0)
+    total, skin = closure_fit.diffuse_albedo(paper_fit, w, a)
+    assert inputs.coat_weight == 0.0 and inputs.specular_ior_level == 0.0
+    assert inputs.specular_eta_f0()[0] == 1.0
+    np.testing.assert_allclose(inputs.base_color, np.clip(total, 0.0, 1.0), rtol=1e-12)
+    assert weight == pytest.approx(float(np.mean(skin / total)))
+    matte = closure_fit.principled_tier_reflection(paper_fit, paper_tables, w, a, gloss=0.0)
+    np.testing.assert_allclose(matte, np.broadcast_to(np.clip(total, 0, 1) / np.pi,
+                                                      matte.shape), rtol=1e-12)
+    weights = closure_fit.layered_weights(paper_fit, w, a, gloss=0.0)
+    assert not any(np.any(weights[name]) for name in closure_fit.LUT_ROWS[:3])
+    layered = {g: closure_fit.layered_tier_reflection(paper_fit, paper_tables, w, a, gloss=g)
+               for g in (0.0, 0.5, 1.0)}
+    np.testing.assert_allclose(layered[0.5], 0.5 * (layered[0.0] + layered[1.0]), rtol=1e-9)
+    kept = closure_fit.tier_errors(paper_fit, paper_tables, w, a)
+    dropped = closure_fit.tier_errors(paper_fit, paper_tables, w, a, gloss=0.0)
+    for tier in closure_fit.TIERS:
+        assert dropped[tier].rms > 2.0 * kept[tier].rms
+
+
+def test_replicas_take_any_directions(paper_tables, paper_fit):
+    """At the tables' own nodes passed explicitly, each replica gives its default values; on
+    an (n, m) batch of directions it keeps the batch's shape; a NaN light direction touches
+    no other value (its own is NaN for the Principled tier; the Layered tier's Glossy lobes
+    count it as below the horizon and its diffuse part does not depend on it)."""
+    nodes = closure_fit.node_directions(paper_tables)
+    wi = direction(np.radians([[10.0, 40.0, 70.0], [0.0, 85.0, 30.0]]), 1.0)
+    wo = direction(np.radians([[60.0, 5.0, 20.0], [45.0, 10.0, 89.0]]), 0.0)
+    wi_nan = wi.copy()
+    wi_nan[0, 0] = np.nan
+    for tier, replica in closure_fit.TIER_REPLICAS.items():
+        np.testing.assert_array_equal(replica(paper_fit, paper_tables, 1.0, 0.0, 1.0, nodes),
+                                      replica(paper_fit, paper_tables, 1.0, 0.0), err_msg=tier)
+        batch = replica(paper_fit, paper_tables, 1.0, 0.0, 1.0, (wi, wo))
+        assert batch.shape == (2, 3, 3) and np.all(np.isfinite(batch)) and batch.min() >= 0
+        with np.errstate(invalid="ignore"):
+            poisoned = replica(paper_fit, paper_tables, 1.0, 0.0, 1.0, (wi_nan, wo))
+        assert not np.isinf(poisoned[0, 0]).any(), tier
+        np.testing.assert_allclose(poisoned[1], batch[1], rtol=1e-12, err_msg=tier)
+        np.testing.assert_allclose(poisoned[0, 1:], batch[0, 1:], rtol=1e-12, err_msg=tier)
