@@ -14,8 +14,10 @@ diffuse albedo (film diffuse + skin seen through the film, or bare skin), divide
 attenuation of the layers above it; Subsurface Weight = the skin's share of it.
 ``LAYERED``: closures added with view-dependent weights: film gloss, path-3 gloss and skin gloss
 (Glossy GGX, roughness fitted, weight = table albedo / closure albedo read from a 1-D image by
-``cos(theta_o)``), film diffuse (Diffuse), the skin through the film and bare (Subsurface, colour
-``(1 - A)^2 skin_diffuse pi T_mean T(theta_o)`` and ``skin_diffuse pi``), mixed by coverage.
+``cos(theta_o)``; the film gloss shares its albedo with a Lambertian companion, its own
+row), film diffuse plus that companion (one Diffuse), the skin through the film and bare
+(Subsurface, colour ``(1 - A)^2 skin_diffuse pi T_mean T(theta_o)`` and ``skin_diffuse pi``),
+mixed by coverage.
 Both take the group's Gloss input ``g`` (0..1): it scales the gloss lobes (coat weight and
 specular level; the Glossy colours), and at 0 Cycles allocates none of them.  The replicas
 below take it as ``gloss``, so the Auto tier predicts a gloss-free candidate from the same
@@ -93,9 +95,10 @@ __all__ = [
 
 TIERS = ("PRINCIPLED", "LAYERED")
 """The node group's tiers, cheapest first."""
-LUT_ROWS = ("film_gloss", "path3_gloss", "skin_gloss", "film_transmittance")
-"""Rows of the LAYERED tier's view-angle image: three Glossy weights and the film's
-transmittance ``T(theta_o)``."""
+LUT_ROWS = ("film_gloss", "path3_gloss", "skin_gloss", "film_transmittance",
+            "film_gloss_diffuse")
+"""Rows of the LAYERED tier's view-angle image: three Glossy weights, the film's
+transmittance ``T(theta_o)`` and the film gloss's Lambertian companion (:func:`fit_glossy`)."""
 DEFAULT_LUT_SIZE = 64
 """Texels per row of the view-angle image (linear filtering between texel centres)."""
 ROUGHNESS_RANGE = (0.2, 1.0)
@@ -236,8 +239,9 @@ class LobeFit:
     Specular IOR Level sets (specular), None for a Glossy BSDF; ``level``: Specular IOR Level
     (specular only; 0 when no lobe beats leaving the gloss out); ``lut``: the Glossy weight per
     view-angle texel, ``(size, 3)`` (Glossy only); ``distribution``: ``GGX``, ``BECKMANN`` or
-    ``ASHIKHMIN_SHIRLEY`` (Glossy only; the Principled BSDF is GGX); ``error``: relative RMS
-    of this lobe against its table (module docstring).
+    ``ASHIKHMIN_SHIRLEY`` (Glossy only; the Principled BSDF is GGX); ``diffuse_lut``: the
+    weight of its Lambertian companion per texel, ``(size, 3)``, or None (:func:`fit_glossy`);
+    ``error``: relative RMS of this lobe against its table (module docstring).
     """
 
     roughness: float
@@ -246,6 +250,7 @@ class LobeFit:
     level: float | None = None
     lut: np.ndarray | None = None
     distribution: str = "GGX"
+    diffuse_lut: np.ndarray | None = None
 
 
 class _Grid:
@@ -369,27 +374,73 @@ def _glossy_lut(roughness: float, distribution: str, albedo_table: np.ndarray,
     return table / np.maximum(closure, 1e-6)[:, None]
 
 
+def _companion_share(grid: _Grid, lobe: np.ndarray, closure_albedo: np.ndarray,
+                     table_albedo: np.ndarray, target: np.ndarray, size: int) -> np.ndarray:
+    """The share ``s`` (per view-angle texel, in [0, 1]) of a table's albedo ``A`` that the
+    Glossy lobe carries when a Lambertian companion carries the rest: weights ``a = s A / E``
+    (Glossy, ``E`` its albedo) and ``b = (1 - s) A`` (Diffuse), so ``a E + b = A`` at every
+    view.  ``s`` minimises ``|a lobe cos_i + b cos_i / pi - target cos_i|`` over the lights
+    of each view node of ``grid`` (closed form), then goes to the texels by ``cos(theta_o)``.
+    All arguments grey: ``lobe`` and ``target`` on the grid, albedos at the grid's views."""
+    g = lobe * grid.cos_i
+    lam = grid.cos_i / np.pi
+    a_over_e = table_albedo / np.maximum(closure_albedo, 1e-6)
+    u = a_over_e * (g - closure_albedo * lam)
+    v = target * grid.cos_i - table_albedo * lam
+    w = grid.weights
+    num = np.sum(w * u * v, axis=(0, 2))
+    den = np.sum(w * u * u, axis=(0, 2))
+    share = np.clip(np.where(den > 0.0, num / np.where(den > 0.0, den, 1.0), 1.0), 0.0, 1.0)
+    cos_views = grid.cos_o[0, :, 0]
+    order = np.argsort(cos_views)
+    return np.interp(lut_nodes(size), cos_views[order], share[order])
+
+
 def fit_glossy(grid: _Grid, target: np.ndarray, albedo_table: np.ndarray,
-               theta_deg: np.ndarray, size: int = DEFAULT_LUT_SIZE) -> LobeFit:
+               theta_deg: np.ndarray, size: int = DEFAULT_LUT_SIZE, *,
+               companion: bool = False) -> LobeFit:
     """Distribution (:data:`cycles_closures.GLOSSY_DISTRIBUTIONS`) and roughness of a Glossy
     BSDF whose view-dependent weight (table albedo / closure albedo, read from a
     ``size``-texel image by ``cos(theta_o)``) best reproduces ``target`` ``(n, n, p, 3)``;
-    ``albedo_table`` ``(n_theta, 3)`` on ``theta_deg``."""
+    ``albedo_table`` ``(n_theta, 3)`` on ``theta_deg``.
+
+    ``companion``: the albedo is shared with a Lambertian companion, in the proportion that
+    fits each view best (:func:`_companion_share`); the weights are then ``lut`` (Glossy) and
+    ``diffuse_lut`` (Diffuse), whose albedos still add up to the table's at every view.  A
+    broad lobe whose radiance keeps a ``cos(theta_i)`` factor (the paper's film gloss) is
+    part Lambertian, which no Glossy closure alone reproduces."""
     target = _rgb(target) * np.ones(3)
+    grey = np.mean(target, axis=-1)
+    theta_views = np.degrees(np.arccos(np.clip(grid.cos_o[0, :, 0], 0.0, 1.0)))
+    table_views = np.mean([np.interp(theta_views, theta_deg, albedo_table[:, c])
+                           for c in range(3)], axis=0)
+    texel_table = np.stack([np.interp(np.degrees(np.arccos(lut_nodes(size))), theta_deg,
+                                      albedo_table[:, c]) for c in range(3)], -1)
     best = None
     for distribution in cc.GLOSSY_DISTRIBUTIONS:
         def lobe(roughness, distribution=distribution, quadrature=SEARCH_QUADRATURE):
             lut = _glossy_lut(roughness, distribution, albedo_table, theta_deg, size,
                               quadrature)
-            value = grid.lobe(roughness, distribution)[..., None] * sample_lut(lut, grid.cos_o)
-            return value, lut
+            shape = grid.lobe(roughness, distribution)
+            diffuse = None
+            if companion:
+                closure = texel_table[:, :1] / np.maximum(lut[:, :1], 1e-12)  # E per texel
+                e_views = np.interp(grid.cos_o[0, :, 0], lut_nodes(size), closure[:, 0])
+                share = _companion_share(grid, shape, e_views[None, :, None],
+                                         table_views[None, :, None], grey, size)
+                diffuse = (1.0 - share)[:, None] * texel_table
+                lut = share[:, None] * lut
+            value = shape[..., None] * sample_lut(lut, grid.cos_o)
+            if diffuse is not None:
+                value = value + sample_lut(diffuse, grid.cos_o) / np.pi
+            return value, lut, diffuse
 
         roughness, error = golden_minimum(lambda r, lobe=lobe: grid.error(lobe(r)[0], target),
                                           *ROUGHNESS_RANGE, tol=FIT_TOLERANCE, coarse=7)
         if best is None or error < best.error:
-            value, lut = lobe(roughness, quadrature=FINAL_QUADRATURE)
+            value, lut, diffuse = lobe(roughness, quadrature=FINAL_QUADRATURE)
             best = LobeFit(roughness=roughness, error=grid.error(value, target), lut=lut,
-                           distribution=distribution)
+                           distribution=distribution, diffuse_lut=diffuse)
     return best
 
 
@@ -612,14 +663,15 @@ def fit_closures(tables: Tables, *, lut_size: int = DEFAULT_LUT_SIZE,
 
     theta_deg = np.asarray(tables.theta_deg, float)
     glossy = {name: fit_glossy(grid, table, np.asarray(getattr(tables, name + "_albedo")),
-                               theta_deg, lut_size)
+                               theta_deg, lut_size, companion=name == "film_gloss")
               for name, table in (("film_gloss", film_gloss), ("path3_gloss", path3),
                                   ("skin_gloss", skin_gloss))}
     transmittance = np.asarray(tables.film_transmittance, float)
     mu = lut_nodes(lut_size)
     t_rows = np.stack([np.interp(np.degrees(np.arccos(mu)), theta_deg, transmittance[:, c])
                        for c in range(3)], -1)
-    lut = np.stack([glossy[name].lut for name in LUT_ROWS[:3]] + [t_rows])
+    lut = np.stack([glossy[name].lut for name in LUT_ROWS[:3]]
+                   + [t_rows, glossy["film_gloss"].diffuse_lut])
 
     ior = subsurface_ior(tables.parameters)
     profiles = fit_profiles(tables)
@@ -730,7 +782,8 @@ def layered_weights(fit: ClosureFit, coverage: float, absorption, gloss: float =
     - ``film_gloss``: ``g w``; ``path3_gloss``: ``g w (1 - A)^2``; ``skin_gloss``: ``g (1 - w)``
       (each times its row; ``g`` the group's Gloss input: at 0 the Glossy colours are 0 and
       Cycles allocates no Glossy closure, ``bsdf_alloc``'s weight cutoff);
-    - ``film_diffuse``: ``w (1 - A) pi P_d,f`` (Diffuse);
+    - ``film_diffuse``: ``w (1 - A) pi P_d,f`` (Diffuse); ``film_gloss_diffuse``: ``g w`` times
+      its row, the film gloss's Lambertian companion, in the same Diffuse closure;
     - ``skin_through``: ``w (1 - A)^2 pi P_d,s T_mean`` (times row ``T``); ``skin_bare``:
       ``(1 - w) pi P_d,s`` (Subsurface).
     """
@@ -743,6 +796,7 @@ def layered_weights(fit: ClosureFit, coverage: float, absorption, gloss: float =
         "path3_gloss": g * w * through**2,
         "skin_gloss": g * (1.0 - w) * one,
         "film_diffuse": w * through * fit.film_albedo,
+        "film_gloss_diffuse": g * w * one,
         "skin_through": w * through**2 * fit.skin_albedo * fit.transmittance_mean,
         "skin_bare": (1.0 - w) * fit.skin_albedo,
     }
@@ -766,6 +820,7 @@ def layered_tier_reflection(fit: ClosureFit, tables: Tables, coverage: float, ab
                                         distribution=glossy.distribution)[..., None]
         value = value + lobe * weights[name] * sample_lut(rows[name], cos_o)
     diffuse = (weights["film_diffuse"] + weights["skin_bare"]
+               + weights["film_gloss_diffuse"] * sample_lut(rows["film_gloss_diffuse"], cos_o)
                + weights["skin_through"] * sample_lut(rows["film_transmittance"], cos_o))
     return value + cc.lambert_reflection(diffuse)
 

@@ -126,7 +126,9 @@ def _group_matches(group, key: str, tier: str, method) -> bool:
     if not nodes.has_interface(group):  # built before a socket existed (Gloss): rebuild
         return False
     if tier == "LAYERED":
-        return bpy.data.images.get(storage.lut_image_name(key)) is not None
+        lut = bpy.data.images.get(storage.lut_image_name(key))
+        # An image of other rows is from an older add-on (before the gloss companion row).
+        return lut is not None and lut.size[1] == len(lut_baker("closure_fit").LUT_ROWS)
     return True
 
 

@@ -277,9 +277,13 @@ def _build_layered(build: _Builder, fit, lut, method: str, radius_mm, ior: float
         build.tree.links.new(b, node.inputs[1])
         return node.outputs[0]
 
+    # The film's diffuse and the Lambertian companion of its gloss (closure_fit.fit_glossy)
+    # share one Diffuse closure: no extra closure to sample.
     film_diffuse = build.node("ShaderNodeBsdfDiffuse", "film diffuse")
+    companion = build.scale(rows["film_gloss_diffuse"], gloss, label="gloss companion x Gloss")
     build.feed(film_diffuse.inputs["Color"],
-               build.vector("MULTIPLY", through, tuple(fit.film_albedo)))
+               build.vector("ADD", build.vector("MULTIPLY", through, tuple(fit.film_albedo)),
+                            companion, label="film diffuse + gloss companion"))
     # The skin seen through the film: the medium keeps the skin's own (bright) colour, tinted
     # by the film's absorption relative to its weakest channel, and the film's transmittances
     # scale the closure as a whole.  A dark colour instead would make the random walk both

@@ -102,6 +102,31 @@ def _radial_integral(profile, r):
     return float(np.trapz(2 * np.pi * r * profile, r))
 
 
+def test_fit_glossy_companion_recovers_a_lobe_plus_lambert(paper_tables):
+    """A target that is 0.7 of a Beckmann lobe plus a Lambertian 0.2: the companion fit finds
+    the lobe and splits the albedo between the two, and the weights' albedos add up to the
+    table's at every texel (so the white furnace is kept)."""
+    grid = closure_fit._Grid(paper_tables, None)
+    wi, wo = closure_fit.node_directions(paper_tables)
+    lobe = cc.microfacet_reflection(wi, wo, 0.5, distribution="BECKMANN")
+    theta = np.asarray(paper_tables.theta_deg)
+    e = cc.microfacet_albedo(np.cos(np.radians(theta)), 0.5, distribution="BECKMANN")
+    albedo = (0.7 * e + 0.2)[:, None] * np.ones(3)
+    target = (0.7 * lobe + 0.2 / np.pi)[..., None] * np.ones(3)
+    plain = closure_fit.fit_glossy(grid, target, albedo, theta)
+    fit = closure_fit.fit_glossy(grid, target, albedo, theta, companion=True)
+    assert plain.diffuse_lut is None and fit.error < 0.25 * plain.error
+    assert fit.distribution == "BECKMANN" and fit.roughness == pytest.approx(0.5, abs=0.02)
+    inner = slice(4, -4)  # texels away from the ends, where interpolation holds them
+    np.testing.assert_allclose(fit.lut[inner], 0.7, atol=0.03)
+    np.testing.assert_allclose(fit.diffuse_lut[inner], 0.2, atol=0.02)
+    mu = closure_fit.lut_nodes(closure_fit.DEFAULT_LUT_SIZE)
+    texel_e = cc.microfacet_albedo(mu, fit.roughness, distribution=fit.distribution)
+    texel_table = np.interp(np.degrees(np.arccos(mu)), theta, albedo[:, 0])
+    np.testing.assert_allclose(fit.lut[:, 0] * texel_e + fit.diffuse_lut[:, 0], texel_table,
+                               rtol=2e-3)
+
+
 @pytest.mark.parametrize("method", cc.SUBSURFACE_METHODS)
 def test_subsurface_profiles_have_unit_area(method):
     r = np.geomspace(1e-7, 400.0, 400000)
