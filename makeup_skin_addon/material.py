@@ -68,8 +68,9 @@ def skin_from_settings(settings):
 
 
 def resolve_tier(settings, scene) -> str:
-    """The tier to build: the settings' own, or for Auto, Layered in Cycles and Principled
-    elsewhere (EEVEE has no angular lookup advantage to offer; issue 5 refines Auto)."""
+    """The tier to build: the settings' own, or for Auto the one
+    :func:`scene_fit.auto_tier` picks from the scene (:mod:`lut_baker.scene_model`: the
+    cheapest within the tolerance of the best predicted error; EEVEE: Principled)."""
     if settings.tier != "AUTO":
         return settings.tier
     return scene_fit.auto_tier(settings, scene)
