@@ -360,18 +360,22 @@ texels); the final weights use :data:`FINAL_QUADRATURE` (within 0.1%, at every t
 FINAL_QUADRATURE = {"n_u": 96, "n_phi": 64, "n_mu": None}
 
 
-def _glossy_lut(roughness: float, distribution: str, albedo_table: np.ndarray,
-                theta_deg: np.ndarray, size: int, quadrature=FINAL_QUADRATURE) -> np.ndarray:
-    """Glossy weights per texel: table albedo / closure albedo at ``cos(theta_o)`` nodes."""
+def _texel_albedo(albedo_table: np.ndarray, theta_deg: np.ndarray, size: int) -> np.ndarray:
+    """A directional albedo table ``(n_theta, 3)`` on ``theta_deg`` at the view-angle texels,
+    ``(size, 3)``."""
+    theta = np.degrees(np.arccos(lut_nodes(size)))
+    return np.stack([np.interp(theta, theta_deg, albedo_table[:, c]) for c in range(3)], -1)
+
+
+def _closure_albedo(roughness: float, distribution: str, size: int,
+                    quadrature=FINAL_QUADRATURE) -> np.ndarray:
+    """A Glossy closure's albedo at the view-angle texels, ``(size,)``."""
     mu = lut_nodes(size)
-    theta = np.degrees(np.arccos(mu))
-    table = np.stack([np.interp(theta, theta_deg, albedo_table[:, c]) for c in range(3)], -1)
     n_mu = quadrature["n_mu"]
     nodes = mu if n_mu is None else np.linspace(mu[0], mu[-1], n_mu)
     closure = cc.microfacet_albedo(nodes, roughness, distribution=distribution,
                                    n_u=quadrature["n_u"], n_phi=quadrature["n_phi"])
-    closure = closure if n_mu is None else np.interp(mu, nodes, closure)
-    return table / np.maximum(closure, 1e-6)[:, None]
+    return closure if n_mu is None else np.interp(mu, nodes, closure)
 
 
 def _companion_share(grid: _Grid, lobe: np.ndarray, closure_albedo: np.ndarray,
@@ -414,18 +418,17 @@ def fit_glossy(grid: _Grid, target: np.ndarray, albedo_table: np.ndarray,
     theta_views = np.degrees(np.arccos(np.clip(grid.cos_o[0, :, 0], 0.0, 1.0)))
     table_views = np.mean([np.interp(theta_views, theta_deg, albedo_table[:, c])
                            for c in range(3)], axis=0)
-    texel_table = np.stack([np.interp(np.degrees(np.arccos(lut_nodes(size))), theta_deg,
-                                      albedo_table[:, c]) for c in range(3)], -1)
+    texel_table = _texel_albedo(albedo_table, theta_deg, size)
     best = None
     for distribution in cc.GLOSSY_DISTRIBUTIONS:
         def lobe(roughness, distribution=distribution, quadrature=SEARCH_QUADRATURE):
-            lut = _glossy_lut(roughness, distribution, albedo_table, theta_deg, size,
-                              quadrature)
+            closure = _closure_albedo(roughness, distribution, size, quadrature)
+            # Glossy weight per texel: table albedo / closure albedo.
+            lut = texel_table / np.maximum(closure, 1e-6)[:, None]
             shape = grid.lobe(roughness, distribution)
             diffuse = None
             if companion:
-                closure = texel_table[:, :1] / np.maximum(lut[:, :1], 1e-12)  # E per texel
-                e_views = np.interp(grid.cos_o[0, :, 0], lut_nodes(size), closure[:, 0])
+                e_views = np.interp(grid.cos_o[0, :, 0], lut_nodes(size), closure)
                 share = _companion_share(grid, shape, e_views[None, :, None],
                                          table_views[None, :, None], grey, size)
                 diffuse = (1.0 - share)[:, None] * texel_table
@@ -613,19 +616,23 @@ def _cosine_mean(values: np.ndarray, theta_deg: np.ndarray) -> np.ndarray:
     return 2.0 * np.tensordot(w * mu, values, axes=(0, 0))
 
 
-def _coat_layering_mean(roughness: float, ior: float) -> float:
-    """Cosine-weighted mean over view angles of the coat's layering albedo
-    (:func:`cycles_closures.coat_view_terms`)."""
+def _view_mean(albedo_of) -> float:
+    """``2 Int a(mu) mu dmu``: the cosine-weighted mean over view angles of ``albedo_of(mu)``
+    (trapezoid on 33 view cosines)."""
     mu = np.linspace(0.0, 1.0, 33)
-    return float(2.0 * np.sum(_trapezoid_weights(mu) * mu
-                              * cc.coat_view_terms(mu, roughness, ior)[1]))
+    return float(2.0 * np.sum(_trapezoid_weights(mu) * mu * albedo_of(mu)))
+
+
+def _coat_layering_mean(roughness: float, ior: float) -> float:
+    """:func:`_view_mean` of the coat's layering albedo
+    (:func:`cycles_closures.coat_view_terms`)."""
+    return _view_mean(lambda mu: cc.coat_view_terms(mu, roughness, ior)[1])
 
 
 def _layering_mean(roughness: float, ior: float, f0=None) -> float:
-    """Cosine-weighted mean over view angles of :func:`cycles_closures.layering_albedo`."""
-    mu = np.linspace(0.0, 1.0, 33)
-    albedo = np.max(np.atleast_2d(cc.layering_albedo(mu, roughness, ior, f0).T).T, axis=-1)
-    return float(2.0 * np.sum(_trapezoid_weights(mu) * mu * albedo))
+    """:func:`_view_mean` of :func:`cycles_closures.layering_albedo` (its largest channel)."""
+    return _view_mean(lambda mu: np.max(
+        np.atleast_2d(cc.layering_albedo(mu, roughness, ior, f0).T).T, axis=-1))
 
 
 def subsurface_ior(parameters: dict) -> float:
