@@ -208,12 +208,8 @@ def material_traits(material, *, refit: bool = False, may_fit: bool = True):
     settings = material.makeup_skin
     coverage = float(settings.coverage)
     absorption = [float(a) for a in settings.effective_absorption()]
-    scale = float(settings.subsurface_scale)
-    if scale <= 0.0 and SAVED_SCALE_KEY in material:
-        scale = float(material[SAVED_SCALE_KEY])
-    gloss = float(settings.gloss)
-    if gloss <= 0.0 and SAVED_GLOSS_KEY in material:
-        gloss = float(material[SAVED_GLOSS_KEY])
+    scale = _kept_value(material, "subsurface_scale", SAVED_SCALE_KEY)
+    gloss = _kept_value(material, "gloss", SAVED_GLOSS_KEY)
     meta = _meta(material)
     errors, omission = (None, None) if refit else _stored_errors(material, coverage,
                                                                  absorption, meta.get("key"))
@@ -292,24 +288,39 @@ def _apply_choice(context, obj, material, candidate) -> list[str]:
             settings.tier = candidate.tier
     finally:
         settings.live_update = live
-    if not candidate.subsurface and settings.subsurface_scale > 0.0:
-        material[SAVED_SCALE_KEY] = float(settings.subsurface_scale)
-        changes.append(f"Subsurface Scale {settings.subsurface_scale:g} -> 0")
-        settings.subsurface_scale = 0.0
-    elif candidate.subsurface and settings.subsurface_scale <= 0.0 and SAVED_SCALE_KEY in material:
-        settings.subsurface_scale = float(material[SAVED_SCALE_KEY])
-        del material[SAVED_SCALE_KEY]
-        changes.append(f"Subsurface Scale 0 -> {settings.subsurface_scale:g}")
-    if not candidate.gloss and settings.gloss > 0.0:
-        material[SAVED_GLOSS_KEY] = float(settings.gloss)
-        changes.append(f"Gloss {settings.gloss:g} -> 0")
-        settings.gloss = 0.0
-    elif candidate.gloss and settings.gloss <= 0.0 and SAVED_GLOSS_KEY in material:
-        settings.gloss = float(material[SAVED_GLOSS_KEY])
-        del material[SAVED_GLOSS_KEY]
-        changes.append(f"Gloss 0 -> {settings.gloss:g}")
+    for on, attribute, key, label in (
+            (candidate.subsurface, "subsurface_scale", SAVED_SCALE_KEY, "Subsurface Scale"),
+            (candidate.gloss, "gloss", SAVED_GLOSS_KEY, "Gloss")):
+        change = _switch(material, attribute, key, label, on)
+        if change:
+            changes.append(change)
     made_up.apply_to_object(context, obj)
     return changes
+
+
+def _kept_value(material, attribute: str, key: str) -> float:
+    """A setting Fit to Scene may switch off (Subsurface Scale, Gloss): its value, or the one
+    saved under ``key`` while it is off."""
+    value = float(getattr(material.makeup_skin, attribute))
+    if value <= 0.0 and key in material:
+        value = float(material[key])
+    return value
+
+
+def _switch(material, attribute: str, key: str, label: str, on: bool) -> str | None:
+    """Switch a setting off (0, its value saved under ``key`` on the material) or back on
+    (the saved value restored); the change for the report, or None."""
+    settings = material.makeup_skin
+    value = float(getattr(settings, attribute))
+    if not on and value > 0.0:
+        material[key] = value
+        setattr(settings, attribute, 0.0)
+        return f"{label} {value:g} -> 0"
+    if on and value <= 0.0 and key in material:
+        setattr(settings, attribute, float(material[key]))
+        del material[key]
+        return f"{label} 0 -> {getattr(settings, attribute):g}"
+    return None
 
 
 class MAKEUPSKIN_OT_fit_to_scene(bpy.types.Operator):
