@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import re
 import sys
 import time
 from dataclasses import replace
@@ -25,6 +24,8 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
+
+from doc_block import replace_block  # noqa: E402  (bench/doc_block.py)
 
 from lut_baker import bake, model, presets  # noqa: E402
 from lut_baker.normalise import made_up_reflection  # noqa: E402
@@ -289,15 +290,6 @@ def study(runs: int) -> str:
     return "\n".join(out)
 
 
-def write_docs(text: str) -> None:
-    doc = DOC.read_text()
-    if BEGIN not in doc or END not in doc:
-        raise SystemExit(f"{DOC} has no {BEGIN} ... {END} block")
-    block = f"{BEGIN}\n{text}\n{END}"
-    DOC.write_text(re.sub(re.escape(BEGIN) + ".*?" + re.escape(END), lambda _: block, doc,
-                          flags=re.S))
-
-
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -309,7 +301,7 @@ def main() -> None:
     text = study(args.runs) if args.study else timings(args.runs)
     print(text)
     if args.write_docs and args.study:
-        write_docs(text)
+        replace_block(DOC, text, BEGIN, END)
 
 
 if __name__ == "__main__":

@@ -27,7 +27,6 @@ import argparse
 import csv
 import importlib
 import os
-import re
 import sys
 import tempfile
 import time
@@ -37,6 +36,8 @@ ROOT = Path(__file__).resolve().parents[1]
 for _path in (ROOT, ROOT / "bench", ROOT / "tools"):
     if str(_path) not in sys.path:
         sys.path.insert(0, str(_path))
+
+from doc_block import replace_block  # noqa: E402  (bench/doc_block.py)
 
 from lut_baker import bake, compare, presets, reference  # noqa: E402
 from lut_baker.baseline import fit_baseline  # noqa: E402
@@ -318,15 +319,6 @@ def baseline_text(baseline, seconds: float) -> str:
     return "\n".join(lines)
 
 
-def write_docs(text: str, path: Path) -> None:
-    doc = path.read_text()
-    if BEGIN not in doc or END not in doc:
-        raise SystemExit(f"{path} has no {BEGIN} ... {END} block")
-    block = f"{BEGIN}\n{text}\n{END}"
-    path.write_text(re.sub(re.escape(BEGIN) + ".*?" + re.escape(END), lambda _: block, doc,
-                           flags=re.S))
-
-
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--size", type=int, default=48, help="pixels (square), default 48")
@@ -369,7 +361,7 @@ def main(argv=None) -> int:
     write_csv(rows, args.out / f"speed_accuracy{suffix}.csv")
     chart(rows, args.out / f"speed_accuracy{suffix}.png")
     if not args.quick and args.out == DOCS:
-        write_docs(text, DOCS / "speed_accuracy.md")
+        replace_block(DOCS / "speed_accuracy.md", text, BEGIN, END)
     print(f"speed_accuracy: {seconds / 60:.1f} min -> {args.out}/speed_accuracy{suffix}.csv, .png")
     return 0
 

@@ -44,6 +44,7 @@ for _path in (ROOT, ROOT / "tools", ROOT / "bench"):
 
 import blender_scene  # noqa: E402  (bench/blender_scene.py)
 import render_sphere  # noqa: E402  (tools/render_sphere.py)
+from doc_block import replace_block  # noqa: E402  (bench/doc_block.py)
 
 from lut_baker import compare  # noqa: E402
 
@@ -379,13 +380,6 @@ def render_table(renders, samples) -> str:
     return "\n".join(lines)
 
 
-def write_docs(path: Path, text: str) -> None:
-    """Replace what lies between :data:`MARKERS` in ``path`` with ``text``."""
-    content = path.read_text()
-    begin, end = content.index(MARKERS[0]), content.index(MARKERS[1])
-    path.write_text(content[:begin + len(MARKERS[0])] + "\n" + text + "\n" + content[end:])
-
-
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--costs", action="store_true",
@@ -435,7 +429,7 @@ def main(argv=None) -> int:
     print(text)
     print(f"# stability sweep: {time.perf_counter() - start:.0f} s")
     if args.out:
-        write_docs(args.out, text)
+        replace_block(args.out, text, *MARKERS)
     return 0
 
 
