@@ -114,7 +114,8 @@ def fit_baseline(skin: MadeUpSkin, tables: Tables, fit: closure_fit.ClosureFit |
     """Fit a stock Principled BSDF to ``tables`` (baked from ``skin``) at the skin's coverage
     and absorption: least squares over the lit pixels of every light's image, each image's
     residual relative to its own RMS (so each light counts alike).  ``fit``: the tables'
-    :class:`~lut_baker.closure_fit.ClosureFit` (fitted here if not given)."""
+    :class:`~lut_baker.closure_fit.ClosureFit` (fitted here if not given).  A light whose
+    image is black (e.g. from behind the sphere) raises ValueError naming it."""
     fit = fit or closure_fit.fit_closures(tables)
     start, weight = closure_fit.principled_inputs(fit, skin.coverage, skin.absorption)
     views = [sphere_directions(resolution, light) for light in lights_deg]
@@ -125,8 +126,12 @@ def fit_baseline(skin: MadeUpSkin, tables: Tables, fit: closure_fit.ClosureFit |
     # as its relative mean square error.
     bounds = np.cumsum([0] + [len(v[1]) for v in views])
     scale = np.empty(len(wi))
-    for a, b in zip(bounds[:-1], bounds[1:], strict=True):
-        scale[a:b] = 1.0 / (np.sqrt(np.mean(ref[a:b] ** 2)) * np.sqrt(3 * (b - a)))
+    for light, a, b in zip(lights_deg, bounds[:-1], bounds[1:], strict=True):
+        level = np.sqrt(np.mean(ref[a:b] ** 2)) if b > a else 0.0
+        if not level > 0.0:
+            raise ValueError(f"the model's sphere image at light {light} degrees is black (no "
+                             "lit pixel or no light reflected): nothing to fit there")
+        scale[a:b] = 1.0 / (level * np.sqrt(3 * (b - a)))
 
     def radiance(inputs):
         return wi[:, 2:3] * cc.principled_reflection(wi, wo, inputs)

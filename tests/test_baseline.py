@@ -59,3 +59,9 @@ def test_paper_baseline_improves_on_its_start_within_socket_ranges(paper):
     assert 1.0 <= values["Coat IOR"] <= 4.0
     assert values["Subsurface Radius"] == pytest.approx(tuple(fit.subsurface_radius_mm))
     assert result.subsurface_method == fit.subsurface_method
+
+
+def test_a_black_image_is_refused_by_name(paper):
+    skin, tables, fit = paper
+    with pytest.raises(ValueError, match="light 180.0 degrees is black"):
+        baseline.fit_baseline(skin, tables, fit, lights_deg=(45.0, 180.0), resolution=16)
