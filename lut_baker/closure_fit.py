@@ -645,11 +645,15 @@ def subsurface_ior(parameters: dict) -> float:
 
 def fit_closures(tables: Tables, *, lut_size: int = DEFAULT_LUT_SIZE,
                  subsurface_method: str | None = None,
-                 max_points: int | None = FIT_POINTS, errors_at=None) -> ClosureFit:
+                 max_points: int | None = FIT_POINTS, errors_at=None,
+                 progress=None) -> ClosureFit:
     """Fit both tiers to ``tables`` and measure their errors at ``errors_at`` = ``(coverage,
     absorption)`` (default: those the tables were baked for).  ``subsurface_method``: force
     one (default: the method whose edge response, fitted error and replica error combined,
-    is closest to the tables'; all three are fitted and reported)."""
+    is closest to the tables'; all three are fitted and reported).  ``progress(fraction,
+    message)``: called as the fit advances (fraction 0..1)."""
+    report = progress or (lambda fraction, message="": None)
+    report(0.0, "fitting the Principled tier")
     grid = _Grid(tables, max_points)
     pick = grid.pick
     film_gloss = np.asarray(tables.film_gloss, float)[pick]
@@ -668,6 +672,7 @@ def fit_closures(tables: Tables, *, lut_size: int = DEFAULT_LUT_SIZE,
     elif specular_bare.level == 0.0:
         specular_bare = replace(specular_bare, roughness=specular_film.roughness)
 
+    report(0.3, "fitting the Layered tier's gloss lobes")
     theta_deg = np.asarray(tables.theta_deg, float)
     glossy = {name: fit_glossy(grid, table, np.asarray(getattr(tables, name + "_albedo")),
                                theta_deg, lut_size, companion=name == "film_gloss")
@@ -680,6 +685,7 @@ def fit_closures(tables: Tables, *, lut_size: int = DEFAULT_LUT_SIZE,
     lut = np.stack([glossy[name].lut for name in LUT_ROWS[:3]]
                    + [t_rows, glossy["film_gloss"].diffuse_lut])
 
+    report(0.6, "fitting the subsurface profile")
     ior = subsurface_ior(tables.parameters)
     profiles = fit_profiles(tables)
     if subsurface_method is None:
@@ -715,7 +721,10 @@ def fit_closures(tables: Tables, *, lut_size: int = DEFAULT_LUT_SIZE,
     if errors_at is None:
         errors_at = (float(tables.parameters.get("coverage", 1.0)),
                      tables.parameters.get("absorption", 0.0))
-    return replace(fit, errors=tier_errors(fit, tables, *errors_at))
+    report(0.8, "measuring the tiers' errors")
+    fit = replace(fit, errors=tier_errors(fit, tables, *errors_at))
+    report(1.0, "fitted")
+    return fit
 
 
 # --------------------------------------------------------------------------------------------

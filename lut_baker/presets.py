@@ -9,6 +9,7 @@ Functions
 - :func:`paper_layers` -- the four layers of SPEC 5 in counts.
 - :func:`paper` -- the paper's made-up skin (foundation "natural" on the bio-plate), normalised.
 - :func:`skin_layers` -- (surface reflection, dipole) of a named skin, albedo units.
+- :func:`skin_albedo` -- a named skin's diffuse albedo ``pi P_d`` per RGB channel.
 - :func:`made_up_skin` -- a named foundation on a named skin with coverage.
 """
 
@@ -31,6 +32,7 @@ __all__ = [
     "paper",
     "paper_layers",
     "skin_layers",
+    "skin_albedo",
     "made_up_skin",
 ]
 
@@ -105,6 +107,13 @@ def skin_layers(name: str):
         return base.skin, base.dipole
     entry = SKINS[name]
     return _literature_skin(entry["sigma_s"], entry["sigma_a"])
+
+
+def skin_albedo(name: str) -> np.ndarray:
+    """The diffuse albedo ``pi P_d`` (RGB, dimensionless) of a named skin's surface layer: what
+    the node group's Skin Color input defaults to."""
+    surface, _ = skin_layers(name)
+    return np.broadcast_to(np.pi * np.asarray(surface.P_d, float), (3,)).copy()
 
 
 def made_up_skin(foundation: str = "paper_natural", skin: str = "paper_bioplate", *,

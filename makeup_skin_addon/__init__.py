@@ -9,11 +9,11 @@ panels as new submodules and append them to :data:`modules`.
     from .. import lut_baker
 """
 
-from . import live, operators, preferences, properties, scene_fit, ui
+from . import live, operators, properties, scene_fit, ui
 
 __all__ = ["modules", "register", "unregister"]
 
-modules = (preferences, properties, operators, ui, live, scene_fit)
+modules = (properties, operators, ui, live, scene_fit)
 
 
 def register():

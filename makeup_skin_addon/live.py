@@ -1,7 +1,7 @@
 """Live update while sliders move.
 
-Socket-level settings (coverage, absorption, tint, subsurface scale) go straight to the
-material's group node.  Settings that change the tables (skin, film overrides, tier) mark the
+Socket-level settings (coverage, absorption, skin colour, subsurface scale, gloss) go straight
+to the material's group node.  Settings that change the tables (skin, film overrides, tier) mark the
 material dirty and start one debounce timer; when it fires, every dirty material is re-baked at
 preview resolution and its group rebuilt in place (copied first if other materials share it).
 Without an event loop (headless) timers never fire: :func:`flush` does the same work at once.
@@ -29,7 +29,7 @@ def _material_of(settings):
 
 
 def sockets_changed(settings) -> None:
-    """Coverage, absorption, tint or scale moved: set the group node's sockets."""
+    """A socket-level setting moved: set the group node's sockets."""
     from .material import update_sockets
 
     material = _material_of(settings)
@@ -70,6 +70,11 @@ def flush(context=None) -> list[str]:
         material = bpy.data.materials.get(_dirty.pop())
         if material is None or not material.makeup_skin.is_made_up:
             continue
+        try:
+            made_up.refuse_linked(None, material)
+        except made_up.LinkedDataError as error:
+            messages.append(f"Made-up Skin: no preview: {error}.")
+            continue
         node = made_up.group_of(material)
         group = node.node_tree if node is not None else None
         if group is not None and group.users > 1:
@@ -79,10 +84,10 @@ def flush(context=None) -> list[str]:
             group, _, _ = made_up.ensure_group(
                 made_up.skin_from_settings(settings), made_up.resolve_tier(settings,
                                                                            context.scene),
-                PREVIEW, messages=messages, group=group,
+                PREVIEW, group=group,
                 method=made_up.forced_method(settings))
         except (ValueError, RuntimeError) as error:
-            messages.append(f"Made-up Skin: preview of {material.name!r} failed: {error}")
+            messages.append(f"Made-up Skin: the preview of {material.name!r} failed: {error}.")
             continue
         made_up.setup_material(material, group, context.scene)
     _messages.extend(messages)

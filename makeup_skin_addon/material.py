@@ -1,14 +1,16 @@
-"""Apply: bake, pack, fit, build or reuse the node group, and give an object the material.
+"""Apply: bake, fit, build or reuse the node group, and make it the surface of the artist's
+own material (converted in place, :mod:`.convert`); Revert and Check Tables.
 
 - :func:`skin_from_settings` -- the panel's settings as a :class:`MadeUpSkin` (coverage 1,
   absorption 0: those two are socket values, applied after the bake).
-- :func:`resolve_tier` -- the tier for the settings and scene (Auto: Layered for Cycles).
+- :func:`resolve_tier` -- the tier for the settings and scene (Auto: from the scene).
 - :func:`units_per_mm` -- scene units in one millimetre, from the scene's unit scale.
-- :func:`group_for_tables` -- the group for baked tables (reused when the same tables and tier
-  were built before; damaged stored tables are reported and replaced).
+- :func:`refuse_linked` -- :class:`LinkedDataError` for data linked from a library.
+- :func:`group_for_tables` -- the group for baked tables (reused when the same tables, tier and
+  method were built before and its images are intact).
 - :func:`ensure_group` -- bake, then :func:`group_for_tables`.
-- :func:`apply_to_object` -- the Apply operator's work.
-- :func:`check_material` -- verify a made-up material's stored tables, re-bake if broken.
+- :func:`apply_to_object` -- the Apply operator's work; :func:`revert_material` Revert's.
+- :func:`check_material` -- verify a made-up material against its bake record, repair it.
 """
 
 from __future__ import annotations
@@ -20,13 +22,16 @@ from collections import OrderedDict
 
 import bpy
 
-from . import nodes, scene_fit, storage
+from . import convert, nodes, scene_fit, storage
 from .package import lut_baker
 from .properties import socket_values
 
 __all__ = [
     "GROUP_NODE",
     "MATERIAL_NAME",
+    "LinkedDataError",
+    "refuse_linked",
+    "revert_material",
     "skin_from_settings",
     "resolve_tier",
     "units_per_mm",
@@ -41,8 +46,7 @@ __all__ = [
     "update_sockets",
 ]
 
-GROUP_NODE = "Made-up Skin"
-"""Name of the group node in a made-up material's node tree."""
+GROUP_NODE = convert.GROUP_NODE
 MATERIAL_NAME = "Made-up Skin"
 ERRORS_KEY = "makeup_skin_errors"
 """Material custom property: the tiers' errors at the settings of the last Apply (JSON): per
@@ -88,8 +92,27 @@ def units_per_mm(scene) -> float:
     return 0.001 / scale
 
 
+class LinkedDataError(ValueError):
+    """The data Apply or Fit to Scene would change is linked from a library."""
+
+
+def refuse_linked(obj, material) -> None:
+    """Raise :class:`LinkedDataError` (naming the library and how to make the data local) if
+    ``material``, its Made-up Skin group, or (when Apply must add a material) ``obj``'s mesh is
+    linked: changes to linked data are lost when the file is saved."""
+    node = convert.group_node(material)
+    checks = [(material, "material"), (node.node_tree if node else None, "node group")]
+    if material is None and obj is not None:
+        checks.append((obj.data, "mesh"))
+    for datablock, kind in checks:
+        reason = convert.linked_library(datablock, kind)
+        if reason is not None:
+            raise LinkedDataError(reason)
+
+
 class _Progress:
-    """``window_manager.progress_*`` over one bake (does nothing headless)."""
+    """``window_manager.progress_*`` from 0 to 100 over Apply's stages (does nothing
+    headless); ``stage(start, end)`` maps a stage's own 0..1 onto its share."""
 
     def __init__(self, context):
         self.wm = getattr(context, "window_manager", None)
@@ -99,9 +122,11 @@ class _Progress:
             self.wm.progress_begin(0, 100)
         return self
 
-    def __call__(self, fraction: float, message: str = "") -> None:
-        if self.wm is not None:
-            self.wm.progress_update(int(100 * fraction))
+    def stage(self, start: float, end: float):
+        def report(fraction: float, message: str = "") -> None:
+            if self.wm is not None:
+                self.wm.progress_update(int(100 * (start + (end - start) * fraction)))
+        return report
 
     def __exit__(self, *exc):
         if self.wm is not None:
@@ -109,58 +134,45 @@ class _Progress:
         return False
 
 
-def _intact(image) -> tuple[bool, str]:
-    try:
-        storage.unpack_tables(image)
-        return True, ""
-    except storage.StorageError as error:
-        return False, str(error)
+BAKE_SHARE = 0.2
+"""Share of Apply's progress bar the bake takes (the closure fit takes the rest: 0.1-0.2 s
+against 1-3 s)."""
+
+
+def _stage(progress, start, end):
+    return progress.stage(start, end) if progress is not None else None
 
 
 def _group_matches(group, key: str, tier: str, method) -> bool:
-    try:
-        meta = json.loads(group.get(nodes.FIT_KEY, "{}"))
-    except ValueError:
-        return False
+    meta = nodes.read_meta(group)
     if (meta.get("key"), meta.get("tier"), meta.get("forced_method")) != (key, tier, method):
         return False
-    if not nodes.has_interface(group):  # built before a socket existed (Gloss): rebuild
+    if not nodes.has_interface(group) or "parameters" not in meta:  # an older add-on's
         return False
-    if tier == "LAYERED":
-        lut = bpy.data.images.get(storage.lut_image_name(key))
-        # An image of other rows is from an older add-on (before the gloss companion row).
-        return lut is not None and lut.size[1] == len(lut_baker("closure_fit").LUT_ROWS)
-    return True
+    return all(storage.image_problem(record) is None for record in meta.get("images", []))
 
 
-def group_for_tables(tables, tier: str, *, messages=None, group=None, errors_at=None,
-                     method=None):
+def group_for_tables(tables, tier: str, *, bake=None, group=None, errors_at=None,
+                     method=None, progress=None):
     """``(group, fit or None)`` of ``tier`` for baked ``tables``.
 
-    The tables are packed under their content hash; a group already built from the same
-    tables, tier and ``method`` (a forced subsurface method, or None for the fit's choice) is
-    reused (no fit) unless ``group`` is given, which is then rebuilt in place.  Stored tables
-    of that hash that fail their checks are reported in ``messages`` and replaced.
-    ``errors_at``: ``(coverage, absorption)`` at which to measure the tiers'
-    errors when fitting (default: the bake's).
+    A group already built from the same tables, tier and ``method`` (a forced subsurface
+    method, or None for the fit's choice) whose images are intact is reused (no fit) unless
+    ``group`` is given, which is then rebuilt in place.  ``bake``: the tables' record
+    (:func:`storage.bake_record`; default: from the tables' own parameters at resolution
+    "default").  ``errors_at``: ``(coverage, absorption)`` at which to measure the tiers'
+    errors when fitting (default: the bake's).  ``progress(fraction, message)``: the fit's.
     """
-    messages = [] if messages is None else messages
-    key = storage.tables_key(tables)
-    image = storage.find_tables_image(key)
-    stored_ok = False
-    if image is not None:
-        stored_ok, problem = _intact(image)
-        if not stored_ok:
-            messages.append(f"Made-up Skin: stored tables {image.name!r} were broken "
-                            f"({problem}); re-baked them")
-    image = storage.pack_tables(tables, key)
+    if bake is None:
+        skin = lut_baker("params_file").skin_from_dict(tables.parameters)
+        bake = storage.bake_record(skin, "default", tables)
+    key = bake["key"]
     existing = bpy.data.node_groups.get(nodes.group_name(tier, key, method))
-    if group is None and existing is not None and stored_ok and _group_matches(
-            existing, key, tier, method):
+    if group is None and existing is not None and _group_matches(existing, key, tier, method):
         return existing, None
-    fit = _fit(tables, key, errors_at)
+    fit = _fit(tables, key, errors_at, progress)
     target = group if group is not None else existing
-    return nodes.build_group(tier, key, fit, image, target, method=method), fit
+    return nodes.build_group(tier, bake, fit, target, method=method), fit
 
 
 _FITS: OrderedDict = OrderedDict()
@@ -169,16 +181,17 @@ FIT_CACHE_SIZE = 8
 
 
 def clear_cache() -> None:
-    """Forget the session's fits (the add-on's unregister calls it)."""
+    """Forget the session's fits and re-baked tables (the add-on's unregister calls it)."""
     _FITS.clear()
+    storage.clear_cache()
 
 
-def _fit(tables, key: str, errors_at):
+def _fit(tables, key: str, errors_at, progress=None):
     """The closure fit of ``tables`` (cached by key), its errors measured at ``errors_at``."""
     cf = lut_baker("closure_fit")
     fit = _FITS.pop(key, None)
     if fit is None:
-        fit = cf.fit_closures(tables, errors_at=errors_at)
+        fit = cf.fit_closures(tables, errors_at=errors_at, progress=progress)
     elif errors_at is not None:
         fit = dataclasses.replace(fit, errors=cf.tier_errors(fit, tables, *errors_at))
     _FITS[key] = fit
@@ -189,45 +202,28 @@ def _fit(tables, key: str, errors_at):
 
 def ensure_group(skin, tier: str, resolution: str = "default", *, progress=None, **options):
     """Bake ``skin`` at ``resolution`` and return ``(group, tables, fit or None)``
-    (:func:`group_for_tables` for the rest)."""
-    tables = lut_baker("bake").bake(skin, resolution, progress=progress)
-    group, fit = group_for_tables(tables, tier, **options)
+    (:func:`group_for_tables` for the rest); ``progress``: a :class:`_Progress` or None."""
+    tables = lut_baker("bake").bake(skin, resolution, progress=_stage(progress, 0.0,
+                                                                      BAKE_SHARE))
+    bake = storage.bake_record(skin, resolution, tables)
+    group, fit = group_for_tables(tables, tier, bake=bake,
+                                  progress=_stage(progress, BAKE_SHARE, 1.0), **options)
     return group, tables, fit
 
 
 def group_of(material):
     """The made-up group node of a material, or None."""
-    tree = material.node_tree if material is not None else None
-    if tree is None:
-        return None
-    node = tree.nodes.get(GROUP_NODE)
-    return node if node is not None and node.type == "GROUP" else None
+    return convert.group_node(material)
 
 
-def setup_material(material, group, scene) -> None:
-    """Point the material's group node at ``group`` (creating the node and the output link if
-    needed; links into the group's inputs, e.g. a painted coverage, are kept)."""
-    if material.node_tree is None and bpy.app.version < (5, 0, 0):
-        material.use_nodes = True
-    tree = material.node_tree
-    node = group_of(material)
-    if node is None:
-        for other in list(tree.nodes):
-            tree.nodes.remove(other)
-        node = tree.nodes.new("ShaderNodeGroup")
-        node.name = node.label = GROUP_NODE
-        node.width = 220
-        output = tree.nodes.new("ShaderNodeOutputMaterial")
-        output.location = (400, 0)
-    node.node_tree = group
-    output = next((n for n in tree.nodes if n.type == "OUTPUT_MATERIAL"), None)
-    if output is None:
-        output = tree.nodes.new("ShaderNodeOutputMaterial")
-        output.location = (400, 0)
-    if not output.inputs["Surface"].is_linked:
-        tree.links.new(node.outputs["Shader"], output.inputs["Surface"])
-    nodes.set_inputs(node, {"Units per mm": units_per_mm(scene)})
+def setup_material(material, group, scene) -> list[str]:
+    """Make ``group`` the surface of ``material`` (:func:`convert.install`: the artist's tree is
+    converted in place, their shader kept and framed) and set the group node's inputs from the
+    settings.  Returns the inputs carried over from the previous shader."""
+    carried = convert.install(material, group)
+    nodes.set_inputs(group_of(material), {"Units per mm": units_per_mm(scene)})
     update_sockets(material)
+    return carried
 
 
 def update_sockets(material) -> None:
@@ -237,26 +233,18 @@ def update_sockets(material) -> None:
         nodes.set_inputs(node, socket_values(material.makeup_skin))
 
 
-def _copy_settings(source, target) -> None:
-    for name in source.bl_rna.properties.keys():
-        if name in ("rna_type", "name", "is_made_up"):
-            continue
-        try:
-            setattr(target, name, getattr(source, name))
-        except (AttributeError, TypeError):
-            pass
+def _users(material) -> list:
+    """Objects whose slots hold ``material``."""
+    return [obj for obj in bpy.data.objects
+            if any(slot.material == material for slot in getattr(obj, "material_slots", ()))]
 
 
 def _material_for(obj):
-    """The object's made-up material, or a new one (settings copied from its active material)
-    assigned to its active slot."""
-    current = obj.active_material
-    if current is not None and current.makeup_skin.is_made_up:
-        return current
+    """The object's active material, or a new one in its active slot (the object had none)."""
+    material = obj.active_material
+    if material is not None:
+        return material
     material = bpy.data.materials.new(MATERIAL_NAME)
-    if current is not None:
-        _copy_settings(current.makeup_skin, material.makeup_skin)
-    material.makeup_skin.is_made_up = True
     if obj.material_slots:
         obj.active_material = material
     else:
@@ -264,25 +252,29 @@ def _material_for(obj):
     return material
 
 
-def apply_to_object(context, obj, *, settings=None, resolution=None) -> tuple:
-    """Bake, pack, build or reuse the group, and give ``obj`` the made-up material.
+def apply_to_object(context, obj, *, resolution=None) -> tuple:
+    """Bake, fit, build or reuse the group, and make it the surface of ``obj``'s active
+    material, converted in place (:func:`setup_material`); an object without a material
+    gets a new one.  Returns ``(material, messages)``: the report's sentences (what was
+    carried over, how many objects share the material).
 
-    ``settings``: defaults to the object's active material's (copied to the new material).
-    Returns ``(material, messages)``; messages are for the operator's report.
+    Raises
+    ------
+    LinkedDataError
+        If the material, its group, or the mesh that would get a new material is linked from
+        a library (nothing is changed).
     """
+    refuse_linked(obj, obj.active_material)
     material = _material_for(obj)
-    if settings is not None and settings != material.makeup_skin:
-        _copy_settings(settings, material.makeup_skin)
     settings = material.makeup_skin
-    settings.is_made_up = True
+    first = not settings.is_made_up or group_of(material) is None
     scene = context.scene
     tier = resolve_tier(settings, scene)
-    messages = []
     absorption = settings.effective_absorption()
     with _Progress(context) as progress:
         group, tables, fit = ensure_group(
             skin_from_settings(settings), tier, resolution or settings.resolution,
-            progress=progress, messages=messages, errors_at=(settings.coverage, absorption),
+            progress=progress, errors_at=(settings.coverage, absorption),
             method=forced_method(settings))
     if fit is not None:
         omission = lut_baker("scene_model").gloss_omissions(tables, fit, settings.coverage,
@@ -294,36 +286,75 @@ def apply_to_object(context, obj, *, settings=None, resolution=None) -> tuple:
                                                   "gloss_omission": omission[name],
                                                   "key": key}
                                            for name, e in fit.errors.items()})
-    setup_material(material, group, scene)
+    carried = setup_material(material, group, scene)
+    settings.is_made_up = True
+    messages = []
+    if first:
+        kept = ("its previous surface is kept, framed and disconnected (Revert restores it)"
+                if convert.can_revert(material) else "it had no surface before")
+        linked = f"; linked {', '.join(carried)}" if carried else ""
+        messages.append(f"Converted {material.name!r} in place: {kept}{linked}.")
+    users = len(_users(material))
+    if users > 1:
+        messages.append(f"{material.name!r} is shared by {users} objects: all of them show "
+                        f"the made-up skin.")
     return material, messages
 
 
-def check_material(context, material) -> list[str]:
-    """Verify a made-up material's group and stored tables; re-bake what is missing or broken.
-    Returns the messages to report (empty when all is well)."""
-    node = group_of(material)
-    problem = None
-    if node is None or node.node_tree is None:
-        problem = "its node group is missing"
-    else:
-        try:
-            meta = json.loads(node.node_tree.get(nodes.FIT_KEY, "{}"))
-            image = bpy.data.images.get(meta.get("tables", ""))
-            storage.unpack_tables(image)
-            if meta.get("tier") == "LAYERED" and bpy.data.images.get(
-                    storage.lut_image_name(meta.get("key", ""))) is None:
-                problem = "its view-angle lookup image is missing"
-        except (ValueError, storage.StorageError) as error:
-            problem = str(error)
-    if problem is None:
-        return []
-    messages = [f"Made-up Skin: material {material.name!r}: {problem}; re-baking"]
+def revert_material(material) -> str:
+    """Give ``material`` back the surface it had before Apply (:func:`convert.revert`); its
+    Made-up Skin settings stay for a later Apply.  Returns the report's sentence."""
+    reason = convert.linked_library(material, "material")
+    if reason is not None:
+        raise LinkedDataError(reason)
+    restored = convert.revert(material)
+    material.makeup_skin.is_made_up = False
+    return f"Reverted {material.name!r}: {restored}."
+
+
+def _rebuild(context, material, group) -> None:
+    """Re-bake from the settings and rebuild ``group`` in place (Check Tables' repair when the
+    group's record cannot be used)."""
     settings = material.makeup_skin
     tier = resolve_tier(settings, context.scene)
-    group = node.node_tree if node is not None else None
     with _Progress(context) as progress:
         group, _, _ = ensure_group(skin_from_settings(settings), tier, settings.resolution,
-                                   progress=progress, messages=messages, group=group,
+                                   progress=progress, group=group,
                                    method=forced_method(settings))
     setup_material(material, group, context.scene)
-    return messages
+
+
+def check_material(context, material) -> tuple[bool, str]:
+    """Verify a made-up material: its group's record re-bakes to the recorded tables and every
+    image the render reads matches its recorded hash; repair what is not by re-baking.
+    Returns ``(intact, one sentence for the report)``."""
+    name = material.name
+    node = group_of(material)
+    if node is None or node.node_tree is None:
+        return False, (f"{name!r}: its Made-up Skin node is gone from the node tree; Apply "
+                       f"puts it back.")
+    group = node.node_tree
+    reason = convert.linked_library(group, "node group")
+    if reason is not None:
+        return False, f"{name!r}: not checked: {reason}."
+    meta = nodes.read_meta(group)
+    if "parameters" not in meta:
+        _rebuild(context, material, group)
+        return False, (f"{name!r}: its group had no bake record (made by an older "
+                       f"version); re-baked it from the panel's settings.")
+    try:
+        tables, same = storage.rebake(meta)
+    except storage.StorageError as error:
+        _rebuild(context, material, group)
+        return False, f"{name!r}: {error}; re-baked it from the panel's settings."
+    problems = [p for p in map(storage.image_problem, meta.get("images", [])) if p]
+    note = ("" if same else " (the tables re-baked here differ from the recorded ones in "
+                            "their last bits: this numpy rounds differently)")
+    if not problems and nodes.has_interface(group):
+        return True, f"{name!r}: intact{note}."
+    bake = {"key": storage.tables_key(tables), "parameters": meta["parameters"],
+            "resolution": meta.get("resolution", "default")}
+    group_for_tables(tables, meta.get("tier", "LAYERED"), bake=bake, group=group,
+                     method=meta.get("forced_method"))
+    what = "; ".join(problems) if problems else "its inputs were of an older version"
+    return False, f"{name!r}: {what}; rebuilt it from a re-bake{note}."

@@ -3,12 +3,19 @@
 Both tiers share one interface, so a material keeps its links when the tier changes:
 
 - inputs: ``Coverage`` (0..1, paintable with a texture), ``Foundation Absorption`` (colour:
-  the fraction of light the film's pigment absorbs per channel), ``Skin Tint`` (multiplies the
-  skin's diffuse albedo), ``Subsurface Scale`` (artist multiplier of the fitted radius),
-  ``Gloss`` (0..1, multiplies the gloss lobes: at 0 Cycles allocates none of them, which the
-  Auto tier uses when the gloss is below the noise), ``Units per mm`` (scene units in one
-  millimetre; the add-on sets it from the scene's unit scale);
+  the fraction of light the film's pigment absorbs per channel), ``Skin Color`` (the skin's
+  diffuse albedo, default the skin preset's: link the character's albedo texture),
+  ``Normal`` and ``Film Normal`` (the skin's and the film's shading normals; unlinked, the
+  surface's), ``Subsurface Scale`` (artist multiplier of the fitted radius), ``Gloss`` (0..1,
+  multiplies the gloss lobes: at 0 Cycles allocates none of them, which the Auto tier uses
+  when the gloss is below the noise), ``Units per mm`` (scene units in one millimetre; the
+  add-on sets it from the scene's unit scale);
 - output: ``Shader``.
+
+Every skin closure is linear in Skin Color: the tables' skin diffuse term enters the model's
+first-order paths (bare skin, and path 3 through the film) as a factor, and the view-angle rows
+are per unit albedo, so a texture scales them exactly.  What stays the preset's: the subsurface
+radius (fitted to the skin's profile), the skin's gloss and the film.
 
 PRINCIPLED: one Principled BSDF (GGX, coat = the film, specular and base/subsurface = the skin)
 whose inputs follow :func:`lut_baker.closure_fit.principled_inputs` in math nodes (Gloss
@@ -22,7 +29,8 @@ Coverage between bare skin and made-up skin: an areal mix of closures, so a pain
 fades out without fringe or halo.
 
 - :func:`group_name` -- name of a group from tier, tables key and a forced subsurface method.
-- :func:`build_group` -- create or rebuild (in place) a group from a fit and its tables.
+- :func:`build_group` -- create or rebuild (in place) a group from a fit and its bake record.
+- :func:`read_meta` -- a group's record (bake, fit summary, image hashes).
 - :func:`set_inputs` -- socket values on a group node from the panel's settings.
 """
 
@@ -36,14 +44,15 @@ import numpy as np
 from . import storage
 from .package import lut_baker
 
-__all__ = ["INPUTS", "GROUP_PREFIX", "FIT_KEY", "TABLES_REF", "group_name", "build_group",
-           "set_inputs", "socket", "has_interface"]
+__all__ = ["INPUTS", "NORMAL_INPUTS", "GROUP_PREFIX", "FIT_KEY", "group_name", "build_group",
+           "read_meta", "set_inputs", "socket", "has_interface"]
 
 GROUP_PREFIX = "Made-up Skin"
 FIT_KEY = "makeup_skin_fit"
 """Custom property of a group: its tables key, tier and the fit's summary (JSON)."""
-TABLES_REF = "makeup_skin_tables"
-"""Custom property of a group holding its tables image (keeps it saved with the file)."""
+LEGACY_TABLES_REF = "makeup_skin_tables"
+"""Custom property by which older versions kept a whole tables image in the file; removed when
+the group is rebuilt."""
 
 INPUTS = (
     # name, socket type, default, min, max, subtype, description
@@ -51,8 +60,15 @@ INPUTS = (
      "Foundation coverage: 0 bare skin, 1 full film (paint it with a texture)"),
     ("Foundation Absorption", "NodeSocketColor", (0.0, 0.0, 0.0, 1.0), None, None, None,
      "Fraction of the light crossing the film's pigment that it absorbs, per channel"),
-    ("Skin Tint", "NodeSocketColor", (1.0, 1.0, 1.0, 1.0), None, None, None,
-     "Multiplies the skin's diffuse albedo"),
+    ("Skin Color", "NodeSocketColor", (0.8, 0.8, 0.8, 1.0), None, None, None,
+     "The skin's diffuse albedo (link the character's albedo texture here); every skin "
+     "closure scales with it, under the film and bare"),
+    ("Normal", "NodeSocketVector", (0.0, 0.0, 0.0), None, None, None,
+     "Normal of the skin's closures (link a Normal Map or Bump node with pore detail); "
+     "unlinked: the surface's shading normal"),
+    ("Film Normal", "NodeSocketVector", (0.0, 0.0, 0.0), None, None, None,
+     "Normal of the foundation film's closures (a softer bump than the skin's: foundation "
+     "fills pores); unlinked: the surface's shading normal"),
     ("Subsurface Scale", "NodeSocketFloat", 1.0, 0.0, 100.0, "NONE",
      "Multiplies the subsurface radius fitted to the skin's profile"),
     ("Gloss", "NodeSocketFloat", 1.0, 0.0, 1.0, "FACTOR",
@@ -62,6 +78,10 @@ INPUTS = (
     ("Units per mm", "NodeSocketFloat", 0.001, 0.0, 1e6, "NONE",
      "Scene units in one millimetre (set from the scene's unit scale on Apply)"),
 )
+NORMAL_INPUTS = ("Normal", "Film Normal")
+"""Vector inputs whose value is hidden: unlinked, a closure's Normal is the shading normal
+(Blender leaves a hidden-value group input unlinked inside the group), and the view-angle
+lookups use the Geometry node's normal instead (:func:`_normal_or_shading`)."""
 
 
 METHOD_LABELS = {"BURLEY": "Burley", "RANDOM_WALK": "RW", "RANDOM_WALK_SKIN": "RW Skin"}
@@ -120,7 +140,7 @@ class _Builder:
         node = self.node("ShaderNodeVectorMath", label, operation=operation)
         self.feed(socket(node.inputs, "Vector"), a)
         self.feed(socket(node.inputs, "Vector_001"), b)
-        return node.outputs["Value" if operation == "DOT_PRODUCT" else "Vector"]
+        return node.outputs["Value" if operation in ("DOT_PRODUCT", "LENGTH") else "Vector"]
 
     def scale(self, vector, factor, label: str = ""):
         """``vector * factor`` (a float)."""
@@ -146,11 +166,23 @@ class _Builder:
         return socket(node.outputs, "Result_" + suffix)
 
 
-def _interface(group) -> None:
+def _input_names(group) -> list[str]:
+    return [item.name for item in group.interface.items_tree
+            if getattr(item, "item_type", "SOCKET") == "SOCKET"
+            and getattr(item, "in_out", "INPUT") == "INPUT"]
+
+
+def _interface(group, skin_albedo) -> None:
     """Create the group's sockets if missing (existing ones keep their links and values); a
-    socket added to a group built before it existed is moved to its place in :data:`INPUTS`."""
-    existing = {item.name for item in group.interface.items_tree
-                if getattr(item, "item_type", "SOCKET") == "SOCKET"}
+    socket added to a group built before it existed is moved to its place in :data:`INPUTS`,
+    and inputs no longer in :data:`INPUTS` are removed.  ``skin_albedo`` (RGB) becomes Skin
+    Color's default."""
+    known = {name for name, *_ in INPUTS}
+    for item in list(group.interface.items_tree):
+        if (getattr(item, "item_type", "SOCKET") == "SOCKET" and item.in_out == "INPUT"
+                and item.name not in known):
+            group.interface.remove(item)
+    existing = set(_input_names(group))
     for position, (name, kind, default, low, high, subtype, description) in enumerate(INPUTS):
         if name in existing:
             continue
@@ -161,25 +193,43 @@ def _interface(group) -> None:
             item.min_value, item.max_value = low, high
         if subtype and hasattr(item, "subtype"):
             item.subtype = subtype
+        if name in NORMAL_INPUTS:
+            item.hide_value = True
         if existing and position:  # after its predecessor (outputs may come first)
             items = list(group.interface.items_tree)
             before = next(i for i, other in enumerate(items)
                           if other.name == INPUTS[position - 1][0])
             group.interface.move(item, before + 1)
-    if "Shader" not in existing:
+    if not any(getattr(item, "in_out", "") == "OUTPUT" and item.name == "Shader"
+               for item in group.interface.items_tree):
         group.interface.new_socket(name="Shader", in_out="OUTPUT", socket_type="NodeSocketShader")
+    colour = next(item for item in group.interface.items_tree
+                  if getattr(item, "in_out", "") == "INPUT" and item.name == "Skin Color")
+    colour.default_value = (*map(float, skin_albedo), 1.0)
 
 
 def has_interface(group) -> bool:
-    """Whether ``group`` has every input of :data:`INPUTS` (a group built by an older version
-    of the add-on may lack one, e.g. Gloss, and is then rebuilt)."""
-    names = {item.name for item in group.interface.items_tree
-             if getattr(item, "item_type", "SOCKET") == "SOCKET"
-             and getattr(item, "in_out", "INPUT") == "INPUT"}
-    return all(name in names for name, *_ in INPUTS)
+    """Whether ``group``'s inputs are exactly :data:`INPUTS` (a group built by an older version
+    of the add-on may lack one, e.g. Film Normal, and is then rebuilt)."""
+    return _input_names(group) == [name for name, *_ in INPUTS]
 
 
-def _common(build: _Builder, fit):
+def _normal_or_shading(build: _Builder, normal, geometry):
+    """The Normal input where linked, else the Geometry node's shading normal: an unlinked
+    hidden vector input reads (0, 0, 0) in math nodes, so a length below 0.5 means unlinked
+    (a mix at factor 0 returns the shading normal exactly)."""
+    linked = build.math("GREATER_THAN", build.vector("LENGTH", normal), 0.5)
+    return build.mix_vector(linked, geometry.outputs["Normal"], normal, label="normal or shading")
+
+
+def _cos_view(build: _Builder, normal, geometry, label: str):
+    """``max(0, I . N)``: the cosine of the view angle against ``normal``."""
+    return build.math("MAXIMUM", build.vector("DOT_PRODUCT", geometry.outputs["Incoming"],
+                                              _normal_or_shading(build, normal, geometry)),
+                      0.0, label=label)
+
+
+def _common(build: _Builder):
     """Group input/output nodes and the terms both tiers use."""
     inputs = build.node("NodeGroupInput")
     output = build.node("NodeGroupOutput")
@@ -187,8 +237,7 @@ def _common(build: _Builder, fit):
     through = build.vector("SUBTRACT", (1.0, 1.0, 1.0), inputs.outputs["Foundation Absorption"],
                            label="1 - A")
     through2 = build.vector("MULTIPLY", through, through, label="(1 - A)^2")
-    skin = build.vector("MULTIPLY", inputs.outputs["Skin Tint"], tuple(fit.skin_albedo),
-                        label="skin albedo")
+    skin = inputs.outputs["Skin Color"]
     scale = build.math("MULTIPLY", inputs.outputs["Subsurface Scale"],
                        inputs.outputs["Units per mm"], label="subsurface scale")
     return inputs, output, w, through, through2, skin, scale, inputs.outputs["Gloss"]
@@ -196,7 +245,7 @@ def _common(build: _Builder, fit):
 
 def _build_principled(build: _Builder, fit, method: str, radius_mm, ior: float):
     cf = lut_baker("closure_fit")
-    inputs, output, w, through, through2, skin, scale, gloss = _common(build, fit)
+    inputs, output, w, through, through2, skin, scale, gloss = _common(build)
     coat_weight = build.math("MULTIPLY", w, gloss, label="coat weight")
     made_skin = build.vector("MULTIPLY", build.vector("MULTIPLY", through2, skin),
                              tuple(fit.transmittance_mean**2), label="skin through film")
@@ -229,7 +278,8 @@ def _build_principled(build: _Builder, fit, method: str, radius_mm, ior: float):
         "Coat Roughness": fit.coat.roughness,
         "Coat IOR": fit.coat.ior, "Subsurface Weight": share,
         "Subsurface Radius": tuple(map(float, radius_mm)), "Subsurface Scale": scale,
-        "Subsurface IOR": ior,
+        "Subsurface IOR": ior, "Normal": inputs.outputs["Normal"],
+        "Coat Normal": inputs.outputs["Film Normal"],
     }
     for name, value in values.items():
         # By identifier: a socket the method leaves unavailable is not found by name in 5.0.
@@ -239,36 +289,40 @@ def _build_principled(build: _Builder, fit, method: str, radius_mm, ior: float):
 
 def _build_layered(build: _Builder, fit, lut, method: str, radius_mm, ior: float):
     cf = lut_baker("closure_fit")
-    inputs, output, w, through, through2, skin, scale, gloss = _common(build, fit)
+    inputs, output, w, through, through2, skin, scale, gloss = _common(build)
     geometry = build.node("ShaderNodeNewGeometry")
-    cos_o = build.math("MAXIMUM", build.vector("DOT_PRODUCT", geometry.outputs["Incoming"],
-                                               geometry.outputs["Normal"]), 0.0,
-                       label="cos theta_o")
+    film_normal, skin_normal = inputs.outputs["Film Normal"], inputs.outputs["Normal"]
+    # Each row is read at the view angle against the normal of the surface it describes: the
+    # skin's own gloss against the skin's, the film and the light through it against the film's.
+    cos_film = _cos_view(build, film_normal, geometry, "cos theta_o (film)")
+    cos_skin = _cos_view(build, skin_normal, geometry, "cos theta_o (skin)")
     rows = {}
     for j, name in enumerate(cf.LUT_ROWS):
         coordinate = build.node("ShaderNodeCombineXYZ", f"u = cos, row {name}")
-        build.feed(coordinate.inputs["X"], cos_o)
+        build.feed(coordinate.inputs["X"], cos_skin if name == "skin_gloss" else cos_film)
         build.feed(coordinate.inputs["Y"], (j + 0.5) / len(cf.LUT_ROWS))
         texture = build.node("ShaderNodeTexImage", name, image=lut, interpolation="Linear",
                              extension="EXTEND")
         build.tree.links.new(coordinate.outputs[0], texture.inputs["Vector"])
         rows[name] = texture.outputs["Color"]
 
-    def glossy(name, colour):
+    def glossy(name, colour, normal):
         lobe = fit.glossy[name]
         node = build.node("ShaderNodeBsdfGlossy", name.replace("_", " "),
                           distribution=lobe.distribution)
         # Gloss 0: colour 0, a closure Cycles does not allocate (bsdf_alloc's weight cutoff).
         build.feed(node.inputs["Color"], build.scale(colour, gloss, label=f"{name} x Gloss"))
         build.feed(node.inputs["Roughness"], lobe.roughness)
+        build.feed(node.inputs["Normal"], normal)
         return node.outputs[0]
 
-    def subsurface(colour, label):
+    def subsurface(colour, label):  # the skin's: its normal
         node = build.node("ShaderNodeSubsurfaceScattering", label, falloff=method)
         build.feed(socket(node.inputs, "Color"), colour)
         build.feed(socket(node.inputs, "Radius"), tuple(map(float, radius_mm)))
         build.feed(socket(node.inputs, "Scale"), scale)
         build.feed(socket(node.inputs, "IOR"), ior)
+        build.feed(socket(node.inputs, "Normal"), skin_normal)
         return node.outputs[0]
 
     def add(a, b):
@@ -284,6 +338,7 @@ def _build_layered(build: _Builder, fit, lut, method: str, radius_mm, ior: float
     build.feed(film_diffuse.inputs["Color"],
                build.vector("ADD", build.vector("MULTIPLY", through, tuple(fit.film_albedo)),
                             companion, label="film diffuse + gloss companion"))
+    build.feed(film_diffuse.inputs["Normal"], film_normal)
     # The skin seen through the film: the medium keeps the skin's own (bright) colour, tinted
     # by the film's absorption relative to its weakest channel, and the film's transmittances
     # scale the closure as a whole.  A dark colour instead would make the random walk both
@@ -304,11 +359,13 @@ def _build_layered(build: _Builder, fit, lut, method: str, radius_mm, ior: float
     build.feed(socket(weighted.inputs, "Fac"), through_weight)
     build.tree.links.new(subsurface(through_colour, "skin through film"),
                          socket(weighted.inputs, "Shader_001"))
-    made_up = add(add(glossy("film_gloss", rows["film_gloss"]), film_diffuse.outputs[0]),
+    made_up = add(add(glossy("film_gloss", rows["film_gloss"], film_normal),
+                      film_diffuse.outputs[0]),
                   add(glossy("path3_gloss", build.vector("MULTIPLY", rows["path3_gloss"],
-                                                         through2)),
+                                                         through2), skin_normal),
                       weighted.outputs[0]))
-    bare = add(glossy("skin_gloss", rows["skin_gloss"]), subsurface(skin, "bare skin"))
+    bare = add(glossy("skin_gloss", rows["skin_gloss"], skin_normal),
+               subsurface(skin, "bare skin"))
     mix = build.node("ShaderNodeMixShader", "coverage (areal mix)")
     build.feed(socket(mix.inputs, "Fac"), w)
     build.tree.links.new(bare, socket(mix.inputs, "Shader"))
@@ -316,37 +373,51 @@ def _build_layered(build: _Builder, fit, lut, method: str, radius_mm, ior: float
     build.tree.links.new(mix.outputs[0], output.inputs["Shader"])
 
 
-def build_group(tier: str, key: str, fit, tables_image, group=None, *, method=None):
-    """Create (or, given ``group``, rebuild in place) the node group of ``tier`` for the tables
-    stored in ``tables_image`` (key ``key``) and their :class:`ClosureFit` ``fit``.
-    ``method``: a subsurface method forced by the user, else the fit's choice."""
+def build_group(tier: str, bake: dict, fit, group=None, *, method=None):
+    """Create (or, given ``group``, rebuild in place) the node group of ``tier`` from a
+    :class:`ClosureFit` ``fit`` of the tables that ``bake`` describes (its record,
+    :func:`storage.bake_record`).  ``method``: a subsurface method forced by the user, else the
+    fit's choice.  The group's :data:`FIT_KEY` holds the bake record, the fit's summary and the
+    SHA-256 of every image the group reads (:func:`storage.image_record`)."""
     cf = lut_baker("closure_fit")
     if tier not in cf.TIERS:
         raise ValueError(f"tier must be one of {cf.TIERS}, got {tier!r}")
+    key = bake["key"]
     name = group_name(tier, key, method)
     if group is None:
         group = bpy.data.node_groups.get(name) or bpy.data.node_groups.new(name,
                                                                            "ShaderNodeTree")
     elif group.name != name and bpy.data.node_groups.get(name) is None:
         group.name = name
-    _interface(group)
+    _interface(group, fit.skin_albedo)
     group.nodes.clear()
     build = _Builder(group)
     forced = method
     method = method or fit.subsurface_method
     radius = fit.profiles[method].radius_mm
     ior = fit.subsurface_ior
+    images = []
     if tier == "PRINCIPLED":
         _build_principled(build, fit, method, radius, ior)
     else:
         lut = storage.lut_image(storage.lut_image_name(key), fit.lut)
+        images.append(storage.image_record(lut))
         _build_layered(build, fit, lut, method, radius, ior)
-    group[FIT_KEY] = json.dumps({"key": key, "tier": tier, "tables": tables_image.name,
-                                 "forced_method": forced, **fit.summary(),
+    group[FIT_KEY] = json.dumps({**bake, "tier": tier, "forced_method": forced,
+                                 "images": images, **fit.summary(),
                                  "subsurface_method": method}, default=float)
-    # An ID property holding the image counts as a user: the tables are saved with the group.
-    group[TABLES_REF] = tables_image
+    if LEGACY_TABLES_REF in group:  # an older add-on kept the whole tables in the file
+        del group[LEGACY_TABLES_REF]
     return group
+
+
+def read_meta(group) -> dict:
+    """A group's :data:`FIT_KEY` record, or {} if it has none or it cannot be read."""
+    try:
+        meta = json.loads(group.get(FIT_KEY, "{}")) if group is not None else {}
+    except (TypeError, ValueError):
+        return {}
+    return meta if isinstance(meta, dict) else {}
 
 
 def set_inputs(node, values: dict) -> None:

@@ -1,15 +1,17 @@
-"""Operators: Apply, Check Tables, and the preset menu's add/remove operator."""
+"""Operators: Apply, Revert, Check Tables, and the preset menu's add/remove operator."""
 
 from __future__ import annotations
 
 import bpy
 from bl_operators.presets import AddPresetBase
 
+from . import convert
 from . import material as made_up
 from .package import lut_baker
 
-__all__ = ["MAKEUPSKIN_OT_apply", "MAKEUPSKIN_OT_check_tables", "MAKEUPSKIN_OT_add_preset",
-           "MAKEUPSKIN_MT_presets", "PRESET_SUBDIR", "register", "unregister"]
+__all__ = ["MAKEUPSKIN_OT_apply", "MAKEUPSKIN_OT_revert", "MAKEUPSKIN_OT_check_tables",
+           "MAKEUPSKIN_OT_add_preset", "MAKEUPSKIN_MT_presets", "PRESET_SUBDIR", "register",
+           "unregister"]
 
 PRESET_SUBDIR = "makeup_skin"
 """Folder under Blender's ``presets`` where parameter sets are saved."""
@@ -23,8 +25,9 @@ class _ObjectPoll:
 
 
 class MAKEUPSKIN_OT_apply(_ObjectPoll, bpy.types.Operator):
-    """Bake the tables, pack them into the file, build or reuse the Made-up Skin node group
-    and give the active object the material"""
+    """Bake and fit the made-up skin and make it the surface of the active object's material,
+    converted in place: the previous surface shader is kept, framed and disconnected, and its
+    albedo and normal links are carried over"""
 
     bl_idname = "makeup_skin.apply"
     bl_label = "Apply Made-up Skin"
@@ -42,35 +45,67 @@ class MAKEUPSKIN_OT_apply(_ObjectPoll, bpy.types.Operator):
         try:
             material, messages = made_up.apply_to_object(context, obj, resolution=resolution)
         except (ValueError, RuntimeError) as error:
-            self.report({"ERROR"}, f"Made-up Skin: {error}")
+            self.report({"ERROR"}, f"Made-up Skin: {_sentence(error)}")
             return {"CANCELLED"}
         for message in messages:
-            self.report({"WARNING"}, message)
-        self.report({"INFO"}, f"Made-up Skin: {material.name!r} applied to {obj.name!r}")
+            self.report({"INFO"}, f"Made-up Skin: {message}")
+        self.report({"INFO"}, f"Made-up Skin: {material.name!r} on {obj.name!r} is made up.")
+        return {"FINISHED"}
+
+
+class MAKEUPSKIN_OT_revert(bpy.types.Operator):
+    """Give the active material back the surface shader it had before Apply and remove the
+    Made-up Skin node (the settings stay for a later Apply)"""
+
+    bl_idname = "makeup_skin.revert"
+    bl_label = "Revert to Previous Surface"
+    bl_options = {"REGISTER", "UNDO"}
+
+    @classmethod
+    def poll(cls, context):
+        obj = context.active_object
+        return obj is not None and convert.can_revert(obj.active_material)
+
+    def execute(self, context):
+        try:
+            message = made_up.revert_material(context.active_object.active_material)
+        except ValueError as error:
+            self.report({"ERROR"}, f"Made-up Skin: {_sentence(error)}")
+            return {"CANCELLED"}
+        self.report({"INFO"}, f"Made-up Skin: {message}")
         return {"FINISHED"}
 
 
 class MAKEUPSKIN_OT_check_tables(bpy.types.Operator):
-    """Check the tables packed for every Made-up Skin material; re-bake missing or broken ones"""
+    """Check every Made-up Skin material against the record of its bake and the hashes of the
+    images its render reads; repair what is missing or damaged by re-baking"""
 
     bl_idname = "makeup_skin.check_tables"
     bl_label = "Check Made-up Skin Tables"
     bl_options = {"REGISTER", "UNDO"}
 
     def execute(self, context):
-        messages = []
+        checked = 0
         for material in list(bpy.data.materials):
-            if material.makeup_skin.is_made_up:
-                try:
-                    messages += made_up.check_material(context, material)
-                except (ValueError, RuntimeError) as error:
-                    messages.append(f"Made-up Skin: {material.name!r} could not be re-baked: "
-                                    f"{error}")
-        for message in messages:
-            self.report({"WARNING"}, message)
-        if not messages:
-            self.report({"INFO"}, "Made-up Skin: all tables intact")
+            if not material.makeup_skin.is_made_up:
+                continue
+            checked += 1
+            try:
+                intact, sentence = made_up.check_material(context, material)
+            except (ValueError, RuntimeError) as error:
+                intact = False
+                sentence = f"{material.name!r} could not be repaired: {_sentence(error)}"
+            self.report({"INFO" if intact else "WARNING"}, f"Made-up Skin: {sentence}")
+        if not checked:
+            self.report({"INFO"}, "Made-up Skin: no made-up material in this file.")
         return {"FINISHED"}
+
+
+def _sentence(error) -> str:
+    """An exception's message as a sentence: capital first letter, final full stop."""
+    text = str(error).strip() or type(error).__name__
+    text = text[0].upper() + text[1:]
+    return text if text.endswith((".", "!", "?")) else text + "."
 
 
 class MAKEUPSKIN_MT_presets(bpy.types.Menu):
@@ -96,14 +131,15 @@ class MAKEUPSKIN_OT_add_preset(AddPresetBase, bpy.types.Operator):
     preset_defines = ["settings = bpy.context.object.active_material.makeup_skin"]
     preset_values = [
         "settings.foundation", "settings.skin", "settings.coverage", "settings.absorption_mode",
-        "settings.absorption", "settings.foundation_colour", "settings.skin_tint",
+        "settings.absorption", "settings.foundation_colour", "settings.skin_colour",
         "settings.subsurface_scale", "settings.gloss", "settings.subsurface_method",
         "settings.override_film", "settings.film_lobe_width", "settings.film_ior",
         "settings.tier", "settings.resolution",
     ]
 
 
-classes = (MAKEUPSKIN_OT_apply, MAKEUPSKIN_OT_check_tables, MAKEUPSKIN_MT_presets,
+classes = (MAKEUPSKIN_OT_apply, MAKEUPSKIN_OT_revert, MAKEUPSKIN_OT_check_tables,
+           MAKEUPSKIN_MT_presets,
            MAKEUPSKIN_OT_add_preset)
 
 

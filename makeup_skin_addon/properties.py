@@ -1,6 +1,6 @@
 """The panel's settings: one :class:`MakeupSkinSettings` per material (``material.makeup_skin``).
 
-Coverage, absorption, skin tint, subsurface scale and gloss are socket values of the material's
+Coverage, absorption, skin colour, subsurface scale and gloss are socket values of the material's
 group node: moving them updates the material at once.  Foundation and skin presets, film overrides,
 tier and resolution change the tables: with live update on, moving them schedules a preview
 re-bake (:mod:`.live`); Apply bakes at full resolution.
@@ -68,7 +68,7 @@ def socket_values(settings) -> dict:
     return {
         "Coverage": settings.coverage,
         "Foundation Absorption": tuple(settings.effective_absorption()),
-        "Skin Tint": tuple(settings.skin_tint),
+        "Skin Color": tuple(settings.skin_colour),
         "Subsurface Scale": settings.subsurface_scale,
         "Gloss": settings.gloss,
     }
@@ -84,6 +84,14 @@ def _update_tables(self, context):
     from . import live
 
     live.tables_changed(self)
+
+
+def _update_skin(self, context):
+    presets = lut_baker("presets")
+    if self.skin in presets.SKINS:
+        # The preset's albedo goes to the socket at once (a linked texture overrides it).
+        self.skin_colour = presets.skin_albedo(self.skin).tolist()
+    _update_tables(self, context)
 
 
 def _update_foundation(self, context):
@@ -107,8 +115,9 @@ class MakeupSkinSettings(bpy.types.PropertyGroup):
         update=_update_foundation)
     skin: bpy.props.EnumProperty(
         name="Skin", items=_cached("skin", _skin_items),
-        description="Skin under the film: the paper's bio-plate or measured human skin",
-        update=_update_tables)
+        description="Skin under the film: the paper's bio-plate or measured human skin (sets "
+                    "Skin Color to its albedo)",
+        update=_update_skin)
     coverage: bpy.props.FloatProperty(
         name="Coverage", default=1.0, min=0.0, max=1.0, subtype="FACTOR",
         description="Fraction of the surface the film covers (0 bare skin, 1 full film); link "
@@ -126,9 +135,13 @@ class MakeupSkinSettings(bpy.types.PropertyGroup):
         name="Foundation Colour", size=3, default=(1.0, 1.0, 1.0), min=0.0, max=1.0,
         subtype="COLOR", description="Colour the pigment lets through (1 - absorption)",
         update=_update_sockets)
-    skin_tint: bpy.props.FloatVectorProperty(
-        name="Skin Tint", size=3, default=(1.0, 1.0, 1.0), min=0.0, max=2.0, subtype="COLOR",
-        description="Multiplies the skin's diffuse albedo", update=_update_sockets)
+    skin_colour: bpy.props.FloatVectorProperty(
+        name="Skin Color", size=3, min=0.0, max=1.0,
+        default=tuple(lut_baker("presets").skin_albedo(next(iter(lut_baker("presets").SKINS)))),
+        subtype="COLOR",
+        description="The skin's diffuse albedo (the skin preset's by default); an albedo "
+                    "texture linked to the group's Skin Color input replaces it",
+        update=_update_sockets)
     subsurface_scale: bpy.props.FloatProperty(
         name="Subsurface Scale", default=1.0, min=0.0, soft_max=4.0, max=100.0,
         description="Multiplies the subsurface radius fitted to the skin's measured profile "

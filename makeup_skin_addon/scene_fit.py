@@ -1,11 +1,11 @@
-"""Fit to Scene: the Auto tier chosen from the scene (issue 5, item 5).
+"""Fit to Scene: the Auto tier chosen from the scene.
 
 What the scene looks like to the model (:class:`lut_baker.scene_model.SceneDescription`) comes
 from the active camera, the render resolution, the objects wearing the material (the nearest
 one: the largest on screen), the lights and the render engine; what the material is
-(:class:`lut_baker.scene_model.MaterialTraits`) from its stored tables and the tiers' errors of
-its last Apply.  :func:`lut_baker.scene_model.choose` then picks the cheapest candidate within
-the tolerance.
+(:class:`lut_baker.scene_model.MaterialTraits`) from its tables (re-baked from its group's
+record) and the tiers' errors of its last Apply.  :func:`lut_baker.scene_model.choose` then
+picks the cheapest candidate within the tolerance.
 
 - :func:`auto_tier` -- the tier for ``Tier = Auto`` (called by
   :func:`makeup_skin_addon.material.resolve_tier`; quick, never raises).
@@ -171,34 +171,30 @@ def _stored_errors(material, coverage, absorption, key=None):
 
 
 def _meta(material) -> dict:
-    """The material's group's fit metadata (its tables key and image, subsurface method,
-    profile fits), or {}."""
+    """The material's group's record (its bake, subsurface method, profile fits), or {}."""
     from . import nodes
     from .material import group_of
 
     node = group_of(material)
-    if node is None or node.node_tree is None:
-        return {}
-    try:
-        return json.loads(node.node_tree.get(nodes.FIT_KEY, "{}"))
-    except ValueError:
-        return {}
+    return nodes.read_meta(node.node_tree) if node is not None else {}
 
 
 def _tables(meta):
-    """The tables stored in the image the metadata names, or None."""
+    """The tables re-baked from the record, or None if it has none or cannot be re-baked."""
     from . import storage
 
+    if "parameters" not in meta:
+        return None
     try:
-        return storage.unpack_tables(bpy.data.images.get(meta.get("tables", "")))
-    except (ValueError, storage.StorageError):
+        return storage.rebake(meta)[0]
+    except storage.StorageError:
         return None
 
 
 def material_traits(material, *, refit: bool = False, may_fit: bool = True):
     """The :class:`lut_baker.scene_model.MaterialTraits` of a made-up material at its coverage
     and absorption, the Subsurface Scale and Gloss applied (the values Fit to Scene saved if
-    it set them to 0).  From its stored tables: the profile, the shares of gloss and skin
+    it set them to 0).  From its re-baked tables: the profile, the shares of gloss and skin
     light, the profile mismatch of the group's subsurface method; the tier errors and gloss
     omissions of the last Apply, or (``refit``, or none stored for this coverage and
     absorption) of a new closure fit (a few seconds; without ``may_fit``, as when a panel
@@ -352,6 +348,7 @@ class MAKEUPSKIN_OT_fit_to_scene(bpy.types.Operator):
         material = obj.active_material
         context.view_layer.update()  # object matrices follow moves only after an update
         try:
+            made_up.refuse_linked(obj, material)
             if material is None or not material.makeup_skin.is_made_up:
                 material, _ = made_up.apply_to_object(context, obj)
             elif material.name in live.pending():
@@ -361,7 +358,7 @@ class MAKEUPSKIN_OT_fit_to_scene(bpy.types.Operator):
             changes = (_apply_choice(context, obj, material, choice.candidate)
                        if self.apply else [])
         except (ValueError, RuntimeError) as error:
-            self.report({"ERROR"}, f"Made-up Skin: Fit to Scene failed: {error}")
+            self.report({"ERROR"}, f"Made-up Skin: Fit to Scene changed nothing: {error}.")
             return {"CANCELLED"}
         chosen = choice.chosen
         material[CHOICE_KEY] = json.dumps({

@@ -1,22 +1,25 @@
-"""Baked tables and lookup images inside the .blend file.
+"""What a made-up material keeps in the .blend: the images its render reads and the record of
+its bake, never the tables themselves.
 
-Tables are stored as a float image (packed into the .blend, which Blender saves as OpenEXR and
-reads back bit-exact): every table of :class:`lut_baker.tables.Tables` flattened as float32 into
-the RGBA pixels, with a JSON description (layout, grids at full precision, parameters, SHA-256
-of the payload) in the image's custom property :data:`META_KEY`.  Names carry the content
-hash, so the same tables are found again instead of being baked twice.
+A bake is identified by its record (:func:`bake_record`): the made-up skin's parameters, the
+resolution name and the tables' content hash.  Baking is deterministic and takes a fraction of
+a second, so the tables are re-baked from the record when Check Tables or a re-fit needs them
+(:func:`rebake`, cached for the session) instead of travelling in every saved file.  The
+images a group reads (the Layered tier's view-angle image) are packed, and the group records
+the SHA-256 of their pixels and of their packed bytes (:func:`image_record`), so damage is
+found before Blender decodes the image (:func:`image_problem`).
 
 - :func:`tables_key` -- content hash of tables (hex; :func:`lut_baker.io.content_hash`).
-- :func:`tables_image_name`, :func:`lut_image_name` -- datablock names from a key.
-- :func:`pack_tables` -- tables -> packed image (reused when it exists and is intact).
-- :func:`unpack_tables` -- packed image -> tables, or :class:`StorageError` saying what is wrong.
-- :func:`lut_image` -- the LAYERED tier's view-angle image (float, Non-Color, Linear, EXTEND).
+- :func:`bake_record`, :func:`rebake` -- a bake's record, and the tables again from it.
+- :func:`lut_image_name`, :func:`lut_image` -- the Layered tier's view-angle image.
+- :func:`image_record`, :func:`image_problem` -- an image's hashes, and what is wrong with it.
+- :func:`write_pixels` -- pixels into an image, packed.
 """
 
 from __future__ import annotations
 
 import hashlib
-import json
+from collections import OrderedDict
 
 import bpy
 import numpy as np
@@ -24,54 +27,25 @@ import numpy as np
 from .package import lut_baker
 
 __all__ = [
-    "META_KEY",
     "StorageError",
     "tables_key",
-    "tables_image_name",
+    "bake_record",
+    "rebake",
+    "clear_cache",
     "lut_image_name",
-    "pack_tables",
-    "unpack_tables",
-    "find_tables_image",
     "lut_image",
+    "image_record",
+    "image_problem",
     "write_pixels",
 ]
 
-META_KEY = "makeup_skin_tables"
-"""Custom property of a tables image holding its JSON description."""
-FORMAT = 2
-"""Version of the in-.blend layout."""
-ATLAS_WIDTH = 1024
-"""Pixels per row of a tables image."""
-TABLES_PREFIX = "MakeupSkin Tables "
 LUT_PREFIX = "MakeupSkin LUT "
+REBAKE_CACHE_SIZE = 8
+"""Re-baked tables kept per content hash in this session."""
 
 
 class StorageError(ValueError):
-    """Tables in the .blend are missing, truncated or altered; the message says which."""
-
-
-GRIDS = ("theta_deg", "phi_deg", "radius_mm")
-"""Grid arrays, kept in the JSON description at full precision (their closed forms are
-checked to 1e-9) rather than in the float32 payload."""
-
-
-def _payload(tables) -> tuple[list, np.ndarray]:
-    """``(layout, float32 payload)``: every table of ``tables`` flattened, in name order."""
-    layout, parts, offset = [], [], 0
-    for name, value in sorted(tables.arrays.items()):
-        if name in GRIDS:
-            continue
-        array = np.ascontiguousarray(value, dtype=np.float32)
-        layout.append({"name": name, "shape": list(array.shape), "offset": offset})
-        parts.append(array.ravel())
-        offset += array.size
-    return layout, np.concatenate(parts) if parts else np.zeros(0, np.float32)
-
-
-def _describe(tables) -> dict:
-    return {"parameters": tables.parameters, "spacings": tables.spacings,
-            "grids": {name: np.asarray(getattr(tables, name), float).tolist()
-                      for name in GRIDS}}
+    """A bake record cannot be re-baked; the message says why, as a sentence's end."""
 
 
 def tables_key(tables) -> str:
@@ -79,8 +53,45 @@ def tables_key(tables) -> str:
     return lut_baker("io").content_hash(tables)
 
 
-def tables_image_name(key: str) -> str:
-    return TABLES_PREFIX + key[:16]
+def bake_record(skin, resolution: str, tables) -> dict:
+    """What identifies a bake: ``{"key", "parameters", "resolution"}`` (plain data)."""
+    return {"key": tables_key(tables),
+            "parameters": lut_baker("params_file").skin_to_dict(skin),
+            "resolution": str(resolution)}
+
+
+_TABLES: OrderedDict = OrderedDict()
+
+
+def clear_cache() -> None:
+    """Forget the session's re-baked tables (the add-on's unregister calls it)."""
+    _TABLES.clear()
+
+
+def rebake(record: dict):
+    """``(tables, same)``: the tables re-baked from a :func:`bake_record` and whether their
+    content hash is the recorded one (a different numpy build may round differently).
+
+    Raises
+    ------
+    StorageError
+        If the record has no readable parameters or resolution.
+    """
+    key = record.get("key")
+    if key in _TABLES:
+        _TABLES.move_to_end(key)
+        return _TABLES[key], True
+    try:
+        skin = lut_baker("params_file").skin_from_dict(record["parameters"])
+        tables = lut_baker("bake").bake(skin, record["resolution"])
+    except (KeyError, TypeError, ValueError) as error:
+        raise StorageError(f"its bake record cannot be re-baked ({error})") from None
+    same = tables_key(tables) == key
+    if same:
+        _TABLES[key] = tables
+        while len(_TABLES) > REBAKE_CACHE_SIZE:
+            _TABLES.popitem(last=False)
+    return tables, same
 
 
 def lut_image_name(key: str, tier: str = "LAYERED") -> str:
@@ -102,108 +113,61 @@ def write_pixels(image: bpy.types.Image, rgba: np.ndarray) -> None:
     image.pack()
 
 
-def _read_pixels(image: bpy.types.Image) -> np.ndarray:
+def _pixel_digest(image) -> str:
     width, height = image.size
     pixels = np.empty(width * height * image.channels, dtype=np.float32)
     image.pixels.foreach_get(pixels)
-    return pixels
+    return hashlib.sha256(pixels.tobytes()).hexdigest()
 
 
-def find_tables_image(key: str):
-    """The tables image of ``key`` in this file, or None."""
-    return bpy.data.images.get(tables_image_name(key))
+def _packed_digest(image) -> str | None:
+    packed = image.packed_file
+    return None if packed is None else hashlib.sha256(bytes(packed.data)).hexdigest()
 
 
-def pack_tables(tables, key: str | None = None) -> bpy.types.Image:
-    """Store ``tables`` in a packed float image named from their hash; an existing intact
-    image of the same key is reused (a damaged one is rewritten)."""
-    key = key or tables_key(tables)
-    image = find_tables_image(key)
-    if image is not None:
-        try:
-            unpack_tables(image)
-            return image
-        except StorageError:
-            pass
-    layout, payload = _payload(tables)
-    height = max(1, -(-payload.size // (4 * ATLAS_WIDTH)))
-    rgba = np.zeros(height * ATLAS_WIDTH * 4, np.float32)
-    rgba[: payload.size] = payload
-    if image is None or tuple(image.size) != (ATLAS_WIDTH, height):
-        if image is not None:
-            bpy.data.images.remove(image)
-        image = _new_float_image(tables_image_name(key), ATLAS_WIDTH, height)
-    image[META_KEY] = json.dumps({
-        "format": FORMAT,
-        "key": key,
-        "layout": layout,
-        "size": int(payload.size),
-        "sha256": hashlib.sha256(payload.tobytes()).hexdigest(),
-        **_describe(tables),
-    }, default=float)
-    write_pixels(image, rgba.reshape(height, ATLAS_WIDTH, 4))
-    return image
+def image_record(image) -> dict:
+    """``{"name", "sha256", "packed_sha256"}``: the image's name, the SHA-256 of its float32
+    pixels and of its packed file's bytes (None if not packed)."""
+    return {"name": image.name, "sha256": _pixel_digest(image),
+            "packed_sha256": _packed_digest(image)}
 
 
-def unpack_tables(image):
-    """The :class:`lut_baker.tables.Tables` stored in ``image``.
+def image_problem(record: dict) -> str | None:
+    """What is wrong with the image an :func:`image_record` describes, as the end of a
+    sentence ("the view-angle image ... is missing"), or None if it is intact.
 
-    Raises
-    ------
-    StorageError
-        If the image is missing, has no or an unreadable description, holds fewer pixels than
-        described, or its payload does not match the stored SHA-256 (the message names which).
-    """
-    Tables = lut_baker("tables").Tables
-
+    The packed bytes are compared first: an image whose packed file changed is never decoded
+    (a damaged OpenEXR header can crash Blender while it reads the pixels)."""
+    name = record.get("name", "")
+    image = bpy.data.images.get(name)
     if image is None:
-        raise StorageError("the tables image is missing from this file")
-    text = image.get(META_KEY)
-    if not isinstance(text, str):
-        raise StorageError(f"image {image.name!r} has no Made-up Skin description")
-    try:
-        meta = json.loads(text)
-        layout, size, digest = meta["layout"], int(meta["size"]), meta["sha256"]
-    except (ValueError, KeyError, TypeError) as error:
-        raise StorageError(f"image {image.name!r}: unreadable description ({error})") from None
-    if meta.get("format") != FORMAT:
-        raise StorageError(f"image {image.name!r}: layout version {meta.get('format')!r}, "
-                           f"expected {FORMAT}")
-    if not image.has_data and image.packed_file is None and not image.filepath:
-        raise StorageError(f"image {image.name!r} holds no pixels")
-    pixels = _read_pixels(image)
-    if pixels.size < size:
-        raise StorageError(f"image {image.name!r} is truncated ({pixels.size} of {size} values)")
-    payload = np.ascontiguousarray(pixels[:size])
-    if hashlib.sha256(payload.tobytes()).hexdigest() != digest:
-        raise StorageError(f"image {image.name!r}: the tables were altered (checksum mismatch)")
-    try:
-        arrays = {name: np.asarray(values, float) for name, values in meta["grids"].items()}
-    except (KeyError, AttributeError, TypeError, ValueError) as error:
-        raise StorageError(f"image {image.name!r}: unreadable grids ({error})") from None
-    for entry in layout:
-        count = int(np.prod(entry["shape"])) if entry["shape"] else 1
-        chunk = payload[entry["offset"]: entry["offset"] + count]
-        arrays[entry["name"]] = chunk.astype(np.float64).reshape(entry["shape"])
-    try:
-        return Tables(**arrays, parameters=meta.get("parameters", {}),
-                      **meta.get("spacings", {}))
-    except (TypeError, ValueError) as error:
-        raise StorageError(f"image {image.name!r}: {error}") from None
+        return f"its lookup image {name!r} is missing"
+    expected = record.get("packed_sha256")
+    if expected is not None and _packed_digest(image) != expected:
+        return f"its lookup image {name!r} was damaged in the file (its packed data changed)"
+    if image.packed_file is None and not image.has_data:
+        return f"its lookup image {name!r} holds no pixels"
+    if _pixel_digest(image) != record.get("sha256"):
+        return f"its lookup image {name!r} was altered (its pixels changed)"
+    return None
 
 
 def lut_image(name: str, rows: np.ndarray) -> bpy.types.Image:
     """The view-angle image ``name``: ``rows`` ``(n_rows, size, 3)``, row ``j`` at texel row
     ``j`` from the bottom (sample it at ``v = (j + 0.5) / n_rows``); float, Non-Color, linear
-    filtering, EXTEND, packed.  An existing image of that name is updated in place."""
+    filtering, EXTEND, packed.  An existing image of that name is replaced (it is the add-on's:
+    damaged, or of an older layout)."""
     rows = np.asarray(rows, np.float32)
     n_rows, size, _ = rows.shape
-    image = bpy.data.images.get(name)
-    if image is None or tuple(image.size) != (size, n_rows):
-        if image is not None:
-            bpy.data.images.remove(image)
-        image = _new_float_image(name, size, n_rows)
+    old = bpy.data.images.get(name)
+    if old is not None:
+        # Never read a possibly damaged image: rename it away, build anew, then drop it.
+        old.name = name + " (old)"
+    image = _new_float_image(name, size, n_rows)
     rgba = np.ones((n_rows, size, 4), np.float32)
     rgba[..., :3] = rows
     write_pixels(image, rgba)
+    if old is not None:
+        old.user_remap(image)
+        bpy.data.images.remove(old)
     return image

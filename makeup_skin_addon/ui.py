@@ -26,6 +26,12 @@ def _errors_text(material) -> list[str]:
     return lines
 
 
+def node_input_linked(node, name: str) -> bool:
+    """Whether the group node's input ``name`` is linked (a texture drives it)."""
+    socket = node.inputs.get(name) if node is not None else None
+    return bool(socket is not None and socket.is_linked)
+
+
 def draw_settings(layout, context) -> None:
     """The panel body, shared by both panels (the active object's material)."""
     obj = context.active_object
@@ -51,7 +57,10 @@ def draw_settings(layout, context) -> None:
         col.prop(settings, "absorption", text="Absorption RGB")
     col.separator()
     col.prop(settings, "skin")
-    col.prop(settings, "skin_tint")
+    colour = col.row()
+    linked = node_input_linked(made_up.group_of(material), "Skin Color")
+    colour.enabled = not linked
+    colour.prop(settings, "skin_colour", **({"text": "Skin Color (linked)"} if linked else {}))
     col.prop(settings, "subsurface_scale")
     col.prop(settings, "gloss", slider=True)
     col.prop(settings, "subsurface_method")
@@ -68,7 +77,9 @@ def draw_settings(layout, context) -> None:
                   icon="INFO")
     col.prop(settings, "resolution")
     col.prop(settings, "live_update")
-    layout.operator("makeup_skin.apply", icon="MATERIAL")
+    row = layout.row(align=True)
+    row.operator("makeup_skin.apply", icon="MATERIAL")
+    row.operator("makeup_skin.revert", text="", icon="LOOP_BACK")
     node = made_up.group_of(material)
     if node is not None and node.node_tree is not None:
         box = layout.box()
