@@ -19,6 +19,7 @@ found before Blender decodes the image (:func:`image_problem`).
 from __future__ import annotations
 
 import hashlib
+import json
 from collections import OrderedDict
 
 import bpy
@@ -78,9 +79,11 @@ def rebake(record: dict):
         If the record has no readable parameters or resolution.
     """
     key = record.get("key")
-    if key in _TABLES:
-        _TABLES.move_to_end(key)
-        return _TABLES[key], True
+    cache_key = json.dumps([key, record.get("parameters"), record.get("resolution")],
+                           sort_keys=True, default=str)
+    if cache_key in _TABLES:
+        _TABLES.move_to_end(cache_key)
+        return _TABLES[cache_key], True
     try:
         skin = lut_baker("params_file").skin_from_dict(record["parameters"])
         tables = lut_baker("bake").bake(skin, record["resolution"])
@@ -88,7 +91,7 @@ def rebake(record: dict):
         raise StorageError(f"its bake record cannot be re-baked ({error})") from None
     same = tables_key(tables) == key
     if same:
-        _TABLES[key] = tables
+        _TABLES[cache_key] = tables
         while len(_TABLES) > REBAKE_CACHE_SIZE:
             _TABLES.popitem(last=False)
     return tables, same

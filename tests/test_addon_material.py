@@ -146,79 +146,86 @@ def test_scene_unit_scale_sets_the_blur(sphere):
     assert node.inputs["Units per mm"].default_value == pytest.approx(0.1)
 
 
-def test_save_reload_renders_the_same_and_keeps_tables_packed(sphere, tmp_path):
+def _lut_images():
     import bpy
 
-    from makeup_skin_addon import storage
-
-    _apply(sphere, "LAYERED")
-    first = _render(tmp_path, "first")
-    path = tmp_path / "made_up.blend"
-    bpy.ops.wm.save_as_mainfile(filepath=str(path))
-    bpy.ops.wm.open_mainfile(filepath=str(path), load_ui=False)
-    tables = [image for image in bpy.data.images if image.name.startswith("MakeupSkin Tables")]
-    luts = [image for image in bpy.data.images if image.name.startswith("MakeupSkin LUT")]
-    assert len(tables) == 1 and len(luts) == 1
-    assert tables[0].packed_file is not None and luts[0].packed_file is not None
-    storage.unpack_tables(tables[0])  # intact after the round trip
-    second = _render(tmp_path, "second")
-    np.testing.assert_array_equal(first, second)
+    return [image for image in bpy.data.images if image.name.startswith("MakeupSkin LUT")]
 
 
-def _tables_image():
-    import bpy
-
-    return next(image for image in bpy.data.images if image.name.startswith("MakeupSkin Tables"))
-
-
-def test_broken_tables_are_reported_and_rebaked(sphere):
-    import bpy
-
-    from makeup_skin_addon import material as made_up
-    from makeup_skin_addon import storage
-
-    material = _apply(sphere, "PRINCIPLED")
-    image = _tables_image()
-    pixels = np.zeros(len(image.pixels), np.float32)
-    image.pixels.foreach_get(pixels)
-    pixels[:100] += 1.0
-    image.pixels.foreach_set(pixels)  # altered in memory: the checksum no longer matches
-    with pytest.raises(storage.StorageError, match="altered"):
-        storage.unpack_tables(image)
-    messages = made_up.check_material(bpy.context, material)
-    assert messages and "altered" in messages[0] and "re-baking" in messages[0]
-    storage.unpack_tables(_tables_image())  # re-baked and intact
-    assert made_up.check_material(bpy.context, material) == []
-    # Deleted tables: the operator reports and re-bakes, never raises.
-    bpy.data.images.remove(_tables_image())
-    assert bpy.ops.makeup_skin.check_tables() == {"FINISHED"}
-    storage.unpack_tables(_tables_image())
-
-
-def test_missing_lookup_image_is_rebuilt(sphere):
+def test_save_reload_renders_the_same_and_keeps_only_what_the_render_reads(sphere, tmp_path):
     import bpy
 
     from makeup_skin_addon import material as made_up
 
     material = _apply(sphere, "LAYERED")
-    lut = next(image for image in bpy.data.images if image.name.startswith("MakeupSkin LUT"))
-    bpy.data.images.remove(lut)
-    messages = made_up.check_material(bpy.context, material)
-    assert messages and "lookup image is missing" in messages[0]
+    first = _render(tmp_path, "first")
+    path = tmp_path / "made_up.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(path))
+    bpy.ops.wm.open_mainfile(filepath=str(path), load_ui=False)
+    luts = _lut_images()
+    assert len(luts) == 1 and luts[0].packed_file is not None
+    saved = [i.name for i in bpy.data.images if i.type != "RENDER_RESULT"]
+    assert saved == [luts[0].name]  # no tables travel in the file
+    assert luts[0].size[0] * luts[0].size[1] <= 64 * 8
+    material = bpy.data.materials[material.name]
+    assert made_up.check_material(bpy.context, material) == (
+        True, f"{material.name!r}: intact.")  # re-bakes to the recorded hash
+    second = _render(tmp_path, "second")
+    np.testing.assert_array_equal(first, second)
+
+
+def test_altered_lookup_image_is_found_and_rebuilt(sphere, tmp_path):
+    import bpy
+
+    from makeup_skin_addon import material as made_up
+
+    material = _apply(sphere, "LAYERED")
+    before = _render(tmp_path, "before")
+    lut = _lut_images()[0]
+    lut.pixels.foreach_set(np.zeros(len(lut.pixels), np.float32))  # what the render reads
+    intact, sentence = made_up.check_material(bpy.context, material)
+    assert not intact and "was altered" in sentence and "rebuilt it from a re-bake" in sentence
+    assert made_up.check_material(bpy.context, material)[0]
+    np.testing.assert_array_equal(_render(tmp_path, "after"), before)
+    # Deleted: the operator reports it in one sentence and rebuilds it, never raises.
+    bpy.data.images.remove(_lut_images()[0])
+    assert bpy.ops.makeup_skin.check_tables() == {"FINISHED"}
+    assert len(_lut_images()) == 1 and made_up.check_material(bpy.context, material)[0]
     group = material.node_tree.nodes["Made-up Skin"].node_tree
     textures = [n for n in group.nodes if n.type == "TEX_IMAGE"]
-    assert textures and all(n.image is not None for n in textures)
+    assert textures and all(n.image == _lut_images()[0] for n in textures)
 
 
-def test_apply_reports_broken_tables_and_replaces_them(sphere):
-    from makeup_skin_addon import storage
+def test_apply_rebuilds_a_damaged_group_instead_of_reusing_it(sphere):
+    import bpy
 
-    _apply(sphere, "PRINCIPLED")
-    image = _tables_image()
-    image["makeup_skin_tables"] = "{not json"
-    _apply(sphere, "PRINCIPLED")  # must not raise
-    assert len(_apply.messages) == 1 and "unreadable description" in _apply.messages[0]
-    storage.unpack_tables(_tables_image())
+    from makeup_skin_addon import material as made_up
+
+    material = _apply(sphere, "LAYERED")
+    lut = _lut_images()[0]
+    lut.pixels.foreach_set(np.zeros(len(lut.pixels), np.float32))
+    _apply(sphere, "LAYERED")  # must not raise, nor reuse the zeroed image
+    assert made_up.check_material(bpy.context, material)[0]
+    assert np.asarray(_lut_images()[0].pixels[:]).max() > 0.0
+
+
+def test_check_tables_reports_one_sentence_per_material(sphere):
+    import bpy
+
+    from makeup_skin_addon import material as made_up
+    from makeup_skin_addon import nodes
+
+    material = _apply(sphere, "PRINCIPLED")
+    group = material.node_tree.nodes["Made-up Skin"].node_tree
+    meta = json.loads(group[nodes.FIT_KEY])
+    meta["parameters"]["film"]["n"] = "not a number"
+    group[nodes.FIT_KEY] = json.dumps(meta)
+    intact, sentence = made_up.check_material(bpy.context, material)
+    assert not intact and sentence.startswith(f"{material.name!r}: its bake record cannot be "
+                                              f"re-baked")
+    assert sentence.endswith("re-baked it from the panel's settings.")
+    assert "\n" not in sentence and "Traceback" not in sentence
+    assert "parameters" in json.loads(group[nodes.FIT_KEY])  # repaired: a readable record
 
 
 def test_live_update_rebakes_at_preview_resolution(sphere):
@@ -247,7 +254,7 @@ def test_unregister_leaves_nothing(addon, bpy_factory):
         # Panels and menus by class name; operators by bl_idname (MAKEUP_SKIN_OT_apply).
         return [name for name in dir(bpy.types) if name.startswith(("MAKEUPSKIN", "MAKEUP_SKIN"))]
 
-    assert len(ours()) == 7 and hasattr(bpy.types.Material, "makeup_skin")  # + Fit to Scene
+    assert len(ours()) == 8 and hasattr(bpy.types.Material, "makeup_skin")  # + Fit to Scene, Revert
     addon.unregister()
     try:
         assert not hasattr(bpy.types.Material, "makeup_skin")

@@ -74,19 +74,29 @@ def test_fresnel_normal_incidence_rgb():
                                rtol=1e-12)
 
 
-@pytest.mark.parametrize("eta", [0.6, 1.0, 1.0001, 1.19, 1.5, 3.0])
+@pytest.mark.parametrize("eta", [0.6, 1.0001, 1.19, 1.5, 3.0])
 def test_fresnel_grazing_is_one(eta):
+    """Any interface reflects everything at grazing incidence (without one, see below)."""
     assert model.fresnel_reflectance(0.0, eta) == pytest.approx(1.0, abs=1e-12)
 
 
 def test_fresnel_index_matched_is_zero():
-    """eta = 1: no interface, no reflection at any incidence short of exactly grazing, and the
+    """eta = 1: no interface, no reflection at any incidence, grazing included, and the
     values next to eta = 1 approach it continuously."""
-    c = np.array([1e-300, 1e-200, 1e-12, 1e-8, 1e-4, 0.3, 1.0])
+    c = np.array([0.0, 5e-324, 1e-300, 1e-200, 1e-12, 1e-8, 1e-4, 0.3, 1.0])
     np.testing.assert_array_equal(model.fresnel_reflectance(c, 1.0), 0.0)
     # Beyond the grazing zone cos < sqrt(2 |eta - 1|) ~ 1.4e-6 the values are near 0.
-    near = model.fresnel_reflectance(c[4:], np.array([[1.0 - 1e-12], [1.0 + 1e-12]]))
+    near = model.fresnel_reflectance(c[6:], np.array([[1.0 - 1e-12], [1.0 + 1e-12]]))
     assert np.all(near < 1e-8)
+
+
+def test_fresnel_index_matched_is_zero_at_grazing_per_channel():
+    """An RGB eta with one channel at 1: that channel is 0 at grazing, the others 1; the
+    unchecked inner-loop function agrees."""
+    eta = np.array([1.19, 1.0, 1.5])
+    np.testing.assert_array_equal(model.fresnel_reflectance(0.0, eta), [1.0, 0.0, 1.0])
+    np.testing.assert_array_equal(model._fresnel(np.zeros((4, 1)), eta), [[1.0, 0.0, 1.0]] * 4)
+    assert model.fresnel_reflectance(0, 1) == 0.0
 
 
 def test_fresnel_total_internal_reflection():
@@ -99,10 +109,13 @@ def test_fresnel_total_internal_reflection():
 
 
 def test_fresnel_matches_reference():
+    """Everywhere but (c = 0, eta = 1), where the reference keeps the limit 1 of the formula
+    and the model the physical 0 (no interface; see test_fresnel_index_matched_is_zero)."""
     c = np.linspace(0.0, 1.0, 101)
     for eta in (0.7, 1.0, 1.19, 2.0):
-        expected = [ref.fresnel(x, eta) for x in c]
-        np.testing.assert_allclose(model.fresnel_reflectance(c, eta), expected, rtol=RTOL)
+        x = c[1:] if eta == 1.0 else c
+        expected = [ref.fresnel(value, eta) for value in x]
+        np.testing.assert_allclose(model.fresnel_reflectance(x, eta), expected, rtol=RTOL)
 
 
 @pytest.mark.parametrize("n", [1e-6, 3.29e-2, 0.04, 1.0, 50.0])
