@@ -157,7 +157,7 @@ def test_save_reload_renders_the_same_and_keeps_only_what_the_render_reads(spher
 
     from makeup_skin_addon import material as made_up
 
-    material = _apply(sphere, "LAYERED")
+    name = _apply(sphere, "LAYERED").name
     first = _render(tmp_path, "first")
     path = tmp_path / "made_up.blend"
     bpy.ops.wm.save_as_mainfile(filepath=str(path))
@@ -167,7 +167,7 @@ def test_save_reload_renders_the_same_and_keeps_only_what_the_render_reads(spher
     saved = [i.name for i in bpy.data.images if i.type != "RENDER_RESULT"]
     assert saved == [luts[0].name]  # no tables travel in the file
     assert luts[0].size[0] * luts[0].size[1] <= 64 * 8
-    material = bpy.data.materials[material.name]
+    material = bpy.data.materials[name]
     assert made_up.check_material(bpy.context, material) == (
         True, f"{material.name!r}: intact.")  # re-bakes to the recorded hash
     second = _render(tmp_path, "second")

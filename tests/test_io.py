@@ -1,5 +1,6 @@
 """Tables on disk (lut_baker.io): float32 OpenEXR atlas + JSON sidecar."""
 
+import errno
 import json
 import os
 
@@ -160,21 +161,97 @@ def test_a_crash_mid_write_leaves_the_old_files_intact(baked, saved, monkeypatch
     assert io.content_hash(io.load_tables(saved)) == io.content_hash(baked)
 
 
-def test_a_crash_between_the_renames_is_detected(baked, saved, monkeypatch):
-    """Image replaced, sidecar not: the pair no longer matches and loading says so."""
+def _fail_sidecar_rename(monkeypatch, error):
+    """Make the rename of the sidecar (the second one) raise ``error``."""
     real_replace = os.replace
 
-    def crash_before_sidecar(src, dst):
+    def replace(src, dst):
         if str(dst).endswith(".json"):
-            raise OSError("simulated crash")
+            raise error
         real_replace(src, dst)
 
-    monkeypatch.setattr(io.os, "replace", crash_before_sidecar)
-    with pytest.raises(OSError):
+    monkeypatch.setattr(io.os, "replace", replace)
+
+
+@pytest.mark.parametrize("error", [OSError(errno.EIO, "Input/output error"), KeyboardInterrupt()])
+def test_a_failure_between_the_renames_puts_the_old_image_back(baked, saved, monkeypatch, error):
+    """Image replaced, sidecar not: the old image comes back, so the old pair still loads."""
+    before = {p.name: p.read_bytes() for p in saved.parent.iterdir()}
+    _fail_sidecar_rename(monkeypatch, error)
+    with pytest.raises(type(error)):
         io.save_tables(bake.bake(presets.paper(), "preview"), saved)
+    assert {p.name: p.read_bytes() for p in saved.parent.iterdir()} == before
+    assert io.content_hash(io.load_tables(saved)) == io.content_hash(baked)
+
+
+def test_a_failure_between_the_renames_of_a_new_pair_leaves_nothing(baked, tmp_path,
+                                                                    monkeypatch):
+    _fail_sidecar_rename(monkeypatch, OSError(errno.EIO, "Input/output error"))
+    with pytest.raises(io.TableWriteError, match="skin.exr.*Input/output error"):
+        io.save_tables(baked, tmp_path / "skin.exr")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_pair_torn_by_a_crash_is_detected(baked, saved, tmp_path):
+    """A crash between the renames (nothing runs to put the old image back): the pair no
+    longer matches and loading says so."""
+    other = io.save_tables(bake.bake(presets.paper(), "preview", inter_reflection=True),
+                           tmp_path / "other" / "skin.exr")
+    os.replace(other, saved)
     with pytest.raises(io.TableFileError, match="different bakes"):
         io.load_tables(saved)
-    assert sorted(p.name for p in saved.parent.iterdir()) == ["skin.exr", "skin.json"]
+
+
+@pytest.mark.parametrize("error", [OSError(errno.ENOSPC, "No space left on device"),
+                                   KeyboardInterrupt()])
+def test_a_failed_or_interrupted_write_leaves_no_temporary(baked, saved, monkeypatch, error):
+    """The failure comes while the temporaries are flushed (both are written by then)."""
+    before = {p.name: p.read_bytes() for p in saved.parent.iterdir()}
+    seen = []
+
+    def fail(fd):
+        seen.extend(sorted(p.name for p in saved.parent.iterdir()))
+        raise error
+
+    monkeypatch.setattr(io.os, "fsync", fail)
+    with pytest.raises(type(error)):
+        io.save_tables(bake.bake(presets.paper(), "preview"), saved)
+    assert len(seen) == 4  # the old pair and two temporaries
+    assert {p.name: p.read_bytes() for p in saved.parent.iterdir()} == before
+
+
+@pytest.mark.parametrize("error, words", [
+    (OSError(errno.ENOSPC, "No space left on device"), "no space left on the disk"),
+    (OSError(errno.EDQUOT, "Disk quota exceeded"), "disk quota"),
+    (PermissionError(errno.EACCES, "Permission denied"), "no permission to write in"),
+    (OSError(errno.EROFS, "Read-only file system"), "read-only file system"),
+    (OSError(errno.EIO, "Input/output error"), "Input/output error"),
+])
+def test_write_errors_say_what_is_wrong_in_one_line(baked, tmp_path, monkeypatch, error, words):
+    def fail(fd):
+        raise error
+
+    monkeypatch.setattr(io.os, "fsync", fail)
+    target = tmp_path / "new" / "skin.exr"
+    with pytest.raises(io.TableWriteError) as raised:
+        io.save_tables(baked, target)
+    message = str(raised.value)
+    assert isinstance(raised.value, OSError) and "\n" not in message
+    assert message.startswith(f"cannot write '{target}': ") and words in message
+    assert list(tmp_path.iterdir()) == []  # the folder it made is gone too
+
+
+def test_target_problems_are_found_before_writing(tmp_path):
+    (tmp_path / "afile").write_text("x")
+    with pytest.raises(io.TableWriteError, match="'.*afile' is a file, not a folder"):
+        io.check_target(tmp_path / "afile" / "deeper" / "skin.exr")
+    (tmp_path / "skin.exr").mkdir()
+    with pytest.raises(io.TableWriteError, match="skin.exr' is a folder"):
+        io.check_target(tmp_path / "skin.exr")
+    with pytest.raises(ValueError, match=".exr"):
+        io.check_target(tmp_path / "skin.png")
+    assert io.check_target(tmp_path / "new" / "skin.exr") == tmp_path / "new" / "skin.exr"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["afile", "skin.exr"]  # made nothing
 
 
 def test_only_exr_paths_are_written(baked, tmp_path):
