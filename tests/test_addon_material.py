@@ -45,17 +45,7 @@ def sphere(addon, blank_scene):
 
 def _render(tmp_path, name="render"):
     """Render the scene to a float EXR and return its RGB pixels (rows bottom-up)."""
-    import bpy
-
-    scene = bpy.context.scene
-    scene.render.image_settings.file_format = "OPEN_EXR"
-    scene.render.image_settings.color_depth = "32"
-    scene.render.filepath = str(tmp_path / f"{name}.exr")
-    bpy.ops.render.render(write_still=True)
-    image = bpy.data.images.load(scene.render.filepath)
-    pixels = np.array(image.pixels[:], dtype=np.float32).reshape(SIZE, SIZE, 4)[..., :3]
-    bpy.data.images.remove(image)
-    return pixels
+    return render_sphere.render_pixels(tmp_path / f"{name}.exr")
 
 
 def _apply(obj, tier="PRINCIPLED", resolution="preview", **settings):

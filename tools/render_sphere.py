@@ -16,7 +16,7 @@ camera looking at it, one sun (angle 0, irradiance ``pi`` W/m^2, so a white Lamb
 facing it is 1.0) ``--light-deg`` degrees from the view direction towards +x, black world, no
 denoiser, film exposure 1.
 
-Functions (for other scripts, e.g. the benchmarks of issue 5):
+Functions (for other scripts, the benchmarks and the tests):
 
 - :func:`build_scene` -- the sphere, camera, sun and render settings in a fresh file, from
   :func:`light_and_camera`, :func:`black_world` and :func:`cycles_settings` (also used alone
@@ -25,6 +25,7 @@ Functions (for other scripts, e.g. the benchmarks of issue 5):
 - :func:`made_up_material` -- a material with the group for given tables and tier.
 - :func:`coverage_ramp` -- coverage painted as a left-to-right ramp.
 - :func:`render` -- render to PNG and EXR; returns seconds.
+- :func:`render_pixels` -- render to a float EXR and return its pixels.
 """
 
 from __future__ import annotations
@@ -43,7 +44,7 @@ if str(REPO_ROOT) not in sys.path:
     sys.path.insert(0, str(REPO_ROOT))
 
 __all__ = ["build_scene", "light_and_camera", "black_world", "cycles_settings",
-           "addon_registered", "made_up_material", "coverage_ramp", "render",
+           "addon_registered", "made_up_material", "coverage_ramp", "render", "render_pixels",
            "load_or_bake", "main"]
 
 IRRADIANCE = math.pi
@@ -216,6 +217,27 @@ def render(png_path) -> float:
     settings.exr_codec = "ZIP"
     result.save_render(str(png_path.with_suffix(".exr")), scene=scene)
     return seconds
+
+
+def render_pixels(exr_path):
+    """Render the current scene to the float32 OpenEXR ``exr_path`` and return its RGB pixels,
+    ``(height, width, 3)`` with row 0 at the bottom (Blender's order)."""
+    import bpy
+    import numpy as np
+
+    scene = bpy.context.scene
+    scene.render.image_settings.file_format = "OPEN_EXR"
+    scene.render.image_settings.color_depth = "32"
+    scene.render.filepath = str(exr_path)
+    bpy.ops.render.render(write_still=True)
+    image = bpy.data.images.load(scene.render.filepath)
+    try:
+        width, height = image.size
+        pixels = np.empty(width * height * 4, np.float32)
+        image.pixels.foreach_get(pixels)
+    finally:
+        bpy.data.images.remove(image)
+    return pixels.reshape(height, width, 4)[..., :3]
 
 
 def main(argv=None) -> int:
