@@ -210,7 +210,8 @@ def fresnel_reflectance(cos_theta, eta):
 
     ``cos_theta`` in [0, 1] is the cosine between the direction and the (micro)normal on the
     incident side; ``eta`` > 0 the relative index.  The two broadcast by numpy's rules.  Total
-    internal reflection (``eta < 1`` beyond the critical angle) gives 1.
+    internal reflection (``eta < 1`` beyond the critical angle) gives 1; ``eta = 1`` (no
+    interface) gives 0 at every angle, grazing included.
 
     >>> float(fresnel_reflectance(1.0, 1.5))  # ((1.5 - 1) / (1.5 + 1))^2
     0.04
@@ -238,8 +239,9 @@ def _fresnel(c: np.ndarray, eta: np.ndarray) -> np.ndarray:
         first = 0.5 * (gmc / gpc) ** 2
         second = 1.0 + ((c * gpc - 1.0) / (c * gmc + 1.0)) ** 2
         f = first * second
-    # g + c = 0 only at eta = 1 and grazing (limit 1); g2 < 0 is total internal reflection.
-    f = np.where((gpc <= 0.0) | (g2 < 0.0), 1.0, f)
+    # g2 < 0 is total internal reflection.  Otherwise g + c = 0 only at eta = 1 and grazing,
+    # where the formula is 0/0: with no interface nothing is reflected.
+    f = np.where(g2 < 0.0, 1.0, np.where(gpc > 0.0, f, 0.0))
     return np.clip(f, 0.0, 1.0)
 
 
