@@ -54,6 +54,10 @@ SECTIONS = {"film": "film", "film_transmission": "film_transmission", "skin_surf
 """Tables of a parameter file -> the layer they set (``skin`` names the skin preset)."""
 TOP_LEVEL = {"name", "foundation", "skin", "coverage", "absorption", "units",
              "reflection_shutter_s", "transmission_shutter_s", "format"}
+NUMBERS = {"coverage": "a number", "reflection_shutter_s": "a number of seconds",
+           "transmission_shutter_s": "a number of seconds"}
+"""Top-level keys that hold one number -> what the message asks for."""
+RGB = "a number or 3 numbers [R, G, B]"
 
 
 def skin_to_dict(skin: MadeUpSkin) -> dict:
@@ -74,6 +78,45 @@ def skin_from_dict(data: dict) -> MadeUpSkin:
         raise ValueError(f"incomplete made-up skin parameters: {error}") from None
 
 
+def _shown(value) -> str:
+    """A parsed TOML value as it reads in the file (``true``, ``'text'``, ``[1, 2]``)."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, list):
+        return "[" + ", ".join(map(_shown, value)) + "]"
+    return repr(value)
+
+
+def _is_number(value) -> bool:
+    """An int or float of TOML (a boolean is not a number)."""
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+def _check(key: str, value, ok: bool, expected: str):
+    """``value`` if ``ok``, else ``ValueError`` naming ``key``, what it expects and the value."""
+    if not ok:
+        raise ValueError(f"{key}: expected {expected}, got {_shown(value)}")
+    return value
+
+
+def _rgb(key: str, value):
+    """A field value: one number or a list of 3 numbers."""
+    ok = _is_number(value) or (isinstance(value, list) and len(value) == 3
+                               and all(map(_is_number, value)))
+    return _check(key, value, ok, RGB)
+
+
+def _check_top_level(mapping: dict) -> None:
+    """The value types of the top-level keys (their ranges are checked by the model)."""
+    for key, expected in NUMBERS.items():
+        if key in mapping:
+            _check(key, mapping[key], _is_number(mapping[key]), expected)
+    if "absorption" in mapping:
+        _rgb("absorption", mapping["absorption"])
+    if "name" in mapping:
+        _check("name", mapping["name"], isinstance(mapping["name"], str), "text in quotes")
+
+
 def _section(mapping: dict, name: str) -> dict:
     section = mapping.get(name, {})
     if not isinstance(section, dict):
@@ -83,7 +126,7 @@ def _section(mapping: dict, name: str) -> dict:
     unknown = sorted(set(section) - allowed)
     if unknown:
         raise ValueError(f"[{name}] has unknown field(s) {unknown}; allowed: {sorted(allowed)}")
-    return section
+    return {field: _rgb(f"[{name}] {field}", value) for field, value in section.items()}
 
 
 def _layer(kind, name: str, fields: dict):
@@ -103,6 +146,7 @@ def params_from_mapping(mapping: dict) -> MadeUpSkin:
     if unknown:
         raise ValueError(f"unknown key(s) {unknown}; allowed: "
                          f"{sorted(TOP_LEVEL | set(SECTIONS))}")
+    _check_top_level(mapping)
     foundation = mapping.get("foundation", "paper_natural")
     skin_name = mapping.get("skin", "paper_bioplate")
     if not isinstance(foundation, str) or foundation not in FOUNDATIONS:
