@@ -3,7 +3,10 @@
 Parameters come from a preset (the paper's film on the paper's skin substitute unless
 --foundation/--skin name others), then a TOML parameter file (--params, schema in
 docs/baking.md), then --coverage/--absorption, each overriding the one before.  Writes
-OUT/NAME.exr and OUT/NAME.json (atomically) and prints one line with the result.
+OUT/NAME.exr and OUT/NAME.json (atomically) and prints one line with the result.  If they
+cannot be written (OUT is a file or read-only, the disk is full, the bake is interrupted) it
+says why in one line, exits non-zero and leaves no partial or temporary file; an earlier
+OUT/NAME pair stays as it was.
 
 examples:
   python -m lut_baker bake --preset paper --out out
@@ -19,13 +22,15 @@ import re
 import sys
 import time
 import types
-from pathlib import Path
+from pathlib import Path, PurePosixPath, PureWindowsPath
 
-__all__ = ["HELP", "configure", "run", "skin_from_args"]
+__all__ = ["HELP", "configure", "run", "skin_from_args", "stem_problem"]
 
 HELP = "bake a made-up skin's lookup tables to an OpenEXR atlas + JSON sidecar"
+PROG = "python -m lut_baker bake"
 PRESETS = ("paper",)
 BAR_WIDTH = 30
+ADDED_SUFFIXES = (".exr", ".json")
 
 
 def _fraction(name: str):
@@ -42,6 +47,43 @@ def _fraction(name: str):
 
     parse.__name__ = name
     return parse
+
+
+def stem_problem(stem: str) -> str | None:
+    """Why ``stem`` cannot name OUT/STEM.exr and OUT/STEM.json, or None."""
+    if not stem.strip():
+        return "the file name is empty"
+    if any(kind(stem).name != stem for kind in (PurePosixPath, PureWindowsPath)):
+        return f"{stem!r} is a path"
+    if stem.startswith("."):
+        return f"{stem!r} starts with a dot"
+    if any(ord(char) < 32 for char in stem):
+        return f"{stem!r} holds a control character"
+    suffix = Path(stem).suffix.lower()
+    if suffix in ADDED_SUFFIXES:
+        return f"{stem!r} ends in {suffix}"
+    return None
+
+
+def _stem(text: str) -> str:
+    """argparse type of --name: a file stem."""
+    problem = stem_problem(text)
+    if problem is not None:
+        raise argparse.ArgumentTypeError(
+            f"{problem}; give a plain file name such as 'mine' (--out names the folder, "
+            ".exr and .json are added)")
+    return text
+
+
+def _default_stem(name: str) -> str:
+    """The file stem of a parameter set's name (characters other than letters, digits and
+    ``._+-`` become ``_``); ``ValueError`` if that is no file name."""
+    stem = re.sub(r"[^A-Za-z0-9._+-]", "_", name)
+    problem = stem_problem(stem)
+    if problem is not None:
+        raise ValueError(f"argument --name: the parameter set's name {name!r} makes no file "
+                         f"name ({problem}); give one with --name")
+    return stem
 
 
 def _one_line_error(parser, message: str):
@@ -81,9 +123,10 @@ def configure(parser: argparse.ArgumentParser) -> None:
                              "the skin beyond the paper's path 3 (the adding equation)")
     parser.add_argument("--out", type=Path, default=Path("out"), metavar="DIR",
                         help="output folder, created if missing (default: %(default)s)")
-    parser.add_argument("--name", metavar="STEM",
-                        help="file name stem of OUT/STEM.exr and OUT/STEM.json (default: the "
-                             "parameter set's name, e.g. 'paper')")
+    parser.add_argument("--name", type=_stem, metavar="STEM",
+                        help="file name stem of OUT/STEM.exr and OUT/STEM.json, without a "
+                             "folder or an extension (default: the parameter set's name, "
+                             "e.g. 'paper')")
 
 
 def skin_from_args(args):
@@ -129,17 +172,23 @@ class _Progress:
             self.stream.flush()
 
 
+def _failed(error: Exception) -> int:
+    """Report what stopped the bake in one line; the exit code 1."""
+    print(f"{PROG}: error: {' '.join(str(error).split())}", file=sys.stderr)
+    return 1
+
+
 def run(args) -> int:
     from .bake import bake
-    from .io import _oiio, content_hash, save_tables
+    from .io import _oiio, check_target, content_hash, save_tables
 
     skin = skin_from_args(args)
-    try:
-        _oiio()  # before the bake: without it nothing can be written
-    except ImportError as error:
-        print(f"python -m lut_baker bake: error: {error}", file=sys.stderr)
-        return 1
-    stem = args.name or re.sub(r"[^A-Za-z0-9._+-]", "_", skin.name)
+    stem = args.name or _default_stem(skin.name)
+    try:  # before the bake: fail in a moment, not after it
+        _oiio()
+        target = check_target(args.out / f"{stem}.exr")
+    except (ImportError, OSError) as error:
+        return _failed(error)
     progress = _Progress()
     start = time.perf_counter()
     try:
@@ -148,7 +197,10 @@ def run(args) -> int:
     finally:
         progress.close()
     seconds = time.perf_counter() - start
-    path = save_tables(tables, args.out / f"{stem}.exr")
+    try:
+        path = save_tables(tables, target)
+    except OSError as error:
+        return _failed(error)
     shape = "x".join(str(n) for n in tables.film_gloss.shape[:3])
     print(f"baked {skin.name} ({args.resolution}, angular {shape}) in {seconds:.2f} s -> "
           f"{path} + {path.with_suffix('.json').name}, sha256 {content_hash(tables)[:16]}")

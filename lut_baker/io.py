@@ -22,28 +22,37 @@ little-endian).  The EXR header repeats version and hash (``makeup_skin:format_v
 ``makeup_skin:sha256``) so that an image and a sidecar from different bakes are caught.
 
 Writing is atomic: both files go to temporaries in the target folder, are flushed to disk and
-renamed into place (image first); a crash never leaves a partial file under the final name.
+renamed into place (image first); a crash never leaves a partial file under the final name.  A
+write that fails or is interrupted (``KeyboardInterrupt`` or any other exception) removes its
+temporaries and the folders it made, and leaves an earlier pair as it was: if the sidecar's
+rename fails after the image's, the earlier image is put back.  Only a crash between the two
+renames can leave a new image beside an old sidecar, and loading then reports the mismatch.
 
 Functions
 ---------
 - :func:`save_tables`, :func:`load_tables` -- write and read (validated) tables.
+- :func:`check_target` -- whether tables can be written to a path (before a long bake).
 - :func:`atlas`, :func:`content_hash` -- the atlas pixels and their hash (no file involved).
 - :class:`TableFileError` -- a corrupt, truncated, mismatched or unsupported table file.
+- :class:`TableWriteError` -- tables that could not be written, said in plain words.
 """
 
 from __future__ import annotations
 
+import contextlib
+import errno
 import hashlib
 import json
 import os
+import shutil
 from pathlib import Path
 
 import numpy as np
 
 from .tables import ANGULAR, CONSTANT, DIRECTIONAL, FORMAT_VERSION, RADIAL, Tables
 
-__all__ = ["save_tables", "load_tables", "atlas", "content_hash", "sidecar_path",
-           "TableFileError", "FORMAT_NAME"]
+__all__ = ["save_tables", "load_tables", "check_target", "atlas", "content_hash",
+           "sidecar_path", "TableFileError", "TableWriteError", "FORMAT_NAME"]
 
 FORMAT_NAME = "makeup-skin-tables"
 UNITS = {
@@ -63,6 +72,23 @@ UNITS = {
 class TableFileError(ValueError):
     """A table file that cannot be used: missing, corrupt, truncated, from another bake or
     of an unsupported format version.  The message says which file and what is wrong."""
+
+
+class TableWriteError(OSError):
+    """Tables that could not be written: a file where a folder should be, a folder without
+    write permission, a full disk, any other failed write.  The message is one line naming the
+    file and saying what is wrong."""
+
+
+WRITE_PROBLEMS = {
+    errno.ENOSPC: "no space left on the disk",
+    errno.EDQUOT: "the disk quota is used up",
+    errno.EROFS: "{folder!r} is on a read-only file system",
+    errno.EACCES: "no permission to write in {folder!r}",
+    errno.EPERM: "no permission to write in {folder!r}",
+    errno.ENAMETOOLONG: "the file name is too long",
+}
+"""errno -> what went wrong, in words (``folder``: the nearest existing output folder)."""
 
 
 def _one_line(message: str) -> str:
@@ -170,41 +196,163 @@ def _fsync(path: Path) -> None:
         os.close(fd)
 
 
-def save_tables(tables: Tables, path) -> Path:
-    """Write ``tables`` to ``path`` (an ``.exr``) and its sidecar ``path.json``, atomically.
-    Returns the image path."""
-    oiio = _oiio()
+def _nearest_existing(folder: Path) -> Path:
+    """``folder`` or its nearest ancestor that exists (as anything)."""
+    for part in (folder, *folder.parents):
+        if part.exists():
+            return part
+    return folder
+
+
+def _target_problem(path: Path) -> str | None:
+    """What stands in the way of writing ``path`` and its sidecar, found without writing."""
+    existing = _nearest_existing(path.parent)
+    if existing.exists() and not existing.is_dir():
+        return f"{str(existing)!r} is a file, not a folder"
+    for target in (path, sidecar_path(path)):
+        if target.is_dir():
+            return f"{str(target)!r} is a folder, not a file"
+    if existing.is_dir() and not os.access(existing, os.W_OK | os.X_OK):
+        return WRITE_PROBLEMS[errno.EACCES].format(folder=str(existing))
+    return None
+
+
+def _write_error(path: Path, error: OSError) -> TableWriteError:
+    """``error`` from writing ``path`` as a :class:`TableWriteError` in plain words."""
+    if isinstance(error, TableWriteError):
+        return error
+    try:
+        reason, folder = _target_problem(path), _nearest_existing(path.parent)
+    except OSError:  # the folders cannot even be looked at: say what the system said
+        reason, folder = None, path.parent
+    if reason is None and error.errno in WRITE_PROBLEMS:
+        reason = WRITE_PROBLEMS[error.errno].format(folder=str(folder))
+    return TableWriteError(f"cannot write {str(path)!r}: "
+                           f"{reason or _one_line(error.strerror or error)}")
+
+
+def _image_path(path) -> Path:
+    """``path`` as a Path; ``ValueError`` unless it ends in ``.exr``."""
     path = Path(path)
     if path.suffix.lower() != ".exr":
         raise ValueError(f"table image must end in .exr, got {str(path)!r}")
-    path.parent.mkdir(parents=True, exist_ok=True)
+    return path
+
+
+def check_target(path) -> Path:
+    """``path`` (an ``.exr``) if tables can be written there as far as can be told without
+    writing anything; else :class:`TableWriteError` (a file where a folder should be, a folder
+    under the image's or the sidecar's name, no write permission).  Run it before a long bake."""
+    path = _image_path(path)
+    try:
+        problem = _target_problem(path)
+    except OSError as error:
+        raise _write_error(path, error) from None
+    if problem is not None:
+        raise TableWriteError(f"cannot write {str(path)!r}: {problem}")
+    return path
+
+
+def _missing_folders(folder: Path) -> list[Path]:
+    """``folder`` and those of its parents that do not exist yet, innermost first."""
+    missing = []
+    for part in (folder, *folder.parents):
+        if part.exists():
+            break
+        missing.append(part)
+    return missing
+
+
+def _remove_folders(folders: list[Path]) -> None:
+    """Remove the (empty) folders a failed write made, innermost first."""
+    for folder in folders:
+        with contextlib.suppress(OSError):
+            folder.rmdir()
+
+
+def _write_image(pixels: np.ndarray, digest: str, path: Path) -> None:
+    """The atlas (row 0 at the bottom) as a float32 EXR with version and hash in its header."""
+    oiio = _oiio()
+    height, width = pixels.shape[:2]
+    spec = oiio.ImageSpec(width, height, 3, oiio.FLOAT)
+    spec.attribute("compression", "zip")
+    spec.attribute("makeup_skin:format_version", FORMAT_VERSION)
+    spec.attribute("makeup_skin:sha256", digest)
+    out = oiio.ImageOutput.create(str(path))
+    if out is None or not out.open(str(path), spec):
+        raise OSError(_one_line(oiio.geterror()))
+    ok = out.write_image(np.ascontiguousarray(pixels[::-1]))
+    error = out.geterror()
+    out.close()
+    if not ok:
+        raise OSError(_one_line(error))
+
+
+def _write_sidecar(meta: dict, path: Path) -> None:
+    """The sidecar's data as indented JSON."""
+    path.write_text(json.dumps(meta, indent=1))
+
+
+def _keep_copy(path: Path, copy: Path) -> bool:
+    """Keep the current ``path`` under the name ``copy`` (a hard link, else a copy); False
+    when there is no file at ``path``."""
+    if not path.is_file():
+        return False
+    try:
+        os.link(path, copy)
+    except OSError:  # a file system without hard links
+        shutil.copy2(path, copy)
+    return True
+
+
+def _replace_pair(image_tmp: Path, json_tmp: Path, path: Path, backup: Path) -> None:
+    """Rename the temporaries onto ``path`` and its sidecar, image first.  If the sidecar's
+    rename fails, the earlier image is put back (the new one removed if there was none), so an
+    earlier pair is never left half-replaced."""
+    had_image = _keep_copy(path, backup)
+    os.replace(image_tmp, path)
+    try:
+        os.replace(json_tmp, sidecar_path(path))
+    except BaseException:
+        if had_image:
+            os.replace(backup, path)
+        else:
+            path.unlink(missing_ok=True)
+        raise
+
+
+def save_tables(tables: Tables, path) -> Path:
+    """Write ``tables`` to ``path`` (an ``.exr``) and its sidecar ``path.json``, atomically
+    (see the module docstring).  Returns the image path.
+
+    Raises :class:`TableWriteError` (an ``OSError``) naming the file and the problem when the
+    tables cannot be written; then no temporary is left and an earlier pair is unchanged, as
+    also when the write is interrupted."""
+    _oiio()
+    path = check_target(path)
     pixels, layout = atlas(tables)
     digest = _hash(pixels)
-    tag = f".{path.stem}.{os.getpid()}.tmp"
-    image_tmp = path.with_name(tag + ".exr")
-    json_tmp = path.with_name(tag + ".json")
+    tag = f".{path.stem}.{os.getpid()}"
+    image_tmp, json_tmp, backup = (path.with_name(tag + end)
+                                   for end in (".tmp.exr", ".tmp.json", ".old.exr"))
+    made = _missing_folders(path.parent)
     try:
-        spec = oiio.ImageSpec(layout["width"], layout["height"], 3, oiio.FLOAT)
-        spec.attribute("compression", "zip")
-        spec.attribute("makeup_skin:format_version", FORMAT_VERSION)
-        spec.attribute("makeup_skin:sha256", digest)
-        out = oiio.ImageOutput.create(str(image_tmp))
-        if out is None or not out.open(str(image_tmp), spec):
-            raise OSError(f"cannot write {str(path)!r}: {_one_line(oiio.geterror())}")
-        ok = out.write_image(np.ascontiguousarray(pixels[::-1]))
-        error = out.geterror()
-        out.close()
-        if not ok:
-            raise OSError(f"cannot write {str(path)!r}: {_one_line(error)}")
-        json_tmp.write_text(json.dumps(_sidecar(tables, layout, digest, path.name), indent=1))
+        path.parent.mkdir(parents=True, exist_ok=True)
+        _write_image(pixels, digest, image_tmp)
+        _write_sidecar(_sidecar(tables, layout, digest, path.name), json_tmp)
         for tmp in (image_tmp, json_tmp):
             _fsync(tmp)
-        os.replace(image_tmp, path)
-        os.replace(json_tmp, sidecar_path(path))
-        _fsync(path.parent)
-    finally:
-        for tmp in (image_tmp, json_tmp):
+        _replace_pair(image_tmp, json_tmp, path, backup)
+    except BaseException as error:
+        for tmp in (image_tmp, json_tmp, backup):
             tmp.unlink(missing_ok=True)
+        _remove_folders(made)
+        if isinstance(error, OSError):
+            raise _write_error(path, error) from error
+        raise
+    backup.unlink(missing_ok=True)
+    with contextlib.suppress(OSError):  # the pair is in place; not every system syncs folders
+        _fsync(path.parent)
     return path
 
 
