@@ -329,3 +329,21 @@ def test_whole_walk_reopened_without_the_addon_renders_the_same(head, tmp_path):
     np.testing.assert_array_equal(after, before)
     assert json.loads(bpy.data.materials["Head Skin"].node_tree.nodes["Made-up Skin"]
                       .node_tree["makeup_skin_fit"])["images"]
+
+
+def test_apply_adds_little_to_the_file(head, tmp_path):
+    """The .blend keeps the bake's record and the view-angle image (5.7 kB), not the tables:
+    Apply adds a few hundred kilobytes per skin, not the 21.6 MB of tables it used to pack."""
+    import bpy
+
+    def saved_size(name):
+        path = tmp_path / f"{name}.blend"
+        bpy.ops.wm.save_as_mainfile(filepath=str(path), copy=True, compress=False)
+        return path.stat().st_size
+
+    other = character.build_character("Other", location=(0.3, 0.0, 0.0))
+    before = saved_size("before")
+    _apply(head)
+    _apply(other, "LAYERED", skin="jensen_skin1")  # two skins: two groups, two images
+    assert saved_size("after") - before < 600e3  # measured 2 x 237 kB: the groups' nodes
+    assert len([image for image in bpy.data.images if image.name.startswith("MakeupSkin")]) == 2
