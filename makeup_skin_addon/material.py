@@ -340,8 +340,8 @@ def check_material(context, material) -> tuple[bool, str]:
     meta = nodes.read_meta(group)
     if "parameters" not in meta:
         _rebuild(context, material, group)
-        return False, (f"{name!r}: its group had no bake record (made by an older "
-                       f"version); re-baked it from the panel's settings.")
+        return False, (f"{name!r}: its group's record is unreadable or from an older "
+                       f"version; re-baked it from the panel's settings.")
     try:
         tables, same = storage.rebake(meta)
     except storage.StorageError as error:

@@ -87,8 +87,9 @@ def rebake(record: dict):
     try:
         skin = lut_baker("params_file").skin_from_dict(record["parameters"])
         tables = lut_baker("bake").bake(skin, record["resolution"])
-    except (KeyError, TypeError, ValueError) as error:
-        raise StorageError(f"its bake record cannot be re-baked ({error})") from None
+    except (KeyError, TypeError, ValueError):
+        raise StorageError("its bake record cannot be re-baked (a parameter is missing or "
+                           "unreadable)") from None
     same = tables_key(tables) == key
     if same:
         _TABLES[cache_key] = tables
