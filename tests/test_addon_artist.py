@@ -171,24 +171,50 @@ def test_no_user_datablock_loses_its_last_user(head, tmp_path):
     assert _orphans(names) == []  # all saved: nothing dropped by the save
 
 
+def _unlinked_against_no_normal_links(head, tmp_path, tier):
+    """``(render with Normal and Film Normal unlinked, render of the same group with no link
+    from those inputs inside)``: the second is the group before it had the inputs."""
+    material = _apply(head, tier)
+    node = _group_node(material)
+    for name in ("Normal", "Film Normal", "Skin Color"):
+        for link in list(node.inputs[name].links):
+            material.node_tree.links.remove(link)
+    node.inputs["Skin Color"].default_value = (0.6, 0.45, 0.4, 1.0)
+    with_inputs = _render(tmp_path, f"{tier}_inputs")
+    bare = node.node_tree.copy()
+    group_input = next(n for n in bare.nodes if n.type == "GROUP_INPUT")
+    for name in ("Normal", "Film Normal"):
+        for link in list(group_input.outputs[name].links):
+            bare.links.remove(link)
+    node.node_tree = bare
+    return with_inputs, _render(tmp_path, f"{tier}_bare")
+
+
 def test_unlinked_normals_render_as_the_shading_normal(head, tmp_path):
     """Leaving Normal and Film Normal unlinked renders exactly as a group whose closures have
-    no Normal link at all (what the group was before it had the inputs), in both tiers."""
+    no Normal link at all, in both tiers (Cycles)."""
     for tier in ("LAYERED", "PRINCIPLED"):
-        material = _apply(head, tier)
-        node = _group_node(material)
-        for name in ("Normal", "Film Normal", "Skin Color"):
-            for link in list(node.inputs[name].links):
-                material.node_tree.links.remove(link)
-        node.inputs["Skin Color"].default_value = (0.6, 0.45, 0.4, 1.0)
-        with_inputs = _render(tmp_path, f"{tier}_inputs")
-        bare = node.node_tree.copy()
-        group_input = next(n for n in bare.nodes if n.type == "GROUP_INPUT")
-        for name in ("Normal", "Film Normal"):
-            for link in list(group_input.outputs[name].links):
-                bare.links.remove(link)
-        node.node_tree = bare
-        np.testing.assert_array_equal(_render(tmp_path, f"{tier}_bare"), with_inputs)
+        with_inputs, bare = _unlinked_against_no_normal_links(head, tmp_path, tier)
+        np.testing.assert_array_equal(bare, with_inputs)
+
+
+@pytest.mark.slow
+def test_unlinked_normals_in_eevee(head, tmp_path):
+    """The same in EEVEE, Principled tier (the one Auto gives EEVEE): a hidden-value group input
+    stays unlinked inside the group, where a visible one would hand the BSDF a zero normal
+    (flat shading in EEVEE 5.0)."""
+    import bpy
+
+    scene = bpy.context.scene
+    scene.render.engine = "BLENDER_EEVEE" if bpy.app.version >= (5, 0, 0) else \
+        "BLENDER_EEVEE_NEXT"
+    scene.eevee.taa_render_samples = 4
+    for light in (obj.data for obj in scene.objects if obj.type == "LIGHT"):
+        light.use_shadow = False  # software OpenGL: ~45 s a render with shadows
+    _render(tmp_path, "warm_up")  # a process's first EEVEE render differs (by up to 0.03)
+    with_inputs, bare = _unlinked_against_no_normal_links(head, tmp_path, "PRINCIPLED")
+    assert with_inputs.mean() > 0.1
+    np.testing.assert_allclose(bare, with_inputs, atol=1e-4)  # a zero normal: ~0.5
 
 
 def test_every_closure_reads_a_normal_input(head, tmp_path):
