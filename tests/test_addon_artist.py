@@ -247,12 +247,7 @@ def test_skin_colour_texture_matches_a_bake_at_that_albedo(addon, blank_scene, t
     from makeup_skin_addon import material as made_up
 
     colour = np.array([0.62, 0.41, 0.33])
-    bpy.ops.mesh.primitive_uv_sphere_add(segments=48, ring_count=24, radius=0.03)
-    obj = bpy.context.active_object
-    bpy.ops.object.shade_smooth()
-    render_sphere.light_and_camera(blank_scene, 0.03, light_deg=40.0)
-    render_sphere.black_world(blank_scene)
-    render_sphere.cycles_settings(blank_scene, size=SIZE, samples=16)
+    obj = render_sphere.add_sphere(blank_scene, 0.03, light_deg=40.0, size=SIZE, samples=16)
     skin = presets.made_up_skin("medium_beige", "jensen_skin2", absorption=0.0)
     tables = bake.bake(skin, "preview")
     material = render_sphere.made_up_material(obj, tables, tier, coverage=0.7,

@@ -31,16 +31,7 @@ def addon(bpy_factory):
 def sphere(addon, blank_scene):
     """A smooth sphere (radius 3 cm), tools/render_sphere.py's camera and sun (60 degrees off
     the view towards +x), black world, Cycles CPU at 16 samples."""
-    import bpy
-
-    scene = blank_scene
-    bpy.ops.mesh.primitive_uv_sphere_add(segments=48, ring_count=24, radius=0.03)
-    obj = bpy.context.active_object
-    bpy.ops.object.shade_smooth()
-    render_sphere.light_and_camera(scene, 0.03, light_deg=60.0)
-    render_sphere.black_world(scene)
-    render_sphere.cycles_settings(scene, size=SIZE, samples=16)
-    return obj
+    return render_sphere.add_sphere(blank_scene, 0.03, light_deg=60.0, size=SIZE, samples=16)
 
 
 def _render(tmp_path, name="render"):

@@ -124,25 +124,11 @@ def _apply(obj, foundation: str, args):
     return material, node
 
 
-def _pixels(path: Path) -> np.ndarray:
-    """A PNG's stored values (0..1, display-encoded), (height, width, 4), rows bottom-up."""
-    import bpy
-
-    image = bpy.data.images.load(str(path), check_existing=False)
-    try:
-        width, height = image.size
-        pixels = np.empty(width * height * 4, np.float32)
-        image.pixels.foreach_get(pixels)
-    finally:
-        bpy.data.images.remove(image)
-    return pixels.reshape(height, width, 4)
-
-
 def _strip(paths, out_path: Path, gap: int = GAP_PX) -> None:
     """The PNGs ``paths`` side by side, ``gap`` white pixels between them, as a PNG."""
     import bpy
 
-    panels = [_pixels(p) for p in paths]
+    panels = [render_sphere.image_pixels(p) for p in paths]
     height = panels[0].shape[0]
     _check(all(p.shape[0] == height for p in panels), "strip panels differ in height")
     width = sum(p.shape[1] for p in panels) + gap * (len(panels) - 1)

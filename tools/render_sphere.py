@@ -18,6 +18,7 @@ denoiser, film exposure 1.
 
 Functions (for other scripts, the benchmarks and the tests):
 
+- :func:`add_sphere` -- a smooth sphere with that camera, sun and render settings in a scene.
 - :func:`build_scene` -- the sphere, camera, sun and render settings in a fresh file, from
   :func:`light_and_camera`, :func:`black_world` and :func:`cycles_settings` (also used alone
   by the tests and tools/calibrate_subsurface.py).
@@ -25,7 +26,8 @@ Functions (for other scripts, the benchmarks and the tests):
 - :func:`made_up_material` -- a material with the group for given tables and tier.
 - :func:`coverage_ramp` -- coverage painted as a left-to-right ramp.
 - :func:`render` -- render to PNG and EXR; returns seconds.
-- :func:`render_pixels` -- render to a float EXR and return its pixels.
+- :func:`render_pixels` -- render to a float EXR and return its pixels; :func:`image_pixels`
+  an image file's pixels.
 """
 
 from __future__ import annotations
@@ -45,6 +47,7 @@ if str(REPO_ROOT) not in sys.path:
 
 __all__ = ["build_scene", "light_and_camera", "black_world", "cycles_settings",
            "addon_registered", "made_up_material", "coverage_ramp", "render", "render_pixels",
+           "image_pixels", "add_sphere",
            "load_or_bake", "main"]
 
 IRRADIANCE = math.pi
@@ -128,8 +131,18 @@ def build_scene(*, size=128, samples=64, radius_mm=30.0, light_deg=45.0, seed=0)
     scene = bpy.context.scene
     scene.unit_settings.system = "METRIC"
     scene.unit_settings.scale_length = 1.0
-    radius = radius_mm * 1e-3
-    bpy.ops.mesh.primitive_uv_sphere_add(segments=128, ring_count=64, radius=radius)
+    return add_sphere(scene, radius_mm * 1e-3, light_deg=light_deg, size=size, samples=samples,
+                      seed=seed, segments=128)
+
+
+def add_sphere(scene, radius: float, *, light_deg=45.0, size=64, samples=16, seed=0,
+               segments=48):
+    """A smooth UV sphere of ``radius`` (scene units) at the origin of ``scene``, with
+    :func:`light_and_camera`, :func:`black_world` and :func:`cycles_settings`; returns it."""
+    import bpy
+
+    bpy.ops.mesh.primitive_uv_sphere_add(segments=segments, ring_count=segments // 2,
+                                         radius=radius)
     sphere = bpy.context.active_object
     bpy.ops.object.shade_smooth()
     light_and_camera(scene, radius, light_deg)
@@ -219,25 +232,33 @@ def render(png_path) -> float:
     return seconds
 
 
-def render_pixels(exr_path):
-    """Render the current scene to the float32 OpenEXR ``exr_path`` and return its RGB pixels,
-    ``(height, width, 3)`` with row 0 at the bottom (Blender's order)."""
+def image_pixels(path):
+    """The pixels of the image file ``path``, ``(height, width, 4)`` float32, row 0 at the
+    bottom (Blender's order)."""
     import bpy
     import numpy as np
 
-    scene = bpy.context.scene
-    scene.render.image_settings.file_format = "OPEN_EXR"
-    scene.render.image_settings.color_depth = "32"
-    scene.render.filepath = str(exr_path)
-    bpy.ops.render.render(write_still=True)
-    image = bpy.data.images.load(scene.render.filepath)
+    image = bpy.data.images.load(str(path), check_existing=False)
     try:
         width, height = image.size
         pixels = np.empty(width * height * 4, np.float32)
         image.pixels.foreach_get(pixels)
     finally:
         bpy.data.images.remove(image)
-    return pixels.reshape(height, width, 4)[..., :3]
+    return pixels.reshape(height, width, 4)
+
+
+def render_pixels(exr_path):
+    """Render the current scene to the float32 OpenEXR ``exr_path`` and return its RGB pixels,
+    ``(height, width, 3)`` with row 0 at the bottom (Blender's order)."""
+    import bpy
+
+    scene = bpy.context.scene
+    scene.render.image_settings.file_format = "OPEN_EXR"
+    scene.render.image_settings.color_depth = "32"
+    scene.render.filepath = str(exr_path)
+    bpy.ops.render.render(write_still=True)
+    return image_pixels(scene.render.filepath)[..., :3]
 
 
 def main(argv=None) -> int:
