@@ -164,6 +164,7 @@ def test_no_user_datablock_loses_its_last_user(head, tmp_path):
     assert bpy.ops.makeup_skin.revert() == {"FINISHED"}
     _apply(head)
     assert bpy.ops.makeup_skin.check_tables() == {"FINISHED"}
+    assert bpy.ops.makeup_skin.fit_to_scene() == {"FINISHED"}
     assert _orphans(names) == []
     path = tmp_path / "head.blend"
     bpy.ops.wm.save_as_mainfile(filepath=str(path))
