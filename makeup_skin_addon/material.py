@@ -143,17 +143,22 @@ def _stage(progress, start, end):
     return progress.stage(start, end) if progress is not None else None
 
 
-def _group_matches(group, key: str, tier: str, method) -> bool:
+def _reusable(group, key: str, tier: str, method, messages: list) -> bool:
+    """Whether ``group`` was built from these tables, tier and method by this version and its
+    images are intact; a damaged image is reported in ``messages``."""
     meta = nodes.read_meta(group)
     if (meta.get("key"), meta.get("tier"), meta.get("forced_method")) != (key, tier, method):
         return False
     if not nodes.has_interface(group) or "parameters" not in meta:  # an older add-on's
         return False
-    return all(storage.image_problem(record) is None for record in meta.get("images", []))
+    problems = [p for p in map(storage.image_problem, meta.get("images", [])) if p]
+    for problem in problems:
+        messages.append(f"Group {group.name!r}: {problem}; rebuilt it.")
+    return not problems
 
 
 def group_for_tables(tables, tier: str, *, bake=None, group=None, errors_at=None,
-                     method=None, progress=None):
+                     method=None, progress=None, messages=None):
     """``(group, fit or None)`` of ``tier`` for baked ``tables``.
 
     A group already built from the same tables, tier and ``method`` (a forced subsurface
@@ -162,13 +167,16 @@ def group_for_tables(tables, tier: str, *, bake=None, group=None, errors_at=None
     (:func:`storage.bake_record`; default: from the tables' own parameters at resolution
     "default").  ``errors_at``: ``(coverage, absorption)`` at which to measure the tiers'
     errors when fitting (default: the bake's).  ``progress(fraction, message)``: the fit's.
+    ``messages``: a list that gets a sentence for each damaged image found (then rebuilt).
     """
+    messages = [] if messages is None else messages
     if bake is None:
         skin = lut_baker("params_file").skin_from_dict(tables.parameters)
         bake = storage.bake_record(skin, "default", tables)
     key = bake["key"]
     existing = bpy.data.node_groups.get(nodes.group_name(tier, key, method))
-    if group is None and existing is not None and _group_matches(existing, key, tier, method):
+    if group is None and existing is not None and _reusable(existing, key, tier, method,
+                                                            messages):
         return existing, None
     fit = _fit(tables, key, errors_at, progress)
     target = group if group is not None else existing
@@ -271,11 +279,12 @@ def apply_to_object(context, obj, *, resolution=None) -> tuple:
     scene = context.scene
     tier = resolve_tier(settings, scene)
     absorption = settings.effective_absorption()
+    messages = []
     with _Progress(context) as progress:
         group, tables, fit = ensure_group(
             skin_from_settings(settings), tier, resolution or settings.resolution,
             progress=progress, errors_at=(settings.coverage, absorption),
-            method=forced_method(settings))
+            method=forced_method(settings), messages=messages)
     if fit is not None:
         omission = lut_baker("scene_model").gloss_omissions(tables, fit, settings.coverage,
                                                             absorption)
@@ -288,7 +297,6 @@ def apply_to_object(context, obj, *, resolution=None) -> tuple:
                                            for name, e in fit.errors.items()})
     carried = setup_material(material, group, scene)
     settings.is_made_up = True
-    messages = []
     if first:
         kept = ("its previous surface is kept, framed and disconnected (Revert restores it)"
                 if convert.can_revert(material) else "it had no surface before")

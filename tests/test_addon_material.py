@@ -186,6 +186,7 @@ def test_apply_rebuilds_a_damaged_group_instead_of_reusing_it(sphere):
     lut = _lut_images()[0]
     lut.pixels.foreach_set(np.zeros(len(lut.pixels), np.float32))
     _apply(sphere, "LAYERED")  # must not raise, nor reuse the zeroed image
+    assert len(_apply.messages) == 1 and "was altered" in _apply.messages[0]
     assert made_up.check_material(bpy.context, material)[0]
     assert np.asarray(_lut_images()[0].pixels[:]).max() > 0.0
 
