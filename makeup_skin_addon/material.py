@@ -32,6 +32,7 @@ __all__ = [
     "LinkedDataError",
     "refuse_linked",
     "revert_material",
+    "rebuild_from_settings",
     "skin_from_settings",
     "resolve_tier",
     "units_per_mm",
@@ -151,7 +152,7 @@ def _reusable(group, key: str, tier: str, method, messages: list) -> bool:
         return False
     if not nodes.has_interface(group) or "parameters" not in meta:  # an older add-on's
         return False
-    problems = [p for p in map(storage.image_problem, meta.get("images", [])) if p]
+    problems = storage.image_problems(meta.get("images", []))
     for problem in problems:
         messages.append(f"Group {group.name!r}: {problem}; rebuilt it.")
     return not problems
@@ -288,7 +289,7 @@ def apply_to_object(context, obj, *, resolution=None) -> tuple:
     if fit is not None:
         omission = lut_baker("scene_model").gloss_omissions(tables, fit, settings.coverage,
                                                             absorption)
-        key = storage.tables_key(tables)
+        key = nodes.read_meta(group)["key"]  # the group's bake: no second hash of the tables
         material[ERRORS_KEY] = json.dumps({name: {"rms": e.rms, "albedo": e.albedo,
                                                   "coverage": e.coverage,
                                                   "absorption": list(e.absorption),
@@ -320,13 +321,14 @@ def revert_material(material) -> str:
     return f"Reverted {material.name!r}: {restored}."
 
 
-def _rebuild(context, material, group) -> None:
-    """Re-bake from the settings and rebuild ``group`` in place (Check Tables' repair when the
-    group's record cannot be used)."""
+def rebuild_from_settings(context, material, group, resolution: str) -> None:
+    """Bake the material's settings at ``resolution``, rebuild ``group`` (its group, or a copy
+    of it) in place and make it the material's surface: the live preview's re-bake, and Check
+    Tables' repair when the group's record cannot be used."""
     settings = material.makeup_skin
-    tier = resolve_tier(settings, context.scene)
     with _Progress(context) as progress:
-        group, _, _ = ensure_group(skin_from_settings(settings), tier, settings.resolution,
+        group, _, _ = ensure_group(skin_from_settings(settings),
+                                   resolve_tier(settings, context.scene), resolution,
                                    progress=progress, group=group,
                                    method=forced_method(settings))
     setup_material(material, group, context.scene)
@@ -347,20 +349,21 @@ def check_material(context, material) -> tuple[bool, str]:
         return False, f"{name!r}: not checked: {reason}."
     meta = nodes.read_meta(group)
     if "parameters" not in meta:
-        _rebuild(context, material, group)
+        rebuild_from_settings(context, material, group, material.makeup_skin.resolution)
         return False, (f"{name!r}: its group's record is unreadable or from an older "
                        f"version; re-baked it from the panel's settings.")
     try:
-        tables, same = storage.rebake(meta)
+        tables, key = storage.rebake(meta)
     except storage.StorageError as error:
-        _rebuild(context, material, group)
+        rebuild_from_settings(context, material, group, material.makeup_skin.resolution)
         return False, f"{name!r}: {error}; re-baked it from the panel's settings."
-    problems = [p for p in map(storage.image_problem, meta.get("images", [])) if p]
-    note = ("" if same else " (the tables re-baked here differ from the recorded ones in "
-                            "their last bits: this numpy rounds differently)")
+    problems = storage.image_problems(meta.get("images", []))
+    note = ("" if key == meta.get("key") else
+            " (the tables re-baked here differ from the recorded ones in their last bits: this "
+            "numpy rounds differently)")
     if not problems and nodes.has_interface(group):
         return True, f"{name!r}: intact{note}."
-    bake = {"key": storage.tables_key(tables), "parameters": meta["parameters"],
+    bake = {"key": key, "parameters": meta["parameters"],
             "resolution": meta.get("resolution", "default")}
     group_for_tables(tables, meta.get("tier", "LAYERED"), bake=bake, group=group,
                      method=meta.get("forced_method"))

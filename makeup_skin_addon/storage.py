@@ -12,7 +12,8 @@ found before Blender decodes the image (:func:`image_problem`).
 - :func:`tables_key` -- content hash of tables (hex; :func:`lut_baker.io.content_hash`).
 - :func:`bake_record`, :func:`rebake` -- a bake's record, and the tables again from it.
 - :func:`lut_image_name`, :func:`lut_image` -- the Layered tier's view-angle image.
-- :func:`image_record`, :func:`image_problem` -- an image's hashes, and what is wrong with it.
+- :func:`image_record`, :func:`image_problem` -- an image's hashes, and what is wrong with it;
+  :func:`image_problems` for a group's images.
 - :func:`write_pixels` -- pixels into an image, packed.
 """
 
@@ -37,6 +38,7 @@ __all__ = [
     "lut_image",
     "image_record",
     "image_problem",
+    "image_problems",
     "write_pixels",
 ]
 
@@ -70,8 +72,8 @@ def clear_cache() -> None:
 
 
 def rebake(record: dict):
-    """``(tables, same)``: the tables re-baked from a :func:`bake_record` and whether their
-    content hash is the recorded one (a different numpy build may round differently).
+    """``(tables, key)``: the tables re-baked from a :func:`bake_record` and their content hash,
+    which a different numpy build may round to other than the recorded ``record["key"]``.
 
     Raises
     ------
@@ -83,19 +85,19 @@ def rebake(record: dict):
                            sort_keys=True, default=str)
     if cache_key in _TABLES:
         _TABLES.move_to_end(cache_key)
-        return _TABLES[cache_key], True
+        return _TABLES[cache_key], key
     try:
         skin = lut_baker("params_file").skin_from_dict(record["parameters"])
         tables = lut_baker("bake").bake(skin, record["resolution"])
     except (KeyError, TypeError, ValueError):
         raise StorageError("its bake record cannot be re-baked (a parameter is missing or "
                            "unreadable)") from None
-    same = tables_key(tables) == key
-    if same:
+    rebaked = tables_key(tables)
+    if rebaked == key:
         _TABLES[cache_key] = tables
         while len(_TABLES) > REBAKE_CACHE_SIZE:
             _TABLES.popitem(last=False)
-    return tables, same
+    return tables, rebaked
 
 
 def lut_image_name(key: str, tier: str = "LAYERED") -> str:
@@ -154,6 +156,11 @@ def image_problem(record: dict) -> str | None:
     if _pixel_digest(image) != record.get("sha256"):
         return f"its lookup image {name!r} was altered (its pixels changed)"
     return None
+
+
+def image_problems(records) -> list[str]:
+    """:func:`image_problem` of each record, the intact ones left out."""
+    return [problem for problem in map(image_problem, records) if problem]
 
 
 def lut_image(name: str, rows: np.ndarray) -> bpy.types.Image:
