@@ -79,17 +79,10 @@ def flush(context=None) -> list[str]:
         group = node.node_tree if node is not None else None
         if group is not None and group.users > 1:
             group = group.copy()  # others keep their look; this material gets its own
-        settings = material.makeup_skin
         try:
-            group, _, _ = made_up.ensure_group(
-                made_up.skin_from_settings(settings), made_up.resolve_tier(settings,
-                                                                           context.scene),
-                PREVIEW, group=group,
-                method=made_up.forced_method(settings))
+            made_up.rebuild_from_settings(context, material, group, PREVIEW)
         except (ValueError, RuntimeError) as error:
             messages.append(f"Made-up Skin: the preview of {material.name!r} failed: {error}.")
-            continue
-        made_up.setup_material(material, group, context.scene)
     _messages.extend(messages)
     return messages
 

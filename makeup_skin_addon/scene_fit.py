@@ -183,8 +183,6 @@ def _tables(meta):
     """The tables re-baked from the record, or None if it has none or cannot be re-baked."""
     from . import storage
 
-    if "parameters" not in meta:
-        return None
     try:
         return storage.rebake(meta)[0]
     except storage.StorageError:
