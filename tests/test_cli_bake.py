@@ -77,6 +77,19 @@ def main_exit(capsys, *args):
     return exit_info.value.code, capsys.readouterr().err
 
 
+def params_error(capsys, path, text):
+    """Write ``text`` to the parameter file ``path``, bake with it into ``out/`` beside it and
+    return the error line: exit code 2, one line, and no ``out/`` made."""
+    path.write_text(text)
+    out = path.parent / "out"
+    code, err = main_exit(capsys, "--params", path, "--out", out)
+    assert code == 2
+    line = err.strip()
+    assert "\n" not in line, err
+    assert not out.exists()
+    return line
+
+
 def test_bad_argument_exits_2_with_one_line_from_the_shell(tmp_path):
     result = run_cli("--coverage", "1.5", "--out", tmp_path)
     assert result.returncode == 2
@@ -114,14 +127,9 @@ def test_bad_arguments_exit_2_with_one_line(capsys, args, named, tmp_path):
     ("coverage = 2", "coverage must lie in"),
 ])
 def test_invalid_parameter_files_exit_2_naming_params(capsys, text, message, tmp_path):
-    bad = tmp_path / "bad.toml"
-    bad.write_text(text)
-    code, err = main_exit(capsys, "--params", bad, "--out", tmp_path / "out")
-    assert code == 2
-    line = err.strip()
-    assert "\n" not in line and "--params" in line
+    line = params_error(capsys, tmp_path / "bad.toml", text)
+    assert "--params" in line
     assert re.search(message, line), line
-    assert not (tmp_path / "out").exists()
 
 
 def test_missing_openimageio_is_one_clear_line(capsys, monkeypatch, tmp_path):
@@ -396,13 +404,8 @@ def test_name_may_hold_dots_inside(tmp_path):
     ('name = ".."', "starts with a dot"),
 ])
 def test_name_from_the_parameter_file_must_make_a_stem(capsys, tmp_path, text, words):
-    params = tmp_path / "p.toml"
-    params.write_text(text)
-    code, err = main_exit(capsys, "--params", params, "--out", tmp_path / "out")
-    assert code == 2
-    line = err.strip()
-    assert "\n" not in line and "--name" in line and words in line, err
-    assert not (tmp_path / "out").exists()
+    line = params_error(capsys, tmp_path / "p.toml", text)
+    assert "--name" in line and words in line, line
 
 
 # --- parameter file values of the wrong type ------------------------------------------------
@@ -426,13 +429,9 @@ def test_name_from_the_parameter_file_must_make_a_stem(capsys, tmp_path, text, w
 ])
 def test_parameter_values_of_the_wrong_type_name_file_and_key(capsys, tmp_path, text, message):
     bad = tmp_path / "params.toml"
-    bad.write_text(text)
-    code, err = main_exit(capsys, "--params", bad, "--out", tmp_path / "out")
-    assert code == 2
-    line = err.strip()
-    assert "\n" not in line and f"--params '{bad}'" in line
+    line = params_error(capsys, bad, text)
+    assert f"--params '{bad}'" in line
     assert re.search(message, line), line
     with pytest.raises(ValueError, match=message) as error:
         params_file.load_params(bad)
     assert str(bad) in str(error.value)
-    assert not (tmp_path / "out").exists()
