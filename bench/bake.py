@@ -27,9 +27,10 @@ sys.path.insert(0, str(ROOT))
 
 from doc_block import replace_block  # noqa: E402  (bench/doc_block.py)
 
-from lut_baker import bake, model, presets  # noqa: E402
-from lut_baker.normalise import made_up_reflection  # noqa: E402
-from lut_baker.tables import ANGULAR, DIRECTIONAL  # noqa: E402
+from lut_baker import bake  # noqa: E402
+from lut_baker.model import layers, presets  # noqa: E402
+from lut_baker.model.made_up_skin import made_up_reflection  # noqa: E402
+from lut_baker.tables.table_set import ANGULAR, DIRECTIONAL  # noqa: E402
 
 DOC = ROOT / "docs" / "baking.md"
 BEGIN, END = "<!-- study:begin -->", "<!-- study:end -->"
@@ -161,7 +162,7 @@ def gloss_tail(tables, skin, n_points=20000, seed=1) -> tuple[float, float, floa
     normalised error, the peak being the composite's."""
     rng = np.random.default_rng(seed)
     wi, wo = bake._sample_directions(n_points, rng, 89.0)
-    exact = np.reshape(model.ts_reflection(wi, wo, bake._gloss_layer(skin.film)), (n_points, -1))
+    exact = np.reshape(layers.ts_reflection(wi, wo, bake._gloss_layer(skin.film)), (n_points, -1))
     peak = tables.node_values().reshape(-1, 3).max(axis=0)
     err = np.abs(tables.angular("film_gloss", wi, wo) - exact) / np.maximum(exact, 0.1 * peak)
     err = err.max(axis=-1)
@@ -170,9 +171,9 @@ def gloss_tail(tables, skin, n_points=20000, seed=1) -> tuple[float, float, floa
 
 def path3_node_error(tables, skin, n_nodes=300, seed=0) -> float:
     """Quadrature error of path 3 alone: the baked ``path3_gloss`` at random nodes against
-    :func:`lut_baker.layers.layered_reflection` (level 0) there, normalised by path 3's peak."""
-    from lut_baker.layers import layered_reflection
-    from lut_baker.quadrature import direction
+    :func:`lut_baker.evaluate.two_layer.layered_reflection` (level 0) there, normalised by path 3's peak."""
+    from lut_baker.evaluate.two_layer import layered_reflection
+    from lut_baker.numerics.quadrature import direction
 
     rng = np.random.default_rng(seed)
     n, p = tables.theta_deg.size, tables.phi_deg.size

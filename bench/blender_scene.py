@@ -1,11 +1,11 @@
-"""A Blender scene that matches :func:`lut_baker.reference.sphere_image` pixel for pixel.
+"""A Blender scene that matches :func:`lut_baker.offline.validation.reference.sphere_image` pixel for pixel.
 
 Built on ``tools/render_sphere.py``'s :func:`build_scene` (sphere, orthographic camera, sun of
 angle 0 and strength ``IRRADIANCE`` = pi W/m^2, black world, Cycles CPU, no denoiser, film
 exposure 1, Standard view transform, a seed), then made to match the reference exactly:
 
 - camera ``ortho_scale = 2 R``: the image spans the sphere's disk, so pixel centres are those of
-  :func:`lut_baker.reference.sphere_points`; clipping from ``R`` to ``100 R`` in front of it
+  :func:`lut_baker.offline.validation.reference.sphere_points`; clipping from ``R`` to ``100 R`` in front of it
   (the default clip start, 0.1 m, hides spheres under 10 mm at build_scene's distance of 10 R);
 - the UV sphere refined to :data:`SEGMENTS` x :data:`SEGMENTS`/2, smooth (tessellation error
   2.8e-4 relative on a Lambert sphere at 64 px, against 1.0e-3 for build_scene's 128 x 64);
@@ -13,7 +13,7 @@ exposure 1, Standard view transform, a seed), then made to match the reference e
   would average whole pixels, BLENDER_NOTES);
 - adaptive sampling off: every pixel takes the samples asked for (Blender's default stops at a
   noise threshold of 0.01, so "1024 samples" rendered faster than 256);
-- float32 EXR read back with rows flipped (:func:`lut_baker.compare.from_blender_pixels`).
+- float32 EXR read back with rows flipped (:func:`lut_baker.offline.validation.compare.from_blender_pixels`).
 
 Units: the scene is in metres (``unit_settings.scale_length = 1``), the sphere's radius is
 ``radius_mm * 1e-3``; the add-on's "Units per mm" and the baseline's Subsurface Scale come
@@ -26,7 +26,7 @@ Functions
 - :func:`set_material` -- give the sphere one material.
 - :func:`shader_material` -- a material of one BSDF node with given inputs.
 - :func:`lambert_material`, :func:`baseline_material` -- the check's and the baseline's
-  (a stock Principled BSDF with :mod:`lut_baker.baseline`'s fitted sockets).
+  (a stock Principled BSDF with :mod:`lut_baker.offline.validation.baseline`'s fitted sockets).
 - :func:`tier_material` -- the add-on's node group of a tier (register the add-on around it:
   :func:`render_sphere.addon_registered`).
 - :func:`set_samples` -- samples and seed of the engine in use.
@@ -47,7 +47,7 @@ for _path in (ROOT, ROOT / "tools"):
 
 import render_sphere  # noqa: E402  (tools/render_sphere.py)
 
-from lut_baker import compare  # noqa: E402
+from lut_baker.offline.validation import compare  # noqa: E402
 
 __all__ = [
     "IRRADIANCE",
@@ -78,7 +78,7 @@ def sphere_scene(*, size: int = 64, samples: int = 64, radius_mm: float = 10.0,
                  light_deg: float = 45.0, seed: int = 0, segments: int = SEGMENTS):
     """The reference's scene in a fresh file (module docstring); returns the sphere object.
     ``light_deg``: angle (degrees) between the light and the view direction, towards image
-    +x, as :func:`lut_baker.reference.light_direction`."""
+    +x, as :func:`lut_baker.offline.validation.reference.light_direction`."""
     import bmesh
     import bpy
 
@@ -143,7 +143,7 @@ def lambert_material(albedo: float = 0.8):
 
 
 def baseline_material(baseline, scene):
-    """A stock Principled BSDF with the sockets of a :class:`lut_baker.baseline.Baseline`
+    """A stock Principled BSDF with the sockets of a :class:`lut_baker.offline.validation.baseline.Baseline`
     (its subsurface method; distribution GGX, which the fit's replica models: the default
     Multiscatter GGX would add ~1% to its specular; Subsurface Scale = the scene's units per
     mm)."""

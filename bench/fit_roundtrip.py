@@ -24,15 +24,15 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from lut_baker.fit import (
+from lut_baker.model.presets import paper_layers
+from lut_baker.offline.measured.layer_fit import (
     fit_dipole,
     fit_reflection,
     fit_transmission,
     poor_start,
     relative_errors,
 )
-from lut_baker.measurements import paper_protocols
-from lut_baker.presets import paper_layers
+from lut_baker.offline.measured.measurements import paper_protocols
 
 TARGETS = {"n": 0.05, "eta": 0.05, "P_s/P_d": 0.05, "P_t/P_d": 0.05,
            "sigma_s": 0.10, "sigma_a": 0.10}

@@ -28,7 +28,10 @@ REPO = Path(__file__).resolve().parent.parent
 if str(REPO) not in sys.path:
     sys.path.insert(0, str(REPO))
 
-from lut_baker import bake, closure_fit, fit, measurements, presets  # noqa: E402
+from lut_baker import bake  # noqa: E402
+from lut_baker.closures import fitting  # noqa: E402
+from lut_baker.model import presets  # noqa: E402
+from lut_baker.offline.measured import layer_fit, measurements  # noqa: E402
 
 GOLDEN = REPO / "tests" / "data" / "golden_digests.json"
 
@@ -72,10 +75,10 @@ def compute() -> dict[str, str]:
             tables = bake.bake(skin, resolution)
             out[f"tables/{name}/{resolution}"] = digest(tables)
             if resolution == "default":
-                out[f"closure_fit/{name}/{resolution}"] = digest(closure_fit.fit_closures(tables))
+                out[f"closure_fit/{name}/{resolution}"] = digest(fitting.fit_closures(tables))
     data = measurements.paper_protocols(noise=0.02, seed=7)
     for kind, item in sorted(data.items()):
-        out[f"measurement_fit/{kind}"] = digest(fit.fit_measurements(item))
+        out[f"measurement_fit/{kind}"] = digest(layer_fit.fit_measurements(item))
     return out
 
 

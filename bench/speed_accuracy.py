@@ -9,10 +9,10 @@ A benchmark, not a test::
 Scene (``bench/blender_scene.py``): the paper preset on a sphere of 10 mm radius, 48 x 48 px,
 Cycles CPU, light 0, 45 and 75 degrees from the view.  Each of PRINCIPLED, LAYERED (the add-on's
 node group, "default" tables) and BASELINE (a stock Principled BSDF whose sockets
-:func:`lut_baker.baseline.fit_baseline` fitted to the same tables) renders at 16, 64, 256 and
+:func:`lut_baker.offline.validation.baseline.fit_baseline` fitted to the same tables) renders at 16, 64, 256 and
 1024 samples with seeds 0 and 1, configurations interleaved so that the load of a shared
 machine falls on all alike.
-Against the reference (:func:`lut_baker.compare.reference_image`, paths 1 + 3 from "high"
+Against the reference (:func:`lut_baker.offline.validation.compare.reference_image`, paths 1 + 3 from "high"
 tables, the skin's diffuse part spread by the dipole profile): relative RMS error over the
 sphere's pixels (mean of the two seeds), the noise floor ``rms(a - b) / sqrt(2)`` and the time
 per render (mean of the two).  The bake axis: per bake resolution, the tables' size, bake time
@@ -39,8 +39,10 @@ for _path in (ROOT, ROOT / "bench", ROOT / "tools"):
 
 from doc_block import replace_block  # noqa: E402  (bench/doc_block.py)
 
-from lut_baker import bake, compare, presets, reference  # noqa: E402
-from lut_baker.baseline import fit_baseline  # noqa: E402
+from lut_baker import bake  # noqa: E402
+from lut_baker.model import presets  # noqa: E402
+from lut_baker.offline.validation import compare, reference  # noqa: E402
+from lut_baker.offline.validation.baseline import fit_baseline  # noqa: E402
 
 DOCS = ROOT / "docs"
 BEGIN, END = "<!-- results:begin -->", "<!-- results:end -->"
@@ -86,7 +88,7 @@ def _row(**values) -> dict:
 def render_rows(skin, tables, baseline, refs: dict, size: int, sample_counts,
                 bake_tables=None):
     """Render every configuration at every light and sample count; the rows of the CSV.
-    ``baseline``: the :class:`lut_baker.baseline.Baseline` of ``tables``.
+    ``baseline``: the :class:`lut_baker.offline.validation.baseline.Baseline` of ``tables``.
     ``bake_tables``: ``{resolution: tables}`` whose LAYERED render error at
     :data:`GOAL_SAMPLES` samples, light 45, seed 0 is returned as ``{resolution: error}``."""
     import blender_scene as scene_module
@@ -306,7 +308,7 @@ def baseline_text(baseline, seconds: float) -> str:
         return f"{value:.3f}"
 
     lights = sorted(baseline.error)
-    lines = [f"The baseline, fitted by `lut_baker.baseline.fit_baseline` in {seconds:.1f} s "
+    lines = [f"The baseline, fitted by `lut_baker.offline.validation.baseline.fit_baseline` in {seconds:.1f} s "
              f"({baseline.evaluations} evaluations; subsurface method "
              f"{baseline.subsurface_method}):", "",
              "| " + " | ".join(baseline.socket_values()) + " |",

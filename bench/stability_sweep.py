@@ -4,14 +4,14 @@
     python bench/stability_sweep.py --costs [--repeats 3]
     python bench/stability_sweep.py --traits
 
-The first form runs :func:`lut_baker.stability.sweep` (the exact model, the bake, the closure
+The first form runs :func:`lut_baker.offline.validation.stability.sweep` (the exact model, the bake, the closure
 fits and the reference images in every regime of issue 5, item 4) and, unless
 ``--no-render``, renders each tier in the same regimes with Cycles (:func:`render_regimes`):
 no NaN, Inf or negative pixel, the white furnace (world colour 1, no light) and the error
 against the reference image.  It prints the table of docs/stability.md (``--out`` rewrites the
 part of that file between its ``<!-- sweep -->`` markers).
 
-``--costs`` measures what :mod:`lut_baker.scene_model` stores: per-sample render time of every
+``--costs`` measures what :mod:`lut_baker.auto_tier` stores: per-sample render time of every
 candidate relative to the fullest (the slope between two sample counts, so that scene set-up
 does not count) and its Monte Carlo noise coefficient (relative RMS between two seeds);
 ``--traits`` prints the paper preset's traits it assumes without tables.
@@ -46,7 +46,7 @@ import blender_scene  # noqa: E402  (bench/blender_scene.py)
 import render_sphere  # noqa: E402  (tools/render_sphere.py)
 from doc_block import replace_block  # noqa: E402  (bench/doc_block.py)
 
-from lut_baker import compare  # noqa: E402
+from lut_baker.offline.validation import compare  # noqa: E402
 
 __all__ = ["Stage", "candidate_material", "furnace_rings", "measure_costs",
            "render_regimes", "main"]
@@ -105,7 +105,7 @@ class Stage:
 
 
 def candidate_material(sphere, tables, candidate):
-    """The made-up material of a :class:`lut_baker.scene_model.Candidate` on ``sphere`` (the
+    """The made-up material of a :class:`lut_baker.auto_tier.Candidate` on ``sphere`` (the
     add-on registered), as Fit to Scene realises it: its tier; ``subsurface=False`` sets
     Subsurface Scale 0 (Cycles then shades the subsurface closures as diffuse ones);
     ``gloss=False`` sets the group's Gloss input to 0 (Cycles then allocates no gloss
@@ -143,39 +143,40 @@ def furnace_rings(image, rings: int = FURNACE_RINGS):
 
 
 # --------------------------------------------------------------------------------------------
-# Costs and noise of the candidates (lut_baker.scene_model's constants)
+# Costs and noise of the candidates (lut_baker.auto_tier's constants)
 # --------------------------------------------------------------------------------------------
 def measure_costs(*, size=96, samples=(16, 272), repeats=3, radius_mm=30.0, coverage=1.0):
     """Per-sample render time (relative to the fullest candidate) and noise coefficient
     ``k`` (one render's relative RMS deviation = k / sqrt(samples)) of every candidate of
-    :data:`lut_baker.scene_model.CANDIDATES`, Cycles CPU, paper preset at ``coverage``, sun at
+    :data:`lut_baker.auto_tier.CANDIDATES`, Cycles CPU, paper preset at ``coverage``, sun at
     45 degrees.
 
     Times: the slope ``(t(high) - t(low)) / (high - low)`` (scene set-up does not count), the
     fastest of ``repeats`` interleaved runs, in wall-clock seconds (``relative_cost``) and in
     the process's CPU seconds (``relative_cpu``: all of Cycles' threads; on a shared machine
     other processes slow the wall clock but not this).  Noise:
-    :func:`lut_baker.compare.noise_floor` of two seeds at the higher count, times
+    :func:`lut_baker.offline.validation.compare.noise_floor` of two seeds at the higher count, times
     ``sqrt(samples)``."""
-    from lut_baker import bake, presets, scene_model
+    from lut_baker import auto_tier, bake
+    from lut_baker.model import presets
 
     tables = bake.bake(presets.made_up_skin("paper_natural", "paper_bioplate",
                                             coverage=coverage), "preview")
     low, high = samples
-    times = {c: {low: [], high: []} for c in scene_model.CANDIDATES}
-    cpu = {c: {low: [], high: []} for c in scene_model.CANDIDATES}
+    times = {c: {low: [], high: []} for c in auto_tier.CANDIDATES}
+    cpu = {c: {low: [], high: []} for c in auto_tier.CANDIDATES}
     noise = {}
 
     with render_sphere.addon_registered():
         stage = Stage(size=size, samples=high, radius_mm=radius_mm)
         for _ in range(repeats):
-            for candidate in scene_model.CANDIDATES:
+            for candidate in auto_tier.CANDIDATES:
                 for count in (low, high):
                     start = time.process_time()
                     times[candidate][count].append(
                         stage.render(tables, candidate, samples=count)[0])
                     cpu[candidate][count].append(time.process_time() - start)
-        for candidate in scene_model.CANDIDATES:
+        for candidate in auto_tier.CANDIDATES:
             a = stage.render(tables, candidate, seed=0)[1]
             b = stage.render(tables, candidate, seed=1)[1]
             noise[candidate] = compare.noise_floor(a, b, 0.5 * (a + b)) * math.sqrt(high)
@@ -183,11 +184,11 @@ def measure_costs(*, size=96, samples=(16, 272), repeats=3, radius_mm=30.0, cove
         return {c: (min(t[high]) - min(t[low])) / (high - low) for c, t in table.items()}
 
     wall, busy = slope(times), slope(cpu)
-    return {c: {"relative_cost": wall[c] / wall[scene_model.FULLEST],
+    return {c: {"relative_cost": wall[c] / wall[auto_tier.FULLEST],
                 "seconds_per_sample": wall[c],
-                "relative_cpu": busy[c] / busy[scene_model.FULLEST],
+                "relative_cpu": busy[c] / busy[auto_tier.FULLEST],
                 "cpu_seconds_per_sample": busy[c],
-                "noise_k": noise[c]} for c in scene_model.CANDIDATES}
+                "noise_k": noise[c]} for c in auto_tier.CANDIDATES}
 
 
 # --------------------------------------------------------------------------------------------
@@ -207,14 +208,15 @@ def _furnace_reference(tables, size):
 
 
 def render_regime(stage, item, candidates, *, seeds=(0, 1), furnace=True, tables=None):
-    """Render every candidate in one :class:`lut_baker.stability.Regime` on ``stage`` (a
+    """Render every candidate in one :class:`lut_baker.offline.validation.stability.Regime` on ``stage`` (a
     :class:`Stage`; the add-on registered): per candidate name ``{"lit", "furnace",
     "spread"}``.  Lit (each of the regime's lights, the worst kept): finite, min, max,
-    ``error`` against :func:`lut_baker.compare.reference_image` (from the tables; spread where
+    ``error`` against :func:`lut_baker.offline.validation.compare.reference_image` (from the tables; spread where
     the reference affords it), ``noise`` (two seeds) and ``bias``.  Furnace: finite, min, max
     pixel, the largest ring mean of :func:`furnace_rings` and its standard error, the exact
     albedo's largest value and the error against the exact furnace image."""
-    from lut_baker import bake, reference, stability
+    from lut_baker import bake
+    from lut_baker.offline.validation import reference, stability
 
     skin = stability.regime_skin(item)
     tables = tables or bake.bake(skin, "preview")
@@ -261,14 +263,15 @@ def render_regime(stage, item, candidates, *, seeds=(0, 1), furnace=True, tables
 def render_regimes(regimes=None, **options) -> dict:
     """:func:`render_regime` of both add-on tiers (and the Auto tier's choice where it is
     another candidate) over ``regimes`` (default all), by regime key."""
-    from lut_baker import scene_model, stability
+    from lut_baker import auto_tier
+    from lut_baker.offline.validation import stability
 
     regimes = stability.REGIMES if regimes is None else regimes
     out = {}
     with render_sphere.addon_registered():
         stage = Stage(**{k: options.pop(k) for k in ("size", "samples") if k in options})
         for item in regimes:
-            candidates = [scene_model.Candidate("PRINCIPLED"), scene_model.Candidate("LAYERED")]
+            candidates = [auto_tier.Candidate("PRINCIPLED"), auto_tier.Candidate("LAYERED")]
             auto = stability.auto_choice(item).candidate
             if auto not in candidates:
                 candidates.append(auto)
@@ -294,12 +297,14 @@ def _print_costs(costs, args, coverage) -> None:
 
 
 def _print_traits() -> None:
-    """The paper preset's traits as lut_baker.scene_model stores them."""
-    from lut_baker import bake, closure_fit, presets, scene_model
+    """The paper preset's traits as lut_baker.auto_tier stores them."""
+    from lut_baker import auto_tier, bake
+    from lut_baker.closures import fitting
+    from lut_baker.model import presets
 
     tables = bake.bake(presets.made_up_skin("paper_natural", "paper_bioplate"), "default")
-    traits = scene_model.traits_from_tables(tables, closure_fit.fit_closures(tables))
-    print(f"# {scene_model.TRAITS_COMMAND}")
+    traits = auto_tier.traits_from_tables(tables, fitting.fit_closures(tables))
+    print(f"# {auto_tier.TRAITS_COMMAND}")
     print("PAPER_TIER_ERRORS =", {k: round(v, 4) for k, v in traits.tier_errors.items()})
     print("PAPER_MISMATCH =", round(traits.profile_mismatch, 4))
     print("PAPER_SKIN_SHARE =", {k: round(v, 4) for k, v in traits.skin_share.items()})
@@ -385,7 +390,7 @@ def main(argv=None) -> int:
     parser.add_argument("--costs", action="store_true",
                         help="measure the candidates' relative costs and noise")
     parser.add_argument("--traits", action="store_true",
-                        help="print the paper preset's traits (lut_baker.scene_model)")
+                        help="print the paper preset's traits (lut_baker.auto_tier)")
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--size", type=int, default=None,
                         help="render size, px (default 96 for --costs, 32 for the sweep)")
@@ -406,7 +411,7 @@ def main(argv=None) -> int:
             _print_costs(measure_costs(size=args.size, samples=tuple(args.samples[:2]),
                                        repeats=args.repeats, coverage=coverage), args, coverage)
         return 0
-    from lut_baker import stability
+    from lut_baker.offline.validation import stability
 
     regimes = ([stability.regime(k) for k in args.regimes] if args.regimes
                else list(stability.REGIMES))
@@ -417,13 +422,13 @@ def main(argv=None) -> int:
         results.append(stability.check_regime(item, error_points=60, model_points=24,
                                               fit=True))
         print(f"# checked {item.key}: {time.perf_counter() - start:.0f} s", flush=True)
-    text = ("Methods without Blender (`lut_baker.stability.check_regime`: exact model at 24 "
+    text = ("Methods without Blender (`lut_baker.offline.validation.stability.check_regime`: exact model at 24 "
             "direction pairs, preview bake, its error at 60 random points, reference images "
             "16 px):\n\n" + pure_table(results))
     if not args.no_render:
         renders = render_regimes(regimes, size=size, samples=samples)
         text += (f"\n\nEach tier in Cycles (`render_regimes`: {size} px, {samples} samples, "
-                 "seeds 0 and 1, against `lut_baker.compare.reference_image` from the preview "
+                 "seeds 0 and 1, against `lut_baker.offline.validation.compare.reference_image` from the preview "
                  "tables, spread where affordable; white furnace: world colour 1, no light, "
                  "rings of equal width in cos(theta_o)):\n\n" + render_table(renders, samples))
     print(text)

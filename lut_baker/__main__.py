@@ -1,7 +1,7 @@
-"""``python -m lut_baker``: the headless command line (see :mod:`lut_baker.cli`)."""
+"""``python -m lut_baker``: the headless command line (see :mod:`lut_baker.offline.cli.main`)."""
 
 import sys
 
-from .cli import main
+from .offline.cli.main import main
 
 sys.exit(main())

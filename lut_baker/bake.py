@@ -1,13 +1,13 @@
-"""Bake a made-up skin into lookup tables (:class:`lut_baker.tables.Tables`), fast.
+"""Bake a made-up skin into lookup tables (:class:`lut_baker.tables.table_set.Tables`), fast.
 
 Path 3 is a product of matrices per azimuthal Fourier order (SPEC 3): the bake evaluates
-:func:`lut_baker.layers.layered_fourier_matrices` with the table's polar grid as the outer
+:func:`lut_baker.evaluate.two_layer.layered_fourier_matrices` with the table's polar grid as the outer
 angles and sums the cosine series on the table's azimuth grid.  What makes it fast:
 
 - the layers' kernels are evaluated from cosines alone (no direction vectors), at the
   ``n_phi // 2 + 1`` distinct azimuths of an even kernel, once per unordered pair of polar
   angles (both kernels are symmetric), and turned into cosine coefficients by one BLAS product
-  (:func:`fourier_coefficients`, equal to :func:`lut_baker.layers.layer_fourier_kernel` within
+  (:func:`fourier_coefficients`, equal to :func:`lut_baker.evaluate.two_layer.layer_fourier_kernel` within
   1e-8), the Fresnel term interpolated from a checked tabulation (:func:`_fresnel_fast`);
 - every kernel table is computed once per bake (:class:`KernelCache`);
 - the bake's quadrature (:func:`bake_quadrature`) is coarser than the exact evaluator's, as
@@ -15,7 +15,7 @@ angles and sums the cosine series on the table's azimuth grid.  What makes it fa
 
 Functions and types
 -------------------
-- :func:`bake` -- the tables of one :class:`~lut_baker.normalise.MadeUpSkin`.
+- :func:`bake` -- the tables of one :class:`~lut_baker.model.made_up_skin.MadeUpSkin`.
 - :class:`Resolution`, :data:`RESOLUTIONS`, :func:`resolution` -- grid sizes per name.
 - :func:`bake_quadrature` -- Gauss-Legendre panels in polar angle, odd azimuth count.
 - :func:`fourier_coefficients` -- cosine coefficients of a layer's kernel, fast.
@@ -35,12 +35,12 @@ from functools import lru_cache
 
 import numpy as np
 
-from .layers import (
+from .evaluate.two_layer import (
     inter_reflection_fourier_matrices,
     layered_fourier_matrices,
     transmission_factor,
 )
-from .model import (
+from .model.layers import (
     Dipole,
     ReflectionLayer,
     TransmissionLayer,
@@ -50,16 +50,16 @@ from .model import (
     dipole_profile,
     dipole_total_reflectance,
 )
-from .normalise import (
+from .model.made_up_skin import (
     MadeUpSkin,
     directional_albedo,
     film_reflection_layer,
     film_transmission_layer,
     made_up_reflection,
 )
-from .params_file import skin_to_dict
-from .quadrature import HemisphereGrid, direction
-from .tables import THETA_OFFSET, Tables, node_cos_azimuths, radius_nodes, theta_nodes
+from .model.params_file import skin_to_dict
+from .numerics.quadrature import HemisphereGrid, direction
+from .tables.table_set import THETA_OFFSET, Tables, node_cos_azimuths, radius_nodes, theta_nodes
 
 __all__ = [
     "Resolution",
@@ -94,7 +94,7 @@ class Resolution:
 
     Table grids: ``n_theta`` polar nodes (theta_i and theta_o) on [0, ``theta_max_deg``] with
     ``theta_spacing``, ``n_phi`` azimuth coordinates on [0, 180] degrees with ``phi_spacing``,
-    ``n_radius`` distances with ``radius_spacing`` (closed forms in :mod:`lut_baker.tables`).
+    ``n_radius`` distances with ``radius_spacing`` (closed forms in :mod:`lut_baker.tables.table_set`).
     Quadrature of the path-3 integrals: ``quad_panels`` Gauss-Legendre panels of
     ``quad_points`` nodes in polar angle, ``quad_phi`` (odd) azimuth samples; the gloss
     albedos use ``albedo_azimuths`` azimuths concentrated at the mirror direction
@@ -171,7 +171,7 @@ def bake_quadrature(panels: int, points: int, n_phi: int) -> HemisphereGrid:
 def _half_vector_cosines(cos_a, sin_a, cos_b, sin_b, cos_phi):
     """``(N.H, V.H)`` of ``wa`` and ``wb`` at relative azimuth ``phi`` (eq. 2's half vector):
     ``|wa + wb|^2 = 2 + 2 wa.wb``, ``N.H = (cos_a + cos_b) / |wa + wb|``, ``V.H = |wa + wb| / 2``;
-    the normal where ``wa + wb`` vanishes (as :func:`lut_baker.model.ts_reflection`)."""
+    the normal where ``wa + wb`` vanishes (as :func:`lut_baker.model.layers.ts_reflection`)."""
     dot = cos_a * cos_b + sin_a * sin_b * cos_phi
     length = np.sqrt(np.maximum(2.0 + 2.0 * dot, 0.0))
     safe = length > 1e-12
@@ -198,7 +198,7 @@ def _fresnel_table(eta: float) -> np.ndarray | None:
 
 
 def _fresnel_fast(cosine: np.ndarray, eta) -> np.ndarray:
-    """:func:`lut_baker.model._fresnel` of cosines in [0, 1] with a trailing channel axis of
+    """:func:`lut_baker.model.layers._fresnel` of cosines in [0, 1] with a trailing channel axis of
     1, interpolated from :func:`_fresnel_table` (5x faster, within 1e-8 relative) when eta is
     one number; the formula itself otherwise."""
     table = _fresnel_table(float(eta)) if np.ndim(eta) == 0 else None
@@ -251,7 +251,7 @@ def _cosine_matrix(n_phi: int) -> np.ndarray:
 
 def fourier_coefficients(layer, theta_a, theta_b, n_phi: int) -> np.ndarray:
     """Cosine coefficients ``(orders, A, B, C)`` of a layer's kernel (the signature and result
-    of :func:`lut_baker.layers.layer_fourier_kernel`, within 1e-8 relative: the tabulated
+    of :func:`lut_baker.evaluate.two_layer.layer_fourier_kernel`, within 1e-8 relative: the tabulated
     Fresnel term), evaluated at the distinct azimuths only, and once per unordered pair when
     ``theta_a`` equals ``theta_b``."""
     theta_a = np.atleast_1d(np.asarray(theta_a, float))
@@ -272,7 +272,7 @@ def fourier_coefficients(layer, theta_a, theta_b, n_phi: int) -> np.ndarray:
 
 class KernelCache:
     """:func:`fourier_coefficients` memoised by (layer, grids): pass as ``fourier=`` to the
-    matrix functions of :mod:`lut_baker.layers` so that one bake evaluates each kernel once."""
+    matrix functions of :mod:`lut_baker.evaluate.two_layer` so that one bake evaluates each kernel once."""
 
     def __init__(self):
         self._store: dict = {}
@@ -346,7 +346,7 @@ def _channel_count(*layers) -> int:
 def gloss_tables(layers, theta_deg, phi_deg, phi_spacing: str = "half_vector",
                  *, pairs: _NodePairs | None = None) -> list[np.ndarray]:
     """Specular parts ``P_s D G F_r`` (eq. 2, 1/sr) of each reflecting layer on the table grid
-    (grids and spacing as :class:`lut_baker.tables.Tables`): ``(n_theta, n_theta, n_phi, 3)``
+    (grids and spacing as :class:`lut_baker.tables.table_set.Tables`): ``(n_theta, n_theta, n_phi, 3)``
     each, evaluated once per unordered (theta_i, theta_o)."""
     pairs = pairs or _NodePairs(theta_deg, phi_deg, phi_spacing)
     layers = [_gloss_layer(layer) for layer in layers]
@@ -446,7 +446,7 @@ def _stage(progress, fraction: float, message: str) -> None:
 
 def bake(skin: MadeUpSkin, resolution_name="default", *, inter_reflection: bool = False,
          progress=None) -> Tables:
-    """Bake the tables of one made-up skin (see :mod:`lut_baker.tables` for their meaning).
+    """Bake the tables of one made-up skin (see :mod:`lut_baker.tables.table_set` for their meaning).
 
     ``resolution_name``: ``"preview"``, ``"default"``, ``"high"`` or a :class:`Resolution`;
     it is scaled up for lobes narrower than the presets' (:meth:`Resolution.for_lobe`).
@@ -584,7 +584,7 @@ def error_samples(skin: MadeUpSkin, n_points: int = 500, seed: int = 0, *, level
                   theta_max_deg: float = 89.0) -> ErrorSamples:
     """``n_points`` random points (grazing rows included, polar angles up to
     ``theta_max_deg``) and the exact evaluator there: paths 1 + 3
-    (:func:`lut_baker.normalise.made_up_reflection`) and path 4's factor at ``level``, the
+    (:func:`lut_baker.model.made_up_skin.made_up_reflection`) and path 4's factor at ``level``, the
     directional albedo at ``albedo_level`` (default ``level``) on the first ``albedo_points``
     of them (default all), and R(d)/Rd on [0, :func:`profile_radius`] (denser near 0)."""
     albedo_level = level if albedo_level is None else albedo_level

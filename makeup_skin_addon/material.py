@@ -52,13 +52,13 @@ MATERIAL_NAME = "Made-up Skin"
 ERRORS_KEY = "makeup_skin_errors"
 """Material custom property: the tiers' errors at the settings of the last Apply (JSON): per
 tier its angular ``rms`` and ``albedo`` errors, ``gloss_omission`` (per light angle, what
-Gloss 0 changes in a sphere's image, :func:`lut_baker.scene_model.gloss_omissions`), the
+Gloss 0 changes in a sphere's image, :func:`lut_baker.auto_tier.gloss_omissions`), the
 ``coverage``, ``absorption`` and tables ``key`` they were measured for."""
 
 
 def skin_from_settings(settings):
     """The made-up skin the settings describe, at coverage 1 and absorption 0."""
-    presets = lut_baker("presets")
+    presets = lut_baker("model.presets")
     skin = presets.made_up_skin(settings.foundation, settings.skin, coverage=1.0,
                                 absorption=0.0)
     if settings.override_film:
@@ -74,7 +74,7 @@ def skin_from_settings(settings):
 
 def resolve_tier(settings, scene) -> str:
     """The tier to build: the settings' own, or for Auto the one
-    :func:`scene_fit.auto_tier` picks from the scene (:mod:`lut_baker.scene_model`: the
+    :func:`scene_fit.auto_tier` picks from the scene (:mod:`lut_baker.auto_tier`: the
     cheapest within the tolerance of the best predicted error; EEVEE: Principled)."""
     if settings.tier != "AUTO":
         return settings.tier
@@ -172,7 +172,7 @@ def group_for_tables(tables, tier: str, *, bake=None, group=None, errors_at=None
     """
     messages = [] if messages is None else messages
     if bake is None:
-        skin = lut_baker("params_file").skin_from_dict(tables.parameters)
+        skin = lut_baker("model.params_file").skin_from_dict(tables.parameters)
         bake = storage.bake_record(skin, "default", tables)
     key = bake["key"]
     existing = bpy.data.node_groups.get(nodes.group_name(tier, key, method))
@@ -197,7 +197,7 @@ def clear_cache() -> None:
 
 def _fit(tables, key: str, errors_at, progress=None):
     """The closure fit of ``tables`` (cached by key), its errors measured at ``errors_at``."""
-    cf = lut_baker("closure_fit")
+    cf = lut_baker("closures.fitting")
     fit = _FITS.pop(key, None)
     if fit is None:
         fit = cf.fit_closures(tables, errors_at=errors_at, progress=progress)
@@ -287,7 +287,7 @@ def apply_to_object(context, obj, *, resolution=None) -> tuple:
             progress=progress, errors_at=(settings.coverage, absorption),
             method=forced_method(settings), messages=messages)
     if fit is not None:
-        omission = lut_baker("scene_model").gloss_omissions(tables, fit, settings.coverage,
+        omission = lut_baker("auto_tier").gloss_omissions(tables, fit, settings.coverage,
                                                             absorption)
         key = nodes.read_meta(group)["key"]  # the group's bake: no second hash of the tables
         material[ERRORS_KEY] = json.dumps({name: {"rms": e.rms, "albedo": e.albedo,

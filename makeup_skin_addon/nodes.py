@@ -1,4 +1,4 @@
-"""The "Made-up Skin" node groups: closures fitted to baked tables (lut_baker.closure_fit).
+"""The "Made-up Skin" node groups: closures fitted to baked tables (lut_baker.closures.fitting).
 
 Both tiers share one interface, so a material keeps its links when the tier changes:
 
@@ -18,13 +18,13 @@ are per unit albedo, so a texture scales them exactly.  What stays the preset's:
 radius (fitted to the skin's profile), the skin's gloss and the film.
 
 PRINCIPLED: one Principled BSDF (GGX, coat = the film, specular and base/subsurface = the skin)
-whose inputs follow :func:`lut_baker.closure_fit.principled_inputs` in math nodes (Gloss
+whose inputs follow :func:`lut_baker.closures.fitting.principled_inputs` in math nodes (Gloss
 scales Coat Weight and Specular IOR Level: at 0 ``svm_node_closure_bsdf`` skips the coat,
 ``coat_weight > CLOSURE_WEIGHT_CUTOFF``, and the specular, ``eta != 1``).
 LAYERED: Glossy, Diffuse and Subsurface closures weighted as
-:func:`lut_baker.closure_fit.layered_weights` (Gloss scales the three Glossy colours: a closure
+:func:`lut_baker.closures.fitting.layered_weights` (Gloss scales the three Glossy colours: a closure
 of weight 0 is never allocated, ``bsdf_alloc``), view-dependent factors read from one float image
-(rows :data:`lut_baker.closure_fit.LUT_ROWS`) at ``u = cos(theta_o)``, and a Mix Shader by
+(rows :data:`lut_baker.closures.fitting.LUT_ROWS`) at ``u = cos(theta_o)``, and a Mix Shader by
 Coverage between bare skin and made-up skin: an areal mix of closures, so a painted coverage
 fades out without fringe or halo.
 
@@ -244,7 +244,7 @@ def _common(build: _Builder):
 
 
 def _build_principled(build: _Builder, fit, method: str, radius_mm, ior: float):
-    cf = lut_baker("closure_fit")
+    cf = lut_baker("closures.fitting")
     inputs, output, w, through, through2, skin, scale, gloss = _common(build)
     coat_weight = build.math("MULTIPLY", w, gloss, label="coat weight")
     made_skin = build.vector("MULTIPLY", build.vector("MULTIPLY", through2, skin),
@@ -288,7 +288,7 @@ def _build_principled(build: _Builder, fit, method: str, radius_mm, ior: float):
 
 
 def _build_layered(build: _Builder, fit, lut, method: str, radius_mm, ior: float):
-    cf = lut_baker("closure_fit")
+    cf = lut_baker("closures.fitting")
     inputs, output, w, through, through2, skin, scale, gloss = _common(build)
     geometry = build.node("ShaderNodeNewGeometry")
     film_normal, skin_normal = inputs.outputs["Film Normal"], inputs.outputs["Normal"]
@@ -379,7 +379,7 @@ def build_group(tier: str, bake: dict, fit, group=None, *, method=None):
     :func:`storage.bake_record`).  ``method``: a subsurface method forced by the user, else the
     fit's choice.  The group's :data:`FIT_KEY` holds the bake record, the fit's summary and the
     SHA-256 of every image the group reads (:func:`storage.image_record`)."""
-    cf = lut_baker("closure_fit")
+    cf = lut_baker("closures.fitting")
     if tier not in cf.TIERS:
         raise ValueError(f"tier must be one of {cf.TIERS}, got {tier!r}")
     key = bake["key"]

@@ -40,13 +40,13 @@ RESOLUTION_ITEMS = (
 
 
 def _foundation_items(self, context):
-    presets = lut_baker("presets")
+    presets = lut_baker("model.presets")
     return [(key, value["label"], f"Foundation shade {value['label']}")
             for key, value in presets.FOUNDATIONS.items()]
 
 
 def _skin_items(self, context):
-    presets = lut_baker("presets")
+    presets = lut_baker("model.presets")
     return [(key, value["label"], f"Skin {value['label']}") for key, value in
             presets.SKINS.items()]
 
@@ -87,7 +87,7 @@ def _update_tables(self, context):
 
 
 def _update_skin(self, context):
-    presets = lut_baker("presets")
+    presets = lut_baker("model.presets")
     if self.skin in presets.SKINS:
         # The preset's albedo goes to the socket at once (a linked texture overrides it).
         self.skin_colour = presets.skin_albedo(self.skin).tolist()
@@ -95,7 +95,7 @@ def _update_skin(self, context):
 
 
 def _update_foundation(self, context):
-    presets = lut_baker("presets")
+    presets = lut_baker("model.presets")
     entry = presets.FOUNDATIONS.get(self.foundation)
     if entry is not None:
         # Assigning runs _update_sockets once more: the shade reaches the material at once.
@@ -137,7 +137,7 @@ class MakeupSkinSettings(bpy.types.PropertyGroup):
         update=_update_sockets)
     skin_colour: bpy.props.FloatVectorProperty(
         name="Skin Color", size=3, min=0.0, max=1.0,
-        default=tuple(lut_baker("presets").skin_albedo(next(iter(lut_baker("presets").SKINS)))),
+        default=tuple(lut_baker("model.presets").skin_albedo(next(iter(lut_baker("model.presets").SKINS)))),
         subtype="COLOR",
         description="The skin's diffuse albedo (the skin preset's by default); an albedo "
                     "texture linked to the group's Skin Color input replaces it",

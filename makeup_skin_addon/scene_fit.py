@@ -1,10 +1,10 @@
 """Fit to Scene: the Auto tier chosen from the scene.
 
-What the scene looks like to the model (:class:`lut_baker.scene_model.SceneDescription`) comes
+What the scene looks like to the model (:class:`lut_baker.auto_tier.SceneDescription`) comes
 from the active camera, the render resolution, the objects wearing the material (the nearest
 one: the largest on screen), the lights and the render engine; what the material is
-(:class:`lut_baker.scene_model.MaterialTraits`) from its tables (re-baked from its group's
-record) and the tiers' errors of its last Apply.  :func:`lut_baker.scene_model.choose` then
+(:class:`lut_baker.auto_tier.MaterialTraits`) from its tables (re-baked from its group's
+record) and the tiers' errors of its last Apply.  :func:`lut_baker.auto_tier.choose` then
 picks the cheapest candidate within the tolerance.
 
 - :func:`auto_tier` -- the tier for ``Tier = Auto`` (called by
@@ -72,7 +72,7 @@ def _centre(obj):
 
 def _footprint_mm(scene, obj, mm_per_unit: float):
     """``(mm per pixel at the object, unit vector from the object to the camera)``."""
-    sm = lut_baker("scene_model")
+    sm = lut_baker("auto_tier")
     camera = scene.camera
     data = camera.data
     scale = scene.render.resolution_percentage / 100.0
@@ -114,9 +114,9 @@ def _light_angles(scene, obj, toward_camera) -> tuple:
 
 
 def describe_scene(scene, material=None, obj=None):
-    """The :class:`lut_baker.scene_model.SceneDescription` of ``scene`` for ``obj`` (default:
+    """The :class:`lut_baker.auto_tier.SceneDescription` of ``scene`` for ``obj`` (default:
     the nearest object wearing ``material``), or None without a camera or an object."""
-    sm = lut_baker("scene_model")
+    sm = lut_baker("auto_tier")
     from .material import units_per_mm
 
     samples, denoise = _samples(scene)
@@ -190,7 +190,7 @@ def _tables(meta):
 
 
 def material_traits(material, *, refit: bool = False, may_fit: bool = True):
-    """The :class:`lut_baker.scene_model.MaterialTraits` of a made-up material at its coverage
+    """The :class:`lut_baker.auto_tier.MaterialTraits` of a made-up material at its coverage
     and absorption, the Subsurface Scale and Gloss applied (the values Fit to Scene saved if
     it set them to 0).  From its re-baked tables: the profile, the shares of gloss and skin
     light, the profile mismatch of the group's subsurface method; the tier errors and gloss
@@ -198,7 +198,7 @@ def material_traits(material, *, refit: bool = False, may_fit: bool = True):
     absorption) of a new closure fit (a few seconds; without ``may_fit``, as when a panel
     draws, the paper preset's tier errors and the tables' gloss share instead).  Without
     tables: the paper preset's traits."""
-    sm = lut_baker("scene_model")
+    sm = lut_baker("auto_tier")
     settings = material.makeup_skin
     coverage = float(settings.coverage)
     absorption = [float(a) for a in settings.effective_absorption()]
@@ -217,7 +217,7 @@ def material_traits(material, *, refit: bool = False, may_fit: bool = True):
                   else sm.paper_traits().scaled(scale, gloss))
     elif traits is None:
         if errors is None and may_fit:
-            fit = lut_baker("closure_fit").fit_closures(tables,
+            fit = lut_baker("closures.fitting").fit_closures(tables,
                                                         errors_at=(coverage, absorption))
             errors = {tier: float(e.rms) for tier, e in fit.errors.items()}
             omission = sm.gloss_omissions(tables, fit, coverage, absorption)
@@ -243,7 +243,7 @@ def choose_for(material, scene, *, obj=None, tolerance=None, refit=False, may_fi
     """``(Choice, SceneDescription or None)`` for ``material`` in ``scene`` (an unknown scene
     counts as a close-up: :data:`UNKNOWN_SCENE`); ``refit``, ``may_fit``: as
     :func:`material_traits`."""
-    sm = lut_baker("scene_model")
+    sm = lut_baker("auto_tier")
     description = describe_scene(scene, material, obj)
     chosen_scene = description
     if chosen_scene is None:

@@ -9,7 +9,7 @@ images a group reads (the Layered tier's view-angle image) are packed, and the g
 the SHA-256 of their pixels and of their packed bytes (:func:`image_record`), so damage is
 found before Blender decodes the image (:func:`image_problem`).
 
-- :func:`tables_key` -- content hash of tables (hex; :func:`lut_baker.io.content_hash`).
+- :func:`tables_key` -- content hash of tables (hex; :func:`lut_baker.tables.codec.content_hash`).
 - :func:`bake_record`, :func:`rebake` -- a bake's record, and the tables again from it.
 - :func:`lut_image_name`, :func:`lut_image` -- the Layered tier's view-angle image.
 - :func:`image_record`, :func:`image_problem` -- an image's hashes, and what is wrong with it;
@@ -52,14 +52,14 @@ class StorageError(ValueError):
 
 
 def tables_key(tables) -> str:
-    """The tables' content hash (SHA-256 hex of their float32 atlas, :mod:`lut_baker.io`)."""
-    return lut_baker("io").content_hash(tables)
+    """The tables' content hash (SHA-256 hex of their float32 atlas, :mod:`lut_baker.tables.codec`)."""
+    return lut_baker("tables.codec").content_hash(tables)
 
 
 def bake_record(skin, resolution: str, tables) -> dict:
     """What identifies a bake: ``{"key", "parameters", "resolution"}`` (plain data)."""
     return {"key": tables_key(tables),
-            "parameters": lut_baker("params_file").skin_to_dict(skin),
+            "parameters": lut_baker("model.params_file").skin_to_dict(skin),
             "resolution": str(resolution)}
 
 
@@ -87,7 +87,7 @@ def rebake(record: dict):
         _TABLES.move_to_end(cache_key)
         return _TABLES[cache_key], key
     try:
-        skin = lut_baker("params_file").skin_from_dict(record["parameters"])
+        skin = lut_baker("model.params_file").skin_from_dict(record["parameters"])
         tables = lut_baker("bake").bake(skin, record["resolution"])
     except (KeyError, TypeError, ValueError):
         raise StorageError("its bake record cannot be re-baked (a parameter is missing or "

@@ -244,7 +244,8 @@ def test_skin_colour_texture_matches_a_bake_at_that_albedo(addon, blank_scene, t
     diffuse term is linear, so the texture scales every skin closure exactly."""
     import bpy
 
-    from lut_baker import bake, presets
+    from lut_baker import bake
+    from lut_baker.model import presets
     from makeup_skin_addon import material as made_up
 
     colour = np.array([0.62, 0.41, 0.33])

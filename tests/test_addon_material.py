@@ -111,7 +111,7 @@ def test_coverage_and_absorption_are_sockets(sphere):
     assert tuple(node.inputs["Foundation Absorption"].default_value)[:3] == pytest.approx(
         (0.1, 0.3, 0.5))
     material.makeup_skin.foundation = "deep_mocha"  # sets the shade's absorption
-    from lut_baker.presets import FOUNDATIONS
+    from lut_baker.model.presets import FOUNDATIONS
 
     assert tuple(node.inputs["Foundation Absorption"].default_value)[:3] == pytest.approx(
         FOUNDATIONS["deep_mocha"]["absorption"])

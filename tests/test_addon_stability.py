@@ -21,13 +21,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from lut_baker import bake, compare, reference, scene_model, stability
+from lut_baker import auto_tier, bake
+from lut_baker.offline.validation import compare, reference, stability
 
 ROOT = Path(__file__).resolve().parent.parent
 SIZE, SAMPLES = 32, 64
 RING_STANDARD_ERRORS = 3.0
 PIXEL_MARGIN = 0.1
-TIERS = (scene_model.Candidate("PRINCIPLED"), scene_model.Candidate("LAYERED"))
+TIERS = (auto_tier.Candidate("PRINCIPLED"), auto_tier.Candidate("LAYERED"))
 ROW = re.compile(r"^\| `(\w+)` \| ([^|]+?) \|(?: [^|]+ \|){4} ([\d.]+)% \|")
 
 

@@ -1,4 +1,4 @@
-"""The bake (lut_baker.bake) and the table contract (lut_baker.tables).
+"""The bake (lut_baker.bake) and the table contract (lut_baker.tables.table_set).
 
 The expensive part, the exact evaluator at 500 random points, is computed once per module.
 """
@@ -8,8 +8,11 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from lut_baker import bake, layers, model, normalise, presets, tables
-from lut_baker.quadrature import direction
+from lut_baker import bake
+from lut_baker.evaluate import two_layer
+from lut_baker.model import layers, made_up_skin, presets
+from lut_baker.numerics.quadrature import direction
+from lut_baker.tables import table_set
 
 
 @pytest.fixture(scope="module")
@@ -29,7 +32,7 @@ def default_tables(paper):
     return bake.bake(paper, "default")
 
 
-def node_directions(t: tables.Tables):
+def node_directions(t: table_set.Tables):
     """(wi, wo) of every angular node, shape (n, n, p, 3)."""
     theta = np.radians(t.theta_deg)
     wi = direction(theta[:, None, None], np.radians(t.node_azimuths()))
@@ -44,13 +47,13 @@ def node_directions(t: tables.Tables):
 def test_fast_fourier_coefficients_equal_the_exact_evaluators(n_phi):
     paper = presets.paper()
     jensen = presets.made_up_skin("deep_mocha", "jensen_skin2")
-    shaded_film = normalise.film_transmission_layer(jensen)  # RGB through absorption
+    shaded_film = made_up_skin.film_transmission_layer(jensen)  # RGB through absorption
     grid = bake.bake_quadrature(2, 6, 17)
     outer = np.radians([0.0, 12.0, 47.0, 80.0, 89.0])
     for layer in (paper.skin, paper.film, paper.film_transmission, jensen.skin, shaded_film):
         for theta_a in (outer, grid.theta):
             fast = bake.fourier_coefficients(layer, theta_a, grid.theta, n_phi)
-            reference = layers.layer_fourier_kernel(layer, theta_a, grid.theta, n_phi)
+            reference = two_layer.layer_fourier_kernel(layer, theta_a, grid.theta, n_phi)
             assert fast.shape == reference.shape
             scale = np.abs(reference).max()
             # the tabulated Fresnel term is within 1e-8 (bake.FRESNEL_TOLERANCE)
@@ -60,9 +63,9 @@ def test_fast_fourier_coefficients_equal_the_exact_evaluators(n_phi):
 def test_layered_matrices_with_fast_kernels_equal_the_default(paper):
     grid = bake.bake_quadrature(2, 6, 17)
     theta = np.radians([0.0, 30.0, 60.0, 85.0])
-    fast = layers.layered_fourier_matrices(theta, theta, paper.film_transmission, paper.skin,
+    fast = two_layer.layered_fourier_matrices(theta, theta, paper.film_transmission, paper.skin,
                                            grid, fourier=bake.KernelCache())
-    slow = layers.layered_fourier_matrices(theta, theta, paper.film_transmission, paper.skin,
+    slow = two_layer.layered_fourier_matrices(theta, theta, paper.film_transmission, paper.skin,
                                            grid)
     np.testing.assert_allclose(fast, slow, rtol=2e-8, atol=1e-15)
 
@@ -73,13 +76,13 @@ def test_skin_diffuse_part_of_path3_is_pd_times_both_transmittances(paper):
     wi = direction(np.radians(rng.uniform(0, 89, 20)), rng.uniform(0, 2 * np.pi, 20))
     wo = direction(np.radians(rng.uniform(0, 89, 20)), rng.uniform(0, 2 * np.pi, 20))
     diffuse_only = paper.skin.scaled(P_s=0.0)
-    path3 = layers.layered_reflection(wi, wo, paper.film_transmission, diffuse_only)
-    t_i = layers.film_transmittance(wi, paper.film_transmission)
-    t_o = layers.film_transmittance(wo, paper.film_transmission)
+    path3 = two_layer.layered_reflection(wi, wo, paper.film_transmission, diffuse_only)
+    t_i = two_layer.film_transmittance(wi, paper.film_transmission)
+    t_o = two_layer.film_transmittance(wo, paper.film_transmission)
     np.testing.assert_allclose(path3, paper.skin.P_d * t_i * t_o, rtol=1e-10)
     # and the gloss part is what remains of the full path 3
-    full = layers.layered_reflection(wi, wo, paper.film_transmission, paper.skin)
-    gloss = layers.layered_reflection(wi, wo, paper.film_transmission,
+    full = two_layer.layered_reflection(wi, wo, paper.film_transmission, paper.skin)
+    gloss = two_layer.layered_reflection(wi, wo, paper.film_transmission,
                                       bake._gloss_layer(paper.skin))
     np.testing.assert_allclose(full, gloss + paper.skin.P_d * t_i * t_o, rtol=1e-10)
 
@@ -87,7 +90,7 @@ def test_skin_diffuse_part_of_path3_is_pd_times_both_transmittances(paper):
 def test_gloss_tables_equal_eq2_at_every_node(default_tables, paper):
     wi, wo = node_directions(default_tables)
     for name, layer in (("film_gloss", paper.film), ("skin_gloss", paper.skin)):
-        exact = model.ts_reflection(wi, wo, bake._gloss_layer(layer))
+        exact = layers.ts_reflection(wi, wo, bake._gloss_layer(layer))
         # within the tabulated Fresnel term's checked 1e-8
         np.testing.assert_allclose(getattr(default_tables, name)[..., 0], exact, rtol=1e-8,
                                    atol=1e-12)
@@ -98,7 +101,7 @@ def test_tabulated_fresnel_is_checked_and_falls_back_near_eta_1():
     assert bake._fresnel_table(1.0001) is None and bake._fresnel_table(0.8) is None
     c = np.random.default_rng(2).uniform(0.0, 1.0, (5000, 1))
     for eta in (1.19, 1.26, 1.0001, 0.8):
-        np.testing.assert_allclose(bake._fresnel_fast(c, eta), model._fresnel(c, eta),
+        np.testing.assert_allclose(bake._fresnel_fast(c, eta), layers._fresnel(c, eta),
                                    rtol=bake.FRESNEL_TOLERANCE)
 
 
@@ -108,31 +111,31 @@ def test_gloss_albedos_match_the_converged_evaluator(paper):
     grid = bake.bake_quadrature(res.quad_panels, res.quad_points, res.quad_phi)
     fast = bake.gloss_albedos((paper.film, paper.skin), theta, grid, res.albedo_azimuths)
     for albedo, layer in zip(fast, (paper.film, paper.skin), strict=True):
-        exact = layers.reflection_albedo(theta, bake._gloss_layer(layer), level=2)
+        exact = two_layer.reflection_albedo(theta, bake._gloss_layer(layer), level=2)
         np.testing.assert_allclose(albedo[:, 0], exact, atol=2e-4)
 
 
 # --------------------------------------------------------------------------------------------
 # Grids
 # --------------------------------------------------------------------------------------------
-@pytest.mark.parametrize("spacing", tables.THETA_SPACINGS)
+@pytest.mark.parametrize("spacing", table_set.THETA_SPACINGS)
 def test_theta_index_inverts_theta_nodes(spacing):
-    nodes = tables.theta_nodes(37, spacing, 89.0, 0.05)
+    nodes = table_set.theta_nodes(37, spacing, 89.0, 0.05)
     assert nodes[0] == 0.0 and nodes[-1] == 89.0 and np.all(np.diff(nodes) > 0)
-    np.testing.assert_allclose(tables.theta_index(nodes, 37, spacing, 89.0, 0.05),
+    np.testing.assert_allclose(table_set.theta_index(nodes, 37, spacing, 89.0, 0.05),
                                np.arange(37), atol=1e-9)
 
 
 def test_grazing_spacing_is_denser_at_grazing_than_at_the_normal():
-    nodes = tables.theta_nodes(96, "grazing", 89.0)
+    nodes = table_set.theta_nodes(96, "grazing", 89.0)
     assert nodes[-1] - nodes[-2] < 0.15 < 2.0 < nodes[1] - nodes[0] < 3.0
 
 
-@pytest.mark.parametrize("spacing", tables.PHI_SPACINGS)
+@pytest.mark.parametrize("spacing", table_set.PHI_SPACINGS)
 def test_phi_index_inverts_node_azimuths(default_tables, spacing):
     t = replace(default_tables, phi_spacing=spacing)
     wi, wo = node_directions(t)
-    index = tables.phi_index(wi, wo, t.phi_deg.size, spacing)
+    index = table_set.phi_index(wi, wo, t.phi_deg.size, spacing)
     inner = (t.theta_deg[:, None, None] > 0) & (t.theta_deg[None, :, None] > 0)
     expected = np.broadcast_to(np.arange(t.phi_deg.size), index.shape)
     np.testing.assert_allclose(index[np.broadcast_to(inner, index.shape)],
@@ -143,7 +146,7 @@ def test_half_vector_coordinate_ends_are_true_azimuths():
     wi = direction(np.radians(70.0), 0.0)
     for phi_deg, expected in ((0.0, 0.0), (180.0, 32.0), (-180.0, 32.0), (360.0, 0.0)):
         wo = direction(np.radians(40.0), np.radians(phi_deg))
-        assert tables.phi_index(wi, wo, 33) == pytest.approx(expected, abs=1e-9)
+        assert table_set.phi_index(wi, wo, 33) == pytest.approx(expected, abs=1e-9)
 
 
 # --------------------------------------------------------------------------------------------
@@ -167,14 +170,14 @@ def test_a_coarse_bake_fails_the_goal(paper, samples):
 
 
 def test_tables_apply_any_coverage_and_absorption_exactly_at_the_nodes(default_tables, paper):
-    """Baked at absorption 0, the formula of lut_baker.tables reproduces the exact evaluator
+    """Baked at absorption 0, the formula of lut_baker.tables.table_set reproduces the exact evaluator
     for another coverage and RGB absorption (at nodes: no interpolation error)."""
     rng = np.random.default_rng(5)
     n = default_tables.theta_deg.size
     i, j, k = rng.integers(0, n, 60), rng.integers(0, n, 60), rng.integers(0, 65, 60)
     wi, wo = (w[i, j, k] for w in node_directions(default_tables))
     other = paper.replace(coverage=0.3, absorption=(0.2, 0.5, 0.9))
-    exact = normalise.made_up_reflection(wi, wo, other)
+    exact = made_up_skin.made_up_reflection(wi, wo, other)
     table = default_tables.made_up_reflection(wi, wo, coverage=0.3, absorption=(0.2, 0.5, 0.9))
     np.testing.assert_allclose(table, exact, rtol=1e-4, atol=1e-6)
 
@@ -183,15 +186,15 @@ def test_directional_tables(default_tables, paper):
     theta = np.array([0.0, 33.0, 66.0, 88.0])
     w = direction(np.radians(theta), 0.0)
     np.testing.assert_allclose(default_tables.directional("film_transmittance", theta)[:, 0],
-                               layers.film_transmittance(w, paper.film_transmission, level=1),
+                               two_layer.film_transmittance(w, paper.film_transmission, level=1),
                                rtol=1e-4)
     np.testing.assert_allclose(default_tables.directional("transmission_factor", theta)[:, 0],
-                               layers.transmission_factor(w, paper.film_transmission,
+                               two_layer.transmission_factor(w, paper.film_transmission,
                                                           paper.dipole, level=1), rtol=1e-4)
     # Int T(w) cos dw over the hemisphere, by a fine 1-D quadrature of the exact T
     x, weights = np.polynomial.legendre.leggauss(64)
     t = np.pi / 4 * (x + 1)
-    exact_t = layers.film_transmittance(direction(t, 0.0), paper.film_transmission, level=1)
+    exact_t = two_layer.film_transmittance(direction(t, 0.0), paper.film_transmission, level=1)
     integral = 2 * np.pi * np.sum(exact_t * np.cos(t) * np.sin(t) * weights * np.pi / 4)
     np.testing.assert_allclose(default_tables.film_transmittance_integral, integral, rtol=1e-4)
     assert np.all(default_tables.film_transmittance_integral <= np.pi)
@@ -200,14 +203,14 @@ def test_directional_tables(default_tables, paper):
 def test_radial_table(default_tables, paper):
     d = default_tables.radius_mm
     assert d[0] == 0.0
-    profile = np.atleast_1d(model.dipole_profile(d, paper.dipole))
+    profile = np.atleast_1d(layers.dipole_profile(d, paper.dipole))
     np.testing.assert_allclose(default_tables.profile[:, 0],
-                               profile / model.dipole_total_reflectance(paper.dipole), rtol=1e-12)
+                               profile / layers.dipole_total_reflectance(paper.dipole), rtol=1e-12)
     # ends where R falls below 1e-4 of its peak, not before
     assert profile[-1] <= 1e-4 * profile[0] * (1 + 1e-6)
-    assert model.dipole_profile(0.99 * d[-1], paper.dipole) > 1e-4 * profile[0]
+    assert layers.dipole_profile(0.99 * d[-1], paper.dipole) > 1e-4 * profile[0]
     np.testing.assert_allclose(default_tables.total_reflectance,
-                               model.dipole_total_reflectance(paper.dipole))
+                               layers.dipole_total_reflectance(paper.dipole))
 
 
 def test_rgb_skin_bakes_per_channel():
@@ -251,11 +254,11 @@ def test_inter_reflection_of_diffuse_layers_is_the_geometric_series():
     a^2 b pi^2 and each further bounce multiplies by (pi b)(pi c)."""
     a, b, c = 0.08, 0.2, 0.12
     grid = bake.bake_quadrature(2, 6, 17)
-    film_t = model.TransmissionLayer(P_d=a, P_t=0.0, n=0.03, eta=1.2)
-    skin = model.ReflectionLayer(P_d=b, P_s=0.0, n=0.03, eta=1.3)
-    below = model.ReflectionLayer(P_d=c, P_s=0.0, n=0.03, eta=1.2)
+    film_t = layers.TransmissionLayer(P_d=a, P_t=0.0, n=0.03, eta=1.2)
+    skin = layers.ReflectionLayer(P_d=b, P_s=0.0, n=0.03, eta=1.3)
+    below = layers.ReflectionLayer(P_d=c, P_s=0.0, n=0.03, eta=1.2)
     theta = np.radians([0.0, 45.0, 80.0])
-    full = layers.inter_reflection_fourier_matrices(theta, theta, film_t, skin, grid,
+    full = two_layer.inter_reflection_fourier_matrices(theta, theta, film_t, skin, grid,
                                                     film_below=below)
     bounce = np.pi * b * np.pi * c
     np.testing.assert_allclose(full[0, ..., 0], a * a * b * np.pi**2 / (1 - bounce), rtol=1e-12)
@@ -266,13 +269,13 @@ def test_inter_reflection_equals_its_neumann_series(paper):
     """(I - S R_f)^-1 S against S + S R_f S + ... summed term by term (glossy layers)."""
     grid = bake.bake_quadrature(2, 6, 17)
     theta = np.radians([10.0, 50.0, 85.0])
-    film_t = normalise.film_transmission_layer(paper)
-    below = normalise.film_reflection_layer(paper)
-    full = layers.inter_reflection_fourier_matrices(theta, theta, film_t, paper.skin, grid,
+    film_t = made_up_skin.film_transmission_layer(paper)
+    below = made_up_skin.film_reflection_layer(paper)
+    full = two_layer.inter_reflection_fourier_matrices(theta, theta, film_t, paper.skin, grid,
                                                     film_below=below)
-    skin_m = layers._inner_matrices(grid, film_t, paper.skin)[..., 0]
-    film_m = layers.layer_fourier_kernel(below, grid.theta, grid.theta, grid.n_phi)[..., 0]
-    rows = layers._transmission_rows(theta, grid, film_t)[..., 0]
+    skin_m = two_layer._inner_matrices(grid, film_t, paper.skin)[..., 0]
+    film_m = two_layer.layer_fourier_kernel(below, grid.theta, grid.theta, grid.n_phi)[..., 0]
+    rows = two_layer._transmission_rows(theta, grid, film_t)[..., 0]
     term, total = skin_m, skin_m.copy()
     for _ in range(40):
         term = term @ film_m @ skin_m
@@ -289,10 +292,10 @@ def test_inter_reflection_table(paper):
     res = bake.RESOLUTIONS["preview"]
     grid = bake.bake_quadrature(res.quad_panels, res.quad_points, res.quad_phi)
     theta = np.radians(t.theta_deg[[4, 30]])
-    film_t = normalise.film_transmission_layer(paper)
-    extra = (layers.inter_reflection_fourier_matrices(
-        theta, theta, film_t, paper.skin, grid, film_below=normalise.film_reflection_layer(paper))
-        - layers.layered_fourier_matrices(theta, theta, film_t, paper.skin, grid))
+    film_t = made_up_skin.film_transmission_layer(paper)
+    extra = (two_layer.inter_reflection_fourier_matrices(
+        theta, theta, film_t, paper.skin, grid, film_below=made_up_skin.film_reflection_layer(paper))
+        - two_layer.layered_fourier_matrices(theta, theta, film_t, paper.skin, grid))
     cos_phi = np.cos(np.radians(t.node_azimuths()[4, 30]))
     series = sum(extra[m, 0, 1, 0] * np.cos(m * np.arccos(cos_phi)) for m in range(len(extra)))
     np.testing.assert_allclose(t.inter_reflection[4, 30, :, 0], series, rtol=1e-9, atol=1e-14)

@@ -1,4 +1,4 @@
-"""The baseline (lut_baker.baseline): a stock Principled BSDF fitted to the model's images.
+"""The baseline (lut_baker.offline.validation.baseline): a stock Principled BSDF fitted to the model's images.
 
 No bpy: the fit runs on the Principled replica (whose agreement with Cycles renders is checked
 in tests/test_render_compare.py).  A fit must find a Principled BSDF that is one (round trip),
@@ -10,15 +10,18 @@ import dataclasses
 import numpy as np
 import pytest
 
-from lut_baker import bake, baseline, closure_fit, presets
-from lut_baker import cycles_closures as cc
+from lut_baker import bake
+from lut_baker.closures import cycles as cc
+from lut_baker.closures import fitting
+from lut_baker.model import presets
+from lut_baker.offline.validation import baseline
 
 
 @pytest.fixture(scope="module")
 def paper():
     skin = presets.paper()
     tables = bake.bake(skin, "preview")
-    return skin, tables, closure_fit.fit_closures(tables)
+    return skin, tables, fitting.fit_closures(tables)
 
 
 class _PrincipledTables:
@@ -33,7 +36,7 @@ class _PrincipledTables:
 
 def test_fit_recovers_a_principled_bsdf(paper):
     skin, _, fit = paper
-    start, _ = closure_fit.principled_inputs(fit, skin.coverage, skin.absorption)
+    start, _ = fitting.principled_inputs(fit, skin.coverage, skin.absorption)
     truth = dataclasses.replace(start, base_color=(0.55, 0.45, 0.35), roughness=0.5,
                                 specular_ior_level=0.4, coat_weight=0.7, coat_roughness=0.3,
                                 coat_ior=1.7)

@@ -1,4 +1,4 @@
-"""`python -m lut_baker bake` (lut_baker.cli_bake) and parameter files (lut_baker.params_file)."""
+"""`python -m lut_baker bake` (lut_baker.offline.cli.bake_command) and parameter files (lut_baker.model.params_file)."""
 
 import errno
 import json
@@ -13,7 +13,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from lut_baker import bake, cli, cli_bake, io, params_file, presets
+from lut_baker import bake
+from lut_baker.model import params_file, presets
+from lut_baker.offline.cli import bake_command, main
+from lut_baker.tables import codec
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "beige_on_skin1.toml"
@@ -27,7 +30,7 @@ def run_cli(*args, cwd=ROOT, **kwargs):
 
 
 def parse(*args):
-    return cli.build_parser().parse_args(["bake", *map(str, args)])
+    return main.build_parser().parse_args(["bake", *map(str, args)])
 
 
 def test_cli_bake_writes_the_same_tables_as_the_function(tmp_path):
@@ -36,8 +39,8 @@ def test_cli_bake_writes_the_same_tables_as_the_function(tmp_path):
     assert result.stdout.count("\n") == 1 and "paper.exr" in result.stdout
     assert "[###" not in result.stderr  # no progress bar when stderr is not a terminal
     meta = json.loads((tmp_path / "paper.json").read_text())
-    assert meta["sha256"] == io.content_hash(bake.bake(presets.paper(), "preview"))
-    assert io.content_hash(io.load_tables(tmp_path / "paper.exr")) == meta["sha256"]
+    assert meta["sha256"] == codec.content_hash(bake.bake(presets.paper(), "preview"))
+    assert codec.content_hash(codec.load_tables(tmp_path / "paper.exr")) == meta["sha256"]
 
 
 def test_cli_options_override_in_order(tmp_path):
@@ -50,30 +53,30 @@ def test_cli_options_override_in_order(tmp_path):
     assert meta["parameters"]["absorption"] == [0.0, 0.5, 1.0]
     assert meta["parameters"]["film"]["n"] == 0.036  # from the file
     assert "inter_reflection" in meta["layout"]
-    skin = cli_bake.skin_from_args(parse("--params", EXAMPLE, "--coverage", "0.25",
+    skin = bake_command.skin_from_args(parse("--params", EXAMPLE, "--coverage", "0.25",
                                          "--absorption", "0", "0.5", "1"))
     expected = bake.bake(skin, "preview", inter_reflection=True)
-    assert meta["sha256"] == io.content_hash(expected)
+    assert meta["sha256"] == codec.content_hash(expected)
 
 
 @pytest.mark.bpy
 def test_bake_inside_blenders_python_gives_the_same_tables():
     """The same bake after `import bpy` (Blender's Python as a module) hashes the same."""
     pytest.importorskip("bpy")
-    code = ("import bpy, lut_baker.bake as b, lut_baker.io as i, lut_baker.presets as p;"
+    code = ("import bpy, lut_baker.bake as b, lut_baker.tables.codec as i, lut_baker.model.presets as p;"
             "print(i.content_hash(b.bake(p.paper(), 'preview')))")
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
     out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=env, capture_output=True,
                          text=True, timeout=300)
     assert out.returncode == 0, out.stderr
-    assert out.stdout.strip().splitlines()[-1] == io.content_hash(
+    assert out.stdout.strip().splitlines()[-1] == codec.content_hash(
         bake.bake(presets.paper(), "preview"))
 
 
 def main_exit(capsys, *args):
     """Run ``python -m lut_baker bake ARGS`` in-process: (exit code, stderr)."""
     with pytest.raises(SystemExit) as exit_info:
-        cli.main(["bake", *map(str, args)])
+        main.main(["bake", *map(str, args)])
     return exit_info.value.code, capsys.readouterr().err
 
 
@@ -134,7 +137,7 @@ def test_invalid_parameter_files_exit_2_naming_params(capsys, text, message, tmp
 
 def test_missing_openimageio_is_one_clear_line(capsys, monkeypatch, tmp_path):
     monkeypatch.setitem(sys.modules, "OpenImageIO", None)  # import fails
-    assert cli.main(["bake", "--resolution", "preview", "--out", str(tmp_path)]) == 1
+    assert main.main(["bake", "--resolution", "preview", "--out", str(tmp_path)]) == 1
     err = capsys.readouterr().err.strip()
     assert "\n" not in err and "needs OpenImageIO" in err and "pip install" in err
     assert not any(tmp_path.iterdir())
@@ -167,7 +170,7 @@ def test_progress_bar_only_on_a_terminal():
 
     for tty in (True, False):
         stream = Stream(tty)
-        progress = cli_bake._Progress(stream)
+        progress = bake_command._Progress(stream)
         progress(0.5, "path 3")
         progress.close()
         assert ("[###############" in stream.text and "50%" in stream.text) is tty
@@ -200,7 +203,7 @@ def test_parameter_file_in_paper_counts_reproduces_the_paper():
 def run_main(capsys, *args):
     """``python -m lut_baker bake ARGS`` in-process: (exit code, stderr), returned or raised."""
     try:
-        code = cli.main(["bake", *map(str, args)])
+        code = main.main(["bake", *map(str, args)])
     except SystemExit as exit_info:
         code = exit_info.code
     return code, capsys.readouterr().err
@@ -298,7 +301,7 @@ def test_write_errors_are_one_line_and_keep_the_old_pair(capsys, monkeypatch, ol
     def fail(fd):
         raise error
 
-    monkeypatch.setattr(io.os, "fsync", fail)
+    monkeypatch.setattr(codec.os, "fsync", fail)
     code, err = run_main(capsys, "--resolution", "preview", "--coverage", "0.5",
                          "--out", folder)
     line = one_error_line(err)
@@ -310,7 +313,7 @@ def test_write_error_in_a_new_folder_leaves_nothing(capsys, monkeypatch, tmp_pat
     def fail(fd):
         raise OSError(errno.ENOSPC, "No space left on device")
 
-    monkeypatch.setattr(io.os, "fsync", fail)
+    monkeypatch.setattr(codec.os, "fsync", fail)
     code, err = run_main(capsys, "--resolution", "preview", "--out", tmp_path / "new" / "out")
     assert code == 1 and "no space left on the disk" in one_error_line(err)
     assert list(tmp_path.iterdir()) == []
@@ -319,14 +322,14 @@ def test_write_error_in_a_new_folder_leaves_nothing(capsys, monkeypatch, tmp_pat
 SLOW_WRITE = """
 import os, signal, sys, time
 signal.signal(signal.SIGINT, signal.default_int_handler)  # as when started from a terminal
-from lut_baker import cli
+from lut_baker.offline.cli import main
 
 def slow_fsync(fd):  # both temporaries are written when they are flushed
     print("writing", flush=True)
     time.sleep(60)
 
 os.fsync = slow_fsync
-sys.exit(cli.main(sys.argv[1:]))
+sys.exit(main.main(sys.argv[1:]))
 """
 
 
@@ -356,9 +359,9 @@ def test_signal_during_the_write_cleans_up(tmp_path, signum, earlier):
 
 
 def test_sigterm_during_the_bake_exits_cleanly(tmp_path):
-    code = ("import os, signal, sys; from lut_baker import bake, cli;"
+    code = ("import os, signal, sys; from lut_baker import bake; from lut_baker.offline.cli import main;"
             "bake.bake = lambda *a, **k: os.kill(os.getpid(), signal.SIGTERM);"
-            "sys.exit(cli.main(sys.argv[1:]))")
+            "sys.exit(main.main(sys.argv[1:]))")
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
     result = subprocess.run([sys.executable, "-c", code, "bake", "--out", str(tmp_path)],
                             cwd=ROOT, env=env, capture_output=True, text=True, timeout=60)

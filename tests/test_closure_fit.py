@@ -1,4 +1,4 @@
-"""Cycles closure replicas (lut_baker.cycles_closures) and the closure fits (lut_baker.closure_fit).
+"""Cycles closure replicas (lut_baker.closures.cycles) and the closure fits (lut_baker.closures.fitting).
 
 The replicas are checked against independent quadratures and closed forms; the fits by round
 trips: tables synthesised from a known closure must give that closure's parameters back.
@@ -9,10 +9,12 @@ import dataclasses
 import numpy as np
 import pytest
 
-from lut_baker import bake, closure_fit, presets
-from lut_baker import cycles_closures as cc
-from lut_baker.quadrature import direction
-from lut_baker.tables import radius_nodes
+from lut_baker import bake
+from lut_baker.closures import cycles as cc
+from lut_baker.closures import fitting
+from lut_baker.model import presets
+from lut_baker.numerics.quadrature import direction
+from lut_baker.tables.table_set import radius_nodes
 
 
 @pytest.fixture(scope="module")
@@ -22,7 +24,7 @@ def paper_tables():
 
 @pytest.fixture(scope="module")
 def paper_fit(paper_tables):
-    return closure_fit.fit_closures(paper_tables)
+    return fitting.fit_closures(paper_tables)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -106,21 +108,21 @@ def test_fit_glossy_companion_recovers_a_lobe_plus_lambert(paper_tables):
     """A target that is 0.7 of a Beckmann lobe plus a Lambertian 0.2: the companion fit finds
     the lobe and splits the albedo between the two, and the weights' albedos add up to the
     table's at every texel (so the white furnace is kept)."""
-    grid = closure_fit._Grid(paper_tables, None)
-    wi, wo = closure_fit.node_directions(paper_tables)
+    grid = fitting._Grid(paper_tables, None)
+    wi, wo = fitting.node_directions(paper_tables)
     lobe = cc.microfacet_reflection(wi, wo, 0.5, distribution="BECKMANN")
     theta = np.asarray(paper_tables.theta_deg)
     e = cc.microfacet_albedo(np.cos(np.radians(theta)), 0.5, distribution="BECKMANN")
     albedo = (0.7 * e + 0.2)[:, None] * np.ones(3)
     target = (0.7 * lobe + 0.2 / np.pi)[..., None] * np.ones(3)
-    plain = closure_fit.fit_glossy(grid, target, albedo, theta)
-    fit = closure_fit.fit_glossy(grid, target, albedo, theta, companion=True)
+    plain = fitting.fit_glossy(grid, target, albedo, theta)
+    fit = fitting.fit_glossy(grid, target, albedo, theta, companion=True)
     assert plain.diffuse_lut is None and fit.error < 0.25 * plain.error
     assert fit.distribution == "BECKMANN" and fit.roughness == pytest.approx(0.5, abs=0.02)
     inner = slice(4, -4)  # texels away from the ends, where interpolation holds them
     np.testing.assert_allclose(fit.lut[inner], 0.7, atol=0.03)
     np.testing.assert_allclose(fit.diffuse_lut[inner], 0.2, atol=0.02)
-    mu = closure_fit.lut_nodes(closure_fit.DEFAULT_LUT_SIZE)
+    mu = fitting.lut_nodes(fitting.DEFAULT_LUT_SIZE)
     texel_e = cc.microfacet_albedo(mu, fit.roughness, distribution=fit.distribution)
     texel_table = np.interp(np.degrees(np.arccos(mu)), theta, albedo[:, 0])
     np.testing.assert_allclose(fit.lut[:, 0] * texel_e + fit.diffuse_lut[:, 0], texel_table,
@@ -177,7 +179,7 @@ def test_edge_response_of_a_uniform_disc():
     disc = np.where(r < a, 1.0 / (np.pi * a * a), 0.0)
     s = np.array([0.0, 0.5, 1.0, 1.9])
     expected = (a * a * np.arccos(s / a) - s * np.sqrt(a * a - s * s)) / (np.pi * a * a)
-    np.testing.assert_allclose(closure_fit.edge_response(r, disc, s), expected, atol=1e-4)
+    np.testing.assert_allclose(fitting.edge_response(r, disc, s), expected, atol=1e-4)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -185,35 +187,35 @@ def test_edge_response_of_a_uniform_disc():
 # ---------------------------------------------------------------------------------------------
 def test_relative_rms_is_zero_against_itself_and_scales(paper_tables):
     f = paper_tables.node_values(1.0, 0.0)
-    assert closure_fit.relative_rms(f, f, paper_tables) == 0.0
-    assert closure_fit.relative_rms(1.1 * f, f, paper_tables) == pytest.approx(0.1)
-    assert closure_fit.albedo_error(1.1 * f, f, paper_tables) == pytest.approx(0.1)
+    assert fitting.relative_rms(f, f, paper_tables) == 0.0
+    assert fitting.relative_rms(1.1 * f, f, paper_tables) == pytest.approx(0.1)
+    assert fitting.albedo_error(1.1 * f, f, paper_tables) == pytest.approx(0.1)
 
 
 def test_view_albedo_matches_the_albedo_tables(paper_tables):
     # The trapezoid rule on the (coarse, preview) table grid against the bake's own albedos.
-    albedo = closure_fit.view_albedo(np.asarray(paper_tables.skin_gloss), paper_tables)
+    albedo = fitting.view_albedo(np.asarray(paper_tables.skin_gloss), paper_tables)
     np.testing.assert_allclose(albedo[:-2], np.asarray(paper_tables.skin_gloss_albedo)[:-2],
                                rtol=0.1)
 
 
 def test_fit_coat_recovers_a_known_coat(paper_tables):
-    grid = closure_fit._Grid(paper_tables, closure_fit.FIT_POINTS)
+    grid = fitting._Grid(paper_tables, fitting.FIT_POINTS)
     synthetic = cc.microfacet_reflection(grid.wi, grid.wo, 0.45,
                                          lambda c: cc.dielectric_fresnel(c, 1.8))
-    fit = closure_fit.fit_coat(grid, np.repeat(synthetic[..., None], 3, axis=-1))
+    fit = fitting.fit_coat(grid, np.repeat(synthetic[..., None], 3, axis=-1))
     assert fit.roughness == pytest.approx(0.45, abs=0.01)
     assert fit.ior == pytest.approx(1.8, abs=0.02)
     assert fit.error < 0.01
 
 
 def test_fit_glossy_recovers_distribution_and_roughness(paper_tables):
-    grid = closure_fit._Grid(paper_tables, None)
-    wi, wo = closure_fit.node_directions(paper_tables)
+    grid = fitting._Grid(paper_tables, None)
+    wi, wo = fitting.node_directions(paper_tables)
     lobe = cc.microfacet_reflection(wi, wo, 0.5, distribution="BECKMANN")
     mu = np.cos(np.radians(paper_tables.theta_deg))
     albedo = cc.microfacet_albedo(mu, 0.5, distribution="BECKMANN")[:, None] * np.ones(3)
-    fit = closure_fit.fit_glossy(grid, lobe[..., None] * np.ones(3), albedo,
+    fit = fitting.fit_glossy(grid, lobe[..., None] * np.ones(3), albedo,
                                  np.asarray(paper_tables.theta_deg))
     assert fit.distribution == "BECKMANN"
     assert fit.roughness == pytest.approx(0.5, abs=0.01)
@@ -230,7 +232,7 @@ def test_fit_profile_recovers_a_known_radius(paper_tables, method):
     profile = np.stack([cc.subsurface_profile(np.maximum(r, r[1] / 2), radius[c], 0.6, method)
                         for c in range(3)], -1)
     tables = dataclasses.replace(paper_tables, radius_mm=r, profile=profile)
-    fit = closure_fit.fit_profile(tables, method, albedo=0.6)
+    fit = fitting.fit_profile(tables, method, albedo=0.6)
     np.testing.assert_allclose(fit.radius_mm, radius, rtol=0.02)
     assert fit.worst_error < 0.005
 
@@ -239,12 +241,12 @@ def test_fit_profile_recovers_a_known_radius(paper_tables, method):
 # The tiers on the paper's tables
 # ---------------------------------------------------------------------------------------------
 def test_paper_fit_parameters_are_in_blender_ranges(paper_fit):
-    assert closure_fit.ROUGHNESS_RANGE[0] <= paper_fit.coat.roughness <= 1.0
-    assert 1.0 < paper_fit.coat.ior <= closure_fit.COAT_IOR_RANGE[1]
+    assert fitting.ROUGHNESS_RANGE[0] <= paper_fit.coat.roughness <= 1.0
+    assert 1.0 < paper_fit.coat.ior <= fitting.COAT_IOR_RANGE[1]
     for lobe in paper_fit.glossy.values():
         assert lobe.distribution in cc.GLOSSY_DISTRIBUTIONS
         assert np.all(np.isfinite(lobe.lut)) and np.all(lobe.lut >= 0.0)
-    assert paper_fit.lut.shape == (len(closure_fit.LUT_ROWS), closure_fit.DEFAULT_LUT_SIZE, 3)
+    assert paper_fit.lut.shape == (len(fitting.LUT_ROWS), fitting.DEFAULT_LUT_SIZE, 3)
     assert np.all(paper_fit.subsurface_radius_mm > 0.0)
     assert paper_fit.subsurface_method in cc.SUBSURFACE_METHODS
     # Burley's edge response follows the dipole's within 1% RMS of the lit level.
@@ -254,25 +256,25 @@ def test_paper_fit_parameters_are_in_blender_ranges(paper_fit):
 def test_layered_tier_keeps_the_albedo(paper_tables, paper_fit):
     # Glossy weights are albedo ratios, so the tier's view albedo follows the tables'.
     for coverage in (0.0, 0.5, 1.0):
-        errors = closure_fit.tier_errors(paper_fit, paper_tables, coverage, (0.1, 0.2, 0.4))
+        errors = fitting.tier_errors(paper_fit, paper_tables, coverage, (0.1, 0.2, 0.4))
         assert errors["LAYERED"].albedo < 0.03
         assert errors["LAYERED"].rms < 0.12
         assert np.isfinite(errors["PRINCIPLED"].rms)
 
 
 def test_layered_beats_principled_on_bare_skin(paper_tables, paper_fit):
-    errors = closure_fit.tier_errors(paper_fit, paper_tables, 0.0, 0.0)
+    errors = fitting.tier_errors(paper_fit, paper_tables, 0.0, 0.0)
     assert errors["LAYERED"].rms < errors["PRINCIPLED"].rms
 
 
 def test_principled_inputs_follow_coverage(paper_fit):
-    bare, weight_bare = closure_fit.principled_inputs(paper_fit, 0.0, 0.0)
-    full, weight_full = closure_fit.principled_inputs(paper_fit, 1.0, (0.3, 0.3, 0.3))
+    bare, weight_bare = fitting.principled_inputs(paper_fit, 0.0, 0.0)
+    full, weight_full = fitting.principled_inputs(paper_fit, 1.0, (0.3, 0.3, 0.3))
     assert bare.coat_weight == 0.0 and full.coat_weight == 1.0
     assert weight_bare == pytest.approx(1.0)  # bare skin: all diffuse light is the skin's
     assert 0.0 < weight_full < 1.0
     # Absorption darkens the film's diffuse light: the base colour drops.
-    darker, _ = closure_fit.principled_inputs(paper_fit, 1.0, (0.6, 0.6, 0.6))
+    darker, _ = fitting.principled_inputs(paper_fit, 1.0, (0.6, 0.6, 0.6))
     assert np.all(np.array(darker.base_color) < np.array(full.base_color))
 
 
@@ -286,10 +288,10 @@ def test_summary_is_plain_data(paper_fit):
 def test_principled_error_does_not_peak_between_coverages(paper_tables, paper_fit):
     # The node group mixes roughness and level by coverage: a half-covered surface must not
     # err much more than the worse of bare and fully covered skin.
-    ends = [closure_fit.tier_errors(paper_fit, paper_tables, w, 0.0)["PRINCIPLED"].rms
+    ends = [fitting.tier_errors(paper_fit, paper_tables, w, 0.0)["PRINCIPLED"].rms
             for w in (0.0, 1.0)]
     for coverage in (0.25, 0.5, 0.75):
-        middle = closure_fit.tier_errors(paper_fit, paper_tables, coverage, 0.0)["PRINCIPLED"]
+        middle = fitting.tier_errors(paper_fit, paper_tables, coverage, 0.0)["PRINCIPLED"]
         assert middle.rms < 1.2 * max(ends)
 
 
@@ -299,23 +301,23 @@ def test_gloss_zero_leaves_only_the_diffuse_closures(paper_tables, paper_fit):
     itself; the Layered tier's Glossy weights are 0 and it is linear in Gloss.  Without its
     gloss, each tier misses the tables' gloss."""
     w, a = 0.5, (0.1, 0.2, 0.4)
-    inputs, weight = closure_fit.principled_inputs(paper_fit, w, a, gloss=0.0)
-    total, skin = closure_fit.diffuse_albedo(paper_fit, w, a)
+    inputs, weight = fitting.principled_inputs(paper_fit, w, a, gloss=0.0)
+    total, skin = fitting.diffuse_albedo(paper_fit, w, a)
     assert inputs.coat_weight == 0.0 and inputs.specular_ior_level == 0.0
     assert inputs.specular_eta_f0()[0] == 1.0
     np.testing.assert_allclose(inputs.base_color, np.clip(total, 0.0, 1.0), rtol=1e-12)
     assert weight == pytest.approx(float(np.mean(skin / total)))
-    matte = closure_fit.principled_tier_reflection(paper_fit, paper_tables, w, a, gloss=0.0)
+    matte = fitting.principled_tier_reflection(paper_fit, paper_tables, w, a, gloss=0.0)
     np.testing.assert_allclose(matte, np.broadcast_to(np.clip(total, 0, 1) / np.pi,
                                                       matte.shape), rtol=1e-12)
-    weights = closure_fit.layered_weights(paper_fit, w, a, gloss=0.0)
-    assert not any(np.any(weights[name]) for name in closure_fit.LUT_ROWS[:3])
-    layered = {g: closure_fit.layered_tier_reflection(paper_fit, paper_tables, w, a, gloss=g)
+    weights = fitting.layered_weights(paper_fit, w, a, gloss=0.0)
+    assert not any(np.any(weights[name]) for name in fitting.LUT_ROWS[:3])
+    layered = {g: fitting.layered_tier_reflection(paper_fit, paper_tables, w, a, gloss=g)
                for g in (0.0, 0.5, 1.0)}
     np.testing.assert_allclose(layered[0.5], 0.5 * (layered[0.0] + layered[1.0]), rtol=1e-9)
-    kept = closure_fit.tier_errors(paper_fit, paper_tables, w, a)
-    dropped = closure_fit.tier_errors(paper_fit, paper_tables, w, a, gloss=0.0)
-    for tier in closure_fit.TIERS:
+    kept = fitting.tier_errors(paper_fit, paper_tables, w, a)
+    dropped = fitting.tier_errors(paper_fit, paper_tables, w, a, gloss=0.0)
+    for tier in fitting.TIERS:
         assert dropped[tier].rms > 2.0 * kept[tier].rms
 
 
@@ -324,12 +326,12 @@ def test_replicas_take_any_directions(paper_tables, paper_fit):
     an (n, m) batch of directions it keeps the batch's shape; a NaN light direction touches
     no other value (its own is NaN for the Principled tier; the Layered tier's Glossy lobes
     count it as below the horizon and its diffuse part does not depend on it)."""
-    nodes = closure_fit.node_directions(paper_tables)
+    nodes = fitting.node_directions(paper_tables)
     wi = direction(np.radians([[10.0, 40.0, 70.0], [0.0, 85.0, 30.0]]), 1.0)
     wo = direction(np.radians([[60.0, 5.0, 20.0], [45.0, 10.0, 89.0]]), 0.0)
     wi_nan = wi.copy()
     wi_nan[0, 0] = np.nan
-    for tier, replica in closure_fit.TIER_REPLICAS.items():
+    for tier, replica in fitting.TIER_REPLICAS.items():
         np.testing.assert_array_equal(replica(paper_fit, paper_tables, 1.0, 0.0, 1.0, nodes),
                                       replica(paper_fit, paper_tables, 1.0, 0.0), err_msg=tier)
         batch = replica(paper_fit, paper_tables, 1.0, 0.0, 1.0, (wi, wo))
@@ -348,7 +350,7 @@ def test_fit_is_linear_in_the_skin_albedo(paper_tables, paper_fit):
     colour = np.array([0.62, 0.41, 0.33])
     skin = presets.paper()
     other = skin.replace(skin=dataclasses.replace(skin.skin, P_d=colour / np.pi))
-    fit = closure_fit.fit_closures(bake.bake(other, "preview"))
+    fit = fitting.fit_closures(bake.bake(other, "preview"))
     np.testing.assert_allclose(fit.skin_albedo, colour, rtol=1e-12)
     np.testing.assert_array_equal(fit.lut, paper_fit.lut)
     same, reference = fit.summary(), paper_fit.summary()

@@ -6,21 +6,21 @@ import struct
 import numpy as np
 import pytest
 
-from lut_baker import figures
-from lut_baker.cli import main
-from lut_baker.model import (
+from lut_baker.model.layers import (
     dipole_profile,
     dipole_total_reflectance,
     ts_reflection,
     ts_transmission,
 )
-from lut_baker.presets import (
+from lut_baker.model.presets import (
     PAPER_FILM_REFLECTION,
     PAPER_FILM_TRANSMISSION,
     PAPER_SKIN_DIPOLE,
     PAPER_SKIN_REFLECTION,
 )
-from lut_baker.protocols import reflection_sweep, transmission_sweep
+from lut_baker.offline import paper_figures
+from lut_baker.offline.cli.main import main
+from lut_baker.offline.measured.protocols import reflection_sweep, transmission_sweep
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
@@ -28,7 +28,7 @@ PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 @pytest.fixture(scope="module")
 def drawn():
     """Every figure drawn with its defaults (the paper's parameters), as {name: Figure}."""
-    return {name: draw() for name, draw in figures.FIGURES.items()}
+    return {name: draw() for name, draw in paper_figures.FIGURES.items()}
 
 
 def lines(figure) -> dict:
@@ -42,12 +42,12 @@ def test_command_writes_every_figure_as_png(tmp_path, capsys, monkeypatch, drawn
     # The figures the fixture drew with their defaults are what the command draws: reuse them
     # (drawing twice would double this file's run time) and test the command's writing.
     for name, figure in drawn.items():
-        monkeypatch.setitem(figures.FIGURES, name, lambda figure=figure: figure)
+        monkeypatch.setitem(paper_figures.FIGURES, name, lambda figure=figure: figure)
     out = tmp_path / "new" / "figs"
     assert main(["figures", "--out", str(out)]) == 0
     written = sorted(p.name for p in out.iterdir())
-    assert written == sorted(f"{name}.png" for name in figures.FIGURES)
-    assert capsys.readouterr().out.split() == [str(out / f"{name}.png") for name in figures.FIGURES]
+    assert written == sorted(f"{name}.png" for name in paper_figures.FIGURES)
+    assert capsys.readouterr().out.split() == [str(out / f"{name}.png") for name in paper_figures.FIGURES]
     for path in out.iterdir():
         data = path.read_bytes()
         assert data[:8] == PNG_SIGNATURE, path.name
@@ -91,9 +91,9 @@ def test_every_figure_has_title_axis_labels_and_legend(drawn):
 
 
 @pytest.mark.parametrize("name, curves, key", [
-    ("fig05_film_reflection", lambda: figures.reflection_curves(PAPER_FILM_REFLECTION), "psi"),
-    ("fig11_skin_reflection", lambda: figures.reflection_curves(PAPER_SKIN_REFLECTION), "psi"),
-    ("fig07_film_transmission", figures.transmission_curves, "theta_i"),
+    ("fig05_film_reflection", lambda: paper_figures.reflection_curves(PAPER_FILM_REFLECTION), "psi"),
+    ("fig11_skin_reflection", lambda: paper_figures.reflection_curves(PAPER_SKIN_REFLECTION), "psi"),
+    ("fig07_film_transmission", paper_figures.transmission_curves, "theta_i"),
 ])
 def test_drawn_angle_curves_are_the_data(drawn, name, curves, key):
     drawn_lines = lines(drawn[name])
@@ -107,7 +107,7 @@ def test_drawn_angle_curves_are_the_data(drawn, name, curves, key):
 
 @pytest.mark.parametrize("layer", [PAPER_FILM_REFLECTION, PAPER_SKIN_REFLECTION])
 def test_reflection_curves_follow_the_protocol_and_peak_at_the_mirror(layer):
-    curves = figures.reflection_curves(layer)
+    curves = paper_figures.reflection_curves(layer)
     assert sorted(curves) == [30.0, 60.0, 90.0, 120.0]
     for psi, curve in curves.items():
         theta_r, brdf, intensity = curve["theta_r_deg"], curve["brdf"], curve["intensity"]
@@ -120,7 +120,7 @@ def test_reflection_curves_follow_the_protocol_and_peak_at_the_mirror(layer):
         expected = ts_reflection(sweep.wi, sweep.wo, layer) * sweep.wi[:, 2]
         np.testing.assert_allclose(intensity[at], expected, rtol=1e-12)
         # The BRDF peaks in the mirror direction theta_r = -psi/2 (alpha = 0)...
-        assert abs(theta_r[np.argmax(brdf)] + psi / 2) <= figures.CURVE_STEP_DEG
+        assert abs(theta_r[np.argmax(brdf)] + psi / 2) <= paper_figures.CURVE_STEP_DEG
         # ...but the camera sees f (N.L): the cosine pulls the peak toward the light's normal
         # incidence, i.e. theta_r below the mirror, by more than the sampling step.
         peak = theta_r[np.argmax(intensity)]
@@ -130,8 +130,8 @@ def test_reflection_curves_follow_the_protocol_and_peak_at_the_mirror(layer):
 
 def test_the_film_is_glossier_than_the_skin():
     """Paper 4.2.1 (fig. 12's text): the skin's specular reflection is weaker than the film's."""
-    film = figures.reflection_curves(PAPER_FILM_REFLECTION)
-    skin = figures.reflection_curves(PAPER_SKIN_REFLECTION)
+    film = paper_figures.reflection_curves(PAPER_FILM_REFLECTION)
+    skin = paper_figures.reflection_curves(PAPER_SKIN_REFLECTION)
     for psi in film:
         def specular(curve, layer):
             return curve["intensity"] - layer.P_d * np.cos(np.radians(curve["theta_i_deg"]))
@@ -141,7 +141,7 @@ def test_the_film_is_glossier_than_the_skin():
 
 
 def test_transmission_curves_peak_straight_through_and_fall_with_incidence():
-    curves = figures.transmission_curves()
+    curves = paper_figures.transmission_curves()
     peaks = []
     for incidence, curve in curves.items():
         theta_t, intensity = curve["theta_t_deg"], curve["intensity"]
@@ -163,12 +163,12 @@ def test_transmission_curves_peak_straight_through_and_fall_with_incidence():
 
 
 def test_profile_is_the_ratio_to_the_lit_pixel():
-    curve = figures.profile_curve()
+    curve = paper_figures.profile_curve()
     assert curve["d_mm"][0] == 0.0 and curve["d_mm"][-1] == pytest.approx(3.0)
     assert curve["ratio"][0] == 1.0
     assert np.all(np.diff(curve["ratio"]) < 0) and np.all(curve["ratio"] > 0)
     # Times R(0), the ratio integrates over the plane to the dipole's closed-form Rd (Jensen).
-    far = figures.profile_curve(max_mm=80.0, step_mm=0.002)
+    far = paper_figures.profile_curve(max_mm=80.0, step_mm=0.002)
     integral = 2 * np.pi * np.trapz(far["ratio"] * far["d_mm"], far["d_mm"])
     rd = float(dipole_total_reflectance(PAPER_SKIN_DIPOLE))
     assert integral * float(dipole_profile(0.0, PAPER_SKIN_DIPOLE)) == pytest.approx(rd, rel=1e-4)
@@ -192,7 +192,7 @@ def test_film_attenuates_the_subsurface_profile(drawn):
     (d, bare), (_, made_up) = drawn_lines["bare"], drawn_lines["made_up"]
     assert d[0] == 0.0 and bare[0] == pytest.approx(1.0)
     assert np.all(made_up < bare) and np.all(made_up > 0)
-    data = figures.made_up_profile_curves()
+    data = paper_figures.made_up_profile_curves()
     np.testing.assert_array_equal(made_up, data["made_up"])
     # Path 4 factorises (SPEC 3): the film scales the whole profile by (t / F_t)^2.
     np.testing.assert_allclose(made_up / bare, (data["t"] / data["F_t"]) ** 2, rtol=1e-12)
@@ -201,7 +201,7 @@ def test_film_attenuates_the_subsurface_profile(drawn):
 
 def test_white_furnace_chart_stays_below_one(drawn):
     drawn_lines = lines(drawn["fig16_directional_albedo"])
-    expected = {f"{name} {c}" for name in figures.FOUNDATIONS for c in "RGB"} | {"bare"}
+    expected = {f"{name} {c}" for name in paper_figures.FOUNDATIONS for c in "RGB"} | {"bare"}
     assert set(drawn_lines) == expected
     for gid, (theta, albedo) in drawn_lines.items():
         assert theta[0] == 0.0 and theta[-1] == 89.0, gid

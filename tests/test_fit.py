@@ -1,4 +1,4 @@
-"""Tests of lut_baker.fit, lut_baker.measurements and ``python -m lut_baker fit``.
+"""Tests of lut_baker.offline.measured.layer_fit, lut_baker.offline.measured.measurements and ``python -m lut_baker fit``.
 
 The round trip (issue 2, item 4): the paper's protocols synthesised from its parameters (SPEC 5,
 raw counts) with 2% multiplicative noise, fitted from a poor start (x3 and /3 in turn, eta 1.5),
@@ -14,12 +14,12 @@ import tomllib
 import numpy as np
 import pytest
 
-from lut_baker import fit as F
-from lut_baker import measurements as M
-from lut_baker.cli import main
-from lut_baker.cli_fit import STRICT_EXIT
-from lut_baker.model import Dipole, ReflectionLayer, TransmissionLayer, fresnel_reflectance
-from lut_baker.presets import paper_layers
+from lut_baker.model.layers import Dipole, ReflectionLayer, TransmissionLayer, fresnel_reflectance
+from lut_baker.model.presets import paper_layers
+from lut_baker.offline.cli.fit_command import STRICT_EXIT
+from lut_baker.offline.cli.main import main
+from lut_baker.offline.measured import layer_fit as F
+from lut_baker.offline.measured import measurements as M
 
 SEEDS = range(20)
 NOISE = 0.02

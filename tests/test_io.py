@@ -1,4 +1,4 @@
-"""Tables on disk (lut_baker.io): float32 OpenEXR atlas + JSON sidecar."""
+"""Tables on disk (lut_baker.tables.codec): float32 OpenEXR atlas + JSON sidecar."""
 
 import errno
 import json
@@ -7,8 +7,10 @@ import os
 import numpy as np
 import pytest
 
-from lut_baker import bake, io, presets
-from lut_baker.tables import ANGULAR, CONSTANT, DIRECTIONAL
+from lut_baker import bake
+from lut_baker.model import presets
+from lut_baker.tables import codec
+from lut_baker.tables.table_set import ANGULAR, CONSTANT, DIRECTIONAL
 
 oiio = pytest.importorskip("OpenImageIO")
 
@@ -21,11 +23,11 @@ def baked():
 
 @pytest.fixture
 def saved(baked, tmp_path):
-    return io.save_tables(baked, tmp_path / "skin.exr")
+    return codec.save_tables(baked, tmp_path / "skin.exr")
 
 
 def test_round_trip_is_float32_exact(baked, saved):
-    loaded = io.load_tables(saved)
+    loaded = codec.load_tables(saved)
     for name, value in baked.arrays.items():
         stored = np.asarray(getattr(loaded, name))
         if name in ("theta_deg", "phi_deg", "radius_mm"):
@@ -34,7 +36,7 @@ def test_round_trip_is_float32_exact(baked, saved):
             np.testing.assert_array_equal(stored, np.asarray(value, np.float32), err_msg=name)
     assert loaded.parameters == baked.parameters
     assert loaded.spacings == baked.spacings
-    assert io.content_hash(loaded) == io.content_hash(baked)
+    assert codec.content_hash(loaded) == codec.content_hash(baked)
     # float32 storage moves values by at most half an ulp: ~6e-8 relative
     relative = np.abs(loaded.film_gloss - baked.film_gloss) / np.maximum(baked.film_gloss, 1e-30)
     assert relative.max() < 6e-8
@@ -47,7 +49,7 @@ def test_sidecar_describes_the_file(baked, saved):
     assert meta["parameters"]["coverage"] == 0.7
     assert meta["grids"]["phi_spacing"] == "half_vector"
     assert {"theta_deg", "radius_mm", "profile"} <= set(meta["units"]) | set(meta["layout"])
-    assert meta["sha256"] == io.content_hash(baked)
+    assert meta["sha256"] == codec.content_hash(baked)
 
 
 def test_atlas_layout_as_documented(baked, saved):
@@ -77,7 +79,7 @@ def test_atlas_layout_as_documented(baked, saved):
 def test_atlas_of_plain_tables_has_no_inter_reflection_block(baked):
     from dataclasses import replace
 
-    _, layout = io.atlas(replace(baked, inter_reflection=None))
+    _, layout = codec.atlas(replace(baked, inter_reflection=None))
     assert "inter_reflection" not in layout["blocks"]
 
 
@@ -90,16 +92,16 @@ def _flip_byte(path, offset):
 @pytest.mark.parametrize("where", [0.05, 0.5, 0.95])
 def test_corrupt_byte_is_reported(saved, where):
     _flip_byte(saved, int(where * saved.stat().st_size))
-    with pytest.raises(io.TableFileError, match="skin.exr"):
-        io.load_tables(saved)
+    with pytest.raises(codec.TableFileError, match="skin.exr"):
+        codec.load_tables(saved)
 
 
 @pytest.mark.parametrize("keep", [0.0, 0.5, 0.99])
 def test_truncated_file_is_reported(saved, keep):
     data = saved.read_bytes()
     saved.write_bytes(data[:int(keep * len(data))])
-    with pytest.raises(io.TableFileError, match="skin.exr"):
-        io.load_tables(saved)
+    with pytest.raises(codec.TableFileError, match="skin.exr"):
+        codec.load_tables(saved)
 
 
 def test_wrong_version_is_reported(saved):
@@ -107,27 +109,27 @@ def test_wrong_version_is_reported(saved):
     meta = json.loads(side.read_text())
     meta["format_version"] = 99
     side.write_text(json.dumps(meta))
-    with pytest.raises(io.TableFileError, match="version 99"):
-        io.load_tables(saved)
+    with pytest.raises(codec.TableFileError, match="version 99"):
+        codec.load_tables(saved)
 
 
 def test_missing_sidecar_is_reported(saved):
     saved.with_suffix(".json").unlink()
-    with pytest.raises(io.TableFileError, match="sidecar.*missing"):
-        io.load_tables(saved)
+    with pytest.raises(codec.TableFileError, match="sidecar.*missing"):
+        codec.load_tables(saved)
 
 
 def test_missing_image_is_reported(tmp_path):
-    with pytest.raises(io.TableFileError, match="does not exist"):
-        io.load_tables(tmp_path / "none.exr")
+    with pytest.raises(codec.TableFileError, match="does not exist"):
+        codec.load_tables(tmp_path / "none.exr")
 
 
 def test_image_and_sidecar_of_different_bakes_are_reported(baked, saved, tmp_path):
-    other = io.save_tables(bake.bake(presets.paper(), "preview", inter_reflection=True),
+    other = codec.save_tables(bake.bake(presets.paper(), "preview", inter_reflection=True),
                            tmp_path / "other.exr")
     saved.with_suffix(".json").write_text(other.with_suffix(".json").read_text())
-    with pytest.raises(io.TableFileError):
-        io.load_tables(saved)
+    with pytest.raises(codec.TableFileError):
+        codec.load_tables(saved)
 
 
 def test_edited_sidecar_values_are_reported(saved):
@@ -135,11 +137,11 @@ def test_edited_sidecar_values_are_reported(saved):
     meta = json.loads(side.read_text())
     meta["grids"]["theta_deg"] = meta["grids"]["theta_deg"][:-1]
     side.write_text(json.dumps(meta))
-    with pytest.raises(io.TableFileError, match="layout|grid"):
-        io.load_tables(saved)
+    with pytest.raises(codec.TableFileError, match="layout|grid"):
+        codec.load_tables(saved)
     side.write_text("{ not json")
-    with pytest.raises(io.TableFileError, match="not a readable sidecar"):
-        io.load_tables(saved)
+    with pytest.raises(codec.TableFileError, match="not a readable sidecar"):
+        codec.load_tables(saved)
 
 
 def test_a_crash_mid_write_leaves_the_old_files_intact(baked, saved, monkeypatch):
@@ -153,12 +155,12 @@ def test_a_crash_mid_write_leaves_the_old_files_intact(baked, saved, monkeypatch
             raise OSError("simulated crash")
         real_replace(src, dst)
 
-    monkeypatch.setattr(io.os, "replace", crash_on_second)
+    monkeypatch.setattr(codec.os, "replace", crash_on_second)
     with pytest.raises(OSError, match="simulated"):
-        io.save_tables(bake.bake(presets.paper(), "preview"), saved)
+        codec.save_tables(bake.bake(presets.paper(), "preview"), saved)
     after = {p.name: p.read_bytes() for p in saved.parent.iterdir()}
     assert after == before  # no temporary left, nothing half-written under the final names
-    assert io.content_hash(io.load_tables(saved)) == io.content_hash(baked)
+    assert codec.content_hash(codec.load_tables(saved)) == codec.content_hash(baked)
 
 
 def _fail_sidecar_rename(monkeypatch, error):
@@ -170,7 +172,7 @@ def _fail_sidecar_rename(monkeypatch, error):
             raise error
         real_replace(src, dst)
 
-    monkeypatch.setattr(io.os, "replace", replace)
+    monkeypatch.setattr(codec.os, "replace", replace)
 
 
 @pytest.mark.parametrize("error", [OSError(errno.EIO, "Input/output error"), KeyboardInterrupt()])
@@ -179,27 +181,27 @@ def test_a_failure_between_the_renames_puts_the_old_image_back(baked, saved, mon
     before = {p.name: p.read_bytes() for p in saved.parent.iterdir()}
     _fail_sidecar_rename(monkeypatch, error)
     with pytest.raises(type(error)):
-        io.save_tables(bake.bake(presets.paper(), "preview"), saved)
+        codec.save_tables(bake.bake(presets.paper(), "preview"), saved)
     assert {p.name: p.read_bytes() for p in saved.parent.iterdir()} == before
-    assert io.content_hash(io.load_tables(saved)) == io.content_hash(baked)
+    assert codec.content_hash(codec.load_tables(saved)) == codec.content_hash(baked)
 
 
 def test_a_failure_between_the_renames_of_a_new_pair_leaves_nothing(baked, tmp_path,
                                                                     monkeypatch):
     _fail_sidecar_rename(monkeypatch, OSError(errno.EIO, "Input/output error"))
-    with pytest.raises(io.TableWriteError, match="skin.exr.*Input/output error"):
-        io.save_tables(baked, tmp_path / "skin.exr")
+    with pytest.raises(codec.TableWriteError, match="skin.exr.*Input/output error"):
+        codec.save_tables(baked, tmp_path / "skin.exr")
     assert list(tmp_path.iterdir()) == []
 
 
 def test_a_pair_torn_by_a_crash_is_detected(baked, saved, tmp_path):
     """A crash between the renames (nothing runs to put the old image back): the pair no
     longer matches and loading says so."""
-    other = io.save_tables(bake.bake(presets.paper(), "preview", inter_reflection=True),
+    other = codec.save_tables(bake.bake(presets.paper(), "preview", inter_reflection=True),
                            tmp_path / "other" / "skin.exr")
     os.replace(other, saved)
-    with pytest.raises(io.TableFileError, match="different bakes"):
-        io.load_tables(saved)
+    with pytest.raises(codec.TableFileError, match="different bakes"):
+        codec.load_tables(saved)
 
 
 @pytest.mark.parametrize("error", [OSError(errno.ENOSPC, "No space left on device"),
@@ -213,9 +215,9 @@ def test_a_failed_or_interrupted_write_leaves_no_temporary(baked, saved, monkeyp
         seen.extend(sorted(p.name for p in saved.parent.iterdir()))
         raise error
 
-    monkeypatch.setattr(io.os, "fsync", fail)
+    monkeypatch.setattr(codec.os, "fsync", fail)
     with pytest.raises(type(error)):
-        io.save_tables(bake.bake(presets.paper(), "preview"), saved)
+        codec.save_tables(bake.bake(presets.paper(), "preview"), saved)
     assert len(seen) == 4  # the old pair and two temporaries
     assert {p.name: p.read_bytes() for p in saved.parent.iterdir()} == before
 
@@ -231,10 +233,10 @@ def test_write_errors_say_what_is_wrong_in_one_line(baked, tmp_path, monkeypatch
     def fail(fd):
         raise error
 
-    monkeypatch.setattr(io.os, "fsync", fail)
+    monkeypatch.setattr(codec.os, "fsync", fail)
     target = tmp_path / "new" / "skin.exr"
-    with pytest.raises(io.TableWriteError) as raised:
-        io.save_tables(baked, target)
+    with pytest.raises(codec.TableWriteError) as raised:
+        codec.save_tables(baked, target)
     message = str(raised.value)
     assert isinstance(raised.value, OSError) and "\n" not in message
     assert message.startswith(f"cannot write '{target}': ") and words in message
@@ -243,21 +245,21 @@ def test_write_errors_say_what_is_wrong_in_one_line(baked, tmp_path, monkeypatch
 
 def test_target_problems_are_found_before_writing(tmp_path):
     (tmp_path / "afile").write_text("x")
-    with pytest.raises(io.TableWriteError, match="'.*afile' is a file, not a folder"):
-        io.check_target(tmp_path / "afile" / "deeper" / "skin.exr")
+    with pytest.raises(codec.TableWriteError, match="'.*afile' is a file, not a folder"):
+        codec.check_target(tmp_path / "afile" / "deeper" / "skin.exr")
     (tmp_path / "skin.exr").mkdir()
-    with pytest.raises(io.TableWriteError, match="skin.exr' is a folder"):
-        io.check_target(tmp_path / "skin.exr")
+    with pytest.raises(codec.TableWriteError, match="skin.exr' is a folder"):
+        codec.check_target(tmp_path / "skin.exr")
     with pytest.raises(ValueError, match=".exr"):
-        io.check_target(tmp_path / "skin.png")
-    assert io.check_target(tmp_path / "new" / "skin.exr") == tmp_path / "new" / "skin.exr"
+        codec.check_target(tmp_path / "skin.png")
+    assert codec.check_target(tmp_path / "new" / "skin.exr") == tmp_path / "new" / "skin.exr"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["afile", "skin.exr"]  # made nothing
 
 
 def test_only_exr_paths_are_written(baked, tmp_path):
     with pytest.raises(ValueError, match=".exr"):
-        io.save_tables(baked, tmp_path / "skin.png")
+        codec.save_tables(baked, tmp_path / "skin.png")
 
 
 def test_load_accepts_the_sidecar_path(baked, saved):
-    assert io.content_hash(io.load_tables(saved.with_suffix(".json"))) == io.content_hash(baked)
+    assert codec.content_hash(codec.load_tables(saved.with_suffix(".json"))) == codec.content_hash(baked)

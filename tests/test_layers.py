@@ -1,4 +1,4 @@
-"""Two-layer functions (lut_baker.layers, SPEC 3): path 3 against an independent brute-force
+"""Two-layer functions (lut_baker.evaluate.two_layer, SPEC 3): path 3 against an independent brute-force
 4-D quadrature, convergence when the grid is doubled (levels 0, 1, 2), reciprocity, RGB
 channels, and the one-dimensional film factors of path 4."""
 
@@ -8,9 +8,10 @@ import numpy as np
 import pytest
 import reference_impl as ref
 
-from lut_baker import layers, normalise, presets
-from lut_baker.model import Dipole, ReflectionLayer, TransmissionLayer
-from lut_baker.quadrature import direction
+from lut_baker.evaluate import two_layer
+from lut_baker.model import made_up_skin, presets
+from lut_baker.model.layers import Dipole, ReflectionLayer, TransmissionLayer
+from lut_baker.numerics.quadrature import direction
 
 CONVERGENCE_RTOL = 1e-4
 
@@ -22,7 +23,7 @@ def _scalar(layer, channel=None):
 
 def _film_and_skin(foundation, skin_name):
     skin = presets.made_up_skin(foundation, skin_name)
-    return normalise.film_transmission_layer(skin), skin.skin
+    return made_up_skin.film_transmission_layer(skin), skin.skin
 
 
 def _random_pairs(count, seed):
@@ -61,7 +62,7 @@ def test_layered_reflection_matches_brute_force_paper():
     film, skin = _film_and_skin("paper_natural", "paper_bioplate")
     wi, wo, brute, accuracy = _brute_force_check(_scalar(film, 0), _scalar(skin), (10, 20, 40))
     for level in (0, 1):
-        model = layers.layered_reflection(wi, wo, film, skin, level=level)[:, 0]
+        model = two_layer.layered_reflection(wi, wo, film, skin, level=level)[:, 0]
         error = np.abs(model - brute) / brute
         print(f"paper level {level}: brute-force rel. error {error.max():.2e}, "
               f"brute-force accuracy {accuracy.max():.2e}")
@@ -74,7 +75,7 @@ def test_layered_reflection_matches_brute_force_jensen_blue():
     """An RGB case, one channel (blue: the most absorbing shade, the sharpest skin lobe)."""
     film, skin = _film_and_skin("medium_beige", "jensen_skin1")
     wi, wo, brute, accuracy = _brute_force_check(_scalar(film, 2), _scalar(skin, 2), (8, 16, 32))
-    model = layers.layered_reflection(wi, wo, film, skin, level=0)[:, 2]
+    model = two_layer.layered_reflection(wi, wo, film, skin, level=0)[:, 2]
     error = np.abs(model - brute) / brute
     print(f"jensen_skin1 blue: brute-force rel. error {error.max():.2e}, "
           f"accuracy {accuracy.max():.2e}")
@@ -96,8 +97,8 @@ def _convergence_points(seed):
 def _fourier_values(film, skin, level, theta_i, theta_o, phi):
     """``f_cs`` on the pairs (theta_i[p], theta_o[q], phi[p, q]) from the level's Fourier
     matrices: one inner table per level instead of one per point (the level-2 grid is big)."""
-    grid = layers.grid_for(film, skin, level=level)
-    matrices = layers.layered_fourier_matrices(theta_i, theta_o, film, skin, grid)
+    grid = two_layer.grid_for(film, skin, level=level)
+    matrices = two_layer.layered_fourier_matrices(theta_i, theta_o, film, skin, grid)
     m = np.arange(matrices.shape[0])[:, None, None]
     return np.einsum("mpqc,mpq->pqc", matrices, np.cos(m * phi[None]))
 
@@ -116,7 +117,7 @@ def test_levels_agree(foundation, skin_name, levels):
     # The same numbers as the public evaluator gives at those directions.
     wi = direction(theta_i[:, None], phi)
     wo = direction(theta_o[None, :], 0.0)
-    np.testing.assert_allclose(layers.layered_reflection(wi, wo, film, skin), values[0],
+    np.testing.assert_allclose(two_layer.layered_reflection(wi, wo, film, skin), values[0],
                                rtol=1e-10)
     assert values[-1].shape == (10, 10, 3) and np.all(values[-1] > 0)
     diff01 = np.max(np.abs(values[0] - values[1]) / values[1])
@@ -137,7 +138,7 @@ def test_pure_lobes_converge_at_grazing():
     skin = ReflectionLayer(P_d=0.0, P_s=2.0, n=0.1, eta=1.26)
     wi = direction(np.radians([80.0, 89.0]), math.pi)
     wo = direction(np.radians([80.0, 89.0]), 0.0)
-    values = [layers.layered_reflection(wi, wo, film, skin, level=level) for level in (0, 1)]
+    values = [two_layer.layered_reflection(wi, wo, film, skin, level=level) for level in (0, 1)]
     change = np.abs(values[0] - values[1]) / values[1]
     print(f"pure lobes n = 0.1: level 0-1 change {change}")
     assert np.all(change <= CONVERGENCE_RTOL)
@@ -146,9 +147,9 @@ def test_pure_lobes_converge_at_grazing():
 def test_converged_evaluator_reports_its_change():
     film, skin = _film_and_skin("light_ivory", "paper_bioplate")
     wi, wo = _random_pairs(12, seed=12)
-    values, change, level = layers.layered_reflection_converged(wi, wo, film, skin)
+    values, change, level = two_layer.layered_reflection_converged(wi, wo, film, skin)
     assert change <= CONVERGENCE_RTOL and level >= 1
-    np.testing.assert_array_equal(values, layers.layered_reflection(wi, wo, film, skin,
+    np.testing.assert_array_equal(values, two_layer.layered_reflection(wi, wo, film, skin,
                                                                     level=level))
 
 
@@ -159,8 +160,8 @@ def test_layered_reciprocity():
                                   ("deep_mocha", "jensen_skin2")):
         film, skin = _film_and_skin(foundation, skin_name)
         wi, wo = _random_pairs(100, seed=13)
-        forward = layers.layered_reflection(wi, wo, film, skin)
-        backward = layers.layered_reflection(wo, wi, film, skin)
+        forward = two_layer.layered_reflection(wi, wo, film, skin)
+        backward = two_layer.layered_reflection(wo, wi, film, skin)
         np.testing.assert_allclose(forward, backward, rtol=1e-9, atol=0)
 
 
@@ -169,11 +170,11 @@ def test_layered_rgb_channels_and_shapes():
     scalar_skin = presets.paper().skin  # scalar skin under an RGB film
     wi, wo = _random_pairs(20, seed=14)
     for this_skin in (skin, scalar_skin):
-        rgb = layers.layered_reflection(wi.reshape(4, 5, 3), wo.reshape(4, 5, 3), film, this_skin)
+        rgb = two_layer.layered_reflection(wi.reshape(4, 5, 3), wo.reshape(4, 5, 3), film, this_skin)
         assert rgb.shape == (4, 5, 3)
         for c in range(3):
             single_skin = this_skin.channel(c) if this_skin.channels else this_skin
-            one = layers.layered_reflection(wi, wo, film.channel(c), single_skin)
+            one = two_layer.layered_reflection(wi, wo, film.channel(c), single_skin)
             assert one.shape == (20,)
             np.testing.assert_allclose(rgb[..., c].ravel(), one, rtol=1e-12)
 
@@ -182,9 +183,9 @@ def test_layered_outside_hemisphere_is_zero():
     film, skin = _film_and_skin("paper_natural", "paper_bioplate")
     wi, wo = _random_pairs(10, seed=15)
     below = wi * np.array([1.0, 1.0, -1.0])
-    assert np.all(layers.layered_reflection(below, wo, film, skin) == 0.0)
-    assert np.all(layers.layered_reflection(wo, below, film, skin) == 0.0)
-    assert np.all(layers.transmission_factor(below, film, presets.paper().dipole) == 0.0)
+    assert np.all(two_layer.layered_reflection(below, wo, film, skin) == 0.0)
+    assert np.all(two_layer.layered_reflection(wo, below, film, skin) == 0.0)
+    assert np.all(two_layer.transmission_factor(below, film, presets.paper().dipole) == 0.0)
 
 
 # --- the film factors of path 4 ------------------------------------------------------------
@@ -199,26 +200,26 @@ def test_film_transmittance_matches_brute_force():
     film = presets.paper().film_transmission
     theta = np.array([0.0, 30.0, 60.0, 80.0, 89.0])
     w = direction(np.radians(theta), 0.0)
-    got = layers.film_transmittance(w, film)
+    got = two_layer.film_transmittance(w, film)
     sums = [ref.brute_force_albedo(_film_kernel(_scalar(film)), w, n, 2 * n) for n in (64, 128)]
     brute = (4 * sums[1] - sums[0]) / 3
     accuracy = np.abs(sums[1] - sums[0]) / 3 / brute
     np.testing.assert_allclose(got, brute, rtol=max(accuracy.max(), 1e-6))
-    np.testing.assert_allclose(layers.transmission_albedo(theta, film), got, rtol=1e-12)
+    np.testing.assert_allclose(two_layer.transmission_albedo(theta, film), got, rtol=1e-12)
 
 
 def test_transmission_factor_fresnel():
-    film = normalise.film_transmission_layer(presets.made_up_skin("light_ivory"))
+    film = made_up_skin.film_transmission_layer(presets.made_up_skin("light_ivory"))
     theta = np.linspace(0.0, 89.0, 12)
     w = direction(np.radians(theta), 0.3)
     lossless = Dipole(sigma_s=1.0, sigma_a=0.0, eta=1.0)
     # eta_s = 1: no Fresnel at the skin, the factor is the film's transmittance.
-    np.testing.assert_allclose(layers.transmission_factor(w, film, lossless),
-                               layers.film_transmittance(w, film), rtol=1e-12)
+    np.testing.assert_allclose(two_layer.transmission_factor(w, film, lossless),
+                               two_layer.film_transmittance(w, film), rtol=1e-12)
     dipole = presets.paper().dipole
-    factor = layers.transmission_factor(w, film, dipole)
+    factor = two_layer.transmission_factor(w, film, dipole)
     assert factor.shape == (12, 3)
-    assert np.all(factor > 0) and np.all(factor < layers.film_transmittance(w, film))
+    assert np.all(factor > 0) and np.all(factor < two_layer.film_transmittance(w, film))
     # Independent: Int f_t(w, -u) (1 - F_r(cos u, eta_s)) cos(theta_u) du, blue channel.
     eta_s = float(dipole.eta)
     film_b = _scalar(film, 2)
@@ -237,4 +238,4 @@ def test_film_transmittance_of_a_diffuse_film_is_pi_p_d():
     """A purely diffuse film (P_t = 0) transmits pi P_d at every incidence."""
     film = TransmissionLayer(P_d=0.2, P_t=0.0, n=0.05, eta=1.3)
     w = direction(np.radians(np.array([0.0, 45.0, 89.0, 90.0])), 1.0)
-    np.testing.assert_allclose(layers.film_transmittance(w, film), math.pi * 0.2, rtol=1e-12)
+    np.testing.assert_allclose(two_layer.film_transmittance(w, film), math.pi * 0.2, rtol=1e-12)

@@ -7,8 +7,9 @@ import numpy as np
 import pytest
 import reference_impl as ref
 
-from lut_baker import layers, model, normalise, presets
-from lut_baker.quadrature import direction
+from lut_baker.evaluate import two_layer
+from lut_baker.model import layers, made_up_skin, presets
+from lut_baker.numerics.quadrature import direction
 
 THETA_DEG = np.arange(0.0, 90.0)  # 0, 1, ..., 89 degrees
 ABSORPTIONS = {"0": 0.0, "0.5": 0.5, "1": 1.0}
@@ -20,9 +21,9 @@ def _fields(layer):
 
 
 def _film_per_second():
-    film = normalise.per_second(presets.PAPER_FILM_REFLECTION, normalise.REFLECTION_SHUTTER_S)
-    film_t = normalise.per_second(presets.PAPER_FILM_TRANSMISSION,
-                                  normalise.TRANSMISSION_SHUTTER_S)
+    film = made_up_skin.per_second(presets.PAPER_FILM_REFLECTION, made_up_skin.REFLECTION_SHUTTER_S)
+    film_t = made_up_skin.per_second(presets.PAPER_FILM_TRANSMISSION,
+                                  made_up_skin.TRANSMISSION_SHUTTER_S)
     return film, film_t
 
 
@@ -31,7 +32,7 @@ def test_k_is_the_films_brightest_total_albedo():
     """A dense independent scan (0..89.5 degrees every 0.5, brute-force hemisphere sums of the
     reference formulas, Richardson-extrapolated) finds the same maximum and where it is."""
     film, film_t = _film_per_second()
-    k, theta_max = normalise.normalisation_constant(film, film_t)
+    k, theta_max = made_up_skin.normalisation_constant(film, film_t)
     assert presets.paper().K == k
     theta = np.arange(0.0, 90.0, 0.5)
     w = direction(np.radians(theta), 0.0)
@@ -57,8 +58,8 @@ def test_k_is_the_films_brightest_total_albedo():
 
 def test_film_albedo_is_at_most_one_and_one_at_k():
     paper = presets.paper()
-    film = (layers.reflection_albedo(THETA_DEG, paper.film)
-            + layers.transmission_albedo(THETA_DEG, paper.film_transmission))
+    film = (two_layer.reflection_albedo(THETA_DEG, paper.film)
+            + two_layer.transmission_albedo(THETA_DEG, paper.film_transmission))
     print(f"film albedo: max {film.max():.9f}, min {film.min():.4f}")
     assert np.all(film <= 1.0 + 1e-12)
     assert film.max() == pytest.approx(1.0, abs=1e-9)
@@ -74,7 +75,7 @@ def test_paper_counts_become_albedo_units():
 
 # --- the white furnace test ----------------------------------------------------------------
 def _albedo(foundation, skin, coverage, absorption=None):
-    return normalise.directional_albedo(
+    return made_up_skin.directional_albedo(
         THETA_DEG, presets.made_up_skin(foundation, skin, coverage=coverage,
                                         absorption=absorption))
 
@@ -90,7 +91,7 @@ def test_white_furnace(skin):
     surface, _ = presets.skin_layers(skin)
     assert np.all(bare <= 1.0)
     np.testing.assert_allclose(bare, np.broadcast_to(np.reshape(
-        layers.reflection_albedo(THETA_DEG, surface), (90, -1)), bare.shape), rtol=1e-12)
+        two_layer.reflection_albedo(THETA_DEG, surface), (90, -1)), bare.shape), rtol=1e-12)
     worst = {"bare": float(bare.max())}
     # Each foundation with its own shade; an explicit absorption replaces the shade, so with
     # one every foundation is the same film: evaluated once.
@@ -120,7 +121,7 @@ def test_furnace_at_89_degrees_direct():
     """Coverage 0.25 and 0.5 evaluated directly at grazing incidence for the paper pair."""
     for coverage in COVERAGES:
         for absorption in ABSORPTIONS.values():
-            value = normalise.directional_albedo(
+            value = made_up_skin.directional_albedo(
                 89.0, presets.made_up_skin(coverage=coverage, absorption=absorption))
             assert value.shape == (3,) and np.all(value <= 1.0) and np.all(value > 0.0)
 
@@ -131,7 +132,7 @@ def test_bare_skin_albedo_against_brute_force():
     w = direction(np.radians(theta), 0.0)
     for name in presets.SKINS:
         surface, _ = presets.skin_layers(name)
-        got = np.reshape(layers.reflection_albedo(theta, surface), (4, -1))
+        got = np.reshape(two_layer.reflection_albedo(theta, surface), (4, -1))
         for c in range(got.shape[1]):
             args = [float(np.broadcast_to(v, (3,))[c]) for v in surface.as_dict().values()]
             brute = ref.brute_force_albedo(lambda a, u, args=args: ref.vector_reflection(
@@ -153,18 +154,18 @@ def test_coverage_zero_is_bare_skin_exactly():
     wi, wo = _pairs(30, 1)
     for name in presets.SKINS:
         skin = presets.made_up_skin("deep_mocha", name, coverage=0.0)
-        bare = np.reshape(model.ts_reflection(wi, wo, skin.skin), (30, -1))
-        np.testing.assert_array_equal(normalise.made_up_reflection(wi, wo, skin),
+        bare = np.reshape(layers.ts_reflection(wi, wo, skin.skin), (30, -1))
+        np.testing.assert_array_equal(made_up_skin.made_up_reflection(wi, wo, skin),
                                       np.broadcast_to(bare, (30, 3)))
 
 
 def test_made_up_reflection_linear_in_coverage():
     wi, wo = _pairs(30, 2)
     skin = presets.made_up_skin("light_ivory", "jensen_skin2")
-    ends = [normalise.made_up_reflection(wi, wo, skin.replace(coverage=c)) for c in (0.0, 1.0)]
+    ends = [made_up_skin.made_up_reflection(wi, wo, skin.replace(coverage=c)) for c in (0.0, 1.0)]
     for coverage in (0.1, 0.25, 0.5, 0.9):
         np.testing.assert_allclose(
-            normalise.made_up_reflection(wi, wo, skin.replace(coverage=coverage)),
+            made_up_skin.made_up_reflection(wi, wo, skin.replace(coverage=coverage)),
             (1 - coverage) * ends[0] + coverage * ends[1], rtol=1e-12)
 
 
@@ -179,9 +180,9 @@ def test_full_absorption_leaves_gloss_and_bare_skin():
         gloss = np.array([ref.ts_reflection(a, b, 0.0, float(film.P_s),
                                                          float(film.n), float(film.eta))
                                        for a, b in zip(wi, wo, strict=True)])
-        bare = model.ts_reflection(wi, wo, skin.skin)
+        bare = layers.ts_reflection(wi, wo, skin.skin)
         expected = (1 - coverage) * bare + coverage * gloss[:, None]
-        np.testing.assert_allclose(normalise.made_up_reflection(wi, wo, skin), expected,
+        np.testing.assert_allclose(made_up_skin.made_up_reflection(wi, wo, skin), expected,
                                    rtol=1e-10)
         assert np.all(gloss > 0)
 
@@ -190,8 +191,8 @@ def test_absorption_lowers_albedo_per_channel():
     wi, wo = _pairs(10, 4)
     shade = presets.made_up_skin("deep_mocha")  # absorption rises from red to blue
     clear = presets.made_up_skin("paper_natural")
-    shaded = normalise.made_up_reflection(wi, wo, shade)
-    assert np.all(shaded < normalise.made_up_reflection(wi, wo, clear))
+    shaded = made_up_skin.made_up_reflection(wi, wo, shade)
+    assert np.all(shaded < made_up_skin.made_up_reflection(wi, wo, clear))
     assert np.all(shaded[:, 0] > shaded[:, 1]) and np.all(shaded[:, 1] > shaded[:, 2])
 
 

@@ -1,4 +1,4 @@
-"""Presets (lut_baker.presets): the paper's fitted values (SPEC 5), the literature skins, the
+"""Presets (lut_baker.model.presets): the paper's fitted values (SPEC 5), the literature skins, the
 foundation shades, and the named bundles built from them."""
 
 import math
@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from lut_baker import model, normalise, presets
+from lut_baker.model import layers, made_up_skin, presets
 
 # SPEC 5 (the paper's table), red channel, pixel counts.
 SPEC_5 = {
@@ -51,7 +51,7 @@ def test_jensen_skins(name):
     np.testing.assert_array_equal(dipole.sigma_a, sigma_a)
     assert float(dipole.g) == 0.0 and float(dipole.eta) == 1.3
     # The diffuse albedo pi P_d is the dipole's total diffuse reflectance (SPEC 4).
-    np.testing.assert_allclose(math.pi * surface.P_d, model.dipole_total_reflectance(dipole),
+    np.testing.assert_allclose(math.pi * surface.P_d, layers.dipole_total_reflectance(dipole),
                                rtol=1e-14)
     assert np.all(math.pi * surface.P_d < 1.0)
     # Red scatters most and absorbs least: skin is reddest.
@@ -89,7 +89,7 @@ def test_made_up_skin():
     assert bundle.K == presets.paper().K
     override = presets.made_up_skin("deep_mocha", absorption=0.2)
     np.testing.assert_array_equal(override.absorption, 0.2)
-    assert normalise.film_transmission_layer(override).P_t == pytest.approx(
+    assert made_up_skin.film_transmission_layer(override).P_t == pytest.approx(
         0.8 * presets.paper().film_transmission.P_t)
 
 

@@ -1,12 +1,12 @@
-"""The exact reference image of a made-up sphere (lut_baker.reference)."""
+"""The exact reference image of a made-up sphere (lut_baker.offline.validation.reference)."""
 
 import numpy as np
 import pytest
 
-from lut_baker import presets
-from lut_baker import reference as ref
-from lut_baker.model import Dipole
-from lut_baker.normalise import made_up_reflection
+from lut_baker.model import presets
+from lut_baker.model.layers import Dipole
+from lut_baker.model.made_up_skin import made_up_reflection
+from lut_baker.offline.validation import reference as ref
 
 
 @pytest.fixture(scope="module")
@@ -64,7 +64,7 @@ def test_spread_converges_when_samples_double(skin):
 def test_profile_cutoff_holds_the_energy(skin):
     from scipy.integrate import quad
 
-    from lut_baker.model import dipole_profile, dipole_total_reflectance
+    from lut_baker.model.layers import dipole_profile, dipole_total_reflectance
 
     cutoff = ref.profile_cutoff_mm(skin, lost_fraction=1e-3)
     inside = 2 * np.pi * quad(lambda d: dipole_profile(d, skin.dipole) * d, 0, cutoff,

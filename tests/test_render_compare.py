@@ -1,9 +1,9 @@
-"""Renders of the reference sphere against :mod:`lut_baker.reference` (issue 5, item 2).
+"""Renders of the reference sphere against :mod:`lut_baker.offline.validation.reference` (issue 5, item 2).
 
-The comparison itself (pure numpy, :mod:`lut_baker.compare`) is tested first; then the scene of
+The comparison itself (pure numpy, :mod:`lut_baker.offline.validation.compare`) is tested first; then the scene of
 ``bench/blender_scene.py`` (Cycles CPU, 48 x 48 px, a sphere of 10 mm, the paper preset, light
 45 degrees from the view) renders a Lambert sphere, the two tiers and the baseline (a stock
-Principled BSDF fitted by :mod:`lut_baker.baseline`), each twice (seeds 0 and 1, 32 samples),
+Principled BSDF fitted by :mod:`lut_baker.offline.validation.baseline`), each twice (seeds 0 and 1, 32 samples),
 and the baseline without subsurface at 256 samples against its replica. The bounds are measured
 (docs/speed_accuracy.md, "Bounds of the tests"), with margin for the noise of one seed pair and
 a busy machine. Blender-side tests use the ``bpy_factory`` fixture (marked ``bpy``); they take
@@ -19,7 +19,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from lut_baker import bake, baseline, compare, presets, reference
+from lut_baker import bake
+from lut_baker.model import presets
+from lut_baker.offline.validation import baseline, compare, reference
 
 SIZE = 48
 SAMPLES = 32

@@ -14,9 +14,11 @@ def test_bake_and_closure_fit_run_without_scipy():
     script = textwrap.dedent("""
         import sys
         sys.modules["scipy"] = None  # any 'import scipy...' now raises ImportError
-        from lut_baker import bake, closure_fit, presets
+        from lut_baker import bake
+        from lut_baker.closures import fitting
+        from lut_baker.model import presets
         tables = bake.bake(presets.made_up_skin("medium_beige", "jensen_skin1"), "preview")
-        closure_fit.fit_closures(tables)
+        fitting.fit_closures(tables)
         print("ok", presets.paper().K)
     """)
     done = subprocess.run([sys.executable, "-c", script], cwd=ROOT, capture_output=True,

@@ -1,4 +1,4 @@
-"""The Auto tier (issue 5, item 5): lut_baker.scene_model, and Fit to Scene in Blender.
+"""The Auto tier (issue 5, item 5): lut_baker.auto_tier, and Fit to Scene in Blender.
 
 Pure tests check the model's parts against independent computations (the pinhole footprint,
 the exact reference's subsurface spread, the tables' gloss share) and its decisions (close-up
@@ -19,8 +19,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from lut_baker import bake, compare, presets, reference, scene_model
-from lut_baker.scene_model import SceneDescription
+from lut_baker import auto_tier, bake
+from lut_baker.auto_tier import SceneDescription
+from lut_baker.model import presets
+from lut_baker.offline.validation import compare, reference
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -32,9 +34,9 @@ def paper_tables():
 
 @pytest.fixture(scope="module")
 def paper_fit(paper_tables):
-    from lut_baker import closure_fit
+    from lut_baker.closures import fitting
 
-    return closure_fit.fit_closures(paper_tables)
+    return fitting.fit_closures(paper_tables)
 
 
 def _matte_film(ior=1.01, coverage=1.0):
@@ -50,33 +52,33 @@ def _matte_film(ior=1.01, coverage=1.0):
 @pytest.fixture(scope="module")
 def matte():
     """``(skin, tables, fit)`` of :func:`_matte_film` (preview bake)."""
-    from lut_baker import closure_fit
+    from lut_baker.closures import fitting
 
     skin = _matte_film()
     tables = bake.bake(skin, "preview")
-    return skin, tables, closure_fit.fit_closures(tables)
+    return skin, tables, fitting.fit_closures(tables)
 
 
 # --------------------------------------------------------------------------------------------
 # Pure: the model's parts
 # --------------------------------------------------------------------------------------------
 def test_footprint_orthographic_and_pinhole():
-    assert scene_model.pixel_footprint_mm("ORTHO", 500, ortho_scale_mm=250.0) == 0.5
+    assert auto_tier.pixel_footprint_mm("ORTHO", 500, ortho_scale_mm=250.0) == 0.5
     # A 36 mm sensor behind a 50 mm lens sees 720 mm at 1 m; over 1000 px that is 0.72 mm.
-    value = scene_model.pixel_footprint_mm("PERSP", 1000, distance_mm=1000.0, sensor_mm=36.0,
+    value = auto_tier.pixel_footprint_mm("PERSP", 1000, distance_mm=1000.0, sensor_mm=36.0,
                                            focal_mm=50.0)
     assert value == pytest.approx(0.72)
     with pytest.raises(ValueError):
-        scene_model.pixel_footprint_mm("ORTHO", 500)
+        auto_tier.pixel_footprint_mm("ORTHO", 500)
     with pytest.raises(ValueError):
-        scene_model.pixel_footprint_mm("PANORAMA", 500, distance_mm=1.0)
+        auto_tier.pixel_footprint_mm("PANORAMA", 500, distance_mm=1.0)
 
 
 def test_mean_radius_of_a_burley_profile():
     """Cycles' Burley profile (shape length d, cut at a = 16 d, renormalised) has the mean
     distance ``[I(d) + I(3d)] / (4 d cdf)`` with ``I(s) = s^2 (1 - e^(-a/s) (1 + a/s))``
     (2.44 d; 2.5 d uncut)."""
-    from lut_baker.cycles_closures import BURLEY_MFP_SCALE, burley_profile
+    from lut_baker.closures.cycles import BURLEY_MFP_SCALE, burley_profile
 
     radius = 6.0
     s = radius * BURLEY_MFP_SCALE
@@ -88,21 +90,21 @@ def test_mean_radius_of_a_burley_profile():
     cdf = 1.0 - 0.25 * math.exp(-16.0) - 0.75 * math.exp(-16.0 / 3.0)
     expected = (moment(s) + moment(3.0 * s)) / (4.0 * s * cdf)
     d = np.concatenate([[0.0], np.geomspace(1e-6, a * (1 - 1e-9), 20000)])
-    mean = scene_model.profile_mean_radius_mm(d, burley_profile(d, radius))
+    mean = auto_tier.profile_mean_radius_mm(d, burley_profile(d, radius))
     assert mean == pytest.approx(expected, rel=1e-3)
 
 
 def test_blur_kernel_is_normalised_and_tends_to_a_point(paper_tables):
-    wide = scene_model.blur_kernel(0.25, paper_tables.radius_mm, paper_tables.profile)
+    wide = auto_tier.blur_kernel(0.25, paper_tables.radius_mm, paper_tables.profile)
     assert np.allclose(wide.sum(axis=(0, 1)), 1.0) and wide.min() >= 0.0
     h = wide.shape[0] // 2
     assert wide[h, h, 0] < 0.5  # the spread leaves the centre cell
-    point = scene_model.blur_kernel(100.0, paper_tables.radius_mm, paper_tables.profile)
+    point = auto_tier.blur_kernel(100.0, paper_tables.radius_mm, paper_tables.profile)
     assert point[point.shape[0] // 2, point.shape[1] // 2, 0] > 0.99
 
 
 def test_omission_error_follows_the_exact_reference(paper_tables):
-    """The pixel-footprint blur model against lut_baker.reference's own spread (spread minus
+    """The pixel-footprint blur model against lut_baker.offline.validation.reference's own spread (spread minus
     local skin light, over the sphere's total): within a factor 2 on a 6 mm sphere at 24 px
     (measured 0.0157 against 0.0184), and it falls as the pixels grow."""
     skin = presets.made_up_skin("paper_natural", "paper_bioplate")
@@ -116,12 +118,12 @@ def test_omission_error_follows_the_exact_reference(paper_tables):
     total = compare.reference_image(skin, tables=paper_tables, resolution=size,
                                     radius_mm=radius, spread=False)[mask]
     exact = np.sqrt(np.mean((spread - local) ** 2)) / np.sqrt(np.mean(total**2))
-    _, share = scene_model.gloss_and_skin_shares(paper_tables, 45.0)
-    predicted = scene_model.subsurface_omission_error(2 * radius / size, 2 * radius, 45.0,
+    _, share = auto_tier.gloss_and_skin_shares(paper_tables, 45.0)
+    predicted = auto_tier.subsurface_omission_error(2 * radius / size, 2 * radius, 45.0,
                                                       paper_tables.radius_mm,
                                                       paper_tables.profile, share)
     assert 0.5 * exact < predicted < 2.0 * exact
-    coarse = [scene_model.subsurface_omission_error(footprint, 400.0, 45.0,
+    coarse = [auto_tier.subsurface_omission_error(footprint, 400.0, 45.0,
                                                     paper_tables.radius_mm,
                                                     paper_tables.profile, share)
               for footprint in (0.5, 4.0, 40.0)]
@@ -131,29 +133,29 @@ def test_omission_error_follows_the_exact_reference(paper_tables):
 def test_shares_add_up(paper_tables):
     """Gloss and skin light are parts of the image: each share is in (0, 1); bare skin is
     nearly all skin light, full film mostly not (the film hides the skin)."""
-    gloss, skin = scene_model.gloss_and_skin_shares(paper_tables, 45.0, 1.0, 0.0)
-    bare_gloss, bare_skin = scene_model.gloss_and_skin_shares(paper_tables, 45.0, 0.0, 0.0)
+    gloss, skin = auto_tier.gloss_and_skin_shares(paper_tables, 45.0, 1.0, 0.0)
+    bare_gloss, bare_skin = auto_tier.gloss_and_skin_shares(paper_tables, 45.0, 0.0, 0.0)
     assert 0.0 < gloss < 1.0 and 0.0 < skin < 0.5 and bare_skin > 0.9 > bare_gloss
-    _, absorbed = scene_model.gloss_and_skin_shares(paper_tables, 45.0, 1.0, 1.0)
+    _, absorbed = auto_tier.gloss_and_skin_shares(paper_tables, 45.0, 1.0, 1.0)
     assert absorbed == 0.0
 
 
 def test_costs_and_noise_cover_every_candidate():
-    for table in (scene_model.RELATIVE_COST, scene_model.NOISE_K):
-        assert set(table) == set(scene_model.COST_SKIN_SHARE)
+    for table in (auto_tier.RELATIVE_COST, auto_tier.NOISE_K):
+        assert set(table) == set(auto_tier.COST_SKIN_SHARE)
         for by_candidate in table.values():
-            assert set(by_candidate) == set(scene_model.CANDIDATES)
-    for coverage, costs in scene_model.RELATIVE_COST.items():
-        assert costs[scene_model.FULLEST] == 1.0 == max(costs.values()), coverage
-        for candidate in scene_model.CANDIDATES:  # the subsurface is the noisy part
-            k = scene_model.NOISE_K[coverage][candidate]
+            assert set(by_candidate) == set(auto_tier.CANDIDATES)
+    for coverage, costs in auto_tier.RELATIVE_COST.items():
+        assert costs[auto_tier.FULLEST] == 1.0 == max(costs.values()), coverage
+        for candidate in auto_tier.CANDIDATES:  # the subsurface is the noisy part
+            k = auto_tier.NOISE_K[coverage][candidate]
             assert (k > 0.03) if candidate.subsurface else (k < 0.01), (coverage, candidate)
     # Interpolated by the skin share, held beyond the measured ones.
-    dropped = scene_model.Candidate("LAYERED", subsurface=False)
-    film, bare = (scene_model.relative_cost(dropped, scene_model.COST_SKIN_SHARE[c])
+    dropped = auto_tier.Candidate("LAYERED", subsurface=False)
+    film, bare = (auto_tier.relative_cost(dropped, auto_tier.COST_SKIN_SHARE[c])
                   for c in (1.0, 0.0))
-    assert bare < scene_model.relative_cost(dropped, 0.5) < film
-    assert scene_model.relative_cost(dropped, 2.0) == bare
+    assert bare < auto_tier.relative_cost(dropped, 0.5) < film
+    assert auto_tier.relative_cost(dropped, 2.0) == bare
 
 
 # --------------------------------------------------------------------------------------------
@@ -164,40 +166,40 @@ DISTANT = SceneDescription(object_size_mm=200.0, footprint_mm=6.25, samples=128)
 
 
 def test_close_up_and_distant_get_different_tiers():
-    close, far = scene_model.choose(CLOSE_UP), scene_model.choose(DISTANT)
+    close, far = auto_tier.choose(CLOSE_UP), auto_tier.choose(DISTANT)
     assert close.candidate != far.candidate
     assert close.candidate.subsurface and not far.candidate.subsurface
     assert far.chosen.cost < close.chosen.cost
     assert far.chosen.error <= far.best_error + far.tolerance
-    traits = scene_model.paper_traits()
-    assert scene_model.needs_subsurface(CLOSE_UP, traits)
-    assert not scene_model.needs_subsurface(DISTANT, traits)
+    traits = auto_tier.paper_traits()
+    assert auto_tier.needs_subsurface(CLOSE_UP, traits)
+    assert not auto_tier.needs_subsurface(DISTANT, traits)
 
 
 def test_half_a_pixel_is_the_threshold():
-    traits = scene_model.paper_traits()
+    traits = auto_tier.paper_traits()
     radius = traits.mean_radius_mm
     for ratio, needed in ((0.45, False), (0.55, True)):
         scene = SceneDescription(object_size_mm=100.0, footprint_mm=radius / ratio)
-        assert scene_model.needs_subsurface(scene, traits) == needed
-        assert scene_model.choose(scene).candidate.subsurface == needed
+        assert auto_tier.needs_subsurface(scene, traits) == needed
+        assert auto_tier.choose(scene).candidate.subsurface == needed
     # The artist's Subsurface Scale widens the spread: 4x makes the distant scene need it.
-    assert scene_model.needs_subsurface(DISTANT, traits.scaled(40.0))
-    assert not scene_model.choose(CLOSE_UP, traits.scaled(0.0)).candidate.subsurface
+    assert auto_tier.needs_subsurface(DISTANT, traits.scaled(40.0))
+    assert not auto_tier.choose(CLOSE_UP, traits.scaled(0.0)).candidate.subsurface
 
 
 def test_eevee_gets_a_tier_that_runs_there():
     for scene in (CLOSE_UP, DISTANT):
         eevee = SceneDescription(**{**scene.__dict__, "engine": "EEVEE"})
-        choice = scene_model.choose(eevee)
-        assert choice.candidate.tier in scene_model.ENGINE_TIERS["EEVEE"]
+        choice = auto_tier.choose(eevee)
+        assert choice.candidate.tier in auto_tier.ENGINE_TIERS["EEVEE"]
         assert all(p.candidate.tier == "PRINCIPLED" for p in choice.predictions)
         assert choice.chosen.noise == 0.0
 
 
 def _traits(gloss_share):
-    paper = scene_model.paper_traits()
-    return scene_model.MaterialTraits(
+    paper = auto_tier.paper_traits()
+    return auto_tier.MaterialTraits(
         tier_errors=dict(paper.tier_errors), radius_mm=paper.radius_mm, profile=paper.profile,
         profile_mismatch=paper.profile_mismatch, skin_share=dict(paper.skin_share),
         gloss_share={angle: gloss_share for angle in paper.gloss_share})
@@ -211,51 +213,51 @@ def test_gloss_below_the_noise_needs_no_gloss_lobe():
     far = SceneDescription(object_size_mm=200.0, footprint_mm=6.25, samples=16)
     close = SceneDescription(object_size_mm=60.0, footprint_mm=0.1, samples=64)
     for scene in (far, close):
-        faint = scene_model.choose(scene, _traits(0.01))
+        faint = auto_tier.choose(scene, _traits(0.01))
         assert not faint.candidate.gloss
         assert faint.candidate.subsurface == (scene is close)
-        assert faint.chosen.cost < scene_model.choose(
-            scene, _traits(0.01), candidates=[c for c in scene_model.CANDIDATES
+        assert faint.chosen.cost < auto_tier.choose(
+            scene, _traits(0.01), candidates=[c for c in auto_tier.CANDIDATES
                                               if c.gloss]).chosen.cost
-        strong = scene_model.choose(scene)
+        strong = auto_tier.choose(scene)
         assert strong.candidate.gloss and "kept" in strong.reasons[2]
         assert all(p.gloss > 0.15 for p in strong.predictions if not p.candidate.gloss)
-    assert "left out" in scene_model.choose(far, _traits(0.01)).reasons[2]
-    matte = scene_model.choose(far, scene_model.paper_traits().scaled(1.0, 0.0))
+    assert "left out" in auto_tier.choose(far, _traits(0.01)).reasons[2]
+    matte = auto_tier.choose(far, auto_tier.paper_traits().scaled(1.0, 0.0))
     assert all(not p.candidate.gloss for p in matte.predictions)
-    half = scene_model.predict(scene_model.FULLEST, far, scene_model.paper_traits().scaled(
+    half = auto_tier.predict(auto_tier.FULLEST, far, auto_tier.paper_traits().scaled(
         1.0, 0.5))
-    assert half.gloss == pytest.approx(0.5 * scene_model.PAPER_GLOSS_OMISSION["LAYERED"][45.0])
+    assert half.gloss == pytest.approx(0.5 * auto_tier.PAPER_GLOSS_OMISSION["LAYERED"][45.0])
 
 
 def test_gloss_omission_is_the_tiers_gloss(paper_tables, paper_fit, matte):
     """What Gloss 0 changes in a sphere's image, from the tiers' replicas: for the paper's
     film within 15% of the tables' gloss share (the fits reproduce the gloss lobes) and the
     stored constants; for a film of index 1.01 under 1.5% at every light angle."""
-    from lut_baker import closure_fit
+    from lut_baker.closures import fitting
 
-    omissions = scene_model.gloss_omissions(paper_tables, paper_fit, lights_deg=(0.0, 45.0))
+    omissions = auto_tier.gloss_omissions(paper_tables, paper_fit, lights_deg=(0.0, 45.0))
     for tier, by_light in omissions.items():
         for light, value in by_light.items():
-            share, _ = scene_model.gloss_and_skin_shares(paper_tables, light)
+            share, _ = auto_tier.gloss_and_skin_shares(paper_tables, light)
             assert value == pytest.approx(share, rel=0.15), (tier, light)
-            assert value == pytest.approx(scene_model.PAPER_GLOSS_OMISSION[tier][light],
+            assert value == pytest.approx(auto_tier.PAPER_GLOSS_OMISSION[tier][light],
                                           rel=0.05), (tier, light)  # default against preview
     _, tables, fit = matte
-    traits = scene_model.traits_from_tables(tables, fit)
-    for tier in closure_fit.TIERS:
+    traits = auto_tier.traits_from_tables(tables, fit)
+    for tier in fitting.TIERS:
         assert max(traits.gloss_omission[tier].values()) < 0.015, tier
         assert traits.gloss_error(tier, 45.0) == traits.gloss_omission[tier][45.0]
 
 
 def test_tolerance_trades_error_for_cost():
-    strict = scene_model.choose(CLOSE_UP, tolerance=0.0)
-    loose = scene_model.choose(CLOSE_UP, tolerance=1.0)
+    strict = auto_tier.choose(CLOSE_UP, tolerance=0.0)
+    loose = auto_tier.choose(CLOSE_UP, tolerance=1.0)
     assert strict.chosen.error == strict.best_error
     assert loose.chosen.cost == min(p.cost for p in loose.predictions)
     assert loose.chosen.cost < strict.chosen.cost
     with pytest.raises(ValueError):
-        scene_model.choose(CLOSE_UP, tolerance=-0.1)
+        auto_tier.choose(CLOSE_UP, tolerance=-0.1)
 
 
 def test_runs_without_scipy():
@@ -263,11 +265,14 @@ def test_runs_without_scipy():
     script = textwrap.dedent("""
         import sys
         sys.modules["scipy"] = None
-        from lut_baker import bake, closure_fit, presets, scene_model
+        from lut_baker import bake
+        from lut_baker.closures import fitting
+        from lut_baker.model import presets
+        from lut_baker import auto_tier
         tables = bake.bake(presets.made_up_skin(), "preview")
-        traits = scene_model.traits_from_tables(tables, closure_fit.fit_closures(tables))
-        scene = scene_model.SceneDescription(object_size_mm=60.0, footprint_mm=0.1)
-        print("ok", scene_model.choose(scene, traits).candidate.name)
+        traits = auto_tier.traits_from_tables(tables, fitting.fit_closures(tables))
+        scene = auto_tier.SceneDescription(object_size_mm=60.0, footprint_mm=0.1)
+        print("ok", auto_tier.choose(scene, traits).candidate.name)
     """)
     done = subprocess.run([sys.executable, "-c", script], cwd=ROOT, capture_output=True,
                           text=True, timeout=300)
@@ -319,12 +324,12 @@ def test_distant_choice_is_within_tolerance_and_cheaper(stage):
     sphere 48 px across (6.25 mm per px; the skin's mean spread 1.15 mm = 0.18 px): the Auto
     choice renders measurably faster than the fullest tier at the same samples and its error
     against the reference stays within the tolerance of the fullest one's."""
-    from lut_baker import closure_fit
+    from lut_baker.closures import fitting
 
     skin = presets.made_up_skin("paper_natural", "paper_bioplate", coverage=0.0)
     tables = bake.bake(skin, "preview")
-    traits = scene_model.traits_from_tables(tables, closure_fit.fit_closures(tables))
-    choice = scene_model.choose(DISTANT_SPHERE, traits)
+    traits = auto_tier.traits_from_tables(tables, fitting.fit_closures(tables))
+    choice = auto_tier.choose(DISTANT_SPHERE, traits)
     assert not choice.candidate.subsurface and choice.chosen.cost < 0.8
     # The spread is far below a pixel here (the predicted omission error is < 0.1%), and
     # the spread reference would need ~2e7 entry points: compare with the local reference.
@@ -333,11 +338,11 @@ def test_distant_choice_is_within_tolerance_and_cheaper(stage):
                                   radius_mm=DISTANT_RADIUS_MM, spread=False,
                                   irradiance=math.pi)
     images, seconds = _render_interleaved(stage, tables, (choice.candidate,
-                                                          scene_model.FULLEST))
+                                                          auto_tier.FULLEST))
     errors = {c.name: compare.relative_rms(image, ref) for c, image in images.items()}
     seconds = {c.name: t for c, t in seconds.items()}
     report = f"errors {errors}, seconds {seconds}"
-    chosen, fullest = choice.candidate.name, scene_model.FULLEST.name
+    chosen, fullest = choice.candidate.name, auto_tier.FULLEST.name
     assert all(np.all(np.isfinite(image)) and image.min() >= 0.0 for image in images.values())
     assert errors[chosen] <= errors[fullest] + choice.tolerance, report
     assert errors[chosen] <= choice.chosen.error, report  # the prediction bounds it
@@ -355,26 +360,26 @@ def test_gloss_below_the_noise_is_left_out_measured(stage, paper_tables, paper_f
         ref = compare.reference_image(skin, tables=tables, resolution=SIZE,
                                       radius_mm=DISTANT_RADIUS_MM, spread=False,
                                       irradiance=math.pi)
-        return tables, scene_model.traits_from_tables(tables, fit), ref
+        return tables, auto_tier.traits_from_tables(tables, fit), ref
 
     tables, traits, ref = setup(*matte)
-    choice = scene_model.choose(DISTANT_SPHERE, traits)
+    choice = auto_tier.choose(DISTANT_SPHERE, traits)
     assert not choice.candidate.gloss and not choice.candidate.subsurface, choice.reasons
     assert choice.chosen.gloss < 0.015 and "left out" in choice.reasons[2]
     images, seconds = _render_interleaved(stage, tables, (choice.candidate,
-                                                          scene_model.FULLEST))
+                                                          auto_tier.FULLEST))
     errors = {c: compare.relative_rms(image, ref) for c, image in images.items()}
     report = (f"errors { {c.name: e for c, e in errors.items()} }, seconds "
               f"{ {c.name: t for c, t in seconds.items()} }")
     assert all(np.all(np.isfinite(image)) and image.min() >= 0.0 for image in images.values())
-    assert errors[choice.candidate] <= errors[scene_model.FULLEST] + choice.tolerance, report
-    assert seconds[choice.candidate] < 0.8 * seconds[scene_model.FULLEST], report
+    assert errors[choice.candidate] <= errors[auto_tier.FULLEST] + choice.tolerance, report
+    assert seconds[choice.candidate] < 0.8 * seconds[auto_tier.FULLEST], report
 
     tables, traits, ref = setup(presets.made_up_skin("paper_natural", "paper_bioplate"),
                                 paper_tables, paper_fit)
-    strong = scene_model.choose(DISTANT_SPHERE, traits)
+    strong = auto_tier.choose(DISTANT_SPHERE, traits)
     assert strong.candidate.gloss and not strong.candidate.subsurface, strong.reasons
-    dropped = scene_model.Candidate(strong.candidate.tier, subsurface=False, gloss=False)
+    dropped = auto_tier.Candidate(strong.candidate.tier, subsurface=False, gloss=False)
     predicted = strong.prediction(dropped)
     assert predicted.error > strong.best_error + strong.tolerance
     measured = {c: compare.relative_rms(stage.render(tables, c)[1], ref)

@@ -9,8 +9,9 @@ import numpy as np
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from lut_baker import layers, model, normalise
-from lut_baker.model import Dipole, ReflectionLayer, TransmissionLayer
+from lut_baker.evaluate import two_layer
+from lut_baker.model import layers, made_up_skin
+from lut_baker.model.layers import Dipole, ReflectionLayer, TransmissionLayer
 
 FAST = settings(max_examples=60, deadline=None, derandomize=True)
 SLOW = settings(max_examples=6, deadline=None, derandomize=True)  # quadrature: ~1-2 s a call
@@ -68,7 +69,7 @@ def _sane(values):
 @given(DIRECTION, DIRECTION, REFLECTION)
 def test_reflection_stable(wi, wo, layer):
     for a, b in ((wi, wo), (wi, wi), (wo, wo), (wi, -wo * [1, 1, -1])):
-        value = model.ts_reflection(a, b, layer)
+        value = layers.ts_reflection(a, b, layer)
         _sane(value)
         assert value >= layer.P_d * (1 - 1e-12)  # the lobe only adds
 
@@ -78,7 +79,7 @@ def test_reflection_stable(wi, wo, layer):
 def test_transmission_stable(wi, wt, layer):
     below = wt * np.array([1.0, 1.0, -1.0])
     for a, b in ((wi, below), (wi, -wi), (below, wi), (-wi, wi)):
-        value = model.ts_transmission(a, b, layer)
+        value = layers.ts_transmission(a, b, layer)
         _sane(value)
         assert value <= layer.P_d + layer.P_t + 1e-9 * (layer.P_d + layer.P_t)
 
@@ -86,7 +87,7 @@ def test_transmission_stable(wi, wt, layer):
 @FAST
 @given(st.floats(0.0, 1.0), ETA)
 def test_fresnel_stable(c, eta):
-    value = model.fresnel_reflectance(c, eta)
+    value = layers.fresnel_reflectance(c, eta)
     _sane(value)
     assert value <= 1.0
 
@@ -94,9 +95,9 @@ def test_fresnel_stable(c, eta):
 @FAST
 @given(DISTANCE, dipoles())
 def test_dipole_stable(d, dipole):
-    profile = model.dipole_profile(np.array([0.0, d]), dipole)
+    profile = layers.dipole_profile(np.array([0.0, d]), dipole)
     _sane(profile)
-    total = model.dipole_total_reflectance(dipole)
+    total = layers.dipole_total_reflectance(dipole)
     _sane(total)
     assert total <= 1.0 + 1e-12
 
@@ -106,14 +107,14 @@ def test_dipole_stable(d, dipole):
 def test_layered_reflection_stable(wi, wo, film, skin):
     wi_set = np.stack([wi, wo, np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.0, 0.0])])
     wo_set = np.stack([wo, wo, np.array([0.0, 0.0, 1.0]), np.array([-1.0, 0.0, 0.0])])
-    _sane(layers.layered_reflection(wi_set, wo_set, film, skin))
+    _sane(two_layer.layered_reflection(wi_set, wo_set, film, skin))
 
 
 @FAST
 @given(DIRECTION, FILM_T, dipoles())
 def test_film_factors_stable(w, film, dipole):
-    factor = layers.transmission_factor(w, film, dipole)
-    through = layers.film_transmittance(w, film)
+    factor = two_layer.transmission_factor(w, film, dipole)
+    through = two_layer.film_transmittance(w, film)
     _sane(factor)
     _sane(through)
     # The skin's Fresnel transmission F_t <= 1 only removes light.
@@ -124,10 +125,10 @@ def test_film_factors_stable(w, film, dipole):
 @given(THETA, FILM_T, SKIN, ALBEDO_P, st.floats(0.0, 1.0), st.floats(0.0, 1.0))
 def test_directional_albedo_stable(theta, film_t, skin, film_p_s, coverage, absorption):
     film = ReflectionLayer(P_d=film_t.P_d, P_s=film_p_s, n=film_t.n, eta=film_t.eta)
-    bundle = normalise.MadeUpSkin(film=film, film_transmission=film_t, skin=skin,
+    bundle = made_up_skin.MadeUpSkin(film=film, film_transmission=film_t, skin=skin,
                                   dipole=Dipole(sigma_s=1.0, sigma_a=0.1), coverage=coverage,
                                   absorption=absorption)
-    value = normalise.directional_albedo(np.array([0.0, theta, 90.0]), bundle)
+    value = made_up_skin.directional_albedo(np.array([0.0, theta, 90.0]), bundle)
     assert value.shape == (3, 3)
     _sane(value)
 
@@ -135,10 +136,10 @@ def test_directional_albedo_stable(theta, film_t, skin, film_p_s, coverage, abso
 def test_grid_follows_the_lobe_width():
     """Narrower lobes (larger n, lobe half-width 1/n degrees) get finer azimuth and polar steps,
     up to the clamp at quadrature.NARROWEST_LOBE_DEG; never coarser as n grows."""
-    from lut_baker.quadrature import NARROWEST_LOBE_DEG
+    from lut_baker.numerics.quadrature import NARROWEST_LOBE_DEG
 
     n_values = np.geomspace(1e-6, 50.0, 40)
-    grids = [layers.grid_for(TransmissionLayer(P_d=1.0, P_t=1.0, n=n, eta=1.3)) for n in n_values]
+    grids = [two_layer.grid_for(TransmissionLayer(P_d=1.0, P_t=1.0, n=n, eta=1.3)) for n in n_values]
     n_phi = np.array([g.n_phi for g in grids])
     n_theta = np.array([g.theta.size for g in grids])
     assert np.all(np.diff(n_phi) >= 0) and np.all(np.diff(n_theta) >= 0)
@@ -152,5 +153,5 @@ def test_grid_follows_the_lobe_width():
     # The narrowest layer sets the grid of a pair.
     wide = ReflectionLayer(P_d=1.0, P_s=1.0, n=0.01, eta=1.3)
     narrow = TransmissionLayer(P_d=1.0, P_t=1.0, n=0.15, eta=1.3)
-    assert layers.grid_for(wide, narrow).n_phi == layers.grid_for(narrow).n_phi
-    assert layers.grid_for(wide, narrow, level=1).n_phi > layers.grid_for(wide, narrow).n_phi
+    assert two_layer.grid_for(wide, narrow).n_phi == two_layer.grid_for(narrow).n_phi
+    assert two_layer.grid_for(wide, narrow, level=1).n_phi > two_layer.grid_for(wide, narrow).n_phi

@@ -1,6 +1,6 @@
 """Stability where the methods fail (issue 5, item 4), without Blender.
 
-Across every regime of :data:`lut_baker.stability.REGIMES` (grazing light and the silhouette, a
+Across every regime of :data:`lut_baker.offline.validation.stability.REGIMES` (grazing light and the silhouette, a
 1 mm and a 2 m sphere, the film lobe at 2, 5, 60 and 90 degrees, indices near 1, coverage 0
 and 1, full absorption): the exact model, the baked tables and the reference images hold no
 NaN, Inf or negative value, the tables' white furnace stays at or below 1, and the reference's
@@ -15,7 +15,9 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from lut_baker import bake, normalise, stability
+from lut_baker import bake
+from lut_baker.model import made_up_skin
+from lut_baker.offline.validation import stability
 
 SPREAD = ("grazing", "silhouette", "tiny", "huge", "coverage0", "coverage1")
 """Regimes whose reference is spread here: the paper's film (its transmittance tabulated
@@ -70,7 +72,7 @@ def test_tables_white_furnace(results, key):
 @pytest.mark.parametrize("key", ["rougher", "eta1", "coverage0"])
 def test_exact_white_furnace(key):
     skin = stability.regime_skin(stability.regime(key))
-    albedo = normalise.directional_albedo(np.array([0.0, 60.0, 89.9]), skin)
+    albedo = made_up_skin.directional_albedo(np.array([0.0, 60.0, 89.9]), skin)
     assert np.all(np.isfinite(albedo)) and albedo.min() >= 0.0
     assert albedo.max() <= 1.0 + stability.FURNACE_TOLERANCE
 

@@ -5,7 +5,7 @@ Usage::
     python tools/closure_report.py [--resolution default]
 
 For every foundation on every skin: each tier's angular error against the tables (relative
-RMS of ``f cos(theta_i)`` and largest view-albedo error, lut_baker.closure_fit) at coverage 1,
+RMS of ``f cos(theta_i)`` and largest view-albedo error, lut_baker.closures.fitting) at coverage 1,
 0.5 and 0 with the shade's absorption; then per skin the Subsurface Radius each Blender method
 needs and how far its edge response stays from the skin's dipole.
 """
@@ -25,7 +25,9 @@ COVERAGES = (1.0, 0.5, 0.0)
 
 
 def main(argv=None) -> int:
-    from lut_baker import bake, closure_fit, presets
+    from lut_baker import bake
+    from lut_baker.closures import fitting
+    from lut_baker.model import presets
 
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--resolution", default="default")
@@ -39,11 +41,11 @@ def main(argv=None) -> int:
             made_up = presets.made_up_skin(foundation, skin)
             tables = bake.bake(made_up, args.resolution)
             start = time.perf_counter()
-            fit = closure_fit.fit_closures(tables)
+            fit = fitting.fit_closures(tables)
             seconds.append(time.perf_counter() - start)
             fits[skin] = fit
             for coverage in COVERAGES:
-                errors = closure_fit.tier_errors(fit, tables, coverage, made_up.absorption)
+                errors = fitting.tier_errors(fit, tables, coverage, made_up.absorption)
                 p, lay = errors["PRINCIPLED"], errors["LAYERED"]
                 print(f"| {foundation} | {skin} | {coverage:g} | {100 * p.rms:.1f}% | "
                       f"{100 * p.albedo:.1f}% | {100 * lay.rms:.1f}% | {100 * lay.albedo:.1f}% |")

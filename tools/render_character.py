@@ -298,7 +298,7 @@ def run(args) -> None:
 
 
 def main(argv=None) -> int:
-    from lut_baker import presets
+    from lut_baker.model import presets
 
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--out", default=str(REPO_ROOT / "docs" / "renders" / "character"),

@@ -37,10 +37,10 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from .bake import bake, table_error
-from .normalise import MadeUpSkin, directional_albedo, made_up_reflection
-from .presets import made_up_skin
-from .quadrature import direction
+from ...bake import bake, table_error
+from ...model.made_up_skin import MadeUpSkin, directional_albedo, made_up_reflection
+from ...model.presets import made_up_skin
+from ...numerics.quadrature import direction
 from .reference import (
     default_samples,
     light_direction,
@@ -251,7 +251,7 @@ def spread_energy_ratio(skin: MadeUpSkin, radius_mm: float, resolution: int,
 
 
 def _tiers(item: Regime, tables) -> dict:
-    from .closure_fit import fit_closures, tier_errors
+    from ...closures.fitting import fit_closures, tier_errors
 
     fit = fit_closures(tables)
     errors = tier_errors(fit, tables, item.coverage, item.absorption)
@@ -261,7 +261,7 @@ def _tiers(item: Regime, tables) -> dict:
 def auto_choice(item: Regime, samples: int = 128):
     """The Auto tier's :class:`scene_model.Choice` for the regime's sphere (``resolution`` px
     across, its lights, Cycles at ``samples``) and skin (the paper preset's traits)."""
-    from .scene_model import SceneDescription, choose
+    from ...auto_tier import SceneDescription, choose
 
     diameter = 2.0 * item.radius_mm
     scene = SceneDescription(object_size_mm=diameter, footprint_mm=diameter / item.resolution,

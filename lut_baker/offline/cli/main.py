@@ -20,9 +20,9 @@ import threading
 __all__ = ["COMMANDS", "main", "build_parser", "Interrupted", "signals_interrupt"]
 
 COMMANDS = {
-    "bake": ".cli_bake",
-    "fit": ".cli_fit",
-    "figures": ".cli_figures",
+    "bake": ".bake_command",
+    "fit": ".fit_command",
+    "figures": ".figures_command",
 }
 """Command name -> module (relative to this package) implementing it."""
 

@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .model import (
+from ..model.layers import (
     Dipole,
     ReflectionLayer,
     TransmissionLayer,
@@ -39,7 +39,7 @@ from .model import (
     _ts_transmission,
     check_directions,
 )
-from .quadrature import (
+from ..numerics.quadrature import (
     HemisphereGrid,
     azimuth_convolution_factor,
     fourier_kernel,
@@ -277,6 +277,6 @@ def reflection_albedo(theta_i_deg, layer: ReflectionLayer, *, level: int = 0):
 def transmission_albedo(theta_i_deg, cosmetic: TransmissionLayer, *, level: int = 0):
     """Directional transmittance of the film at incidence ``theta_i_deg`` (degrees)."""
     theta = np.radians(np.asarray(theta_i_deg, float))
-    from .quadrature import direction
+    from ..numerics.quadrature import direction
 
     return film_transmittance(direction(theta, 0.0), cosmetic, level=level)

@@ -26,10 +26,10 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .layers import film_transmittance
-from .model import dipole_profile, dipole_total_reflectance
-from .normalise import MadeUpSkin, film_transmission_layer, made_up_reflection
-from .quadrature import direction
+from ...evaluate.two_layer import film_transmittance
+from ...model.layers import dipole_profile, dipole_total_reflectance
+from ...model.made_up_skin import MadeUpSkin, film_transmission_layer, made_up_reflection
+from ...numerics.quadrature import direction
 
 __all__ = [
     "sphere_points",

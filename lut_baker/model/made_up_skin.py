@@ -23,14 +23,15 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .layers import (
+from ..evaluate.two_layer import (
     grid_for,
     layered_fourier_matrices,
     layered_reflection,
     reflection_albedo,
     transmission_albedo,
 )
-from .model import (
+from ..numerics.optimise import golden_minimum
+from .layers import (
     Dipole,
     ReflectionLayer,
     TransmissionLayer,
@@ -38,7 +39,6 @@ from .model import (
     _ts_reflection,
     check_directions,
 )
-from .optimise import golden_minimum
 
 __all__ = [
     "REFLECTION_SHUTTER_S",

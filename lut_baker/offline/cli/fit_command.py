@@ -12,7 +12,7 @@ layer type as keywords), then ``[stderr]``, ``[relative_stderr]`` (eta: relative
 condition number, correlation matrix over ``free``, warnings).  Warnings (ill-conditioned or
 degenerate parameters, poor fit) also go to stderr, one per line.
 
-CSV columns (units in the names; ``#`` lines are comments; see lut_baker.measurements):
+CSV columns (units in the names; ``#`` lines are comments; see lut_baker.offline.measured.measurements):
   reflection    psi_deg, alpha_deg (or theta_r_deg), intensity_counts
   transmission  incidence_deg, theta_t_deg, intensity_counts
   dipole        distance_mm, ratio   (ratio to the lit pixel, modelled as R(d)/R(0))
@@ -30,8 +30,10 @@ from pathlib import Path
 
 import numpy as np
 
-from .fit import D_MIN_MM, fit_dipole, fit_reflection, fit_transmission
-from .measurements import (
+from ...model.layers import Dipole, ReflectionLayer
+from ...model.presets import paper_layers
+from ..measured.layer_fit import D_MIN_MM, fit_dipole, fit_reflection, fit_transmission
+from ..measured.measurements import (
     MAX_NOISE,
     PAPER_INCIDENCES_DEG,
     PAPER_RELATIVE_ANGLES_DEG,
@@ -42,8 +44,6 @@ from .measurements import (
     read_measurements,
     write_measurements,
 )
-from .model import Dipole, ReflectionLayer
-from .presets import paper_layers
 
 __all__ = ["HELP", "STRICT_EXIT", "configure", "run", "result_document", "to_toml"]
 
@@ -146,7 +146,7 @@ def _check_options(options: dict) -> None:
 
 
 def result_document(result) -> dict:
-    """The output block of a :class:`~lut_baker.fit.FitResult` as nested plain data."""
+    """The output block of a :class:`~lut_baker.offline.measured.layer_fit.FitResult` as nested plain data."""
     data = result.as_dict()
     return {
         result.kind: data["params"],

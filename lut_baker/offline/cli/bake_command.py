@@ -92,8 +92,8 @@ def _one_line_error(parser, message: str):
 
 
 def configure(parser: argparse.ArgumentParser) -> None:
-    from .bake import RESOLUTIONS
-    from .presets import FOUNDATIONS, SKINS
+    from ...bake import RESOLUTIONS
+    from ...model.presets import FOUNDATIONS, SKINS
 
     parser.error = types.MethodType(_one_line_error, parser)
     parser.add_argument("--preset", choices=PRESETS, default="paper",
@@ -130,9 +130,9 @@ def configure(parser: argparse.ArgumentParser) -> None:
 
 
 def skin_from_args(args):
-    """The :class:`~lut_baker.normalise.MadeUpSkin` the options describe (``ValueError``
+    """The :class:`~lut_baker.model.made_up_skin.MadeUpSkin` the options describe (``ValueError``
     naming the option on bad input)."""
-    from .params_file import params_from_mapping, read_mapping
+    from ...model.params_file import params_from_mapping, read_mapping
 
     mapping = {}
     if args.params is not None:
@@ -179,8 +179,8 @@ def _failed(error: Exception) -> int:
 
 
 def run(args) -> int:
-    from .bake import bake
-    from .io import _oiio, check_target, content_hash, save_tables
+    from ...bake import bake
+    from ...tables.codec import _oiio, check_target, content_hash, save_tables
 
     skin = skin_from_args(args)
     stem = args.name or _default_stem(skin.name)

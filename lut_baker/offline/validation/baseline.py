@@ -5,14 +5,14 @@ parameters fitted to the same model as well as it allows".  The fit here is the 
 baseline this project can make without rendering: its sockets are chosen by least squares on
 the images that matter, the sphere under one distant light at 0, 45 and 75 degrees from the
 view, each pixel ``E f cos(theta_i)`` of the Principled BSDF's replica
-(:func:`lut_baker.cycles_closures.principled_reflection`) against paths 1 + 3 read from the
-baked tables (:func:`lut_baker.compare.local_image`, no spread on either side: the subsurface
+(:func:`lut_baker.closures.cycles.principled_reflection`) against paths 1 + 3 read from the
+baked tables (:func:`lut_baker.offline.validation.compare.local_image`, no spread on either side: the subsurface
 radius is fitted separately, to the profile, as for the tiers).
 
 Free sockets: Base Color (RGB), Roughness, Specular IOR Level, Coat Weight, Coat Roughness and
 Coat IOR, within the ranges Blender's sockets allow; IOR stays at the tiers' 1.5 (Specular IOR
 Level scales its F0).  The start is the PRINCIPLED tier's own table-space fit
-(:func:`lut_baker.closure_fit.principled_inputs`), so the baseline is never worse than that
+(:func:`lut_baker.closures.fitting.principled_inputs`), so the baseline is never worse than that
 tier on this measure; Subsurface Weight, Radius, IOR and method are the tier's (its radius is
 fitted to the dipole's profile, the method chosen by that fit).  The baseline differs from the
 PRINCIPLED tier in what it is: constants typed into one node for one coverage and absorption,
@@ -30,11 +30,11 @@ from dataclasses import dataclass, replace
 import numpy as np
 from scipy.optimize import least_squares
 
-from . import closure_fit
-from . import cycles_closures as cc
+from ...closures import cycles as cc
+from ...closures import fitting
+from ...model.made_up_skin import MadeUpSkin
+from ...tables.table_set import Tables
 from .compare import local_image, sphere_directions
-from .normalise import MadeUpSkin
-from .tables import Tables
 
 __all__ = ["LIGHTS_DEG", "FIT_RESOLUTION", "MAX_EVALUATIONS", "Baseline", "principled_image",
            "fit_baseline"]
@@ -108,16 +108,16 @@ def _inputs(x: np.ndarray, start: cc.PrincipledInputs) -> cc.PrincipledInputs:
                    coat_weight=x[5], coat_roughness=x[6], coat_ior=x[7])
 
 
-def fit_baseline(skin: MadeUpSkin, tables: Tables, fit: closure_fit.ClosureFit | None = None, *,
+def fit_baseline(skin: MadeUpSkin, tables: Tables, fit: fitting.ClosureFit | None = None, *,
                  lights_deg=LIGHTS_DEG, resolution: int = FIT_RESOLUTION,
                  max_evaluations: int = MAX_EVALUATIONS) -> Baseline:
     """Fit a stock Principled BSDF to ``tables`` (baked from ``skin``) at the skin's coverage
     and absorption: least squares over the lit pixels of every light's image, each image's
     residual relative to its own RMS (so each light counts alike).  ``fit``: the tables'
-    :class:`~lut_baker.closure_fit.ClosureFit` (fitted here if not given).  A light whose
+    :class:`~lut_baker.closures.fitting.ClosureFit` (fitted here if not given).  A light whose
     image is black (e.g. from behind the sphere) raises ValueError naming it."""
-    fit = fit or closure_fit.fit_closures(tables)
-    start, weight = closure_fit.principled_inputs(fit, skin.coverage, skin.absorption)
+    fit = fit or fitting.fit_closures(tables)
+    start, weight = fitting.principled_inputs(fit, skin.coverage, skin.absorption)
     views = [sphere_directions(resolution, light) for light in lights_deg]
     wi = np.concatenate([v[1] for v in views])
     wo = np.concatenate([v[2] for v in views])

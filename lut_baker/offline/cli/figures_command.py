@@ -31,7 +31,7 @@ def run(args: argparse.Namespace) -> int:
         import matplotlib  # noqa: F401  (checked here so a missing install is one clear line)
     except ModuleNotFoundError as error:
         raise ValueError("the figures need matplotlib: pip install matplotlib") from error
-    from .figures import render_all
+    from ..paper_figures import render_all
 
     if args.out.exists() and not args.out.is_dir():
         raise ValueError(f"--out {args.out} exists and is not a folder")

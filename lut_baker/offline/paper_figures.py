@@ -31,8 +31,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .layers import layered_reflection, transmission_factor
-from .model import (
+from ..evaluate.two_layer import layered_reflection, transmission_factor
+from ..model.layers import (
     Dipole,
     ReflectionLayer,
     TransmissionLayer,
@@ -41,14 +41,14 @@ from .model import (
     ts_reflection,
     ts_transmission,
 )
-from .normalise import (
+from ..model.made_up_skin import (
     MadeUpSkin,
     directional_albedo,
     film_reflection_layer,
     film_transmission_layer,
     made_up_reflection,
 )
-from .presets import (
+from ..model.presets import (
     FOUNDATIONS,
     PAPER_FILM_REFLECTION,
     PAPER_FILM_TRANSMISSION,
@@ -57,7 +57,7 @@ from .presets import (
     made_up_skin,
     paper,
 )
-from .protocols import (
+from .measured.protocols import (
     ReflectionSweep,
     in_plane_direction,
     profile_distances,
@@ -154,7 +154,7 @@ def reflection_curves(layer: ReflectionLayer = PAPER_FILM_REFLECTION,
     """Paper eq. 2 in the reflection protocol (SPEC 6): per relative angle psi (degrees) a dict
     of ``theta_r_deg``, ``theta_i_deg = theta_r_deg + psi`` (signed, degrees), ``brdf`` ``f_r``
     and ``intensity`` ``f_r cos(theta_i)`` (units of ``layer``: counts per 3 s for the paper),
-    at the protocol's samples (:func:`~lut_baker.protocols.reflection_sweep`) densified."""
+    at the protocol's samples (:func:`~lut_baker.offline.measured.protocols.reflection_sweep`) densified."""
     curves = {}
     for psi in relative_angles_deg:
         sweep = _dense_reflection(psi)
@@ -173,7 +173,7 @@ def transmission_curves(layer: TransmissionLayer = PAPER_FILM_TRANSMISSION,
     """Paper eq. 4 in the transmission protocol (SPEC 6): per incidence (degrees) a dict of
     ``theta_t_deg`` (signed, from -z; straight through at theta_t = incidence), ``btdf``
     ``f_t`` and ``intensity`` ``f_t cos(theta_i)`` (counts per 10 s for the paper), at the
-    protocol's samples (:func:`~lut_baker.protocols.transmission_sweep`) densified."""
+    protocol's samples (:func:`~lut_baker.offline.measured.protocols.transmission_sweep`) densified."""
     curves = {}
     for incidence in incidences_deg:
         theta_t = _densified(transmission_sweep(incidence).theta_t_deg)
@@ -200,7 +200,7 @@ def made_up_reflection_curves(skin: MadeUpSkin | None = None, relative_angle_deg
     """Made-up skin in the reflection protocol at one relative angle (paper 5.1, eq. 9), as
     intensities ``f cos(theta_i)`` in albedo units (1/sr, SPEC 4): ``path1`` (film surface),
     ``path3`` (through the film, off the skin surface, back through), ``bare`` (the skin alone)
-    and ``sum`` {coverage: :func:`~lut_baker.normalise.made_up_reflection` at that coverage}."""
+    and ``sum`` {coverage: :func:`~lut_baker.model.made_up_skin.made_up_reflection` at that coverage}."""
     skin = paper() if skin is None else skin
     sweep = _dense_reflection(relative_angle_deg, MADE_UP_STEP_DEG)
     wi, wo, cosine = sweep.wi, sweep.wo, sweep.wi[..., 2]
@@ -223,7 +223,7 @@ def made_up_profile_curves(skin: MadeUpSkin | None = None, angle_deg: float = 30
                            max_mm: float = 3.0, step_mm: float = 0.01) -> dict:
     """Path 4 at incidence = view = ``angle_deg`` in the specular geometry (paper 5.2):
     ``bare = (1/pi) F_t(wo) R(d) F_t(wi)`` (eq. 5) and ``made_up = R(d)/pi t(wi) t(wo)``
-    (eq. 8, SPEC 3, ``t`` = :func:`~lut_baker.layers.transmission_factor` of the absorbing
+    (eq. 8, SPEC 3, ``t`` = :func:`~lut_baker.evaluate.two_layer.transmission_factor` of the absorbing
     film), both divided by ``bare`` at d = 0.  Also returns ``t`` and ``F_t`` at that angle."""
     skin = paper() if skin is None else skin
     wi = in_plane_direction(angle_deg)
@@ -293,7 +293,7 @@ def _figure(title: str, xlabel: str, ylabel: str):
         from matplotlib.figure import Figure
     except ModuleNotFoundError as error:
         raise ModuleNotFoundError(
-            "lut_baker.figures needs matplotlib to draw (pip install matplotlib)"
+            "lut_baker.offline.paper_figures needs matplotlib to draw (pip install matplotlib)"
         ) from error
     with matplotlib.rc_context(_STYLE):
         figure = Figure(figsize=FIGSIZE_IN, dpi=DPI, layout="constrained")

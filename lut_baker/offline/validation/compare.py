@@ -1,7 +1,7 @@
-"""Comparing rendered sphere images with the reference images of :mod:`lut_baker.reference`.
+"""Comparing rendered sphere images with the reference images of :mod:`lut_baker.offline.validation.reference`.
 
 Pure numpy: the Blender side (``bench/blender_scene.py``) renders, this module measures.  An
-image is ``(n, n, 3)`` float, rows top-down as :func:`lut_baker.reference.sphere_points` lays
+image is ``(n, n, 3)`` float, rows top-down as :func:`lut_baker.offline.validation.reference.sphere_points` lays
 them out; a render read from Blender (rows bottom-up) goes through :func:`from_blender_pixels`.
 
 Error measures (issue 5, item 2), all over the sphere's pixels (:func:`sphere_mask`), every
@@ -20,7 +20,7 @@ Functions
 - :func:`relative_rms`, :func:`noise_floor`, :func:`bias` -- the measures above.
 - :func:`lambert_image` -- the analytic image of a Lambertian sphere, ``E a / pi max(0, N.L)``.
 - :func:`reference_image` -- the made-up sphere's reference, exact or with paths 1 + 3 read
-  from baked tables (same geometry and spread as :func:`lut_baker.reference.sphere_image`).
+  from baked tables (same geometry and spread as :func:`lut_baker.offline.validation.reference.sphere_image`).
 - :func:`local_image` -- the image of any local reflection function (no spread);
   :func:`sphere_directions` -- its pixels' local light and view directions.
 - :func:`pareto_front` -- the points no other point beats in both cost and error.
@@ -30,8 +30,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import reference
-from .normalise import MadeUpSkin
+from ...model.made_up_skin import MadeUpSkin
+from ..validation import reference
 
 __all__ = [
     "sphere_mask",
@@ -116,13 +116,13 @@ def reference_image(skin: MadeUpSkin, *, tables=None, resolution: int = 64,
                     radius_mm: float = 10.0, light_angle_deg: float = 45.0,
                     irradiance: float = 1.0, spread: bool = True,
                     samples: int | None = None) -> np.ndarray:
-    """The reference image ``(n, n, 3)`` of :func:`lut_baker.reference.sphere_image`.
+    """The reference image ``(n, n, 3)`` of :func:`lut_baker.offline.validation.reference.sphere_image`.
 
     ``tables=None``: exactly that (paths 1 + 3 by the exact evaluator, ~20 ms per pixel).
     ``tables`` (baked from ``skin``): paths 1 + 3 interpolated from them instead
-    (:meth:`lut_baker.tables.Tables.made_up_reflection`, error <= 1e-3 of the peak at the
+    (:meth:`lut_baker.tables.table_set.Tables.made_up_reflection`, error <= 1e-3 of the peak at the
     "default" and "high" resolutions, docs/baking.md), everything else the same: the
-    skin-diffuse part is spread by :func:`lut_baker.reference.spread_diffuse` when
+    skin-diffuse part is spread by :func:`lut_baker.offline.validation.reference.spread_diffuse` when
     ``spread``.  ``tests/test_render_compare.py`` checks that the two agree."""
     if tables is None:
         return reference.sphere_image(skin, resolution=resolution, radius_mm=radius_mm,

@@ -40,7 +40,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .model import (
+from ...model.layers import (
     Dipole,
     ReflectionLayer,
     TransmissionLayer,
@@ -48,7 +48,7 @@ from .model import (
     ts_reflection,
     ts_transmission,
 )
-from .presets import paper_layers
+from ...model.presets import paper_layers
 from .protocols import (
     profile_distances,
     reflection_geometry,
@@ -148,7 +148,7 @@ class ProfileData:
 
 
 def _directions(data, key: str, angle: str, second: str, geometry, valid: tuple) -> None:
-    """Set ``data.wi`` and ``data.<second>`` from :mod:`lut_baker.protocols`' ``geometry``,
+    """Set ``data.wi`` and ``data.<second>`` from :mod:`lut_baker.offline.measured.protocols`' ``geometry``,
     one experiment per distinct value of the column ``key`` (within ``valid = (low, high,
     low_open)`` degrees; high is always open)."""
     low, high, low_open = valid
@@ -326,7 +326,7 @@ def synthesize_transmission(layer: TransmissionLayer, incidences_deg=PAPER_INCID
 def synthesize_profile(dipole: Dipole, distance_mm=None, noise: float = 0.0,
                        rng=None) -> ProfileData:
     """The pencil-beam profile (SPEC 6): ``R(d)/R(0)`` at ``distance_mm`` (default
-    :func:`lut_baker.protocols.profile_distances`, 0 to 3 mm by 0.05)."""
+    :func:`lut_baker.offline.measured.protocols.profile_distances`, 0 to 3 mm by 0.05)."""
     d = profile_distances() if distance_mm is None else np.asarray(distance_mm, float)
     return ProfileData(d, _noisy(profile_ratio(d, dipole), noise, rng))
 

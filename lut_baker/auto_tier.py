@@ -42,7 +42,7 @@ Functions and types
 - :func:`gloss_and_skin_shares` -- shares of the gloss and of the spreading skin light in a
   sphere's image.
 - :func:`gloss_omission_error`, :func:`gloss_omissions` -- what the tiers' Gloss input at 0
-  changes in a sphere's image (their replicas in :mod:`lut_baker.closure_fit`).
+  changes in a sphere's image (their replicas in :mod:`lut_baker.closures.fitting`).
 - :func:`profile_mismatch` -- how far a fitted closure's edge response is from the tables'.
 - :func:`blur_kernel`, :func:`subsurface_omission_error` -- the pixel-footprint blur argument.
 - :func:`relative_cost`, :func:`noise`, :func:`predict`, :class:`Prediction`,
@@ -57,7 +57,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from .quadrature import direction
+from .numerics.quadrature import direction
 
 __all__ = [
     "Candidate",
@@ -386,10 +386,10 @@ def gloss_omission_error(tables, fit, tier: str, light_deg: float, coverage=None
                          absorption=None, *, resolution: int = 48) -> float:
     """Relative RMS change of a sphere's image (orthographic, one distant light ``light_deg``
     from the view, the lit pixels) when ``tier``'s Gloss input goes from 1 to 0: the tier's
-    replica (:data:`lut_baker.closure_fit.TIER_REPLICAS` with the closure fit ``fit``) with
+    replica (:data:`lut_baker.closures.fitting.TIER_REPLICAS` with the closure fit ``fit``) with
     and without its gloss lobes, over the RMS of the tables' radiance ``f cos(theta_i)``, at
     the coverage and absorption (default: the tables')."""
-    from .closure_fit import TIER_REPLICAS
+    from .closures.fitting import TIER_REPLICAS
 
     wi, wo = _sphere_directions(resolution, light_deg)
     w, a = tables._mix(coverage, absorption)
@@ -406,7 +406,7 @@ def gloss_omissions(tables, fit, coverage=None, absorption=None, *,
                     lights_deg=None) -> dict:
     """:func:`gloss_omission_error` of every tier at ``lights_deg`` (default
     :data:`SHARE_LIGHTS_DEG`): ``{tier: {light angle: error}}``."""
-    from .closure_fit import TIERS
+    from .closures.fitting import TIERS
 
     lights = SHARE_LIGHTS_DEG if lights_deg is None else lights_deg
     return {tier: {float(light): gloss_omission_error(tables, fit, tier, light, coverage,
@@ -419,7 +419,7 @@ def profile_mismatch(tables, fit_error) -> float:
     RMS difference of its edge response and the tables', a fraction of the lit level:
     :class:`closure_fit.ProfileFit` ``error``) over the RMS of the tables' edge response's
     departure from a sharp edge, largest over channels."""
-    from .closure_fit import _profile_grid, edge_response
+    from .closures.fitting import _profile_grid, edge_response
 
     r_max = float(tables.radius_mm[-1])
     r = _profile_grid(r_max)
@@ -439,7 +439,7 @@ def traits_from_tables(tables, fit, coverage=None, absorption=None, *,
                        ) -> MaterialTraits:
     """:class:`MaterialTraits` of baked ``tables`` and their :class:`closure_fit.ClosureFit`
     ``fit`` at a coverage and absorption (default: the tables')."""
-    from .closure_fit import tier_errors
+    from .closures.fitting import tier_errors
 
     w, a = tables._mix(coverage, absorption)
     errors = tier_errors(fit, tables, w, a)
@@ -472,9 +472,9 @@ def _paper_traits() -> MaterialTraits:
     """The constants above with the paper dipole's profile on the bake's
     radial grid (exact and cheap to recompute)."""
     from .bake import RESOLUTIONS, profile_radius
-    from .model import dipole_profile, dipole_total_reflectance
-    from .presets import made_up_skin
-    from .tables import radius_nodes
+    from .model.layers import dipole_profile, dipole_total_reflectance
+    from .model.presets import made_up_skin
+    from .tables.table_set import radius_nodes
 
     dipole = made_up_skin("paper_natural", "paper_bioplate").dipole
     res = RESOLUTIONS["default"]

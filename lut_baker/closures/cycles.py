@@ -46,8 +46,8 @@ from functools import lru_cache
 
 import numpy as np
 
-from .model import _fresnel
-from .quadrature import direction, hemisphere_grid
+from ..model.layers import _fresnel
+from ..numerics.quadrature import direction, hemisphere_grid
 
 __all__ = [
     "DISTRIBUTIONS",
@@ -166,7 +166,7 @@ def microfacet_shadowing(cos_i, cos_o, alpha, distribution: str = "GGX"):
 
 def dielectric_fresnel(cos_theta, eta):
     """Unpolarised dielectric Fresnel reflectance (Cycles ``fresnel_dielectric_cos``); the same
-    formula as the paper's ``F_r`` (:func:`lut_baker.model.fresnel_reflectance`)."""
+    formula as the paper's ``F_r`` (:func:`lut_baker.model.layers.fresnel_reflectance`)."""
     return _fresnel(np.clip(np.asarray(cos_theta, float), 0.0, 1.0), np.asarray(eta, float))
 
 
@@ -234,7 +234,7 @@ def lambert_reflection(albedo):
 
 def directional_albedo(brdf, cos_theta, *, lobe_width_deg: float = 20.0, level: int = 0):
     """``Int brdf(w, v) cos(theta_w) dw`` for view directions ``v`` at ``cos_theta`` (any
-    shape), by the hemisphere quadrature of :mod:`lut_baker.quadrature`.
+    shape), by the hemisphere quadrature of :mod:`lut_baker.numerics.quadrature`.
 
     ``brdf(w, v)`` takes direction arrays ``(..., 3)`` and returns ``(...)`` or ``(..., C)``.
     """

@@ -1,8 +1,8 @@
 """Fitting Blender closure parameters to baked tables, and each tier's error against them.
 
 A Cycles shader sees the view direction but not the light's, so the add-on's tiers are
-closures (replicated in :mod:`lut_baker.cycles_closures`) whose parameters are fitted here to the
-tables of :mod:`lut_baker.tables`, with weights that may depend on the view angle through 1-D
+closures (replicated in :mod:`lut_baker.closures.cycles`) whose parameters are fitted here to the
+tables of :mod:`lut_baker.tables.table_set`, with weights that may depend on the view angle through 1-D
 lookup images.  Everything is numpy only (it runs inside Blender, which ships no scipy).
 
 Tiers
@@ -21,7 +21,7 @@ mixed by coverage.
 Both take the group's Gloss input ``g`` (0..1): it scales the gloss lobes (coat weight and
 specular level; the Glossy colours), and at 0 Cycles allocates none of them.  The replicas
 below take it as ``gloss``, so the Auto tier predicts a gloss-free candidate from the same
-formulas as the node group (:func:`lut_baker.scene_model.gloss_omission_error`).
+formulas as the node group (:func:`lut_baker.auto_tier.gloss_omission_error`).
 
 Errors
 ------
@@ -56,9 +56,9 @@ from dataclasses import asdict, dataclass, field, replace
 
 import numpy as np
 
-from . import cycles_closures as cc
-from .optimise import golden_minimum
-from .tables import Tables
+from ..closures import cycles as cc
+from ..numerics.optimise import golden_minimum
+from ..tables.table_set import Tables
 
 __all__ = [
     "TIERS",

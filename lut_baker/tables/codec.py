@@ -49,7 +49,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .tables import ANGULAR, CONSTANT, DIRECTIONAL, FORMAT_VERSION, RADIAL, Tables
+from .table_set import ANGULAR, CONSTANT, DIRECTIONAL, FORMAT_VERSION, RADIAL, Tables
 
 __all__ = ["save_tables", "load_tables", "check_target", "atlas", "content_hash",
            "sidecar_path", "TableFileError", "TableWriteError", "FORMAT_NAME"]
@@ -101,7 +101,7 @@ def _oiio():
         import OpenImageIO
     except ImportError as error:  # pragma: no cover - the test venv has it
         raise ImportError(
-            "lut_baker.io needs OpenImageIO to read and write .exr tables "
+            "lut_baker.tables.codec needs OpenImageIO to read and write .exr tables "
             "(pip install OpenImageIO; Blender ships it as the OpenImageIO module)"
         ) from error
     return OpenImageIO

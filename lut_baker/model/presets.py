@@ -1,7 +1,7 @@
 """Parameter presets: the paper's fitted layers (SPEC 5), skins from the literature, shades.
 
 Paper values are 16-bit pixel counts (red channel, applied to all three); they become albedo
-units through :func:`lut_baker.normalise.from_paper_counts`.  Literature skins are given
+units through :func:`lut_baker.model.made_up_skin.from_paper_counts`.  Literature skins are given
 directly in albedo units (1/sr) on the same scale.
 
 Functions
@@ -19,8 +19,8 @@ from functools import lru_cache
 
 import numpy as np
 
-from .model import Dipole, ReflectionLayer, TransmissionLayer, dipole_total_reflectance
-from .normalise import MadeUpSkin, from_paper_counts
+from .layers import Dipole, ReflectionLayer, TransmissionLayer, dipole_total_reflectance
+from .made_up_skin import MadeUpSkin, from_paper_counts
 
 __all__ = [
     "PAPER_FILM_REFLECTION",

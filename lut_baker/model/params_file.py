@@ -3,8 +3,8 @@
 A parameter file starts from presets and overrides what it names::
 
     name = "beige on skin 1"
-    foundation = "medium_beige"      # lut_baker.presets.FOUNDATIONS (default paper_natural)
-    skin = "jensen_skin1"            # lut_baker.presets.SKINS (default paper_bioplate)
+    foundation = "medium_beige"      # lut_baker.model.presets.FOUNDATIONS (default paper_natural)
+    skin = "jensen_skin1"            # lut_baker.model.presets.SKINS (default paper_bioplate)
     coverage = 0.8                   # [0, 1]
     absorption = [0.1, 0.24, 0.42]   # [0, 1], one number or R G B
 
@@ -17,11 +17,11 @@ A parameter file starts from presets and overrides what it names::
 Values are albedo units (1/sr, SPEC 4) unless ``units = "counts"``: then ``[film]``,
 ``[film_transmission]`` and ``[skin_surface]`` must each be complete and are the paper's counts
 (reflection at 3 s, transmission at 10 s, or ``reflection_shutter_s``/``transmission_shutter_s``),
-normalised with the K they imply (:func:`lut_baker.normalise.from_paper_counts`).
+normalised with the K they imply (:func:`lut_baker.model.made_up_skin.from_paper_counts`).
 
 Functions
 ---------
-- :func:`skin_to_dict` -- a :class:`~lut_baker.normalise.MadeUpSkin` as JSON-ready data.
+- :func:`skin_to_dict` -- a :class:`~lut_baker.model.made_up_skin.MadeUpSkin` as JSON-ready data.
 - :func:`skin_from_dict` -- the inverse.
 - :func:`load_params` -- read and validate a TOML parameter file into a MadeUpSkin.
 - :func:`read_mapping` -- read a TOML parameter file without interpreting it.
@@ -35,8 +35,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .model import Dipole, ReflectionLayer, TransmissionLayer
-from .normalise import MadeUpSkin, from_paper_counts
+from .layers import Dipole, ReflectionLayer, TransmissionLayer
+from .made_up_skin import MadeUpSkin, from_paper_counts
 from .presets import FOUNDATIONS, SKINS, made_up_skin, paper
 
 __all__ = ["skin_to_dict", "skin_from_dict", "load_params", "read_mapping",

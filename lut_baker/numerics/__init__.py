@@ -1,0 +1,2 @@
+"""Numerical building blocks with no physics in them: quadrature rules, directions and their
+geometry, one-dimensional optimisation."""

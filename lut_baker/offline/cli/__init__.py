@@ -1,0 +1,1 @@
+"""The command line, ``python -m lut_baker <command>``: one module per command."""
