@@ -59,7 +59,10 @@ def test_zip_contents(extension_zip):
     names = zipfile.ZipFile(extension_zip).namelist()
     assert "makeup_skin_addon/convert.py" in names
     assert "lut_baker/__init__.py" in names
+    assert "lut_baker/closures/fitting.py" in names
     assert not [n for n in names if n.startswith("tests/") or "/tests/" in n]
+    # the runtime only: no scipy-backed validation, no command line
+    assert not [n for n in names if n.startswith(("lut_baker/offline/", "lut_baker/__main__"))]
 
 
 def _registered_classes(bpy, module_prefix):

@@ -11,8 +11,8 @@ run in a subprocess and bpy itself is never imported here. ``MAKEUP_SKIN_BLENDER
 at another copy of ``blender_ext.py``.
 
 After building, the zip is checked: it holds the root ``__init__.py``, the manifest and every
-``.py`` of ``makeup_skin_addon/`` and ``lut_baker/``, and nothing from development (tests,
-caches, tools, ...). On success the zip path is the last line on stdout; on failure the exit
+``.py`` of ``makeup_skin_addon/`` and of ``lut_baker/`` outside ``lut_baker/offline/``, and
+nothing offline or from development (tests, caches, tools, ...). On success the zip path is the last line on stdout; on failure the exit
 status is 1 and the tool's own message is on stderr.
 
 Functions (importable, e.g. by the tests):
@@ -47,8 +47,12 @@ __all__ = [
 
 REPO_ROOT = Path(__file__).resolve().parent.parent
 
-#: Python packages that must ship complete (every ``.py`` outside ``tests/``).
+#: Python packages that must ship complete (every ``.py`` outside ``tests/`` and
+#: :data:`OFFLINE`).
 ADDON_PACKAGES = ("makeup_skin_addon", "lut_baker")
+
+#: What must not ship: lut_baker's offline part (scipy, matplotlib, the command line).
+OFFLINE = ("lut_baker/offline/", "lut_baker/__main__.py")
 
 #: The only top-level entries a zip may have; anything else is development clutter that the
 #: manifest's ``paths_exclude_pattern`` should have left out.
@@ -130,9 +134,10 @@ def validate(source_dir: Path | str = REPO_ROOT) -> str:
 def check_zip(zip_path: Path | str, source_dir: Path | str = REPO_ROOT) -> list[str]:
     """Return the problems of a built extension zip (an empty list if it is fine).
 
-    Every ``.py`` file of :data:`ADDON_PACKAGES` in ``source_dir`` (outside ``tests/`` and
-    ``__pycache__/``) must be in the zip, and nothing outside :data:`ALLOWED_TOP_LEVEL`, no
-    ``tests/`` folder and no compiled Python.
+    Every ``.py`` file of :data:`ADDON_PACKAGES` in ``source_dir`` (outside ``tests/``,
+    ``__pycache__/`` and :data:`OFFLINE`) must be in the zip, and nothing outside
+    :data:`ALLOWED_TOP_LEVEL`, nothing of :data:`OFFLINE`, no ``tests/`` folder and no compiled
+    Python.
     """
     source_dir = Path(source_dir)
     with zipfile.ZipFile(zip_path) as zf:
@@ -146,6 +151,7 @@ def check_zip(zip_path: Path | str, source_dir: Path | str = REPO_ROOT) -> list[
             p.relative_to(source_dir).as_posix()
             for p in (source_dir / package).rglob("*.py")
             if not {"tests", "__pycache__"} & set(p.relative_to(source_dir).parts)
+            and not p.relative_to(source_dir).as_posix().startswith(OFFLINE)
         ]
         if not sources:
             problems.append(f"no {package}/*.py in {source_dir}")
@@ -155,6 +161,8 @@ def check_zip(zip_path: Path | str, source_dir: Path | str = REPO_ROOT) -> list[
         top = parts[0] + ("/" if len(parts) > 1 else "")
         if top not in ALLOWED_TOP_LEVEL:
             problems.append(f"unexpected {name} (add it to paths_exclude_pattern)")
+        elif name.startswith(OFFLINE):
+            problems.append(f"offline module shipped: {name}")
         elif "tests" in parts[:-1] or "__pycache__" in parts or name.endswith((".pyc", ".pyo")):
             problems.append(f"development file shipped: {name}")
     return problems
