@@ -28,8 +28,8 @@ sys.path.insert(0, str(ROOT))
 from doc_block import replace_block  # noqa: E402  (bench/doc_block.py)
 
 from lut_baker import bake  # noqa: E402
-from lut_baker.model import layers, presets  # noqa: E402
-from lut_baker.model.made_up_skin import made_up_reflection  # noqa: E402
+from lut_baker.evaluate.made_up import made_up_reflection  # noqa: E402
+from lut_baker.model import microfacet, presets  # noqa: E402
 from lut_baker.tables.table_set import ANGULAR, DIRECTIONAL  # noqa: E402
 
 DOC = ROOT / "docs" / "baking.md"
@@ -135,7 +135,7 @@ def timings(runs: int) -> str:
     out.append(table(["dimension", "value", "median ms", "x default"], rows))
 
     rng = np.random.default_rng(1)
-    wi, wo = bake._sample_directions(200, rng, 89.0)
+    wi, wo = bake.sample_directions(200, rng, 89.0)
     exact_med, _, _ = timed(lambda: made_up_reflection(wi, wo, skin, level=0), max(1, runs // 3))
     per_point = exact_med / 200
     rows = []
@@ -161,8 +161,9 @@ def gloss_tail(tables, skin, n_points=20000, seed=1) -> tuple[float, float, floa
     """Film-top gloss alone (exact: eq. 2 directly) at many points: (p99, p99.9, max) of the
     normalised error, the peak being the composite's."""
     rng = np.random.default_rng(seed)
-    wi, wo = bake._sample_directions(n_points, rng, 89.0)
-    exact = np.reshape(layers.ts_reflection(wi, wo, bake._gloss_layer(skin.film)), (n_points, -1))
+    wi, wo = bake.sample_directions(n_points, rng, 89.0)
+    exact = np.reshape(microfacet.ts_reflection(wi, wo, bake.gloss_layer(skin.film)),
+                       (n_points, -1))
     peak = tables.node_values().reshape(-1, 3).max(axis=0)
     err = np.abs(tables.angular("film_gloss", wi, wo) - exact) / np.maximum(exact, 0.1 * peak)
     err = err.max(axis=-1)
@@ -173,7 +174,7 @@ def path3_node_error(tables, skin, n_nodes=300, seed=0) -> float:
     """Quadrature error of path 3 alone: the baked ``path3_gloss`` at random nodes against
     :func:`lut_baker.evaluate.two_layer.layered_reflection` (level 0) there, normalised by path 3's peak."""
     from lut_baker.evaluate.two_layer import layered_reflection
-    from lut_baker.numerics.quadrature import direction
+    from lut_baker.numerics.geometry import direction
 
     rng = np.random.default_rng(seed)
     n, p = tables.theta_deg.size, tables.phi_deg.size
@@ -182,7 +183,7 @@ def path3_node_error(tables, skin, n_nodes=300, seed=0) -> float:
     wi = direction(np.radians(tables.theta_deg[i]), azimuth)
     wo = direction(np.radians(tables.theta_deg[j]), 0.0)
     exact = np.reshape(layered_reflection(wi, wo, skin.film_transmission,
-                                          bake._gloss_layer(skin.skin)), (n_nodes, -1))
+                                          bake.gloss_layer(skin.skin)), (n_nodes, -1))
     peak = np.max(tables.path3_gloss)
     return float(np.max(np.abs(tables.path3_gloss[i, j, k] - exact)) / peak)
 

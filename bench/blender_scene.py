@@ -78,7 +78,7 @@ def sphere_scene(*, size: int = 64, samples: int = 64, radius_mm: float = 10.0,
                  light_deg: float = 45.0, seed: int = 0, segments: int = SEGMENTS):
     """The reference's scene in a fresh file (module docstring); returns the sphere object.
     ``light_deg``: angle (degrees) between the light and the view direction, towards image
-    +x, as :func:`lut_baker.offline.validation.reference.light_direction`."""
+    +x, as :func:`lut_baker.numerics.geometry.light_direction`."""
     import bmesh
     import bpy
 

@@ -3,7 +3,7 @@ multiplicative noise, fitted from a poor start, compared with the truth.
 
     python bench/fit_roundtrip.py [--seeds 20] [--noise 0.02]
 
-Prints, per protocol and parameter: the target of issue 2 (5%; 10% for the dipole), the median
+Prints, per protocol and parameter: the recovery target (5%; 10% for the dipole), the median
 and worst relative error over the seeds, the median relative standard error the fit reports,
 the worst error in units of that standard error, how many fits flagged the parameter, and the
 time per fit.  Errors and standard errors are relative to the value (eta included).  The
@@ -36,7 +36,7 @@ from lut_baker.offline.measured.measurements import paper_protocols
 
 TARGETS = {"n": 0.05, "eta": 0.05, "P_s/P_d": 0.05, "P_t/P_d": 0.05,
            "sigma_s": 0.10, "sigma_a": 0.10}
-"""Issue 2's recovery targets (relative)."""
+"""The recovery targets (relative): what a fit of the paper's protocols should reach."""
 
 
 def relative_stderrs(result) -> dict[str, float]:

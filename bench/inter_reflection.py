@@ -23,7 +23,7 @@ sys.path.insert(0, str(ROOT))
 
 from lut_baker import bake  # noqa: E402
 from lut_baker.model import presets  # noqa: E402
-from lut_baker.numerics.quadrature import direction  # noqa: E402
+from lut_baker.numerics.geometry import direction  # noqa: E402
 
 FOUNDATIONS = ("paper_natural", "light_ivory", "medium_beige", "deep_mocha")
 CHANNELS = ("R", "G", "B")

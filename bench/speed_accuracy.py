@@ -1,4 +1,4 @@
-"""Render time against error for the Made-up Skin tiers and the baseline (issue 5, item 3).
+"""Render time against error for the Made-up Skin tiers and the baseline.
 
 A benchmark, not a test::
 
@@ -155,7 +155,7 @@ def bake_rows(skin, runs: int = 3):
 
 
 def goals(rows) -> list[dict]:
-    """Issue 5's goals at :data:`GOAL_SAMPLES` samples, per light: the best tier's excess
+    """The goals at :data:`GOAL_SAMPLES` samples, per light: the best tier's excess
     over its noise floor, its error against the baseline's, its time against the baseline's."""
     out = []
     for light in sorted({r["light_deg"] for r in rows if r["axis"] == "render"}):

@@ -5,7 +5,7 @@
     python bench/stability_sweep.py --traits
 
 The first form runs :func:`lut_baker.offline.validation.stability.sweep` (the exact model, the bake, the closure
-fits and the reference images in every regime of issue 5, item 4) and, unless
+fits and the reference images in every regime of stability.REGIMES) and, unless
 ``--no-render``, renders each tier in the same regimes with Cycles (:func:`render_regimes`):
 no NaN, Inf or negative pixel, the white furnace (world colour 1, no light) and the error
 against the reference image.  It prints the table of docs/stability.md (``--out`` rewrites the

@@ -57,7 +57,8 @@ from functools import lru_cache
 
 import numpy as np
 
-from .numerics.quadrature import direction
+from .numerics.geometry import polar_angle_deg, sphere_directions, sphere_normals
+from .numerics.quadrature import trapezoid_weights
 
 __all__ = [
     "Candidate",
@@ -318,44 +319,15 @@ def _at_angle(table: dict, light_deg: float) -> float:
     return float(np.interp(light_deg, angles, [table[a] for a in angles]))
 
 
-def _trapezoid(y: np.ndarray, x: np.ndarray) -> np.ndarray:
-    """Trapezoid rule along the first axis."""
-    dx = np.diff(x)
-    return np.tensordot(dx, 0.5 * (y[1:] + y[:-1]), axes=(0, 0))
-
-
 def profile_mean_radius_mm(radius_mm, profile) -> float:
     """Mean distance (mm) between where light enters and leaves: ``Int d P(d) 2 pi d dd`` of
     the normalised profile ``P = R/Rd`` (largest over channels)."""
     d = np.asarray(radius_mm, float)
     p = np.reshape(np.asarray(profile, float), (d.size, -1))
-    mass = _trapezoid(p * (2.0 * np.pi * d)[:, None], d)
-    mean = _trapezoid(p * (2.0 * np.pi * d * d)[:, None], d)
+    w = trapezoid_weights(d)
+    mass = w @ (p * (2.0 * np.pi * d)[:, None])
+    mean = w @ (p * (2.0 * np.pi * d * d)[:, None])
     return float(np.max(mean / np.maximum(mass, 1e-300)))
-
-
-def _sphere_directions(resolution: int, light_deg: float):
-    """Local ``(wi, wo)`` at the lit pixel centres of a unit sphere seen orthographically from
-    +z (the reference's framing) with a distant light ``light_deg`` from the view in x-z.  The
-    model is isotropic, so only the polar angles and the relative azimuth are built (numpy
-    only: this runs inside Blender)."""
-    centres = (np.arange(resolution) + 0.5) / resolution * 2.0 - 1.0
-    x, y = np.meshgrid(centres, -centres)
-    inside = x * x + y * y < 1.0
-    x, y = x[inside], y[inside]
-    z = np.sqrt(1.0 - x * x - y * y)
-    a = math.radians(light_deg)
-    cos_i = x * math.sin(a) + z * math.cos(a)
-    lit = cos_i > 0.0
-    cos_i, cos_o = cos_i[lit], z[lit]
-    sin_i = np.sqrt(np.clip(1.0 - cos_i**2, 0.0, None))
-    sin_o = np.sqrt(np.clip(1.0 - cos_o**2, 0.0, None))
-    # l.v = cos(a) = cos_i cos_o + sin_i sin_o cos(phi)
-    cos_phi = np.where(sin_i * sin_o > 1e-12,
-                       (math.cos(a) - cos_i * cos_o) / np.maximum(sin_i * sin_o, 1e-12), 1.0)
-    phi = np.arccos(np.clip(cos_phi, -1.0, 1.0))
-    return (direction(np.arccos(np.clip(cos_i, -1.0, 1.0)), phi),
-            direction(np.arccos(np.clip(cos_o, -1.0, 1.0)), np.zeros_like(phi)))
 
 
 def gloss_and_skin_shares(tables, light_deg: float, coverage=None, absorption=None, *,
@@ -365,17 +337,20 @@ def gloss_and_skin_shares(tables, light_deg: float, coverage=None, absorption=No
     the lit pixels of the gloss lobes' radiance (film, path-3 and skin gloss at the coverage
     and absorption) and of the skin's diffuse part (what spreads), against the total radiance
     ``f cos(theta_i)`` from the tables."""
-    wi, wo = _sphere_directions(resolution, light_deg)
-    w, a = tables._mix(coverage, absorption)
-    through = 1.0 - a
+    from .model.made_up_skin import coverage_weights
+
+    _, wi, wo = sphere_directions(resolution, light_deg)
+    w, a = tables.coverage_and_absorption(coverage, absorption)
+    weights = coverage_weights(w, a)
     cos_i = wi[:, 2:3]
     total = tables.made_up_reflection(wi, wo, w, a) * cos_i
-    gloss = (w * tables.angular("film_gloss", wi, wo)
-             + w * through**2 * tables.angular("path3_gloss", wi, wo)
-             + (1.0 - w) * tables.angular("skin_gloss", wi, wo)) * cos_i
-    t_i = tables.directional("film_transmittance", np.degrees(np.arccos(wi[:, 2])))
-    t_o = tables.directional("film_transmittance", np.degrees(np.arccos(wo[:, 2])))
-    skin = tables.skin_diffuse * (w * through**2 * t_i * t_o + (1.0 - w)) * cos_i
+    gloss = (weights.covered * tables.angular("film_gloss", wi, wo)
+             + weights.covered * weights.twice * tables.angular("path3_gloss", wi, wo)
+             + weights.bare * tables.angular("skin_gloss", wi, wo)) * cos_i
+    t_i = tables.directional("film_transmittance", polar_angle_deg(wi))
+    t_o = tables.directional("film_transmittance", polar_angle_deg(wo))
+    skin = tables.skin_diffuse * (weights.covered * weights.twice * t_i * t_o
+                                  + weights.bare) * cos_i
     norm = np.sqrt(np.mean(total**2))
     if not norm > 0:
         return 0.0, 0.0
@@ -391,8 +366,8 @@ def gloss_omission_error(tables, fit, tier: str, light_deg: float, coverage=None
     the coverage and absorption (default: the tables')."""
     from .closures.fitting import TIER_REPLICAS
 
-    wi, wo = _sphere_directions(resolution, light_deg)
-    w, a = tables._mix(coverage, absorption)
+    _, wi, wo = sphere_directions(resolution, light_deg)
+    w, a = tables.coverage_and_absorption(coverage, absorption)
     cos_i = wi[:, 2:3]
     norm = np.sqrt(np.mean((tables.made_up_reflection(wi, wo, w, a) * cos_i) ** 2))
     if not norm > 0:
@@ -419,10 +394,10 @@ def profile_mismatch(tables, fit_error) -> float:
     RMS difference of its edge response and the tables', a fraction of the lit level:
     :class:`closure_fit.ProfileFit` ``error``) over the RMS of the tables' edge response's
     departure from a sharp edge, largest over channels."""
-    from .closures.fitting import _profile_grid, edge_response
+    from .closures.fitting import edge_response, profile_grid
 
     r_max = float(tables.radius_mm[-1])
-    r = _profile_grid(r_max)
+    r = profile_grid(r_max)
     s = np.linspace(0.0, r_max, 48)
     reference = edge_response(r, tables.radial(r), s)
     departure = np.sqrt(np.mean(reference**2, axis=0))  # the sharp edge is 0 inside
@@ -441,7 +416,7 @@ def traits_from_tables(tables, fit, coverage=None, absorption=None, *,
     ``fit`` at a coverage and absorption (default: the tables')."""
     from .closures.fitting import tier_errors
 
-    w, a = tables._mix(coverage, absorption)
+    w, a = tables.coverage_and_absorption(coverage, absorption)
     errors = tier_errors(fit, tables, w, a)
     shares = {float(angle): gloss_and_skin_shares(tables, angle, w, a) for angle in lights_deg}
     return MaterialTraits(
@@ -472,7 +447,7 @@ def _paper_traits() -> MaterialTraits:
     """The constants above with the paper dipole's profile on the bake's
     radial grid (exact and cheap to recompute)."""
     from .bake import RESOLUTIONS, profile_radius
-    from .model.layers import dipole_profile, dipole_total_reflectance
+    from .model.dipole import dipole_profile, dipole_total_reflectance
     from .model.presets import made_up_skin
     from .tables.table_set import radius_nodes
 
@@ -558,11 +533,9 @@ def subsurface_omission_error(footprint_mm: float, object_size_mm: float, light_
     per_pixel = max(int(round(footprint_mm / cell)), 1)
     pixels = max(int(math.ceil(object_size_mm / (cell * per_pixel))), 1)
     m = pixels * per_pixel
-    centres = ((np.arange(m) + 0.5) / m * 2.0 - 1.0) * (0.5 * m * cell / radius_obj)
-    x, y = np.meshgrid(centres, -centres)
-    r2 = x * x + y * y
-    disk = (r2 < 1.0).astype(float)
-    z = np.sqrt(np.clip(1.0 - r2, 0.0, None))
+    normals, inside = sphere_normals(m, 0.5 * m * cell / radius_obj)
+    disk = inside.astype(float)
+    x, z = normals[..., 0], normals[..., 2]
     a = math.radians(light_deg)
     shading = np.clip(x * math.sin(a) + z * math.cos(a), 0.0, None) * disk
     if not np.any(shading > 0):

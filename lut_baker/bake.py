@@ -10,21 +10,23 @@ angles and sums the cosine series on the table's azimuth grid.  What makes it fa
   (:func:`fourier_coefficients`, equal to :func:`lut_baker.evaluate.two_layer.layer_fourier_kernel` within
   1e-8), the Fresnel term interpolated from a checked tabulation (:func:`_fresnel_fast`);
 - every kernel table is computed once per bake (:class:`KernelCache`);
-- the bake's quadrature (:func:`bake_quadrature`) is coarser than the exact evaluator's, as
-  coarse as the convergence study (``bench/bake.py --study``, docs/baking.md) allows.
+- the bake's quadrature (:func:`lut_baker.numerics.quadrature.hemisphere_panels`) is coarser
+  than the exact evaluator's, as coarse as the convergence study (``bench/bake.py --study``,
+  docs/baking.md) allows.
 
 Functions and types
 -------------------
 - :func:`bake` -- the tables of one :class:`~lut_baker.model.made_up_skin.MadeUpSkin`.
 - :class:`Resolution`, :data:`RESOLUTIONS`, :func:`resolution` -- grid sizes per name.
-- :func:`bake_quadrature` -- Gauss-Legendre panels in polar angle, odd azimuth count.
 - :func:`fourier_coefficients` -- cosine coefficients of a layer's kernel, fast.
 - :class:`KernelCache` -- memoises :func:`fourier_coefficients` within one bake.
+- :func:`gloss_layer` -- a layer's Torrance-Sparrow specular part alone.
 - :func:`gloss_tables` -- Torrance-Sparrow specular parts (eq. 2) on the table grid.
 - :func:`gloss_albedos` -- their directional albedos (order 0, azimuths adapted to the lobe).
 - :func:`inter_reflection_albedo` -- what the inter-reflections add to the albedo.
 - :func:`profile_radius` -- where the dipole's R(d) falls to a fraction of its peak (mm).
-- :func:`error_samples` -- random points (grazing included) and the exact values there.
+- :func:`error_samples` -- random points (grazing included) and the exact values there;
+  :func:`sample_directions` -- the random direction pairs alone.
 - :func:`table_error` -- the interpolated tables against the exact evaluator.
 """
 
@@ -35,30 +37,31 @@ from functools import lru_cache
 
 import numpy as np
 
+from .evaluate.made_up import directional_albedo, made_up_reflection
 from .evaluate.two_layer import (
     inter_reflection_fourier_matrices,
     layered_fourier_matrices,
     transmission_factor,
 )
-from .model.layers import (
-    Dipole,
-    ReflectionLayer,
-    TransmissionLayer,
-    _attenuation,
-    _distribution,
-    _fresnel,
-    dipole_profile,
-    dipole_total_reflectance,
-)
-from .model.made_up_skin import (
-    MadeUpSkin,
-    directional_albedo,
-    film_reflection_layer,
-    film_transmission_layer,
-    made_up_reflection,
+from .model.dipole import dipole_profile, dipole_total_reflectance
+from .model.layers import Dipole, ReflectionLayer
+from .model.made_up_skin import MadeUpSkin, film_reflection_layer, film_transmission_layer
+from .model.microfacet import (
+    fresnel_term,
+    half_vector_cosines,
+    ts_specular_from_cosines,
+    ts_transmission_from_cosines,
 )
 from .model.params_file import skin_to_dict
-from .numerics.quadrature import HemisphereGrid, direction
+from .numerics.cache import LRUCache
+from .numerics.geometry import direction, folded_azimuth_deg, polar_angle_deg
+from .numerics.quadrature import (
+    HemisphereGrid,
+    hemisphere_panels,
+    mirror_weighted_azimuths,
+    order0_integral,
+    uniform_azimuths,
+)
 from .tables.table_set import THETA_OFFSET, Tables, node_cos_azimuths, radius_nodes, theta_nodes
 
 __all__ = [
@@ -66,15 +69,16 @@ __all__ = [
     "RESOLUTIONS",
     "resolution",
     "bake",
-    "bake_quadrature",
     "fourier_coefficients",
     "KernelCache",
+    "gloss_layer",
     "gloss_tables",
     "gloss_albedos",
     "profile_radius",
     "table_error",
     "inter_reflection_albedo",
     "error_samples",
+    "sample_directions",
     "ErrorSamples",
     "PROFILE_FLOOR",
     "REFERENCE_LOBE_DEG",
@@ -150,36 +154,9 @@ def resolution(name_or_resolution) -> Resolution:
     return RESOLUTIONS[name_or_resolution]
 
 
-@lru_cache(maxsize=16)
-def bake_quadrature(panels: int, points: int, n_phi: int) -> HemisphereGrid:
-    """Quadrature over the upper hemisphere (projected solid angle): ``panels`` equal
-    Gauss-Legendre panels of ``points`` nodes over [0, 90] degrees, ``n_phi`` (odd) azimuths."""
-    if panels < 1 or points < 1 or n_phi < 3 or n_phi % 2 == 0:
-        raise ValueError(f"need panels, points >= 1 and odd n_phi >= 3, got "
-                         f"{panels}, {points}, {n_phi}")
-    x, w = np.polynomial.legendre.leggauss(points)
-    half = np.pi / 4.0 / panels
-    mid = half * (2.0 * np.arange(panels) + 1.0)
-    theta = (mid[:, None] + half * x[None, :]).ravel()
-    weight = np.cos(theta) * np.sin(theta) * np.tile(half * w, panels)
-    return HemisphereGrid(theta=theta, weight=weight, n_phi=n_phi)
-
-
 # --------------------------------------------------------------------------------------------
 # Kernels from cosines
 # --------------------------------------------------------------------------------------------
-def _half_vector_cosines(cos_a, sin_a, cos_b, sin_b, cos_phi):
-    """``(N.H, V.H)`` of ``wa`` and ``wb`` at relative azimuth ``phi`` (eq. 2's half vector):
-    ``|wa + wb|^2 = 2 + 2 wa.wb``, ``N.H = (cos_a + cos_b) / |wa + wb|``, ``V.H = |wa + wb| / 2``;
-    the normal where ``wa + wb`` vanishes (as :func:`lut_baker.model.layers.ts_reflection`)."""
-    dot = cos_a * cos_b + sin_a * sin_b * cos_phi
-    length = np.sqrt(np.maximum(2.0 + 2.0 * dot, 0.0))
-    safe = length > 1e-12
-    n_dot_h = np.where(safe, (cos_a + cos_b) / np.where(safe, length, 1.0), 1.0)
-    v_dot_h = np.where(safe, 0.5 * length, np.broadcast_to(cos_b, length.shape))
-    return np.clip(n_dot_h, 0.0, 1.0), np.clip(v_dot_h, 0.0, 1.0)
-
-
 FRESNEL_NODES = 1 << 16
 """Intervals of the tabulated Fresnel term on cos in [0, 1] (:func:`_fresnel_fast`)."""
 FRESNEL_TOLERANCE = 1e-8
@@ -191,19 +168,19 @@ def _fresnel_table(eta: float) -> np.ndarray | None:
     """``F_r`` (eq. 2) at ``FRESNEL_NODES + 1`` uniform cosines, or None when linear
     interpolation of it errs by more than ``FRESNEL_TOLERANCE`` (eta near 1, or below 1 where
     total internal reflection puts a kink in F)."""
-    nodes = _fresnel(np.linspace(0.0, 1.0, FRESNEL_NODES + 1), eta)
-    mid = _fresnel((np.arange(FRESNEL_NODES) + 0.5) / FRESNEL_NODES, eta)
+    nodes = fresnel_term(np.linspace(0.0, 1.0, FRESNEL_NODES + 1), eta)
+    mid = fresnel_term((np.arange(FRESNEL_NODES) + 0.5) / FRESNEL_NODES, eta)
     error = np.abs(0.5 * (nodes[1:] + nodes[:-1]) - mid) / np.maximum(mid, 1e-300)
     return nodes if error.max() <= FRESNEL_TOLERANCE else None
 
 
 def _fresnel_fast(cosine: np.ndarray, eta) -> np.ndarray:
-    """:func:`lut_baker.model.layers._fresnel` of cosines in [0, 1] with a trailing channel axis of
-    1, interpolated from :func:`_fresnel_table` (5x faster, within 1e-8 relative) when eta is
-    one number; the formula itself otherwise."""
+    """:func:`lut_baker.model.microfacet.fresnel_term` of cosines in [0, 1] with a trailing
+    channel axis of 1, interpolated from :func:`_fresnel_table` (5x faster, within 1e-8
+    relative) when eta is one number; the formula itself otherwise."""
     table = _fresnel_table(float(eta)) if np.ndim(eta) == 0 else None
     if table is None:
-        return _fresnel(cosine, eta)
+        return fresnel_term(cosine, eta)
     x = cosine * FRESNEL_NODES
     low = np.minimum(x.astype(np.intp), FRESNEL_NODES - 1)
     below = table[low]
@@ -211,18 +188,15 @@ def _fresnel_fast(cosine: np.ndarray, eta) -> np.ndarray:
 
 
 def _reflection_values(layer: ReflectionLayer, cos_a, cos_b, n_dot_h, v_dot_h):
-    """``P_d + P_s D(alpha) G F_r(V.H)`` (eq. 2) with a trailing channel axis (1 or 3)."""
-    alpha = np.degrees(np.arccos(n_dot_h))[..., None]
-    geometry = _attenuation(n_dot_h, cos_b, cos_a, v_dot_h)[..., None]
-    lobe = _distribution(alpha, layer.n) * geometry * _fresnel_fast(v_dot_h[..., None], layer.eta)
+    """``P_d + P_s (D G F_r)`` (eq. 2) of ``wa``, ``wb`` with polar cosines ``cos_a``,
+    ``cos_b`` and half-vector cosines ``n_dot_h``, ``v_dot_h``, with a trailing channel axis
+    (1 or 3): :func:`~lut_baker.model.microfacet.ts_specular_from_cosines` of the unit lobe,
+    its Fresnel term from :func:`_fresnel_fast`."""
+    # P_s times the unit lobe, P_s (D G F_r), rather than ts_reflection_from_cosines's
+    # (P_s D) G F_r: the tables' last bits follow this grouping (bench/golden_digests.py).
+    lobe = ts_specular_from_cosines(n_dot_h[..., None], v_dot_h[..., None], cos_b[..., None],
+                                    cos_a[..., None], 1.0, layer.n, layer.eta, _fresnel_fast)
     return layer.P_d + layer.P_s * lobe
-
-
-def _transmission_values(layer: TransmissionLayer, n_dot_h, v_dot_h):
-    """``P_d + P_t D(beta) (1 - F_r(V.H))`` (eq. 4) with a trailing channel axis."""
-    beta = np.degrees(np.arccos(n_dot_h))[..., None]
-    through = 1.0 - _fresnel_fast(v_dot_h[..., None], layer.eta)
-    return layer.P_d + layer.P_t * _distribution(beta, layer.n) * through
 
 
 def _kernel_values(layer, theta_a, theta_b, cos_phi):
@@ -231,10 +205,11 @@ def _kernel_values(layer, theta_a, theta_b, cos_phi):
     ``f_t(wa, -wb)`` for the film (whose lobe is the mirror image: azimuth ``phi + pi``)."""
     cos_a, sin_a, cos_b, sin_b = np.cos(theta_a), np.sin(theta_a), np.cos(theta_b), np.sin(theta_b)
     if isinstance(layer, ReflectionLayer):
-        n_dot_h, v_dot_h = _half_vector_cosines(cos_a, sin_a, cos_b, sin_b, cos_phi)
+        n_dot_h, v_dot_h = half_vector_cosines(cos_a, sin_a, cos_b, sin_b, cos_phi)
         return _reflection_values(layer, cos_a, cos_b, n_dot_h, v_dot_h)
-    n_dot_h, v_dot_h = _half_vector_cosines(cos_a, sin_a, cos_b, sin_b, -cos_phi)
-    return _transmission_values(layer, n_dot_h, v_dot_h)
+    n_dot_h, v_dot_h = half_vector_cosines(cos_a, sin_a, cos_b, sin_b, -cos_phi)
+    return ts_transmission_from_cosines(n_dot_h[..., None], v_dot_h[..., None], layer,
+                                        _fresnel_fast)
 
 
 @lru_cache(maxsize=16)
@@ -257,7 +232,7 @@ def fourier_coefficients(layer, theta_a, theta_b, n_phi: int) -> np.ndarray:
     theta_a = np.atleast_1d(np.asarray(theta_a, float))
     theta_b = np.atleast_1d(np.asarray(theta_b, float))
     matrix = _cosine_matrix(n_phi)
-    cos_phi = np.cos(2.0 * np.pi * np.arange(matrix.shape[1]) / n_phi)
+    cos_phi = np.cos(uniform_azimuths(n_phi)[:matrix.shape[1]])
     if theta_a.shape == theta_b.shape and np.array_equal(theta_a, theta_b):
         upper = np.triu_indices(theta_a.size)
         values = _kernel_values(layer, theta_a[upper[0], None], theta_b[upper[1], None], cos_phi)
@@ -272,24 +247,25 @@ def fourier_coefficients(layer, theta_a, theta_b, n_phi: int) -> np.ndarray:
 
 class KernelCache:
     """:func:`fourier_coefficients` memoised by (layer, grids): pass as ``fourier=`` to the
-    matrix functions of :mod:`lut_baker.evaluate.two_layer` so that one bake evaluates each kernel once."""
+    matrix functions of :mod:`lut_baker.evaluate.two_layer` so that one bake evaluates each
+    kernel once."""
 
     def __init__(self):
-        self._store: dict = {}
+        self._store = LRUCache(None)
 
     def __call__(self, layer, theta_a, theta_b, n_phi: int) -> np.ndarray:
         theta_a = np.atleast_1d(np.asarray(theta_a, float))
         theta_b = np.atleast_1d(np.asarray(theta_b, float))
         key = (id(layer), theta_a.tobytes(), theta_b.tobytes(), n_phi)
-        if key not in self._store:  # the layer is kept alive so that its id stays unique
-            self._store[key] = (layer, fourier_coefficients(layer, theta_a, theta_b, n_phi))
-        return self._store[key][1]
+        # The layer is stored too, so that it stays alive and its id unique.
+        return self._store.get_or_compute(key, lambda: (layer, fourier_coefficients(
+            layer, theta_a, theta_b, n_phi)))[1]
 
 
 # --------------------------------------------------------------------------------------------
 # Tables
 # --------------------------------------------------------------------------------------------
-def _gloss_layer(layer: ReflectionLayer) -> ReflectionLayer:
+def gloss_layer(layer: ReflectionLayer) -> ReflectionLayer:
     """The Torrance-Sparrow specular part of a layer (``P_d`` = 0)."""
     if not np.any(layer.P_d):
         return layer
@@ -349,29 +325,20 @@ def gloss_tables(layers, theta_deg, phi_deg, phi_spacing: str = "half_vector",
     (grids and spacing as :class:`lut_baker.tables.table_set.Tables`): ``(n_theta, n_theta, n_phi, 3)``
     each, evaluated once per unordered (theta_i, theta_o)."""
     pairs = pairs or _NodePairs(theta_deg, phi_deg, phi_spacing)
-    layers = [_gloss_layer(layer) for layer in layers]
+    layers = [gloss_layer(layer) for layer in layers]
 
     def values(chunk):
         cos_a, cos_b = pairs.cos_a[chunk], pairs.cos_b[chunk]
-        n_dot_h, v_dot_h = _half_vector_cosines(cos_a, pairs.sin_a[chunk], cos_b,
-                                                pairs.sin_b[chunk], pairs.cos_phi[chunk])
+        n_dot_h, v_dot_h = half_vector_cosines(cos_a, pairs.sin_a[chunk], cos_b,
+                                               pairs.sin_b[chunk], pairs.cos_phi[chunk])
         return [_reflection_values(layer, cos_a, cos_b, n_dot_h, v_dot_h) for layer in layers]
 
     return pairs.tables(values, [_channel_count(layer) for layer in layers])
 
 
 AZIMUTH_POWER = 3
-"""Exponent of the azimuth substitution of :func:`gloss_albedos`."""
-
-
-@lru_cache(maxsize=8)
-def _mirror_weighted_azimuths(count: int) -> tuple[np.ndarray, np.ndarray]:
-    """``(cos(phi_k), w_k)`` with ``Int_0^{2 pi} f(phi) dphi ~ sum_k w_k f(phi_k)`` for even
-    ``f``: Gauss-Legendre in ``s`` after ``phi = pi (1 - s^p)``, dense at the mirror azimuth."""
-    x, w = np.polynomial.legendre.leggauss(count)
-    s = 0.5 * (x + 1.0)
-    weight = 2.0 * np.pi * AZIMUTH_POWER * s ** (AZIMUTH_POWER - 1) * 0.5 * w
-    return np.cos(np.pi * (1.0 - s**AZIMUTH_POWER)), weight
+"""Exponent of the azimuth substitution of :func:`gloss_albedos`
+(:func:`lut_baker.numerics.quadrature.mirror_weighted_azimuths`)."""
 
 
 def gloss_albedos(layers, theta_deg, grid: HemisphereGrid, azimuths: int) -> list[np.ndarray]:
@@ -382,12 +349,12 @@ def gloss_albedos(layers, theta_deg, grid: HemisphereGrid, azimuths: int) -> lis
     ``azimuths`` Gauss-Legendre nodes in ``s`` with ``phi = pi (1 - s^3)``: towards grazing the
     gloss lobe narrows in azimuth like ``cos(theta_i) + cos(theta_o)`` (about 1 degree wide at 89
     degrees), and the substitution resolves every width at once (polar nodes from ``grid``)."""
-    layers = [_gloss_layer(layer) for layer in layers]
-    cos_phi, weight = _mirror_weighted_azimuths(int(azimuths))
+    layers = [gloss_layer(layer) for layer in layers]
+    cos_phi, weight = mirror_weighted_azimuths(int(azimuths), AZIMUTH_POWER)
     theta = np.radians(np.asarray(theta_deg, float))[:, None, None]
     cos_a, sin_a = np.cos(theta), np.sin(theta)
     cos_b, sin_b = np.cos(grid.theta)[:, None], np.sin(grid.theta)[:, None]
-    n_dot_h, v_dot_h = _half_vector_cosines(cos_a, sin_a, cos_b, sin_b, cos_phi)
+    n_dot_h, v_dot_h = half_vector_cosines(cos_a, sin_a, cos_b, sin_b, cos_phi)
     out = []
     for layer in layers:
         values = _reflection_values(layer, cos_a, cos_b, n_dot_h, v_dot_h)  # (T, N, S, C)
@@ -410,13 +377,6 @@ def _cosine_series(matrices: np.ndarray, pairs: _NodePairs) -> np.ndarray:
         return [np.maximum(series, 0.0)]
 
     return pairs.tables(values, [matrices.shape[-1]])[0]
-
-
-def _order0_integral(matrix0: np.ndarray, grid: HemisphereGrid, weight=None) -> np.ndarray:
-    """``2 pi sum_u K_0(theta, theta_u) weight_u W_u``: an order-0 kernel integrated over the
-    hemisphere (projected solid angle).  ``matrix0``: ``(P, N, C)`` -> ``(P, C)``."""
-    w = grid.weight[:, None] if weight is None else grid.weight[:, None] * weight
-    return 2.0 * np.pi * np.sum(matrix0 * w[None], axis=1)
 
 
 def profile_radius(dipole: Dipole, floor: float = PROFILE_FLOOR) -> float:
@@ -464,21 +424,21 @@ def bake(skin: MadeUpSkin, resolution_name="default", *, inter_reflection: bool 
     phi_deg = np.linspace(0.0, 180.0, res.n_phi)
     pairs = _NodePairs(theta_deg, phi_deg, res.phi_spacing)
     theta = np.radians(theta_deg)
-    grid = bake_quadrature(res.quad_panels, res.quad_points, res.quad_phi)
+    grid = hemisphere_panels(res.quad_panels, res.quad_points, res.quad_phi)
     kernels = KernelCache()
     film_t = skin.film_transmission  # absorption 0: the tables apply it afterwards
-    film_gloss_layer, skin_gloss = _gloss_layer(skin.film), _gloss_layer(skin.skin)
+    film_gloss_layer, skin_gloss = gloss_layer(skin.film), gloss_layer(skin.skin)
 
     _stage(progress, 0.05, "path 3 (Fourier matrices)")
     outer = np.concatenate([theta, grid.theta])
     path3_m = layered_fourier_matrices(theta, outer, film_t, skin_gloss, grid, fourier=kernels)
     path3 = _cosine_series(path3_m[:, :, :theta.size], pairs)
-    path3_albedo = _order0_integral(path3_m[0, :, theta.size:], grid)
+    path3_albedo = order0_integral(path3_m[0, :, theta.size:], grid)
 
     _stage(progress, 0.45, "transmittances and albedos")
     rows0 = kernels(film_t, theta, grid.theta, grid.n_phi)[0]
-    fresnel_t = 1.0 - _fresnel(np.cos(grid.theta)[:, None], np.atleast_1d(skin.dipole.eta))
-    inner_t = _order0_integral(kernels(film_t, grid.theta, grid.theta, grid.n_phi)[0], grid)
+    fresnel_t = 1.0 - fresnel_term(np.cos(grid.theta)[:, None], np.atleast_1d(skin.dipole.eta))
+    inner_t = order0_integral(kernels(film_t, grid.theta, grid.theta, grid.n_phi)[0], grid)
     albedos = gloss_albedos((film_gloss_layer, skin_gloss), theta_deg, grid,
                             res.albedo_azimuths)
 
@@ -508,15 +468,15 @@ def bake(skin: MadeUpSkin, resolution_name="default", *, inter_reflection: bool 
         film_gloss=film_gloss,
         path3_gloss=path3,
         skin_gloss=skin_gloss_table,
-        film_transmittance=_rgb(_order0_integral(rows0, grid)),
-        transmission_factor=_rgb(_order0_integral(rows0, grid, fresnel_t)),
+        film_transmittance=_rgb(order0_integral(rows0, grid)),
+        transmission_factor=_rgb(order0_integral(rows0, grid, fresnel_t)),
         film_gloss_albedo=albedos[0],
         path3_gloss_albedo=_rgb(path3_albedo),
         skin_gloss_albedo=albedos[1],
         film_diffuse=_rgb(np.atleast_1d(skin.film.P_d)),
         skin_diffuse=_rgb(np.atleast_1d(skin.skin.P_d)),
         total_reflectance=_rgb(total),
-        film_transmittance_integral=_rgb(_order0_integral(inner_t[None], grid)[0]),
+        film_transmittance_integral=_rgb(order0_integral(inner_t[None], grid)[0]),
         profile=_rgb(profile),
         parameters=skin_to_dict(skin),
         inter_reflection=extra,
@@ -534,7 +494,7 @@ def inter_reflection_albedo(skin: MadeUpSkin, theta_deg, resolution_name="defaul
     beyond path 3 (the adding equation's further terms, as in :func:`bake`'s
     ``inter_reflection`` table), at the skin's absorption, before coverage: ``(n, 3)``."""
     res = resolution(resolution_name)
-    grid = bake_quadrature(res.quad_panels, res.quad_points, res.quad_phi)
+    grid = hemisphere_panels(res.quad_panels, res.quad_points, res.quad_phi)
     theta = np.radians(np.atleast_1d(np.asarray(theta_deg, float)))
     film_t = film_transmission_layer(skin)
     kernels = KernelCache()
@@ -542,13 +502,13 @@ def inter_reflection_albedo(skin: MadeUpSkin, theta_deg, resolution_name="defaul
                                              film_below=film_reflection_layer(skin),
                                              fourier=kernels)
     first = layered_fourier_matrices(theta, grid.theta, film_t, skin.skin, grid, fourier=kernels)
-    return _rgb(_order0_integral(full[0] - first[0], grid))
+    return _rgb(order0_integral(full[0] - first[0], grid))
 
 
 # --------------------------------------------------------------------------------------------
 # Error against the exact evaluator
 # --------------------------------------------------------------------------------------------
-def _sample_directions(n_points: int, rng: np.random.Generator, theta_max_deg: float):
+def sample_directions(n_points: int, rng: np.random.Generator, theta_max_deg: float):
     """Random (wi, wo): 60% with both polar angles uniform on [0, theta_max], 20% with wi and
     20% with both on the grazing rows [80, theta_max] degrees; azimuths uniform."""
     grazing = min(80.0, theta_max_deg)
@@ -584,12 +544,12 @@ def error_samples(skin: MadeUpSkin, n_points: int = 500, seed: int = 0, *, level
                   theta_max_deg: float = 89.0) -> ErrorSamples:
     """``n_points`` random points (grazing rows included, polar angles up to
     ``theta_max_deg``) and the exact evaluator there: paths 1 + 3
-    (:func:`lut_baker.model.made_up_skin.made_up_reflection`) and path 4's factor at ``level``, the
+    (:func:`lut_baker.evaluate.made_up.made_up_reflection`) and path 4's factor at ``level``, the
     directional albedo at ``albedo_level`` (default ``level``) on the first ``albedo_points``
     of them (default all), and R(d)/Rd on [0, :func:`profile_radius`] (denser near 0)."""
     albedo_level = level if albedo_level is None else albedo_level
     rng = np.random.default_rng(seed)
-    wi, wo = _sample_directions(n_points, rng, theta_max_deg)
+    wi, wo = sample_directions(n_points, rng, theta_max_deg)
     theta = rng.uniform(0.0, theta_max_deg, n_points)
     albedo_theta = theta[:n_points if albedo_points is None else albedo_points]
     transmission = transmission_factor(direction(np.radians(theta), 0.0), skin.film_transmission,
@@ -643,16 +603,14 @@ def table_error(tables: Tables, skin: MadeUpSkin | None = None, n_points: int = 
                                 tables.profile.max(axis=0))
     worst = int(np.argmax(reflection.max(axis=-1)))
     wi, wo = samples.wi[worst], samples.wo[worst]
-    azimuth = np.degrees(np.arctan2(wi[1], wi[0]) - np.arctan2(wo[1], wo[0]))
     result = {
         "reflection": float(reflection.max()),
         "albedo": float(albedo.max()),
         "transmission": float(transmission.max()),
         "profile": float(profile.max()),
         "peak": peak.tolist(),
-        "worst": [float(np.degrees(np.arccos(np.clip(wi[2], -1.0, 1.0)))),
-                  float(np.degrees(np.arccos(np.clip(wo[2], -1.0, 1.0)))),
-                  float(abs((azimuth + 180.0) % 360.0 - 180.0))],
+        "worst": [float(polar_angle_deg(wi)), float(polar_angle_deg(wo)),
+                  float(folded_azimuth_deg(wi, wo))],
     }
     result["max"] = max(result[k] for k in ("reflection", "albedo", "transmission", "profile"))
     return result

@@ -1,19 +1,34 @@
 """The Blender side of Made-up Skin: the only package that imports bpy.
 
-Each submodule owns its classes and has its own ``register()``/``unregister()``; this package
-registers them in the order of :data:`modules` and unregisters them in reverse. Add operators and
-panels as new submodules and append them to :data:`modules`.
+The modules form layers, lowest first; a module imports add-on modules only from layers below
+its own, and only at module level (no import inside a function, no cycle):
 
-``lut_baker`` (bpy-free) is reached relatively and lazily, inside the functions that need it::
+1. ``keys`` -- every name stored in users' files: custom-property keys, node group, node, frame,
+   material and image names, the ``bl_idname`` prefixes, the presets folder (no bpy).
+2. ``package`` -- the add-on's package names and :func:`.package.lut_baker`, the only way to
+   ``lut_baker`` (``lut_baker("closures.fitting")``; no bpy).
+3. ``convert`` -- the artist's material converted in place and back (install, revert).
+4. ``storage`` -- what the .blend keeps: bake records, re-bakes, packed images and their hashes.
+5. ``nodes`` -- the node groups built from closure fits, and their records.
+6. ``scene_fit`` -- the scene and the material as the Auto tier sees them, the choice, and its
+   settings (units per mm, Auto tier, Fit to Scene's settings and record).
+7. ``material`` -- the apply pipeline: Apply, Revert, Check Tables, the rebuild from settings.
+8. ``live`` -- the live preview: socket updates at once, debounced preview re-bakes.
+9. ``properties`` -- the panel's settings (PropertyGroup); their ``update=`` callbacks call
+   ``live``.
+10. ``operators`` -- Apply, Revert, Check Tables, Fit to Scene, the preset menu and its operator.
+11. ``ui`` -- the panels: settings, buttons, the group's record and errors, Fit to Scene.
 
-    from .. import lut_baker
+This package (the top) registers the modules with classes or session state in that order
+(:data:`modules`) and unregisters them in reverse.  A new operator goes into ``operators``, a
+new panel or section into ``ui``; a new module takes its own place in the list above.
 """
 
 from . import live, operators, properties, scene_fit, ui
 
 __all__ = ["modules", "register", "unregister"]
 
-modules = (properties, operators, ui, live, scene_fit)
+modules = (scene_fit, live, properties, operators, ui)
 
 
 def register():

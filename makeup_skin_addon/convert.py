@@ -2,10 +2,10 @@
 
 :func:`install` puts the Made-up Skin group node into a material's node tree and makes it the
 Material Output's Surface.  The shader that was the surface stays in the tree, disconnected,
-inside a frame labelled :data:`FRAME_LABEL`, with every link and value it had; what was linked
+inside a frame labelled :data:`.keys.FRAME_LABEL`, with every link and value it had; what was linked
 into its Base Color, Normal and (a Principled BSDF's) Coat Normal is also linked into the
 group's Skin Color, Normal and Film Normal, so an albedo texture and a normal map carry over.
-The material records the previous surface (:data:`RECORD_KEY`), and :func:`revert` reconnects
+The material records the previous surface (:data:`.keys.RECORD_KEY`), and :func:`revert` reconnects
 it and removes the group node and the frame (the add-on's own nodes), leaving the tree as it
 was.  The Material Output's other inputs (Volume, Displacement) are never touched.
 
@@ -22,16 +22,11 @@ import json
 
 import bpy
 
-__all__ = ["GROUP_NODE", "FRAME_LABEL", "RECORD_KEY", "CARRIED_INPUTS", "group_node",
-           "linked_library", "material_output", "install", "revert", "can_revert"]
+from .keys import FRAME_LABEL, FRAME_NAME, GROUP_NODE, RECORD_KEY
 
-GROUP_NODE = "Made-up Skin"
-"""Name of the group node in a made-up material's node tree."""
-FRAME_NAME = "Made-up Skin: previous surface"
-FRAME_LABEL = "Before Made-up Skin (Revert restores it)"
-RECORD_KEY = "makeup_skin_previous_surface"
-"""Material custom property (JSON): the previous surface's node, its output socket, its parent
-and location, and the output node, for :func:`revert`."""
+__all__ = ["CARRIED_INPUTS", "group_node", "linked_library", "material_output", "install",
+           "revert", "can_revert"]
+
 CARRIED_INPUTS = (
     # (the previous shader's inputs, by name in order of preference) -> the group's input
     (("Base Color", "Color"), "Skin Color"),

@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import bpy
 
+from . import material as made_up
+
 __all__ = ["DEBOUNCE_S", "sockets_changed", "tables_changed", "flush", "pending", "register",
            "unregister"]
 
@@ -30,11 +32,9 @@ def _material_of(settings):
 
 def sockets_changed(settings) -> None:
     """A socket-level setting moved: set the group node's sockets."""
-    from .material import update_sockets
-
     material = _material_of(settings)
     if material is not None and settings.is_made_up:
-        update_sockets(material)
+        made_up.update_sockets(material)
 
 
 def tables_changed(settings) -> None:
@@ -62,8 +62,6 @@ def _timer():
 
 def flush(context=None) -> list[str]:
     """Re-bake every dirty material at preview resolution now; returns report messages."""
-    from . import material as made_up
-
     context = context or bpy.context
     messages = []
     while _dirty:
@@ -92,10 +90,8 @@ def register():
 
 
 def unregister():
-    from .material import clear_cache
-
     if bpy.app.timers.is_registered(_timer):
         bpy.app.timers.unregister(_timer)
     _dirty.clear()
     _messages.clear()
-    clear_cache()
+    made_up.clear_cache()

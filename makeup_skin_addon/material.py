@@ -4,7 +4,8 @@ own material (converted in place, :mod:`.convert`); Revert and Check Tables.
 - :func:`skin_from_settings` -- the panel's settings as a :class:`MadeUpSkin` (coverage 1,
   absorption 0: those two are socket values, applied after the bake).
 - :func:`resolve_tier` -- the tier for the settings and scene (Auto: from the scene).
-- :func:`units_per_mm` -- scene units in one millimetre, from the scene's unit scale.
+- :func:`socket_values` -- the settings' group-node socket values; :func:`update_sockets`
+  sets them on a material's group node.
 - :func:`refuse_linked` -- :class:`LinkedDataError` for data linked from a library.
 - :func:`group_for_tables` -- the group for baked tables (reused when the same tables, tier and
   method were built before and its images are intact).
@@ -23,19 +24,17 @@ from collections import OrderedDict
 import bpy
 
 from . import convert, nodes, scene_fit, storage
+from .keys import ERRORS_KEY, MATERIAL_NAME, group_name
 from .package import lut_baker
-from .properties import socket_values
+from .scene_fit import units_per_mm
 
 __all__ = [
-    "GROUP_NODE",
-    "MATERIAL_NAME",
     "LinkedDataError",
     "refuse_linked",
     "revert_material",
     "rebuild_from_settings",
     "skin_from_settings",
     "resolve_tier",
-    "units_per_mm",
     "forced_method",
     "group_for_tables",
     "ensure_group",
@@ -45,15 +44,8 @@ __all__ = [
     "check_material",
     "clear_cache",
     "update_sockets",
+    "socket_values",
 ]
-
-GROUP_NODE = convert.GROUP_NODE
-MATERIAL_NAME = "Made-up Skin"
-ERRORS_KEY = "makeup_skin_errors"
-"""Material custom property: the tiers' errors at the settings of the last Apply (JSON): per
-tier its angular ``rms`` and ``albedo`` errors, ``gloss_omission`` (per light angle, what
-Gloss 0 changes in a sphere's image, :func:`lut_baker.auto_tier.gloss_omissions`), the
-``coverage``, ``absorption`` and tables ``key`` they were measured for."""
 
 
 def skin_from_settings(settings):
@@ -84,13 +76,6 @@ def resolve_tier(settings, scene) -> str:
 def forced_method(settings):
     """The subsurface method the settings force, or None (Auto: the fit's best)."""
     return None if settings.subsurface_method == "AUTO" else settings.subsurface_method
-
-
-def units_per_mm(scene) -> float:
-    """Scene units in one millimetre: ``0.001 / unit_settings.scale_length`` (a scene in
-    metres gives 0.001, one modelled in centimetres with scale 0.01 gives 0.1)."""
-    scale = float(scene.unit_settings.scale_length) or 1.0
-    return 0.001 / scale
 
 
 class LinkedDataError(ValueError):
@@ -175,7 +160,7 @@ def group_for_tables(tables, tier: str, *, bake=None, group=None, errors_at=None
         skin = lut_baker("model.params_file").skin_from_dict(tables.parameters)
         bake = storage.bake_record(skin, "default", tables)
     key = bake["key"]
-    existing = bpy.data.node_groups.get(nodes.group_name(tier, key, method))
+    existing = bpy.data.node_groups.get(group_name(tier, key, method))
     if group is None and existing is not None and _reusable(existing, key, tier, method,
                                                             messages):
         return existing, None
@@ -233,6 +218,17 @@ def setup_material(material, group, scene) -> list[str]:
     nodes.set_inputs(group_of(material), {"Units per mm": units_per_mm(scene)})
     update_sockets(material)
     return carried
+
+
+def socket_values(settings) -> dict:
+    """Group-node socket values of the settings (by socket name)."""
+    return {
+        "Coverage": settings.coverage,
+        "Foundation Absorption": tuple(settings.effective_absorption()),
+        "Skin Color": tuple(settings.skin_colour),
+        "Subsurface Scale": settings.subsurface_scale,
+        "Gloss": settings.gloss,
+    }
 
 
 def update_sockets(material) -> None:

@@ -28,8 +28,8 @@ of weight 0 is never allocated, ``bsdf_alloc``), view-dependent factors read fro
 Coverage between bare skin and made-up skin: an areal mix of closures, so a painted coverage
 fades out without fringe or halo.
 
-- :func:`group_name` -- name of a group from tier, tables key and a forced subsurface method.
-- :func:`build_group` -- create or rebuild (in place) a group from a fit and its bake record.
+- :func:`build_group` -- create or rebuild (in place) a group from a fit and its bake record,
+  named by :func:`.keys.group_name` (tier, tables key, a forced subsurface method).
 - :func:`read_meta` -- a group's record (bake, fit summary, image hashes).
 - :func:`set_inputs` -- socket values on a group node from the panel's settings.
 """
@@ -42,17 +42,11 @@ import bpy
 import numpy as np
 
 from . import storage
+from .keys import FIT_KEY, LEGACY_TABLES_REF, group_name, lut_image_name
 from .package import lut_baker
 
-__all__ = ["INPUTS", "NORMAL_INPUTS", "GROUP_PREFIX", "FIT_KEY", "group_name", "build_group",
-           "read_meta", "set_inputs", "socket", "has_interface"]
-
-GROUP_PREFIX = "Made-up Skin"
-FIT_KEY = "makeup_skin_fit"
-"""Custom property of a group: its tables key, tier and the fit's summary (JSON)."""
-LEGACY_TABLES_REF = "makeup_skin_tables"
-"""Custom property by which older versions kept a whole tables image in the file; removed when
-the group is rebuilt."""
+__all__ = ["INPUTS", "NORMAL_INPUTS", "build_group", "read_meta", "set_inputs", "socket",
+           "has_interface"]
 
 INPUTS = (
     # name, socket type, default, min, max, subtype, description
@@ -82,15 +76,6 @@ NORMAL_INPUTS = ("Normal", "Film Normal")
 """Vector inputs whose value is hidden: unlinked, a closure's Normal is the shading normal
 (Blender leaves a hidden-value group input unlinked inside the group), and the view-angle
 lookups use the Geometry node's normal instead (:func:`_normal_or_shading`)."""
-
-
-METHOD_LABELS = {"BURLEY": "Burley", "RANDOM_WALK": "RW", "RANDOM_WALK_SKIN": "RW Skin"}
-
-
-def group_name(tier: str, key: str, method: str | None = None) -> str:
-    """``Made-up Skin <Tier> [<method>] <key>``; no method: the fit's own choice."""
-    label = f" {METHOD_LABELS[method]}" if method else ""
-    return f"{GROUP_PREFIX} {tier.title()}{label} {key[:8]}"
 
 
 def socket(sockets, identifier: str):
@@ -377,8 +362,8 @@ def build_group(tier: str, bake: dict, fit, group=None, *, method=None):
     """Create (or, given ``group``, rebuild in place) the node group of ``tier`` from a
     :class:`ClosureFit` ``fit`` of the tables that ``bake`` describes (its record,
     :func:`storage.bake_record`).  ``method``: a subsurface method forced by the user, else the
-    fit's choice.  The group's :data:`FIT_KEY` holds the bake record, the fit's summary and the
-    SHA-256 of every image the group reads (:func:`storage.image_record`)."""
+    fit's choice.  The group's :data:`.keys.FIT_KEY` holds the bake record, the fit's summary
+    and the SHA-256 of every image the group reads (:func:`storage.image_record`)."""
     cf = lut_baker("closures.fitting")
     if tier not in cf.TIERS:
         raise ValueError(f"tier must be one of {cf.TIERS}, got {tier!r}")
@@ -400,7 +385,7 @@ def build_group(tier: str, bake: dict, fit, group=None, *, method=None):
     if tier == "PRINCIPLED":
         _build_principled(build, fit, method, radius, ior)
     else:
-        lut = storage.lut_image(storage.lut_image_name(key), fit.lut)
+        lut = storage.lut_image(lut_image_name(key), fit.lut)
         images.append(storage.image_record(lut))
         _build_layered(build, fit, lut, method, radius, ior)
     group[FIT_KEY] = json.dumps({**bake, "tier": tier, "forced_method": forced,
@@ -412,7 +397,7 @@ def build_group(tier: str, bake: dict, fit, group=None, *, method=None):
 
 
 def read_meta(group) -> dict:
-    """A group's :data:`FIT_KEY` record, or {} if it has none or it cannot be read."""
+    """A group's :data:`.keys.FIT_KEY` record, or {} if it has none or it cannot be read."""
     try:
         meta = json.loads(group.get(FIT_KEY, "{}")) if group is not None else {}
     except (TypeError, ValueError):

@@ -1,20 +1,21 @@
-"""Operators: Apply, Revert, Check Tables, and the preset menu's add/remove operator."""
+"""Operators: Apply, Revert, Check Tables, Fit to Scene, and the preset menu with its add/remove
+operator.  Each operator's work is a function of a lower module (:mod:`.material`,
+:mod:`.scene_fit`, :mod:`.live`); here it is run and reported.  Idnames are
+``makeup_skin.<name>`` (:data:`.keys.OPERATOR_PREFIX`)."""
 
 from __future__ import annotations
 
 import bpy
 from bl_operators.presets import AddPresetBase
 
-from . import convert
+from . import convert, live, scene_fit
 from . import material as made_up
+from .keys import OPERATOR_PREFIX, PRESET_SUBDIR, SETTINGS_ATTRIBUTE
 from .package import lut_baker
 
 __all__ = ["MAKEUPSKIN_OT_apply", "MAKEUPSKIN_OT_revert", "MAKEUPSKIN_OT_check_tables",
-           "MAKEUPSKIN_OT_add_preset", "MAKEUPSKIN_MT_presets", "PRESET_SUBDIR", "register",
-           "unregister"]
-
-PRESET_SUBDIR = "makeup_skin"
-"""Folder under Blender's ``presets`` where parameter sets are saved."""
+           "MAKEUPSKIN_OT_fit_to_scene", "MAKEUPSKIN_OT_add_preset", "MAKEUPSKIN_MT_presets",
+           "PRESET_SUBDIR", "register", "unregister"]
 
 
 class _ObjectPoll:
@@ -29,7 +30,7 @@ class MAKEUPSKIN_OT_apply(_ObjectPoll, bpy.types.Operator):
     converted in place: the previous surface shader is kept, framed and disconnected, and its
     albedo and normal links are carried over"""
 
-    bl_idname = "makeup_skin.apply"
+    bl_idname = f"{OPERATOR_PREFIX}.apply"
     bl_label = "Apply Made-up Skin"
     bl_options = {"REGISTER", "UNDO"}
 
@@ -57,7 +58,7 @@ class MAKEUPSKIN_OT_revert(bpy.types.Operator):
     """Give the active material back the surface shader it had before Apply and remove the
     Made-up Skin node (the settings stay for a later Apply)"""
 
-    bl_idname = "makeup_skin.revert"
+    bl_idname = f"{OPERATOR_PREFIX}.revert"
     bl_label = "Revert to Previous Surface"
     bl_options = {"REGISTER", "UNDO"}
 
@@ -80,7 +81,7 @@ class MAKEUPSKIN_OT_check_tables(bpy.types.Operator):
     """Check every Made-up Skin material against the record of its bake and the hashes of the
     images its render reads; repair what is missing or damaged by re-baking"""
 
-    bl_idname = "makeup_skin.check_tables"
+    bl_idname = f"{OPERATOR_PREFIX}.check_tables"
     bl_label = "Check Made-up Skin Tables"
     bl_options = {"REGISTER", "UNDO"}
 
@@ -98,6 +99,61 @@ class MAKEUPSKIN_OT_check_tables(bpy.types.Operator):
             self.report({"INFO" if intact else "WARNING"}, f"Made-up Skin: {sentence}")
         if not checked:
             self.report({"INFO"}, "Made-up Skin: no made-up material in this file.")
+        return {"FINISHED"}
+
+
+class MAKEUPSKIN_OT_fit_to_scene(bpy.types.Operator):
+    """Choose the cheapest Made-up Skin tier that stays within the tolerance in this scene
+    (camera, resolution, object size, lights, engine, samples), report it with its predicted
+    error, and apply it"""
+
+    bl_idname = f"{OPERATOR_PREFIX}.fit_to_scene"
+    bl_label = "Fit to Scene"
+    bl_options = {"REGISTER", "UNDO"}
+
+    tolerance: bpy.props.FloatProperty(
+        name="Tolerance", default=0.02, min=0.0, max=1.0, subtype="FACTOR",
+        description="Error a cheaper tier may add to the best tier's (relative RMS)")
+    apply: bpy.props.BoolProperty(
+        name="Apply", default=True,
+        description="Set the chosen tier and subsurface on the material (else only report)")
+
+    @classmethod
+    def poll(cls, context):
+        obj = context.active_object
+        return obj is not None and obj.type == "MESH"
+
+    def execute(self, context):
+        obj = context.active_object
+        material = obj.active_material
+        context.view_layer.update()  # object matrices follow moves only after an update
+        try:
+            made_up.refuse_linked(obj, material)
+            if material is None or not material.makeup_skin.is_made_up:
+                material, _ = made_up.apply_to_object(context, obj)
+            elif material.name in live.pending():
+                live.flush(context)  # judge the tables the settings describe now
+            choice, description = scene_fit.choose_for(material, context.scene, obj=obj,
+                                                       tolerance=self.tolerance)
+            changes = []
+            if self.apply:
+                changes = scene_fit.set_choice(material, choice.candidate)
+                made_up.apply_to_object(context, obj)
+        except (ValueError, RuntimeError) as error:
+            self.report({"ERROR"}, f"Made-up Skin: Fit to Scene changed nothing: {error}.")
+            return {"CANCELLED"}
+        chosen = choice.chosen
+        scene_fit.record_choice(material, choice, description)
+        if description is None:
+            self.report({"WARNING"}, "Made-up Skin: no camera or object in the scene: assumed "
+                                     "a close-up")
+        self.report({"INFO"}, f"Made-up Skin: Fit to Scene chose {chosen.candidate.name}: "
+                              f"predicted error {100 * chosen.error:.1f}% (best "
+                              f"{100 * choice.best_error:.1f}% + {100 * choice.tolerance:.0f}%)"
+                              f", cost {chosen.cost:.2f} of the fullest tier"
+                              + (f"; {', '.join(changes)}" if changes else ""))
+        for line in choice.reasons[:3]:
+            self.report({"INFO"}, f"Made-up Skin: {line}")
         return {"FINISHED"}
 
 
@@ -123,12 +179,12 @@ class MAKEUPSKIN_OT_add_preset(AddPresetBase, bpy.types.Operator):
         obj = context.object
         return obj is not None and obj.active_material is not None
 
-    bl_idname = "makeup_skin.add_preset"
+    bl_idname = f"{OPERATOR_PREFIX}.add_preset"
     bl_label = "Add Made-up Skin Preset"
-    preset_menu = "MAKEUPSKIN_MT_presets"
+    preset_menu = MAKEUPSKIN_MT_presets.__name__
     preset_subdir = PRESET_SUBDIR
     # The active object's material: also defined in the shader editor, unlike context.material.
-    preset_defines = ["settings = bpy.context.object.active_material.makeup_skin"]
+    preset_defines = [f"settings = bpy.context.object.active_material.{SETTINGS_ATTRIBUTE}"]
     preset_values = [
         "settings.foundation", "settings.skin", "settings.coverage", "settings.absorption_mode",
         "settings.absorption", "settings.foundation_colour", "settings.skin_colour",
@@ -139,8 +195,7 @@ class MAKEUPSKIN_OT_add_preset(AddPresetBase, bpy.types.Operator):
 
 
 classes = (MAKEUPSKIN_OT_apply, MAKEUPSKIN_OT_revert, MAKEUPSKIN_OT_check_tables,
-           MAKEUPSKIN_MT_presets,
-           MAKEUPSKIN_OT_add_preset)
+           MAKEUPSKIN_OT_fit_to_scene, MAKEUPSKIN_MT_presets, MAKEUPSKIN_OT_add_preset)
 
 
 _register, unregister = bpy.utils.register_classes_factory(classes)

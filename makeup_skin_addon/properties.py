@@ -3,7 +3,8 @@
 Coverage, absorption, skin colour, subsurface scale and gloss are socket values of the material's
 group node: moving them updates the material at once.  Foundation and skin presets, film overrides,
 tier and resolution change the tables: with live update on, moving them schedules a preview
-re-bake (:mod:`.live`); Apply bakes at full resolution.
+re-bake (:mod:`.live`); Apply bakes at full resolution.  The settings are registered as
+``Material.makeup_skin`` (:data:`.keys.SETTINGS_ATTRIBUTE`).
 """
 
 from __future__ import annotations
@@ -12,9 +13,11 @@ import math
 
 import bpy
 
+from . import live
+from .keys import SETTINGS_ATTRIBUTE
 from .package import lut_baker
 
-__all__ = ["MakeupSkinSettings", "register", "unregister", "TIER_ITEMS", "socket_values"]
+__all__ = ["MakeupSkinSettings", "register", "unregister", "TIER_ITEMS"]
 
 TIER_ITEMS = (
     ("AUTO", "Auto", "The cheapest tier within 2% of the best one's error in this scene (camera, "
@@ -51,6 +54,12 @@ def _skin_items(self, context):
             presets.SKINS.items()]
 
 
+def _first_skin_albedo() -> tuple:
+    """The albedo of the first skin preset: Skin Color's default."""
+    presets = lut_baker("model.presets")
+    return tuple(presets.skin_albedo(next(iter(presets.SKINS))))
+
+
 # Enum items must stay referenced while Blender shows them.
 _ITEMS_CACHE: dict[str, list] = {}
 
@@ -63,26 +72,11 @@ def _cached(name, function):
     return items
 
 
-def socket_values(settings) -> dict:
-    """Group-node socket values of the settings (by socket name)."""
-    return {
-        "Coverage": settings.coverage,
-        "Foundation Absorption": tuple(settings.effective_absorption()),
-        "Skin Color": tuple(settings.skin_colour),
-        "Subsurface Scale": settings.subsurface_scale,
-        "Gloss": settings.gloss,
-    }
-
-
 def _update_sockets(self, context):
-    from . import live
-
     live.sockets_changed(self)
 
 
 def _update_tables(self, context):
-    from . import live
-
     live.tables_changed(self)
 
 
@@ -137,7 +131,7 @@ class MakeupSkinSettings(bpy.types.PropertyGroup):
         update=_update_sockets)
     skin_colour: bpy.props.FloatVectorProperty(
         name="Skin Color", size=3, min=0.0, max=1.0,
-        default=tuple(lut_baker("model.presets").skin_albedo(next(iter(lut_baker("model.presets").SKINS)))),
+        default=_first_skin_albedo(),
         subtype="COLOR",
         description="The skin's diffuse albedo (the skin preset's by default); an albedo "
                     "texture linked to the group's Skin Color input replaces it",
@@ -195,10 +189,11 @@ _register_classes, _unregister_classes = bpy.utils.register_classes_factory(clas
 
 def register():
     _register_classes()
-    bpy.types.Material.makeup_skin = bpy.props.PointerProperty(type=MakeupSkinSettings)
+    setattr(bpy.types.Material, SETTINGS_ATTRIBUTE,
+            bpy.props.PointerProperty(type=MakeupSkinSettings))
 
 
 def unregister():
-    del bpy.types.Material.makeup_skin
+    delattr(bpy.types.Material, SETTINGS_ATTRIBUTE)
     _unregister_classes()
     _ITEMS_CACHE.clear()

@@ -7,17 +7,22 @@ one: the largest on screen), the lights and the render engine; what the material
 record) and the tiers' errors of its last Apply.  :func:`lut_baker.auto_tier.choose` then
 picks the cheapest candidate within the tolerance.
 
+- :func:`units_per_mm` -- scene units in one millimetre, from the scene's unit scale.
 - :func:`auto_tier` -- the tier for ``Tier = Auto`` (called by
   :func:`makeup_skin_addon.material.resolve_tier`; quick, never raises).
 - :func:`describe_scene` -- the scene as the model sees it (None without a camera or object).
 - :func:`material_traits` -- the material as the model sees it (cached per tables).
 - :func:`choose_for` -- the choice for a material in a scene.
-- :class:`MAKEUPSKIN_OT_fit_to_scene` (``makeup_skin.fit_to_scene``) -- choose, report the
-  choice and the predicted error, and apply it: the tier, Subsurface Scale 0 when the scene
-  does not resolve the subsurface, Gloss 0 when the gloss lobes change the image by less
-  than the tolerance allows (below the noise); the values before are kept and given back
+- :func:`set_choice` -- a choice's settings on the material: the tier, Subsurface Scale 0 when
+  the scene does not resolve the subsurface, Gloss 0 when the gloss lobes change the image by
+  less than the tolerance allows (below the noise); the values before are kept and given back
   when a later fit needs them.
-- :func:`draw_fit` -- the panels' button and the last choice (appended to both panels).
+- :func:`record_choice`, :func:`last_choice` -- the last choice, kept on the material for the
+  panel (:data:`.keys.CHOICE_KEY`).
+
+This module changes settings and custom properties only: the Fit to Scene operator
+(:class:`makeup_skin_addon.operators.MAKEUPSKIN_OT_fit_to_scene`) applies the choice, and the
+panels (:func:`makeup_skin_addon.ui.draw_fit`) show it.
 """
 
 from __future__ import annotations
@@ -26,25 +31,25 @@ import json
 import math
 from collections import OrderedDict
 
-import bpy
-
+from . import convert, nodes, storage
+from .keys import CHOICE_KEY, ERRORS_KEY, SAVED_GLOSS_KEY, SAVED_SCALE_KEY
 from .package import lut_baker
 
-__all__ = ["CHOICE_KEY", "SAVED_SCALE_KEY", "SAVED_GLOSS_KEY", "ENVIRONMENT_LIGHT_DEG",
-           "auto_tier",
-           "describe_scene", "material_traits", "choose_for", "MAKEUPSKIN_OT_fit_to_scene",
-           "draw_fit", "register", "unregister"]
+__all__ = ["ENVIRONMENT_LIGHT_DEG", "units_per_mm", "auto_tier", "describe_scene",
+           "material_traits", "choose_for", "set_choice", "record_choice", "last_choice",
+           "register", "unregister"]
 
-CHOICE_KEY = "makeup_skin_scene_fit"
-"""Material custom property: the last Fit to Scene choice (JSON), shown in the panel."""
-SAVED_SCALE_KEY = "makeup_skin_saved_subsurface_scale"
-"""Material custom property: the Subsurface Scale before Fit to Scene set it to 0."""
-SAVED_GLOSS_KEY = "makeup_skin_saved_gloss"
-"""Material custom property: the Gloss before Fit to Scene set it to 0."""
 ENVIRONMENT_LIGHT_DEG = 45.0
 """Light angle (degrees from the view) assumed when the scene has no lamp (world light)."""
 UNKNOWN_SCENE = {"object_size_mm": 100.0, "footprint_mm": 0.01}
 """Without a camera or an object wearing the material: a close-up (everything resolved)."""
+
+
+def units_per_mm(scene) -> float:
+    """Scene units in one millimetre: ``0.001 / unit_settings.scale_length`` (a scene in
+    metres gives 0.001, one modelled in centimetres with scale 0.01 gives 0.1)."""
+    scale = float(scene.unit_settings.scale_length) or 1.0
+    return 0.001 / scale
 
 
 def _engine(scene) -> str:
@@ -117,8 +122,6 @@ def describe_scene(scene, material=None, obj=None):
     """The :class:`lut_baker.auto_tier.SceneDescription` of ``scene`` for ``obj`` (default:
     the nearest object wearing ``material``), or None without a camera or an object."""
     sm = lut_baker("auto_tier")
-    from .material import units_per_mm
-
     samples, denoise = _samples(scene)
     objects = [obj] if obj is not None else (_wearers(material, scene) if material else [])
     if scene.camera is None or not objects:
@@ -148,8 +151,6 @@ def _stored_errors(material, coverage, absorption, key=None):
     """``(tier errors (rms), gloss omissions or None)`` of the last Apply if measured at this
     coverage and absorption (and, when stored, for the tables ``key``: a preview re-bake
     since then changed the tables), else ``(None, None)``."""
-    from .material import ERRORS_KEY
-
     try:
         errors = json.loads(material.get(ERRORS_KEY, "{}"))
     except ValueError:
@@ -172,17 +173,12 @@ def _stored_errors(material, coverage, absorption, key=None):
 
 def _meta(material) -> dict:
     """The material's group's record (its bake, subsurface method, profile fits), or {}."""
-    from . import nodes
-    from .material import group_of
-
-    node = group_of(material)
+    node = convert.group_node(material)
     return nodes.read_meta(node.node_tree) if node is not None else {}
 
 
 def _tables(meta):
     """The tables re-baked from the record, or None if it has none or cannot be re-baked."""
-    from . import storage
-
     try:
         return storage.rebake(meta)[0]
     except storage.StorageError:
@@ -267,11 +263,10 @@ def auto_tier(settings, scene) -> str:
         return "LAYERED" if scene.render.engine == "CYCLES" else "PRINCIPLED"
 
 
-def _apply_choice(context, obj, material, candidate) -> list[str]:
-    """Set the tier, the Subsurface Scale and the Gloss of the choice, then Apply.  Returns
-    what changed, for the report."""
-    from . import material as made_up
-
+def set_choice(material, candidate) -> list[str]:
+    """Set the tier, the Subsurface Scale and the Gloss of the choice's ``candidate`` on
+    ``material``'s settings (the caller then Applies).  Returns what changed, for the
+    report."""
     settings = material.makeup_skin
     changes = []
     live = settings.live_update
@@ -288,8 +283,30 @@ def _apply_choice(context, obj, material, candidate) -> list[str]:
         change = _switch(material, attribute, key, label, on)
         if change:
             changes.append(change)
-    made_up.apply_to_object(context, obj)
     return changes
+
+
+def record_choice(material, choice, description) -> None:
+    """Keep a :func:`choose_for` result on the material (:data:`.keys.CHOICE_KEY`, JSON) for
+    the panel; ``description`` None: the scene was unknown."""
+    chosen = choice.chosen
+    material[CHOICE_KEY] = json.dumps({
+        "candidate": chosen.candidate.name, "tier": chosen.candidate.tier,
+        "subsurface": chosen.candidate.subsurface, "gloss": chosen.candidate.gloss,
+        "error": chosen.error,
+        "best_error": choice.best_error, "cost": chosen.cost,
+        "tolerance": choice.tolerance, "reasons": list(choice.reasons),
+        "known_scene": description is not None})
+
+
+def last_choice(material) -> dict | None:
+    """The choice :func:`record_choice` kept on ``material``, or None (none, or unreadable)."""
+    if material is None or CHOICE_KEY not in material:
+        return None
+    try:
+        return json.loads(material[CHOICE_KEY])
+    except ValueError:
+        return None
 
 
 def _kept_value(material, attribute: str, key: str) -> float:
@@ -317,102 +334,10 @@ def _switch(material, attribute: str, key: str, label: str, on: bool) -> str | N
     return None
 
 
-class MAKEUPSKIN_OT_fit_to_scene(bpy.types.Operator):
-    """Choose the cheapest Made-up Skin tier that stays within the tolerance in this scene
-    (camera, resolution, object size, lights, engine, samples), report it with its predicted
-    error, and apply it"""
-
-    bl_idname = "makeup_skin.fit_to_scene"
-    bl_label = "Fit to Scene"
-    bl_options = {"REGISTER", "UNDO"}
-
-    tolerance: bpy.props.FloatProperty(
-        name="Tolerance", default=0.02, min=0.0, max=1.0, subtype="FACTOR",
-        description="Error a cheaper tier may add to the best tier's (relative RMS)")
-    apply: bpy.props.BoolProperty(
-        name="Apply", default=True,
-        description="Set the chosen tier and subsurface on the material (else only report)")
-
-    @classmethod
-    def poll(cls, context):
-        obj = context.active_object
-        return obj is not None and obj.type == "MESH"
-
-    def execute(self, context):
-        from . import live
-        from . import material as made_up
-
-        obj = context.active_object
-        material = obj.active_material
-        context.view_layer.update()  # object matrices follow moves only after an update
-        try:
-            made_up.refuse_linked(obj, material)
-            if material is None or not material.makeup_skin.is_made_up:
-                material, _ = made_up.apply_to_object(context, obj)
-            elif material.name in live.pending():
-                live.flush(context)  # judge the tables the settings describe now
-            choice, description = choose_for(material, context.scene, obj=obj,
-                                             tolerance=self.tolerance)
-            changes = (_apply_choice(context, obj, material, choice.candidate)
-                       if self.apply else [])
-        except (ValueError, RuntimeError) as error:
-            self.report({"ERROR"}, f"Made-up Skin: Fit to Scene changed nothing: {error}.")
-            return {"CANCELLED"}
-        chosen = choice.chosen
-        material[CHOICE_KEY] = json.dumps({
-            "candidate": chosen.candidate.name, "tier": chosen.candidate.tier,
-            "subsurface": chosen.candidate.subsurface, "gloss": chosen.candidate.gloss,
-            "error": chosen.error,
-            "best_error": choice.best_error, "cost": chosen.cost,
-            "tolerance": choice.tolerance, "reasons": list(choice.reasons),
-            "known_scene": description is not None})
-        if description is None:
-            self.report({"WARNING"}, "Made-up Skin: no camera or object in the scene: assumed "
-                                     "a close-up")
-        self.report({"INFO"}, f"Made-up Skin: Fit to Scene chose {chosen.candidate.name}: "
-                              f"predicted error {100 * chosen.error:.1f}% (best "
-                              f"{100 * choice.best_error:.1f}% + {100 * choice.tolerance:.0f}%)"
-                              f", cost {chosen.cost:.2f} of the fullest tier"
-                              + (f"; {', '.join(changes)}" if changes else ""))
-        for line in choice.reasons[:3]:
-            self.report({"INFO"}, f"Made-up Skin: {line}")
-        return {"FINISHED"}
-
-
-def draw_fit(self, context) -> None:
-    """Appended to the Made-up Skin panels: the Fit to Scene button and the last choice."""
-    layout = self.layout
-    layout.operator(MAKEUPSKIN_OT_fit_to_scene.bl_idname, icon="SCENE_DATA")
-    material = context.material
-    if material is None or CHOICE_KEY not in material:
-        return
-    try:
-        last = json.loads(material[CHOICE_KEY])
-    except ValueError:
-        return
-    box = layout.box()
-    box.label(text=f"Fit to Scene: {last['candidate']}", icon="INFO")
-    box.label(text=f"Predicted error {100 * last['error']:.1f}%, cost {last['cost']:.2f}")
-
-
-classes = (MAKEUPSKIN_OT_fit_to_scene,)
-_register, _unregister = bpy.utils.register_classes_factory(classes)
-
-
-def _panels():
-    from . import ui
-
-    return (ui.MAKEUPSKIN_PT_material, ui.MAKEUPSKIN_PT_node_editor)
-
-
 def register():
-    _register()
-    for panel in _panels():
-        panel.append(draw_fit)
+    """Nothing to register: the Fit to Scene operator is in :mod:`.operators`."""
 
 
 def unregister():
-    for panel in _panels():
-        panel.remove(draw_fit)
-    _unregister()
+    """Forget the session's material traits."""
     _TRAITS.clear()

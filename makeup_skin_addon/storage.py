@@ -11,7 +11,8 @@ found before Blender decodes the image (:func:`image_problem`).
 
 - :func:`tables_key` -- content hash of tables (hex; :func:`lut_baker.tables.codec.content_hash`).
 - :func:`bake_record`, :func:`rebake` -- a bake's record, and the tables again from it.
-- :func:`lut_image_name`, :func:`lut_image` -- the Layered tier's view-angle image.
+- :func:`lut_image` -- the Layered tier's view-angle image (named by
+  :func:`.keys.lut_image_name`).
 - :func:`image_record`, :func:`image_problem` -- an image's hashes, and what is wrong with it;
   :func:`image_problems` for a group's images.
 - :func:`write_pixels` -- pixels into an image, packed.
@@ -21,7 +22,6 @@ from __future__ import annotations
 
 import hashlib
 import json
-from collections import OrderedDict
 
 import bpy
 import numpy as np
@@ -34,7 +34,6 @@ __all__ = [
     "bake_record",
     "rebake",
     "clear_cache",
-    "lut_image_name",
     "lut_image",
     "image_record",
     "image_problem",
@@ -42,7 +41,6 @@ __all__ = [
     "write_pixels",
 ]
 
-LUT_PREFIX = "MakeupSkin LUT "
 REBAKE_CACHE_SIZE = 8
 """Re-baked tables kept per content hash in this session."""
 
@@ -52,7 +50,8 @@ class StorageError(ValueError):
 
 
 def tables_key(tables) -> str:
-    """The tables' content hash (SHA-256 hex of their float32 atlas, :mod:`lut_baker.tables.codec`)."""
+    """The tables' content hash (SHA-256 hex of their float32 atlas,
+    :mod:`lut_baker.tables.codec`)."""
     return lut_baker("tables.codec").content_hash(tables)
 
 
@@ -63,7 +62,7 @@ def bake_record(skin, resolution: str, tables) -> dict:
             "resolution": str(resolution)}
 
 
-_TABLES: OrderedDict = OrderedDict()
+_TABLES = lut_baker("numerics.cache").LRUCache(REBAKE_CACHE_SIZE)
 
 
 def clear_cache() -> None:
@@ -83,9 +82,9 @@ def rebake(record: dict):
     key = record.get("key")
     cache_key = json.dumps([key, record.get("parameters"), record.get("resolution")],
                            sort_keys=True, default=str)
-    if cache_key in _TABLES:
-        _TABLES.move_to_end(cache_key)
-        return _TABLES[cache_key], key
+    cached = _TABLES.get(cache_key)
+    if cached is not None:
+        return cached, key
     try:
         skin = lut_baker("model.params_file").skin_from_dict(record["parameters"])
         tables = lut_baker("bake").bake(skin, record["resolution"])
@@ -94,14 +93,8 @@ def rebake(record: dict):
                            "unreadable)") from None
     rebaked = tables_key(tables)
     if rebaked == key:
-        _TABLES[cache_key] = tables
-        while len(_TABLES) > REBAKE_CACHE_SIZE:
-            _TABLES.popitem(last=False)
+        _TABLES.put(cache_key, tables)
     return tables, rebaked
-
-
-def lut_image_name(key: str, tier: str = "LAYERED") -> str:
-    return f"{LUT_PREFIX}{tier.title()} {key[:16]}"
 
 
 def _new_float_image(name: str, width: int, height: int) -> bpy.types.Image:
@@ -123,7 +116,7 @@ def _pixel_digest(image) -> str:
     width, height = image.size
     pixels = np.empty(width * height * image.channels, dtype=np.float32)
     image.pixels.foreach_get(pixels)
-    return hashlib.sha256(pixels.tobytes()).hexdigest()
+    return lut_baker("tables.codec").pixel_hash(pixels)
 
 
 def _packed_digest(image) -> str | None:

@@ -1,4 +1,8 @@
-"""Panels: Material properties and the shader editor's sidebar (tab "Made-up Skin")."""
+"""Panels: Material properties and the shader editor's sidebar (tab "Made-up Skin").
+
+Both draw :func:`draw_settings` (the settings, Apply and Revert, the group's record and
+errors) and then :func:`draw_fit` (the Fit to Scene button and the last choice).
+"""
 
 from __future__ import annotations
 
@@ -7,17 +11,25 @@ import json
 import bpy
 
 from . import material as made_up
-from . import nodes
-from .operators import MAKEUPSKIN_MT_presets, MAKEUPSKIN_OT_add_preset
+from . import scene_fit
+from .keys import CLASS_PREFIX, ERRORS_KEY, FIT_KEY
+from .operators import (
+    MAKEUPSKIN_MT_presets,
+    MAKEUPSKIN_OT_add_preset,
+    MAKEUPSKIN_OT_apply,
+    MAKEUPSKIN_OT_check_tables,
+    MAKEUPSKIN_OT_fit_to_scene,
+    MAKEUPSKIN_OT_revert,
+)
 
-__all__ = ["MAKEUPSKIN_PT_material", "MAKEUPSKIN_PT_node_editor", "draw_settings", "register",
-           "unregister"]
+__all__ = ["MAKEUPSKIN_PT_material", "MAKEUPSKIN_PT_node_editor", "draw_settings", "draw_fit",
+           "register", "unregister"]
 
 
 def _errors_text(material) -> list[str]:
     lines = []
     try:
-        errors = json.loads(material.get(made_up.ERRORS_KEY, "{}"))
+        errors = json.loads(material.get(ERRORS_KEY, "{}"))
     except ValueError:
         errors = {}
     for tier, error in errors.items():
@@ -42,7 +54,7 @@ def draw_settings(layout, context) -> None:
     row.operator(MAKEUPSKIN_OT_add_preset.bl_idname, text="", icon="REMOVE").remove_active = True
     if material is None:
         layout.label(text="No material: Apply creates one")
-        layout.operator("makeup_skin.apply", icon="MATERIAL")
+        layout.operator(MAKEUPSKIN_OT_apply.bl_idname, icon="MATERIAL")
         return
     settings = material.makeup_skin
     layout.use_property_split = True
@@ -78,14 +90,14 @@ def draw_settings(layout, context) -> None:
     col.prop(settings, "resolution")
     col.prop(settings, "live_update")
     row = layout.row(align=True)
-    row.operator("makeup_skin.apply", icon="MATERIAL")
-    row.operator("makeup_skin.revert", text="", icon="LOOP_BACK")
+    row.operator(MAKEUPSKIN_OT_apply.bl_idname, icon="MATERIAL")
+    row.operator(MAKEUPSKIN_OT_revert.bl_idname, text="", icon="LOOP_BACK")
     node = made_up.group_of(material)
     if node is not None and node.node_tree is not None:
         box = layout.box()
         box.label(text=f"Group: {node.node_tree.name}", icon="NODETREE")
         try:
-            meta = json.loads(node.node_tree.get(nodes.FIT_KEY, "{}"))
+            meta = json.loads(node.node_tree.get(FIT_KEY, "{}"))
         except ValueError:
             meta = {}
         if meta:
@@ -98,20 +110,33 @@ def draw_settings(layout, context) -> None:
             box.label(text="Angular error against the tables:")
             for line in lines:
                 box.label(text=line)
-        box.operator("makeup_skin.check_tables", icon="CHECKMARK")
+        box.operator(MAKEUPSKIN_OT_check_tables.bl_idname, icon="CHECKMARK")
+
+
+def draw_fit(layout, context) -> None:
+    """The Fit to Scene button and the last choice (:func:`.scene_fit.last_choice`), below
+    :func:`draw_settings` in both panels."""
+    layout.operator(MAKEUPSKIN_OT_fit_to_scene.bl_idname, icon="SCENE_DATA")
+    last = scene_fit.last_choice(context.material)
+    if last is None:
+        return
+    box = layout.box()
+    box.label(text=f"Fit to Scene: {last['candidate']}", icon="INFO")
+    box.label(text=f"Predicted error {100 * last['error']:.1f}%, cost {last['cost']:.2f}")
 
 
 class _SettingsPanel:
-    """Shared body: :func:`draw_settings`."""
+    """Shared body: :func:`draw_settings`, then :func:`draw_fit`."""
 
     bl_label = "Made-up Skin"
 
     def draw(self, context):
         draw_settings(self.layout, context)
+        draw_fit(self.layout, context)
 
 
 class MAKEUPSKIN_PT_material(_SettingsPanel, bpy.types.Panel):
-    bl_idname = "MAKEUPSKIN_PT_material"
+    bl_idname = f"{CLASS_PREFIX}_PT_material"
     bl_space_type = "PROPERTIES"
     bl_region_type = "WINDOW"
     bl_context = "material"
@@ -122,7 +147,7 @@ class MAKEUPSKIN_PT_material(_SettingsPanel, bpy.types.Panel):
 
 
 class MAKEUPSKIN_PT_node_editor(_SettingsPanel, bpy.types.Panel):
-    bl_idname = "MAKEUPSKIN_PT_node_editor"
+    bl_idname = f"{CLASS_PREFIX}_PT_node_editor"
     bl_space_type = "NODE_EDITOR"
     bl_region_type = "UI"
     bl_category = "Made-up Skin"

@@ -9,9 +9,10 @@ import numpy as np
 import pytest
 
 from lut_baker import bake
-from lut_baker.evaluate import two_layer
-from lut_baker.model import layers, made_up_skin, presets
-from lut_baker.numerics.quadrature import direction
+from lut_baker.evaluate import made_up, two_layer
+from lut_baker.model import dipole, layers, made_up_skin, microfacet, presets
+from lut_baker.numerics.geometry import direction
+from lut_baker.numerics.quadrature import hemisphere_panels
 from lut_baker.tables import table_set
 
 
@@ -48,7 +49,7 @@ def test_fast_fourier_coefficients_equal_the_exact_evaluators(n_phi):
     paper = presets.paper()
     jensen = presets.made_up_skin("deep_mocha", "jensen_skin2")
     shaded_film = made_up_skin.film_transmission_layer(jensen)  # RGB through absorption
-    grid = bake.bake_quadrature(2, 6, 17)
+    grid = hemisphere_panels(2, 6, 17)
     outer = np.radians([0.0, 12.0, 47.0, 80.0, 89.0])
     for layer in (paper.skin, paper.film, paper.film_transmission, jensen.skin, shaded_film):
         for theta_a in (outer, grid.theta):
@@ -61,7 +62,7 @@ def test_fast_fourier_coefficients_equal_the_exact_evaluators(n_phi):
 
 
 def test_layered_matrices_with_fast_kernels_equal_the_default(paper):
-    grid = bake.bake_quadrature(2, 6, 17)
+    grid = hemisphere_panels(2, 6, 17)
     theta = np.radians([0.0, 30.0, 60.0, 85.0])
     fast = two_layer.layered_fourier_matrices(theta, theta, paper.film_transmission, paper.skin,
                                            grid, fourier=bake.KernelCache())
@@ -83,14 +84,14 @@ def test_skin_diffuse_part_of_path3_is_pd_times_both_transmittances(paper):
     # and the gloss part is what remains of the full path 3
     full = two_layer.layered_reflection(wi, wo, paper.film_transmission, paper.skin)
     gloss = two_layer.layered_reflection(wi, wo, paper.film_transmission,
-                                      bake._gloss_layer(paper.skin))
+                                      bake.gloss_layer(paper.skin))
     np.testing.assert_allclose(full, gloss + paper.skin.P_d * t_i * t_o, rtol=1e-10)
 
 
 def test_gloss_tables_equal_eq2_at_every_node(default_tables, paper):
     wi, wo = node_directions(default_tables)
     for name, layer in (("film_gloss", paper.film), ("skin_gloss", paper.skin)):
-        exact = layers.ts_reflection(wi, wo, bake._gloss_layer(layer))
+        exact = microfacet.ts_reflection(wi, wo, bake.gloss_layer(layer))
         # within the tabulated Fresnel term's checked 1e-8
         np.testing.assert_allclose(getattr(default_tables, name)[..., 0], exact, rtol=1e-8,
                                    atol=1e-12)
@@ -101,17 +102,17 @@ def test_tabulated_fresnel_is_checked_and_falls_back_near_eta_1():
     assert bake._fresnel_table(1.0001) is None and bake._fresnel_table(0.8) is None
     c = np.random.default_rng(2).uniform(0.0, 1.0, (5000, 1))
     for eta in (1.19, 1.26, 1.0001, 0.8):
-        np.testing.assert_allclose(bake._fresnel_fast(c, eta), layers._fresnel(c, eta),
+        np.testing.assert_allclose(bake._fresnel_fast(c, eta), microfacet.fresnel_term(c, eta),
                                    rtol=bake.FRESNEL_TOLERANCE)
 
 
 def test_gloss_albedos_match_the_converged_evaluator(paper):
     theta = np.array([0.0, 40.0, 70.0, 85.0, 89.0])
     res = bake.RESOLUTIONS["default"]
-    grid = bake.bake_quadrature(res.quad_panels, res.quad_points, res.quad_phi)
+    grid = hemisphere_panels(res.quad_panels, res.quad_points, res.quad_phi)
     fast = bake.gloss_albedos((paper.film, paper.skin), theta, grid, res.albedo_azimuths)
     for albedo, layer in zip(fast, (paper.film, paper.skin), strict=True):
-        exact = two_layer.reflection_albedo(theta, bake._gloss_layer(layer), level=2)
+        exact = two_layer.reflection_albedo(theta, bake.gloss_layer(layer), level=2)
         np.testing.assert_allclose(albedo[:, 0], exact, atol=2e-4)
 
 
@@ -177,7 +178,7 @@ def test_tables_apply_any_coverage_and_absorption_exactly_at_the_nodes(default_t
     i, j, k = rng.integers(0, n, 60), rng.integers(0, n, 60), rng.integers(0, 65, 60)
     wi, wo = (w[i, j, k] for w in node_directions(default_tables))
     other = paper.replace(coverage=0.3, absorption=(0.2, 0.5, 0.9))
-    exact = made_up_skin.made_up_reflection(wi, wo, other)
+    exact = made_up.made_up_reflection(wi, wo, other)
     table = default_tables.made_up_reflection(wi, wo, coverage=0.3, absorption=(0.2, 0.5, 0.9))
     np.testing.assert_allclose(table, exact, rtol=1e-4, atol=1e-6)
 
@@ -203,14 +204,14 @@ def test_directional_tables(default_tables, paper):
 def test_radial_table(default_tables, paper):
     d = default_tables.radius_mm
     assert d[0] == 0.0
-    profile = np.atleast_1d(layers.dipole_profile(d, paper.dipole))
+    profile = np.atleast_1d(dipole.dipole_profile(d, paper.dipole))
     np.testing.assert_allclose(default_tables.profile[:, 0],
-                               profile / layers.dipole_total_reflectance(paper.dipole), rtol=1e-12)
+                               profile / dipole.dipole_total_reflectance(paper.dipole), rtol=1e-12)
     # ends where R falls below 1e-4 of its peak, not before
     assert profile[-1] <= 1e-4 * profile[0] * (1 + 1e-6)
-    assert layers.dipole_profile(0.99 * d[-1], paper.dipole) > 1e-4 * profile[0]
+    assert dipole.dipole_profile(0.99 * d[-1], paper.dipole) > 1e-4 * profile[0]
     np.testing.assert_allclose(default_tables.total_reflectance,
-                               layers.dipole_total_reflectance(paper.dipole))
+                               dipole.dipole_total_reflectance(paper.dipole))
 
 
 def test_rgb_skin_bakes_per_channel():
@@ -253,7 +254,7 @@ def test_inter_reflection_of_diffuse_layers_is_the_geometric_series():
     """All layers Lambertian: f_t = a, f_s = b, film underside albedo R_f = pi c.  Path 3 is
     a^2 b pi^2 and each further bounce multiplies by (pi b)(pi c)."""
     a, b, c = 0.08, 0.2, 0.12
-    grid = bake.bake_quadrature(2, 6, 17)
+    grid = hemisphere_panels(2, 6, 17)
     film_t = layers.TransmissionLayer(P_d=a, P_t=0.0, n=0.03, eta=1.2)
     skin = layers.ReflectionLayer(P_d=b, P_s=0.0, n=0.03, eta=1.3)
     below = layers.ReflectionLayer(P_d=c, P_s=0.0, n=0.03, eta=1.2)
@@ -267,15 +268,15 @@ def test_inter_reflection_of_diffuse_layers_is_the_geometric_series():
 
 def test_inter_reflection_equals_its_neumann_series(paper):
     """(I - S R_f)^-1 S against S + S R_f S + ... summed term by term (glossy layers)."""
-    grid = bake.bake_quadrature(2, 6, 17)
+    grid = hemisphere_panels(2, 6, 17)
     theta = np.radians([10.0, 50.0, 85.0])
     film_t = made_up_skin.film_transmission_layer(paper)
     below = made_up_skin.film_reflection_layer(paper)
     full = two_layer.inter_reflection_fourier_matrices(theta, theta, film_t, paper.skin, grid,
                                                     film_below=below)
-    skin_m = two_layer._inner_matrices(grid, film_t, paper.skin)[..., 0]
+    skin_m = two_layer.inner_matrices(grid, film_t, paper.skin)[..., 0]
     film_m = two_layer.layer_fourier_kernel(below, grid.theta, grid.theta, grid.n_phi)[..., 0]
-    rows = two_layer._transmission_rows(theta, grid, film_t)[..., 0]
+    rows = two_layer.transmission_rows(theta, grid, film_t)[..., 0]
     term, total = skin_m, skin_m.copy()
     for _ in range(40):
         term = term @ film_m @ skin_m
@@ -290,7 +291,7 @@ def test_inter_reflection_table(paper):
     assert np.all(t.inter_reflection >= 0.0) and t.inter_reflection.max() > 0.0
     # the same numbers from the exact evaluator's (slow) kernels on the bake's quadrature
     res = bake.RESOLUTIONS["preview"]
-    grid = bake.bake_quadrature(res.quad_panels, res.quad_points, res.quad_phi)
+    grid = hemisphere_panels(res.quad_panels, res.quad_points, res.quad_phi)
     theta = np.radians(t.theta_deg[[4, 30]])
     film_t = made_up_skin.film_transmission_layer(paper)
     extra = (two_layer.inter_reflection_fourier_matrices(

@@ -15,6 +15,7 @@ import pytest
 
 from lut_baker import bake
 from lut_baker.model import params_file, presets
+from lut_baker.offline import exr_files
 from lut_baker.offline.cli import bake_command, main
 from lut_baker.tables import codec
 
@@ -40,7 +41,7 @@ def test_cli_bake_writes_the_same_tables_as_the_function(tmp_path):
     assert "[###" not in result.stderr  # no progress bar when stderr is not a terminal
     meta = json.loads((tmp_path / "paper.json").read_text())
     assert meta["sha256"] == codec.content_hash(bake.bake(presets.paper(), "preview"))
-    assert codec.content_hash(codec.load_tables(tmp_path / "paper.exr")) == meta["sha256"]
+    assert codec.content_hash(exr_files.load_tables(tmp_path / "paper.exr")) == meta["sha256"]
 
 
 def test_cli_options_override_in_order(tmp_path):
@@ -170,7 +171,7 @@ def test_progress_bar_only_on_a_terminal():
 
     for tty in (True, False):
         stream = Stream(tty)
-        progress = bake_command._Progress(stream)
+        progress = bake_command.Progress(stream)
         progress(0.5, "path 3")
         progress.close()
         assert ("[###############" in stream.text and "50%" in stream.text) is tty
@@ -301,7 +302,7 @@ def test_write_errors_are_one_line_and_keep_the_old_pair(capsys, monkeypatch, ol
     def fail(fd):
         raise error
 
-    monkeypatch.setattr(codec.os, "fsync", fail)
+    monkeypatch.setattr(exr_files.os, "fsync", fail)
     code, err = run_main(capsys, "--resolution", "preview", "--coverage", "0.5",
                          "--out", folder)
     line = one_error_line(err)
@@ -313,7 +314,7 @@ def test_write_error_in_a_new_folder_leaves_nothing(capsys, monkeypatch, tmp_pat
     def fail(fd):
         raise OSError(errno.ENOSPC, "No space left on device")
 
-    monkeypatch.setattr(codec.os, "fsync", fail)
+    monkeypatch.setattr(exr_files.os, "fsync", fail)
     code, err = run_main(capsys, "--resolution", "preview", "--out", tmp_path / "new" / "out")
     assert code == 1 and "no space left on the disk" in one_error_line(err)
     assert list(tmp_path.iterdir()) == []

@@ -13,7 +13,7 @@ from lut_baker import bake
 from lut_baker.closures import cycles as cc
 from lut_baker.closures import fitting
 from lut_baker.model import presets
-from lut_baker.numerics.quadrature import direction
+from lut_baker.numerics.geometry import direction
 from lut_baker.tables.table_set import radius_nodes
 
 
@@ -108,7 +108,7 @@ def test_fit_glossy_companion_recovers_a_lobe_plus_lambert(paper_tables):
     """A target that is 0.7 of a Beckmann lobe plus a Lambertian 0.2: the companion fit finds
     the lobe and splits the albedo between the two, and the weights' albedos add up to the
     table's at every texel (so the white furnace is kept)."""
-    grid = fitting._Grid(paper_tables, None)
+    grid = fitting.NodeGrid(paper_tables, None)
     wi, wo = fitting.node_directions(paper_tables)
     lobe = cc.microfacet_reflection(wi, wo, 0.5, distribution="BECKMANN")
     theta = np.asarray(paper_tables.theta_deg)
@@ -200,7 +200,7 @@ def test_view_albedo_matches_the_albedo_tables(paper_tables):
 
 
 def test_fit_coat_recovers_a_known_coat(paper_tables):
-    grid = fitting._Grid(paper_tables, fitting.FIT_POINTS)
+    grid = fitting.NodeGrid(paper_tables, fitting.FIT_POINTS)
     synthetic = cc.microfacet_reflection(grid.wi, grid.wo, 0.45,
                                          lambda c: cc.dielectric_fresnel(c, 1.8))
     fit = fitting.fit_coat(grid, np.repeat(synthetic[..., None], 3, axis=-1))
@@ -210,7 +210,7 @@ def test_fit_coat_recovers_a_known_coat(paper_tables):
 
 
 def test_fit_glossy_recovers_distribution_and_roughness(paper_tables):
-    grid = fitting._Grid(paper_tables, None)
+    grid = fitting.NodeGrid(paper_tables, None)
     wi, wo = fitting.node_directions(paper_tables)
     lobe = cc.microfacet_reflection(wi, wo, 0.5, distribution="BECKMANN")
     mu = np.cos(np.radians(paper_tables.theta_deg))

@@ -6,12 +6,8 @@ import struct
 import numpy as np
 import pytest
 
-from lut_baker.model.layers import (
-    dipole_profile,
-    dipole_total_reflectance,
-    ts_reflection,
-    ts_transmission,
-)
+from lut_baker.model.dipole import dipole_profile, dipole_total_reflectance
+from lut_baker.model.microfacet import ts_reflection, ts_transmission
 from lut_baker.model.presets import (
     PAPER_FILM_REFLECTION,
     PAPER_FILM_TRANSMISSION,

@@ -1,4 +1,5 @@
-"""Tables on disk (lut_baker.tables.codec): float32 OpenEXR atlas + JSON sidecar."""
+"""Tables on disk (lut_baker.offline.exr_files, with the atlas and hash of
+lut_baker.tables.codec): float32 OpenEXR atlas + JSON sidecar."""
 
 import errno
 import json
@@ -9,6 +10,7 @@ import pytest
 
 from lut_baker import bake
 from lut_baker.model import presets
+from lut_baker.offline import exr_files
 from lut_baker.tables import codec
 from lut_baker.tables.table_set import ANGULAR, CONSTANT, DIRECTIONAL
 
@@ -23,11 +25,11 @@ def baked():
 
 @pytest.fixture
 def saved(baked, tmp_path):
-    return codec.save_tables(baked, tmp_path / "skin.exr")
+    return exr_files.save_tables(baked, tmp_path / "skin.exr")
 
 
 def test_round_trip_is_float32_exact(baked, saved):
-    loaded = codec.load_tables(saved)
+    loaded = exr_files.load_tables(saved)
     for name, value in baked.arrays.items():
         stored = np.asarray(getattr(loaded, name))
         if name in ("theta_deg", "phi_deg", "radius_mm"):
@@ -93,7 +95,7 @@ def _flip_byte(path, offset):
 def test_corrupt_byte_is_reported(saved, where):
     _flip_byte(saved, int(where * saved.stat().st_size))
     with pytest.raises(codec.TableFileError, match="skin.exr"):
-        codec.load_tables(saved)
+        exr_files.load_tables(saved)
 
 
 @pytest.mark.parametrize("keep", [0.0, 0.5, 0.99])
@@ -101,7 +103,7 @@ def test_truncated_file_is_reported(saved, keep):
     data = saved.read_bytes()
     saved.write_bytes(data[:int(keep * len(data))])
     with pytest.raises(codec.TableFileError, match="skin.exr"):
-        codec.load_tables(saved)
+        exr_files.load_tables(saved)
 
 
 def test_wrong_version_is_reported(saved):
@@ -110,26 +112,26 @@ def test_wrong_version_is_reported(saved):
     meta["format_version"] = 99
     side.write_text(json.dumps(meta))
     with pytest.raises(codec.TableFileError, match="version 99"):
-        codec.load_tables(saved)
+        exr_files.load_tables(saved)
 
 
 def test_missing_sidecar_is_reported(saved):
     saved.with_suffix(".json").unlink()
     with pytest.raises(codec.TableFileError, match="sidecar.*missing"):
-        codec.load_tables(saved)
+        exr_files.load_tables(saved)
 
 
 def test_missing_image_is_reported(tmp_path):
     with pytest.raises(codec.TableFileError, match="does not exist"):
-        codec.load_tables(tmp_path / "none.exr")
+        exr_files.load_tables(tmp_path / "none.exr")
 
 
 def test_image_and_sidecar_of_different_bakes_are_reported(baked, saved, tmp_path):
-    other = codec.save_tables(bake.bake(presets.paper(), "preview", inter_reflection=True),
-                           tmp_path / "other.exr")
+    other = exr_files.save_tables(bake.bake(presets.paper(), "preview", inter_reflection=True),
+                                  tmp_path / "other.exr")
     saved.with_suffix(".json").write_text(other.with_suffix(".json").read_text())
     with pytest.raises(codec.TableFileError):
-        codec.load_tables(saved)
+        exr_files.load_tables(saved)
 
 
 def test_edited_sidecar_values_are_reported(saved):
@@ -138,10 +140,10 @@ def test_edited_sidecar_values_are_reported(saved):
     meta["grids"]["theta_deg"] = meta["grids"]["theta_deg"][:-1]
     side.write_text(json.dumps(meta))
     with pytest.raises(codec.TableFileError, match="layout|grid"):
-        codec.load_tables(saved)
+        exr_files.load_tables(saved)
     side.write_text("{ not json")
     with pytest.raises(codec.TableFileError, match="not a readable sidecar"):
-        codec.load_tables(saved)
+        exr_files.load_tables(saved)
 
 
 def test_a_crash_mid_write_leaves_the_old_files_intact(baked, saved, monkeypatch):
@@ -155,12 +157,12 @@ def test_a_crash_mid_write_leaves_the_old_files_intact(baked, saved, monkeypatch
             raise OSError("simulated crash")
         real_replace(src, dst)
 
-    monkeypatch.setattr(codec.os, "replace", crash_on_second)
+    monkeypatch.setattr(exr_files.os, "replace", crash_on_second)
     with pytest.raises(OSError, match="simulated"):
-        codec.save_tables(bake.bake(presets.paper(), "preview"), saved)
+        exr_files.save_tables(bake.bake(presets.paper(), "preview"), saved)
     after = {p.name: p.read_bytes() for p in saved.parent.iterdir()}
     assert after == before  # no temporary left, nothing half-written under the final names
-    assert codec.content_hash(codec.load_tables(saved)) == codec.content_hash(baked)
+    assert codec.content_hash(exr_files.load_tables(saved)) == codec.content_hash(baked)
 
 
 def _fail_sidecar_rename(monkeypatch, error):
@@ -172,7 +174,7 @@ def _fail_sidecar_rename(monkeypatch, error):
             raise error
         real_replace(src, dst)
 
-    monkeypatch.setattr(codec.os, "replace", replace)
+    monkeypatch.setattr(exr_files.os, "replace", replace)
 
 
 @pytest.mark.parametrize("error", [OSError(errno.EIO, "Input/output error"), KeyboardInterrupt()])
@@ -181,27 +183,27 @@ def test_a_failure_between_the_renames_puts_the_old_image_back(baked, saved, mon
     before = {p.name: p.read_bytes() for p in saved.parent.iterdir()}
     _fail_sidecar_rename(monkeypatch, error)
     with pytest.raises(type(error)):
-        codec.save_tables(bake.bake(presets.paper(), "preview"), saved)
+        exr_files.save_tables(bake.bake(presets.paper(), "preview"), saved)
     assert {p.name: p.read_bytes() for p in saved.parent.iterdir()} == before
-    assert codec.content_hash(codec.load_tables(saved)) == codec.content_hash(baked)
+    assert codec.content_hash(exr_files.load_tables(saved)) == codec.content_hash(baked)
 
 
 def test_a_failure_between_the_renames_of_a_new_pair_leaves_nothing(baked, tmp_path,
                                                                     monkeypatch):
     _fail_sidecar_rename(monkeypatch, OSError(errno.EIO, "Input/output error"))
     with pytest.raises(codec.TableWriteError, match="skin.exr.*Input/output error"):
-        codec.save_tables(baked, tmp_path / "skin.exr")
+        exr_files.save_tables(baked, tmp_path / "skin.exr")
     assert list(tmp_path.iterdir()) == []
 
 
 def test_a_pair_torn_by_a_crash_is_detected(baked, saved, tmp_path):
     """A crash between the renames (nothing runs to put the old image back): the pair no
     longer matches and loading says so."""
-    other = codec.save_tables(bake.bake(presets.paper(), "preview", inter_reflection=True),
-                           tmp_path / "other" / "skin.exr")
+    other = exr_files.save_tables(bake.bake(presets.paper(), "preview", inter_reflection=True),
+                                  tmp_path / "other" / "skin.exr")
     os.replace(other, saved)
     with pytest.raises(codec.TableFileError, match="different bakes"):
-        codec.load_tables(saved)
+        exr_files.load_tables(saved)
 
 
 @pytest.mark.parametrize("error", [OSError(errno.ENOSPC, "No space left on device"),
@@ -215,9 +217,9 @@ def test_a_failed_or_interrupted_write_leaves_no_temporary(baked, saved, monkeyp
         seen.extend(sorted(p.name for p in saved.parent.iterdir()))
         raise error
 
-    monkeypatch.setattr(codec.os, "fsync", fail)
+    monkeypatch.setattr(exr_files.os, "fsync", fail)
     with pytest.raises(type(error)):
-        codec.save_tables(bake.bake(presets.paper(), "preview"), saved)
+        exr_files.save_tables(bake.bake(presets.paper(), "preview"), saved)
     assert len(seen) == 4  # the old pair and two temporaries
     assert {p.name: p.read_bytes() for p in saved.parent.iterdir()} == before
 
@@ -233,10 +235,10 @@ def test_write_errors_say_what_is_wrong_in_one_line(baked, tmp_path, monkeypatch
     def fail(fd):
         raise error
 
-    monkeypatch.setattr(codec.os, "fsync", fail)
+    monkeypatch.setattr(exr_files.os, "fsync", fail)
     target = tmp_path / "new" / "skin.exr"
     with pytest.raises(codec.TableWriteError) as raised:
-        codec.save_tables(baked, target)
+        exr_files.save_tables(baked, target)
     message = str(raised.value)
     assert isinstance(raised.value, OSError) and "\n" not in message
     assert message.startswith(f"cannot write '{target}': ") and words in message
@@ -246,20 +248,21 @@ def test_write_errors_say_what_is_wrong_in_one_line(baked, tmp_path, monkeypatch
 def test_target_problems_are_found_before_writing(tmp_path):
     (tmp_path / "afile").write_text("x")
     with pytest.raises(codec.TableWriteError, match="'.*afile' is a file, not a folder"):
-        codec.check_target(tmp_path / "afile" / "deeper" / "skin.exr")
+        exr_files.check_target(tmp_path / "afile" / "deeper" / "skin.exr")
     (tmp_path / "skin.exr").mkdir()
     with pytest.raises(codec.TableWriteError, match="skin.exr' is a folder"):
-        codec.check_target(tmp_path / "skin.exr")
+        exr_files.check_target(tmp_path / "skin.exr")
     with pytest.raises(ValueError, match=".exr"):
-        codec.check_target(tmp_path / "skin.png")
-    assert codec.check_target(tmp_path / "new" / "skin.exr") == tmp_path / "new" / "skin.exr"
+        exr_files.check_target(tmp_path / "skin.png")
+    assert exr_files.check_target(tmp_path / "new" / "skin.exr") == tmp_path / "new" / "skin.exr"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["afile", "skin.exr"]  # made nothing
 
 
 def test_only_exr_paths_are_written(baked, tmp_path):
     with pytest.raises(ValueError, match=".exr"):
-        codec.save_tables(baked, tmp_path / "skin.png")
+        exr_files.save_tables(baked, tmp_path / "skin.png")
 
 
 def test_load_accepts_the_sidecar_path(baked, saved):
-    assert codec.content_hash(codec.load_tables(saved.with_suffix(".json"))) == codec.content_hash(baked)
+    loaded = exr_files.load_tables(saved.with_suffix(".json"))
+    assert codec.content_hash(loaded) == codec.content_hash(baked)

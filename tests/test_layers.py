@@ -11,7 +11,7 @@ import reference_impl as ref
 from lut_baker.evaluate import two_layer
 from lut_baker.model import made_up_skin, presets
 from lut_baker.model.layers import Dipole, ReflectionLayer, TransmissionLayer
-from lut_baker.numerics.quadrature import direction
+from lut_baker.numerics.geometry import direction
 
 CONVERGENCE_RTOL = 1e-4
 

@@ -1,6 +1,7 @@
-"""Single-layer functions (lut_baker.model.layers, SPEC 2): known values, broadcasting, RGB channels,
-agreement with the independent reference (tests/reference_impl.py) in the paper's raw units,
-reciprocity, the dipole's closed form, input validation and hemisphere masking."""
+"""Single-layer functions (lut_baker.model.microfacet, lut_baker.model.dipole; SPEC 2): known
+values, broadcasting, RGB channels, agreement with the independent reference
+(tests/reference_impl.py) in the paper's raw units, reciprocity, the dipole's closed form, input
+validation and hemisphere masking."""
 
 import math
 
@@ -9,7 +10,8 @@ import pytest
 import reference_impl as ref
 from scipy.integrate import quad
 
-from lut_baker.model import layers, presets
+from lut_baker.model import microfacet, presets
+from lut_baker.model.dipole import dipole_profile, dipole_total_reflectance
 from lut_baker.model.layers import Dipole, ReflectionLayer, TransmissionLayer
 
 RTOL = 1e-10
@@ -64,29 +66,29 @@ def _layer_args(layer, channel=None):
 # --- known values --------------------------------------------------------------------------
 @pytest.mark.parametrize("eta", [0.5, 1.0, 1.0001, 1.19, 1.26, 1.33, 1.5, 2.42, 10.0])
 def test_fresnel_normal_incidence(eta):
-    assert layers.fresnel_reflectance(1.0, eta) == pytest.approx(((eta - 1) / (eta + 1)) ** 2,
+    assert microfacet.fresnel_reflectance(1.0, eta) == pytest.approx(((eta - 1) / (eta + 1)) ** 2,
                                                                 rel=1e-12, abs=1e-15)
 
 
 def test_fresnel_normal_incidence_rgb():
     eta = np.array([1.19, 1.33, 1.5])
-    np.testing.assert_allclose(layers.fresnel_reflectance(1.0, eta), ((eta - 1) / (eta + 1)) ** 2,
-                               rtol=1e-12)
+    np.testing.assert_allclose(microfacet.fresnel_reflectance(1.0, eta),
+                               ((eta - 1) / (eta + 1)) ** 2, rtol=1e-12)
 
 
 @pytest.mark.parametrize("eta", [0.6, 1.0001, 1.19, 1.5, 3.0])
 def test_fresnel_grazing_is_one(eta):
     """Any interface reflects everything at grazing incidence (without one, see below)."""
-    assert layers.fresnel_reflectance(0.0, eta) == pytest.approx(1.0, abs=1e-12)
+    assert microfacet.fresnel_reflectance(0.0, eta) == pytest.approx(1.0, abs=1e-12)
 
 
 def test_fresnel_index_matched_is_zero():
     """eta = 1: no interface, no reflection at any incidence, grazing included, and the
     values next to eta = 1 approach it continuously."""
     c = np.array([0.0, 5e-324, 1e-300, 1e-200, 1e-12, 1e-8, 1e-4, 0.3, 1.0])
-    np.testing.assert_array_equal(layers.fresnel_reflectance(c, 1.0), 0.0)
+    np.testing.assert_array_equal(microfacet.fresnel_reflectance(c, 1.0), 0.0)
     # Beyond the grazing zone cos < sqrt(2 |eta - 1|) ~ 1.4e-6 the values are near 0.
-    near = layers.fresnel_reflectance(c[6:], np.array([[1.0 - 1e-12], [1.0 + 1e-12]]))
+    near = microfacet.fresnel_reflectance(c[6:], np.array([[1.0 - 1e-12], [1.0 + 1e-12]]))
     assert np.all(near < 1e-8)
 
 
@@ -94,17 +96,18 @@ def test_fresnel_index_matched_is_zero_at_grazing_per_channel():
     """An RGB eta with one channel at 1: that channel is 0 at grazing, the others 1; the
     unchecked inner-loop function agrees."""
     eta = np.array([1.19, 1.0, 1.5])
-    np.testing.assert_array_equal(layers.fresnel_reflectance(0.0, eta), [1.0, 0.0, 1.0])
-    np.testing.assert_array_equal(layers._fresnel(np.zeros((4, 1)), eta), [[1.0, 0.0, 1.0]] * 4)
-    assert layers.fresnel_reflectance(0, 1) == 0.0
+    np.testing.assert_array_equal(microfacet.fresnel_reflectance(0.0, eta), [1.0, 0.0, 1.0])
+    np.testing.assert_array_equal(microfacet.fresnel_term(np.zeros((4, 1)), eta),
+                                  [[1.0, 0.0, 1.0]] * 4)
+    assert microfacet.fresnel_reflectance(0, 1) == 0.0
 
 
 def test_fresnel_total_internal_reflection():
     eta = 1.0 / 1.5
     cos_critical = math.sqrt(1.0 - eta**2)
     c = np.linspace(0.0, cos_critical * (1 - 1e-9), 50)
-    np.testing.assert_array_equal(layers.fresnel_reflectance(c, eta), 1.0)
-    beyond = layers.fresnel_reflectance(np.linspace(cos_critical * 1.01, 1.0, 50), eta)
+    np.testing.assert_array_equal(microfacet.fresnel_reflectance(c, eta), 1.0)
+    beyond = microfacet.fresnel_reflectance(np.linspace(cos_critical * 1.01, 1.0, 50), eta)
     assert np.all(beyond < 1.0) and np.all(np.diff(beyond) < 0)
 
 
@@ -115,14 +118,15 @@ def test_fresnel_matches_reference():
     for eta in (0.7, 1.0, 1.19, 2.0):
         x = c[1:] if eta == 1.0 else c
         expected = [ref.fresnel(value, eta) for value in x]
-        np.testing.assert_allclose(layers.fresnel_reflectance(x, eta), expected, rtol=RTOL)
+        np.testing.assert_allclose(microfacet.fresnel_reflectance(x, eta), expected, rtol=RTOL)
 
 
 @pytest.mark.parametrize("n", [1e-6, 3.29e-2, 0.04, 1.0, 50.0])
 def test_distribution_half_width(n):
     """The lobe's 1/e half-width is 1/n degrees (SPEC 2.1)."""
-    assert layers.microfacet_distribution(1.0 / n, n) == pytest.approx(math.exp(-1.0), rel=1e-12)
-    assert layers.microfacet_distribution(0.0, n) == 1.0
+    assert microfacet.microfacet_distribution(1.0 / n, n) == pytest.approx(math.exp(-1.0),
+                                                                           rel=1e-12)
+    assert microfacet.microfacet_distribution(0.0, n) == 1.0
 
 
 @pytest.mark.parametrize("nh, nv, nl, vh, expected", [
@@ -133,14 +137,14 @@ def test_distribution_half_width(n):
     (1.0, 0.0, 0.0, 0.0, 0.0),  # opposite horizontal pair: VH = 0
 ])
 def test_geometric_attenuation_cases(nh, nv, nl, vh, expected):
-    assert layers.geometric_attenuation(nh, nv, nl, vh) == pytest.approx(expected, rel=1e-12)
+    assert microfacet.geometric_attenuation(nh, nv, nl, vh) == pytest.approx(expected, rel=1e-12)
 
 
 def test_reflection_at_normal_mirror_known_value():
     layer = presets.PAPER_SKIN_REFLECTION
     z = np.array([0.0, 0.0, 1.0])
     expected = 2.00e4 + 2.05e5 * 1.0 * 1.0 * ((1.26 - 1) / (1.26 + 1)) ** 2
-    assert layers.ts_reflection(z, z, layer) == pytest.approx(expected, rel=1e-12)
+    assert microfacet.ts_reflection(z, z, layer) == pytest.approx(expected, rel=1e-12)
 
 
 # --- broadcasting and channels -------------------------------------------------------------
@@ -150,22 +154,22 @@ def test_nd_directions_broadcast():
     wo = _random_upper(rng, 20).reshape(4, 5, 3)
     wt = -_random_upper(rng, 20).reshape(4, 5, 3)
     for func, a, b, layer in [
-        (layers.ts_reflection, wi, wo, RAW_REFLECTION["film"]),
-        (layers.ts_transmission, wi, wt, RAW_TRANSMISSION["film"]),
-        (layers.ts_reflection, wi, wo, RAW_REFLECTION["rgb"]),
+        (microfacet.ts_reflection, wi, wo, RAW_REFLECTION["film"]),
+        (microfacet.ts_transmission, wi, wt, RAW_TRANSMISSION["film"]),
+        (microfacet.ts_reflection, wi, wo, RAW_REFLECTION["rgb"]),
     ]:
         whole = func(a, b, layer)
         assert whole.shape == (4, 5) + layer.channels
         flat = np.array([func(x, y, layer) for x, y in zip(a.reshape(-1, 3), b.reshape(-1, 3),
                                                             strict=True)])
         np.testing.assert_array_equal(whole.reshape(flat.shape), flat)
-    one = layers.ts_reflection(wi[0, 0], wo, RAW_REFLECTION["film"])  # (3,) with (4, 5, 3)
-    np.testing.assert_array_equal(one, layers.ts_reflection(
+    one = microfacet.ts_reflection(wi[0, 0], wo, RAW_REFLECTION["film"])  # (3,) with (4, 5, 3)
+    np.testing.assert_array_equal(one, microfacet.ts_reflection(
         np.broadcast_to(wi[0, 0], wo.shape), wo, RAW_REFLECTION["film"]))
     d = np.linspace(0, 3, 20).reshape(4, 5)
-    profile = layers.dipole_profile(d, DIPOLES["jensen_skin1"])
+    profile = dipole_profile(d, DIPOLES["jensen_skin1"])
     assert profile.shape == (4, 5, 3)
-    np.testing.assert_array_equal(profile[1, 2], layers.dipole_profile(d[1, 2],
+    np.testing.assert_array_equal(profile[1, 2], dipole_profile(d[1, 2],
                                                                       DIPOLES["jensen_skin1"]))
 
 
@@ -174,10 +178,10 @@ def test_rgb_layer_equals_scalar_layer_per_channel():
     wi, wo = _random_upper(rng, 50), _random_upper(rng, 50)
     d = np.linspace(0.0, 5.0, 30)
     cases = [
-        (layers.ts_reflection, (wi, wo), RAW_REFLECTION["rgb"]),
-        (layers.ts_transmission, (wi, -wo), RAW_TRANSMISSION["rgb"]),
-        (layers.dipole_profile, (d,), DIPOLES["jensen_skin2"]),
-        (layers.dipole_total_reflectance, (), DIPOLES["jensen_skin2"]),
+        (microfacet.ts_reflection, (wi, wo), RAW_REFLECTION["rgb"]),
+        (microfacet.ts_transmission, (wi, -wo), RAW_TRANSMISSION["rgb"]),
+        (dipole_profile, (d,), DIPOLES["jensen_skin2"]),
+        (dipole_total_reflectance, (), DIPOLES["jensen_skin2"]),
     ]
     for func, args, layer in cases:
         rgb = func(*args, layer)
@@ -204,7 +208,7 @@ def test_reflection_matches_reference(name):
     rng = np.random.default_rng(3)
     pairs = list(zip(_random_upper(rng, 200), _random_upper(rng, 200), strict=True))
     pairs += _grazing_pairs()
-    _assert_matches_reference(layers.ts_reflection, ref.ts_reflection, pairs, layer)
+    _assert_matches_reference(microfacet.ts_reflection, ref.ts_reflection, pairs, layer)
 
 
 @pytest.mark.parametrize("name", sorted(RAW_TRANSMISSION))
@@ -215,14 +219,14 @@ def test_transmission_matches_reference(name):
     # Grazing pairs with the second direction moved below, and light crossing upward.
     pairs += [(a, b * np.array([1, 1, -1])) for a, b in _grazing_pairs()]
     pairs += [(b * np.array([1, 1, -1]), a) for a, b in _grazing_pairs()]
-    _assert_matches_reference(layers.ts_transmission, ref.ts_transmission, pairs, layer)
+    _assert_matches_reference(microfacet.ts_transmission, ref.ts_transmission, pairs, layer)
 
 
 @pytest.mark.parametrize("name", sorted(DIPOLES))
 def test_dipole_profile_matches_reference(name):
     dipole = DIPOLES[name]
     d = np.concatenate([[0.0, 1e-9], np.geomspace(1e-4, 50.0, 60)])
-    got = layers.dipole_profile(d, dipole)
+    got = dipole_profile(d, dipole)
     for c in range(3) if dipole.channels else [None]:
         expected = [ref.dipole_profile(x, *_layer_args(dipole, c)) for x in d]
         np.testing.assert_allclose(got if c is None else got[:, c], expected, rtol=RTOL)
@@ -233,8 +237,8 @@ def test_reflection_reciprocity():
     rng = np.random.default_rng(5)
     wi, wo = _random_upper(rng, 500), _random_upper(rng, 500)
     for layer in RAW_REFLECTION.values():
-        np.testing.assert_allclose(layers.ts_reflection(wi, wo, layer),
-                                   layers.ts_reflection(wo, wi, layer), rtol=1e-12)
+        np.testing.assert_allclose(microfacet.ts_reflection(wi, wo, layer),
+                                   microfacet.ts_reflection(wo, wi, layer), rtol=1e-12)
 
 
 def test_transmission_reciprocity_and_mirror_symmetry():
@@ -246,9 +250,9 @@ def test_transmission_reciprocity_and_mirror_symmetry():
     wt = np.concatenate([wt, [b * np.array([1, 1, -1]) for _, b in pairs]])
     mirror = np.array([1.0, 1.0, -1.0])
     for layer in RAW_TRANSMISSION.values():
-        forward = layers.ts_transmission(wi, wt, layer)
-        np.testing.assert_allclose(layers.ts_transmission(-wt, -wi, layer), forward, rtol=RTOL)
-        np.testing.assert_allclose(layers.ts_transmission(wi * mirror, wt * mirror, layer),
+        forward = microfacet.ts_transmission(wi, wt, layer)
+        np.testing.assert_allclose(microfacet.ts_transmission(-wt, -wi, layer), forward, rtol=RTOL)
+        np.testing.assert_allclose(microfacet.ts_transmission(wi * mirror, wt * mirror, layer),
                                    forward, rtol=RTOL)
 
 
@@ -260,24 +264,24 @@ def test_transmission_lobe_peaks_straight_through():
         layer = TransmissionLayer(P_d=10.0, P_t=100.0, n=0.0346, eta=eta)
         for theta in angles:
             wi = np.array([math.sin(math.radians(theta)), 0.0, math.cos(math.radians(theta))])
-            straight = layers.ts_transmission(wi, -wi, layer)
+            straight = microfacet.ts_transmission(wi, -wi, layer)
             assert straight == pytest.approx(10.0 + 100.0 * (1 - ref.fresnel(wi[2], eta)))
             rng = np.random.default_rng(7)
             around = -_unit(wi + 0.3 * rng.normal(size=(400, 3)))
             around = around[around[:, 2] < 0]
-            assert np.all(layers.ts_transmission(wi, around, layer) < straight)
+            assert np.all(microfacet.ts_transmission(wi, around, layer) < straight)
 
 
 # --- dipole --------------------------------------------------------------------------------
 @pytest.mark.parametrize("name", sorted(DIPOLES))
 def test_dipole_integral_equals_closed_form(name):
     dipole = DIPOLES[name]
-    closed = np.atleast_1d(layers.dipole_total_reflectance(dipole))
+    closed = np.atleast_1d(dipole_total_reflectance(dipole))
     for c in range(closed.size):
         channel = dipole.channel(c) if dipole.channels else dipole
 
         def integrand(d, channel=channel):
-            return 2.0 * math.pi * float(layers.dipole_profile(d, channel)) * d
+            return 2.0 * math.pi * float(dipole_profile(d, channel)) * d
 
         # Split at a few mean free paths: the profile is sharp near d = 0, slow in its tail.
         z = 1.0 / float(channel.sigma_s * (1 - channel.g) + channel.sigma_a)
@@ -288,15 +292,15 @@ def test_dipole_integral_equals_closed_form(name):
 
 def test_dipole_finite_at_zero_distance():
     for dipole in DIPOLES.values():
-        at_zero = np.atleast_1d(layers.dipole_profile(0.0, dipole))
+        at_zero = np.atleast_1d(dipole_profile(0.0, dipole))
         assert np.all(np.isfinite(at_zero)) and np.all(at_zero > 0)
-        np.testing.assert_allclose(at_zero, np.atleast_1d(layers.dipole_profile(1e-9, dipole)),
+        np.testing.assert_allclose(at_zero, np.atleast_1d(dipole_profile(1e-9, dipole)),
                                    rtol=1e-9)
 
 
 def test_dipole_lossless_reflects_everything():
     """sigma_a = 0: nothing is absorbed, Rd = 1 (the closed form's limit)."""
-    assert layers.dipole_total_reflectance(Dipole(sigma_s=1.0, sigma_a=0.0)) == pytest.approx(1.0)
+    assert dipole_total_reflectance(Dipole(sigma_s=1.0, sigma_a=0.0)) == pytest.approx(1.0)
 
 
 # --- validation ----------------------------------------------------------------------------
@@ -348,34 +352,34 @@ def test_dipole_validation(field, value, message):
 def test_direction_validation(bad, message):
     z = np.array([0.0, 0.0, 1.0])
     with pytest.raises(ValueError, match=message):
-        layers.ts_reflection(bad, z, RAW_REFLECTION["film"])
+        microfacet.ts_reflection(bad, z, RAW_REFLECTION["film"])
     with pytest.raises(ValueError, match=message):
-        layers.ts_transmission(bad, -z, RAW_TRANSMISSION["film"])
+        microfacet.ts_transmission(bad, -z, RAW_TRANSMISSION["film"])
     with pytest.raises(ValueError, match=message.replace("wi must", "wo must")):
-        layers.ts_reflection(z, bad, RAW_REFLECTION["film"])
+        microfacet.ts_reflection(z, bad, RAW_REFLECTION["film"])
     with pytest.raises(ValueError, match=message.replace("wi must", "wt must")):
-        layers.ts_transmission(z, bad, RAW_TRANSMISSION["film"])
+        microfacet.ts_transmission(z, bad, RAW_TRANSMISSION["film"])
 
 
 def test_function_argument_validation():
     with pytest.raises(ValueError, match=r"eta must lie in \(0, inf\)"):
-        layers.fresnel_reflectance(0.5, 0.0)
+        microfacet.fresnel_reflectance(0.5, 0.0)
     with pytest.raises(ValueError, match=r"eta must lie in \(0, inf\)"):
-        layers.fresnel_reflectance(0.5, float("nan"))
+        microfacet.fresnel_reflectance(0.5, float("nan"))
     with pytest.raises(ValueError, match=r"cos_theta must lie in \[0, 1\]"):
-        layers.fresnel_reflectance(float("nan"), 1.3)
+        microfacet.fresnel_reflectance(float("nan"), 1.3)
     with pytest.raises(ValueError, match=r"cos_theta must lie in \[0, 1\]"):
-        layers.fresnel_reflectance(1.5, 1.3)
+        microfacet.fresnel_reflectance(1.5, 1.3)
     with pytest.raises(ValueError, match=r"d_mm must be distances >= 0 \(mm\)"):
-        layers.dipole_profile(-0.1, DIPOLES["paper"])
+        dipole_profile(-0.1, DIPOLES["paper"])
     with pytest.raises(ValueError, match=r"d_mm must be distances >= 0 \(mm\)"):
-        layers.dipole_profile([0.1, float("nan")], DIPOLES["paper"])
+        dipole_profile([0.1, float("nan")], DIPOLES["paper"])
     with pytest.raises(ValueError, match=r"n must lie in \(0, inf\)"):
-        layers.microfacet_distribution(1.0, 0.0)
+        microfacet.microfacet_distribution(1.0, 0.0)
     with pytest.raises(ValueError, match=r"angle_deg must be finite"):
-        layers.microfacet_distribution(float("nan"), 0.04)
+        microfacet.microfacet_distribution(float("nan"), 0.04)
     with pytest.raises(ValueError, match=r"must lie in \[0, 1\]"):
-        layers.geometric_attenuation(float("nan"), 0.5, 0.5, 0.5)
+        microfacet.geometric_attenuation(float("nan"), 0.5, 0.5, 0.5)
 
 
 # --- hemispheres ---------------------------------------------------------------------------
@@ -385,12 +389,36 @@ def test_outside_hemisphere_is_zero():
     up[:, 2] += 1e-3  # strictly above the horizon
     up, up2 = _unit(up), _unit(up2 + [0, 0, 1e-3])
     for layer in RAW_REFLECTION.values():
-        assert np.all(layers.ts_reflection(-up, up2, layer) == 0.0)
-        assert np.all(layers.ts_reflection(up, -up2, layer) == 0.0)
+        assert np.all(microfacet.ts_reflection(-up, up2, layer) == 0.0)
+        assert np.all(microfacet.ts_reflection(up, -up2, layer) == 0.0)
     for layer in RAW_TRANSMISSION.values():
-        assert np.all(layers.ts_transmission(up, up2, layer) == 0.0)
-        assert np.all(layers.ts_transmission(-up, -up2, layer) == 0.0)
+        assert np.all(microfacet.ts_transmission(up, up2, layer) == 0.0)
+        assert np.all(microfacet.ts_transmission(-up, -up2, layer) == 0.0)
     # The same pairs inside the hemispheres are not 0 (the masks above are not vacuous).
-    assert np.all(layers.ts_reflection(up, up2, RAW_REFLECTION["film"]) > 0.0)
-    assert np.all(layers.ts_transmission(up, -up2, RAW_TRANSMISSION["film"]) > 0.0)
-    assert np.all(layers.ts_transmission(-up, up2, RAW_TRANSMISSION["film"]) > 0.0)
+    assert np.all(microfacet.ts_reflection(up, up2, RAW_REFLECTION["film"]) > 0.0)
+    assert np.all(microfacet.ts_transmission(up, -up2, RAW_TRANSMISSION["film"]) > 0.0)
+    assert np.all(microfacet.ts_transmission(-up, up2, RAW_TRANSMISSION["film"]) > 0.0)
+
+
+# --- one formula, two geometries -------------------------------------------------------------
+def test_polar_angle_cosines_give_the_vector_values():
+    """The bake evaluates eqs. 2 and 4 from polar angles and a relative azimuth
+    (half_vector_cosines), the exact evaluator from unit vectors: the same formulas over the
+    same cosines, so the two agree to rounding."""
+    rng = np.random.default_rng(9)
+    wa, wb = _random_upper(rng, 200), _random_upper(rng, 200)
+    cos_a, cos_b = wa[:, 2], wb[:, 2]
+    sin_a, sin_b = np.hypot(wa[:, 0], wa[:, 1]), np.hypot(wb[:, 0], wb[:, 1])
+    cos_phi = (wa[:, 0] * wb[:, 0] + wa[:, 1] * wb[:, 1]) / (sin_a * sin_b)
+    n_dot_h, v_dot_h = microfacet.half_vector_cosines(cos_a, sin_a, cos_b, sin_b, cos_phi)
+    cosines = [x[:, None] for x in (n_dot_h, v_dot_h, cos_b, cos_a)]
+    for layer in RAW_REFLECTION.values():
+        np.testing.assert_allclose(microfacet.ts_reflection_from_cosines(*cosines, layer),
+                                   np.reshape(microfacet.ts_reflection(wa, wb, layer), (200, -1)),
+                                   rtol=1e-11)
+    # f_t(wa, -wb): the lobe is the mirror image, at azimuth phi + pi
+    n_dot_h, v_dot_h = microfacet.half_vector_cosines(cos_a, sin_a, cos_b, sin_b, -cos_phi)
+    for layer in RAW_TRANSMISSION.values():
+        np.testing.assert_allclose(
+            microfacet.ts_transmission_from_cosines(n_dot_h[:, None], v_dot_h[:, None], layer),
+            np.reshape(microfacet.ts_transmission(wa, -wb, layer), (200, -1)), rtol=1e-11)

@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 import reference_impl as ref
 
-from lut_baker.evaluate import two_layer
-from lut_baker.model import layers, made_up_skin, presets
-from lut_baker.numerics.quadrature import direction
+from lut_baker.evaluate import made_up, two_layer
+from lut_baker.model import made_up_skin, microfacet, presets
+from lut_baker.numerics.geometry import direction
 
 THETA_DEG = np.arange(0.0, 90.0)  # 0, 1, ..., 89 degrees
 ABSORPTIONS = {"0": 0.0, "0.5": 0.5, "1": 1.0}
@@ -75,7 +75,7 @@ def test_paper_counts_become_albedo_units():
 
 # --- the white furnace test ----------------------------------------------------------------
 def _albedo(foundation, skin, coverage, absorption=None):
-    return made_up_skin.directional_albedo(
+    return made_up.directional_albedo(
         THETA_DEG, presets.made_up_skin(foundation, skin, coverage=coverage,
                                         absorption=absorption))
 
@@ -121,7 +121,7 @@ def test_furnace_at_89_degrees_direct():
     """Coverage 0.25 and 0.5 evaluated directly at grazing incidence for the paper pair."""
     for coverage in COVERAGES:
         for absorption in ABSORPTIONS.values():
-            value = made_up_skin.directional_albedo(
+            value = made_up.directional_albedo(
                 89.0, presets.made_up_skin(coverage=coverage, absorption=absorption))
             assert value.shape == (3,) and np.all(value <= 1.0) and np.all(value > 0.0)
 
@@ -154,18 +154,18 @@ def test_coverage_zero_is_bare_skin_exactly():
     wi, wo = _pairs(30, 1)
     for name in presets.SKINS:
         skin = presets.made_up_skin("deep_mocha", name, coverage=0.0)
-        bare = np.reshape(layers.ts_reflection(wi, wo, skin.skin), (30, -1))
-        np.testing.assert_array_equal(made_up_skin.made_up_reflection(wi, wo, skin),
+        bare = np.reshape(microfacet.ts_reflection(wi, wo, skin.skin), (30, -1))
+        np.testing.assert_array_equal(made_up.made_up_reflection(wi, wo, skin),
                                       np.broadcast_to(bare, (30, 3)))
 
 
 def test_made_up_reflection_linear_in_coverage():
     wi, wo = _pairs(30, 2)
     skin = presets.made_up_skin("light_ivory", "jensen_skin2")
-    ends = [made_up_skin.made_up_reflection(wi, wo, skin.replace(coverage=c)) for c in (0.0, 1.0)]
+    ends = [made_up.made_up_reflection(wi, wo, skin.replace(coverage=c)) for c in (0.0, 1.0)]
     for coverage in (0.1, 0.25, 0.5, 0.9):
         np.testing.assert_allclose(
-            made_up_skin.made_up_reflection(wi, wo, skin.replace(coverage=coverage)),
+            made_up.made_up_reflection(wi, wo, skin.replace(coverage=coverage)),
             (1 - coverage) * ends[0] + coverage * ends[1], rtol=1e-12)
 
 
@@ -180,9 +180,9 @@ def test_full_absorption_leaves_gloss_and_bare_skin():
         gloss = np.array([ref.ts_reflection(a, b, 0.0, float(film.P_s),
                                                          float(film.n), float(film.eta))
                                        for a, b in zip(wi, wo, strict=True)])
-        bare = layers.ts_reflection(wi, wo, skin.skin)
+        bare = microfacet.ts_reflection(wi, wo, skin.skin)
         expected = (1 - coverage) * bare + coverage * gloss[:, None]
-        np.testing.assert_allclose(made_up_skin.made_up_reflection(wi, wo, skin), expected,
+        np.testing.assert_allclose(made_up.made_up_reflection(wi, wo, skin), expected,
                                    rtol=1e-10)
         assert np.all(gloss > 0)
 
@@ -191,8 +191,8 @@ def test_absorption_lowers_albedo_per_channel():
     wi, wo = _pairs(10, 4)
     shade = presets.made_up_skin("deep_mocha")  # absorption rises from red to blue
     clear = presets.made_up_skin("paper_natural")
-    shaded = made_up_skin.made_up_reflection(wi, wo, shade)
-    assert np.all(shaded < made_up_skin.made_up_reflection(wi, wo, clear))
+    shaded = made_up.made_up_reflection(wi, wo, shade)
+    assert np.all(shaded < made_up.made_up_reflection(wi, wo, clear))
     assert np.all(shaded[:, 0] > shaded[:, 1]) and np.all(shaded[:, 1] > shaded[:, 2])
 
 

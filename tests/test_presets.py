@@ -6,7 +6,8 @@ import math
 import numpy as np
 import pytest
 
-from lut_baker.model import layers, made_up_skin, presets
+from lut_baker.model import made_up_skin, presets
+from lut_baker.model.dipole import dipole_total_reflectance
 
 # SPEC 5 (the paper's table), red channel, pixel counts.
 SPEC_5 = {
@@ -51,7 +52,7 @@ def test_jensen_skins(name):
     np.testing.assert_array_equal(dipole.sigma_a, sigma_a)
     assert float(dipole.g) == 0.0 and float(dipole.eta) == 1.3
     # The diffuse albedo pi P_d is the dipole's total diffuse reflectance (SPEC 4).
-    np.testing.assert_allclose(math.pi * surface.P_d, layers.dipole_total_reflectance(dipole),
+    np.testing.assert_allclose(math.pi * surface.P_d, dipole_total_reflectance(dipole),
                                rtol=1e-14)
     assert np.all(math.pi * surface.P_d < 1.0)
     # Red scatters most and absorbs least: skin is reddest.

@@ -3,9 +3,10 @@
 import numpy as np
 import pytest
 
+from lut_baker.evaluate.made_up import made_up_reflection
 from lut_baker.model import presets
 from lut_baker.model.layers import Dipole
-from lut_baker.model.made_up_skin import made_up_reflection
+from lut_baker.numerics import geometry
 from lut_baker.offline.validation import reference as ref
 
 
@@ -23,10 +24,10 @@ def test_local_image_is_the_brdf_times_cosine(skin):
     _, normals, mask = ref.sphere_points(8, 5.0)
     row, col = 2, 5
     assert mask[row, col]
-    light = ref.light_direction(45.0)
+    light = geometry.light_direction(45.0)
     n = normals[row, col][None]
-    wi = ref.local_directions(light[None], n)
-    wo = ref.local_directions(ref.VIEW[None], n)
+    wi = geometry.local_directions(light[None], n)
+    wo = geometry.local_directions(geometry.VIEW[None], n)
     expected = made_up_reflection(wi, wo, skin)[0] * wi[0, 2]
     np.testing.assert_allclose(image[row, col], expected, rtol=1e-12)
     assert np.all(image[~mask] == 0.0)
@@ -64,7 +65,7 @@ def test_spread_converges_when_samples_double(skin):
 def test_profile_cutoff_holds_the_energy(skin):
     from scipy.integrate import quad
 
-    from lut_baker.model.layers import dipole_profile, dipole_total_reflectance
+    from lut_baker.model.dipole import dipole_profile, dipole_total_reflectance
 
     cutoff = ref.profile_cutoff_mm(skin, lost_fraction=1e-3)
     inside = 2 * np.pi * quad(lambda d: dipole_profile(d, skin.dipole) * d, 0, cutoff,

@@ -22,6 +22,7 @@ import pytest
 from lut_baker import auto_tier, bake
 from lut_baker.auto_tier import SceneDescription
 from lut_baker.model import presets
+from lut_baker.numerics import geometry
 from lut_baker.offline.validation import compare, reference
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -111,7 +112,7 @@ def test_omission_error_follows_the_exact_reference(paper_tables):
     radius, size = 3.0, 24
     _, normals, mask = reference.sphere_points(size, radius)
     points = normals[mask]
-    light = reference.light_direction(45.0)
+    light = geometry.light_direction(45.0)
     local = reference.local_diffuse(points, light, skin)
     spread = reference.spread_diffuse(points, light, skin, radius_mm=radius,
                                       samples=reference.default_samples(skin, radius))

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from lut_baker import bake
-from lut_baker.model import made_up_skin
+from lut_baker.evaluate import made_up
 from lut_baker.offline.validation import stability
 
 SPREAD = ("grazing", "silhouette", "tiny", "huge", "coverage0", "coverage1")
@@ -72,7 +72,7 @@ def test_tables_white_furnace(results, key):
 @pytest.mark.parametrize("key", ["rougher", "eta1", "coverage0"])
 def test_exact_white_furnace(key):
     skin = stability.regime_skin(stability.regime(key))
-    albedo = made_up_skin.directional_albedo(np.array([0.0, 60.0, 89.9]), skin)
+    albedo = made_up.directional_albedo(np.array([0.0, 60.0, 89.9]), skin)
     assert np.all(np.isfinite(albedo)) and albedo.min() >= 0.0
     assert albedo.max() <= 1.0 + stability.FURNACE_TOLERANCE
 

@@ -59,6 +59,7 @@ def load_or_bake(tables_path=None, foundation="paper_natural", skin="paper_biopl
     """Tables from a file or folder written by ``python -m lut_baker bake``, else baked."""
     from lut_baker import bake
     from lut_baker.model import presets
+    from lut_baker.offline import exr_files
     from lut_baker.tables import codec
 
     if tables_path is not None:
@@ -71,7 +72,7 @@ def load_or_bake(tables_path=None, foundation="paper_natural", skin="paper_biopl
                                  f"{path}, found {len(found)}; pass the .exr itself")
             path = found[0]
         try:
-            return codec.load_tables(path)
+            return exr_files.load_tables(path)
         except codec.TableFileError as error:
             raise SystemExit(f"render_sphere: {error}") from None
     return bake.bake(presets.made_up_skin(foundation, skin), resolution)

@@ -24,6 +24,7 @@ Functions
 - :func:`dielectric_fss`, :func:`ggx_energy_compensation`, :func:`coat_view_terms` -- the
   multiple-scattering compensation Cycles gives the Principled coat.
 - :func:`lambert_reflection` -- ``albedo / pi``.
+- :func:`view_table` -- a smooth function of the view cosine, tabulated and interpolated.
 - :func:`principled_reflection` -- the Principled BSDF's coat, specular and diffuse layers
   (``svm_node_closure_bsdf``), for the inputs in :class:`PrincipledInputs`.
 - :func:`burley_profile` -- Christensen-Burley radial profile as Cycles scales it.
@@ -46,8 +47,9 @@ from functools import lru_cache
 
 import numpy as np
 
-from ..model.layers import _fresnel
-from ..numerics.quadrature import direction, hemisphere_grid
+from ..model.microfacet import fresnel_term
+from ..numerics.geometry import direction, half_vector
+from ..numerics.quadrature import gauss_legendre, hemisphere_grid, midpoint_nodes
 
 __all__ = [
     "DISTRIBUTIONS",
@@ -69,6 +71,7 @@ __all__ = [
     "microfacet_albedo",
     "layering_albedo",
     "lambert_reflection",
+    "view_table",
     "PrincipledInputs",
     "principled_reflection",
     "burley_profile",
@@ -147,8 +150,7 @@ def ashikhmin_shirley_reflection(wi, wo, roughness):
     ``(e + 1) / (8 pi) (N.H)^e / ((H.wi) max(cos_i, cos_o))``, no cosine; 0 below the surface."""
     wi, wo = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
     e = ashikhmin_shirley_exponent(roughness)
-    h = wi + wo
-    h = h / np.maximum(np.sqrt(np.sum(h * h, axis=-1, keepdims=True)), 1e-12)
+    h = half_vector(wi, wo)
     h_dot_i = np.maximum(np.abs(np.sum(h * wi, axis=-1)), 1e-6)
     h_dot_n = np.maximum(h[..., 2], 1e-6)
     upper = (wi[..., 2] > 0.0) & (wo[..., 2] > 0.0)
@@ -165,9 +167,9 @@ def microfacet_shadowing(cos_i, cos_o, alpha, distribution: str = "GGX"):
 
 
 def dielectric_fresnel(cos_theta, eta):
-    """Unpolarised dielectric Fresnel reflectance (Cycles ``fresnel_dielectric_cos``); the same
-    formula as the paper's ``F_r`` (:func:`lut_baker.model.layers.fresnel_reflectance`)."""
-    return _fresnel(np.clip(np.asarray(cos_theta, float), 0.0, 1.0), np.asarray(eta, float))
+    """Cycles' ``fresnel_dielectric_cos``: the model's ``F_r`` (eq. 2, :func:`fresnel_term`) at
+    cosines clipped to [0, 1] (Cycles alone gives 1 at eta = 1 and grazing, the model 0)."""
+    return fresnel_term(np.clip(np.asarray(cos_theta, float), 0.0, 1.0), np.asarray(eta, float))
 
 
 def f0_from_ior(eta):
@@ -212,8 +214,7 @@ def microfacet_reflection(wi, wo, roughness, fresnel=None, distribution: str = "
     d_function = DISTRIBUTIONS[distribution][0]
     cos_i = wi[..., 2]
     cos_o = wo[..., 2]
-    h = wi + wo
-    h = h / np.maximum(np.sqrt(np.sum(h * h, axis=-1, keepdims=True)), 1e-12)
+    h = half_vector(wi, wo)
     upper = (cos_i > 0.0) & (cos_o > 0.0)
     safe_i = np.where(upper, cos_i, 1.0)
     safe_o = np.where(upper, cos_o, 1.0)
@@ -240,23 +241,15 @@ def directional_albedo(brdf, cos_theta, *, lobe_width_deg: float = 20.0, level: 
     """
     cos_theta = np.asarray(cos_theta, float)
     grid = hemisphere_grid(lobe_width_deg, level)
-    phi = 2.0 * np.pi * np.arange(grid.n_phi) / grid.n_phi
-    w = direction(grid.theta[:, None], phi[None, :])  # (N, P, 3)
+    w = direction(grid.theta[:, None], grid.phi[None, :])  # (N, P, 3)
     theta_v = np.arccos(np.clip(cos_theta.ravel(), 0.0, 1.0))
     v = direction(theta_v, 0.0)[:, None, None, :]  # (V, 1, 1, 3)
     values = np.asarray(brdf(w[None], v))
-    weights = grid.weight[None, :, None] * (2.0 * np.pi / grid.n_phi)
+    weights = grid.weight[None, :, None] * grid.phi_weight
     if values.ndim == 4:
         total = np.einsum("vnpc,vnp->vc", values, np.broadcast_to(weights, values.shape[:3]))
         return total.reshape(cos_theta.shape + (values.shape[-1],))
     return np.sum(values * weights, axis=(1, 2)).reshape(cos_theta.shape)
-
-
-@lru_cache(maxsize=8)
-def _unit_gauss_legendre(n: int) -> tuple[np.ndarray, np.ndarray]:
-    """Gauss-Legendre nodes and weights on (0, 1)."""
-    x, w = np.polynomial.legendre.leggauss(n)
-    return 0.5 * (x + 1.0), 0.5 * w
 
 
 def microfacet_albedo(cos_view, roughness, fresnel=None, distribution: str = "GGX", *,
@@ -274,7 +267,7 @@ def microfacet_albedo(cos_view, roughness, fresnel=None, distribution: str = "GG
     """
     cos_view = np.asarray(cos_view, float)
     alpha = np.square(max(float(roughness), ROUGHNESS_EPS))
-    u, w_u = _unit_gauss_legendre(n_u)
+    u, w_u = gauss_legendre(n_u)
     if distribution == "GGX":
         tan2 = alpha * alpha * u / (1.0 - u)
     elif distribution == "BECKMANN":
@@ -287,7 +280,7 @@ def microfacet_albedo(cos_view, roughness, fresnel=None, distribution: str = "GG
                          f"{distribution!r}")
     cos_h = 1.0 / np.sqrt(1.0 + tan2)
     sin_h = np.sqrt(tan2) * cos_h
-    phi = (np.arange(n_phi) + 0.5) * np.pi / n_phi
+    phi = midpoint_nodes(n_phi, 0.0, np.pi)
     mu_o = np.clip(cos_view.ravel(), 1e-6, 1.0)[:, None, None]
     sin_o = np.sqrt(1.0 - mu_o * mu_o)
     hx = sin_h[None, :, None] * np.cos(phi)[None, None, :]
@@ -372,7 +365,7 @@ def coat_view_terms(cos_view, roughness, ior):
 @lru_cache(maxsize=64)
 def _ggx_average_albedo(roughness: float) -> float:
     """``2 Int E(mu) mu dmu`` of the Fresnel-free GGX albedo (Cycles' ``ggx_Eavg``)."""
-    mu, w = _unit_gauss_legendre(32)
+    mu, w = gauss_legendre(32)
     return float(2.0 * np.sum(w * mu * microfacet_albedo(mu, roughness)))
 
 
@@ -430,21 +423,21 @@ def principled_reflection(wi, wo, inputs: PrincipledInputs):
     else:
         spec = microfacet_reflection(wi, wo, inputs.roughness,
                                      lambda c: schlick_ior_fresnel(c, eta, f0))
-        a_s = 1.0 - np.max(_view_table(cos_o, lambda c: layering_albedo(
+        a_s = 1.0 - np.max(view_table(cos_o, lambda c: layering_albedo(
             c, inputs.roughness, eta, f0)), axis=-1)
         lower = spec + a_s[..., None] * base
     if inputs.coat_weight <= 0.0:
         return lower
     coat = microfacet_reflection(wi, wo, inputs.coat_roughness,
                                  lambda c: dielectric_fresnel(c, inputs.coat_ior))
-    terms = _view_table(cos_o, lambda c: np.stack(
+    terms = view_table(cos_o, lambda c: np.stack(
         coat_view_terms(c, inputs.coat_roughness, inputs.coat_ior), axis=-1))
     a_c = np.clip(1.0 - inputs.coat_weight * terms[..., 1], 0.0, 1.0)
     return (inputs.coat_weight * (coat * terms[..., 0])[..., None]
             + a_c[..., None] * lower)
 
 
-def _view_table(cos_view: np.ndarray, function, size: int = 64) -> np.ndarray:
+def view_table(cos_view: np.ndarray, function, size: int = 64) -> np.ndarray:
     """``function`` of the view cosine, tabulated on ``size`` nodes and interpolated linearly
     (the layering albedos are smooth; tabulating keeps a replica of a large grid cheap)."""
     nodes = np.linspace(0.0, 1.0, size)

@@ -34,11 +34,12 @@ albedo ``Int f cos(theta_i) dw_i``.
 Functions and types
 -------------------
 - :func:`node_directions`, :func:`angular_weights` -- the tables' nodes as directions, and
-  quadrature weights on them.
+  quadrature weights on them; :class:`NodeGrid` -- both with the cosines the fits reuse.
 - :func:`relative_rms`, :func:`albedo_error`, :func:`view_albedo` -- the error measures.
 - :func:`golden_minimum` -- 1-D bounded minimisation (golden section).
 - :func:`fit_coat`, :func:`fit_specular`, :func:`fit_glossy` -- GGX lobes fitted to a table.
-- :func:`edge_response` -- a radial profile's response to a straight shadow edge.
+- :func:`edge_response` -- a radial profile's response to a straight shadow edge, on the
+  radii of :func:`profile_grid`.
 - :func:`fit_profile`, :func:`fit_profiles` -- Subsurface Radius per channel for a Blender
   subsurface method, fitted to the radial profile's edge response.
 - :func:`lut_nodes`, :func:`sample_lut` -- the 1-D image's texel centres and its sampling.
@@ -57,7 +58,10 @@ from dataclasses import asdict, dataclass, field, replace
 import numpy as np
 
 from ..closures import cycles as cc
+from ..model.made_up_skin import coverage_weights
+from ..numerics.geometry import half_vector
 from ..numerics.optimise import golden_minimum
+from ..numerics.quadrature import trapezoid_weights
 from ..tables.table_set import Tables
 
 __all__ = [
@@ -66,6 +70,7 @@ __all__ = [
     "DEFAULT_LUT_SIZE",
     "node_directions",
     "angular_weights",
+    "NodeGrid",
     "relative_rms",
     "view_albedo",
     "albedo_error",
@@ -80,6 +85,7 @@ __all__ = [
     "fit_specular",
     "fit_glossy",
     "edge_response",
+    "profile_grid",
     "fit_profile",
     "fit_profiles",
     "subsurface_ior",
@@ -143,23 +149,13 @@ def node_directions(tables: Tables):
     return wi, wo
 
 
-def _trapezoid_weights(x: np.ndarray, axis: int = -1) -> np.ndarray:
-    """Trapezoid-rule weights of nodes ``x`` along ``axis`` (any monotonic spacing)."""
-    x = np.moveaxis(np.asarray(x, float), axis, -1)
-    dx = np.diff(x, axis=-1)
-    w = np.zeros_like(x)
-    w[..., :-1] += 0.5 * dx
-    w[..., 1:] += 0.5 * dx
-    return np.moveaxis(w, -1, axis)
-
-
 def _azimuth_weights(tables: Tables, theta_index, phi_index) -> np.ndarray:
     """Trapezoid weights of the nodes' actual (warped) azimuths, ``(n, n, p)``, doubled for the
     other half turn.  Where ``theta_i`` or ``theta_o`` is 0 nothing depends on azimuth and the
     nodes collapse to one azimuth: they share the full turn evenly."""
     azimuth = np.radians(tables.node_azimuths())[np.ix_(theta_index, theta_index, phi_index)]
-    weights = 2.0 * _trapezoid_weights(azimuth, axis=-1)
-    even = 2.0 * _trapezoid_weights(np.linspace(0.0, np.pi, len(phi_index)))
+    weights = 2.0 * trapezoid_weights(azimuth, axis=-1)
+    even = 2.0 * trapezoid_weights(np.linspace(0.0, np.pi, len(phi_index)))
     theta = np.asarray(tables.theta_deg, float)[theta_index]
     flat = (theta[:, None] == 0.0) | (theta[None, :] == 0.0)
     return np.where(flat[..., None], even, weights)
@@ -173,7 +169,7 @@ def angular_weights(tables: Tables, theta_index=None, phi_index=None) -> np.ndar
     theta_index = np.arange(tables.theta_deg.size) if theta_index is None else theta_index
     phi_index = np.arange(tables.phi_deg.size) if phi_index is None else phi_index
     theta = np.radians(np.asarray(tables.theta_deg, float))[theta_index]
-    dtheta = _trapezoid_weights(theta)
+    dtheta = trapezoid_weights(theta)
     w_i = np.sin(theta) * dtheta
     w_o = np.cos(theta) * np.sin(theta) * dtheta
     return w_i[:, None, None] * w_o[None, :, None] * _azimuth_weights(tables, theta_index,
@@ -197,7 +193,7 @@ def view_albedo(f, tables: Tables) -> np.ndarray:
     """``Int f cos(theta_i) dw_i`` per view angle ``theta_o`` of the nodes: ``(n_theta[, 3])``
     (trapezoid rule on the tables' grid)."""
     theta = np.radians(np.asarray(tables.theta_deg, float))
-    w_i = np.cos(theta) * np.sin(theta) * _trapezoid_weights(theta)
+    w_i = np.cos(theta) * np.sin(theta) * trapezoid_weights(theta)
     every_theta, every_phi = np.arange(theta.size), np.arange(tables.phi_deg.size)
     weights = w_i[:, None, None] * _azimuth_weights(tables, every_theta, every_phi)
     f = np.asarray(f, float)
@@ -253,7 +249,7 @@ class LobeFit:
     diffuse_lut: np.ndarray | None = None
 
 
-class _Grid:
+class NodeGrid:
     """Node directions, weights and the cosines the GGX fits reuse (optionally subsampled)."""
 
     def __init__(self, tables: Tables, max_points: int | None = None):
@@ -274,8 +270,7 @@ class _Grid:
         self.weights = angular_weights(tables, it, ip)
         self.cos_i = self.wi[..., 2]
         self.cos_o = self.wo[..., 2]
-        h = self.wi + self.wo
-        h = h / np.maximum(np.linalg.norm(h, axis=-1, keepdims=True), 1e-12)
+        h = half_vector(self.wi, self.wo)
         self.cos_h = h[..., 2]
         self.cos_hi = np.clip(np.sum(h * self.wi, axis=-1), 0.0, 1.0)
 
@@ -297,7 +292,7 @@ def _rgb(values: np.ndarray) -> np.ndarray:
     return values if values.shape[-1:] == (3,) and values.ndim == 4 else values[..., None]
 
 
-def _fit_roughness_and(grid: _Grid, target: np.ndarray, fresnel, second_range, scale=1.0,
+def _fit_roughness_and(grid: NodeGrid, target: np.ndarray, fresnel, second_range, scale=1.0,
                        view_factor=None):
     """``(roughness, second, error)``: a GGX lobe with Fresnel ``fresnel(cos_hi, second)``
     fitted to ``target`` (channels averaged) by nested golden-section searches, the second
@@ -321,12 +316,12 @@ def _fit_roughness_and(grid: _Grid, target: np.ndarray, fresnel, second_range, s
     return (roughness, *error_for(roughness))
 
 
-def fit_coat(grid: _Grid, target: np.ndarray) -> LobeFit:
+def fit_coat(grid: NodeGrid, target: np.ndarray) -> LobeFit:
     """Coat Roughness and Coat IOR of a GGX coat (weight 1, dielectric Fresnel, Cycles'
     energy compensation) fitted to ``target`` (the film's gloss, ``(n, n, p, 3)`` on ``grid``;
     its channels averaged)."""
     def compensation(roughness, ior):
-        return cc._view_table(grid.cos_o, lambda c: cc.ggx_energy_compensation(
+        return cc.view_table(grid.cos_o, lambda c: cc.ggx_energy_compensation(
             c, roughness, float(cc.dielectric_fss(ior)))[0], size=17)
 
     roughness, ior, error = _fit_roughness_and(grid, target, cc.dielectric_fresnel,
@@ -342,7 +337,7 @@ def _specular_fresnel(cos_hi, level):
     return cc.schlick_ior_fresnel(cos_hi, eta, f0)
 
 
-def fit_specular(grid: _Grid, target: np.ndarray, attenuation=None) -> LobeFit:
+def fit_specular(grid: NodeGrid, target: np.ndarray, attenuation=None) -> LobeFit:
     """Roughness and Specular IOR Level (at IOR :data:`SPECULAR_IOR`) of the Principled
     specular fitted to ``target`` ``(n, n, p, 3)`` (channels averaged).  ``attenuation``: the
     factor the layers above apply to it per view node (the coat's ``1 - E_coat``), or None."""
@@ -378,7 +373,7 @@ def _closure_albedo(roughness: float, distribution: str, size: int,
     return closure if n_mu is None else np.interp(mu, nodes, closure)
 
 
-def _companion_share(grid: _Grid, lobe: np.ndarray, closure_albedo: np.ndarray,
+def _companion_share(grid: NodeGrid, lobe: np.ndarray, closure_albedo: np.ndarray,
                      table_albedo: np.ndarray, target: np.ndarray, size: int) -> np.ndarray:
     """The share ``s`` (per view-angle texel, in [0, 1]) of a table's albedo ``A`` that the
     Glossy lobe carries when a Lambertian companion carries the rest: weights ``a = s A / E``
@@ -400,7 +395,7 @@ def _companion_share(grid: _Grid, lobe: np.ndarray, closure_albedo: np.ndarray,
     return np.interp(lut_nodes(size), cos_views[order], share[order])
 
 
-def fit_glossy(grid: _Grid, target: np.ndarray, albedo_table: np.ndarray,
+def fit_glossy(grid: NodeGrid, target: np.ndarray, albedo_table: np.ndarray,
                theta_deg: np.ndarray, size: int = DEFAULT_LUT_SIZE, *,
                companion: bool = False) -> LobeFit:
     """Distribution (:data:`cycles_closures.GLOSSY_DISTRIBUTIONS`) and roughness of a Glossy
@@ -478,10 +473,10 @@ def edge_response(r_mm, profile, s_mm) -> np.ndarray:
     r = np.asarray(r_mm, float)
     s = np.asarray(s_mm, float)[:, None]
     arc = np.where(r > s, 2.0 * np.arccos(np.clip(s / np.maximum(r, 1e-300), -1.0, 1.0)), 0.0)
-    return (arc * (r * _trapezoid_weights(r))) @ np.asarray(profile, float)
+    return (arc * (r * trapezoid_weights(r))) @ np.asarray(profile, float)
 
 
-def _profile_grid(r_max: float) -> np.ndarray:
+def profile_grid(r_max: float) -> np.ndarray:
     """Integration radii (mm) for :func:`edge_response`: geometric, to 40 x the table's end."""
     return np.concatenate([[0.0], np.geomspace(1e-5 * r_max, 40.0 * r_max, 1200)])
 
@@ -496,7 +491,7 @@ def fit_profile(tables: Tables, method: str, *, albedo=None) -> ProfileFit:
     albedo = np.clip(np.pi * np.asarray(tables.skin_diffuse, float) if albedo is None
                      else np.broadcast_to(np.asarray(albedo, float), (3,)), 0.0, 1.0)
     r_max = float(tables.radius_mm[-1])
-    r = _profile_grid(r_max)
+    r = profile_grid(r_max)
     s = np.linspace(0.0, r_max, 48)
     reference = edge_response(r, tables.radial(r), s)  # (48, 3)
     radii, errors, worst, done = [], [], [], {}
@@ -612,7 +607,7 @@ def _cosine_mean(values: np.ndarray, theta_deg: np.ndarray) -> np.ndarray:
     values = np.asarray(values, float)[::-1]
     mu = np.concatenate([[0.0], mu])
     values = np.concatenate([values[:1], values])
-    w = _trapezoid_weights(mu)
+    w = trapezoid_weights(mu)
     return 2.0 * np.tensordot(w * mu, values, axes=(0, 0))
 
 
@@ -620,7 +615,7 @@ def _view_mean(albedo_of) -> float:
     """``2 Int a(mu) mu dmu``: the cosine-weighted mean over view angles of ``albedo_of(mu)``
     (trapezoid on 33 view cosines)."""
     mu = np.linspace(0.0, 1.0, 33)
-    return float(2.0 * np.sum(_trapezoid_weights(mu) * mu * albedo_of(mu)))
+    return float(2.0 * np.sum(trapezoid_weights(mu) * mu * albedo_of(mu)))
 
 
 def _coat_layering_mean(roughness: float, ior: float) -> float:
@@ -654,14 +649,14 @@ def fit_closures(tables: Tables, *, lut_size: int = DEFAULT_LUT_SIZE,
     message)``: called as the fit advances (fraction 0..1)."""
     report = progress or (lambda fraction, message="": None)
     report(0.0, "fitting the Principled tier")
-    grid = _Grid(tables, max_points)
+    grid = NodeGrid(tables, max_points)
     pick = grid.pick
     film_gloss = np.asarray(tables.film_gloss, float)[pick]
     path3 = np.asarray(tables.path3_gloss, float)[pick]
     skin_gloss = np.asarray(tables.skin_gloss, float)[pick]
 
     coat = fit_coat(grid, film_gloss)
-    e_coat = cc._view_table(grid.cos_o, lambda c: cc.coat_view_terms(c, coat.roughness,
+    e_coat = cc.view_table(grid.cos_o, lambda c: cc.coat_view_terms(c, coat.roughness,
                                                                       coat.ior)[1])
     specular_bare = fit_specular(grid, skin_gloss)
     specular_film = fit_specular(grid, path3, attenuation=1.0 - e_coat)
@@ -737,11 +732,12 @@ def _absorption(absorption) -> np.ndarray:
 def diffuse_albedo(fit: ClosureFit, coverage: float, absorption) -> tuple[np.ndarray, np.ndarray]:
     """``(total, skin part)`` of the diffuse albedo per channel at coverage ``w`` and
     absorption ``A``: ``(1 - w) pi P_d,s + w [(1 - A) pi P_d,f + (1 - A)^2 pi P_d,s T_mean^2]``
-    and its skin terms (which the subsurface closure carries)."""
-    through = 1.0 - _absorption(absorption)
-    skin_through = through**2 * fit.skin_albedo * fit.transmittance_mean**2
-    skin = (1.0 - coverage) * fit.skin_albedo + coverage * skin_through
-    return skin + coverage * through * fit.film_albedo, skin
+    (:func:`~lut_baker.model.made_up_skin.coverage_weights`) and its skin terms (which the
+    subsurface closure carries)."""
+    weights = coverage_weights(coverage, _absorption(absorption))
+    skin_through = weights.twice * fit.skin_albedo * fit.transmittance_mean**2
+    skin = weights.bare * fit.skin_albedo + weights.covered * skin_through
+    return skin + weights.covered * weights.once * fit.film_albedo, skin
 
 
 def principled_inputs(fit: ClosureFit, coverage: float, absorption, gloss: float = 1.0):
@@ -763,18 +759,20 @@ def principled_inputs(fit: ClosureFit, coverage: float, absorption, gloss: float
     """
     w = float(coverage)
     g = float(gloss)
-    through2 = float(np.mean((1.0 - _absorption(absorption)) ** 2))
+    weights = coverage_weights(w, _absorption(absorption))
+    bare, covered = weights.bare, weights.covered
+    through2 = float(np.mean(weights.twice))
     total, skin = diffuse_albedo(fit, w, absorption)
-    total = total + g * w * (1.0 - _absorption(absorption)) ** 2 * fit.gloss_to_diffuse
-    e_spec = (1.0 - w) * fit.specular_albedo_mean[0] + w * fit.specular_albedo_mean[1]
-    base = total / ((1.0 - g * w * fit.coat_albedo_mean) * (1.0 - g * e_spec))
-    level = g * ((1.0 - w) * fit.specular_bare.level + w * fit.specular_film.level * through2)
+    total = total + g * covered * weights.twice * fit.gloss_to_diffuse
+    e_spec = bare * fit.specular_albedo_mean[0] + covered * fit.specular_albedo_mean[1]
+    base = total / ((1.0 - g * covered * fit.coat_albedo_mean) * (1.0 - g * e_spec))
+    level = g * (bare * fit.specular_bare.level + covered * fit.specular_film.level * through2)
     inputs = cc.PrincipledInputs(
         base_color=tuple(np.clip(base, 0.0, 1.0)),
-        roughness=(1.0 - w) * fit.specular_bare.roughness + w * fit.specular_film.roughness,
+        roughness=bare * fit.specular_bare.roughness + covered * fit.specular_film.roughness,
         ior=SPECULAR_IOR,
         specular_ior_level=level,
-        coat_weight=g * w,
+        coat_weight=g * covered,
         coat_roughness=fit.coat.roughness,
         coat_ior=fit.coat.ior,
     )
@@ -803,18 +801,18 @@ def layered_weights(fit: ClosureFit, coverage: float, absorption, gloss: float =
     - ``skin_through``: ``w (1 - A)^2 pi P_d,s T_mean`` (times row ``T``); ``skin_bare``:
       ``(1 - w) pi P_d,s`` (Subsurface).
     """
-    w = float(coverage)
     g = float(gloss)
-    through = 1.0 - _absorption(absorption)
+    weights = coverage_weights(float(coverage), _absorption(absorption))
+    bare, covered = weights.bare, weights.covered
     one = np.ones(3)
     return {
-        "film_gloss": g * w * one,
-        "path3_gloss": g * w * through**2,
-        "skin_gloss": g * (1.0 - w) * one,
-        "film_diffuse": w * through * fit.film_albedo,
-        "film_gloss_diffuse": g * w * one,
-        "skin_through": w * through**2 * fit.skin_albedo * fit.transmittance_mean,
-        "skin_bare": (1.0 - w) * fit.skin_albedo,
+        "film_gloss": g * covered * one,
+        "path3_gloss": g * covered * weights.twice,
+        "skin_gloss": g * bare * one,
+        "film_diffuse": covered * weights.once * fit.film_albedo,
+        "film_gloss_diffuse": g * covered * one,
+        "skin_through": covered * weights.twice * fit.skin_albedo * fit.transmittance_mean,
+        "skin_bare": bare * fit.skin_albedo,
     }
 
 

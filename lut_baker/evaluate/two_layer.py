@@ -24,27 +24,23 @@ Functions
 - :func:`layered_fourier_matrices` -- the per-order matrices of ``f_cs`` between two polar grids.
 - :func:`layer_fourier_kernel` -- cosine coefficients of one layer's kernel (the default
   ``fourier`` of the matrix functions; a faster one with the same signature may be passed).
+- :func:`inner_matrices`, :func:`transmission_rows` -- the skin bounce and the film crossings
+  of those matrices.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from ..model.layers import (
-    Dipole,
-    ReflectionLayer,
-    TransmissionLayer,
-    _fresnel,
-    _ts_reflection,
-    _ts_transmission,
-    check_directions,
-)
+from ..model.layers import Dipole, ReflectionLayer, TransmissionLayer
+from ..model.microfacet import check_directions, fresnel_term, ts_reflection, ts_transmission
+from ..numerics.geometry import direction, relative_azimuth
 from ..numerics.quadrature import (
     HemisphereGrid,
     azimuth_convolution_factor,
     fourier_kernel,
     hemisphere_grid,
-    relative_azimuth,
+    order0_integral,
 )
 
 __all__ = [
@@ -58,6 +54,8 @@ __all__ = [
     "grid_for",
     "inter_reflection_fourier_matrices",
     "layer_fourier_kernel",
+    "inner_matrices",
+    "transmission_rows",
 ]
 
 POINT_CHUNK = 64
@@ -85,7 +83,7 @@ def transmission_kernel(cosmetic: TransmissionLayer):
     downward along ``-u`` (both arguments upper-hemisphere directions)."""
 
     def kernel(w_top, u):
-        return _channels(_ts_transmission(w_top, -u, cosmetic), cosmetic)
+        return _channels(ts_transmission(w_top, -u, cosmetic, check=False), cosmetic)
 
     return kernel
 
@@ -94,7 +92,7 @@ def reflection_kernel(layer: ReflectionLayer):
     """``(wi, wo) -> f_r(wi, wo)`` with channel axis."""
 
     def kernel(wi, wo):
-        return _channels(_ts_reflection(wi, wo, layer), layer)
+        return _channels(ts_reflection(wi, wo, layer, check=False), layer)
 
     return kernel
 
@@ -108,7 +106,7 @@ def layer_fourier_kernel(layer, theta_a, theta_b, n_phi: int) -> np.ndarray:
     return fourier_kernel(transmission_kernel(layer), theta_a, theta_b, n_phi)
 
 
-def _inner_matrices(grid: HemisphereGrid, cosmetic, skin: ReflectionLayer,
+def inner_matrices(grid: HemisphereGrid, cosmetic, skin: ReflectionLayer,
                     fourier=layer_fourier_kernel) -> np.ndarray:
     """``c_m^2 W B_m W`` on the grid's polar nodes: shape ``(orders, N, N, C)``."""
     b = fourier(skin, grid.theta, grid.theta, grid.n_phi)
@@ -117,7 +115,7 @@ def _inner_matrices(grid: HemisphereGrid, cosmetic, skin: ReflectionLayer,
     return factor[:, None, None, None] * w[None, :, None, None] * b * w[None, None, :, None]
 
 
-def _transmission_rows(theta, grid: HemisphereGrid, cosmetic,
+def transmission_rows(theta, grid: HemisphereGrid, cosmetic,
                        fourier=layer_fourier_kernel) -> np.ndarray:
     """``T_m(theta, theta_u)`` for outer polar angles ``theta``: shape ``(orders, P, N, C)``."""
     return fourier(cosmetic, theta, grid.theta, grid.n_phi)
@@ -142,9 +140,9 @@ def layered_fourier_matrices(theta_i, theta_o, cosmetic, skin, grid: HemisphereG
     the kernels are still sampled at every azimuth, but the products run once).
     """
     keep = slice(None, orders)
-    inner = _inner_matrices(grid, cosmetic, skin, fourier)[keep]
-    rows = _transmission_rows(theta_i, grid, cosmetic, fourier)[keep]
-    cols = _transmission_rows(theta_o, grid, cosmetic, fourier)[keep]
+    inner = inner_matrices(grid, cosmetic, skin, fourier)[keep]
+    rows = transmission_rows(theta_i, grid, cosmetic, fourier)[keep]
+    cols = transmission_rows(theta_o, grid, cosmetic, fourier)[keep]
     return _batched_matmul(_batched_matmul(rows, inner), np.swapaxes(cols, 1, 2))
 
 
@@ -160,7 +158,7 @@ def inter_reflection_fourier_matrices(theta_i, theta_o, cosmetic, skin, grid, *,
         return layered_fourier_matrices(theta_i, theta_o, cosmetic, skin, grid, fourier=fourier)
     # S = c_m^2 W B_m W carries the two azimuth integrals around a skin bounce; each further
     # bounce off the film's underside adds R_f S, so the sum is S (I - R_f S)^-1 = (I - S R_f)^-1 S.
-    skin_m = _inner_matrices(grid, cosmetic, skin, fourier)
+    skin_m = inner_matrices(grid, cosmetic, skin, fourier)
     film_m = fourier(film_below, grid.theta, grid.theta, grid.n_phi)
     channels = max(film_m.shape[-1], skin_m.shape[-1])
     skin_m = np.broadcast_to(skin_m, skin_m.shape[:3] + (channels,))
@@ -171,8 +169,8 @@ def inter_reflection_fourier_matrices(theta_i, theta_o, cosmetic, skin, grid, *,
         for c in range(channels):
             s_m = skin_m[m, :, :, c]
             adding[m, :, :, c] = np.linalg.solve(eye - s_m @ film_m[m, :, :, c], s_m)
-    rows = _transmission_rows(theta_i, grid, cosmetic, fourier)
-    cols = _transmission_rows(theta_o, grid, cosmetic, fourier)
+    rows = transmission_rows(theta_i, grid, cosmetic, fourier)
+    cols = transmission_rows(theta_o, grid, cosmetic, fourier)
     return _batched_matmul(_batched_matmul(rows, adding), np.swapaxes(cols, 1, 2))
 
 
@@ -197,15 +195,15 @@ def layered_reflection(wi, wo, cosmetic: TransmissionLayer, skin: ReflectionLaye
     wi = wi.reshape(-1, 3)
     wo = wo.reshape(-1, 3)
     grid = grid or grid_for(cosmetic, skin, level=level)
-    inner = _inner_matrices(grid, cosmetic, skin)
+    inner = inner_matrices(grid, cosmetic, skin)
     theta_i = np.arccos(np.clip(wi[:, 2], 0.0, 1.0))
     theta_o = np.arccos(np.clip(wo[:, 2], 0.0, 1.0))
     phi = relative_azimuth(wi, wo)
     out = np.empty((wi.shape[0], 3 if (cosmetic.channels or skin.channels) else 1))
     for start in range(0, wi.shape[0], POINT_CHUNK):
         s = slice(start, start + POINT_CHUNK)
-        rows = _transmission_rows(theta_i[s], grid, cosmetic)  # (M, P, N, C)
-        cols = _transmission_rows(theta_o[s], grid, cosmetic)  # (M, P, N, C)
+        rows = transmission_rows(theta_i[s], grid, cosmetic)  # (M, P, N, C)
+        cols = transmission_rows(theta_o[s], grid, cosmetic)  # (M, P, N, C)
         through = _batched_matmul(rows, inner)  # (M, P, N, C)
         diag = np.einsum("mpnc,mpnc->mpc", through, cols)
         out[s] = _fourier_sum(diag, phi[s])
@@ -241,7 +239,7 @@ def transmission_factor(w, cosmetic: TransmissionLayer, skin: Dipole, *, level: 
     w = check_directions("w", w)
     grid = grid_for(cosmetic, level=level)
     # (N, C): the dipole may be RGB through its coefficients with a scalar eta.
-    fresnel_t = 1.0 - _fresnel(np.cos(grid.theta)[:, None], np.atleast_1d(skin.eta))
+    fresnel_t = 1.0 - fresnel_term(np.cos(grid.theta)[:, None], np.atleast_1d(skin.eta))
     fresnel_t = np.broadcast_to(fresnel_t, (grid.theta.size, 3 if skin.channels else 1))
     return _hemisphere_factor(w, grid, cosmetic, fresnel_t, skin)
 
@@ -258,8 +256,8 @@ def _hemisphere_factor(w, grid, cosmetic, below_weight, *layers):
     """``2 pi sum_u T_0(theta_w, theta_u) below_weight(u) W_u`` (order 0: azimuth integrated)."""
     batch = w.shape[:-1]
     theta = np.arccos(np.clip(w.reshape(-1, 3)[:, 2], 0.0, 1.0))
-    t0 = _transmission_rows(theta, grid, cosmetic)[0]  # (P, N, C)
-    value = 2.0 * np.pi * np.einsum("pnc,nc,n->pc", t0, below_weight, grid.weight)
+    t0 = transmission_rows(theta, grid, cosmetic)[0]  # (P, N, C)
+    value = order0_integral(t0, grid, below_weight)
     value = np.where(w.reshape(-1, 3)[:, 2:3] >= 0.0, value, 0.0)
     return _squeeze(value.reshape(batch + (value.shape[-1],)), cosmetic, *layers)
 
@@ -270,13 +268,11 @@ def reflection_albedo(theta_i_deg, layer: ReflectionLayer, *, level: int = 0):
     theta = np.radians(np.asarray(theta_i_deg, float))
     grid = grid_for(layer, level=level)
     r0 = fourier_kernel(reflection_kernel(layer), theta.ravel(), grid.theta, grid.n_phi)[0]
-    value = 2.0 * np.pi * np.einsum("pnc,n->pc", r0, grid.weight)
+    value = order0_integral(r0, grid)
     return _squeeze(value.reshape(theta.shape + (value.shape[-1],)), layer)
 
 
 def transmission_albedo(theta_i_deg, cosmetic: TransmissionLayer, *, level: int = 0):
     """Directional transmittance of the film at incidence ``theta_i_deg`` (degrees)."""
     theta = np.radians(np.asarray(theta_i_deg, float))
-    from ..numerics.quadrature import direction
-
     return film_transmittance(direction(theta, 0.0), cosmetic, level=level)

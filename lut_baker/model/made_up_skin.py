@@ -1,4 +1,5 @@
-"""From the paper's pixel counts to albedo units, and the made-up skin bundle (SPEC section 4).
+"""From the paper's pixel counts to albedo units, the made-up skin bundle and its mixing rule
+(docs/model.md §4).
 
 The paper's fitted values are 16-bit counts at two shutter times.  Dividing each layer by its
 shutter time puts them on one scale (counts per second); dividing by one constant ``K`` makes
@@ -7,38 +8,30 @@ them albedos.  ``K`` is chosen so that the film as measured is lossless where it
 
 Functions and types
 -------------------
-- :func:`normalisation_constant` -- ``K`` from the film's two measured layers (SPEC 4).
+- :func:`normalisation_constant` -- ``K`` from the film's two measured layers (docs/model.md
+  §4).
 - :func:`per_second` -- a layer divided by its shutter time.
 - :class:`MadeUpSkin` -- the bundle in albedo units: film, skin, dipole, coverage, absorption.
 - :func:`from_paper_counts` -- build a :class:`MadeUpSkin` from layers in pixel counts.
+- :func:`coverage_weights` -- the weights of coverage and absorption: how bare skin, the film
+  and the skin seen through the film are mixed.
 - :func:`film_reflection_layer`, :func:`film_transmission_layer` -- the film with its pigment
   absorption applied.
-- :func:`made_up_reflection` -- paths 1 + 3 with coverage (paper eq. 9, SPEC 4), 1/sr.
-- :func:`directional_albedo` -- paths 1 + 3 integrated over the view hemisphere.
+
+The made-up skin's reflection and albedo, which sum these parts, are evaluated in
+:mod:`lut_baker.evaluate.made_up`.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 
-from ..evaluate.two_layer import (
-    grid_for,
-    layered_fourier_matrices,
-    layered_reflection,
-    reflection_albedo,
-    transmission_albedo,
-)
+from ..evaluate.two_layer import reflection_albedo, transmission_albedo
 from ..numerics.optimise import golden_minimum
-from .layers import (
-    Dipole,
-    ReflectionLayer,
-    TransmissionLayer,
-    _parameter,
-    _ts_reflection,
-    check_directions,
-)
+from .layers import Dipole, ReflectionLayer, TransmissionLayer, check_parameter
 
 __all__ = [
     "REFLECTION_SHUTTER_S",
@@ -47,10 +40,10 @@ __all__ = [
     "per_second",
     "MadeUpSkin",
     "from_paper_counts",
+    "CoverageWeights",
+    "coverage_weights",
     "film_reflection_layer",
     "film_transmission_layer",
-    "made_up_reflection",
-    "directional_albedo",
 ]
 
 REFLECTION_SHUTTER_S = 3.0
@@ -69,7 +62,7 @@ def per_second(layer, shutter_s: float):
 
 def normalisation_constant(film_reflection: ReflectionLayer,
                            film_transmission: TransmissionLayer) -> tuple[float, float]:
-    """``K`` (SPEC 4): the largest total directional albedo of the film over incidence.
+    """``K`` (docs/model.md §4): the largest total directional albedo of the film over incidence.
 
     Both layers in the same unit per second (see :func:`per_second`).  Returns ``(K,
     theta_max_deg)``, where ``theta_max_deg`` is the incidence at which the film is brightest.
@@ -109,12 +102,13 @@ class MadeUpSkin:
     name: str = field(default="custom")
 
     def __post_init__(self):
-        coverage = _parameter("coverage", self.coverage, 0.0, 1.0, low_open=False, high_open=False)
+        coverage = check_parameter("coverage", self.coverage, 0.0, 1.0,
+                                   low_open=False, high_open=False)
         if coverage.shape != ():
             raise ValueError("coverage must be a float in [0, 1]")
         object.__setattr__(self, "coverage", float(coverage))
-        absorption = _parameter("absorption", self.absorption, 0.0, 1.0,
-                                low_open=False, high_open=False)
+        absorption = check_parameter("absorption", self.absorption, 0.0, 1.0,
+                                     low_open=False, high_open=False)
         object.__setattr__(self, "absorption", absorption)
         for name, kind in (("film", ReflectionLayer), ("film_transmission", TransmissionLayer),
                            ("skin", ReflectionLayer), ("dipole", Dipole)):
@@ -133,7 +127,8 @@ def from_paper_counts(film: ReflectionLayer, film_transmission: TransmissionLaye
                       reflection_shutter_s: float = REFLECTION_SHUTTER_S,
                       transmission_shutter_s: float = TRANSMISSION_SHUTTER_S,
                       **options) -> MadeUpSkin:
-    """Layers in the paper's pixel counts -> :class:`MadeUpSkin` in albedo units (SPEC 4)."""
+    """Layers in the paper's pixel counts -> :class:`MadeUpSkin` in albedo units
+    (docs/model.md §4)."""
     film_s = per_second(film, reflection_shutter_s)
     transmission_s = per_second(film_transmission, transmission_shutter_s)
     skin_s = per_second(skin, reflection_shutter_s)
@@ -148,54 +143,45 @@ def from_paper_counts(film: ReflectionLayer, film_transmission: TransmissionLaye
     )
 
 
+class CoverageWeights(NamedTuple):
+    """The weights of :func:`coverage_weights`."""
+
+    bare: float
+    """``1 - w``: the bare skin's share of the area."""
+    covered: float
+    """``w``: the film's share of the area."""
+    once: np.ndarray
+    """``1 - A``: what is left of light that crosses the film's pigment once."""
+    twice: np.ndarray
+    """``(1 - A)^2``: what is left of light that crosses it twice (paths 3 and 4)."""
+
+
+def coverage_weights(coverage, absorption) -> CoverageWeights:
+    """The mixing weights of coverage ``w`` and absorption ``A`` (docs/model.md §4, dimensionless;
+    ``A`` per channel).  The made-up skin is::
+
+        f = covered [f_gloss,c + once P_d,c + twice f_cs] + bare f_r,s
+
+    with ``covered = w``, ``bare = 1 - w``, ``once = 1 - A`` (the film's diffuse reflection
+    crosses its pigment once; its gloss ``f_gloss,c`` does not cross it) and ``twice =
+    (1 - A)^2`` (the skin seen through the film, path 3 ``f_cs`` with the film unabsorbed,
+    crosses it twice; so does path 4).  Every mix of the made-up skin's parts uses these
+    weights: the exact evaluator, the tables, the closures' tiers, the Auto tier and the
+    reference images.  The add-on's node group (makeup_skin_addon/nodes.py) builds the same mix
+    from math nodes and must follow it.
+    """
+    once = 1.0 - np.asarray(absorption, dtype=float)
+    return CoverageWeights(bare=1.0 - coverage, covered=coverage, once=once, twice=once**2)
+
+
 def film_reflection_layer(skin: MadeUpSkin) -> ReflectionLayer:
-    """The film's top reflection with pigment absorption on its diffuse part (SPEC 4)."""
-    return skin.film.scaled(P_d=1.0 - skin.absorption)
+    """The film's top reflection with pigment absorption on its diffuse part (docs/model.md §4:
+    ``P_d`` times :func:`coverage_weights`' ``once``)."""
+    return skin.film.scaled(P_d=coverage_weights(skin.coverage, skin.absorption).once)
 
 
 def film_transmission_layer(skin: MadeUpSkin) -> TransmissionLayer:
-    """The film's transmission with pigment absorption on all of it (SPEC 4)."""
-    return skin.film_transmission.scaled(P_d=1.0 - skin.absorption, P_t=1.0 - skin.absorption)
-
-
-def made_up_reflection(wi, wo, skin: MadeUpSkin, *, level: int = 0):
-    """Made-up skin BRDF, paths 1 + 3 (paper eq. 9) mixed with bare skin by coverage (SPEC 4).
-
-    ``(1 - w) f_r,s + w (f_r,c + f_cs)``, in 1/sr, RGB: shape ``(..., 3)``.
-    """
-    wi = check_directions("wi", wi)
-    wo = check_directions("wo", wo)
-    film = film_reflection_layer(skin)
-    film_t = film_transmission_layer(skin)
-    bare = _rgb(_ts_reflection(wi, wo, skin.skin), skin.skin)
-    top = _rgb(_ts_reflection(wi, wo, film), film)
-    path3 = _rgb(layered_reflection(wi, wo, film_t, skin.skin, level=level), film_t, skin.skin)
-    return (1.0 - skin.coverage) * bare + skin.coverage * (top + path3)
-
-
-def _rgb(values: np.ndarray, *layers) -> np.ndarray:
-    """Broadcast a result of ``layers`` to RGB: ``(...)`` for scalar layers -> ``(..., 3)``."""
-    values = np.asarray(values)
-    rgb = any(layer.channels for layer in layers)
-    return values if rgb else np.repeat(values[..., None], 3, axis=-1)
-
-
-def directional_albedo(theta_i_deg, skin: MadeUpSkin, *, level: int = 0) -> np.ndarray:
-    """Paths 1 + 3 (with coverage) integrated over the view hemisphere, per RGB channel:
-    ``Int f(wi, wo) cos(theta_o) dwo`` at incidence ``theta_i_deg`` (degrees).  A white
-    furnace test asserts it is <= 1.  Shape ``theta_i_deg.shape + (3,)``."""
-    theta = np.radians(np.atleast_1d(np.asarray(theta_i_deg, float)))
-    film_t = film_transmission_layer(skin)
-    grid = grid_for(film_t, skin.skin, skin.film, level=level)
-    path3 = layered_fourier_matrices(theta, grid.theta, film_t, skin.skin, grid,
-                                     orders=1)[0]  # (P, N, C)
-    path3 = 2.0 * np.pi * np.einsum("pnc,n->pc", path3, grid.weight)
-    path3 = path3 if (film_t.channels or skin.skin.channels) else path3[..., 0]
-    film = film_reflection_layer(skin)
-    top = reflection_albedo(np.degrees(theta), film, level=level)
-    bare = reflection_albedo(np.degrees(theta), skin.skin, level=level)
-    total = (1.0 - skin.coverage) * _rgb(bare, skin.skin) + skin.coverage * (
-        _rgb(top, film) + _rgb(path3, film_t, skin.skin)
-    )
-    return total.reshape(np.shape(theta_i_deg) + (3,))
-
+    """The film's transmission with pigment absorption on all of it (docs/model.md §4: ``P_d``
+    and ``P_t`` times :func:`coverage_weights`' ``once``; crossed twice, it gives ``twice``)."""
+    once = coverage_weights(skin.coverage, skin.absorption).once
+    return skin.film_transmission.scaled(P_d=once, P_t=once)

@@ -19,7 +19,8 @@ from functools import lru_cache
 
 import numpy as np
 
-from .layers import Dipole, ReflectionLayer, TransmissionLayer, dipole_total_reflectance
+from .dipole import dipole_total_reflectance
+from .layers import Dipole, ReflectionLayer, TransmissionLayer
 from .made_up_skin import MadeUpSkin, from_paper_counts
 
 __all__ = [

@@ -1,14 +1,22 @@
-"""Hemisphere quadrature and azimuthal Fourier expansion of isotropic kernels.
+"""Quadrature rules, and the azimuthal Fourier expansion of isotropic kernels.
 
-An isotropic kernel ``K(theta_a, theta_b, dphi)`` (even in ``dphi``) is expanded as
+Every integration rule of ``lut_baker`` is written here once.  An isotropic kernel
+``K(theta_a, theta_b, dphi)`` (even in ``dphi``) is expanded as
 ``K = sum_m K_m(theta_a, theta_b) cos(m dphi)``; chaining kernels over the hemisphere then
-becomes a product of matrices per Fourier order (SPEC section 3).
+becomes a product of matrices per Fourier order (docs/model.md §3).
 
 Functions
 ---------
-- :func:`hemisphere_grid` -- Gauss-Legendre panels in polar angle, uniform odd azimuth count,
-  sized from the narrowest lobe (degrees) so sharp lobes are resolved.
-- :func:`direction` -- unit vectors from polar and azimuth angles (radians).
+- :func:`gauss_legendre` -- composite Gauss-Legendre nodes and weights on an interval.
+- :func:`midpoint_nodes` -- the midpoint rule's nodes on an interval.
+- :func:`trapezoid_weights` -- trapezoid-rule weights on any monotonic grid.
+- :func:`cumulative_trapezoid` -- the running trapezoid integral.
+- :func:`uniform_azimuths` -- equally spaced azimuths on a full turn.
+- :func:`mirror_weighted_azimuths` -- an azimuth rule dense at the mirror azimuth.
+- :func:`hemisphere_panels` -- Gauss-Legendre panels in polar angle, odd azimuth count.
+- :func:`hemisphere_grid` -- the same sized from the narrowest lobe (degrees), so sharp lobes
+  are resolved.
+- :func:`order0_integral` -- an order-0 kernel integrated over the hemisphere.
 - :func:`fourier_kernel` -- cosine coefficients ``K_m`` of an isotropic kernel on grids.
 - :func:`azimuth_convolution_factor` -- ``2 pi`` for m = 0, ``pi`` otherwise.
 """
@@ -16,16 +24,25 @@ Functions
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
+from .geometry import direction
+
 __all__ = [
+    "gauss_legendre",
+    "midpoint_nodes",
+    "trapezoid_weights",
+    "cumulative_trapezoid",
+    "uniform_azimuths",
+    "mirror_weighted_azimuths",
     "HemisphereGrid",
+    "hemisphere_panels",
     "hemisphere_grid",
-    "direction",
+    "order0_integral",
     "fourier_kernel",
     "azimuth_convolution_factor",
-    "relative_azimuth",
     "grazing_azimuth_width_deg",
 ]
 
@@ -33,10 +50,71 @@ GAUSS_POINTS_PER_PANEL = 8
 WIDEST_PANEL_DEG = 22.5
 """Panels are never wider than this, so the G kink of broad lobes still converges."""
 GRAZING_DEG = 89.0
-"""The most grazing direction the evaluator promises to resolve (issue 2: to 89 degrees)."""
+"""The most grazing direction (degrees) the evaluator resolves."""
 NARROWEST_LOBE_DEG = 5.0
 """Lobes narrower than this (n > 0.2 / degree) are not resolved further: the grid would cost
 O(width^-4).  The exact evaluator reports them as not converged rather than guess."""
+
+
+def _read_only(*arrays: np.ndarray) -> tuple[np.ndarray, ...]:
+    """The arrays, made read-only (cached rules hand the same arrays to every caller)."""
+    for array in arrays:
+        array.setflags(write=False)
+    return arrays
+
+
+@lru_cache(maxsize=32)
+def gauss_legendre(points: int, start: float = 0.0, stop: float = 1.0,
+                   panels: int = 1) -> tuple[np.ndarray, np.ndarray]:
+    """``(nodes, weights)`` of the composite Gauss-Legendre rule: ``panels`` equal panels of
+    ``points`` nodes on [``start``, ``stop``], ``Int f dx ~ sum_k weights_k f(nodes_k)``
+    (read-only arrays, in the units of ``start`` and ``stop``)."""
+    x, w = np.polynomial.legendre.leggauss(points)
+    half = (stop - start) / 2.0 / panels
+    mid = start + half * (2.0 * np.arange(panels) + 1.0)
+    nodes = (mid[:, None] + half * x[None, :]).ravel()
+    return _read_only(nodes, np.tile(half * w, panels))
+
+
+def midpoint_nodes(count: int, start: float, stop: float) -> np.ndarray:
+    """The midpoint rule's ``count`` nodes on [``start``, ``stop``] (each weighs
+    ``(stop - start) / count``)."""
+    return start + (np.arange(count) + 0.5) * (stop - start) / count
+
+
+def trapezoid_weights(x: np.ndarray, axis: int = -1) -> np.ndarray:
+    """Trapezoid-rule weights of nodes ``x`` along ``axis`` (any monotonic spacing, in the
+    units of ``x``): ``Int f dx ~ sum_k weights_k f(x_k)``."""
+    x = np.moveaxis(np.asarray(x, float), axis, -1)
+    dx = np.diff(x, axis=-1)
+    w = np.zeros_like(x)
+    w[..., :-1] += 0.5 * dx
+    w[..., 1:] += 0.5 * dx
+    return np.moveaxis(w, -1, axis)
+
+
+def cumulative_trapezoid(y: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """``Int_{x_0}^{x_k} y dx`` for ``k = 1..K-1`` by the trapezoid rule along the first axis
+    of ``y`` ``(K, ...)``: shape ``(K - 1, ...)``, units of ``y`` times those of ``x``."""
+    y = np.asarray(y, float)
+    dx = np.diff(np.asarray(x, float)).reshape((-1,) + (1,) * (y.ndim - 1))
+    return np.cumsum(0.5 * (y[1:] + y[:-1]) * dx, axis=0)
+
+
+def uniform_azimuths(n_phi: int) -> np.ndarray:
+    """``2 pi k / n_phi`` for ``k = 0..n_phi-1`` (radians): the periodic trapezoid rule's
+    nodes on a full turn (each weighs ``2 pi / n_phi``)."""
+    return 2.0 * np.pi * np.arange(n_phi) / n_phi
+
+
+@lru_cache(maxsize=8)
+def mirror_weighted_azimuths(count: int, power: int) -> tuple[np.ndarray, np.ndarray]:
+    """``(cos(phi_k), w_k)`` with ``Int_0^{2 pi} f(phi) dphi ~ sum_k w_k f(phi_k)`` for even
+    ``f`` (radians): Gauss-Legendre in ``s`` after ``phi = pi (1 - s^power)``, dense at the
+    mirror azimuth ``pi`` (read-only arrays)."""
+    s, w = gauss_legendre(count)
+    weight = 2.0 * np.pi * power * s ** (power - 1) * w
+    return _read_only(np.cos(np.pi * (1.0 - s**power)), weight)
 
 
 @dataclass(frozen=True)
@@ -61,6 +139,28 @@ class HemisphereGrid:
     def size(self) -> tuple[int, int]:
         return (self.theta.size, self.n_phi)
 
+    @property
+    def phi(self) -> np.ndarray:
+        """The ``n_phi`` azimuths (radians, :func:`uniform_azimuths`)."""
+        return uniform_azimuths(self.n_phi)
+
+    @property
+    def phi_weight(self) -> float:
+        """The weight of each azimuth, ``2 pi / n_phi`` (radians)."""
+        return 2.0 * np.pi / self.n_phi
+
+
+@lru_cache(maxsize=16)
+def hemisphere_panels(panels: int, points: int, n_phi: int) -> HemisphereGrid:
+    """Quadrature over the upper hemisphere (projected solid angle): ``panels`` equal
+    Gauss-Legendre panels of ``points`` nodes over [0, 90] degrees, ``n_phi`` (odd) azimuths."""
+    if panels < 1 or points < 1 or n_phi < 3 or n_phi % 2 == 0:
+        raise ValueError(f"need panels, points >= 1 and odd n_phi >= 3, got "
+                         f"{panels}, {points}, {n_phi}")
+    theta, dtheta = gauss_legendre(points, 0.0, np.pi / 2, panels)
+    (weight,) = _read_only(np.cos(theta) * np.sin(theta) * dtheta)
+    return HemisphereGrid(theta=theta, weight=weight, n_phi=n_phi)
+
 
 def hemisphere_grid(lobe_width_deg: float = 90.0, level: int = 0) -> HemisphereGrid:
     """A grid that resolves a lobe of 1/e half-width ``lobe_width_deg`` (degrees).
@@ -78,18 +178,11 @@ def hemisphere_grid(lobe_width_deg: float = 90.0, level: int = 0) -> HemisphereG
         raise ValueError(f"level must be >= 0, got {level!r}")
     width = min(max(float(lobe_width_deg), NARROWEST_LOBE_DEG), 90.0)
     panels = int(np.ceil(90.0 / min(1.5 * width, WIDEST_PANEL_DEG))) * 2**level
-    x, w = np.polynomial.legendre.leggauss(GAUSS_POINTS_PER_PANEL)
-    edges = np.linspace(0.0, np.pi / 2, panels + 1)
-    half = 0.5 * np.diff(edges)
-    mid = 0.5 * (edges[1:] + edges[:-1])
-    theta = (mid[:, None] + half[:, None] * x[None, :]).ravel()
-    dtheta = (half[:, None] * w[None, :]).ravel()
-    weight = np.cos(theta) * np.sin(theta) * dtheta
     samples_per_turn = max(64, int(np.ceil(4 * 360.0 / width)),
                            int(np.ceil(360.0 / grazing_azimuth_width_deg(width))))
     samples_per_turn += samples_per_turn % 2  # even, so n_phi is odd (no Nyquist order)
     n_phi = samples_per_turn * 2**level + 1
-    return HemisphereGrid(theta=theta, weight=weight, n_phi=n_phi)
+    return hemisphere_panels(panels, GAUSS_POINTS_PER_PANEL, n_phi)
 
 
 def grazing_azimuth_width_deg(lobe_width_deg: float, theta_deg: float = GRAZING_DEG) -> float:
@@ -105,16 +198,12 @@ def grazing_azimuth_width_deg(lobe_width_deg: float, theta_deg: float = GRAZING_
     return float(np.degrees(2.0 * np.cos(np.radians(theta_deg)) * np.tan(width)))
 
 
-def direction(theta, phi) -> np.ndarray:
-    """Unit vectors ``(..., 3)`` for polar angle ``theta`` and azimuth ``phi`` (radians)."""
-    theta, phi = np.broadcast_arrays(np.asarray(theta, float), np.asarray(phi, float))
-    s = np.sin(theta)
-    return np.stack([s * np.cos(phi), s * np.sin(phi), np.cos(theta)], axis=-1)
-
-
-def relative_azimuth(wi: np.ndarray, wo: np.ndarray) -> np.ndarray:
-    """Azimuth of ``wi`` minus that of ``wo`` (radians); 0 where either is the normal."""
-    return np.arctan2(wi[..., 1], wi[..., 0]) - np.arctan2(wo[..., 1], wo[..., 0])
+def order0_integral(matrix0: np.ndarray, grid: HemisphereGrid, weight=None) -> np.ndarray:
+    """``2 pi sum_u K_0(theta, theta_u) weight_u W_u``: an order-0 kernel ``matrix0``
+    ``(P, N, C)`` (cosine coefficients on ``grid``'s polar nodes) integrated over the hemisphere
+    (projected solid angle), ``weight`` ``(N, C)`` or None a factor per node: ``(P, C)``."""
+    w = grid.weight[:, None] if weight is None else grid.weight[:, None] * weight
+    return 2.0 * np.pi * np.sum(matrix0 * w[None], axis=1)
 
 
 def azimuth_convolution_factor(orders: int) -> np.ndarray:
@@ -133,7 +222,7 @@ def fourier_kernel(kernel, theta_a, theta_b, n_phi: int) -> np.ndarray:
     """
     theta_a = np.atleast_1d(np.asarray(theta_a, float))
     theta_b = np.atleast_1d(np.asarray(theta_b, float))
-    phi = 2.0 * np.pi * np.arange(n_phi) / n_phi
+    phi = uniform_azimuths(n_phi)
     wa = direction(theta_a[:, None, None], np.zeros((1, 1, 1)))
     wb = direction(theta_b[None, :, None], phi[None, None, :])
     wa = np.broadcast_to(wa, (theta_a.size, theta_b.size, n_phi, 3))

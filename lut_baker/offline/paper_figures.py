@@ -31,23 +31,12 @@ from pathlib import Path
 
 import numpy as np
 
+from ..evaluate.made_up import directional_albedo, made_up_reflection
 from ..evaluate.two_layer import layered_reflection, transmission_factor
-from ..model.layers import (
-    Dipole,
-    ReflectionLayer,
-    TransmissionLayer,
-    dipole_profile,
-    fresnel_reflectance,
-    ts_reflection,
-    ts_transmission,
-)
-from ..model.made_up_skin import (
-    MadeUpSkin,
-    directional_albedo,
-    film_reflection_layer,
-    film_transmission_layer,
-    made_up_reflection,
-)
+from ..model.dipole import dipole_profile
+from ..model.layers import Dipole, ReflectionLayer, TransmissionLayer
+from ..model.made_up_skin import MadeUpSkin, film_reflection_layer, film_transmission_layer
+from ..model.microfacet import fresnel_reflectance, ts_reflection, ts_transmission
 from ..model.presets import (
     FOUNDATIONS,
     PAPER_FILM_REFLECTION,
@@ -200,7 +189,7 @@ def made_up_reflection_curves(skin: MadeUpSkin | None = None, relative_angle_deg
     """Made-up skin in the reflection protocol at one relative angle (paper 5.1, eq. 9), as
     intensities ``f cos(theta_i)`` in albedo units (1/sr, SPEC 4): ``path1`` (film surface),
     ``path3`` (through the film, off the skin surface, back through), ``bare`` (the skin alone)
-    and ``sum`` {coverage: :func:`~lut_baker.model.made_up_skin.made_up_reflection` at that coverage}."""
+    and ``sum`` {coverage: :func:`~lut_baker.evaluate.made_up.made_up_reflection` at that coverage}."""
     skin = paper() if skin is None else skin
     sweep = _dense_reflection(relative_angle_deg, MADE_UP_STEP_DEG)
     wi, wo, cosine = sweep.wi, sweep.wo, sweep.wi[..., 2]

@@ -1,9 +1,10 @@
-"""Baked tables on disk: one float32 OpenEXR atlas plus a JSON sidecar (docs/baking.md).
+"""The one binary codec of baked tables: the atlas layout, its packing and unpacking, the
+content hash and the sidecar data (numpy only: the add-on uses it inside Blender; the files on
+disk are :mod:`lut_baker.offline.exr_files`).
 
 The atlas is one RGB image holding every table, so a shader needs one image texture (linear
 interpolation, extension EXTEND, colour space Non-Color).  Rows are counted from the bottom,
-as Blender's pixel rows are (the EXR file stores them top-down: row ``r`` is the file's
-scanline ``height - 1 - r``); pixel ``(x, y)`` has its centre at texture coordinates
+as Blender's pixel rows are; pixel ``(x, y)`` has its centre at texture coordinates
 ``((x + 0.5) / width, (y + 0.5) / height)``.  Blocks, bottom-up:
 
 - each angular table (``film_gloss``, ``path3_gloss``, ``skin_gloss``, then
@@ -15,44 +16,33 @@ scanline ``height - 1 - r``); pixel ``(x, y)`` has its centre at texture coordin
 - one row for ``profile``: pixel ``(r, row)``;
 - one row of constants (``CONSTANT`` order): pixel ``(c, row)``.
 
-The sidecar (same name, ``.json``) holds the format version, the layout (first row and row
-count of each block), the grids and their closed forms, units, the made-up skin's parameters
-(with K) and ``sha256``, the hash of the atlas's float32 pixels in the row order above (C order,
-little-endian).  The EXR header repeats version and hash (``makeup_skin:format_version``,
-``makeup_skin:sha256``) so that an image and a sidecar from different bakes are caught.
-
-Writing is atomic: both files go to temporaries in the target folder, are flushed to disk and
-renamed into place (image first); a crash never leaves a partial file under the final name.  A
-write that fails or is interrupted (``KeyboardInterrupt`` or any other exception) removes its
-temporaries and the folders it made, and leaves an earlier pair as it was: if the sidecar's
-rename fails after the image's, the earlier image is put back.  Only a crash between the two
-renames can leave a new image beside an old sidecar, and loading then reports the mismatch.
+The sidecar data hold the format version, the layout (first row and row count of each block),
+the grids and their closed forms, units, the made-up skin's parameters (with K) and
+``sha256``, the hash of the atlas's float32 pixels in the row order above (C order,
+little-endian).
 
 Functions
 ---------
-- :func:`save_tables`, :func:`load_tables` -- write and read (validated) tables.
-- :func:`check_target` -- whether tables can be written to a path (before a long bake).
-- :func:`atlas`, :func:`content_hash` -- the atlas pixels and their hash (no file involved).
+- :func:`atlas_layout` -- first row and row count of each block, and the image size.
+- :func:`atlas`, :func:`tables_from_atlas` -- tables packed into the atlas pixels, and back.
+- :func:`pixel_hash`, :func:`content_hash` -- the hash of float32 pixels, and of tables.
+- :func:`sidecar_data`, :func:`check_sidecar`, :func:`check_layout` -- the sidecar's data, and
+  its checks.
 - :class:`TableFileError` -- a corrupt, truncated, mismatched or unsupported table file.
 - :class:`TableWriteError` -- tables that could not be written, said in plain words.
 """
 
 from __future__ import annotations
 
-import contextlib
-import errno
 import hashlib
-import json
-import os
-import shutil
-from pathlib import Path
 
 import numpy as np
 
 from .table_set import ANGULAR, CONSTANT, DIRECTIONAL, FORMAT_VERSION, RADIAL, Tables
 
-__all__ = ["save_tables", "load_tables", "check_target", "atlas", "content_hash",
-           "sidecar_path", "TableFileError", "TableWriteError", "FORMAT_NAME"]
+__all__ = ["atlas_layout", "atlas", "tables_from_atlas", "pixel_hash", "content_hash",
+           "sidecar_data", "check_sidecar", "check_layout", "TableFileError",
+           "TableWriteError", "FORMAT_NAME", "UNITS"]
 
 FORMAT_NAME = "makeup-skin-tables"
 UNITS = {
@@ -80,44 +70,13 @@ class TableWriteError(OSError):
     file and saying what is wrong."""
 
 
-WRITE_PROBLEMS = {
-    errno.ENOSPC: "no space left on the disk",
-    errno.EDQUOT: "the disk quota is used up",
-    errno.EROFS: "{folder!r} is on a read-only file system",
-    errno.EACCES: "no permission to write in {folder!r}",
-    errno.EPERM: "no permission to write in {folder!r}",
-    errno.ENAMETOOLONG: "the file name is too long",
-}
-"""errno -> what went wrong, in words (``folder``: the nearest existing output folder)."""
-
-
-def _one_line(message: str) -> str:
-    """OpenImageIO's (multi-line) error text as one line."""
-    return " ".join(str(message).split())[:400]
-
-
-def _oiio():
-    try:
-        import OpenImageIO
-    except ImportError as error:  # pragma: no cover - the test venv has it
-        raise ImportError(
-            "lut_baker.tables.codec needs OpenImageIO to read and write .exr tables "
-            "(pip install OpenImageIO; Blender ships it as the OpenImageIO module)"
-        ) from error
-    return OpenImageIO
-
-
-def sidecar_path(path) -> Path:
-    """The JSON sidecar of an atlas path (same name, ``.json``)."""
-    return Path(path).with_suffix(".json")
-
-
 def _angular_names(tables: Tables) -> tuple[str, ...]:
     return ANGULAR + (("inter_reflection",) if tables.inter_reflection is not None else ())
 
 
-def _layout(n_theta: int, n_phi: int, n_radius: int, angular: tuple[str, ...]) -> dict:
-    """First row and row count of each block (rows from the bottom), and the image size."""
+def atlas_layout(n_theta: int, n_phi: int, n_radius: int, angular: tuple[str, ...]) -> dict:
+    """First row and row count of each block (rows from the bottom), and the image size
+    (pixels), of the atlas of ``angular`` tables on the given grid sizes."""
     blocks, row = {}, 0
     for name in angular:
         blocks[name] = {"row": row, "rows": n_theta, "columns": n_theta * n_phi,
@@ -140,7 +99,7 @@ def atlas(tables: Tables) -> tuple[np.ndarray, dict]:
     """``(pixels, layout)``: the float32 atlas ``(height, width, 3)`` with row 0 at the
     bottom, and its layout (see the module docstring)."""
     n_theta, n_phi = tables.theta_deg.size, tables.phi_deg.size
-    layout = _layout(n_theta, n_phi, tables.radius_mm.size, _angular_names(tables))
+    layout = atlas_layout(n_theta, n_phi, tables.radius_mm.size, _angular_names(tables))
     pixels = np.zeros((layout["height"], layout["width"], 3), np.float32)
     blocks = layout["blocks"]
     for name in _angular_names(tables):
@@ -157,14 +116,17 @@ def atlas(tables: Tables) -> tuple[np.ndarray, dict]:
 
 def content_hash(tables: Tables) -> str:
     """sha256 (hex) of the float32 atlas of ``tables``: equal hashes, equal stored tables."""
-    return _hash(atlas(tables)[0])
+    return pixel_hash(atlas(tables)[0])
 
 
-def _hash(pixels: np.ndarray) -> str:
+def pixel_hash(pixels: np.ndarray) -> str:
+    """sha256 (hex) of ``pixels`` as little-endian float32 in C order."""
     return hashlib.sha256(np.ascontiguousarray(pixels, "<f4").tobytes()).hexdigest()
 
 
-def _sidecar(tables: Tables, layout: dict, digest: str, image_name: str) -> dict:
+def sidecar_data(tables: Tables, layout: dict, digest: str, image_name: str) -> dict:
+    """The sidecar of the atlas of ``tables`` (plain data): its ``layout``, ``digest``
+    (:func:`pixel_hash`), the image's file name, grids, units and the skin's parameters."""
     return {
         "format": FORMAT_NAME,
         "format_version": FORMAT_VERSION,
@@ -188,254 +150,57 @@ def _sidecar(tables: Tables, layout: dict, digest: str, image_name: str) -> dict
     }
 
 
-def _fsync(path: Path) -> None:
-    fd = os.open(path, os.O_RDONLY)
-    try:
-        os.fsync(fd)
-    finally:
-        os.close(fd)
-
-
-def _nearest_existing(folder: Path) -> Path:
-    """``folder`` or its nearest ancestor that exists (as anything)."""
-    for part in (folder, *folder.parents):
-        if part.exists():
-            return part
-    return folder
-
-
-def _target_problem(path: Path) -> str | None:
-    """What stands in the way of writing ``path`` and its sidecar, found without writing."""
-    existing = _nearest_existing(path.parent)
-    if existing.exists() and not existing.is_dir():
-        return f"{str(existing)!r} is a file, not a folder"
-    for target in (path, sidecar_path(path)):
-        if target.is_dir():
-            return f"{str(target)!r} is a folder, not a file"
-    if existing.is_dir() and not os.access(existing, os.W_OK | os.X_OK):
-        return WRITE_PROBLEMS[errno.EACCES].format(folder=str(existing))
-    return None
-
-
-def _write_error(path: Path, error: OSError) -> TableWriteError:
-    """``error`` from writing ``path`` as a :class:`TableWriteError` in plain words."""
-    if isinstance(error, TableWriteError):
-        return error
-    try:
-        reason, folder = _target_problem(path), _nearest_existing(path.parent)
-    except OSError:  # the folders cannot even be looked at: say what the system said
-        reason, folder = None, path.parent
-    if reason is None and error.errno in WRITE_PROBLEMS:
-        reason = WRITE_PROBLEMS[error.errno].format(folder=str(folder))
-    return TableWriteError(f"cannot write {str(path)!r}: "
-                           f"{reason or _one_line(error.strerror or error)}")
-
-
-def _image_path(path) -> Path:
-    """``path`` as a Path; ``ValueError`` unless it ends in ``.exr``."""
-    path = Path(path)
-    if path.suffix.lower() != ".exr":
-        raise ValueError(f"table image must end in .exr, got {str(path)!r}")
-    return path
-
-
-def check_target(path) -> Path:
-    """``path`` (an ``.exr``) if tables can be written there as far as can be told without
-    writing anything; else :class:`TableWriteError` (a file where a folder should be, a folder
-    under the image's or the sidecar's name, no write permission).  Run it before a long bake."""
-    path = _image_path(path)
-    try:
-        problem = _target_problem(path)
-    except OSError as error:
-        raise _write_error(path, error) from None
-    if problem is not None:
-        raise TableWriteError(f"cannot write {str(path)!r}: {problem}")
-    return path
-
-
-def _missing_folders(folder: Path) -> list[Path]:
-    """``folder`` and those of its parents that do not exist yet, innermost first."""
-    missing = []
-    for part in (folder, *folder.parents):
-        if part.exists():
-            break
-        missing.append(part)
-    return missing
-
-
-def _remove_folders(folders: list[Path]) -> None:
-    """Remove the (empty) folders a failed write made, innermost first."""
-    for folder in folders:
-        with contextlib.suppress(OSError):
-            folder.rmdir()
-
-
-def _write_image(pixels: np.ndarray, digest: str, path: Path) -> None:
-    """The atlas (row 0 at the bottom) as a float32 EXR with version and hash in its header."""
-    oiio = _oiio()
-    height, width = pixels.shape[:2]
-    spec = oiio.ImageSpec(width, height, 3, oiio.FLOAT)
-    spec.attribute("compression", "zip")
-    spec.attribute("makeup_skin:format_version", FORMAT_VERSION)
-    spec.attribute("makeup_skin:sha256", digest)
-    out = oiio.ImageOutput.create(str(path))
-    if out is None or not out.open(str(path), spec):
-        raise OSError(_one_line(oiio.geterror()))
-    ok = out.write_image(np.ascontiguousarray(pixels[::-1]))
-    error = out.geterror()
-    out.close()
-    if not ok:
-        raise OSError(_one_line(error))
-
-
-def _write_sidecar(meta: dict, path: Path) -> None:
-    """The sidecar's data as indented JSON."""
-    path.write_text(json.dumps(meta, indent=1))
-
-
-def _keep_copy(path: Path, copy: Path) -> bool:
-    """Keep the current ``path`` under the name ``copy`` (a hard link, else a copy); False
-    when there is no file at ``path``."""
-    if not path.is_file():
-        return False
-    try:
-        os.link(path, copy)
-    except OSError:  # a file system without hard links
-        shutil.copy2(path, copy)
-    return True
-
-
-def _replace_pair(image_tmp: Path, json_tmp: Path, path: Path, backup: Path) -> None:
-    """Rename the temporaries onto ``path`` and its sidecar, image first.  If the sidecar's
-    rename fails, the earlier image is put back (the new one removed if there was none), so an
-    earlier pair is never left half-replaced."""
-    had_image = _keep_copy(path, backup)
-    os.replace(image_tmp, path)
-    try:
-        os.replace(json_tmp, sidecar_path(path))
-    except BaseException:
-        if had_image:
-            os.replace(backup, path)
-        else:
-            path.unlink(missing_ok=True)
-        raise
-
-
-def save_tables(tables: Tables, path) -> Path:
-    """Write ``tables`` to ``path`` (an ``.exr``) and its sidecar ``path.json``, atomically
-    (see the module docstring).  Returns the image path.
-
-    Raises :class:`TableWriteError` (an ``OSError``) naming the file and the problem when the
-    tables cannot be written; then no temporary is left and an earlier pair is unchanged, as
-    also when the write is interrupted."""
-    _oiio()
-    path = check_target(path)
-    pixels, layout = atlas(tables)
-    digest = _hash(pixels)
-    tag = f".{path.stem}.{os.getpid()}"
-    image_tmp, json_tmp, backup = (path.with_name(tag + end)
-                                   for end in (".tmp.exr", ".tmp.json", ".old.exr"))
-    made = _missing_folders(path.parent)
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        _write_image(pixels, digest, image_tmp)
-        _write_sidecar(_sidecar(tables, layout, digest, path.name), json_tmp)
-        for tmp in (image_tmp, json_tmp):
-            _fsync(tmp)
-        _replace_pair(image_tmp, json_tmp, path, backup)
-    except BaseException as error:
-        for tmp in (image_tmp, json_tmp, backup):
-            tmp.unlink(missing_ok=True)
-        _remove_folders(made)
-        if isinstance(error, OSError):
-            raise _write_error(path, error) from error
-        raise
-    backup.unlink(missing_ok=True)
-    with contextlib.suppress(OSError):  # the pair is in place; not every system syncs folders
-        _fsync(path.parent)
-    return path
-
-
-def _read_sidecar(path: Path) -> dict:
-    side = sidecar_path(path)
-    try:
-        meta = json.loads(side.read_text())
-    except FileNotFoundError:
-        raise TableFileError(f"{str(side)!r}: the sidecar of {path.name!r} is missing; "
-                             "re-bake the tables") from None
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as error:
-        raise TableFileError(f"{str(side)!r} is not a readable sidecar: {error}") from None
+def check_sidecar(meta, where: str) -> dict:
+    """``meta`` if it is sidecar data of this format version; else :class:`TableFileError`
+    naming ``where`` (the sidecar's file)."""
     if not isinstance(meta, dict) or meta.get("format") != FORMAT_NAME:
-        raise TableFileError(f"{str(side)!r} is not a {FORMAT_NAME} sidecar")
+        raise TableFileError(f"{where!r} is not a {FORMAT_NAME} sidecar")
     if meta.get("format_version") != FORMAT_VERSION:
-        raise TableFileError(f"{str(side)!r} has format version {meta.get('format_version')!r}; "
+        raise TableFileError(f"{where!r} has format version {meta.get('format_version')!r}; "
                              f"this lut_baker reads version {FORMAT_VERSION}: re-bake the tables")
     return meta
 
 
-def _read_pixels(path: Path, meta: dict) -> np.ndarray:
-    oiio = _oiio()
-    image = oiio.ImageInput.open(str(path))
-    if image is None:
-        raise TableFileError(f"{str(path)!r} cannot be read as an image: "
-                             f"{_one_line(oiio.geterror())}")
-    try:
-        spec = image.spec()
-        shape = (spec.height, spec.width, spec.nchannels)
-        if spec.getattribute("makeup_skin:sha256") != meta["sha256"]:
-            raise TableFileError(f"{str(path)!r} and its sidecar come from different bakes "
-                                 "(their hashes differ); re-bake the tables")
-        if shape != (meta["height"], meta["width"], 3):
-            raise TableFileError(f"{str(path)!r} is {shape[1]} x {shape[0]} x {shape[2]}, its "
-                                 f"sidecar says {meta['width']} x {meta['height']} x 3")
-        pixels = image.read_image(oiio.FLOAT)
-        if pixels is None or image.has_error:
-            raise TableFileError(f"{str(path)!r} is truncated or corrupt: "
-                                 f"{_one_line(image.geterror())}")
-    finally:
-        image.close()
-    pixels = np.asarray(pixels, np.float32).reshape(shape)[::-1]
-    if _hash(pixels) != meta["sha256"]:
-        raise TableFileError(f"{str(path)!r} is corrupt: its pixels do not match the sidecar's "
-                             "sha256; re-bake the tables")
-    return pixels
+def _grids(meta: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(theta_deg, phi_deg, radius_mm)`` of sidecar data."""
+    grids = meta["grids"]
+    return tuple(np.asarray(grids[k], float) for k in ("theta_deg", "phi_deg", "radius_mm"))
 
 
-def load_tables(path) -> Tables:
-    """Read tables written by :func:`save_tables` (the ``.exr`` or its ``.json``).
+def _stored_angular_names(meta: dict) -> tuple[str, ...]:
+    """The angular tables the sidecar data's layout holds."""
+    return tuple(name for name in ANGULAR + ("inter_reflection",) if name in meta["layout"])
 
-    Validates format version, image size, layout, grids and the content hash; raises
-    :class:`TableFileError` naming the file and the problem otherwise.  Values are the stored
-    float32 numbers (as float64 arrays)."""
-    path = Path(path)
-    path = path.with_suffix(".exr") if path.suffix.lower() == ".json" else path
-    if not path.is_file():
-        raise TableFileError(f"{str(path)!r} does not exist")
-    meta = _read_sidecar(path)
-    try:
-        grids = meta["grids"]
-        theta, phi, radius = (np.asarray(grids[k], float)
-                              for k in ("theta_deg", "phi_deg", "radius_mm"))
-        angular = tuple(name for name in ANGULAR + ("inter_reflection",)
-                        if name in meta["layout"])
-        expected = _layout(theta.size, phi.size, radius.size, angular)
-        if expected["blocks"] != meta["layout"] or (expected["width"], expected["height"]) != (
-                meta["width"], meta["height"]):
-            raise TableFileError(f"{str(sidecar_path(path))!r}: layout does not match its grids")
-        pixels = _read_pixels(path, meta).astype(float)
-        blocks = meta["layout"]
-        n, p = theta.size, phi.size
-        arrays = {name: pixels[blocks[name]["row"]:blocks[name]["row"] + n, :n * p].reshape(
-            n, n, p, 3) for name in angular}
-        arrays.update({name: pixels[blocks[name]["row"], :blocks[name]["columns"]]
-                       for name in DIRECTIONAL + RADIAL})
-        constants = pixels[blocks["constants"]["row"], :len(CONSTANT)]
-        arrays.update({name: constants[i] for i, name in enumerate(CONSTANT)})
-        spacing = {k: grids[k] for k in ("theta_spacing", "theta_offset", "phi_spacing",
-                                         "radius_spacing")}
-        return Tables(theta_deg=theta, phi_deg=phi, radius_mm=radius, **arrays,
-                      parameters=meta["parameters"], **spacing)
-    except TableFileError:
-        raise
-    except (KeyError, TypeError, ValueError) as error:
-        raise TableFileError(f"{str(sidecar_path(path))!r} is inconsistent: {error}") from None
+
+def check_layout(meta: dict, where: str) -> None:
+    """:class:`TableFileError` naming ``where`` unless the sidecar data's layout and image size
+    are :func:`atlas_layout` of its grids (``KeyError``, ``TypeError`` or ``ValueError`` when an
+    entry is missing or malformed)."""
+    theta, phi, radius = _grids(meta)
+    expected = atlas_layout(theta.size, phi.size, radius.size, _stored_angular_names(meta))
+    if expected["blocks"] != meta["layout"] or (expected["width"], expected["height"]) != (
+            meta["width"], meta["height"]):
+        raise TableFileError(f"{where!r}: layout does not match its grids")
+
+
+def tables_from_atlas(pixels: np.ndarray, meta: dict) -> Tables:
+    """The tables stored in atlas ``pixels`` ``(height, width, 3)`` (row 0 at the bottom)
+    described by sidecar data ``meta`` (checked by :func:`check_layout`): the stored float32
+    values as float64 arrays (``KeyError``, ``TypeError`` or ``ValueError`` when an entry is
+    missing or malformed)."""
+    theta, phi, radius = _grids(meta)
+    angular = _stored_angular_names(meta)
+    pixels = np.asarray(pixels, np.float32).astype(float)
+    blocks = meta["layout"]
+    n, p = theta.size, phi.size
+    arrays = {name: pixels[blocks[name]["row"]:blocks[name]["row"] + n, :n * p].reshape(
+        n, n, p, 3) for name in angular}
+    arrays.update({name: pixels[blocks[name]["row"], :blocks[name]["columns"]]
+                   for name in DIRECTIONAL + RADIAL})
+    constants = pixels[blocks["constants"]["row"], :len(CONSTANT)]
+    arrays.update({name: constants[i] for i, name in enumerate(CONSTANT)})
+    grids = meta["grids"]
+    spacing = {k: grids[k] for k in ("theta_spacing", "theta_offset", "phi_spacing",
+                                     "radius_spacing")}
+    return Tables(theta_deg=theta, phi_deg=phi, radius_mm=radius, **arrays,
+                  parameters=meta["parameters"], **spacing)

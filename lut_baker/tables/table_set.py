@@ -8,8 +8,10 @@ afterwards (by a shader socket or by :meth:`Tables.made_up_reflection`)::
         + (1 - w) [skin_gloss + skin_diffuse]
 
 ``T`` is the film's directional transmittance (light crosses the film twice on path 3, so
-its pigment absorbs twice).  The skin's diffuse part of path 3 is the part that spreads under
-the surface with the dipole's normalised profile ``profile = R(d) / Rd`` (SPEC 4).
+its pigment absorbs twice).  The weights ``w``, ``1 - w``, ``1 - A``, ``(1 - A)^2`` are
+:func:`lut_baker.model.made_up_skin.coverage_weights`.  The skin's diffuse part of path 3 is
+the part that spreads under the surface with the dipole's normalised profile
+``profile = R(d) / Rd`` (docs/model.md §4).
 
 Angular tables are indexed ``[theta_i, theta_o, phi]`` on the grids ``theta_deg`` (degrees
 from the normal) and ``phi_deg`` (relative azimuth, degrees, 0..180 by symmetry); radial ones by
@@ -62,6 +64,9 @@ from __future__ import annotations
 from dataclasses import dataclass, field, fields
 
 import numpy as np
+
+from ..model.made_up_skin import coverage_weights
+from ..numerics.geometry import folded_azimuth_deg, polar_angle_deg
 
 __all__ = [
     "FORMAT_VERSION",
@@ -160,23 +165,17 @@ def theta_index(theta_deg, n: int, spacing: str, theta_max_deg: float,
     return x / top * (n - 1)
 
 
-def _folded_azimuth_deg(wi: np.ndarray, wo: np.ndarray) -> np.ndarray:
-    """Relative azimuth of ``wi`` and ``wo`` folded into [0, 180] degrees."""
-    phi = np.arctan2(wi[..., 1], wi[..., 0]) - np.arctan2(wo[..., 1], wo[..., 0])
-    return np.abs(np.mod(np.degrees(phi) + 180.0, 360.0) - 180.0)
-
-
 def phi_index(wi, wo, n: int, spacing: str = "half_vector") -> np.ndarray:
     """Fractional index of the azimuth coordinate of unit directions ``wi``, ``wo``
     ``(..., 3)`` on ``n`` nodes over [0, 180] (module docstring)."""
     _check_spacing(spacing, PHI_SPACINGS, "phi_spacing")
     wi, wo = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
     if spacing == "uniform":
-        return _folded_azimuth_deg(wi, wo) / 180.0 * (n - 1)
-    theta_i, theta_o = _polar_deg(wi), _polar_deg(wo)
+        return folded_azimuth_deg(wi, wo) / 180.0 * (n - 1)
+    theta_i, theta_o = polar_angle_deg(wi), polar_angle_deg(wo)
     h = wi + wo
     length = np.linalg.norm(h, axis=-1)
-    alpha = _polar_deg(h / np.where(length > 1e-12, length, 1.0)[..., None])
+    alpha = polar_angle_deg(h / np.where(length > 1e-12, length, 1.0)[..., None])
     span = np.minimum(theta_i, theta_o)
     fraction = (0.5 * (theta_i + theta_o) - alpha) / np.where(span > 1e-9, span, 1.0)
     return np.where(span > 1e-9, np.clip(fraction, 0.0, 1.0), 0.0) * (n - 1)
@@ -244,10 +243,6 @@ def _trilinear(table: np.ndarray, xi: np.ndarray, xo: np.ndarray, xp: np.ndarray
             for dk, wk in ((0, 1.0 - tk), (1, tk)):
                 out = out + (wi * wj * wk)[..., None] * table[i + di, j + dj, k + dk]
     return out
-
-
-def _polar_deg(w: np.ndarray) -> np.ndarray:
-    return np.degrees(np.arccos(np.clip(w[..., 2], -1.0, 1.0)))
 
 
 @dataclass(frozen=True, eq=False)
@@ -354,8 +349,8 @@ class Tables:
         """Angular table ``name`` interpolated trilinearly at unit directions ``(..., 3)``;
         shape ``(..., 3)``."""
         wi, wo = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
-        return _trilinear(np.asarray(getattr(self, name)), self.theta_index(_polar_deg(wi)),
-                          self.theta_index(_polar_deg(wo)),
+        return _trilinear(np.asarray(getattr(self, name)), self.theta_index(polar_angle_deg(wi)),
+                          self.theta_index(polar_angle_deg(wo)),
                           phi_index(wi, wo, self.phi_deg.size, self.phi_spacing))
 
     def directional(self, name: str, theta_deg) -> np.ndarray:
@@ -368,7 +363,9 @@ class Tables:
         value = _linear(np.asarray(self.profile), self.radius_index(d))
         return np.where((d <= self.radius_mm[-1])[..., None], value, 0.0)
 
-    def _mix(self, coverage, absorption) -> tuple[float, np.ndarray]:
+    def coverage_and_absorption(self, coverage=None, absorption=None) -> tuple[float, np.ndarray]:
+        """``(coverage, absorption (3,))``: the given ones, or where None those the tables were
+        baked for (``parameters``)."""
         w = self.parameters.get("coverage", 1.0) if coverage is None else coverage
         a = self.parameters.get("absorption", 0.0) if absorption is None else absorption
         return float(w), np.broadcast_to(np.asarray(a, float), (3,))
@@ -377,16 +374,16 @@ class Tables:
         """The module docstring's formula from angular ``parts`` (by table name) and the film
         transmittances ``t_i``, ``t_o``; the inter-reflection part, baked at one absorption,
         is scaled by ``((1 - A) / (1 - A_baked))^2``."""
-        w, a = self._mix(coverage, absorption)
-        through = 1.0 - a
+        weights = coverage_weights(*self.coverage_and_absorption(coverage, absorption))
         path3 = parts["path3_gloss"] + self.skin_diffuse * t_i * t_o
-        film = parts["film_gloss"] + through * self.film_diffuse + through**2 * path3
+        film = (parts["film_gloss"] + weights.once * self.film_diffuse
+                + weights.twice * path3)
         if self.inter_reflection is not None:
-            baked = 1.0 - np.broadcast_to(np.asarray(self.parameters.get("absorption", 0.0)),
-                                          (3,))
-            ratio = np.where(baked > 0.0, through / np.where(baked > 0.0, baked, 1.0), 0.0)
+            baked = coverage_weights(*self.coverage_and_absorption()).once
+            ratio = np.where(baked > 0.0, weights.once / np.where(baked > 0.0, baked, 1.0), 0.0)
             film = film + parts["inter_reflection"] * ratio**2
-        return w * film + (1.0 - w) * (parts["skin_gloss"] + self.skin_diffuse)
+        return (weights.covered * film
+                + weights.bare * (parts["skin_gloss"] + self.skin_diffuse))
 
     def _angular_names(self) -> tuple[str, ...]:
         return ANGULAR + (("inter_reflection",) if self.inter_reflection is not None else ())
@@ -398,8 +395,8 @@ class Tables:
         ``wi`` or ``wo`` is below the surface."""
         wi, wo = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
         parts = {name: self.angular(name, wi, wo) for name in self._angular_names()}
-        t_i = self.directional("film_transmittance", _polar_deg(wi))
-        t_o = self.directional("film_transmittance", _polar_deg(wo))
+        t_i = self.directional("film_transmittance", polar_angle_deg(wi))
+        t_o = self.directional("film_transmittance", polar_angle_deg(wo))
         value = self._combine(parts, t_i, t_o, coverage, absorption)
         upper = (wi[..., 2] >= 0.0) & (wo[..., 2] >= 0.0)
         return np.where(upper[..., None], value, 0.0)
@@ -414,12 +411,11 @@ class Tables:
     def directional_albedo(self, theta_deg, coverage=None, absorption=None) -> np.ndarray:
         """``Int f(wi, wo) cos(theta_o) dwo`` (paths 1 + 3, no inter-reflection) at incidence
         ``theta_deg`` (degrees) from the albedo tables; shape ``(..., 3)``."""
-        w, a = self._mix(coverage, absorption)
-        through = 1.0 - a
+        weights = coverage_weights(*self.coverage_and_absorption(coverage, absorption))
         path3 = (self.directional("path3_gloss_albedo", theta_deg) + self.skin_diffuse
                  * self.directional("film_transmittance", theta_deg)
                  * self.film_transmittance_integral)
         film = (self.directional("film_gloss_albedo", theta_deg)
-                + through * np.pi * self.film_diffuse + through**2 * path3)
+                + weights.once * np.pi * self.film_diffuse + weights.twice * path3)
         bare = self.directional("skin_gloss_albedo", theta_deg) + np.pi * self.skin_diffuse
-        return w * film + (1.0 - w) * bare
+        return weights.covered * film + weights.bare * bare

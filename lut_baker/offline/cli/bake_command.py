@@ -24,7 +24,7 @@ import time
 import types
 from pathlib import Path, PurePosixPath, PureWindowsPath
 
-__all__ = ["HELP", "configure", "run", "skin_from_args", "stem_problem"]
+__all__ = ["HELP", "configure", "run", "skin_from_args", "stem_problem", "Progress"]
 
 HELP = "bake a made-up skin's lookup tables to an OpenEXR atlas + JSON sidecar"
 PROG = "python -m lut_baker bake"
@@ -152,7 +152,7 @@ def skin_from_args(args):
         raise ValueError(f"argument {where}: {error}") from None
 
 
-class _Progress:
+class Progress:
     """A progress bar on a terminal (stderr), nothing otherwise."""
 
     def __init__(self, stream=sys.stderr):
@@ -180,16 +180,17 @@ def _failed(error: Exception) -> int:
 
 def run(args) -> int:
     from ...bake import bake
-    from ...tables.codec import _oiio, check_target, content_hash, save_tables
+    from ...tables.codec import content_hash
+    from ..exr_files import check_target, require_oiio, save_tables
 
     skin = skin_from_args(args)
     stem = args.name or _default_stem(skin.name)
     try:  # before the bake: fail in a moment, not after it
-        _oiio()
+        require_oiio()
         target = check_target(args.out / f"{stem}.exr")
     except (ImportError, OSError) as error:
         return _failed(error)
-    progress = _Progress()
+    progress = Progress()
     start = time.perf_counter()
     try:
         tables = bake(skin, args.resolution, inter_reflection=args.inter_reflection,

@@ -40,14 +40,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ...model.layers import (
-    Dipole,
-    ReflectionLayer,
-    TransmissionLayer,
-    dipole_profile,
-    ts_reflection,
-    ts_transmission,
-)
+from ...model.dipole import dipole_profile
+from ...model.layers import Dipole, ReflectionLayer, TransmissionLayer
+from ...model.microfacet import ts_reflection, ts_transmission
 from ...model.presets import paper_layers
 from .protocols import (
     profile_distances,

@@ -33,8 +33,9 @@ from scipy.optimize import least_squares
 from ...closures import cycles as cc
 from ...closures import fitting
 from ...model.made_up_skin import MadeUpSkin
+from ...numerics.geometry import sphere_directions
 from ...tables.table_set import Tables
-from .compare import local_image, sphere_directions
+from .compare import local_image
 
 __all__ = ["LIGHTS_DEG", "FIT_RESOLUTION", "MAX_EVALUATIONS", "Baseline", "principled_image",
            "fit_baseline"]

@@ -21,8 +21,9 @@ Functions
 - :func:`lambert_image` -- the analytic image of a Lambertian sphere, ``E a / pi max(0, N.L)``.
 - :func:`reference_image` -- the made-up sphere's reference, exact or with paths 1 + 3 read
   from baked tables (same geometry and spread as :func:`lut_baker.offline.validation.reference.sphere_image`).
-- :func:`local_image` -- the image of any local reflection function (no spread);
-  :func:`sphere_directions` -- its pixels' local light and view directions.
+- :func:`local_image` -- the image of any local reflection function (no spread), at the
+  pixels' local light and view directions
+  (:func:`lut_baker.numerics.geometry.sphere_directions`).
 - :func:`pareto_front` -- the points no other point beats in both cost and error.
 """
 
@@ -31,6 +32,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...model.made_up_skin import MadeUpSkin
+from ...numerics.geometry import light_direction, sphere_directions, sphere_normals
 from ..validation import reference
 
 __all__ = [
@@ -42,14 +44,13 @@ __all__ = [
     "lambert_image",
     "reference_image",
     "local_image",
-    "sphere_directions",
     "pareto_front",
 ]
 
 
 def sphere_mask(resolution: int) -> np.ndarray:
     """``(n, n)`` booleans: pixel centres inside the sphere's disk (the reference's mask)."""
-    return reference.sphere_points(resolution, 1.0)[2]
+    return sphere_normals(resolution)[1]
 
 
 def from_blender_pixels(pixels, resolution: int) -> np.ndarray:
@@ -106,8 +107,8 @@ def lambert_image(resolution: int, light_angle_deg: float, albedo: float = 0.8,
                   irradiance: float = 1.0) -> np.ndarray:
     """The analytic image of a Lambertian sphere: ``E albedo / pi max(0, N.L)`` per pixel
     centre (the light ``light_angle_deg`` degrees from the view), ``(n, n, 3)``."""
-    _, normals, mask = reference.sphere_points(resolution, 1.0)
-    cosine = np.clip(normals @ reference.light_direction(light_angle_deg), 0.0, None)
+    normals, mask = sphere_normals(resolution)
+    cosine = np.clip(normals @ light_direction(light_angle_deg), 0.0, None)
     value = np.where(mask, irradiance * albedo / np.pi * cosine, 0.0)
     return np.repeat(value[..., None], 3, axis=-1)
 
@@ -133,7 +134,7 @@ def reference_image(skin: MadeUpSkin, *, tables=None, resolution: int = 64,
                         resolution, light_angle_deg, irradiance)
     if spread:
         _, normals, mask = reference.sphere_points(resolution, radius_mm)
-        light = reference.light_direction(light_angle_deg)
+        light = light_direction(light_angle_deg)
         points = normals[mask]
         samples = samples or reference.default_samples(skin, radius_mm)
         image[mask] += (reference.spread_diffuse(points, light, skin, radius_mm=radius_mm,
@@ -152,21 +153,6 @@ def local_image(reflection, resolution: int, light_angle_deg: float,
     image = np.zeros((resolution, resolution, 3))
     image[lit] = irradiance * np.asarray(reflection(wi, wo)) * wi[:, 2:3]
     return image
-
-
-def sphere_directions(resolution: int, light_angle_deg: float):
-    """``(lit (n, n) booleans, wi (P, 3), wo (P, 3))``: the pixels whose centre sees a lit
-    point of the sphere, and at those points (row-major order) the local unit directions to
-    the light and to the camera (normal = +z)."""
-    _, normals, mask = reference.sphere_points(resolution, 1.0)
-    light = reference.light_direction(light_angle_deg)
-    points = normals[mask]
-    wi = reference.local_directions(np.broadcast_to(light, points.shape), points)
-    wo = reference.local_directions(np.broadcast_to(reference.VIEW, points.shape), points)
-    seen = (wi[:, 2] > 0.0) & (wo[:, 2] > 0.0)
-    lit = np.zeros_like(mask)
-    lit[mask] = seen
-    return lit, wi[seen], wo[seen]
 
 
 def pareto_front(cost, error) -> np.ndarray:

@@ -10,8 +10,9 @@ where it entered but spread over the lit surface by the dipole's normalised prof
 
 Functions
 ---------
-- :func:`sphere_points` -- pixel centres on the sphere: positions (mm), normals, mask.
-- :func:`local_directions` -- world directions into each point's tangent frame.
+- :func:`sphere_points` -- pixel centres on the sphere: positions (mm), normals, mask (the
+  framing of :mod:`lut_baker.numerics.geometry`, which also takes world directions into each
+  point's tangent frame).
 - :func:`fibonacci_sphere` -- near-uniform surface samples with equal areas (mm^2).
 - :func:`local_radiance` -- radiance of paths 1 + 3 at each point (nothing spread).
 - :func:`local_diffuse` -- the skin-diffuse part of paths 1 + 3 where it entered.
@@ -26,33 +27,25 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
+from ...evaluate.made_up import made_up_reflection
 from ...evaluate.two_layer import film_transmittance
-from ...model.layers import dipole_profile, dipole_total_reflectance
-from ...model.made_up_skin import MadeUpSkin, film_transmission_layer, made_up_reflection
-from ...numerics.quadrature import direction
+from ...model.dipole import dipole_profile, dipole_total_reflectance
+from ...model.made_up_skin import MadeUpSkin, coverage_weights, film_transmission_layer
+from ...numerics.cache import LRUCache
+from ...numerics.geometry import VIEW, direction, light_direction, local_directions, sphere_normals
+from ...numerics.quadrature import cumulative_trapezoid
 
 __all__ = [
     "sphere_points",
-    "local_directions",
     "fibonacci_sphere",
     "local_radiance",
     "local_diffuse",
     "default_samples",
-    "light_direction",
     "spread_diffuse",
     "sphere_image",
     "spread_convergence",
     "profile_cutoff_mm",
 ]
-
-VIEW = np.array([0.0, 0.0, 1.0])
-"""Direction toward the orthographic camera, world frame."""
-
-
-def light_direction(angle_from_view_deg: float) -> np.ndarray:
-    """Unit vector toward a light ``angle_from_view_deg`` (degrees) from the view, in x-z."""
-    a = np.radians(angle_from_view_deg)
-    return np.array([np.sin(a), 0.0, np.cos(a)])
 
 
 def sphere_points(resolution: int, radius_mm: float):
@@ -63,29 +56,8 @@ def sphere_points(resolution: int, radius_mm: float):
     """
     if resolution < 1 or not radius_mm > 0:
         raise ValueError("resolution must be >= 1 and radius_mm > 0 (mm)")
-    centres = (np.arange(resolution) + 0.5) / resolution * 2.0 - 1.0
-    x, y = np.meshgrid(centres, -centres)
-    r2 = x * x + y * y
-    mask = r2 < 1.0
-    z = np.sqrt(np.clip(1.0 - r2, 0.0, None))
-    normals = np.where(mask[..., None], np.stack([x, y, z], axis=-1), 0.0)
+    normals, mask = sphere_normals(resolution)
     return normals * radius_mm, normals, mask
-
-
-def _tangent_frame(normals: np.ndarray):
-    """An orthonormal tangent and bitangent per normal (any: the model is isotropic)."""
-    helper = np.where(np.abs(normals[..., 2:3]) < 0.9, [0.0, 0.0, 1.0], [1.0, 0.0, 0.0])
-    tangent = np.cross(helper, normals)
-    tangent /= np.linalg.norm(tangent, axis=-1, keepdims=True)
-    return tangent, np.cross(normals, tangent)
-
-
-def local_directions(world: np.ndarray, normals: np.ndarray) -> np.ndarray:
-    """Express world unit vectors ``(..., 3)`` in each normal's local frame (normal = +z)."""
-    tangent, bitangent = _tangent_frame(normals)
-    local = np.stack([np.sum(world * tangent, -1), np.sum(world * bitangent, -1),
-                      np.sum(world * normals, -1)], axis=-1)
-    return local / np.linalg.norm(local, axis=-1, keepdims=True)
 
 
 def fibonacci_sphere(count: int, radius_mm: float):
@@ -121,8 +93,7 @@ def profile_cutoff_mm(skin: MadeUpSkin, lost_fraction: float = 1e-3) -> float:
     total ``Rd = 2 pi Int R(d) d dd`` in every channel."""
     d = np.concatenate([[0.0], np.geomspace(1e-4, 1e4, 4000)])
     profile = np.reshape(dipole_profile(d, skin.dipole), (d.size, -1))
-    ring = 0.5 * (profile[1:] * d[1:, None] + profile[:-1] * d[:-1, None]) * np.diff(d)[:, None]
-    captured = 2.0 * np.pi * np.cumsum(ring, axis=0)
+    captured = 2.0 * np.pi * cumulative_trapezoid(profile * d[:, None], d)
     rd = np.reshape(dipole_total_reflectance(skin.dipole), (1, -1))
     inside = np.all(captured >= (1.0 - lost_fraction) * rd, axis=1)
     return float(d[1:][np.argmax(inside)]) if np.any(inside) else float(d[-1])
@@ -133,7 +104,7 @@ TRANSMITTANCE_NODES = 1025
 so the interpolation error (< 1e-7 relative) stays far below the reference's tolerance."""
 
 
-_TRANSMITTANCE_CACHE: dict = {}
+_TRANSMITTANCE_CACHE = LRUCache(8)
 """``T`` on the polar nodes per film layer (keyed by its parameters, at most 8 kept): the
 tabulation takes seconds and one spread image needs it four times."""
 
@@ -142,13 +113,8 @@ def _film_transmittance_rgb(local: np.ndarray, skin: MadeUpSkin) -> np.ndarray:
     """``(1 - A) T(w)`` per point for local directions (P, 3): the film crossed once, RGB."""
     film_t = film_transmission_layer(skin)
     theta = np.linspace(0.0, np.pi / 2, TRANSMITTANCE_NODES)
-    key = repr(film_t.as_dict())
-    nodes = _TRANSMITTANCE_CACHE.get(key)
-    if nodes is None:
-        nodes = np.reshape(film_transmittance(direction(theta, 0.0), film_t), (theta.size, -1))
-        while len(_TRANSMITTANCE_CACHE) >= 8:
-            _TRANSMITTANCE_CACHE.pop(next(iter(_TRANSMITTANCE_CACHE)))
-        _TRANSMITTANCE_CACHE[key] = nodes
+    nodes = _TRANSMITTANCE_CACHE.get_or_compute(repr(film_t.as_dict()), lambda: np.reshape(
+        film_transmittance(direction(theta, 0.0), film_t), (theta.size, -1)))
     polar = np.arccos(np.clip(local[:, 2], 0.0, 1.0))
     t = np.stack([np.interp(polar, theta, nodes[:, c % nodes.shape[1]]) for c in range(3)], -1)
     return np.where(local[:, 2:3] > 0.0, t, 0.0)
@@ -156,15 +122,17 @@ def _film_transmittance_rgb(local: np.ndarray, skin: MadeUpSkin) -> np.ndarray:
 
 def local_diffuse(normals: np.ndarray, light: np.ndarray, skin: MadeUpSkin,
                   irradiance: float = 1.0) -> np.ndarray:
-    """The skin-diffuse part of paths 1 + 3 where it entered (SPEC 4), radiance (P, 3):
-    ``P_d,s [w T_A(wi) T_A(wo) + (1 - w)] E cos(theta_i)`` with ``T_A = (1 - A) T``."""
+    """The skin-diffuse part of paths 1 + 3 where it entered (docs/model.md §4), radiance (P, 3):
+    ``P_d,s [w T_A(wi) T_A(wo) + (1 - w)] E cos(theta_i)`` with ``T_A = (1 - A) T`` (the
+    weights of :func:`~lut_baker.model.made_up_skin.coverage_weights`)."""
     wi = local_directions(np.broadcast_to(light, normals.shape), normals)
     wo = local_directions(np.broadcast_to(VIEW, normals.shape), normals)
     through = _film_transmittance_rgb(wi, skin) * _film_transmittance_rgb(wo, skin)
     lit = ((wi[:, 2] > 0.0) & (wo[:, 2] > 0.0))[:, None]
-    w = skin.coverage
+    weights = coverage_weights(skin.coverage, skin.absorption)
     p_d = np.asarray(skin.skin.P_d) * np.ones(3)
-    return np.where(lit, p_d * (w * through + (1.0 - w)) * irradiance * wi[:, 2:3], 0.0)
+    return np.where(lit, p_d * (weights.covered * through + weights.bare) * irradiance
+                    * wi[:, 2:3], 0.0)
 
 
 def spread_diffuse(exit_normals: np.ndarray, light: np.ndarray, skin: MadeUpSkin, *,
@@ -205,9 +173,9 @@ def spread_diffuse(exit_normals: np.ndarray, light: np.ndarray, skin: MadeUpSkin
             k = kernel[:, c % kernel.shape[1]]
             bare[chunk, c] = np.bincount(owner, k, rows)
             through[chunk, c] = np.bincount(owner, k * entry_film[neighbours, c], rows)
-    w = skin.coverage
+    weights = coverage_weights(skin.coverage, skin.absorption)
     p_d = np.asarray(skin.skin.P_d) * np.ones(3)
-    out = p_d * (w * exit_film * through + (1.0 - w) * bare)
+    out = p_d * (weights.covered * exit_film * through + weights.bare * bare)
     return np.where(exit_local[:, 2:3] > 0.0, out, 0.0)
 
 

@@ -38,12 +38,12 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ...bake import bake, table_error
-from ...model.made_up_skin import MadeUpSkin, directional_albedo, made_up_reflection
+from ...evaluate.made_up import directional_albedo, made_up_reflection
+from ...model.made_up_skin import MadeUpSkin
 from ...model.presets import made_up_skin
-from ...numerics.quadrature import direction
+from ...numerics.geometry import direction, light_direction
 from .reference import (
     default_samples,
-    light_direction,
     local_diffuse,
     sphere_image,
     sphere_points,

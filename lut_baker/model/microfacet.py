@@ -1,0 +1,253 @@
+"""Torrance-Sparrow reflection and the film's transmission (paper eqs. 2, 4; docs/model.md §2.1,
+§2.2), each term written once, over cosines.
+
+The formulas take the cosines ``n.h``, ``v.h``, ``n.v``, ``n.l`` (any shapes that broadcast
+against each other and against the layer's parameters); the vector functions :func:`ts_reflection`
+and :func:`ts_transmission` compute those cosines from unit vectors ``(..., 3)`` in the local
+frame (normal +z, ``wi`` toward the light, ``wo`` toward the viewer) and call them, and the bake
+computes them from polar angles and relative azimuths (:func:`half_vector_cosines`) and calls the
+same formulas.  Every layer parameter may be a scalar or an RGB triple; vector results have shape
+``batch + channels`` where ``channels`` is ``()`` for scalar layers and ``(3,)`` for RGB ones.
+
+Functions
+---------
+- :func:`fresnel_term` -- unpolarised dielectric Fresnel ``F_r(c, eta)`` (eq. 2);
+  :func:`fresnel_reflectance` checks its arguments first.
+- :func:`distribution_term` -- ``D = exp(-(alpha n)^2)``, alpha in degrees, n in 1/degree
+  (eqs. 2, 4); :func:`microfacet_distribution` checks its arguments first.
+- :func:`attenuation_term` -- Torrance-Sparrow ``G`` (eq. 2); :func:`geometric_attenuation`
+  checks its arguments first.
+- :func:`ts_specular_from_cosines` -- eq. 2's specular term ``P_s D G F_r``.
+- :func:`ts_reflection_from_cosines` -- the BRDF ``P_d + P_s D G F_r`` (eq. 2).
+- :func:`ts_transmission_from_cosines` -- the film's BTDF ``P_d + P_t D(beta) F_t`` (eq. 4).
+- :func:`ts_reflection`, :func:`ts_transmission` -- the same at unit vectors.
+- :func:`half_vector_cosines` -- ``(n.h, v.h)`` from polar angles and a relative azimuth.
+- :func:`check_directions` -- unit vectors ``(..., 3)`` or ``ValueError``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .layers import ReflectionLayer, TransmissionLayer, channel_axis
+
+__all__ = [
+    "UNIT_TOLERANCE",
+    "check_directions",
+    "fresnel_term",
+    "fresnel_reflectance",
+    "distribution_term",
+    "microfacet_distribution",
+    "attenuation_term",
+    "geometric_attenuation",
+    "ts_specular_from_cosines",
+    "ts_reflection_from_cosines",
+    "ts_transmission_from_cosines",
+    "ts_reflection",
+    "ts_transmission",
+    "half_vector_cosines",
+]
+
+UNIT_TOLERANCE = 1e-6
+"""How far ``|w|`` may stray from 1 (and a cosine from [0, 1]) before it is rejected."""
+
+
+# --------------------------------------------------------------------------------------------
+# Directions
+# --------------------------------------------------------------------------------------------
+def check_directions(name: str, w) -> np.ndarray:
+    """Return ``w`` as a float array of unit vectors ``(..., 3)`` or raise ``ValueError``."""
+    w = np.asarray(w, dtype=float)
+    if w.ndim == 0 or w.shape[-1] != 3:
+        raise ValueError(f"{name} must have shape (..., 3), got {w.shape}")
+    if not np.all(np.isfinite(w)):
+        raise ValueError(f"{name} must be finite unit vectors; it holds NaN or Inf")
+    norm = np.linalg.norm(w, axis=-1)
+    if np.any(np.abs(norm - 1.0) > UNIT_TOLERANCE):
+        worst = float(np.max(np.abs(norm - 1.0)))
+        raise ValueError(f"{name} must be unit vectors (|w| = 1 within 1e-6), off by {worst:.3g}")
+    return w
+
+
+def _half_vector(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Normalised ``a + b``; the normal where ``a + b`` vanishes (opposite horizontal pair)."""
+    h = a + b
+    length = np.linalg.norm(h, axis=-1, keepdims=True)
+    safe = length > 1e-12
+    return np.where(safe, h / np.where(safe, length, 1.0), np.array([0.0, 0.0, 1.0]))
+
+
+def half_vector_cosines(cos_a, sin_a, cos_b, sin_b, cos_phi):
+    """``(n.h, v.h)`` of the half vector of ``wa``, ``wb`` (eq. 2) from their polar angles'
+    cosines and sines and the cosine of their relative azimuth (all broadcasting):
+    ``|wa + wb|^2 = 2 + 2 wa.wb``, ``n.h = (cos_a + cos_b) / |wa + wb|``, ``v.h = |wa + wb| / 2``;
+    the normal where ``wa + wb`` vanishes (as :func:`ts_reflection`).  Both in [0, 1]."""
+    dot = cos_a * cos_b + sin_a * sin_b * cos_phi
+    length = np.sqrt(np.maximum(2.0 + 2.0 * dot, 0.0))
+    safe = length > 1e-12
+    n_dot_h = np.where(safe, (cos_a + cos_b) / np.where(safe, length, 1.0), 1.0)
+    v_dot_h = np.where(safe, 0.5 * length, np.broadcast_to(cos_b, length.shape))
+    return np.clip(n_dot_h, 0.0, 1.0), np.clip(v_dot_h, 0.0, 1.0)
+
+
+def _angle_from_normal_deg(cos_angle: np.ndarray) -> np.ndarray:
+    """Angle (degrees) of a unit vector with z-component ``cos_angle`` from the normal."""
+    return np.degrees(np.arccos(np.clip(cos_angle, -1.0, 1.0)))
+
+
+# --------------------------------------------------------------------------------------------
+# The terms of eqs. 2 and 4
+# --------------------------------------------------------------------------------------------
+def fresnel_term(c: np.ndarray, eta: np.ndarray) -> np.ndarray:
+    """Unpolarised dielectric Fresnel reflectance ``F_r(c, eta)`` (paper eq. 2, dimensionless)
+    at cosines ``c`` in [0, 1] and relative index ``eta`` > 0, without argument checks (for
+    inner loops; :func:`fresnel_reflectance` checks).  Total internal reflection gives 1;
+    ``eta = 1`` (no interface) gives 0 at every angle, grazing included."""
+    # g^2 = (eta^2 - 1) + c^2, with eta^2 - 1 = (eta - 1)(eta + 1): no cancellation near
+    # eta = 1 (where g -> c and F -> 0), and no underflow of c^2 for eta >= 1 (hypot).
+    excess = (eta - 1.0) * (eta + 1.0)
+    g2 = excess + c * c
+    g = np.where(excess >= 0.0, np.hypot(np.sqrt(np.maximum(excess, 0.0)), c),
+                 np.sqrt(np.maximum(g2, 0.0)))
+    gpc = g + c
+    gmc = g - c
+    with np.errstate(divide="ignore", invalid="ignore"):
+        first = 0.5 * (gmc / gpc) ** 2
+        second = 1.0 + ((c * gpc - 1.0) / (c * gmc + 1.0)) ** 2
+        f = first * second
+    # g2 < 0 is total internal reflection.  Otherwise g + c = 0 only at eta = 1 and grazing,
+    # where the formula is 0/0: with no interface nothing is reflected.
+    f = np.where(g2 < 0.0, 1.0, np.where(gpc > 0.0, f, 0.0))
+    return np.clip(f, 0.0, 1.0)
+
+
+def fresnel_reflectance(cos_theta, eta):
+    """:func:`fresnel_term` with its arguments checked (paper eq. 2, dimensionless).
+
+    ``cos_theta`` in [0, 1] is the cosine between the direction and the (micro)normal on the
+    incident side; ``eta`` > 0 the relative index.  The two broadcast by numpy's rules.
+
+    >>> float(fresnel_reflectance(1.0, 1.5))  # ((1.5 - 1) / (1.5 + 1))^2
+    0.04
+    """
+    c = np.asarray(cos_theta, dtype=float)
+    eta = np.asarray(eta, dtype=float)
+    if np.any(np.isnan(c)) or np.any((c < -UNIT_TOLERANCE) | (c > 1.0 + UNIT_TOLERANCE)):
+        raise ValueError("cos_theta must lie in [0, 1]")
+    if not np.all(np.isfinite(eta)) or np.any(eta <= 0.0):
+        raise ValueError(f"eta must lie in (0, inf), got {eta!r}")
+    return fresnel_term(np.clip(c, 0.0, 1.0), eta)
+
+
+def distribution_term(angle_deg: np.ndarray, n) -> np.ndarray:
+    """Torrance-Sparrow facet distribution ``D = exp(-(angle n)^2)`` (paper eqs. 2, 4,
+    dimensionless): ``angle_deg`` is alpha (or beta for transmission) in degrees, ``n`` in
+    1/degree; without argument checks (:func:`microfacet_distribution` checks)."""
+    return np.exp(-np.square(angle_deg * n))
+
+
+def microfacet_distribution(angle_deg, n):
+    """:func:`distribution_term` with its arguments checked (paper eqs. 2, 4): finite angles
+    in degrees, ``n`` > 0 in 1/degree."""
+    angle = np.asarray(angle_deg, dtype=float)
+    n = np.asarray(n, dtype=float)
+    if not np.all(np.isfinite(angle)):
+        raise ValueError("angle_deg must be finite angles (degrees)")
+    if not np.all(np.isfinite(n)) or np.any(n <= 0.0):
+        raise ValueError(f"n must lie in (0, inf) (1/degree), got {n!r}")
+    return distribution_term(angle, n)
+
+
+def attenuation_term(n_dot_h, n_dot_v, n_dot_l, v_dot_h) -> np.ndarray:
+    """Torrance-Sparrow shadowing/masking ``G = min(1, 2 NH NV / VH, 2 NH NL / VH)`` (paper
+    eq. 2, dimensionless) of cosines in [0, 1], without argument checks
+    (:func:`geometric_attenuation` checks).  Where ``VH`` is 0 (an opposite horizontal pair)
+    G is 0."""
+    n_dot_h, n_dot_v, n_dot_l, v_dot_h = np.broadcast_arrays(n_dot_h, n_dot_v, n_dot_l, v_dot_h)
+    safe = v_dot_h > 1e-12
+    ratio = 2.0 * n_dot_h * np.minimum(n_dot_v, n_dot_l) / np.where(safe, v_dot_h, 1.0)
+    return np.where(safe, np.clip(ratio, 0.0, 1.0), 0.0)
+
+
+def geometric_attenuation(n_dot_h, n_dot_v, n_dot_l, v_dot_h):
+    """:func:`attenuation_term` with its arguments checked: cosines in [0, 1] (eq. 2)."""
+    cosines = np.broadcast_arrays(*(np.asarray(x, dtype=float)
+                                    for x in (n_dot_h, n_dot_v, n_dot_l, v_dot_h)))
+    if any(np.any(~((x >= 0.0) & (x <= 1.0 + UNIT_TOLERANCE))) for x in cosines):
+        raise ValueError("n_dot_h, n_dot_v, n_dot_l and v_dot_h must lie in [0, 1]")
+    return attenuation_term(*cosines)
+
+
+# --------------------------------------------------------------------------------------------
+# Eqs. 2 and 4 over cosines
+# --------------------------------------------------------------------------------------------
+def ts_specular_from_cosines(n_dot_h, v_dot_h, n_dot_v, n_dot_l, P_s, n, eta,
+                             fresnel=fresnel_term):
+    """Eq. 2's specular term ``P_s D(alpha) G F_r(v.h)`` in the unit of ``P_s`` (1/sr once
+    normalised), ``alpha = acos(n.h)`` in degrees, ``n`` in 1/degree.  ``fresnel(c, eta)``:
+    :func:`fresnel_term` or an accelerator of it (the bake's tabulation)."""
+    alpha = _angle_from_normal_deg(n_dot_h)
+    geometry = attenuation_term(n_dot_h, n_dot_v, n_dot_l, v_dot_h)
+    return P_s * distribution_term(alpha, n) * geometry * fresnel(v_dot_h, eta)
+
+
+def ts_reflection_from_cosines(n_dot_h, v_dot_h, n_dot_v, n_dot_l, layer: ReflectionLayer,
+                               fresnel=fresnel_term):
+    """Torrance-Sparrow BRDF ``f_r = P_d + P_s D(alpha) G F_r(v.h)`` (paper eq. 2), without
+    the cosine, in the unit of ``P_d``/``P_s`` (1/sr once normalised).  The cosines must
+    broadcast against the layer's parameters (a trailing channel axis for RGB layers)."""
+    return layer.P_d + ts_specular_from_cosines(n_dot_h, v_dot_h, n_dot_v, n_dot_l, layer.P_s,
+                                                layer.n, layer.eta, fresnel)
+
+
+def ts_transmission_from_cosines(n_dot_h, v_dot_h, layer: TransmissionLayer,
+                                 fresnel=fresnel_term):
+    """Thin-film BTDF ``f_t = P_d + P_t D(beta) (1 - F_r(v'.h'))`` (paper eq. 4), without the
+    cosine, in the unit of ``P_d``/``P_t``: ``n_dot_h`` is ``n.h'`` (``beta = acos(n.h')`` in
+    degrees), ``v_dot_h`` is ``v'.h'``, with ``v'`` the transmitted direction mirrored through
+    the film plane and ``h'`` the half vector of ``wi`` and ``v'`` (docs/model.md §2.2)."""
+    beta = _angle_from_normal_deg(n_dot_h)
+    through = 1.0 - fresnel(v_dot_h, layer.eta)
+    return layer.P_d + layer.P_t * distribution_term(beta, layer.n) * through
+
+
+# --------------------------------------------------------------------------------------------
+# Eqs. 2 and 4 at unit vectors
+# --------------------------------------------------------------------------------------------
+def ts_reflection(wi, wo, layer: ReflectionLayer, *, check: bool = True):
+    """:func:`ts_reflection_from_cosines` at unit vectors ``wi``, ``wo`` ``(..., 3)`` (paper
+    eq. 2); where either lies below the surface (z < 0) the value is 0.  ``check=False`` skips
+    the direction checks (inner loops that pass unit vectors)."""
+    if check:
+        wi = check_directions("wi", wi)
+        wo = check_directions("wo", wo)
+    wi, wo = np.broadcast_arrays(wi, wo)
+    h = _half_vector(wi, wo)
+    n_dot_l = wi[..., 2]
+    n_dot_v = wo[..., 2]
+    v_dot_h = np.clip(np.sum(wo * h, axis=-1), 0.0, 1.0)
+    cosines = (channel_axis(x, layer) for x in (h[..., 2], v_dot_h, n_dot_v, n_dot_l))
+    value = ts_reflection_from_cosines(*cosines, layer)
+    upper = (n_dot_l >= 0.0) & (n_dot_v >= 0.0)
+    return np.where(channel_axis(upper, layer), value, 0.0)
+
+
+def ts_transmission(wi, wt, layer: TransmissionLayer, *, check: bool = True):
+    """:func:`ts_transmission_from_cosines` at unit vectors ``wi`` above the film (z > 0) and
+    ``wt`` below (z < 0) (paper eq. 4).  The film is symmetric, so the pair mirrored through
+    the film plane gives the same value (light crossing upward); pairs on the same side
+    evaluate to 0.  ``check=False`` skips the direction checks."""
+    if check:
+        wi = check_directions("wi", wi)
+        wt = check_directions("wt", wt)
+    wi, wt = np.broadcast_arrays(wi, wt)
+    crossing = wi[..., 2] * wt[..., 2] <= 0.0
+    # Upward crossing (``wi`` below, or on the horizon with ``wt`` above): mirror the pair.
+    flip = np.where(wi[..., 2:3] < wt[..., 2:3], -1.0, 1.0)
+    top = wi * np.concatenate([np.ones_like(flip), np.ones_like(flip), flip], axis=-1)
+    mirrored = wt * np.concatenate([np.ones_like(flip), np.ones_like(flip), -flip], axis=-1)
+    h = _half_vector(top, mirrored)
+    v_dot_h = np.clip(np.sum(mirrored * h, axis=-1), 0.0, 1.0)
+    value = ts_transmission_from_cosines(channel_axis(h[..., 2], layer),
+                                         channel_axis(v_dot_h, layer), layer)
+    return np.where(channel_axis(crossing, layer), value, 0.0)

@@ -1,0 +1,61 @@
+"""A least-recently-used cache for values whose inputs ``functools.lru_cache`` cannot take.
+
+``functools.lru_cache`` memoises a function of hashable arguments; :class:`LRUCache` is for the
+other cases: the key is built from arrays or records by the caller, or only some results may
+be kept.  Plain Python (it runs inside Blender).
+
+Types
+-----
+- :class:`LRUCache` -- at most ``size`` values by hashable key, the least recently used
+  dropped first.
+"""
+
+from __future__ import annotations
+
+from collections import OrderedDict
+
+__all__ = ["LRUCache"]
+
+
+class LRUCache:
+    """At most ``size`` values (None: no limit) by hashable key; reading or storing a key makes
+    it the most recently used, and storing beyond ``size`` drops the least recently used."""
+
+    def __init__(self, size: int | None):
+        if size is not None and size < 1:
+            raise ValueError(f"size must be >= 1 or None, got {size!r}")
+        self.size = size
+        self._values: OrderedDict = OrderedDict()
+
+    def __len__(self) -> int:
+        return len(self._values)
+
+    def __contains__(self, key) -> bool:
+        return key in self._values
+
+    def get(self, key, default=None):
+        """The value stored under ``key`` (now the most recently used), else ``default``."""
+        if key not in self._values:
+            return default
+        self._values.move_to_end(key)
+        return self._values[key]
+
+    def put(self, key, value) -> None:
+        """Store ``value`` under ``key``, dropping the least recently used beyond ``size``."""
+        self._values[key] = value
+        self._values.move_to_end(key)
+        while self.size is not None and len(self._values) > self.size:
+            self._values.popitem(last=False)
+
+    def get_or_compute(self, key, compute):
+        """The value under ``key``; if there is none, ``compute()`` stored under it first."""
+        if key in self._values:
+            self._values.move_to_end(key)
+            return self._values[key]
+        value = compute()
+        self.put(key, value)
+        return value
+
+    def clear(self) -> None:
+        """Forget every value."""
+        self._values.clear()

@@ -1,0 +1,127 @@
+"""Every name the add-on leaves in users' files and preferences, in one place (no bpy).
+
+These strings are stored in .blend files (custom properties, datablock and node names), in the
+user's presets folder, in keymaps and screen layouts (operator and panel idnames): changing one
+orphans what older files hold.  Other modules import them from here; nothing below imports
+anything.
+
+Identifiers (``bl_idname``):
+
+- :data:`OPERATOR_PREFIX` -- operators are ``makeup_skin.<name>`` (``bpy.ops.makeup_skin``).
+- :data:`CLASS_PREFIX` -- class names ``MAKEUPSKIN_OT_*``, ``MAKEUPSKIN_PT_*``,
+  ``MAKEUPSKIN_MT_*``; a panel's or menu's ``bl_idname`` is its class name.
+- :data:`SETTINGS_ATTRIBUTE` -- ``Material.makeup_skin``, the panel's settings
+  (:class:`makeup_skin_addon.properties.MakeupSkinSettings`); its ID properties are stored
+  under this name.
+- :data:`PRESET_SUBDIR` -- the folder under Blender's ``presets`` where parameter sets are saved.
+
+Custom properties of a material (JSON strings unless said otherwise):
+
+- :data:`RECORD_KEY` -- the surface before Apply, for Revert (:mod:`.convert`).
+- :data:`ERRORS_KEY` -- the tiers' errors at the settings of the last Apply (:mod:`.material`).
+- :data:`CHOICE_KEY` -- the last Fit to Scene choice (:mod:`.scene_fit`).
+- :data:`SAVED_SCALE_KEY`, :data:`SAVED_GLOSS_KEY` -- floats: the Subsurface Scale and Gloss
+  before Fit to Scene set them to 0.
+
+Custom properties of a node group:
+
+- :data:`FIT_KEY` -- the group's record: bake, tier, fit summary, image hashes (:mod:`.nodes`).
+- :data:`LEGACY_TABLES_REF` -- where older versions kept a whole tables image (removed on
+  rebuild).
+
+Datablock and node names (docs/addon.md, "Apply keeps the artist's material" and "The node
+group"; Apply finds groups and images by name and reuses them):
+
+- :data:`MATERIAL_NAME` -- the material Apply adds to an object that has none.
+- :data:`GROUP_NODE` -- name and label of the group node in a made-up material's tree.
+- :data:`FRAME_NAME`, :data:`FRAME_LABEL` -- the frame around the previous surface shader.
+- :func:`group_name` -- ``Made-up Skin <Tier> [<method>] <key>`` (:data:`GROUP_PREFIX`,
+  :data:`METHOD_LABELS`).
+- :func:`lut_image_name` -- ``MakeupSkin LUT <Tier> <key>`` (:data:`LUT_PREFIX`).
+"""
+
+from __future__ import annotations
+
+__all__ = [
+    "OPERATOR_PREFIX",
+    "CLASS_PREFIX",
+    "SETTINGS_ATTRIBUTE",
+    "PRESET_SUBDIR",
+    "RECORD_KEY",
+    "ERRORS_KEY",
+    "CHOICE_KEY",
+    "SAVED_SCALE_KEY",
+    "SAVED_GLOSS_KEY",
+    "FIT_KEY",
+    "LEGACY_TABLES_REF",
+    "MATERIAL_NAME",
+    "GROUP_NODE",
+    "FRAME_NAME",
+    "FRAME_LABEL",
+    "GROUP_PREFIX",
+    "METHOD_LABELS",
+    "LUT_PREFIX",
+    "group_name",
+    "lut_image_name",
+]
+
+# --- identifiers ---------------------------------------------------------------------------
+OPERATOR_PREFIX = "makeup_skin"
+"""Operator ``bl_idname`` prefix: ``makeup_skin.apply`` and so on."""
+CLASS_PREFIX = "MAKEUPSKIN"
+"""Prefix of the add-on's class names, hence of its panels' and menus' ``bl_idname``."""
+SETTINGS_ATTRIBUTE = "makeup_skin"
+"""Name of the settings pointer on ``bpy.types.Material`` (the code reads it as
+``material.makeup_skin``)."""
+PRESET_SUBDIR = "makeup_skin"
+"""Folder under Blender's ``presets`` where parameter sets are saved."""
+
+# --- custom properties of a material ---------------------------------------------------------
+RECORD_KEY = "makeup_skin_previous_surface"
+"""Material custom property (JSON): the previous surface's node, its output socket, its parent
+and location, and the output node, for :func:`makeup_skin_addon.convert.revert`."""
+ERRORS_KEY = "makeup_skin_errors"
+"""Material custom property: the tiers' errors at the settings of the last Apply (JSON): per
+tier its angular ``rms`` and ``albedo`` errors, ``gloss_omission`` (per light angle, what
+Gloss 0 changes in a sphere's image, :func:`lut_baker.auto_tier.gloss_omissions`), the
+``coverage``, ``absorption`` and tables ``key`` they were measured for."""
+CHOICE_KEY = "makeup_skin_scene_fit"
+"""Material custom property: the last Fit to Scene choice (JSON), shown in the panel."""
+SAVED_SCALE_KEY = "makeup_skin_saved_subsurface_scale"
+"""Material custom property: the Subsurface Scale before Fit to Scene set it to 0."""
+SAVED_GLOSS_KEY = "makeup_skin_saved_gloss"
+"""Material custom property: the Gloss before Fit to Scene set it to 0."""
+
+# --- custom properties of a node group -------------------------------------------------------
+FIT_KEY = "makeup_skin_fit"
+"""Custom property of a group: its tables key, tier and the fit's summary (JSON)."""
+LEGACY_TABLES_REF = "makeup_skin_tables"
+"""Custom property by which older versions kept a whole tables image in the file; removed when
+the group is rebuilt."""
+
+# --- datablock and node names ------------------------------------------------------------------
+MATERIAL_NAME = "Made-up Skin"
+"""Name of the material Apply adds to an object without one."""
+GROUP_NODE = "Made-up Skin"
+"""Name of the group node in a made-up material's node tree."""
+FRAME_NAME = "Made-up Skin: previous surface"
+"""Name of the frame around the previous surface shader."""
+FRAME_LABEL = "Before Made-up Skin (Revert restores it)"
+"""Label of that frame."""
+GROUP_PREFIX = "Made-up Skin"
+"""Start of every node group name (:func:`group_name`)."""
+METHOD_LABELS = {"BURLEY": "Burley", "RANDOM_WALK": "RW", "RANDOM_WALK_SKIN": "RW Skin"}
+"""A forced subsurface method's part of a group name."""
+LUT_PREFIX = "MakeupSkin LUT "
+"""Start of every view-angle image name (:func:`lut_image_name`)."""
+
+
+def group_name(tier: str, key: str, method: str | None = None) -> str:
+    """``Made-up Skin <Tier> [<method>] <key>``; no method: the fit's own choice."""
+    label = f" {METHOD_LABELS[method]}" if method else ""
+    return f"{GROUP_PREFIX} {tier.title()}{label} {key[:8]}"
+
+
+def lut_image_name(key: str, tier: str = "LAYERED") -> str:
+    """``MakeupSkin LUT <Tier> <key>``: the name of the Layered tier's view-angle image."""
+    return f"{LUT_PREFIX}{tier.title()} {key[:16]}"
