@@ -1,4 +1,4 @@
-"""The Auto tier (issue 5, item 5): model no more than the scene needs.
+"""The Auto tier: model no more than the scene needs.
 
 From a description of the scene (camera, resolution, the object's size in mm, its distance or
 pixel footprint, the lights, the engine, the samples) this module predicts, for every

@@ -1,6 +1,6 @@
 """Bake a made-up skin into lookup tables (:class:`lut_baker.tables.table_set.Tables`), fast.
 
-Path 3 is a product of matrices per azimuthal Fourier order (SPEC 3): the bake evaluates
+Path 3 is a product of matrices per azimuthal Fourier order (docs/model.md §3): the bake evaluates
 :func:`lut_baker.evaluate.two_layer.layered_fourier_matrices` with the table's polar grid as the outer
 angles and sums the cosine series on the table's azimuth grid.  What makes it fast:
 

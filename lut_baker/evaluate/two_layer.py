@@ -1,4 +1,4 @@
-"""The two-layer functions of made-up skin (paper section 3, SPEC section 3).
+"""The two-layer functions of made-up skin (paper section 3, docs/model.md §3).
 
 Path 3, light through the film, reflected by the skin's surface, back through the film::
 
@@ -15,9 +15,9 @@ levels agree, which makes it the project's exact evaluator.
 
 Functions
 ---------
-- :func:`layered_reflection` -- ``f_cs`` (paper eq. 7, SPEC 3) at given directions.
+- :func:`layered_reflection` -- ``f_cs`` (paper eq. 7, docs/model.md §3) at given directions.
 - :func:`layered_reflection_converged` -- the same, refined until two levels agree.
-- :func:`transmission_factor` -- path 4's angular factor (paper eq. 8, SPEC 3).
+- :func:`transmission_factor` -- path 4's angular factor (paper eq. 8, docs/model.md §3).
 - :func:`film_transmittance` -- ``Int f_t(w, -u) cos(theta_u) du``, the film's directional
   transmittance.
 - :func:`reflection_albedo` -- ``Int f_r(wi, wo) cos(theta_o) dwo`` of a reflecting layer.
@@ -134,7 +134,7 @@ def layered_fourier_matrices(theta_i, theta_o, cosmetic, skin, grid: HemisphereG
 
     ``theta_i``, ``theta_o``: polar angles (radians) of the outer directions; returns shape
     ``(orders, len(theta_i), len(theta_o), C)``.  Cost: one kernel table per layer and two
-    batched matrix products per order (SPEC 3).  ``fourier``: the function giving each layer's
+    batched matrix products per order (docs/model.md §3).  ``fourier``: the function giving each layer's
     kernel coefficients (signature of :func:`layer_fourier_kernel`, e.g. a faster or cached one).
     ``orders``: keep only the first orders (1 for azimuth-integrated quantities such as albedos:
     the kernels are still sampled at every azimuth, but the products run once).
@@ -183,7 +183,7 @@ def _fourier_sum(matrices_diag: np.ndarray, phi: np.ndarray) -> np.ndarray:
 
 def layered_reflection(wi, wo, cosmetic: TransmissionLayer, skin: ReflectionLayer, *,
                        level: int = 0, grid: HemisphereGrid | None = None):
-    """Path 3 of made-up skin, ``f_cs(wi, wo)`` (paper eq. 7, SPEC 3), without the cosine.
+    """Path 3 of made-up skin, ``f_cs(wi, wo)`` (paper eq. 7, docs/model.md §3), without the cosine.
 
     ``wi``, ``wo``: unit vectors ``(..., 3)``; 0 where either is below the surface.  Units:
     cosmetic units squared times skin units (albedo units in, albedo units out).
@@ -234,7 +234,7 @@ def layered_reflection_converged(wi, wo, cosmetic, skin, *, rtol: float = 1e-4,
 
 def transmission_factor(w, cosmetic: TransmissionLayer, skin: Dipole, *, level: int = 0):
     """Path 4's angular factor ``t(w) = Int f_t(w, -u) F_t(eta_s, u) cos(theta_u) du``
-    (paper eq. 8, SPEC 3): light through the film into the skin (or out of it, by
+    (paper eq. 8, docs/model.md §3): light through the film into the skin (or out of it, by
     reciprocity).  ``w``: unit vectors ``(..., 3)``, 0 below the surface."""
     w = check_directions("w", w)
     grid = grid_for(cosmetic, level=level)

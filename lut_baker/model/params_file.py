@@ -14,7 +14,7 @@ A parameter file starts from presets and overrides what it names::
     [skin_surface]         # skin surface reflection (eq. 2): P_d, P_s, n, eta
     [dipole]               # skin subsurface (eq. 6): sigma_s, sigma_a in 1/mm, g, eta
 
-Values are albedo units (1/sr, SPEC 4) unless ``units = "counts"``: then ``[film]``,
+Values are albedo units (1/sr, docs/model.md §4) unless ``units = "counts"``: then ``[film]``,
 ``[film_transmission]`` and ``[skin_surface]`` must each be complete and are the paper's counts
 (reflection at 3 s, transmission at 10 s, or ``reflection_shutter_s``/``transmission_shutter_s``),
 normalised with the K they imply (:func:`lut_baker.model.made_up_skin.from_paper_counts`).

@@ -1,4 +1,4 @@
-"""Parameter presets: the paper's fitted layers (SPEC 5), skins from the literature, shades.
+"""Parameter presets: the paper's fitted layers (docs/model.md §5), skins from the literature, shades.
 
 Paper values are 16-bit pixel counts (red channel, applied to all three); they become albedo
 units through :func:`lut_baker.model.made_up_skin.from_paper_counts`.  Literature skins are given
@@ -6,7 +6,7 @@ directly in albedo units (1/sr) on the same scale.
 
 Functions
 ---------
-- :func:`paper_layers` -- the four layers of SPEC 5 in counts.
+- :func:`paper_layers` -- the four layers of docs/model.md §5 in counts.
 - :func:`paper` -- the paper's made-up skin (foundation "natural" on the bio-plate), normalised.
 - :func:`skin_layers` -- (surface reflection, dipole) of a named skin, albedo units.
 - :func:`skin_albedo` -- a named skin's diffuse albedo ``pi P_d`` per RGB channel.
@@ -43,13 +43,13 @@ PAPER_FILM_REFLECTION = ReflectionLayer(P_d=1.29e4, P_s=8.93e5, n=3.29e-2, eta=1
 PAPER_FILM_TRANSMISSION = TransmissionLayer(P_d=2.64e4, P_t=1.08e4, n=3.46e-2, eta=1.19)
 # Section 4.2.1: skin substitute (white bio-plate), reflection, 3 s shutter.
 PAPER_SKIN_REFLECTION = ReflectionLayer(P_d=2.00e4, P_s=2.05e5, n=4.00e-2, eta=1.26)
-# Section 4.2.2: the bio-plate's dipole (1/mm); the paper gives no g, so g = 0 (SPEC 2.3).
+# Section 4.2.2: the bio-plate's dipole (1/mm); the paper gives no g, so g = 0 (docs/model.md §2.3).
 PAPER_SKIN_DIPOLE = Dipole(sigma_s=2.83, sigma_a=2.82e-2, g=0.0, eta=1.26)
 
 FOUNDATIONS: dict[str, dict] = {
     # The paper's film, measured in red only; no absorption is known, so none is applied.
     "paper_natural": {"absorption": (0.0, 0.0, 0.0), "label": "Paper (natural, as measured)"},
-    # Shades: the paper's film with pigment absorption per RGB channel (SPEC 4, "Absorption").
+    # Shades: the paper's film with pigment absorption per RGB channel (docs/model.md §4, "Absorption").
     # Chosen by hand so the film's diffuse colour over white reads as the named shade.
     "light_ivory": {"absorption": (0.04, 0.10, 0.22), "label": "Light ivory"},
     "medium_beige": {"absorption": (0.10, 0.24, 0.42), "label": "Medium beige"},
@@ -60,7 +60,7 @@ FOUNDATIONS: dict[str, dict] = {
 @lru_cache(maxsize=1)
 def paper() -> MadeUpSkin:
     """The paper's made-up skin: foundation "natural" on the bio-plate, coverage 1, albedo
-    units with K from SPEC 4."""
+    units with K from docs/model.md §4."""
     film, film_t, skin, dipole = paper_layers()
     return from_paper_counts(film, film_t, skin, dipole, name="paper")
 
@@ -74,7 +74,7 @@ def _literature_skin(sigma_s_reduced, sigma_a, eta=1.3):
     """Surface layer and dipole of a skin given by reduced scattering and absorption (1/mm).
 
     Diffuse: ``P_d = Rd / pi`` (the dipole's closed-form total reflectance is the skin's diffuse
-    albedo, SPEC 4).  Gloss: Weyrich et al. 2006 (SIGGRAPH, "Analysis of human faces using a
+    albedo, docs/model.md §4).  Gloss: Weyrich et al. 2006 (SIGGRAPH, "Analysis of human faces using a
     measurement-based skin reflectance model") fit Beckmann roughness m ~ 0.35 to faces; the
     Torrance-Sparrow lobe with the same 1/e half-width, atan(0.35) = 19.3 degrees, has
     n = 0.052 / degree.  Its strength is the bio-plate's (normalised), as no TS fit in the

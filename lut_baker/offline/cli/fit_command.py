@@ -18,7 +18,7 @@ CSV columns (units in the names; ``#`` lines are comments; see lut_baker.offline
   dipole        distance_mm, ratio   (ratio to the lit pixel, modelled as R(d)/R(0))
 
 Exit codes: 0 done; 2 bad input (one line naming the problem); 3 the fit warned and --strict
-was given.  ``synthesize`` writes the paper's protocols (SPEC 6) from its parameters (SPEC 5)
+was given.  ``synthesize`` writes the paper's protocols (docs/model.md §6) from its parameters (docs/model.md §5)
 as CSV files plus ``truth.toml``, to try the round trip.
 """
 
@@ -71,7 +71,7 @@ def configure(parser) -> None:
         command.add_argument("csv", type=Path, help="measurements (CSV, see fit --help)")
         if kind == "dipole":
             command.add_argument("--g", type=float, default=0.0,
-                                 help="phase asymmetry, held fixed (default 0, SPEC 2.3)")
+                                 help="phase asymmetry, held fixed (default 0, docs/model.md §2.3)")
             command.add_argument("--eta", type=float, default=1.26,
                                  help="relative index, held fixed (default 1.26, the paper's "
                                       "skin)")
@@ -90,8 +90,8 @@ def configure(parser) -> None:
         command.add_argument("--strict", action="store_true",
                              help=f"exit {STRICT_EXIT} when the fit warns")
     synth = sub.add_parser("synthesize", help="write the paper's protocols as CSV files",
-                           description="Synthesise the paper's experiments (SPEC 6) from its "
-                                       "parameters (SPEC 5) with multiplicative noise.")
+                           description="Synthesise the paper's experiments (docs/model.md §6) from its "
+                                       "parameters (docs/model.md §5) with multiplicative noise.")
     synth.add_argument("--preset", choices=("paper",), default="paper")
     synth.add_argument("--out", type=Path, required=True, help="output folder")
     synth.add_argument("--noise", type=float, default=0.02,

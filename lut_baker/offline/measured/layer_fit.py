@@ -1,4 +1,4 @@
-"""Fitting the paper's layers to measurements (paper sections 4.1, 4.2; SPEC 5, 6).
+"""Fitting the paper's layers to measurements (paper sections 4.1, 4.2; docs/model.md §5, 6).
 
 Each fit minimises relative residuals ``log(model) - log(measured)`` with
 :func:`scipy.optimize.least_squares` (suited to multiplicative noise: 2% noise gives a residual

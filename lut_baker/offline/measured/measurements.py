@@ -1,11 +1,11 @@
-"""Measurements laid out as in the paper's experiments (SPEC 6): data types, CSV files, the
+"""Measurements laid out as in the paper's experiments (docs/model.md §6): data types, CSV files, the
 forward model of what the instrument records, and synthesis of the paper's protocols.
 
 What a camera records (paper eqs. 1-4): ``I = f(wi, wo) (N.L)`` in counts, with ``f`` the layer's
 BRDF (eq. 2) or BTDF (eq. 4) and ``N.L`` the cosine of incidence.  The subsurface profile
 (4.1.3, 4.2.2) is "the ratio of scattered intensity to the lit pixel"; it is modelled as
 ``R(d) / R(0)`` (eq. 6): the lit pixel is the profile's own value at d = 0, so only the shape of
-``R`` is measured (SPEC 4, "No double counting").
+``R`` is measured (docs/model.md §4, "No double counting").
 
 CSV files: one header line of column names carrying their units, then one sample per line;
 lines starting with ``#`` are comments.  Columns (any order, extra columns ignored):
@@ -29,7 +29,7 @@ Functions and types
 - :func:`write_measurements` -- a data set as a CSV file.
 - :func:`synthesize_reflection`, :func:`synthesize_transmission`, :func:`synthesize_profile`
   -- a protocol evaluated on a layer, with multiplicative noise.
-- :func:`paper_protocols` -- the paper's four experiments on its fitted layers (SPEC 5, 6).
+- :func:`paper_protocols` -- the paper's four experiments on its fitted layers (docs/model.md §5, 6).
 """
 
 from __future__ import annotations
@@ -87,7 +87,7 @@ def _groups(key: np.ndarray):
 
 @dataclass(frozen=True, eq=False)
 class ReflectionData:
-    """Reflection samples (SPEC 6): light-camera angle ``psi_deg``, signed ``alpha_deg``
+    """Reflection samples (docs/model.md §6): light-camera angle ``psi_deg``, signed ``alpha_deg``
     (degrees) and ``intensity_counts`` per sample.  ``wi``/``wo`` are the directions."""
 
     psi_deg: np.ndarray
@@ -107,7 +107,7 @@ class ReflectionData:
 
 @dataclass(frozen=True, eq=False)
 class TransmissionData:
-    """Transmission samples (SPEC 6): ``incidence_deg``, signed ``theta_t_deg`` (degrees from
+    """Transmission samples (docs/model.md §6): ``incidence_deg``, signed ``theta_t_deg`` (degrees from
     -z) and ``intensity_counts`` per sample.  ``wi``/``wt`` are the directions."""
 
     incidence_deg: np.ndarray
@@ -127,7 +127,7 @@ class TransmissionData:
 
 @dataclass(frozen=True, eq=False)
 class ProfileData:
-    """Subsurface profile (SPEC 6): ``distance_mm`` from the lit pixel and the ``ratio`` of the
+    """Subsurface profile (docs/model.md §6): ``distance_mm`` from the lit pixel and the ``ratio`` of the
     scattered intensity there to the lit pixel's."""
 
     distance_mm: np.ndarray
@@ -298,7 +298,7 @@ def _noisy(values: np.ndarray, noise: float, rng) -> np.ndarray:
 
 def synthesize_reflection(layer: ReflectionLayer, relative_angles_deg=PAPER_RELATIVE_ANGLES_DEG,
                           noise: float = 0.0, rng=None) -> ReflectionData:
-    """The reflection experiment (SPEC 6) at each ``psi`` on the paper's alpha steps, evaluated
+    """The reflection experiment (docs/model.md §6) at each ``psi`` on the paper's alpha steps, evaluated
     on a scalar ``layer`` with relative noise ``noise`` (``rng``: seed or Generator)."""
     sweeps = [reflection_sweep(psi) for psi in relative_angles_deg]
     psi = np.concatenate([np.full(s.alpha_deg.shape, s.relative_angle_deg) for s in sweeps])
@@ -309,7 +309,7 @@ def synthesize_reflection(layer: ReflectionLayer, relative_angles_deg=PAPER_RELA
 
 def synthesize_transmission(layer: TransmissionLayer, incidences_deg=PAPER_INCIDENCES_DEG,
                             noise: float = 0.0, rng=None) -> TransmissionData:
-    """The transmission experiment (SPEC 6) at each incidence on the paper's beta steps."""
+    """The transmission experiment (docs/model.md §6) at each incidence on the paper's beta steps."""
     sweeps = [transmission_sweep(incidence) for incidence in incidences_deg]
     incidence = np.concatenate([np.full(s.theta_t_deg.shape, s.incidence_deg) for s in sweeps])
     theta_t = np.concatenate([s.theta_t_deg for s in sweeps])
@@ -320,14 +320,14 @@ def synthesize_transmission(layer: TransmissionLayer, incidences_deg=PAPER_INCID
 
 def synthesize_profile(dipole: Dipole, distance_mm=None, noise: float = 0.0,
                        rng=None) -> ProfileData:
-    """The pencil-beam profile (SPEC 6): ``R(d)/R(0)`` at ``distance_mm`` (default
+    """The pencil-beam profile (docs/model.md §6): ``R(d)/R(0)`` at ``distance_mm`` (default
     :func:`lut_baker.offline.measured.protocols.profile_distances`, 0 to 3 mm by 0.05)."""
     d = profile_distances() if distance_mm is None else np.asarray(distance_mm, float)
     return ProfileData(d, _noisy(profile_ratio(d, dipole), noise, rng))
 
 
 def paper_protocols(noise: float = 0.02, seed=None) -> dict:
-    """The paper's experiments on its fitted layers in counts (SPEC 5, 6): ``{"film_reflection",
+    """The paper's experiments on its fitted layers in counts (docs/model.md §5, 6): ``{"film_reflection",
     "film_transmission", "skin_reflection", "skin_profile"}`` -> data set.  The four draw
     independent noise from one seed."""
     film, film_t, skin, dipole = paper_layers()

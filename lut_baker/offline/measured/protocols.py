@@ -1,4 +1,4 @@
-"""The paper's measurement geometries (SPEC 6), as direction arrays the model can evaluate.
+"""The paper's measurement geometries (docs/model.md §6), as direction arrays the model can evaluate.
 
 Reflection (4.1.1, 4.2.1, 5.1): light and camera fixed in one plane with the sample, at a
 relative angle psi; the sample rotates, so the half vector H (fixed) makes a signed angle alpha
@@ -8,7 +8,7 @@ with the normal N.  In the sample's frame::
 
 so ``alpha = 0`` is the mirror configuration.  Transmission (4.1.2): the film and the light turn
 together (incidence fixed); the camera below sees transmission angle ``theta_t``; the step rule
-applies to beta.  Sampling is densest near the lobe (SPEC 6): |angle| <= 3 degrees at 0.2,
+applies to beta.  Sampling is densest near the lobe (docs/model.md §6): |angle| <= 3 degrees at 0.2,
 3-5 at 0.5, 5-10 at 1, 10-20 at 2, beyond at 3.
 
 Functions
@@ -42,7 +42,7 @@ __all__ = [
 ]
 
 STEP_RULE = ((3.0, 0.2), (5.0, 0.5), (10.0, 1.0), (20.0, 2.0), (np.inf, 3.0))
-"""``(upper bound of |angle|, step)`` pairs in degrees, from SPEC 6."""
+"""``(upper bound of |angle|, step)`` pairs in degrees, from docs/model.md §6."""
 
 
 def step_angles(limit_deg: float) -> np.ndarray:

@@ -1,7 +1,7 @@
 """The baseline a user would otherwise use: one stock Principled BSDF, fitted to the model.
 
-Issue 5 compares the add-on's tiers with "a stock Principled BSDF with coat and subsurface, its
-parameters fitted to the same model as well as it allows".  The fit here is the strongest such
+The add-on's tiers are measured against a stock Principled BSDF with coat and subsurface,
+its parameters fitted to the same model as well as it allows (docs/speed_accuracy.md).  The fit here is the strongest such
 baseline this project can make without rendering: its sockets are chosen by least squares on
 the images that matter, the sphere under one distant light at 0, 45 and 75 degrees from the
 view, each pixel ``E f cos(theta_i)`` of the Principled BSDF's replica

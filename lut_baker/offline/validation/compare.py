@@ -1,16 +1,16 @@
-"""Comparing rendered sphere images with the reference images of :mod:`lut_baker.offline.validation.reference`.
+"""Comparing rendered sphere images with the reference images of :mod:`.reference`.
 
 Pure numpy: the Blender side (``bench/blender_scene.py``) renders, this module measures.  An
-image is ``(n, n, 3)`` float, rows top-down as :func:`lut_baker.offline.validation.reference.sphere_points` lays
-them out; a render read from Blender (rows bottom-up) goes through :func:`from_blender_pixels`.
+image is ``(n, n, 3)`` float, rows top-down as :func:`.reference.sphere_points` lays them
+out; a render read from Blender (rows bottom-up) goes through :func:`from_blender_pixels`.
 
-Error measures (issue 5, item 2), all over the sphere's pixels (:func:`sphere_mask`), every
+Error measures, all over the sphere's pixels (:func:`sphere_mask`), every
 channel pooled, relative to the reference's RMS there:
 
 - error ``e = rms(image - reference) / rms(reference)``;
 - Monte Carlo noise floor ``s = rms(a - b) / sqrt(2) / rms(reference)`` from two renders with
   different seeds: the noise of one image (the difference holds the noise twice);
-- excess over the floor ``e - s`` (what issue 5's goal bounds) and the bias estimate
+- excess over the floor ``e - s`` (what the speed/accuracy goals bound, docs/speed_accuracy.md) and the bias estimate
   ``sqrt(max(e^2 - s^2, 0))`` (noise and bias add in quadrature).
 
 Functions

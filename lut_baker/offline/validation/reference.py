@@ -1,12 +1,12 @@
-"""Reference images of the exact model: a sphere under a distant light (issue 5, item 1).
+"""Reference images of the exact model: a sphere under a distant light.
 
 The scene: a sphere of radius ``radius_mm`` seen by an orthographic camera looking down -z
 (every view direction is +z), one distant light from direction ``light`` with irradiance
 ``irradiance`` (radiance units per 1/sr, e.g. W/m^2), black surroundings.  Per pixel centre the
-radiance of paths 1 + 3 (SPEC 3, eq. 9) is evaluated exactly.  With ``spread=True`` the skin's
+radiance of paths 1 + 3 (docs/model.md §3, eq. 9) is evaluated exactly.  With ``spread=True`` the skin's
 diffuse part of path 3 -- ``w (1 - A)^2 P_d,s T(wi) T(wo) E cos(theta_i)`` -- is not returned
 where it entered but spread over the lit surface by the dipole's normalised profile
-``R(d) / Rd`` (SPEC 4), with the chord distance between surface points.
+``R(d) / Rd`` (docs/model.md §4), with the chord distance between surface points.
 
 Functions
 ---------
@@ -137,7 +137,7 @@ def local_diffuse(normals: np.ndarray, light: np.ndarray, skin: MadeUpSkin,
 
 def spread_diffuse(exit_normals: np.ndarray, light: np.ndarray, skin: MadeUpSkin, *,
                    radius_mm: float, samples: int, irradiance: float = 1.0) -> np.ndarray:
-    """The skin-diffuse part after spreading under the surface (SPEC 4), radiance (P, 3)::
+    """The skin-diffuse part after spreading under the surface (docs/model.md §4), radiance (P, 3)::
 
         L(x_o) = P_d,s sum_i E cos(theta_i) [w T_A(wi) T_A(wo) + (1 - w)] R(|x_i - x_o|)/Rd dA
 

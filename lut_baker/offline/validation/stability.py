@@ -1,4 +1,4 @@
-"""Stability where the methods fail (issue 5, item 4): a sweep over the regimes that break them.
+"""Stability where the methods fail: a sweep over the regimes that break them.
 
 The regimes (:data:`REGIMES`): grazing light (80-89 degrees from the view) and the silhouette
 (view 80-89 degrees from the normal); a 1 mm sphere (the subsurface spread is larger than the
@@ -126,7 +126,7 @@ REGIMES = (
     Regime("coverage1", "coverage 1 (full film)", coverage=1.0),
     Regime("absorbed", "full absorption (A = 1)", absorption=1.0),
 )
-"""The regimes of issue 5, item 4 (the paper preset otherwise: 10 mm sphere, light 45 deg,
+"""The regimes where a method breaks (the paper preset otherwise: 10 mm sphere, light 45 deg,
 16 px for the reference images; the sphere-size regimes on bare skin, where the subsurface
 is most of the image)."""
 
