@@ -1,14 +1,14 @@
 """Bake a made-up skin into lookup tables (:class:`lut_baker.tables.table_set.Tables`), fast.
 
 Path 3 is a product of matrices per azimuthal Fourier order (docs/model.md §3): the bake evaluates
-:func:`lut_baker.evaluate.two_layer.layered_fourier_matrices` with the table's polar grid as the outer
-angles and sums the cosine series on the table's azimuth grid.  What makes it fast:
+:func:`lut_baker.evaluate.two_layer.layered_fourier_matrices` with the table's polar grid as the
+outer angles and sums the cosine series on the table's azimuth grid.  What makes it fast:
 
 - the layers' kernels are evaluated from cosines alone (no direction vectors), at the
   ``n_phi // 2 + 1`` distinct azimuths of an even kernel, once per unordered pair of polar
   angles (both kernels are symmetric), and turned into cosine coefficients by one BLAS product
-  (:func:`fourier_coefficients`, equal to :func:`lut_baker.evaluate.two_layer.layer_fourier_kernel` within
-  1e-8), the Fresnel term interpolated from a checked tabulation (:func:`_fresnel_fast`);
+  (:func:`fourier_coefficients`, equal to :func:`lut_baker.evaluate.two_layer.layer_fourier_kernel`
+  within 1e-8), the Fresnel term interpolated from a checked tabulation (:func:`_fresnel_fast`);
 - every kernel table is computed once per bake (:class:`KernelCache`);
 - the bake's quadrature (:func:`lut_baker.numerics.quadrature.hemisphere_panels`) is coarser
   than the exact evaluator's, as coarse as the convergence study (``bench/bake.py --study``,
@@ -98,10 +98,10 @@ class Resolution:
 
     Table grids: ``n_theta`` polar nodes (theta_i and theta_o) on [0, ``theta_max_deg``] with
     ``theta_spacing``, ``n_phi`` azimuth coordinates on [0, 180] degrees with ``phi_spacing``,
-    ``n_radius`` distances with ``radius_spacing`` (closed forms in :mod:`lut_baker.tables.table_set`).
-    Quadrature of the path-3 integrals: ``quad_panels`` Gauss-Legendre panels of
-    ``quad_points`` nodes in polar angle, ``quad_phi`` (odd) azimuth samples; the gloss
-    albedos use ``albedo_azimuths`` azimuths concentrated at the mirror direction
+    ``n_radius`` distances with ``radius_spacing`` (closed forms in
+    :mod:`lut_baker.tables.table_set`). Quadrature of the path-3 integrals: ``quad_panels``
+    Gauss-Legendre panels of ``quad_points`` nodes in polar angle, ``quad_phi`` (odd) azimuth
+    samples; the gloss albedos use ``albedo_azimuths`` azimuths concentrated at the mirror direction
     (:func:`gloss_albedos`).
     """
 
@@ -226,9 +226,9 @@ def _cosine_matrix(n_phi: int) -> np.ndarray:
 
 def fourier_coefficients(layer, theta_a, theta_b, n_phi: int) -> np.ndarray:
     """Cosine coefficients ``(orders, A, B, C)`` of a layer's kernel (the signature and result
-    of :func:`lut_baker.evaluate.two_layer.layer_fourier_kernel`, within 1e-8 relative: the tabulated
-    Fresnel term), evaluated at the distinct azimuths only, and once per unordered pair when
-    ``theta_a`` equals ``theta_b``."""
+    of :func:`lut_baker.evaluate.two_layer.layer_fourier_kernel`, within 1e-8 relative: the
+    tabulated Fresnel term), evaluated at the distinct azimuths only, and once per unordered pair
+    when ``theta_a`` equals ``theta_b``."""
     theta_a = np.atleast_1d(np.asarray(theta_a, float))
     theta_b = np.atleast_1d(np.asarray(theta_b, float))
     matrix = _cosine_matrix(n_phi)
@@ -322,8 +322,8 @@ def _channel_count(*layers) -> int:
 def gloss_tables(layers, theta_deg, phi_deg, phi_spacing: str = "half_vector",
                  *, pairs: _NodePairs | None = None) -> list[np.ndarray]:
     """Specular parts ``P_s D G F_r`` (eq. 2, 1/sr) of each reflecting layer on the table grid
-    (grids and spacing as :class:`lut_baker.tables.table_set.Tables`): ``(n_theta, n_theta, n_phi, 3)``
-    each, evaluated once per unordered (theta_i, theta_o)."""
+    (grids and spacing as :class:`lut_baker.tables.table_set.Tables`): ``(n_theta, n_theta, n_phi,
+    3)`` each, evaluated once per unordered (theta_i, theta_o)."""
     pairs = pairs or _NodePairs(theta_deg, phi_deg, phi_spacing)
     layers = [gloss_layer(layer) for layer in layers]
 
@@ -406,7 +406,8 @@ def _stage(progress, fraction: float, message: str) -> None:
 
 def bake(skin: MadeUpSkin, resolution_name="default", *, inter_reflection: bool = False,
          progress=None) -> Tables:
-    """Bake the tables of one made-up skin (see :mod:`lut_baker.tables.table_set` for their meaning).
+    """Bake the tables of one made-up skin (see :mod:`lut_baker.tables.table_set` for their
+    meaning).
 
     ``resolution_name``: ``"preview"``, ``"default"``, ``"high"`` or a :class:`Resolution`;
     it is scaled up for lobes narrower than the presets' (:meth:`Resolution.for_lobe`).

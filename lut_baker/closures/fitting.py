@@ -2,8 +2,8 @@
 
 A Cycles shader sees the view direction but not the light's, so the add-on's tiers are
 closures (replicated in :mod:`lut_baker.closures.cycles`) whose parameters are fitted here to the
-tables of :mod:`lut_baker.tables.table_set`, with weights that may depend on the view angle through 1-D
-lookup images.  Everything is numpy only (it runs inside Blender, which ships no scipy).
+tables of :mod:`lut_baker.tables.table_set`, with weights that may depend on the view angle through
+1-D lookup images.  Everything is numpy only (it runs inside Blender, which ships no scipy).
 
 Tiers
 -----

@@ -134,10 +134,10 @@ def layered_fourier_matrices(theta_i, theta_o, cosmetic, skin, grid: HemisphereG
 
     ``theta_i``, ``theta_o``: polar angles (radians) of the outer directions; returns shape
     ``(orders, len(theta_i), len(theta_o), C)``.  Cost: one kernel table per layer and two
-    batched matrix products per order (docs/model.md §3).  ``fourier``: the function giving each layer's
-    kernel coefficients (signature of :func:`layer_fourier_kernel`, e.g. a faster or cached one).
-    ``orders``: keep only the first orders (1 for azimuth-integrated quantities such as albedos:
-    the kernels are still sampled at every azimuth, but the products run once).
+    batched matrix products per order (docs/model.md §3).  ``fourier``: the function giving each
+    layer's kernel coefficients (signature of :func:`layer_fourier_kernel`, e.g. a faster or cached
+    one). ``orders``: keep only the first orders (1 for azimuth-integrated quantities such as
+    albedos: the kernels are still sampled at every azimuth, but the products run once).
     """
     keep = slice(None, orders)
     inner = inner_matrices(grid, cosmetic, skin, fourier)[keep]

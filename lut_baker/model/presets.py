@@ -1,4 +1,5 @@
-"""Parameter presets: the paper's fitted layers (docs/model.md §5), skins from the literature, shades.
+"""Parameter presets: the paper's fitted layers (docs/model.md §5), skins from the literature,
+shades.
 
 Paper values are 16-bit pixel counts (red channel, applied to all three); they become albedo
 units through :func:`lut_baker.model.made_up_skin.from_paper_counts`.  Literature skins are given
@@ -49,8 +50,9 @@ PAPER_SKIN_DIPOLE = Dipole(sigma_s=2.83, sigma_a=2.82e-2, g=0.0, eta=1.26)
 FOUNDATIONS: dict[str, dict] = {
     # The paper's film, measured in red only; no absorption is known, so none is applied.
     "paper_natural": {"absorption": (0.0, 0.0, 0.0), "label": "Paper (natural, as measured)"},
-    # Shades: the paper's film with pigment absorption per RGB channel (docs/model.md §4, "Absorption").
-    # Chosen by hand so the film's diffuse colour over white reads as the named shade.
+    # Shades: the paper's film with pigment absorption per RGB channel (docs/model.md §4,
+    # "Absorption"). Chosen by hand so the film's diffuse colour over white reads as the named
+    # shade.
     "light_ivory": {"absorption": (0.04, 0.10, 0.22), "label": "Light ivory"},
     "medium_beige": {"absorption": (0.10, 0.24, 0.42), "label": "Medium beige"},
     "deep_mocha": {"absorption": (0.38, 0.56, 0.70), "label": "Deep mocha"},
@@ -74,8 +76,8 @@ def _literature_skin(sigma_s_reduced, sigma_a, eta=1.3):
     """Surface layer and dipole of a skin given by reduced scattering and absorption (1/mm).
 
     Diffuse: ``P_d = Rd / pi`` (the dipole's closed-form total reflectance is the skin's diffuse
-    albedo, docs/model.md §4).  Gloss: Weyrich et al. 2006 (SIGGRAPH, "Analysis of human faces using a
-    measurement-based skin reflectance model") fit Beckmann roughness m ~ 0.35 to faces; the
+    albedo, docs/model.md §4).  Gloss: Weyrich et al. 2006 (SIGGRAPH, "Analysis of human faces using
+    a measurement-based skin reflectance model") fit Beckmann roughness m ~ 0.35 to faces; the
     Torrance-Sparrow lobe with the same 1/e half-width, atan(0.35) = 19.3 degrees, has
     n = 0.052 / degree.  Its strength is the bio-plate's (normalised), as no TS fit in the
     paper's form is published for real skin.

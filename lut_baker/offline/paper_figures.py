@@ -13,7 +13,8 @@ Data functions
 - :func:`transmission_curves` -- paper eq. 4 along the transmission protocol (fig. 7).
 - :func:`profile_curve` -- dipole ``R(d) / R(0)`` (paper eq. 6, fig. 13).
 - :func:`made_up_reflection_curves` -- paths 1, 3, their sum with coverage (eq. 9, fig. 14).
-- :func:`made_up_profile_curves` -- bare (eq. 5) and made-up (eq. 8, docs/model.md §3) profiles (fig. 15).
+- :func:`made_up_profile_curves` -- bare (eq. 5) and made-up (eq. 8, docs/model.md §3) profiles
+  (fig. 15).
 - :func:`directional_albedo_curves` -- paths 1 + 3 integrated, per foundation (docs/model.md §4).
 
 Drawing functions
@@ -87,7 +88,8 @@ RELATIVE_ANGLES_DEG = (30.0, 60.0, 90.0, 120.0)
 INCIDENCES_DEG = (0.0, 30.0, 60.0)
 """Incidence angles of the transmission experiment (4.1.2), degrees."""
 CHANNEL = 0
-"""The channel drawn where a layer is RGB: red, the only one the paper measured (docs/model.md §1)."""
+"""The channel drawn where a layer is RGB: red, the only one the paper measured (docs/model.md
+§1)."""
 ALBEDO_ANGLES_DEG = np.append(np.arange(0.0, 89.0, 2.0), 89.0)
 """Incidence angles (degrees) of the white-furnace chart: every 2 degrees, and 89."""
 CURVE_STEP_DEG = 0.25
@@ -140,10 +142,11 @@ def _dense_reflection(relative_angle_deg: float,
 
 def reflection_curves(layer: ReflectionLayer = PAPER_FILM_REFLECTION,
                       relative_angles_deg=RELATIVE_ANGLES_DEG) -> dict:
-    """Paper eq. 2 in the reflection protocol (docs/model.md §6): per relative angle psi (degrees) a dict
-    of ``theta_r_deg``, ``theta_i_deg = theta_r_deg + psi`` (signed, degrees), ``brdf`` ``f_r``
+    """Paper eq. 2 in the reflection protocol (docs/model.md §6): per relative angle psi (degrees) a
+    dict of ``theta_r_deg``, ``theta_i_deg = theta_r_deg + psi`` (signed, degrees), ``brdf`` ``f_r``
     and ``intensity`` ``f_r cos(theta_i)`` (units of ``layer``: counts per 3 s for the paper),
-    at the protocol's samples (:func:`~lut_baker.offline.measured.protocols.reflection_sweep`) densified."""
+    at the protocol's samples (:func:`~lut_baker.offline.measured.protocols.reflection_sweep`)
+    densified."""
     curves = {}
     for psi in relative_angles_deg:
         sweep = _dense_reflection(psi)
@@ -159,10 +162,11 @@ def reflection_curves(layer: ReflectionLayer = PAPER_FILM_REFLECTION,
 
 def transmission_curves(layer: TransmissionLayer = PAPER_FILM_TRANSMISSION,
                         incidences_deg=INCIDENCES_DEG) -> dict:
-    """Paper eq. 4 in the transmission protocol (docs/model.md §6): per incidence (degrees) a dict of
-    ``theta_t_deg`` (signed, from -z; straight through at theta_t = incidence), ``btdf``
+    """Paper eq. 4 in the transmission protocol (docs/model.md §6): per incidence (degrees) a dict
+    of ``theta_t_deg`` (signed, from -z; straight through at theta_t = incidence), ``btdf``
     ``f_t`` and ``intensity`` ``f_t cos(theta_i)`` (counts per 10 s for the paper), at the
-    protocol's samples (:func:`~lut_baker.offline.measured.protocols.transmission_sweep`) densified."""
+    protocol's samples (:func:`~lut_baker.offline.measured.protocols.transmission_sweep`)
+    densified."""
     curves = {}
     for incidence in incidences_deg:
         theta_t = _densified(transmission_sweep(incidence).theta_t_deg)
@@ -187,9 +191,10 @@ def profile_curve(dipole: Dipole = PAPER_SKIN_DIPOLE, max_mm: float = 3.0,
 def made_up_reflection_curves(skin: MadeUpSkin | None = None, relative_angle_deg: float = 60.0,
                               coverages=(1.0, 0.5)) -> dict:
     """Made-up skin in the reflection protocol at one relative angle (paper 5.1, eq. 9), as
-    intensities ``f cos(theta_i)`` in albedo units (1/sr, docs/model.md §4): ``path1`` (film surface),
-    ``path3`` (through the film, off the skin surface, back through), ``bare`` (the skin alone)
-    and ``sum`` {coverage: :func:`~lut_baker.evaluate.made_up.made_up_reflection` at that coverage}."""
+    intensities ``f cos(theta_i)`` in albedo units (1/sr, docs/model.md §4): ``path1`` (film
+    surface), ``path3`` (through the film, off the skin surface, back through), ``bare`` (the skin
+    alone) and ``sum`` {coverage: :func:`~lut_baker.evaluate.made_up.made_up_reflection` at that
+    coverage}."""
     skin = paper() if skin is None else skin
     sweep = _dense_reflection(relative_angle_deg, MADE_UP_STEP_DEG)
     wi, wo, cosine = sweep.wi, sweep.wo, sweep.wi[..., 2]
@@ -212,8 +217,9 @@ def made_up_profile_curves(skin: MadeUpSkin | None = None, angle_deg: float = 30
                            max_mm: float = 3.0, step_mm: float = 0.01) -> dict:
     """Path 4 at incidence = view = ``angle_deg`` in the specular geometry (paper 5.2):
     ``bare = (1/pi) F_t(wo) R(d) F_t(wi)`` (eq. 5) and ``made_up = R(d)/pi t(wi) t(wo)``
-    (eq. 8, docs/model.md §3, ``t`` = :func:`~lut_baker.evaluate.two_layer.transmission_factor` of the absorbing
-    film), both divided by ``bare`` at d = 0.  Also returns ``t`` and ``F_t`` at that angle."""
+    (eq. 8, docs/model.md §3, ``t`` = :func:`~lut_baker.evaluate.two_layer.transmission_factor` of
+    the absorbing film), both divided by ``bare`` at d = 0.  Also returns ``t`` and ``F_t`` at that
+    angle."""
     skin = paper() if skin is None else skin
     wi = in_plane_direction(angle_deg)
     wo = in_plane_direction(-angle_deg)
@@ -237,8 +243,9 @@ def made_up_profile_curves(skin: MadeUpSkin | None = None, angle_deg: float = 30
 
 def directional_albedo_curves(foundations=None, skin: str = "paper_bioplate",
                               theta_deg=None) -> dict:
-    """Directional albedo of paths 1 + 3 (docs/model.md §4) against incidence ``theta_deg`` (degrees) per
-    foundation preset on ``skin``, RGB ``(P, 3)``; ``"bare"`` is the skin alone (coverage 0)."""
+    """Directional albedo of paths 1 + 3 (docs/model.md §4) against incidence ``theta_deg``
+    (degrees) per foundation preset on ``skin``, RGB ``(P, 3)``; ``"bare"`` is the skin alone
+    (coverage 0)."""
     names = tuple(FOUNDATIONS) if foundations is None else tuple(foundations)
     theta = ALBEDO_ANGLES_DEG if theta_deg is None else np.asarray(theta_deg, float)
     curves = {"theta_deg": theta}
@@ -420,8 +427,8 @@ def fig15_made_up_profile(skin: MadeUpSkin | None = None, angle_deg: float = 30.
 
 
 def fig16_directional_albedo(foundations=None, skin: str = "paper_bioplate"):
-    """Beyond the paper: the directional albedo of paths 1 + 3 (docs/model.md §4) per foundation preset
-    on ``skin``, against incidence; a white furnace check (every curve <= 1)."""
+    """Beyond the paper: the directional albedo of paths 1 + 3 (docs/model.md §4) per foundation
+    preset on ``skin``, against incidence; a white furnace check (every curve <= 1)."""
     curves = directional_albedo_curves(foundations, skin)
     theta = curves["theta_deg"]
     names = [name for name in curves if name not in ("theta_deg", "bare")]

@@ -12,14 +12,15 @@ layer type as keywords), then ``[stderr]``, ``[relative_stderr]`` (eta: relative
 condition number, correlation matrix over ``free``, warnings).  Warnings (ill-conditioned or
 degenerate parameters, poor fit) also go to stderr, one per line.
 
-CSV columns (units in the names; ``#`` lines are comments; see lut_baker.offline.measured.measurements):
+CSV columns (units in the names; ``#`` lines are comments; see
+lut_baker.offline.measured.measurements):
   reflection    psi_deg, alpha_deg (or theta_r_deg), intensity_counts
   transmission  incidence_deg, theta_t_deg, intensity_counts
   dipole        distance_mm, ratio   (ratio to the lit pixel, modelled as R(d)/R(0))
 
 Exit codes: 0 done; 2 bad input (one line naming the problem); 3 the fit warned and --strict
-was given.  ``synthesize`` writes the paper's protocols (docs/model.md §6) from its parameters (docs/model.md §5)
-as CSV files plus ``truth.toml``, to try the round trip.
+was given.  ``synthesize`` writes the paper's protocols (docs/model.md §6) from its parameters
+(docs/model.md §5) as CSV files plus ``truth.toml``, to try the round trip.
 """
 
 from __future__ import annotations
@@ -90,8 +91,9 @@ def configure(parser) -> None:
         command.add_argument("--strict", action="store_true",
                              help=f"exit {STRICT_EXIT} when the fit warns")
     synth = sub.add_parser("synthesize", help="write the paper's protocols as CSV files",
-                           description="Synthesise the paper's experiments (docs/model.md §6) from its "
-                                       "parameters (docs/model.md §5) with multiplicative noise.")
+                           description="Synthesise the paper's experiments (docs/model.md §6) "
+                                       "from its parameters (docs/model.md §5) with "
+                                       "multiplicative noise.")
     synth.add_argument("--preset", choices=("paper",), default="paper")
     synth.add_argument("--out", type=Path, required=True, help="output folder")
     synth.add_argument("--noise", type=float, default=0.02,
@@ -146,7 +148,8 @@ def _check_options(options: dict) -> None:
 
 
 def result_document(result) -> dict:
-    """The output block of a :class:`~lut_baker.offline.measured.layer_fit.FitResult` as nested plain data."""
+    """The output block of a :class:`~lut_baker.offline.measured.layer_fit.FitResult` as
+    nested plain data."""
     data = result.as_dict()
     return {
         result.kind: data["params"],

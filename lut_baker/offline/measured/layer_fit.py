@@ -4,7 +4,8 @@ Each fit minimises relative residuals ``log(model) - log(measured)`` with
 :func:`scipy.optimize.least_squares` (suited to multiplicative noise: 2% noise gives a residual
 rms of 0.02) over conditioned parameters: ``log`` of ``P_d``, ``P_s``/``P_t``, ``n``,
 ``sigma_s``, ``sigma_a`` and ``log(eta - 1)``.  The forward models are
-:mod:`lut_baker.offline.measured.measurements`' (``I = f N.L``, paper eqs. 1-4; ``R(d)/R(0)``, eq. 6).
+:mod:`lut_baker.offline.measured.measurements`' (``I = f N.L``, paper eqs. 1-4; ``R(d)/R(0)``, eq.
+6).
 
 Starting point: the intensity is linear in ``P_d`` and ``P_s``/``P_t``, so for each ``n`` on a
 coarse logarithmic grid (and at the caller's start, if any) they are solved by non-negative
@@ -254,8 +255,9 @@ def fit_dipole(data: ProfileData, start: Dipole | None = None, *, g: float = 0.0
 
 
 def fit_measurements(data, start=None, **options) -> FitResult:
-    """The fit matching the data set's type (:class:`~lut_baker.offline.measured.measurements.ReflectionData`,
-    ``TransmissionData`` or ``ProfileData``); ``options`` go to that fit."""
+    """The fit matching the data set's type
+    (:class:`~lut_baker.offline.measured.measurements.ReflectionData`, ``TransmissionData`` or
+    ``ProfileData``); ``options`` go to that fit."""
     fits = {ReflectionData: fit_reflection, TransmissionData: fit_transmission,
             ProfileData: fit_dipole}
     if type(data) not in fits:

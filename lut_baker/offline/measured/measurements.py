@@ -1,5 +1,5 @@
-"""Measurements laid out as in the paper's experiments (docs/model.md §6): data types, CSV files, the
-forward model of what the instrument records, and synthesis of the paper's protocols.
+"""Measurements laid out as in the paper's experiments (docs/model.md §6): data types, CSV files,
+the forward model of what the instrument records, and synthesis of the paper's protocols.
 
 What a camera records (paper eqs. 1-4): ``I = f(wi, wo) (N.L)`` in counts, with ``f`` the layer's
 BRDF (eq. 2) or BTDF (eq. 4) and ``N.L`` the cosine of incidence.  The subsurface profile
@@ -29,7 +29,8 @@ Functions and types
 - :func:`write_measurements` -- a data set as a CSV file.
 - :func:`synthesize_reflection`, :func:`synthesize_transmission`, :func:`synthesize_profile`
   -- a protocol evaluated on a layer, with multiplicative noise.
-- :func:`paper_protocols` -- the paper's four experiments on its fitted layers (docs/model.md §5, 6).
+- :func:`paper_protocols` -- the paper's four experiments on its fitted layers (docs/model.md §5,
+  6).
 """
 
 from __future__ import annotations
@@ -107,8 +108,8 @@ class ReflectionData:
 
 @dataclass(frozen=True, eq=False)
 class TransmissionData:
-    """Transmission samples (docs/model.md §6): ``incidence_deg``, signed ``theta_t_deg`` (degrees from
-    -z) and ``intensity_counts`` per sample.  ``wi``/``wt`` are the directions."""
+    """Transmission samples (docs/model.md §6): ``incidence_deg``, signed ``theta_t_deg`` (degrees
+    from -z) and ``intensity_counts`` per sample.  ``wi``/``wt`` are the directions."""
 
     incidence_deg: np.ndarray
     theta_t_deg: np.ndarray
@@ -127,8 +128,8 @@ class TransmissionData:
 
 @dataclass(frozen=True, eq=False)
 class ProfileData:
-    """Subsurface profile (docs/model.md §6): ``distance_mm`` from the lit pixel and the ``ratio`` of the
-    scattered intensity there to the lit pixel's."""
+    """Subsurface profile (docs/model.md §6): ``distance_mm`` from the lit pixel and the ``ratio``
+    of the scattered intensity there to the lit pixel's."""
 
     distance_mm: np.ndarray
     ratio: np.ndarray
@@ -143,9 +144,9 @@ class ProfileData:
 
 
 def _directions(data, key: str, angle: str, second: str, geometry, valid: tuple) -> None:
-    """Set ``data.wi`` and ``data.<second>`` from :mod:`lut_baker.offline.measured.protocols`' ``geometry``,
-    one experiment per distinct value of the column ``key`` (within ``valid = (low, high,
-    low_open)`` degrees; high is always open)."""
+    """Set ``data.wi`` and ``data.<second>`` from :mod:`lut_baker.offline.measured.protocols`'
+    ``geometry``, one experiment per distinct value of the column ``key`` (within ``valid = (low,
+    high, low_open)`` degrees; high is always open)."""
     low, high, low_open = valid
     wi = np.empty(getattr(data, angle).shape + (3,))
     other = np.empty_like(wi)
@@ -298,8 +299,8 @@ def _noisy(values: np.ndarray, noise: float, rng) -> np.ndarray:
 
 def synthesize_reflection(layer: ReflectionLayer, relative_angles_deg=PAPER_RELATIVE_ANGLES_DEG,
                           noise: float = 0.0, rng=None) -> ReflectionData:
-    """The reflection experiment (docs/model.md §6) at each ``psi`` on the paper's alpha steps, evaluated
-    on a scalar ``layer`` with relative noise ``noise`` (``rng``: seed or Generator)."""
+    """The reflection experiment (docs/model.md §6) at each ``psi`` on the paper's alpha steps,
+    evaluated on a scalar ``layer`` with relative noise ``noise`` (``rng``: seed or Generator)."""
     sweeps = [reflection_sweep(psi) for psi in relative_angles_deg]
     psi = np.concatenate([np.full(s.alpha_deg.shape, s.relative_angle_deg) for s in sweeps])
     alpha = np.concatenate([s.alpha_deg for s in sweeps])
@@ -309,7 +310,8 @@ def synthesize_reflection(layer: ReflectionLayer, relative_angles_deg=PAPER_RELA
 
 def synthesize_transmission(layer: TransmissionLayer, incidences_deg=PAPER_INCIDENCES_DEG,
                             noise: float = 0.0, rng=None) -> TransmissionData:
-    """The transmission experiment (docs/model.md §6) at each incidence on the paper's beta steps."""
+    """The transmission experiment (docs/model.md §6) at each incidence on the paper's beta
+    steps."""
     sweeps = [transmission_sweep(incidence) for incidence in incidences_deg]
     incidence = np.concatenate([np.full(s.theta_t_deg.shape, s.incidence_deg) for s in sweeps])
     theta_t = np.concatenate([s.theta_t_deg for s in sweeps])
@@ -327,9 +329,9 @@ def synthesize_profile(dipole: Dipole, distance_mm=None, noise: float = 0.0,
 
 
 def paper_protocols(noise: float = 0.02, seed=None) -> dict:
-    """The paper's experiments on its fitted layers in counts (docs/model.md §5, 6): ``{"film_reflection",
-    "film_transmission", "skin_reflection", "skin_profile"}`` -> data set.  The four draw
-    independent noise from one seed."""
+    """The paper's experiments on its fitted layers in counts (docs/model.md §5, 6):
+    ``{"film_reflection", "film_transmission", "skin_reflection", "skin_profile"}`` -> data set.
+    The four draw independent noise from one seed."""
     film, film_t, skin, dipole = paper_layers()
     rngs = np.random.default_rng(seed).spawn(4)
     return {

@@ -1,4 +1,5 @@
-"""The paper's measurement geometries (docs/model.md §6), as direction arrays the model can evaluate.
+"""The paper's measurement geometries (docs/model.md §6), as direction arrays the model can
+evaluate.
 
 Reflection (4.1.1, 4.2.1, 5.1): light and camera fixed in one plane with the sample, at a
 relative angle psi; the sample rotates, so the half vector H (fixed) makes a signed angle alpha

@@ -1,13 +1,13 @@
 """The baseline a user would otherwise use: one stock Principled BSDF, fitted to the model.
 
 The add-on's tiers are measured against a stock Principled BSDF with coat and subsurface,
-its parameters fitted to the same model as well as it allows (docs/speed_accuracy.md).  The fit here is the strongest such
-baseline this project can make without rendering: its sockets are chosen by least squares on
-the images that matter, the sphere under one distant light at 0, 45 and 75 degrees from the
-view, each pixel ``E f cos(theta_i)`` of the Principled BSDF's replica
+its parameters fitted to the same model as well as it allows (docs/speed_accuracy.md).  The fit here
+is the strongest such baseline this project can make without rendering: its sockets are chosen by
+least squares on the images that matter, the sphere under one distant light at 0, 45 and 75 degrees
+from the view, each pixel ``E f cos(theta_i)`` of the Principled BSDF's replica
 (:func:`lut_baker.closures.cycles.principled_reflection`) against paths 1 + 3 read from the
-baked tables (:func:`lut_baker.offline.validation.compare.local_image`, no spread on either side: the subsurface
-radius is fitted separately, to the profile, as for the tiers).
+baked tables (:func:`lut_baker.offline.validation.compare.local_image`, no spread on either side:
+the subsurface radius is fitted separately, to the profile, as for the tiers).
 
 Free sockets: Base Color (RGB), Roughness, Specular IOR Level, Coat Weight, Coat Roughness and
 Coat IOR, within the ranges Blender's sockets allow; IOR stays at the tiers' 1.5 (Specular IOR

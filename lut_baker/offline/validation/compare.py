@@ -10,8 +10,8 @@ channel pooled, relative to the reference's RMS there:
 - error ``e = rms(image - reference) / rms(reference)``;
 - Monte Carlo noise floor ``s = rms(a - b) / sqrt(2) / rms(reference)`` from two renders with
   different seeds: the noise of one image (the difference holds the noise twice);
-- excess over the floor ``e - s`` (what the speed/accuracy goals bound, docs/speed_accuracy.md) and the bias estimate
-  ``sqrt(max(e^2 - s^2, 0))`` (noise and bias add in quadrature).
+- excess over the floor ``e - s`` (what the speed/accuracy goals bound, docs/speed_accuracy.md) and
+  the bias estimate ``sqrt(max(e^2 - s^2, 0))`` (noise and bias add in quadrature).
 
 Functions
 ---------
@@ -20,7 +20,8 @@ Functions
 - :func:`relative_rms`, :func:`noise_floor`, :func:`bias` -- the measures above.
 - :func:`lambert_image` -- the analytic image of a Lambertian sphere, ``E a / pi max(0, N.L)``.
 - :func:`reference_image` -- the made-up sphere's reference, exact or with paths 1 + 3 read
-  from baked tables (same geometry and spread as :func:`lut_baker.offline.validation.reference.sphere_image`).
+  from baked tables (same geometry and spread as
+  :func:`lut_baker.offline.validation.reference.sphere_image`).
 - :func:`local_image` -- the image of any local reflection function (no spread), at the
   pixels' local light and view directions
   (:func:`lut_baker.numerics.geometry.sphere_directions`).
@@ -117,14 +118,15 @@ def reference_image(skin: MadeUpSkin, *, tables=None, resolution: int = 64,
                     radius_mm: float = 10.0, light_angle_deg: float = 45.0,
                     irradiance: float = 1.0, spread: bool = True,
                     samples: int | None = None) -> np.ndarray:
-    """The reference image ``(n, n, 3)`` of :func:`lut_baker.offline.validation.reference.sphere_image`.
+    """The reference image ``(n, n, 3)`` of
+    :func:`lut_baker.offline.validation.reference.sphere_image`.
 
     ``tables=None``: exactly that (paths 1 + 3 by the exact evaluator, ~20 ms per pixel).
     ``tables`` (baked from ``skin``): paths 1 + 3 interpolated from them instead
     (:meth:`lut_baker.tables.table_set.Tables.made_up_reflection`, error <= 1e-3 of the peak at the
     "default" and "high" resolutions, docs/baking.md), everything else the same: the
-    skin-diffuse part is spread by :func:`lut_baker.offline.validation.reference.spread_diffuse` when
-    ``spread``.  ``tests/test_render_compare.py`` checks that the two agree."""
+    skin-diffuse part is spread by :func:`lut_baker.offline.validation.reference.spread_diffuse`
+    when ``spread``.  ``tests/test_render_compare.py`` checks that the two agree."""
     if tables is None:
         return reference.sphere_image(skin, resolution=resolution, radius_mm=radius_mm,
                                       light_angle_deg=light_angle_deg, irradiance=irradiance,

@@ -3,8 +3,8 @@
 The scene: a sphere of radius ``radius_mm`` seen by an orthographic camera looking down -z
 (every view direction is +z), one distant light from direction ``light`` with irradiance
 ``irradiance`` (radiance units per 1/sr, e.g. W/m^2), black surroundings.  Per pixel centre the
-radiance of paths 1 + 3 (docs/model.md §3, eq. 9) is evaluated exactly.  With ``spread=True`` the skin's
-diffuse part of path 3 -- ``w (1 - A)^2 P_d,s T(wi) T(wo) E cos(theta_i)`` -- is not returned
+radiance of paths 1 + 3 (docs/model.md §3, eq. 9) is evaluated exactly.  With ``spread=True`` the
+skin's diffuse part of path 3 -- ``w (1 - A)^2 P_d,s T(wi) T(wo) E cos(theta_i)`` -- is not returned
 where it entered but spread over the lit surface by the dipole's normalised profile
 ``R(d) / Rd`` (docs/model.md §4), with the chord distance between surface points.
 
