@@ -10,8 +10,8 @@ exact image)::
 
     E = sqrt(e_angle^2 + e_subsurface^2 + e_gloss^2 + noise^2)
 
-- ``e_angle``: the tier's angular error against the tables (:func:`closure_fit.tier_errors`,
-  relative RMS of ``f cos(theta_i)``);
+- ``e_angle``: the tier's angular error against the tables
+  (:func:`lut_baker.closures.fitting.tier_errors`, relative RMS of ``f cos(theta_i)``);
 - ``e_subsurface``: without the subsurface closure, the light the skin spreads under the
   surface stays where it entered; how much that changes the image is the pixel-footprint blur
   argument, computed by :func:`subsurface_omission_error` (the profile's blur of a sphere's
@@ -57,8 +57,14 @@ from functools import lru_cache
 
 import numpy as np
 
+from .bake import RESOLUTIONS, profile_radius
+from .closures.fitting import TIER_REPLICAS, TIERS, edge_response, profile_grid, tier_errors
+from .model.dipole import dipole_profile, dipole_total_reflectance
+from .model.made_up_skin import coverage_weights
+from .model.presets import made_up_skin
 from .numerics.geometry import polar_angle_deg, sphere_directions, sphere_normals
 from .numerics.quadrature import trapezoid_weights
+from .tables.table_set import radius_nodes
 
 __all__ = [
     "Candidate",
@@ -148,23 +154,9 @@ RELATIVE_COST = {
                   strict=True)),
 }
 """Render time per sample relative to :data:`FULLEST`, by coverage (1: the paper's film, 0:
-bare skin), then by candidate: Cycles CPU on 2 threads, 96 px sphere of 30 mm, paper preset,
-sun at 45 degrees, the slope between 16 and 272 samples, the fastest of 3 interleaved runs,
-measured by :data:`COST_COMMAND` on bpy 5.0.1; gloss-free candidates with the group's Gloss
-input at 0, as Fit to Scene sets it.  Each value is the median of three runs of the command
-(the runs whose fullest candidate took within 15% of the quietest run's time per sample, 15.3
-ms on the film and 16.0 ms on bare skin; runs beside another process's load were left out):
-the runs spread by up to 0.15 (``PRINCIPLED`` 0.73-0.88 on the film), so differences under
-~10% are not resolved.  Under the film the subsurface closure carries little weight (Cycles
-rarely samples it), so leaving it out saves little time there but all of its noise
-(:data:`NOISE_K`); on bare skin it saves a third.  Gloss 0 with the subsurface kept saves
-0.03 (``PRINCIPLED`` on the film, whose specular is already off) to 0.27 (``LAYERED`` on bare
-skin) of the fullest's time; with both left out a candidate costs 0.5-0.7 of it.  Adaptive
-sampling is off in these measurements (every pixel takes every sample); with Blender's default
-(adaptive, noise threshold 0.01) a first run gave 0.61 for ``LAYERED, no subsurface`` on the
-film: noise-free candidates stop sooner, so the savings are then larger than modelled.  EEVEE
-uses the same order (its render time here is shader compilation on software OpenGL: 9-96 s a
-render, not a cost)."""
+bare skin), then by candidate, as :data:`COST_COMMAND` measures it (Cycles CPU, adaptive
+sampling off).  How it was measured and how far the runs spread (up to 0.15, so differences
+under ~10% are not resolved): docs/stability.md, "The Auto tier"."""
 NOISE_K = {
     1.0: dict(zip(_ORDER, (0.2474, 0.0006, 0.2595, 0.0007, 0.2413, 0.0006, 0.2594, 0.0007),
                   strict=True)),
@@ -172,12 +164,9 @@ NOISE_K = {
                   strict=True)),
 }
 """Noise coefficient ``k`` by coverage and candidate: one render's relative RMS deviation from
-the converged image is ``k / sqrt(samples)`` (same command, two seeds at 272 samples; the
-same in every run: the seeds fix the images).  The subsurface closure is the noisy part (1.5%
-at 272 samples, 3.1% at 64); on bare skin the skin's gloss lobe makes most of it (0.170 with
-the lobe, 0.036 without); a sun of angle 0 adds almost none.  Area lights and environments
-add noise to every candidate alike, so these understate the noise there and the choice leans
-towards the fullest tier."""
+the converged image is ``k / sqrt(samples)`` (:data:`COST_COMMAND`, two seeds at 272 samples).
+A sun is assumed: area lights and environments add noise to every candidate alike, so the
+choice then leans towards the fullest tier (docs/stability.md)."""
 COST_SKIN_SHARE = {1.0: 0.1327, 0.0: 0.9591}
 """The paper preset's skin share (:func:`gloss_and_skin_shares`, light 45 degrees) at the
 coverages the costs were measured at: a material's costs are interpolated by its share."""
@@ -266,7 +255,7 @@ class SceneDescription:
 class MaterialTraits:
     """What the Auto tier needs of a made-up material at its coverage and absorption.
 
-    ``tier_errors``: angular relative RMS per tier (:func:`closure_fit.tier_errors`);
+    ``tier_errors``: angular relative RMS per tier (:func:`lut_baker.closures.fitting.tier_errors`);
     ``radius_mm``, ``profile``: the normalised radial profile ``R(d)/Rd`` (1/mm^2, ``(n, 3)``)
     on distances (mm), the tables' ``radius_mm`` and ``profile``; ``profile_mismatch``: the
     fitted closure's relative edge-response error (:func:`profile_mismatch`);
@@ -337,8 +326,6 @@ def gloss_and_skin_shares(tables, light_deg: float, coverage=None, absorption=No
     the lit pixels of the gloss lobes' radiance (film, path-3 and skin gloss at the coverage
     and absorption) and of the skin's diffuse part (what spreads), against the total radiance
     ``f cos(theta_i)`` from the tables."""
-    from .model.made_up_skin import coverage_weights
-
     _, wi, wo = sphere_directions(resolution, light_deg)
     w, a = tables.coverage_and_absorption(coverage, absorption)
     weights = coverage_weights(w, a)
@@ -364,8 +351,6 @@ def gloss_omission_error(tables, fit, tier: str, light_deg: float, coverage=None
     replica (:data:`lut_baker.closures.fitting.TIER_REPLICAS` with the closure fit ``fit``) with
     and without its gloss lobes, over the RMS of the tables' radiance ``f cos(theta_i)``, at
     the coverage and absorption (default: the tables')."""
-    from .closures.fitting import TIER_REPLICAS
-
     _, wi, wo = sphere_directions(resolution, light_deg)
     w, a = tables.coverage_and_absorption(coverage, absorption)
     cos_i = wi[:, 2:3]
@@ -381,8 +366,6 @@ def gloss_omissions(tables, fit, coverage=None, absorption=None, *,
                     lights_deg=None) -> dict:
     """:func:`gloss_omission_error` of every tier at ``lights_deg`` (default
     :data:`SHARE_LIGHTS_DEG`): ``{tier: {light angle: error}}``."""
-    from .closures.fitting import TIERS
-
     lights = SHARE_LIGHTS_DEG if lights_deg is None else lights_deg
     return {tier: {float(light): gloss_omission_error(tables, fit, tier, light, coverage,
                                                       absorption)
@@ -392,10 +375,8 @@ def gloss_omissions(tables, fit, coverage=None, absorption=None, *,
 def profile_mismatch(tables, fit_error) -> float:
     """Relative error of a fitted subsurface closure's blur: ``fit_error`` (per channel, the
     RMS difference of its edge response and the tables', a fraction of the lit level:
-    :class:`closure_fit.ProfileFit` ``error``) over the RMS of the tables' edge response's
-    departure from a sharp edge, largest over channels."""
-    from .closures.fitting import edge_response, profile_grid
-
+    :class:`lut_baker.closures.fitting.ProfileFit` ``error``) over the RMS of the tables' edge
+    response's departure from a sharp edge, largest over channels."""
     r_max = float(tables.radius_mm[-1])
     r = profile_grid(r_max)
     s = np.linspace(0.0, r_max, 48)
@@ -412,10 +393,9 @@ shares."""
 def traits_from_tables(tables, fit, coverage=None, absorption=None, *,
                        lights_deg=SHARE_LIGHTS_DEG, method: str | None = None
                        ) -> MaterialTraits:
-    """:class:`MaterialTraits` of baked ``tables`` and their :class:`closure_fit.ClosureFit`
-    ``fit`` at a coverage and absorption (default: the tables')."""
-    from .closures.fitting import tier_errors
-
+    """:class:`MaterialTraits` of baked ``tables`` and their
+    :class:`lut_baker.closures.fitting.ClosureFit` ``fit`` at a coverage and absorption (default:
+    the tables')."""
     w, a = tables.coverage_and_absorption(coverage, absorption)
     errors = tier_errors(fit, tables, w, a)
     shares = {float(angle): gloss_and_skin_shares(tables, angle, w, a) for angle in lights_deg}
@@ -446,11 +426,6 @@ what the Auto tier assumes of a material it has no tables for yet."""
 def _paper_traits() -> MaterialTraits:
     """The constants above with the paper dipole's profile on the bake's
     radial grid (exact and cheap to recompute)."""
-    from .bake import RESOLUTIONS, profile_radius
-    from .model.dipole import dipole_profile, dipole_total_reflectance
-    from .model.presets import made_up_skin
-    from .tables.table_set import radius_nodes
-
     dipole = made_up_skin("paper_natural", "paper_bioplate").dipole
     res = RESOLUTIONS["default"]
     radius = radius_nodes(res.n_radius, res.radius_spacing, profile_radius(dipole))

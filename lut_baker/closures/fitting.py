@@ -398,8 +398,8 @@ def _companion_share(grid: NodeGrid, lobe: np.ndarray, closure_albedo: np.ndarra
 def fit_glossy(grid: NodeGrid, target: np.ndarray, albedo_table: np.ndarray,
                theta_deg: np.ndarray, size: int = DEFAULT_LUT_SIZE, *,
                companion: bool = False) -> LobeFit:
-    """Distribution (:data:`cycles_closures.GLOSSY_DISTRIBUTIONS`) and roughness of a Glossy
-    BSDF whose view-dependent weight (table albedo / closure albedo, read from a
+    """Distribution (:data:`lut_baker.closures.cycles.GLOSSY_DISTRIBUTIONS`) and roughness of a
+    Glossy BSDF whose view-dependent weight (table albedo / closure albedo, read from a
     ``size``-texel image by ``cos(theta_o)``) best reproduces ``target`` ``(n, n, p, 3)``;
     ``albedo_table`` ``(n_theta, 3)`` on ``theta_deg``.
 
@@ -620,12 +620,13 @@ def _view_mean(albedo_of) -> float:
 
 def _coat_layering_mean(roughness: float, ior: float) -> float:
     """:func:`_view_mean` of the coat's layering albedo
-    (:func:`cycles_closures.coat_view_terms`)."""
+    (:func:`lut_baker.closures.cycles.coat_view_terms`)."""
     return _view_mean(lambda mu: cc.coat_view_terms(mu, roughness, ior)[1])
 
 
 def _layering_mean(roughness: float, ior: float, f0=None) -> float:
-    """:func:`_view_mean` of :func:`cycles_closures.layering_albedo` (its largest channel)."""
+    """:func:`_view_mean` of :func:`lut_baker.closures.cycles.layering_albedo` (its largest
+    channel)."""
     return _view_mean(lambda mu: np.max(
         np.atleast_2d(cc.layering_albedo(mu, roughness, ior, f0).T).T, axis=-1))
 

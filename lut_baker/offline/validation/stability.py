@@ -7,16 +7,16 @@ panel's range (5 and 60 degrees) and beyond (2 and 90); indices of refraction ne
 and 1; full absorption.  In each, :func:`check_regime` runs the methods that compute made-up
 skin without Blender and measures what must always hold and how far each is from its reference:
 
-- ``model``: the exact evaluator (:func:`normalise.made_up_reflection`) at directions of the
-  regime: finite, non-negative; its directional albedo (white furnace) at most 1;
+- ``model``: the exact evaluator (:func:`lut_baker.evaluate.made_up.made_up_reflection`) at
+  directions of the regime: finite, non-negative; its directional albedo (white furnace) at most 1;
 - ``bake``: the tables (:func:`bake.bake`): finite, non-negative, albedo at most 1, and their
   error against the exact evaluator (:func:`bake.table_error`);
 - ``reference``: the sphere image (:func:`reference.sphere_image`, local and, where the entry
   samples stay affordable, spread): finite, non-negative, and the spread image's total at most
   the local one's (spreading moves light, it does not make it);
 - ``tiers`` (``fit=True``): the closure fits' angular and albedo errors against the tables
-  (:func:`closure_fit.tier_errors`) at the regime's coverage and absorption;
-- ``auto``: the Auto tier's choice for the regime's scene (:func:`scene_model.choose`).
+  (:func:`lut_baker.closures.fitting.tier_errors`) at the regime's coverage and absorption;
+- ``auto``: the Auto tier's choice for the regime's scene (:func:`lut_baker.auto_tier.choose`).
 
 Functions and types
 -------------------
@@ -37,7 +37,9 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from ...auto_tier import SceneDescription, choose
 from ...bake import bake, table_error
+from ...closures.fitting import fit_closures, tier_errors
 from ...evaluate.made_up import directional_albedo, made_up_reflection
 from ...model.made_up_skin import MadeUpSkin
 from ...model.presets import made_up_skin
@@ -251,18 +253,14 @@ def spread_energy_ratio(skin: MadeUpSkin, radius_mm: float, resolution: int,
 
 
 def _tiers(item: Regime, tables) -> dict:
-    from ...closures.fitting import fit_closures, tier_errors
-
     fit = fit_closures(tables)
     errors = tier_errors(fit, tables, item.coverage, item.absorption)
     return {tier: {"rms": e.rms, "albedo": e.albedo} for tier, e in errors.items()}
 
 
 def auto_choice(item: Regime, samples: int = 128):
-    """The Auto tier's :class:`scene_model.Choice` for the regime's sphere (``resolution`` px
-    across, its lights, Cycles at ``samples``) and skin (the paper preset's traits)."""
-    from ...auto_tier import SceneDescription, choose
-
+    """The Auto tier's :class:`lut_baker.auto_tier.Choice` for the regime's sphere (``resolution``
+    px across, its lights, Cycles at ``samples``) and skin (the paper preset's traits)."""
     diameter = 2.0 * item.radius_mm
     scene = SceneDescription(object_size_mm=diameter, footprint_mm=diameter / item.resolution,
                              lights_deg=item.lights_deg, samples=samples)
