@@ -2,8 +2,9 @@
 
 Socket-level settings (coverage, absorption, skin colour, subsurface scale, gloss) go straight
 to the material's group node.  Settings that change the tables (skin, film overrides, tier) mark the
-material dirty and start one debounce timer; when it fires, every dirty material is re-baked at
-preview resolution and its group rebuilt in place (copied first if other materials share it).
+material dirty and start one debounce timer (:func:`rebake_timer`); when it fires, every dirty
+material is re-baked at preview resolution and its group rebuilt in place (copied first if other
+materials share it).
 Without an event loop (headless) timers never fire: :func:`flush` does the same work at once.
 :func:`unregister` removes the timer, so none is left behind (bpy 4.5 hangs at exit otherwise).
 """
@@ -14,8 +15,8 @@ import bpy
 
 from . import material as made_up
 
-__all__ = ["DEBOUNCE_S", "sockets_changed", "tables_changed", "flush", "pending", "register",
-           "unregister"]
+__all__ = ["DEBOUNCE_S", "sockets_changed", "tables_changed", "flush", "pending",
+           "rebake_timer", "register", "unregister"]
 
 DEBOUNCE_S = 0.3
 """Seconds without a further change before a preview re-bake runs."""
@@ -45,9 +46,9 @@ def tables_changed(settings) -> None:
     _dirty.add(material.name)
     if bpy.app.background:
         return  # no event loop: flush() runs the re-bake when asked
-    if bpy.app.timers.is_registered(_timer):
-        bpy.app.timers.unregister(_timer)
-    bpy.app.timers.register(_timer, first_interval=DEBOUNCE_S)
+    if bpy.app.timers.is_registered(rebake_timer):
+        bpy.app.timers.unregister(rebake_timer)
+    bpy.app.timers.register(rebake_timer, first_interval=DEBOUNCE_S)
 
 
 def pending() -> set[str]:
@@ -55,7 +56,9 @@ def pending() -> set[str]:
     return set(_dirty)
 
 
-def _timer():
+def rebake_timer():
+    """The debounce timer's function (registered with ``bpy.app.timers``): :func:`flush`,
+    once."""
     flush()
     return None  # one shot
 
@@ -90,8 +93,8 @@ def register():
 
 
 def unregister():
-    if bpy.app.timers.is_registered(_timer):
-        bpy.app.timers.unregister(_timer)
+    if bpy.app.timers.is_registered(rebake_timer):
+        bpy.app.timers.unregister(rebake_timer)
     _dirty.clear()
     _messages.clear()
     made_up.clear_cache()

@@ -19,7 +19,6 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
-from collections import OrderedDict
 
 import bpy
 
@@ -169,9 +168,9 @@ def group_for_tables(tables, tier: str, *, bake=None, group=None, errors_at=None
     return nodes.build_group(tier, bake, fit, target, method=method), fit
 
 
-_FITS: OrderedDict = OrderedDict()
 FIT_CACHE_SIZE = 8
 """Closure fits kept per tables key in this session (a fit takes seconds, a bake 0.2 s)."""
+_FITS = lut_baker("numerics.cache").LRUCache(FIT_CACHE_SIZE)
 
 
 def clear_cache() -> None:
@@ -183,14 +182,12 @@ def clear_cache() -> None:
 def _fit(tables, key: str, errors_at, progress=None):
     """The closure fit of ``tables`` (cached by key), its errors measured at ``errors_at``."""
     cf = lut_baker("closures.fitting")
-    fit = _FITS.pop(key, None)
+    fit = _FITS.get(key)
     if fit is None:
         fit = cf.fit_closures(tables, errors_at=errors_at, progress=progress)
     elif errors_at is not None:
         fit = dataclasses.replace(fit, errors=cf.tier_errors(fit, tables, *errors_at))
-    _FITS[key] = fit
-    while len(_FITS) > FIT_CACHE_SIZE:
-        _FITS.popitem(last=False)
+    _FITS.put(key, fit)
     return fit
 
 

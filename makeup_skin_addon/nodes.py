@@ -316,7 +316,7 @@ def _build_layered(build: _Builder, fit, lut, method: str, radius_mm, ior: float
         build.tree.links.new(b, node.inputs[1])
         return node.outputs[0]
 
-    # The film's diffuse and the Lambertian companion of its gloss (closure_fit.fit_glossy)
+    # The film's diffuse and the Lambertian companion of its gloss (closures.fitting.fit_glossy)
     # share one Diffuse closure: no extra closure to sample.
     film_diffuse = build.node("ShaderNodeBsdfDiffuse", "film diffuse")
     companion = build.scale(rows["film_gloss_diffuse"], gloss, label="gloss companion x Gloss")

@@ -29,7 +29,6 @@ from __future__ import annotations
 
 import json
 import math
-from collections import OrderedDict
 
 from . import convert, nodes, storage
 from .keys import CHOICE_KEY, ERRORS_KEY, SAVED_GLOSS_KEY, SAVED_SCALE_KEY
@@ -143,8 +142,9 @@ def describe_scene(scene, material=None, obj=None):
                                engine=_engine(scene), samples=samples, denoise=denoise)
 
 
-_TRAITS: OrderedDict = OrderedDict()
 TRAITS_CACHE_SIZE = 16
+"""Material traits kept in this session (:func:`material_traits`, by all they depend on)."""
+_TRAITS = lut_baker("numerics.cache").LRUCache(TRAITS_CACHE_SIZE)
 
 
 def _stored_errors(material, coverage, absorption, key=None):
@@ -206,7 +206,7 @@ def material_traits(material, *, refit: bool = False, may_fit: bool = True):
     key = (meta.get("key"), meta.get("subsurface_method"), coverage, tuple(absorption),
            None if errors is None else tuple(sorted(errors.items())), omission is not None,
            scale, gloss, may_fit)
-    traits = _TRAITS.pop(key, None)
+    traits = _TRAITS.get(key)
     tables = _tables(meta) if traits is None and meta else None
     if traits is None and tables is None:
         traits = (sm.paper_traits() if (scale, gloss) == (1.0, 1.0)
@@ -229,9 +229,7 @@ def material_traits(material, *, refit: bool = False, may_fit: bool = True):
             skin_share={a: v[1] for a, v in shares.items()},
             gloss_share={a: v[0] for a, v in shares.items()}, subsurface_scale=scale,
             gloss_omission=omission, gloss_scale=gloss)
-    _TRAITS[key] = traits
-    while len(_TRAITS) > TRAITS_CACHE_SIZE:
-        _TRAITS.popitem(last=False)
+    _TRAITS.put(key, traits)
     return traits
 
 

@@ -224,7 +224,7 @@ def test_live_update_rebakes_at_preview_resolution(sphere):
     assert not live.pending()
     after = node.node_tree["makeup_skin_fit"]
     assert json.loads(after)["key"] != json.loads(before)["key"]
-    assert not bpy.app.timers.is_registered(live._timer)
+    assert not bpy.app.timers.is_registered(live.rebake_timer)
 
 
 def test_unregister_leaves_nothing(addon, bpy_factory):
@@ -241,7 +241,7 @@ def test_unregister_leaves_nothing(addon, bpy_factory):
     try:
         assert not hasattr(bpy.types.Material, "makeup_skin")
         assert ours() == []
-        assert not bpy.app.timers.is_registered(live._timer)
+        assert not bpy.app.timers.is_registered(live.rebake_timer)
         assert live.pending() == set()
     finally:
         addon.register()
