@@ -172,7 +172,8 @@ def gloss_tail(tables, skin, n_points=20000, seed=1) -> tuple[float, float, floa
 
 def path3_node_error(tables, skin, n_nodes=300, seed=0) -> float:
     """Quadrature error of path 3 alone: the baked ``path3_gloss`` at random nodes against
-    :func:`lut_baker.evaluate.two_layer.layered_reflection` (level 0) there, normalised by path 3's peak."""
+    :func:`lut_baker.evaluate.two_layer.layered_reflection` (level 0) there, normalised by path 3's
+    peak."""
     from lut_baker.evaluate.two_layer import layered_reflection
     from lut_baker.numerics.geometry import direction
 

@@ -2,18 +2,19 @@
 
     python bench/character_files.py --repo CHECKOUT --out DIR [--json FILE] [--repeats 3]
 
-Measures the add-on of ``CHECKOUT`` (its ``makeup_skin_addon`` and ``lut_baker`` are imported:
-the checkout goes first on ``sys.path``) on the scene of *this* script's repository
-(``tools/character.py``, loaded by file path), so an old and a new checkout are measured on the
-same scene.  Uses only what every checkout has: ``bpy.ops.makeup_skin.apply()`` on the active,
-selected object, and the settings ``material.makeup_skin.<tier|skin|foundation|resolution>``
-of the object's active material (set before Apply).  Whether Apply gives the object a new
-material or converts the artist's own one, the script just calls it and measures.
+Measures the add-on of ``CHECKOUT`` (its ``makeup_skin_addon`` and ``lut_baker`` are imported: the
+checkout goes first on ``sys.path``) on the scene of *this* script's repository
+(``tests/support/character.py``, imported after the add-on with this repository's ``tests`` last on
+``sys.path``), so an old and a new checkout are measured on the same scene. Uses only what every
+checkout has: ``bpy.ops.makeup_skin.apply()`` on the active, selected object, and the settings
+``material.makeup_skin.<tier|skin|foundation|resolution>`` of the object's active material (set
+before Apply). Whether Apply gives the object a new material or converts the artist's own one, the
+script just calls it and measures.
 
 (a) Saved .blend sizes (``save_as_mainfile(compress=False)``, written to ``--out``):
 
 - ``empty`` -- a factory-empty file;
-- ``1 char`` -- one character (tools/character.py, seed 0), no Made-up Skin;
+- ``1 char`` -- one character (tests/support/character.py, seed 0), no Made-up Skin;
 - ``1 char, applied`` -- the same after Apply (default settings, tier Layered);
 - ``3 chars`` -- three characters (seeds 0, 1, 2: each its own material and textures);
 - ``3 chars, applied`` -- the same after Apply: skins ``paper_bioplate``, ``paper_bioplate``,
@@ -37,7 +38,6 @@ Run with the venv's python of the Blender line to measure (``$(tools/venv.sh)/bi
 from __future__ import annotations
 
 import argparse
-import importlib.util
 import json
 import os
 import statistics
@@ -49,7 +49,7 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve()
 OWN_ROOT = HERE.parents[1]
-CHARACTER_PY = OWN_ROOT / "tools" / "character.py"
+OWN_TESTS = OWN_ROOT / "tests"
 TIER = "LAYERED"
 RESOLUTIONS = ("preview", "default")
 THREE_SKINS = ("paper_bioplate", "paper_bioplate", "jensen_skin1")
@@ -57,7 +57,8 @@ THREE_SKINS = ("paper_bioplate", "paper_bioplate", "jensen_skin1")
 
 def _setup(repo: Path):
     """Put ``repo`` first on sys.path, import the add-on and lut_baker from it (checked), then
-    tools/character.py of this script's repository by path; returns ``(bpy, addon, character)``.
+    tests/support/character.py of this script's repository (its ``tests`` folder appended to
+    sys.path, after everything the add-on came from); returns ``(bpy, addon, character)``.
     BLENDER_USER_RESOURCES goes to a temporary folder before bpy is imported."""
     os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="character_files_"))
     sys.path.insert(0, str(repo))
@@ -70,9 +71,10 @@ def _setup(repo: Path):
         if not Path(module.__file__).resolve().is_relative_to(repo):
             raise SystemExit(f"character_files: {module.__name__} came from {module.__file__}, "
                              f"not from {repo}")
-    spec = importlib.util.spec_from_file_location("character", CHARACTER_PY)
-    character = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(character)
+    if str(OWN_TESTS) not in sys.path:
+        sys.path.append(str(OWN_TESTS))
+    from support import character
+
     return bpy, makeup_skin_addon, character
 
 
@@ -194,7 +196,7 @@ def _commit(repo: Path) -> str:
 
 
 def print_report(results: dict) -> None:
-    print(f"\nMade-up Skin on tools/character.py heads -- Blender {results['blender']}, "
+    print(f"\nMade-up Skin on tests/support/character.py heads -- Blender {results['blender']}, "
           f"checkout {results['repo']} at {results['commit']}")
     print(f"\n{'file':<18} {'bytes':>11} {'MB':>8} {'packed MB':>10} {'materials':>9} "
           f"{'images':>6} {'orphaned':>8}")
@@ -245,7 +247,7 @@ def main(argv=None) -> int:
             print("TIMINGS " + json.dumps(timing_worker(bpy, character, args.worker)))
             return 0
         results = {"blender": bpy.app.version_string, "repo": str(repo),
-                   "commit": _commit(repo), "character_py": str(CHARACTER_PY),
+                   "commit": _commit(repo), "character_py": character.__file__,
                    "sizes": measure_sizes(bpy, character, args.out.resolve())}
     finally:
         addon.unregister()  # bpy 4.5 hangs at exit while an add-on stays registered

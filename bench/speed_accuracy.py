@@ -6,19 +6,19 @@ A benchmark, not a test::
     python bench/speed_accuracy.py --quick    # 16 and 64 samples, no bake axis (smoke run)
     python bench/speed_accuracy.py --replot   # redraw the PNG from the CSV
 
-Scene (``bench/blender_scene.py``): the paper preset on a sphere of 10 mm radius, 48 x 48 px,
-Cycles CPU, light 0, 45 and 75 degrees from the view.  Each of PRINCIPLED, LAYERED (the add-on's
-node group, "default" tables) and BASELINE (a stock Principled BSDF whose sockets
-:func:`lut_baker.offline.validation.baseline.fit_baseline` fitted to the same tables) renders at 16, 64, 256 and
-1024 samples with seeds 0 and 1, configurations interleaved so that the load of a shared
-machine falls on all alike.
-Against the reference (:func:`lut_baker.offline.validation.compare.reference_image`, paths 1 + 3 from "high"
-tables, the skin's diffuse part spread by the dipole profile): relative RMS error over the
-sphere's pixels (mean of the two seeds), the noise floor ``rms(a - b) / sqrt(2)`` and the time
-per render (mean of the two).  The bake axis: per bake resolution, the tables' size, bake time
-(median of 3), table error (:func:`lut_baker.bake.table_error`, 500 points) and the LAYERED
-tier's render error at 256 samples, light 45 degrees, seed 0.  48 px keeps the whole run near
-8 minutes on 2 cores (the 1024-sample renders take most of it; 64 px would take ~14).
+Scene (``tests/support/bench_scene.py``, shared with the tests): the paper preset on a sphere of
+10 mm radius, 48 x 48 px, Cycles CPU, light 0, 45 and 75 degrees from the view. Each of PRINCIPLED,
+LAYERED (the add-on's node group, "default" tables) and BASELINE (a stock Principled BSDF whose
+sockets :func:`lut_baker.offline.validation.baseline.fit_baseline` fitted to the same tables)
+renders at 16, 64, 256 and 1024 samples with seeds 0 and 1, configurations interleaved so that the
+load of a shared machine falls on all alike.
+Against the reference (:func:`lut_baker.offline.validation.compare.reference_image`, paths 1 + 3
+from "high" tables, the skin's diffuse part spread by the dipole profile): relative RMS error over
+the sphere's pixels (mean of the two seeds), the noise floor ``rms(a - b) / sqrt(2)`` and the time
+per render (mean of the two). The bake axis: per bake resolution, the tables' size, bake time
+(median of 3), table error (:func:`lut_baker.bake.table_error`, 500 points) and the LAYERED tier's
+render error at 256 samples, light 45 degrees, seed 0. 48 px keeps the whole run near 8 minutes on 2
+cores (the 1024-sample renders take most of it; 64 px would take ~14).
 """
 
 from __future__ import annotations
@@ -33,7 +33,7 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-for _path in (ROOT, ROOT / "bench", ROOT / "tools"):
+for _path in (ROOT, ROOT / "bench", ROOT / "tests"):
     if str(_path) not in sys.path:
         sys.path.insert(0, str(_path))
 
@@ -71,13 +71,13 @@ def _bake_bench():
 
 def references(skin, size: int, lights) -> dict:
     """Reference image per light (degrees)."""
-    import blender_scene
+    from support import bench_scene
 
     tables = bake.bake(skin, "high")
     samples = reference.default_samples(skin, RADIUS_MM, SPREAD_PER_MEAN_FREE_PATH)
     return {light: compare.reference_image(skin, tables=tables, resolution=size,
                                            radius_mm=RADIUS_MM, light_angle_deg=light,
-                                           irradiance=blender_scene.IRRADIANCE, samples=samples)
+                                           irradiance=bench_scene.IRRADIANCE, samples=samples)
             for light in lights}
 
 
@@ -91,16 +91,16 @@ def render_rows(skin, tables, baseline, refs: dict, size: int, sample_counts,
     ``baseline``: the :class:`lut_baker.offline.validation.baseline.Baseline` of ``tables``.
     ``bake_tables``: ``{resolution: tables}`` whose LAYERED render error at
     :data:`GOAL_SAMPLES` samples, light 45, seed 0 is returned as ``{resolution: error}``."""
-    import blender_scene as scene_module
     import bpy
-    import render_sphere
+    from support import bench_scene as scene_module
+    from support import sphere_scene
 
     rows, bake_errors = [], {}
     for light, ref in refs.items():
         sphere = scene_module.sphere_scene(size=size, samples=16, radius_mm=RADIUS_MM,
                                            light_deg=light)
         scene = bpy.context.scene
-        with render_sphere.addon_registered():
+        with sphere_scene.addon_registered():
             materials = {name: scene_module.tier_material(sphere, tables, name)
                          for name in CONFIGS[:2]}
             materials["BASELINE"] = scene_module.baseline_material(baseline, scene)
@@ -308,7 +308,8 @@ def baseline_text(baseline, seconds: float) -> str:
         return f"{value:.3f}"
 
     lights = sorted(baseline.error)
-    lines = [f"The baseline, fitted by `lut_baker.offline.validation.baseline.fit_baseline` in {seconds:.1f} s "
+    lines = [f"The baseline, fitted by `lut_baker.offline.validation.baseline.fit_baseline` in "
+             f"{seconds:.1f} s "
              f"({baseline.evaluations} evaluations; subsurface method "
              f"{baseline.subsurface_method}):", "",
              "| " + " | ".join(baseline.socket_values()) + " |",

@@ -4,25 +4,21 @@
     python bench/stability_sweep.py --costs [--repeats 3]
     python bench/stability_sweep.py --traits
 
-The first form runs :func:`lut_baker.offline.validation.stability.sweep` (the exact model, the bake, the closure
-fits and the reference images in every regime of stability.REGIMES) and, unless
-``--no-render``, renders each tier in the same regimes with Cycles (:func:`render_regimes`):
-no NaN, Inf or negative pixel, the white furnace (world colour 1, no light) and the error
-against the reference image.  It prints the table of docs/stability.md (``--out`` rewrites the
-part of that file between its ``<!-- sweep -->`` markers).
+The first form runs :func:`lut_baker.offline.validation.stability.sweep` (the exact model, the bake,
+the closure fits and the reference images in every regime of stability.REGIMES) and, unless
+``--no-render``, renders each tier in the same regimes with Cycles (:func:`render_regimes`): no NaN,
+Inf or negative pixel, the white furnace (world colour 1, no light) and the error against the
+reference image. It prints the table of docs/stability.md (``--out`` rewrites the part of that file
+between its ``<!-- sweep -->`` markers).
 
 ``--costs`` measures what :mod:`lut_baker.auto_tier` stores: per-sample render time of every
 candidate relative to the fullest (the slope between two sample counts, so that scene set-up
 does not count) and its Monte Carlo noise coefficient (relative RMS between two seeds);
 ``--traits`` prints the paper preset's traits it assumes without tables.
 
-bpy helpers on top of bench/blender_scene.py (the reference's scene; also used by
-tests/test_addon_stability.py and tests/test_scene_model.py):
-
-- :class:`Stage` -- one scene built once, changed between renders (radius, light, seed,
-  white furnace: no light, world colour 1).
-- :func:`candidate_material` -- the made-up material of a scene-model candidate.
-- :func:`furnace_rings` -- a furnace image averaged over rings of the view angle.
+The scene is tests/support/bench_scene.py's (the reference's scene, shared with the tests):
+its :class:`~support.bench_scene.Stage` (one scene built once, changed between renders),
+:func:`~support.bench_scene.candidate_material` and :func:`~support.bench_scene.furnace_rings`.
 """
 
 from __future__ import annotations
@@ -38,108 +34,17 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
-for _path in (ROOT, ROOT / "tools", ROOT / "bench"):
+for _path in (ROOT, ROOT / "tests", ROOT / "bench"):
     if str(_path) not in sys.path:
         sys.path.insert(0, str(_path))
 
-import blender_scene  # noqa: E402  (bench/blender_scene.py)
-import render_sphere  # noqa: E402  (tools/render_sphere.py)
 from doc_block import replace_block  # noqa: E402  (bench/doc_block.py)
+from support.bench_scene import IRRADIANCE, Stage, furnace_rings  # noqa: E402
+from support.sphere_scene import addon_registered  # noqa: E402
 
 from lut_baker.offline.validation import compare  # noqa: E402
 
-__all__ = ["Stage", "candidate_material", "furnace_rings", "measure_costs",
-           "render_regimes", "main"]
-
-
-class Stage:
-    """One :func:`blender_scene.sphere_scene` built once (it takes 10-15 s on this machine:
-    the 256-segment sphere) and changed between renders: sphere radius (the mesh rescaled,
-    camera reframed as sphere_scene frames it), light angle, seed, samples, white furnace."""
-
-    def __init__(self, *, size=32, samples=128, radius_mm=10.0):
-        import bpy
-
-        self.sphere = blender_scene.sphere_scene(size=size, samples=samples,
-                                                 radius_mm=radius_mm)
-        self.scene = bpy.context.scene
-        self.radius_mm = radius_mm
-        self.sun = self.scene.objects["Sun"]
-        self.background = next((n for n in (self.scene.world.node_tree.nodes
-                                             if self.scene.world.node_tree else ())
-                                if n.type == "BACKGROUND"), None)
-
-    def frame(self, radius_mm: float) -> None:
-        """Rescale the sphere to ``radius_mm`` and reframe the camera (ortho 2R at -10R)."""
-        from mathutils import Matrix
-
-        if radius_mm != self.radius_mm:
-            self.sphere.data.transform(Matrix.Scale(radius_mm / self.radius_mm, 4))
-            self.sphere.data.update()
-            self.radius_mm = radius_mm
-        radius = radius_mm * 1e-3
-        camera = self.scene.camera
-        camera.location = (0.0, -10.0 * radius, 0.0)
-        camera.data.ortho_scale = 2.0 * radius
-        camera.data.clip_start = radius
-        camera.data.clip_end = 100.0 * radius
-
-    def light(self, light_deg: float) -> None:
-        """The sun ``light_deg`` from the view towards +x (as tools/render_sphere.py)."""
-        self.sun.rotation_euler = (math.pi / 2, 0.0, math.radians(light_deg))
-
-    def furnace(self, on: bool) -> None:
-        """White furnace (no light, world colour 1) or the sun in a black world."""
-        self.sun.hide_render = on
-        value = 1.0 if on else 0.0
-        self.scene.world.color = (value,) * 3
-        if self.background is not None:
-            self.background.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
-            self.background.inputs["Strength"].default_value = value
-
-    def render(self, tables, candidate, *, seed=0, samples=None):
-        """Render ``candidate`` (:func:`candidate_material`): ``(seconds, image)``."""
-        blender_scene.set_samples(self.scene, samples or self.scene.cycles.samples, seed)
-        candidate_material(self.sphere, tables, candidate)
-        return blender_scene.render_image()
-
-
-def candidate_material(sphere, tables, candidate):
-    """The made-up material of a :class:`lut_baker.auto_tier.Candidate` on ``sphere`` (the
-    add-on registered), as Fit to Scene realises it: its tier; ``subsurface=False`` sets
-    Subsurface Scale 0 (Cycles then shades the subsurface closures as diffuse ones);
-    ``gloss=False`` sets the group's Gloss input to 0 (Cycles then allocates no gloss
-    closure)."""
-    material = blender_scene.tier_material(sphere, tables, candidate.tier)
-    node = material.node_tree.nodes["Made-up Skin"]
-    if not candidate.subsurface:
-        material.makeup_skin.subsurface_scale = 0.0
-        node.inputs["Subsurface Scale"].default_value = 0.0
-    if not candidate.gloss:
-        material.makeup_skin.gloss = 0.0
-        node.inputs["Gloss"].default_value = 0.0
-    return material
-
-
-FURNACE_RINGS = 8
-"""Rings of equal width in ``cos(theta_o)`` over which :func:`furnace_rings` averages."""
-
-
-def furnace_rings(image, rings: int = FURNACE_RINGS):
-    """``(cos_view centres, ring means (rings, 3), ring standard errors (rings, 3))`` of a
-    white-furnace image over rings of the view cosine (pixel centres of the sphere)."""
-    size = image.shape[0]
-    centres = (np.arange(size) + 0.5) / size * 2.0 - 1.0
-    x, y = np.meshgrid(centres, -centres)
-    r2 = x * x + y * y
-    mask = r2 < 1.0
-    cos_view = np.sqrt(np.clip(1.0 - r2, 0.0, None))[mask]
-    values = np.asarray(image, float)[mask]
-    ring = np.minimum((cos_view * rings).astype(int), rings - 1)
-    means = np.stack([values[ring == k].mean(axis=0) for k in range(rings)])
-    errors = np.stack([values[ring == k].std(axis=0) / np.sqrt(max((ring == k).sum(), 1))
-                       for k in range(rings)])
-    return (np.arange(rings) + 0.5) / rings, means, errors
+__all__ = ["measure_costs", "render_regime", "render_regimes", "main"]
 
 
 # --------------------------------------------------------------------------------------------
@@ -167,7 +72,7 @@ def measure_costs(*, size=96, samples=(16, 272), repeats=3, radius_mm=30.0, cove
     cpu = {c: {low: [], high: []} for c in auto_tier.CANDIDATES}
     noise = {}
 
-    with render_sphere.addon_registered():
+    with addon_registered():
         stage = Stage(size=size, samples=high, radius_mm=radius_mm)
         for _ in range(repeats):
             for candidate in auto_tier.CANDIDATES:
@@ -208,13 +113,13 @@ def _furnace_reference(tables, size):
 
 
 def render_regime(stage, item, candidates, *, seeds=(0, 1), furnace=True, tables=None):
-    """Render every candidate in one :class:`lut_baker.offline.validation.stability.Regime` on ``stage`` (a
-    :class:`Stage`; the add-on registered): per candidate name ``{"lit", "furnace",
-    "spread"}``.  Lit (each of the regime's lights, the worst kept): finite, min, max,
-    ``error`` against :func:`lut_baker.offline.validation.compare.reference_image` (from the tables; spread where
-    the reference affords it), ``noise`` (two seeds) and ``bias``.  Furnace: finite, min, max
-    pixel, the largest ring mean of :func:`furnace_rings` and its standard error, the exact
-    albedo's largest value and the error against the exact furnace image."""
+    """Render every candidate in one :class:`lut_baker.offline.validation.stability.Regime` on
+    ``stage`` (a :class:`Stage`; the add-on registered): per candidate name ``{"lit", "furnace",
+    "spread"}``. Lit (each of the regime's lights, the worst kept): finite, min, max, ``error``
+    against :func:`lut_baker.offline.validation.compare.reference_image` (from the tables; spread
+    where the reference affords it), ``noise`` (two seeds) and ``bias``. Furnace: finite, min, max
+    pixel, the largest ring mean of :func:`furnace_rings` and its standard error, the exact albedo's
+    largest value and the error against the exact furnace image."""
     from lut_baker import bake
     from lut_baker.offline.validation import reference, stability
 
@@ -227,7 +132,7 @@ def render_regime(stage, item, candidates, *, seeds=(0, 1), furnace=True, tables
                   <= stability.MAX_SPREAD_SAMPLES)
     references = {light: compare.reference_image(
         skin, tables=tables, resolution=size, radius_mm=item.radius_mm, light_angle_deg=light,
-        irradiance=blender_scene.IRRADIANCE, spread=affordable) for light in item.lights_deg}
+        irradiance=IRRADIANCE, spread=affordable) for light in item.lights_deg}
     furnace_ref = _furnace_reference(tables, size)
     mask = compare.sphere_mask(size)
     stage.frame(item.radius_mm)
@@ -268,7 +173,7 @@ def render_regimes(regimes=None, **options) -> dict:
 
     regimes = stability.REGIMES if regimes is None else regimes
     out = {}
-    with render_sphere.addon_registered():
+    with addon_registered():
         stage = Stage(**{k: options.pop(k) for k in ("size", "samples") if k in options})
         for item in regimes:
             candidates = [auto_tier.Candidate("PRINCIPLED"), auto_tier.Candidate("LAYERED")]
@@ -318,7 +223,8 @@ def _print_traits() -> None:
 # The docs' tables
 # --------------------------------------------------------------------------------------------
 TEST_SAMPLES = 64
-"""Samples of tests/test_addon_stability.py's renders: the bounds allow for their noise."""
+"""Samples of tests/makeup_skin_addon/test_render_stability.py's renders: the bounds allow
+for their noise."""
 MARKERS = ("<!-- sweep: begin (python bench/stability_sweep.py --out docs/stability.md) -->",
            "<!-- sweep: end -->")
 
@@ -422,15 +328,16 @@ def main(argv=None) -> int:
         results.append(stability.check_regime(item, error_points=60, model_points=24,
                                               fit=True))
         print(f"# checked {item.key}: {time.perf_counter() - start:.0f} s", flush=True)
-    text = ("Methods without Blender (`lut_baker.offline.validation.stability.check_regime`: exact model at 24 "
-            "direction pairs, preview bake, its error at 60 random points, reference images "
-            "16 px):\n\n" + pure_table(results))
+    text = ("Methods without Blender (`lut_baker.offline.validation.stability.check_regime`: exact "
+            "model at 24 direction pairs, preview bake, its error at 60 random points, reference "
+            "images 16 px):\n\n" + pure_table(results))
     if not args.no_render:
         renders = render_regimes(regimes, size=size, samples=samples)
         text += (f"\n\nEach tier in Cycles (`render_regimes`: {size} px, {samples} samples, "
-                 "seeds 0 and 1, against `lut_baker.offline.validation.compare.reference_image` from the preview "
-                 "tables, spread where affordable; white furnace: world colour 1, no light, "
-                 "rings of equal width in cos(theta_o)):\n\n" + render_table(renders, samples))
+                 "seeds 0 and 1, against `lut_baker.offline.validation.compare.reference_image` "
+                 "from the preview tables, spread where affordable; white furnace: world colour 1, "
+                 "no light, rings of equal width in cos(theta_o)):\n\n"
+                 + render_table(renders, samples))
     print(text)
     print(f"# stability sweep: {time.perf_counter() - start:.0f} s")
     if args.out:

@@ -12,11 +12,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from support import sphere_scene
 
 REPO_ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(REPO_ROOT / "tools"))  # the tools are scripts, not a package
-import render_sphere  # noqa: E402
-
 pytestmark = pytest.mark.bpy
 REPO_MODULE = "makeup_skin_apply_repo"
 
@@ -63,6 +61,7 @@ def installed(bpy_factory, tmp_path_factory):
         prefs.extensions.repos.remove(prefs.extensions.repos[repo_index])
 
 
+@pytest.mark.slow  # renders
 def test_apply_from_the_installed_extension(installed, tmp_path):
     import bpy
 
@@ -86,8 +85,8 @@ def test_apply_from_the_installed_extension(installed, tmp_path):
     assert Path(made_up.__file__).is_relative_to(installed["repo_dir"])
     assert made_up.check_material(bpy.context, material)[0]  # re-bakes to its recorded hash
 
-    render_sphere.light_and_camera(scene, 0.03, light_deg=0.0)
-    render_sphere.cycles_settings(scene, size=32, samples=8)
+    sphere_scene.light_and_camera(scene, 0.03, light_deg=0.0)
+    sphere_scene.cycles_settings(scene, size=32, samples=8)
     scene.render.image_settings.file_format = "OPEN_EXR"
     scene.render.filepath = str(tmp_path / "installed.exr")
     bpy.ops.render.render(write_still=True)

@@ -86,12 +86,15 @@ def _repo_index(bpy, module):
 
 @contextlib.contextmanager
 def _without_repo_on_path():
-    """Hide the source tree's ``lut_baker``, so only the installed copy can be imported."""
+    """Hide the source tree's ``lut_baker``, so only the installed copy can be imported: the
+    checkout's root leaves ``sys.path``, and so does ``tests`` (pytest's ``pythonpath``), whose
+    folder of tests named ``lut_baker`` would otherwise import as an empty namespace package."""
     saved_path = sys.path[:]
     saved_modules = {
         k: v for k, v in sys.modules.items() if k == "lut_baker" or k.startswith("lut_baker.")
     }
-    sys.path[:] = [p for p in sys.path if Path(p or ".").resolve() != REPO_ROOT]
+    hidden = {REPO_ROOT, REPO_ROOT / "tests"}
+    sys.path[:] = [p for p in sys.path if Path(p or ".").resolve() not in hidden]
     for name in saved_modules:
         del sys.modules[name]
     try:

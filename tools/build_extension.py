@@ -11,9 +11,9 @@ run in a subprocess and bpy itself is never imported here. ``MAKEUP_SKIN_BLENDER
 at another copy of ``blender_ext.py``.
 
 After building, the zip is checked: it holds the root ``__init__.py``, the manifest and every
-``.py`` of ``makeup_skin_addon/`` and of ``lut_baker/`` outside ``lut_baker/offline/``, and
-nothing offline or from development (tests, caches, tools, ...). On success the zip path is the last line on stdout; on failure the exit
-status is 1 and the tool's own message is on stderr.
+``.py`` of ``makeup_skin_addon/`` and of ``lut_baker/`` outside ``lut_baker/offline/``, and nothing
+offline or from development (tests, caches, tools, ...). On success the zip path is the last line on
+stdout; on failure the exit status is 1 and the tool's own message is on stderr.
 
 Functions (importable, e.g. by the tests):
 

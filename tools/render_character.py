@@ -1,4 +1,5 @@
-"""Render the textured head (tools/character.py) as an artist sees it, before and after Apply.
+"""Render the textured head (tests/support/character.py) as an artist sees it, before and after
+Apply.
 
 Usage::
 
@@ -42,13 +43,12 @@ from pathlib import Path
 
 import numpy as np
 
-TOOLS = Path(__file__).resolve().parent
-REPO_ROOT = TOOLS.parent
-if str(TOOLS) not in sys.path:
-    sys.path.insert(0, str(TOOLS))
+REPO_ROOT = Path(__file__).resolve().parent.parent
+for _path in (REPO_ROOT, REPO_ROOT / "tests"):
+    if str(_path) not in sys.path:
+        sys.path.insert(0, str(_path))
 
-import character  # noqa: E402
-import render_sphere  # noqa: E402  (puts the checkout's root on sys.path)
+from support import character, sphere_scene  # noqa: E402  (tests/support/)
 
 __all__ = ["main"]
 
@@ -72,7 +72,7 @@ def _check(condition: bool, message: str) -> None:
 
 def _render(out: Path, name: str, what: str, scene, keep_exr: bool = False) -> Path:
     path = out / f"{name}.png"
-    seconds = render_sphere.render(path)
+    seconds = sphere_scene.render(path)
     _check(path.is_file(), f"the render of {name} wrote no {path}")
     if not keep_exr:
         path.with_suffix(".exr").unlink(missing_ok=True)
@@ -128,7 +128,7 @@ def _strip(paths, out_path: Path, gap: int = GAP_PX) -> None:
     """The PNGs ``paths`` side by side, ``gap`` white pixels between them, as a PNG."""
     import bpy
 
-    panels = [render_sphere.image_pixels(p) for p in paths]
+    panels = [sphere_scene.image_pixels(p) for p in paths]
     height = panels[0].shape[0]
     _check(all(p.shape[0] == height for p in panels), "strip panels differ in height")
     width = sum(p.shape[1] for p in panels) + gap * (len(panels) - 1)
@@ -280,7 +280,7 @@ def run(args) -> None:
         return _render(out, name, what, scene, args.keep_exr)
 
     strip = [shoot("before", "the artist's own material")]
-    with render_sphere.addon_registered():
+    with sphere_scene.addon_registered():
         for foundation in FOUNDATIONS:
             _apply(head, foundation, args)
             strip.append(shoot(foundation, f"after Apply, {foundation}"))

@@ -11,47 +11,35 @@ lut_baker bake``) or the ``.exr`` itself; without it the tables are baked from
 beside it (same stem), then prints one line with the render time.  Run it with the venv's
 python (``$(tools/venv.sh)/bin/python``).
 
-Scene: a smooth UV sphere of ``--radius-mm`` millimetres (scene in metres), an orthographic
-camera looking at it, one sun (angle 0, irradiance ``pi`` W/m^2, so a white Lambertian surface
-facing it is 1.0) ``--light-deg`` degrees from the view direction towards +x, black world, no
-denoiser, film exposure 1.
-
-Functions (for other scripts, the benchmarks and the tests):
-
-- :func:`add_sphere` -- a smooth sphere with that camera, sun and render settings in a scene.
-- :func:`build_scene` -- the sphere, camera, sun and render settings in a fresh file, from
-  :func:`light_and_camera`, :func:`black_world` and :func:`cycles_settings` (also used alone
-  by the tests and tools/calibrate_subsurface.py).
-- :func:`addon_registered` -- the add-on from this checkout, registered for a ``with`` block.
-- :func:`made_up_material` -- a material with the group for given tables and tier.
-- :func:`coverage_ramp` -- coverage painted as a left-to-right ramp.
-- :func:`render` -- render to PNG and EXR; returns seconds.
-- :func:`render_pixels` -- render to a float EXR and return its pixels; :func:`image_pixels`
-  an image file's pixels.
+Scene (tests/support/sphere_scene.py, shared with the tests and the benchmarks): a smooth UV
+sphere of ``--radius-mm`` millimetres (scene in metres), an orthographic camera looking at it,
+one sun (angle 0, irradiance ``pi`` W/m^2, so a white Lambertian surface facing it is 1.0)
+``--light-deg`` degrees from the view direction towards +x, black world, no denoiser, film
+exposure 1.
 """
 
 from __future__ import annotations
 
 import argparse
-import contextlib
-import math
 import os
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 REPO_ROOT = Path(__file__).resolve().parent.parent
-if str(REPO_ROOT) not in sys.path:
-    sys.path.insert(0, str(REPO_ROOT))
+for _path in (REPO_ROOT, REPO_ROOT / "tests"):
+    if str(_path) not in sys.path:
+        sys.path.insert(0, str(_path))
 
-__all__ = ["build_scene", "light_and_camera", "black_world", "cycles_settings",
-           "addon_registered", "made_up_material", "coverage_ramp", "render", "render_pixels",
-           "image_pixels", "add_sphere",
-           "load_or_bake", "main"]
+from support.sphere_scene import (  # noqa: E402  (tests/support/sphere_scene.py)
+    addon_registered,
+    build_scene,
+    coverage_ramp,
+    made_up_material,
+    render,
+)
 
-IRRADIANCE = math.pi
-"""Sun strength (W/m^2): a white Lambertian surface facing the sun renders as 1.0."""
+__all__ = ["load_or_bake", "main"]
 
 
 def load_or_bake(tables_path=None, foundation="paper_natural", skin="paper_bioplate",
@@ -76,192 +64,6 @@ def load_or_bake(tables_path=None, foundation="paper_natural", skin="paper_biopl
         except codec.TableFileError as error:
             raise SystemExit(f"render_sphere: {error}") from None
     return bake.bake(presets.made_up_skin(foundation, skin), resolution)
-
-
-def light_and_camera(scene, radius: float, light_deg: float = 45.0) -> None:
-    """An orthographic camera on -y looking at a sphere of ``radius`` (scene units) at the
-    origin, framing it with 10% margin, and a sun (angle 0, irradiance :data:`IRRADIANCE`)
-    from the camera's side, turned ``light_deg`` degrees towards +x about the vertical."""
-    import bpy
-
-    camera = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
-    scene.collection.objects.link(camera)
-    camera.data.type = "ORTHO"
-    camera.data.ortho_scale = 2.2 * radius
-    camera.location = (0.0, -10.0 * radius, 0.0)
-    camera.rotation_euler = (math.pi / 2, 0.0, 0.0)
-    scene.camera = camera
-    sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
-    scene.collection.objects.link(sun)
-    sun.data.energy = IRRADIANCE
-    sun.data.angle = 0.0
-    sun.rotation_euler = (math.pi / 2, 0.0, math.radians(light_deg))  # shines along its -Z
-
-
-def black_world(scene) -> None:
-    """A black world (5.0 gives new worlds a Background node, 4.5 uses the world colour)."""
-    import bpy
-
-    world = bpy.data.worlds.new("Black")
-    world.color = (0.0, 0.0, 0.0)
-    for node in (world.node_tree.nodes if world.node_tree is not None else ()):
-        if node.type == "BACKGROUND":
-            node.inputs["Strength"].default_value = 0.0
-    scene.world = world
-
-
-def cycles_settings(scene, *, size: int, samples: int, seed: int = 0,
-                    height: int | None = None) -> None:
-    """Cycles on the CPU, no denoiser, film exposure 1, view transform Standard."""
-    scene.render.engine = "CYCLES"
-    scene.cycles.device = "CPU"
-    scene.cycles.samples = samples
-    scene.cycles.seed = seed
-    scene.cycles.use_denoising = False
-    scene.cycles.film_exposure = 1.0
-    scene.render.resolution_x = size
-    scene.render.resolution_y = size if height is None else height
-    scene.render.resolution_percentage = 100
-    scene.view_settings.view_transform = "Standard"
-    scene.view_settings.look = "None"
-
-
-def build_scene(*, size=128, samples=64, radius_mm=30.0, light_deg=45.0, seed=0):
-    """Sphere, camera, sun and Cycles settings in a fresh file; returns the sphere object."""
-    import bpy
-
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    scene = bpy.context.scene
-    scene.unit_settings.system = "METRIC"
-    scene.unit_settings.scale_length = 1.0
-    return add_sphere(scene, radius_mm * 1e-3, light_deg=light_deg, size=size, samples=samples,
-                      seed=seed, segments=128)
-
-
-def add_sphere(scene, radius: float, *, light_deg=45.0, size=64, samples=16, seed=0,
-               segments=48):
-    """A smooth UV sphere of ``radius`` (scene units) at the origin of ``scene``, with
-    :func:`light_and_camera`, :func:`black_world` and :func:`cycles_settings`; returns it."""
-    import bpy
-
-    bpy.ops.mesh.primitive_uv_sphere_add(segments=segments, ring_count=segments // 2,
-                                         radius=radius)
-    sphere = bpy.context.active_object
-    bpy.ops.object.shade_smooth()
-    light_and_camera(scene, radius, light_deg)
-    black_world(scene)
-    cycles_settings(scene, size=size, samples=samples, seed=seed)
-    return sphere
-
-
-@contextlib.contextmanager
-def addon_registered():
-    """The add-on from this checkout registered for the duration (bpy 4.5 hangs at exit while
-    an add-on's classes stay registered, so always leave through here)."""
-    import bpy
-
-    import makeup_skin_addon
-
-    if hasattr(bpy.types.Material, "makeup_skin"):
-        yield
-        return
-    makeup_skin_addon.register()
-    try:
-        yield
-    finally:
-        makeup_skin_addon.unregister()
-
-
-def made_up_material(obj, tables, tier="LAYERED", *, coverage=None, absorption=None):
-    """Give ``obj`` a material with the Made-up Skin group for ``tables`` (the add-on must be
-    registered: :func:`addon_registered`).  Coverage and absorption default to the tables'."""
-    import bpy
-
-    from makeup_skin_addon import material as made_up
-
-    material = bpy.data.materials.new(made_up.MATERIAL_NAME)
-    obj.data.materials.append(material)
-    settings = material.makeup_skin
-    settings.is_made_up = True
-    settings.live_update = False
-    settings.tier = tier
-    settings.coverage = tables.parameters.get("coverage", 1.0) if coverage is None else coverage
-    absorption = tables.parameters.get("absorption", 0.0) if absorption is None else absorption
-    settings.absorption = [absorption] * 3 if isinstance(absorption, float) else absorption
-    group, _ = made_up.group_for_tables(tables, tier, errors_at=(settings.coverage,
-                                                                 list(settings.absorption)))
-    made_up.setup_material(material, group, bpy.context.scene)
-    return material
-
-
-def coverage_ramp(material, obj) -> None:
-    """Link a left-to-right ramp (coverage 0 at the sphere's left edge, 1 at its right) into
-    the group's Coverage socket: what a painted coverage texture does."""
-    from makeup_skin_addon import material as made_up
-
-    tree = material.node_tree
-    coordinates = tree.nodes.new("ShaderNodeTexCoord")
-    separate = tree.nodes.new("ShaderNodeSeparateXYZ")
-    tree.links.new(coordinates.outputs["Object"], separate.inputs[0])
-    ramp = tree.nodes.new("ShaderNodeMapRange")
-    ramp.clamp = True
-    tree.links.new(separate.outputs["X"], ramp.inputs["Value"])
-    radius = max(obj.dimensions) / 2
-    ramp.inputs["From Min"].default_value = -radius
-    ramp.inputs["From Max"].default_value = radius
-    tree.links.new(ramp.outputs["Result"], made_up.group_of(material).inputs["Coverage"])
-
-
-def render(png_path) -> float:
-    """Render the current scene; write ``png_path`` and the float EXR beside it; seconds."""
-    import bpy
-
-    scene = bpy.context.scene
-    png_path = Path(png_path)
-    png_path.parent.mkdir(parents=True, exist_ok=True)
-    start = time.perf_counter()
-    bpy.ops.render.render()
-    seconds = time.perf_counter() - start
-    result = bpy.data.images["Render Result"]
-    settings = scene.render.image_settings
-    settings.file_format = "PNG"
-    settings.color_mode = "RGBA"
-    settings.color_depth = "8"
-    result.save_render(str(png_path), scene=scene)
-    settings.file_format = "OPEN_EXR"
-    settings.color_depth = "32"
-    settings.exr_codec = "ZIP"
-    result.save_render(str(png_path.with_suffix(".exr")), scene=scene)
-    return seconds
-
-
-def image_pixels(path):
-    """The pixels of the image file ``path``, ``(height, width, 4)`` float32, row 0 at the
-    bottom (Blender's order)."""
-    import bpy
-    import numpy as np
-
-    image = bpy.data.images.load(str(path), check_existing=False)
-    try:
-        width, height = image.size
-        pixels = np.empty(width * height * 4, np.float32)
-        image.pixels.foreach_get(pixels)
-    finally:
-        bpy.data.images.remove(image)
-    return pixels.reshape(height, width, 4)
-
-
-def render_pixels(exr_path):
-    """Render the current scene to the float32 OpenEXR ``exr_path`` and return its RGB pixels,
-    ``(height, width, 3)`` with row 0 at the bottom (Blender's order)."""
-    import bpy
-
-    scene = bpy.context.scene
-    scene.render.image_settings.file_format = "OPEN_EXR"
-    scene.render.image_settings.color_depth = "32"
-    scene.render.filepath = str(exr_path)
-    bpy.ops.render.render(write_still=True)
-    return image_pixels(scene.render.filepath)[..., :3]
 
 
 def main(argv=None) -> int:

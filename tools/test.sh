@@ -2,6 +2,7 @@
 # The project's test command (what CI runs through .ci/run).
 #
 #   tools/test.sh [extra pytest args for the main run]
+#   tools/test.sh -m "not slow"    # the fast tier (no renders or exact-model sweeps)
 #
 # 1. Blender 5.0 venv: `ruff check .`, then the whole suite, `pytest -q`.
 # 2. If MAKEUP_SKIN_BLENDER_LINES (default "5.0 4.5") names 4.5: the Blender-side tests,

@@ -1,0 +1,52 @@
+"""lut_baker.numerics.quadrature: the Gauss-Legendre, hemisphere, trapezoid and azimuth rules
+and the order-0 Fourier integral."""
+
+import numpy as np
+import pytest
+
+from lut_baker.numerics import quadrature
+
+
+@pytest.mark.parametrize("panels", [1, 3, 7])
+def test_gauss_legendre_integrates_polynomials_exactly(panels):
+    nodes, weights = quadrature.gauss_legendre(5, -1.0, 2.0, panels)
+    assert nodes.size == weights.size == 5 * panels
+    assert np.all(np.diff(nodes) > 0) and np.all((nodes > -1.0) & (nodes < 2.0))
+    exact = (2.0**10 - 1.0) / 10.0  # Int_{-1}^{2} x^9 dx
+    assert np.sum(weights * nodes**9) == pytest.approx(exact, rel=1e-13)
+    with pytest.raises(ValueError):
+        nodes[0] = 0.0  # cached: every caller shares the arrays
+
+
+def test_hemisphere_rules_integrate_the_projected_solid_angle():
+    """``Int cos(theta) dw = pi`` over the hemisphere, by both grids."""
+    for grid in (quadrature.hemisphere_panels(3, 10, 33), quadrature.hemisphere_grid(20.0)):
+        assert np.sum(grid.weight) * grid.n_phi * grid.phi_weight == pytest.approx(np.pi,
+                                                                                rel=1e-12)
+        assert grid.phi.size == grid.n_phi and grid.phi[1] == pytest.approx(grid.phi_weight)
+    with pytest.raises(ValueError):
+        quadrature.hemisphere_panels(2, 6, 16)  # even azimuth count
+
+
+def test_trapezoid_rules():
+    x = np.array([0.0, 0.5, 2.0, 3.0])
+    w = quadrature.trapezoid_weights(x)
+    np.testing.assert_allclose(w, [0.25, 1.0, 1.25, 0.5])
+    y = np.stack([2.0 * x + 1.0, x], axis=-1)  # linear: the rule is exact
+    running = quadrature.cumulative_trapezoid(y, x)
+    np.testing.assert_allclose(running[:, 0], x[1:] ** 2 + x[1:])
+    np.testing.assert_allclose(running[-1], w @ y)
+
+
+def test_azimuth_rules():
+    cos_phi, weight = quadrature.mirror_weighted_azimuths(16, 3)
+    assert np.sum(weight) == pytest.approx(2.0 * np.pi)
+    assert np.sum(weight * cos_phi**2) == pytest.approx(np.pi)
+    nodes = quadrature.midpoint_nodes(4, 0.0, np.pi)
+    np.testing.assert_allclose(nodes, np.pi * np.array([1, 3, 5, 7]) / 8)
+
+
+def test_order0_integral_of_a_constant_kernel():
+    grid = quadrature.hemisphere_panels(2, 6, 17)
+    kernel = np.full((1, grid.theta.size, 1), 1.0 / np.pi)  # a Lambertian BRDF's K_0
+    assert quadrature.order0_integral(kernel, grid)[0, 0] == pytest.approx(1.0, rel=1e-12)

@@ -1,0 +1,267 @@
+"""The bake (lut_baker.bake): its fast kernels against the exact evaluators, the tables
+against the exact model, and the inter-reflection table.
+
+The expensive part, the exact evaluator at 500 random points, is computed once per module.
+"""
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+from support.samples import node_directions
+
+from lut_baker import bake
+from lut_baker.evaluate import two_layer
+from lut_baker.model import dipole, layers, made_up_skin, microfacet, presets
+from lut_baker.numerics.geometry import direction
+from lut_baker.numerics.quadrature import hemisphere_panels
+
+
+@pytest.fixture(scope="module")
+def paper():
+    return presets.paper()
+
+
+@pytest.fixture(scope="module")
+def samples(paper):
+    # the exact evaluator at level 0 (within 1e-4 of level 2 for the film gloss's albedo at
+    # 89 degrees); the albedo, the slow part, on 100 of the 500 points
+    return bake.error_samples(paper, n_points=500, seed=0, albedo_points=100)
+
+
+@pytest.fixture(scope="module")
+def default_tables(paper):
+    return bake.bake(paper, "default")
+
+
+# --------------------------------------------------------------------------------------------
+# Kernels
+# --------------------------------------------------------------------------------------------
+@pytest.mark.parametrize("n_phi", [17, 33, 76])
+def test_fast_fourier_coefficients_equal_the_exact_evaluators(n_phi):
+    paper = presets.paper()
+    jensen = presets.made_up_skin("deep_mocha", "jensen_skin2")
+    shaded_film = made_up_skin.film_transmission_layer(jensen)  # RGB through absorption
+    grid = hemisphere_panels(2, 6, 17)
+    outer = np.radians([0.0, 12.0, 47.0, 80.0, 89.0])
+    for layer in (paper.skin, paper.film, paper.film_transmission, jensen.skin, shaded_film):
+        for theta_a in (outer, grid.theta):
+            fast = bake.fourier_coefficients(layer, theta_a, grid.theta, n_phi)
+            reference = two_layer.layer_fourier_kernel(layer, theta_a, grid.theta, n_phi)
+            assert fast.shape == reference.shape
+            scale = np.abs(reference).max()
+            # the tabulated Fresnel term is within 1e-8 (bake.FRESNEL_TOLERANCE)
+            np.testing.assert_allclose(fast, reference, rtol=0, atol=2e-8 * scale)
+
+
+def test_layered_matrices_with_fast_kernels_equal_the_default(paper):
+    grid = hemisphere_panels(2, 6, 17)
+    theta = np.radians([0.0, 30.0, 60.0, 85.0])
+    fast = two_layer.layered_fourier_matrices(theta, theta, paper.film_transmission, paper.skin,
+                                           grid, fourier=bake.KernelCache())
+    slow = two_layer.layered_fourier_matrices(theta, theta, paper.film_transmission, paper.skin,
+                                           grid)
+    np.testing.assert_allclose(fast, slow, rtol=2e-8, atol=1e-15)
+
+
+def test_skin_diffuse_part_of_path3_is_pd_times_both_transmittances(paper):
+    """Int Int f_t P_d f_t cos cos = P_d T(wi) T(wo): the split the tables rely on."""
+    rng = np.random.default_rng(3)
+    wi = direction(np.radians(rng.uniform(0, 89, 20)), rng.uniform(0, 2 * np.pi, 20))
+    wo = direction(np.radians(rng.uniform(0, 89, 20)), rng.uniform(0, 2 * np.pi, 20))
+    diffuse_only = paper.skin.scaled(P_s=0.0)
+    path3 = two_layer.layered_reflection(wi, wo, paper.film_transmission, diffuse_only)
+    t_i = two_layer.film_transmittance(wi, paper.film_transmission)
+    t_o = two_layer.film_transmittance(wo, paper.film_transmission)
+    np.testing.assert_allclose(path3, paper.skin.P_d * t_i * t_o, rtol=1e-10)
+    # and the gloss part is what remains of the full path 3
+    full = two_layer.layered_reflection(wi, wo, paper.film_transmission, paper.skin)
+    gloss = two_layer.layered_reflection(wi, wo, paper.film_transmission,
+                                      bake.gloss_layer(paper.skin))
+    np.testing.assert_allclose(full, gloss + paper.skin.P_d * t_i * t_o, rtol=1e-10)
+
+
+def test_gloss_tables_equal_eq2_at_every_node(default_tables, paper):
+    wi, wo = node_directions(default_tables)
+    for name, layer in (("film_gloss", paper.film), ("skin_gloss", paper.skin)):
+        exact = microfacet.ts_reflection(wi, wo, bake.gloss_layer(layer))
+        # within the tabulated Fresnel term's checked 1e-8
+        np.testing.assert_allclose(getattr(default_tables, name)[..., 0], exact, rtol=1e-8,
+                                   atol=1e-12)
+
+
+def test_tabulated_fresnel_is_checked_and_falls_back_near_eta_1():
+    assert bake._fresnel_table(1.19) is not None
+    assert bake._fresnel_table(1.0001) is None and bake._fresnel_table(0.8) is None
+    c = np.random.default_rng(2).uniform(0.0, 1.0, (5000, 1))
+    for eta in (1.19, 1.26, 1.0001, 0.8):
+        np.testing.assert_allclose(bake._fresnel_fast(c, eta), microfacet.fresnel_term(c, eta),
+                                   rtol=bake.FRESNEL_TOLERANCE)
+
+
+def test_gloss_albedos_match_the_converged_evaluator(paper):
+    theta = np.array([0.0, 40.0, 70.0, 85.0, 89.0])
+    res = bake.RESOLUTIONS["default"]
+    grid = hemisphere_panels(res.quad_panels, res.quad_points, res.quad_phi)
+    fast = bake.gloss_albedos((paper.film, paper.skin), theta, grid, res.albedo_azimuths)
+    for albedo, layer in zip(fast, (paper.film, paper.skin), strict=True):
+        exact = two_layer.reflection_albedo(theta, bake.gloss_layer(layer), level=2)
+        np.testing.assert_allclose(albedo[:, 0], exact, atol=2e-4)
+
+
+# --------------------------------------------------------------------------------------------
+# The bake against the exact evaluator
+# --------------------------------------------------------------------------------------------
+@pytest.mark.slow
+def test_default_tables_meet_the_error_goal(default_tables, samples):
+    error = bake.table_error(default_tables, samples=samples)
+    for name in ("reflection", "albedo", "transmission", "profile"):
+        assert error[name] <= 1e-3, (name, error)
+
+
+@pytest.mark.slow
+def test_preview_tables_err_below_one_percent(paper, samples):
+    error = bake.table_error(bake.bake(paper, "preview"), samples=samples)
+    assert error["max"] < 1e-2, error
+
+
+@pytest.mark.slow
+def test_a_coarse_bake_fails_the_goal(paper, samples):
+    """The error measure can fail: a 12 x 12 x 9 table misses 1e-3 by far."""
+    coarse = replace(bake.RESOLUTIONS["preview"], n_theta=12, n_phi=9, n_radius=8)
+    assert bake.table_error(bake.bake(paper, coarse), samples=samples)["max"] > 1e-2
+
+
+def test_directional_tables(default_tables, paper):
+    theta = np.array([0.0, 33.0, 66.0, 88.0])
+    w = direction(np.radians(theta), 0.0)
+    np.testing.assert_allclose(default_tables.directional("film_transmittance", theta)[:, 0],
+                               two_layer.film_transmittance(w, paper.film_transmission, level=1),
+                               rtol=1e-4)
+    np.testing.assert_allclose(default_tables.directional("transmission_factor", theta)[:, 0],
+                               two_layer.transmission_factor(w, paper.film_transmission,
+                                                          paper.dipole, level=1), rtol=1e-4)
+    # Int T(w) cos dw over the hemisphere, by a fine 1-D quadrature of the exact T
+    x, weights = np.polynomial.legendre.leggauss(64)
+    t = np.pi / 4 * (x + 1)
+    exact_t = two_layer.film_transmittance(direction(t, 0.0), paper.film_transmission, level=1)
+    integral = 2 * np.pi * np.sum(exact_t * np.cos(t) * np.sin(t) * weights * np.pi / 4)
+    np.testing.assert_allclose(default_tables.film_transmittance_integral, integral, rtol=1e-4)
+    assert np.all(default_tables.film_transmittance_integral <= np.pi)
+
+
+def test_radial_table(default_tables, paper):
+    d = default_tables.radius_mm
+    assert d[0] == 0.0
+    profile = np.atleast_1d(dipole.dipole_profile(d, paper.dipole))
+    np.testing.assert_allclose(default_tables.profile[:, 0],
+                               profile / dipole.dipole_total_reflectance(paper.dipole), rtol=1e-12)
+    # ends where R falls below 1e-4 of its peak, not before
+    assert profile[-1] <= 1e-4 * profile[0] * (1 + 1e-6)
+    assert dipole.dipole_profile(0.99 * d[-1], paper.dipole) > 1e-4 * profile[0]
+    np.testing.assert_allclose(default_tables.total_reflectance,
+                               dipole.dipole_total_reflectance(paper.dipole))
+
+
+def test_rgb_skin_bakes_per_channel():
+    skin = presets.made_up_skin("medium_beige", "jensen_skin1", coverage=0.5)
+    t = bake.bake(skin, "preview")
+    assert t.skin_diffuse.shape == (3,) and len(set(t.skin_diffuse.tolist())) == 3
+    assert len(set(t.profile[1].tolist())) == 3
+    error = bake.table_error(t, samples=bake.error_samples(skin, n_points=60, seed=2,
+                                                           albedo_points=10))
+    assert error["max"] < 1e-2, error
+
+
+def test_narrow_lobes_scale_the_grids(paper):
+    sharp = paper.replace(film=paper.film.scaled(n=3.0))  # 1/e half-width 10 degrees
+    res = bake.RESOLUTIONS["preview"].for_lobe(1.0 / float(sharp.film.n))
+    assert res.n_theta > bake.RESOLUTIONS["preview"].n_theta
+    assert bake.bake(sharp, "preview").theta_deg.size == res.n_theta
+
+
+def test_progress_is_reported_in_order(paper):
+    calls = []
+    bake.bake(paper, "preview", inter_reflection=True,
+              progress=lambda f, m: calls.append((f, m)))
+    fractions = [f for f, _ in calls]
+    assert fractions[0] == 0.0 and fractions[-1] == 1.0 and fractions == sorted(fractions)
+    assert all(isinstance(m, str) and m for _, m in calls) and len(calls) >= 5
+
+
+def test_bad_input_is_rejected(paper):
+    with pytest.raises(ValueError, match="resolution"):
+        bake.bake(paper, "ultra")
+    with pytest.raises(ValueError, match="MadeUpSkin"):
+        bake.bake(paper.film, "preview")
+
+
+# --------------------------------------------------------------------------------------------
+# Inter-reflection (the adding equation)
+# --------------------------------------------------------------------------------------------
+def test_inter_reflection_of_diffuse_layers_is_the_geometric_series():
+    """All layers Lambertian: f_t = a, f_s = b, film underside albedo R_f = pi c.  Path 3 is
+    a^2 b pi^2 and each further bounce multiplies by (pi b)(pi c)."""
+    a, b, c = 0.08, 0.2, 0.12
+    grid = hemisphere_panels(2, 6, 17)
+    film_t = layers.TransmissionLayer(P_d=a, P_t=0.0, n=0.03, eta=1.2)
+    skin = layers.ReflectionLayer(P_d=b, P_s=0.0, n=0.03, eta=1.3)
+    below = layers.ReflectionLayer(P_d=c, P_s=0.0, n=0.03, eta=1.2)
+    theta = np.radians([0.0, 45.0, 80.0])
+    full = two_layer.inter_reflection_fourier_matrices(theta, theta, film_t, skin, grid,
+                                                    film_below=below)
+    bounce = np.pi * b * np.pi * c
+    np.testing.assert_allclose(full[0, ..., 0], a * a * b * np.pi**2 / (1 - bounce), rtol=1e-12)
+    np.testing.assert_allclose(full[1:], 0.0, atol=1e-15)
+
+
+def test_inter_reflection_equals_its_neumann_series(paper):
+    """(I - S R_f)^-1 S against S + S R_f S + ... summed term by term (glossy layers)."""
+    grid = hemisphere_panels(2, 6, 17)
+    theta = np.radians([10.0, 50.0, 85.0])
+    film_t = made_up_skin.film_transmission_layer(paper)
+    below = made_up_skin.film_reflection_layer(paper)
+    full = two_layer.inter_reflection_fourier_matrices(theta, theta, film_t, paper.skin, grid,
+                                                    film_below=below)
+    skin_m = two_layer.inner_matrices(grid, film_t, paper.skin)[..., 0]
+    film_m = two_layer.layer_fourier_kernel(below, grid.theta, grid.theta, grid.n_phi)[..., 0]
+    rows = two_layer.transmission_rows(theta, grid, film_t)[..., 0]
+    term, total = skin_m, skin_m.copy()
+    for _ in range(40):
+        term = term @ film_m @ skin_m
+        total += term
+    series = rows @ total @ np.swapaxes(rows, 1, 2)
+    np.testing.assert_allclose(full[..., 0], series, rtol=1e-10, atol=1e-14)
+
+
+def test_inter_reflection_table(paper):
+    t = bake.bake(paper, "preview", inter_reflection=True)
+    assert t.inter_reflection.shape == t.path3_gloss.shape
+    assert np.all(t.inter_reflection >= 0.0) and t.inter_reflection.max() > 0.0
+    # the same numbers from the exact evaluator's (slow) kernels on the bake's quadrature
+    res = bake.RESOLUTIONS["preview"]
+    grid = hemisphere_panels(res.quad_panels, res.quad_points, res.quad_phi)
+    theta = np.radians(t.theta_deg[[4, 30]])
+    film_t = made_up_skin.film_transmission_layer(paper)
+    extra = (two_layer.inter_reflection_fourier_matrices(
+        theta, theta, film_t, paper.skin, grid,
+        film_below=made_up_skin.film_reflection_layer(paper))
+        - two_layer.layered_fourier_matrices(theta, theta, film_t, paper.skin, grid))
+    cos_phi = np.cos(np.radians(t.node_azimuths()[4, 30]))
+    series = sum(extra[m, 0, 1, 0] * np.cos(m * np.arccos(cos_phi)) for m in range(len(extra)))
+    np.testing.assert_allclose(t.inter_reflection[4, 30, :, 0], series, rtol=1e-9, atol=1e-14)
+    # made_up_reflection adds it with the coverage weight
+    wi, wo = (w[3, 5, 7] for w in node_directions(t))
+    with_ir = t.made_up_reflection(wi, wo, coverage=0.5)
+    without = replace(t, inter_reflection=None).made_up_reflection(wi, wo, coverage=0.5)
+    np.testing.assert_allclose(with_ir - without, 0.5 * t.inter_reflection[3, 5, 7], rtol=1e-9)
+
+
+@pytest.mark.parametrize("foundation", ["paper_natural", "deep_mocha"])
+def test_white_furnace_with_inter_reflections(foundation):
+    """Paths 1 + 3 plus all inter-reflections still reflect at most what arrives."""
+    skin = presets.made_up_skin(foundation)
+    theta = np.array([0.0, 45.0, 75.0, 89.0])
+    albedo = bake.bake(skin, "preview").directional_albedo(theta)
+    extra = bake.inter_reflection_albedo(skin, theta, "preview")
+    assert np.all(extra > 0.0) and np.all(albedo + extra <= 1.0), albedo + extra

@@ -1,0 +1,37 @@
+"""Fixtures of the add-on's tests (Blender, headless).
+
+- ``addon`` -- the add-on from this checkout (``makeup_skin_addon`` as a top-level package),
+  registered for the test and unregistered after it (bpy 4.5 hangs at exit while an add-on's
+  classes stay registered); a fresh registration starts with empty caches.  Yields the package.
+- ``sphere`` -- a smooth sphere (radius 3 cm), the camera and sun of
+  tests/support/sphere_scene.py (60 degrees off the view towards +x), black world, Cycles CPU
+  at 16 samples, :data:`support.addon_steps.SPHERE_PX` px.
+- ``head`` -- the textured head of tests/support/character.py (its own Principled material
+  with an albedo texture and a pore normal map), a portrait camera and lights, Cycles at 16
+  samples, :data:`support.addon_steps.HEAD_PX` px.
+"""
+
+import pytest
+from support import character, sphere_scene
+from support.addon_steps import HEAD_PX, SPHERE_PX
+
+
+@pytest.fixture
+def addon(bpy_factory):
+    import makeup_skin_addon
+
+    with sphere_scene.addon_registered():
+        yield makeup_skin_addon
+
+
+@pytest.fixture
+def sphere(addon, blank_scene):
+    return sphere_scene.add_sphere(blank_scene, 0.03, light_deg=60.0, size=SPHERE_PX,
+                                   samples=16)
+
+
+@pytest.fixture
+def head(addon, blank_scene):
+    obj = character.build_character("Head")
+    character.portrait_camera_and_lights(blank_scene, obj, size=HEAD_PX, samples=16)
+    return obj

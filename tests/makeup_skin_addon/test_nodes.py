@@ -1,0 +1,127 @@
+"""The Made-up Skin node groups (makeup_skin_addon.nodes): Normal, Film Normal and Skin Color
+reach every closure (Cycles and EEVEE), an albedo texture in Skin Color renders as a bake
+at that albedo, and a forced subsurface method gets its own group."""
+
+import dataclasses
+import json
+
+import numpy as np
+import pytest
+from support import sphere_scene
+from support.addon_steps import HEAD_PX, apply_operator, apply_pipeline, group_node, render
+
+
+def _unlinked_against_no_normal_links(head, tmp_path, tier):
+    """``(render with Normal and Film Normal unlinked, render of the same group with no link
+    from those inputs inside)``: the second is the group before it had the inputs."""
+    material = apply_operator(head, tier)
+    node = group_node(material)
+    for name in ("Normal", "Film Normal", "Skin Color"):
+        for link in list(node.inputs[name].links):
+            material.node_tree.links.remove(link)
+    node.inputs["Skin Color"].default_value = (0.6, 0.45, 0.4, 1.0)
+    with_inputs = render(tmp_path, f"{tier}_inputs")
+    bare = node.node_tree.copy()
+    group_input = next(n for n in bare.nodes if n.type == "GROUP_INPUT")
+    for name in ("Normal", "Film Normal"):
+        for link in list(group_input.outputs[name].links):
+            bare.links.remove(link)
+    node.node_tree = bare
+    return with_inputs, render(tmp_path, f"{tier}_bare")
+
+
+@pytest.mark.slow  # renders compared
+def test_unlinked_normals_render_as_the_shading_normal(head, tmp_path):
+    """Leaving Normal and Film Normal unlinked renders exactly as a group whose closures have
+    no Normal link at all, in both tiers (Cycles)."""
+    for tier in ("LAYERED", "PRINCIPLED"):
+        with_inputs, bare = _unlinked_against_no_normal_links(head, tmp_path, tier)
+        np.testing.assert_array_equal(bare, with_inputs)
+
+
+@pytest.mark.slow
+def test_unlinked_normals_in_eevee(head, tmp_path):
+    """The same in EEVEE, Principled tier (the one Auto gives EEVEE): a hidden-value group input
+    stays unlinked inside the group, where a visible one would hand the BSDF a zero normal
+    (flat shading in EEVEE 5.0)."""
+    import bpy
+
+    scene = bpy.context.scene
+    scene.render.engine = "BLENDER_EEVEE" if bpy.app.version >= (5, 0, 0) else \
+        "BLENDER_EEVEE_NEXT"
+    scene.eevee.taa_render_samples = 4
+    for light in (obj.data for obj in scene.objects if obj.type == "LIGHT"):
+        light.use_shadow = False  # software OpenGL: ~45 s a render with shadows
+    render(tmp_path, "warm_up")  # a process's first EEVEE render differs (by up to 0.03)
+    with_inputs, bare = _unlinked_against_no_normal_links(head, tmp_path, "PRINCIPLED")
+    assert with_inputs.mean() > 0.1
+    np.testing.assert_allclose(bare, with_inputs, atol=1e-4)  # a zero normal: ~0.5
+
+
+@pytest.mark.slow  # renders compared
+def test_every_closure_reads_a_normal_input(head, tmp_path):
+    from makeup_skin_addon import nodes
+
+    for tier in ("LAYERED", "PRINCIPLED"):
+        group = group_node(apply_operator(head, tier)).node_tree
+        closures = [n for n in group.nodes if n.type.startswith(("BSDF", "SUBSURFACE"))]
+        assert closures
+        for closure in closures:
+            sources = {link.from_socket.name for name in ("Normal", "Coat Normal")
+                       if name in closure.inputs for link in closure.inputs[name].links}
+            assert sources and sources <= set(nodes.NORMAL_INPUTS), closure.name
+    # A bump on the film changes the render; on neither input it does not.
+    material = head.active_material
+    node = group_node(material)
+    smooth = render(tmp_path, "smooth")
+    material.node_tree.links.new(node.inputs["Normal"].links[0].from_socket,
+                                 node.inputs["Film Normal"])
+    assert np.abs(render(tmp_path, "bumped") - smooth).max() > 1e-3
+
+
+@pytest.mark.slow  # renders compared
+@pytest.mark.parametrize("tier", ["LAYERED", "PRINCIPLED"])
+def test_skin_colour_texture_matches_a_bake_at_that_albedo(addon, blank_scene, tmp_path, tier):
+    """An albedo texture in Skin Color renders as the tables baked with that albedo: the skin's
+    diffuse term is linear, so the texture scales every skin closure exactly."""
+    import bpy
+
+    from lut_baker import bake
+    from lut_baker.model import presets
+    from makeup_skin_addon import material as made_up
+
+    colour = np.array([0.62, 0.41, 0.33])
+    obj = sphere_scene.add_sphere(blank_scene, 0.03, light_deg=40.0, size=HEAD_PX, samples=16)
+    skin = presets.made_up_skin("medium_beige", "jensen_skin2", absorption=0.0)
+    tables = bake.bake(skin, "preview")
+    material = sphere_scene.made_up_material(obj, tables, tier, coverage=0.7,
+                                              absorption=[0.1, 0.24, 0.42])
+    texture = material.node_tree.nodes.new("ShaderNodeTexImage")
+    texture.image = bpy.data.images.new("flat albedo", 4, 4, float_buffer=True)
+    texture.image.colorspace_settings.name = "Non-Color"
+    texture.image.pixels.foreach_set(np.tile([*colour, 1.0], 16).astype(np.float32))
+    material.node_tree.links.new(texture.outputs["Color"],
+                                 made_up.group_of(material).inputs["Skin Color"])
+    textured = render(tmp_path, "textured")
+
+    own = skin.replace(skin=dataclasses.replace(skin.skin, P_d=colour / np.pi))
+    group, _ = made_up.group_for_tables(bake.bake(own, "preview"), tier)
+    material.node_tree.nodes.remove(texture)
+    made_up.group_of(material).node_tree = group
+    made_up.group_of(material).inputs["Skin Color"].default_value = (*colour, 1.0)
+    baked = render(tmp_path, "baked")
+    assert np.abs(textured - baked).max() < 1e-5 * max(baked.max(), 1.0)
+
+
+def test_forced_subsurface_method_gets_its_own_group(sphere):
+    material, _ = apply_pipeline(sphere, "PRINCIPLED")
+    auto = material.node_tree.nodes["Made-up Skin"].node_tree
+    material, _ = apply_pipeline(sphere, "PRINCIPLED", subsurface_method="RANDOM_WALK_SKIN")
+    group = material.node_tree.nodes["Made-up Skin"].node_tree
+    assert group != auto and " RW Skin " in group.name
+    principled = next(n for n in group.nodes if n.type == "BSDF_PRINCIPLED")
+    assert principled.subsurface_method == "RANDOM_WALK_SKIN"
+    meta = json.loads(group["makeup_skin_fit"])
+    radius = meta["profiles"]["RANDOM_WALK_SKIN"]["radius_mm"]
+    assert tuple(next(s for s in principled.inputs if s.identifier == "Subsurface Radius")
+                 .default_value) == pytest.approx(radius)

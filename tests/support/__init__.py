@@ -1,0 +1,19 @@
+"""Helpers shared by the tests, the benchmarks (bench/) and the development scripts (tools/).
+
+Tests import them as ``from support import ...`` (pytest puts ``tests`` on ``sys.path``, see
+pyproject.toml); the scripts put ``tests`` on ``sys.path`` themselves.  Nothing here changes
+``sys.path``, and no module imports ``bpy`` at module level: bpy is imported inside the
+functions that need it, after the caller has set ``BLENDER_USER_RESOURCES``.
+
+- :mod:`support.reference_impl` -- an independent implementation of the model's formulas
+  (docs/model.md §2-§4), written without ``lut_baker``.
+- :mod:`support.digests` -- SHA-256 digests of baked tables and fits
+  (``tests/data/golden_digests.json``).
+- :mod:`support.sphere_scene` -- the reference sphere scene (camera, sun, black world, Cycles
+  settings), the add-on registered for a ``with`` block, made-up materials, renders.
+- :mod:`support.bench_scene` -- that scene made to match
+  :func:`lut_baker.offline.validation.reference.sphere_image` pixel for pixel, and a
+  :class:`~support.bench_scene.Stage` built once and changed between renders.
+- :mod:`support.character` -- an artist's textured head (albedo texture, pore normal map).
+- :mod:`support.subsurface_edge` -- Cycles' subsurface blur of a shadow edge, and its replica.
+"""
