@@ -4,7 +4,7 @@
     python bench/bake.py --study              # convergence study (markdown tables)
     python bench/bake.py --study --write-docs # ... and put them into docs/baking.md
 
-Errors are those of :func:`lut_baker.bake.table_error`: the largest of
+Errors are those of :func:`lut_baker.table_accuracy.table_error`: the largest of
 ``|table - exact| / max(|exact|, 0.1 peak)`` over 500 random points (20% with theta_i and 20% with
 both angles in the grazing rows 80..89 degrees), so <= 1e-3 meets "1e-3 relative or 1e-4 of the
 peak, whichever is larger".  The machine is shared: timings are medians, and ratios measured in
@@ -30,6 +30,7 @@ from doc_block import replace_block  # noqa: E402  (bench/doc_block.py)
 from lut_baker import bake  # noqa: E402
 from lut_baker.evaluate.made_up import made_up_reflection  # noqa: E402
 from lut_baker.model import microfacet, presets  # noqa: E402
+from lut_baker.offline.validation import table_accuracy  # noqa: E402
 from lut_baker.tables.table_set import ANGULAR, DIRECTIONAL  # noqa: E402
 
 DOC = ROOT / "docs" / "baking.md"
@@ -89,13 +90,13 @@ def fmt(x: float) -> str:
 def timings(runs: int) -> str:
     load_before = os.getloadavg()[0]
     skin = presets.paper()
-    samples = bake.error_samples(skin, albedo_points=100)
+    samples = table_accuracy.error_samples(skin, albedo_points=100)
     out = []
     rows = []
     goals = {"preview": 0.030, "default": 0.200}
     for name in ("preview", "default", "high"):
         med, best, tables = timed(lambda n=name: bake.bake(skin, n), runs)
-        err = bake.table_error(tables, samples=samples)
+        err = table_accuracy.table_error(tables, samples=samples)
         goal = goals.get(name)
         rows.append([name, tables.film_gloss.shape[:3], f"{megabytes(tables):.1f}",
                      f"{med * 1e3:.1f}", f"{best * 1e3:.1f}",
@@ -135,7 +136,7 @@ def timings(runs: int) -> str:
     out.append(table(["dimension", "value", "median ms", "x default"], rows))
 
     rng = np.random.default_rng(1)
-    wi, wo = bake.sample_directions(200, rng, 89.0)
+    wi, wo = table_accuracy.sample_directions(200, rng, 89.0)
     exact_med, _, _ = timed(lambda: made_up_reflection(wi, wo, skin, level=0), max(1, runs // 3))
     per_point = exact_med / 200
     rows = []
@@ -161,7 +162,7 @@ def gloss_tail(tables, skin, n_points=20000, seed=1) -> tuple[float, float, floa
     """Film-top gloss alone (exact: eq. 2 directly) at many points: (p99, p99.9, max) of the
     normalised error, the peak being the composite's."""
     rng = np.random.default_rng(seed)
-    wi, wo = bake.sample_directions(n_points, rng, 89.0)
+    wi, wo = table_accuracy.sample_directions(n_points, rng, 89.0)
     exact = np.reshape(microfacet.ts_reflection(wi, wo, bake.gloss_layer(skin.film)),
                        (n_points, -1))
     peak = tables.node_values().reshape(-1, 3).max(axis=0)
@@ -193,13 +194,14 @@ def study(runs: int) -> str:
     out = []
     skin = presets.paper()
     print("exact samples (seeds 0-2) ...", file=sys.stderr)
-    samples = [bake.error_samples(skin, seed=s, albedo_points=500 if s == 0 else 1)
+    samples = [table_accuracy.error_samples(skin, seed=s, albedo_points=500 if s == 0 else 1)
                for s in range(3)]
     base = bake.RESOLUTIONS["default"]
 
     def reflection_errors(res):
         tables = bake.bake(skin, res)
-        return tables, [bake.table_error(tables, samples=s)["reflection"] for s in samples]
+        return tables, [table_accuracy.table_error(tables, samples=s)["reflection"]
+                        for s in samples]
 
     # 1. spacings
     rows = []
@@ -248,7 +250,7 @@ def study(runs: int) -> str:
         res = replace(base, quad_panels=panels, quad_points=points, quad_phi=quad_phi,
                       albedo_azimuths=azimuths)
         med, _, tables = timed(lambda r=res: bake.bake(skin, r), runs)
-        err = bake.table_error(tables, samples=samples[0])
+        err = table_accuracy.table_error(tables, samples=samples[0])
         rows.append([f"{panels} x {points}", quad_phi, azimuths, f"{med * 1e3:.0f}",
                      fmt(path3_node_error(tables, skin)), fmt(err["transmission"]),
                      fmt(err["albedo"]), fmt(err["reflection"])])
@@ -263,8 +265,8 @@ def study(runs: int) -> str:
     for spacing in ("quadratic", "uniform"):
         for n_radius in (16, 32, 64, 96, 128, 256, 512):
             tables = bake.bake(skin, replace(base, radius_spacing=spacing, n_radius=n_radius))
-            rows.append([spacing, n_radius, fmt(bake.table_error(tables, samples=samples[0])
-                                                ["profile"])])
+            error = table_accuracy.table_error(tables, samples=samples[0])
+            rows.append([spacing, n_radius, fmt(error["profile"])])
     out.append("\n### 4. Radial profile R(d)/Rd (paper dipole, d up to "
                f"{bake.profile_radius(skin.dipole):.2f} mm)\n")
     out.append(table(["spacing", "n_radius", "error (500 points)"], rows))
@@ -273,13 +275,13 @@ def study(runs: int) -> str:
     rows = []
     for label, make in PRESETS.items():
         made_up = make()
-        preset_samples = bake.error_samples(made_up, albedo_points=100)
+        preset_samples = table_accuracy.error_samples(made_up, albedo_points=100)
         for name in bake.RESOLUTIONS:
             tables = bake.bake(made_up, name)
-            err = bake.table_error(tables, samples=preset_samples)
+            err = table_accuracy.table_error(tables, samples=preset_samples)
             as_float32 = replace(tables, **{k: np.asarray(getattr(tables, k), np.float32)
                                             for k in ANGULAR + DIRECTIONAL + ("profile",)})
-            err32 = bake.table_error(as_float32, samples=preset_samples)
+            err32 = table_accuracy.table_error(as_float32, samples=preset_samples)
             rows.append([label, name, fmt(err["reflection"]), fmt(err["albedo"]),
                          fmt(err["transmission"]), fmt(err["profile"]), fmt(err32["max"]),
                          "yes" if err["max"] <= (GOAL if name != "preview" else 10 * GOAL)

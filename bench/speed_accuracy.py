@@ -16,9 +16,10 @@ Against the reference (:func:`lut_baker.offline.validation.compare.reference_ima
 from "high" tables, the skin's diffuse part spread by the dipole profile): relative RMS error over
 the sphere's pixels (mean of the two seeds), the noise floor ``rms(a - b) / sqrt(2)`` and the time
 per render (mean of the two). The bake axis: per bake resolution, the tables' size, bake time
-(median of 3), table error (:func:`lut_baker.bake.table_error`, 500 points) and the LAYERED tier's
-render error at 256 samples, light 45 degrees, seed 0. 48 px keeps the whole run near 8 minutes on 2
-cores (the 1024-sample renders take most of it; 64 px would take ~14).
+(median of 3), table error
+(:func:`lut_baker.offline.validation.table_accuracy.table_error`, 500 points) and the LAYERED
+tier's render error at 256 samples, light 45 degrees, seed 0. 48 px keeps the whole run near 8
+minutes on 2 cores (the 1024-sample renders take most of it; 64 px would take ~14).
 """
 
 from __future__ import annotations
@@ -41,7 +42,11 @@ from doc_block import replace_block  # noqa: E402  (bench/doc_block.py)
 
 from lut_baker import bake  # noqa: E402
 from lut_baker.model import presets  # noqa: E402
-from lut_baker.offline.validation import compare, reference  # noqa: E402
+from lut_baker.offline.validation import (  # noqa: E402
+    compare,
+    reference,
+    table_accuracy,  # noqa: E402
+)
 from lut_baker.offline.validation.baseline import fit_baseline  # noqa: E402
 
 DOCS = ROOT / "docs"
@@ -142,7 +147,7 @@ def render_rows(skin, tables, baseline, refs: dict, size: int, sample_counts,
 def bake_rows(skin, runs: int = 3):
     """Per bake resolution: tables, and a row without the render error yet."""
     bench = _bake_bench()
-    samples = bake.error_samples(skin, albedo_points=100)
+    samples = table_accuracy.error_samples(skin, albedo_points=100)
     tables, rows = {}, {}
     for name, resolution in bake.RESOLUTIONS.items():
         median, _, baked = bench.timed(lambda r=resolution: bake.bake(skin, r), runs)
@@ -150,7 +155,7 @@ def bake_rows(skin, runs: int = 3):
         rows[name] = _row(axis="bake", config="LAYERED", light_deg=45.0, samples=GOAL_SAMPLES,
                           resolution=name, table_entries=bench.entries(resolution),
                           table_mb=bench.megabytes(baked), bake_ms=1e3 * median,
-                          table_error=bake.table_error(baked, samples=samples)["max"])
+                          table_error=table_accuracy.table_error(baked, samples=samples)["max"])
     return tables, rows
 
 

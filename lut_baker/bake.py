@@ -7,8 +7,9 @@ outer angles and sums the cosine series on the table's azimuth grid.  What makes
 - the layers' kernels are evaluated from cosines alone (no direction vectors), at the
   ``n_phi // 2 + 1`` distinct azimuths of an even kernel, once per unordered pair of polar
   angles (both kernels are symmetric), and turned into cosine coefficients by one BLAS product
-  (:func:`fourier_coefficients`, equal to :func:`lut_baker.evaluate.two_layer.layer_fourier_kernel`
-  within 1e-8), the Fresnel term interpolated from a checked tabulation (:func:`_fresnel_fast`);
+  (:func:`fourier_coefficients`, equal to :func:`lut_baker.model.albedo.layer_fourier_kernel`
+  within 1e-8), the Fresnel term interpolated from a checked tabulation
+  (:func:`fresnel_interpolated`);
 - every kernel table is computed once per bake (:class:`KernelCache`);
 - the bake's quadrature (:func:`lut_baker.numerics.quadrature.hemisphere_panels`) is coarser
   than the exact evaluator's, as coarse as the convergence study (``bench/bake.py --study``,
@@ -25,9 +26,10 @@ Functions and types
 - :func:`gloss_albedos` -- their directional albedos (order 0, azimuths adapted to the lobe).
 - :func:`inter_reflection_albedo` -- what the inter-reflections add to the albedo.
 - :func:`profile_radius` -- where the dipole's R(d) falls to a fraction of its peak (mm).
-- :func:`error_samples` -- random points (grazing included) and the exact values there;
-  :func:`sample_directions` -- the random direction pairs alone.
-- :func:`table_error` -- the interpolated tables against the exact evaluator.
+- :func:`rgb_view` -- a channel axis of 1 or 3 as 3, without a copy.
+
+How close the tables come to the exact evaluator is measured offline, by
+:mod:`lut_baker.offline.validation.table_accuracy`.
 """
 
 from __future__ import annotations
@@ -37,24 +39,19 @@ from functools import lru_cache
 
 import numpy as np
 
-from .evaluate.made_up import directional_albedo, made_up_reflection
-from .evaluate.two_layer import (
-    inter_reflection_fourier_matrices,
-    layered_fourier_matrices,
-    transmission_factor,
-)
+from .evaluate.two_layer import inter_reflection_fourier_matrices, layered_fourier_matrices
 from .model.dipole import dipole_profile, dipole_total_reflectance
 from .model.layers import Dipole, ReflectionLayer
 from .model.made_up_skin import MadeUpSkin, film_reflection_layer, film_transmission_layer
 from .model.microfacet import (
     fresnel_term,
+    fresnel_transmittance,
     half_vector_cosines,
     ts_specular_from_cosines,
     ts_transmission_from_cosines,
 )
 from .model.params_file import skin_to_dict
 from .numerics.cache import LRUCache
-from .numerics.geometry import direction, folded_azimuth_deg, polar_angle_deg
 from .numerics.quadrature import (
     HemisphereGrid,
     hemisphere_panels,
@@ -71,15 +68,14 @@ __all__ = [
     "bake",
     "fourier_coefficients",
     "KernelCache",
+    "fresnel_tabulation",
+    "fresnel_interpolated",
     "gloss_layer",
     "gloss_tables",
     "gloss_albedos",
     "profile_radius",
-    "table_error",
     "inter_reflection_albedo",
-    "error_samples",
-    "sample_directions",
-    "ErrorSamples",
+    "rgb_view",
     "PROFILE_FLOOR",
     "REFERENCE_LOBE_DEG",
 ]
@@ -158,13 +154,13 @@ def resolution(name_or_resolution) -> Resolution:
 # Kernels from cosines
 # --------------------------------------------------------------------------------------------
 FRESNEL_NODES = 1 << 16
-"""Intervals of the tabulated Fresnel term on cos in [0, 1] (:func:`_fresnel_fast`)."""
+"""Intervals of the tabulated Fresnel term on cos in [0, 1] (:func:`fresnel_interpolated`)."""
 FRESNEL_TOLERANCE = 1e-8
 """Largest relative error of the tabulation, checked at every midpoint when it is built."""
 
 
 @lru_cache(maxsize=16)
-def _fresnel_table(eta: float) -> np.ndarray | None:
+def fresnel_tabulation(eta: float) -> np.ndarray | None:
     """``F_r`` (eq. 2) at ``FRESNEL_NODES + 1`` uniform cosines, or None when linear
     interpolation of it errs by more than ``FRESNEL_TOLERANCE`` (eta near 1, or below 1 where
     total internal reflection puts a kink in F)."""
@@ -174,11 +170,11 @@ def _fresnel_table(eta: float) -> np.ndarray | None:
     return nodes if error.max() <= FRESNEL_TOLERANCE else None
 
 
-def _fresnel_fast(cosine: np.ndarray, eta) -> np.ndarray:
+def fresnel_interpolated(cosine: np.ndarray, eta) -> np.ndarray:
     """:func:`lut_baker.model.microfacet.fresnel_term` of cosines in [0, 1] with a trailing
-    channel axis of 1, interpolated from :func:`_fresnel_table` (5x faster, within 1e-8
+    channel axis of 1, interpolated from :func:`fresnel_tabulation` (5x faster, within 1e-8
     relative) when eta is one number; the formula itself otherwise."""
-    table = _fresnel_table(float(eta)) if np.ndim(eta) == 0 else None
+    table = fresnel_tabulation(float(eta)) if np.ndim(eta) == 0 else None
     if table is None:
         return fresnel_term(cosine, eta)
     x = cosine * FRESNEL_NODES
@@ -191,11 +187,11 @@ def _reflection_values(layer: ReflectionLayer, cos_a, cos_b, n_dot_h, v_dot_h):
     """``P_d + P_s (D G F_r)`` (eq. 2) of ``wa``, ``wb`` with polar cosines ``cos_a``,
     ``cos_b`` and half-vector cosines ``n_dot_h``, ``v_dot_h``, with a trailing channel axis
     (1 or 3): :func:`~lut_baker.model.microfacet.ts_specular_from_cosines` of the unit lobe,
-    its Fresnel term from :func:`_fresnel_fast`."""
+    its Fresnel term from :func:`fresnel_interpolated`."""
     # P_s times the unit lobe, P_s (D G F_r), rather than ts_reflection_from_cosines's
     # (P_s D) G F_r: the tables' last bits follow this grouping (bench/golden_digests.py).
     lobe = ts_specular_from_cosines(n_dot_h[..., None], v_dot_h[..., None], cos_b[..., None],
-                                    cos_a[..., None], 1.0, layer.n, layer.eta, _fresnel_fast)
+                                    cos_a[..., None], 1.0, layer.n, layer.eta, fresnel_interpolated)
     return layer.P_d + layer.P_s * lobe
 
 
@@ -209,7 +205,7 @@ def _kernel_values(layer, theta_a, theta_b, cos_phi):
         return _reflection_values(layer, cos_a, cos_b, n_dot_h, v_dot_h)
     n_dot_h, v_dot_h = half_vector_cosines(cos_a, sin_a, cos_b, sin_b, -cos_phi)
     return ts_transmission_from_cosines(n_dot_h[..., None], v_dot_h[..., None], layer,
-                                        _fresnel_fast)
+                                        fresnel_interpolated)
 
 
 @lru_cache(maxsize=16)
@@ -226,7 +222,7 @@ def _cosine_matrix(n_phi: int) -> np.ndarray:
 
 def fourier_coefficients(layer, theta_a, theta_b, n_phi: int) -> np.ndarray:
     """Cosine coefficients ``(orders, A, B, C)`` of a layer's kernel (the signature and result
-    of :func:`lut_baker.evaluate.two_layer.layer_fourier_kernel`, within 1e-8 relative: the
+    of :func:`lut_baker.model.albedo.layer_fourier_kernel`, within 1e-8 relative: the
     tabulated Fresnel term), evaluated at the distinct azimuths only, and once per unordered pair
     when ``theta_a`` equals ``theta_b``."""
     theta_a = np.atleast_1d(np.asarray(theta_a, float))
@@ -272,7 +268,7 @@ def gloss_layer(layer: ReflectionLayer) -> ReflectionLayer:
     return ReflectionLayer(P_d=0.0, P_s=layer.P_s, n=layer.n, eta=layer.eta)
 
 
-def _rgb(values: np.ndarray) -> np.ndarray:
+def rgb_view(values: np.ndarray) -> np.ndarray:
     """A trailing channel axis of 1 or 3 as 3 (a read-only broadcast view, no copy)."""
     return np.broadcast_to(values, values.shape[:-1] + (3,))
 
@@ -312,7 +308,7 @@ class _NodePairs:
             for table, values in zip(out, function(chunk), strict=True):
                 table[i, j] = values
                 table[j, i] = values
-        return [_rgb(table) for table in out]
+        return [rgb_view(table) for table in out]
 
 
 def _channel_count(*layers) -> int:
@@ -358,7 +354,7 @@ def gloss_albedos(layers, theta_deg, grid: HemisphereGrid, azimuths: int) -> lis
     out = []
     for layer in layers:
         values = _reflection_values(layer, cos_a, cos_b, n_dot_h, v_dot_h)  # (T, N, S, C)
-        out.append(_rgb(np.einsum("tnsc,s,n->tc", values, weight, grid.weight)))
+        out.append(rgb_view(np.einsum("tnsc,s,n->tc", values, weight, grid.weight)))
     return out
 
 
@@ -438,7 +434,8 @@ def bake(skin: MadeUpSkin, resolution_name="default", *, inter_reflection: bool 
 
     _stage(progress, 0.45, "transmittances and albedos")
     rows0 = kernels(film_t, theta, grid.theta, grid.n_phi)[0]
-    fresnel_t = 1.0 - fresnel_term(np.cos(grid.theta)[:, None], np.atleast_1d(skin.dipole.eta))
+    fresnel_t = fresnel_transmittance(np.cos(grid.theta)[:, None],
+                                      np.atleast_1d(skin.dipole.eta))
     inner_t = order0_integral(kernels(film_t, grid.theta, grid.theta, grid.n_phi)[0], grid)
     albedos = gloss_albedos((film_gloss_layer, skin_gloss), theta_deg, grid,
                             res.albedo_azimuths)
@@ -469,16 +466,16 @@ def bake(skin: MadeUpSkin, resolution_name="default", *, inter_reflection: bool 
         film_gloss=film_gloss,
         path3_gloss=path3,
         skin_gloss=skin_gloss_table,
-        film_transmittance=_rgb(order0_integral(rows0, grid)),
-        transmission_factor=_rgb(order0_integral(rows0, grid, fresnel_t)),
+        film_transmittance=rgb_view(order0_integral(rows0, grid)),
+        transmission_factor=rgb_view(order0_integral(rows0, grid, fresnel_t)),
         film_gloss_albedo=albedos[0],
-        path3_gloss_albedo=_rgb(path3_albedo),
+        path3_gloss_albedo=rgb_view(path3_albedo),
         skin_gloss_albedo=albedos[1],
-        film_diffuse=_rgb(np.atleast_1d(skin.film.P_d)),
-        skin_diffuse=_rgb(np.atleast_1d(skin.skin.P_d)),
-        total_reflectance=_rgb(total),
-        film_transmittance_integral=_rgb(order0_integral(inner_t[None], grid)[0]),
-        profile=_rgb(profile),
+        film_diffuse=rgb_view(np.atleast_1d(skin.film.P_d)),
+        skin_diffuse=rgb_view(np.atleast_1d(skin.skin.P_d)),
+        total_reflectance=rgb_view(total),
+        film_transmittance_integral=rgb_view(order0_integral(inner_t[None], grid)[0]),
+        profile=rgb_view(profile),
         parameters=skin_to_dict(skin),
         inter_reflection=extra,
         theta_spacing=res.theta_spacing,
@@ -503,115 +500,4 @@ def inter_reflection_albedo(skin: MadeUpSkin, theta_deg, resolution_name="defaul
                                              film_below=film_reflection_layer(skin),
                                              fourier=kernels)
     first = layered_fourier_matrices(theta, grid.theta, film_t, skin.skin, grid, fourier=kernels)
-    return _rgb(order0_integral(full[0] - first[0], grid))
-
-
-# --------------------------------------------------------------------------------------------
-# Error against the exact evaluator
-# --------------------------------------------------------------------------------------------
-def sample_directions(n_points: int, rng: np.random.Generator, theta_max_deg: float):
-    """Random (wi, wo): 60% with both polar angles uniform on [0, theta_max], 20% with wi and
-    20% with both on the grazing rows [80, theta_max] degrees; azimuths uniform."""
-    grazing = min(80.0, theta_max_deg)
-    n_one = n_points // 5
-    low_i = np.zeros(n_points)
-    low_o = np.zeros(n_points)
-    low_i[n_points - 2 * n_one:] = grazing
-    low_o[n_points - n_one:] = grazing
-    theta_i = rng.uniform(low_i, theta_max_deg)
-    theta_o = rng.uniform(low_o, theta_max_deg)
-    phi_i, phi_o = rng.uniform(0.0, 2.0 * np.pi, (2, n_points))
-    return direction(np.radians(theta_i), phi_i), direction(np.radians(theta_o), phi_o)
-
-
-@dataclass(frozen=True, eq=False)
-class ErrorSamples:
-    """Random points and the exact evaluator's values there (see :func:`error_samples`)."""
-
-    skin: MadeUpSkin
-    wi: np.ndarray
-    wo: np.ndarray
-    reflection: np.ndarray
-    theta_deg: np.ndarray
-    albedo_theta_deg: np.ndarray
-    albedo: np.ndarray
-    transmission: np.ndarray
-    d_mm: np.ndarray
-    profile: np.ndarray
-
-
-def error_samples(skin: MadeUpSkin, n_points: int = 500, seed: int = 0, *, level: int = 0,
-                  albedo_level: int | None = None, albedo_points: int | None = None,
-                  theta_max_deg: float = 89.0) -> ErrorSamples:
-    """``n_points`` random points (grazing rows included, polar angles up to
-    ``theta_max_deg``) and the exact evaluator there: paths 1 + 3
-    (:func:`lut_baker.evaluate.made_up.made_up_reflection`) and path 4's factor at ``level``, the
-    directional albedo at ``albedo_level`` (default ``level``) on the first ``albedo_points``
-    of them (default all), and R(d)/Rd on [0, :func:`profile_radius`] (denser near 0)."""
-    albedo_level = level if albedo_level is None else albedo_level
-    rng = np.random.default_rng(seed)
-    wi, wo = sample_directions(n_points, rng, theta_max_deg)
-    theta = rng.uniform(0.0, theta_max_deg, n_points)
-    albedo_theta = theta[:n_points if albedo_points is None else albedo_points]
-    transmission = transmission_factor(direction(np.radians(theta), 0.0), skin.film_transmission,
-                                       skin.dipole, level=level)
-    d = profile_radius(skin.dipole) * rng.uniform(0.0, 1.0, n_points) ** 2
-    profile = np.reshape(dipole_profile(d, skin.dipole), (n_points, -1)) / np.atleast_1d(
-        dipole_total_reflectance(skin.dipole))
-    return ErrorSamples(
-        skin=skin, wi=wi, wo=wo, reflection=made_up_reflection(wi, wo, skin, level=level),
-        theta_deg=theta, albedo_theta_deg=albedo_theta,
-        albedo=directional_albedo(albedo_theta, skin, level=albedo_level),
-        transmission=_rgb(np.reshape(transmission, (n_points, -1))), d_mm=d,
-        profile=_rgb(profile))
-
-
-def _normalised_error(approx, exact, peak) -> np.ndarray:
-    """``|approx - exact| / max(|exact|, 0.1 peak)``: <= 1e-3 is the goal's "1e-3 relative or
-    1e-4 of the peak, whichever is larger"."""
-    return np.abs(approx - exact) / np.maximum(np.abs(exact), 0.1 * np.asarray(peak))
-
-
-def table_error(tables: Tables, skin: MadeUpSkin | None = None, n_points: int = 500,
-                seed: int = 0, *, level: int = 0, samples: ErrorSamples | None = None) -> dict:
-    """Interpolated tables against the exact evaluator at random points.
-
-    Errors are normalised as ``|table - exact| / max(|exact|, 0.1 peak)`` per channel (peak: the
-    largest value of the quantity on the table's nodes), so a value <= 1e-3 meets "1e-3 relative
-    or 1e-4 of the peak, whichever is larger".  The points come from :func:`error_samples`
-    (``skin``, ``n_points``, ``seed``, ``level``) unless ``samples`` are given.  Returns a dict
-    of maxima: ``reflection`` (paths 1 + 3 by :meth:`Tables.made_up_reflection`, without
-    inter-reflection), ``albedo`` (directional), ``transmission`` (path 4's factor),
-    ``profile`` (R(d)/Rd), ``max`` (of those four); ``worst`` (theta_i, theta_o, relative
-    azimuth in degrees of the worst reflection point) and ``peak`` (1/sr per channel).
-    """
-    if samples is None:
-        if skin is None:
-            raise ValueError("table_error needs the skin or precomputed samples")
-        samples = error_samples(skin, n_points, seed, level=level)
-    skin = samples.skin
-    plain = replace(tables, inter_reflection=None)
-    w, a = skin.coverage, skin.absorption
-    peak = plain.node_values(w, a).reshape(-1, 3).max(axis=0)
-    reflection = _normalised_error(plain.made_up_reflection(samples.wi, samples.wo, w, a),
-                                   samples.reflection, peak)
-    albedo = _normalised_error(plain.directional_albedo(samples.albedo_theta_deg, w, a),
-                               samples.albedo,
-                               plain.directional_albedo(tables.theta_deg, w, a).max(axis=0))
-    transmission = _normalised_error(tables.directional("transmission_factor", samples.theta_deg),
-                                     samples.transmission, tables.transmission_factor.max(axis=0))
-    profile = _normalised_error(tables.radial(samples.d_mm), samples.profile,
-                                tables.profile.max(axis=0))
-    worst = int(np.argmax(reflection.max(axis=-1)))
-    wi, wo = samples.wi[worst], samples.wo[worst]
-    result = {
-        "reflection": float(reflection.max()),
-        "albedo": float(albedo.max()),
-        "transmission": float(transmission.max()),
-        "profile": float(profile.max()),
-        "peak": peak.tolist(),
-        "worst": [float(polar_angle_deg(wi)), float(polar_angle_deg(wo)),
-                  float(folded_azimuth_deg(wi, wo))],
-    }
-    result["max"] = max(result[k] for k in ("reflection", "albedo", "transmission", "profile"))
-    return result
+    return rgb_view(order0_integral(full[0] - first[0], grid))

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..model.albedo import grid_for, reflection_albedo
 from ..model.made_up_skin import (
     MadeUpSkin,
     coverage_weights,
@@ -18,7 +19,7 @@ from ..model.made_up_skin import (
     film_transmission_layer,
 )
 from ..model.microfacet import check_directions, ts_reflection
-from .two_layer import grid_for, layered_fourier_matrices, layered_reflection, reflection_albedo
+from .two_layer import layered_fourier_matrices, layered_reflection
 
 __all__ = [
     "made_up_reflection",

@@ -32,78 +32,29 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..model.layers import Dipole, ReflectionLayer, TransmissionLayer
-from ..model.microfacet import check_directions, fresnel_term, ts_reflection, ts_transmission
-from ..numerics.geometry import direction, relative_azimuth
-from ..numerics.quadrature import (
-    HemisphereGrid,
-    azimuth_convolution_factor,
-    fourier_kernel,
-    hemisphere_grid,
-    order0_integral,
+from ..model.albedo import (
+    drop_channel_axis,
+    grid_for,
+    hemisphere_factor,
+    layer_fourier_kernel,
+    transmission_rows,
 )
+from ..model.layers import Dipole, ReflectionLayer, TransmissionLayer
+from ..model.microfacet import check_directions, fresnel_transmittance
+from ..numerics.geometry import relative_azimuth
+from ..numerics.quadrature import HemisphereGrid, azimuth_convolution_factor
 
 __all__ = [
     "layered_reflection",
     "layered_reflection_converged",
     "transmission_factor",
-    "film_transmittance",
-    "reflection_albedo",
-    "transmission_albedo",
     "layered_fourier_matrices",
-    "grid_for",
     "inter_reflection_fourier_matrices",
-    "layer_fourier_kernel",
     "inner_matrices",
-    "transmission_rows",
 ]
 
 POINT_CHUNK = 64
 """Evaluation points processed together (bounds memory at a few tens of MB)."""
-
-
-def _channels(values: np.ndarray, layer) -> np.ndarray:
-    """Give per-layer values a trailing channel axis (length 1 for scalar layers)."""
-    return values if layer.channels else values[..., None]
-
-
-def _squeeze(values: np.ndarray, *layers) -> np.ndarray:
-    """Drop the channel axis again when every layer involved is scalar."""
-    return values if any(layer.channels for layer in layers) else values[..., 0]
-
-
-def grid_for(*layers, level: int = 0) -> HemisphereGrid:
-    """The hemisphere grid that resolves the narrowest lobe of ``layers`` at ``level``."""
-    widths = [1.0 / float(np.max(layer.n)) for layer in layers if hasattr(layer, "n")]
-    return hemisphere_grid(min(widths, default=90.0), level)
-
-
-def transmission_kernel(cosmetic: TransmissionLayer):
-    """``(w_top, u) -> f_t(w_top, -u)`` with channel axis: light from ``w_top`` leaving
-    downward along ``-u`` (both arguments upper-hemisphere directions)."""
-
-    def kernel(w_top, u):
-        return _channels(ts_transmission(w_top, -u, cosmetic, check=False), cosmetic)
-
-    return kernel
-
-
-def reflection_kernel(layer: ReflectionLayer):
-    """``(wi, wo) -> f_r(wi, wo)`` with channel axis."""
-
-    def kernel(wi, wo):
-        return _channels(ts_reflection(wi, wo, layer, check=False), layer)
-
-    return kernel
-
-
-def layer_fourier_kernel(layer, theta_a, theta_b, n_phi: int) -> np.ndarray:
-    """Cosine coefficients ``(orders, A, B, C)`` of a layer's kernel between polar angles
-    ``theta_a``, ``theta_b`` (radians): ``f_r(wa, wb)`` of a :class:`ReflectionLayer`,
-    ``f_t(wa, -wb)`` of a :class:`TransmissionLayer` (see :func:`quadrature.fourier_kernel`)."""
-    if isinstance(layer, ReflectionLayer):
-        return fourier_kernel(reflection_kernel(layer), theta_a, theta_b, n_phi)
-    return fourier_kernel(transmission_kernel(layer), theta_a, theta_b, n_phi)
 
 
 def inner_matrices(grid: HemisphereGrid, cosmetic, skin: ReflectionLayer,
@@ -113,12 +64,6 @@ def inner_matrices(grid: HemisphereGrid, cosmetic, skin: ReflectionLayer,
     w = grid.weight
     factor = azimuth_convolution_factor(grid.orders) ** 2
     return factor[:, None, None, None] * w[None, :, None, None] * b * w[None, None, :, None]
-
-
-def transmission_rows(theta, grid: HemisphereGrid, cosmetic,
-                       fourier=layer_fourier_kernel) -> np.ndarray:
-    """``T_m(theta, theta_u)`` for outer polar angles ``theta``: shape ``(orders, P, N, C)``."""
-    return fourier(cosmetic, theta, grid.theta, grid.n_phi)
 
 
 def _batched_matmul(left: np.ndarray, right: np.ndarray) -> np.ndarray:
@@ -209,7 +154,7 @@ def layered_reflection(wi, wo, cosmetic: TransmissionLayer, skin: ReflectionLaye
         out[s] = _fourier_sum(diag, phi[s])
     upper = (wi[:, 2] >= 0.0) & (wo[:, 2] >= 0.0)
     out = np.where(upper[:, None], np.maximum(out, 0.0), 0.0)
-    return _squeeze(out.reshape(batch + (out.shape[-1],)), cosmetic, skin)
+    return drop_channel_axis(out.reshape(batch + (out.shape[-1],)), cosmetic, skin)
 
 
 def layered_reflection_converged(wi, wo, cosmetic, skin, *, rtol: float = 1e-4,
@@ -239,40 +184,7 @@ def transmission_factor(w, cosmetic: TransmissionLayer, skin: Dipole, *, level: 
     w = check_directions("w", w)
     grid = grid_for(cosmetic, level=level)
     # (N, C): the dipole may be RGB through its coefficients with a scalar eta.
-    fresnel_t = 1.0 - fresnel_term(np.cos(grid.theta)[:, None], np.atleast_1d(skin.eta))
+    fresnel_t = fresnel_transmittance(np.cos(grid.theta)[:, None], np.atleast_1d(skin.eta))
     fresnel_t = np.broadcast_to(fresnel_t, (grid.theta.size, 3 if skin.channels else 1))
-    return _hemisphere_factor(w, grid, cosmetic, fresnel_t, skin)
+    return hemisphere_factor(w, grid, cosmetic, fresnel_t, skin)
 
-
-def film_transmittance(w, cosmetic: TransmissionLayer, *, level: int = 0):
-    """The film's directional transmittance ``Int f_t(w, -u) cos(theta_u) du`` (eq. 4
-    integrated): how much of the light arriving from ``w`` crosses the film."""
-    w = check_directions("w", w)
-    grid = grid_for(cosmetic, level=level)
-    return _hemisphere_factor(w, grid, cosmetic, np.ones((grid.theta.size, 1)), cosmetic)
-
-
-def _hemisphere_factor(w, grid, cosmetic, below_weight, *layers):
-    """``2 pi sum_u T_0(theta_w, theta_u) below_weight(u) W_u`` (order 0: azimuth integrated)."""
-    batch = w.shape[:-1]
-    theta = np.arccos(np.clip(w.reshape(-1, 3)[:, 2], 0.0, 1.0))
-    t0 = transmission_rows(theta, grid, cosmetic)[0]  # (P, N, C)
-    value = order0_integral(t0, grid, below_weight)
-    value = np.where(w.reshape(-1, 3)[:, 2:3] >= 0.0, value, 0.0)
-    return _squeeze(value.reshape(batch + (value.shape[-1],)), cosmetic, *layers)
-
-
-def reflection_albedo(theta_i_deg, layer: ReflectionLayer, *, level: int = 0):
-    """Directional albedo ``Int f_r(wi, wo) cos(theta_o) dwo`` of a reflecting layer (eq. 2
-    integrated) at incidence ``theta_i_deg`` (degrees, any shape)."""
-    theta = np.radians(np.asarray(theta_i_deg, float))
-    grid = grid_for(layer, level=level)
-    r0 = fourier_kernel(reflection_kernel(layer), theta.ravel(), grid.theta, grid.n_phi)[0]
-    value = order0_integral(r0, grid)
-    return _squeeze(value.reshape(theta.shape + (value.shape[-1],)), layer)
-
-
-def transmission_albedo(theta_i_deg, cosmetic: TransmissionLayer, *, level: int = 0):
-    """Directional transmittance of the film at incidence ``theta_i_deg`` (degrees)."""
-    theta = np.radians(np.asarray(theta_i_deg, float))
-    return film_transmittance(direction(theta, 0.0), cosmetic, level=level)

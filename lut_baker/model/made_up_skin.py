@@ -29,8 +29,8 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..evaluate.two_layer import reflection_albedo, transmission_albedo
 from ..numerics.optimise import golden_minimum
+from .albedo import reflection_albedo, transmission_albedo
 from .layers import Dipole, ReflectionLayer, TransmissionLayer, check_parameter
 
 __all__ = [

@@ -35,6 +35,7 @@ __all__ = [
     "UNIT_TOLERANCE",
     "check_directions",
     "fresnel_term",
+    "fresnel_transmittance",
     "fresnel_reflectance",
     "distribution_term",
     "microfacet_distribution",
@@ -119,6 +120,12 @@ def fresnel_term(c: np.ndarray, eta: np.ndarray) -> np.ndarray:
     # where the formula is 0/0: with no interface nothing is reflected.
     f = np.where(g2 < 0.0, 1.0, np.where(gpc > 0.0, f, 0.0))
     return np.clip(f, 0.0, 1.0)
+
+
+def fresnel_transmittance(c: np.ndarray, eta: np.ndarray) -> np.ndarray:
+    """Unpolarised Fresnel transmittance ``F_t = 1 - F_r`` at cosine ``c`` and relative index
+    ``eta`` (unchecked, like :func:`fresnel_term`)."""
+    return 1.0 - fresnel_term(c, eta)
 
 
 def fresnel_reflectance(cos_theta, eta):

@@ -12,9 +12,10 @@ from support.samples import node_directions
 
 from lut_baker import bake
 from lut_baker.evaluate import two_layer
-from lut_baker.model import dipole, layers, made_up_skin, microfacet, presets
+from lut_baker.model import albedo, dipole, layers, made_up_skin, microfacet, presets
 from lut_baker.numerics.geometry import direction
 from lut_baker.numerics.quadrature import hemisphere_panels
+from lut_baker.offline.validation import table_accuracy
 
 
 @pytest.fixture(scope="module")
@@ -26,7 +27,7 @@ def paper():
 def samples(paper):
     # the exact evaluator at level 0 (within 1e-4 of level 2 for the film gloss's albedo at
     # 89 degrees); the albedo, the slow part, on 100 of the 500 points
-    return bake.error_samples(paper, n_points=500, seed=0, albedo_points=100)
+    return table_accuracy.error_samples(paper, n_points=500, seed=0, albedo_points=100)
 
 
 @pytest.fixture(scope="module")
@@ -47,7 +48,7 @@ def test_fast_fourier_coefficients_equal_the_exact_evaluators(n_phi):
     for layer in (paper.skin, paper.film, paper.film_transmission, jensen.skin, shaded_film):
         for theta_a in (outer, grid.theta):
             fast = bake.fourier_coefficients(layer, theta_a, grid.theta, n_phi)
-            reference = two_layer.layer_fourier_kernel(layer, theta_a, grid.theta, n_phi)
+            reference = albedo.layer_fourier_kernel(layer, theta_a, grid.theta, n_phi)
             assert fast.shape == reference.shape
             scale = np.abs(reference).max()
             # the tabulated Fresnel term is within 1e-8 (bake.FRESNEL_TOLERANCE)
@@ -71,8 +72,8 @@ def test_skin_diffuse_part_of_path3_is_pd_times_both_transmittances(paper):
     wo = direction(np.radians(rng.uniform(0, 89, 20)), rng.uniform(0, 2 * np.pi, 20))
     diffuse_only = paper.skin.scaled(P_s=0.0)
     path3 = two_layer.layered_reflection(wi, wo, paper.film_transmission, diffuse_only)
-    t_i = two_layer.film_transmittance(wi, paper.film_transmission)
-    t_o = two_layer.film_transmittance(wo, paper.film_transmission)
+    t_i = albedo.film_transmittance(wi, paper.film_transmission)
+    t_o = albedo.film_transmittance(wo, paper.film_transmission)
     np.testing.assert_allclose(path3, paper.skin.P_d * t_i * t_o, rtol=1e-10)
     # and the gloss part is what remains of the full path 3
     full = two_layer.layered_reflection(wi, wo, paper.film_transmission, paper.skin)
@@ -91,12 +92,12 @@ def test_gloss_tables_equal_eq2_at_every_node(default_tables, paper):
 
 
 def test_tabulated_fresnel_is_checked_and_falls_back_near_eta_1():
-    assert bake._fresnel_table(1.19) is not None
-    assert bake._fresnel_table(1.0001) is None and bake._fresnel_table(0.8) is None
+    assert bake.fresnel_tabulation(1.19) is not None
+    assert bake.fresnel_tabulation(1.0001) is None and bake.fresnel_tabulation(0.8) is None
     c = np.random.default_rng(2).uniform(0.0, 1.0, (5000, 1))
     for eta in (1.19, 1.26, 1.0001, 0.8):
-        np.testing.assert_allclose(bake._fresnel_fast(c, eta), microfacet.fresnel_term(c, eta),
-                                   rtol=bake.FRESNEL_TOLERANCE)
+        np.testing.assert_allclose(bake.fresnel_interpolated(c, eta),
+                                   microfacet.fresnel_term(c, eta), rtol=bake.FRESNEL_TOLERANCE)
 
 
 def test_gloss_albedos_match_the_converged_evaluator(paper):
@@ -104,9 +105,9 @@ def test_gloss_albedos_match_the_converged_evaluator(paper):
     res = bake.RESOLUTIONS["default"]
     grid = hemisphere_panels(res.quad_panels, res.quad_points, res.quad_phi)
     fast = bake.gloss_albedos((paper.film, paper.skin), theta, grid, res.albedo_azimuths)
-    for albedo, layer in zip(fast, (paper.film, paper.skin), strict=True):
-        exact = two_layer.reflection_albedo(theta, bake.gloss_layer(layer), level=2)
-        np.testing.assert_allclose(albedo[:, 0], exact, atol=2e-4)
+    for gloss_albedo, layer in zip(fast, (paper.film, paper.skin), strict=True):
+        exact = albedo.reflection_albedo(theta, bake.gloss_layer(layer), level=2)
+        np.testing.assert_allclose(gloss_albedo[:, 0], exact, atol=2e-4)
 
 
 # --------------------------------------------------------------------------------------------
@@ -114,14 +115,14 @@ def test_gloss_albedos_match_the_converged_evaluator(paper):
 # --------------------------------------------------------------------------------------------
 @pytest.mark.slow
 def test_default_tables_meet_the_error_goal(default_tables, samples):
-    error = bake.table_error(default_tables, samples=samples)
+    error = table_accuracy.table_error(default_tables, samples=samples)
     for name in ("reflection", "albedo", "transmission", "profile"):
         assert error[name] <= 1e-3, (name, error)
 
 
 @pytest.mark.slow
 def test_preview_tables_err_below_one_percent(paper, samples):
-    error = bake.table_error(bake.bake(paper, "preview"), samples=samples)
+    error = table_accuracy.table_error(bake.bake(paper, "preview"), samples=samples)
     assert error["max"] < 1e-2, error
 
 
@@ -129,14 +130,14 @@ def test_preview_tables_err_below_one_percent(paper, samples):
 def test_a_coarse_bake_fails_the_goal(paper, samples):
     """The error measure can fail: a 12 x 12 x 9 table misses 1e-3 by far."""
     coarse = replace(bake.RESOLUTIONS["preview"], n_theta=12, n_phi=9, n_radius=8)
-    assert bake.table_error(bake.bake(paper, coarse), samples=samples)["max"] > 1e-2
+    assert table_accuracy.table_error(bake.bake(paper, coarse), samples=samples)["max"] > 1e-2
 
 
 def test_directional_tables(default_tables, paper):
     theta = np.array([0.0, 33.0, 66.0, 88.0])
     w = direction(np.radians(theta), 0.0)
     np.testing.assert_allclose(default_tables.directional("film_transmittance", theta)[:, 0],
-                               two_layer.film_transmittance(w, paper.film_transmission, level=1),
+                               albedo.film_transmittance(w, paper.film_transmission, level=1),
                                rtol=1e-4)
     np.testing.assert_allclose(default_tables.directional("transmission_factor", theta)[:, 0],
                                two_layer.transmission_factor(w, paper.film_transmission,
@@ -144,7 +145,7 @@ def test_directional_tables(default_tables, paper):
     # Int T(w) cos dw over the hemisphere, by a fine 1-D quadrature of the exact T
     x, weights = np.polynomial.legendre.leggauss(64)
     t = np.pi / 4 * (x + 1)
-    exact_t = two_layer.film_transmittance(direction(t, 0.0), paper.film_transmission, level=1)
+    exact_t = albedo.film_transmittance(direction(t, 0.0), paper.film_transmission, level=1)
     integral = 2 * np.pi * np.sum(exact_t * np.cos(t) * np.sin(t) * weights * np.pi / 4)
     np.testing.assert_allclose(default_tables.film_transmittance_integral, integral, rtol=1e-4)
     assert np.all(default_tables.film_transmittance_integral <= np.pi)
@@ -168,8 +169,8 @@ def test_rgb_skin_bakes_per_channel():
     t = bake.bake(skin, "preview")
     assert t.skin_diffuse.shape == (3,) and len(set(t.skin_diffuse.tolist())) == 3
     assert len(set(t.profile[1].tolist())) == 3
-    error = bake.table_error(t, samples=bake.error_samples(skin, n_points=60, seed=2,
-                                                           albedo_points=10))
+    samples = table_accuracy.error_samples(skin, n_points=60, seed=2, albedo_points=10)
+    error = table_accuracy.table_error(t, samples=samples)
     assert error["max"] < 1e-2, error
 
 
@@ -224,8 +225,8 @@ def test_inter_reflection_equals_its_neumann_series(paper):
     full = two_layer.inter_reflection_fourier_matrices(theta, theta, film_t, paper.skin, grid,
                                                     film_below=below)
     skin_m = two_layer.inner_matrices(grid, film_t, paper.skin)[..., 0]
-    film_m = two_layer.layer_fourier_kernel(below, grid.theta, grid.theta, grid.n_phi)[..., 0]
-    rows = two_layer.transmission_rows(theta, grid, film_t)[..., 0]
+    film_m = albedo.layer_fourier_kernel(below, grid.theta, grid.theta, grid.n_phi)[..., 0]
+    rows = albedo.transmission_rows(theta, grid, film_t)[..., 0]
     term, total = skin_m, skin_m.copy()
     for _ in range(40):
         term = term @ film_m @ skin_m

@@ -11,7 +11,7 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from lut_baker.evaluate import made_up, two_layer
-from lut_baker.model import made_up_skin, microfacet
+from lut_baker.model import albedo, made_up_skin, microfacet
 from lut_baker.model.dipole import dipole_profile, dipole_total_reflectance
 from lut_baker.model.layers import Dipole, ReflectionLayer, TransmissionLayer
 
@@ -118,7 +118,7 @@ def test_layered_reflection_stable(wi, wo, film, skin):
 @given(DIRECTION, FILM_T, dipoles())
 def test_film_factors_stable(w, film, dipole):
     factor = two_layer.transmission_factor(w, film, dipole)
-    through = two_layer.film_transmittance(w, film)
+    through = albedo.film_transmittance(w, film)
     _sane(factor)
     _sane(through)
     # The skin's Fresnel transmission F_t <= 1 only removes light.
@@ -144,7 +144,7 @@ def test_grid_follows_the_lobe_width():
     from lut_baker.numerics.quadrature import NARROWEST_LOBE_DEG
 
     n_values = np.geomspace(1e-6, 50.0, 40)
-    grids = [two_layer.grid_for(TransmissionLayer(P_d=1.0, P_t=1.0, n=n, eta=1.3))
+    grids = [albedo.grid_for(TransmissionLayer(P_d=1.0, P_t=1.0, n=n, eta=1.3))
              for n in n_values]
     n_phi = np.array([g.n_phi for g in grids])
     n_theta = np.array([g.theta.size for g in grids])
@@ -159,5 +159,5 @@ def test_grid_follows_the_lobe_width():
     # The narrowest layer sets the grid of a pair.
     wide = ReflectionLayer(P_d=1.0, P_s=1.0, n=0.01, eta=1.3)
     narrow = TransmissionLayer(P_d=1.0, P_t=1.0, n=0.15, eta=1.3)
-    assert two_layer.grid_for(wide, narrow).n_phi == two_layer.grid_for(narrow).n_phi
-    assert two_layer.grid_for(wide, narrow, level=1).n_phi > two_layer.grid_for(wide, narrow).n_phi
+    assert albedo.grid_for(wide, narrow).n_phi == albedo.grid_for(narrow).n_phi
+    assert albedo.grid_for(wide, narrow, level=1).n_phi > albedo.grid_for(wide, narrow).n_phi

@@ -28,7 +28,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ...evaluate.made_up import made_up_reflection
-from ...evaluate.two_layer import film_transmittance
+from ...model.albedo import film_transmittance
 from ...model.dipole import dipole_profile, dipole_total_reflectance
 from ...model.made_up_skin import MadeUpSkin, coverage_weights, film_transmission_layer
 from ...numerics.cache import LRUCache

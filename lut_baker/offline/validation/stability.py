@@ -10,7 +10,7 @@ skin without Blender and measures what must always hold and how far each is from
 - ``model``: the exact evaluator (:func:`lut_baker.evaluate.made_up.made_up_reflection`) at
   directions of the regime: finite, non-negative; its directional albedo (white furnace) at most 1;
 - ``bake``: the tables (:func:`bake.bake`): finite, non-negative, albedo at most 1, and their
-  error against the exact evaluator (:func:`bake.table_error`);
+  error against the exact evaluator (:func:`.table_accuracy.table_error`);
 - ``reference``: the sphere image (:func:`reference.sphere_image`, local and, where the entry
   samples stay affordable, spread): finite, non-negative, and the spread image's total at most
   the local one's (spreading moves light, it does not make it);
@@ -38,7 +38,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ...auto_tier import SceneDescription, choose
-from ...bake import bake, table_error
+from ...bake import bake
 from ...closures.fitting import fit_closures, tier_errors
 from ...evaluate.made_up import directional_albedo, made_up_reflection
 from ...model.made_up_skin import MadeUpSkin
@@ -51,6 +51,7 @@ from .reference import (
     sphere_points,
     spread_diffuse,
 )
+from .table_accuracy import table_error
 
 __all__ = [
     "Regime",
@@ -286,7 +287,8 @@ def check_regime(item: Regime, *, bake_resolution: str = "preview", error_points
     ``resolution``: of the reference images (default the regime's); ``spread``: spread
     their skin light where the entry samples are affordable (the first spread for a film
     layer tabulates its transmittance: 4-7 s);
-    ``error_points``: random points of :func:`bake.table_error` (0 or unaffordable: skipped);
+    ``error_points``: random points of :func:`.table_accuracy.table_error` (0 or unaffordable:
+    skipped);
     ``fit``: also the closure fits' tier errors (a few seconds)."""
     skin = regime_skin(item)
     affordable = item.exact_affordable

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 from support import reference_impl as ref
 
-from lut_baker.evaluate import made_up, two_layer
-from lut_baker.model import microfacet, presets
+from lut_baker.evaluate import made_up
+from lut_baker.model import albedo, microfacet, presets
 from lut_baker.numerics.geometry import direction
 
 THETA_DEG = np.arange(0.0, 90.0)  # 0, 1, ..., 89 degrees
@@ -36,7 +36,7 @@ def test_white_furnace(skin):
     surface, _ = presets.skin_layers(skin)
     assert np.all(bare <= 1.0)
     np.testing.assert_allclose(bare, np.broadcast_to(np.reshape(
-        two_layer.reflection_albedo(THETA_DEG, surface), (90, -1)), bare.shape), rtol=1e-12)
+        albedo.reflection_albedo(THETA_DEG, surface), (90, -1)), bare.shape), rtol=1e-12)
     worst = {"bare": float(bare.max())}
     # Each foundation with its own shade; an explicit absorption replaces the shade, so with
     # one every foundation is the same film: evaluated once.

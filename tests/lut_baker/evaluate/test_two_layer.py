@@ -10,7 +10,7 @@ import pytest
 from support import reference_impl as ref
 
 from lut_baker.evaluate import two_layer
-from lut_baker.model import made_up_skin, presets
+from lut_baker.model import albedo, made_up_skin, presets
 from lut_baker.model.layers import Dipole, ReflectionLayer, TransmissionLayer
 from lut_baker.numerics.geometry import direction
 
@@ -99,7 +99,7 @@ def _convergence_points(seed):
 def _fourier_values(film, skin, level, theta_i, theta_o, phi):
     """``f_cs`` on the pairs (theta_i[p], theta_o[q], phi[p, q]) from the level's Fourier
     matrices: one inner table per level instead of one per point (the level-2 grid is big)."""
-    grid = two_layer.grid_for(film, skin, level=level)
+    grid = albedo.grid_for(film, skin, level=level)
     matrices = two_layer.layered_fourier_matrices(theta_i, theta_o, film, skin, grid)
     m = np.arange(matrices.shape[0])[:, None, None]
     return np.einsum("mpqc,mpq->pqc", matrices, np.cos(m * phi[None]))
@@ -208,12 +208,12 @@ def test_film_transmittance_matches_brute_force():
     film = presets.paper().film_transmission
     theta = np.array([0.0, 30.0, 60.0, 80.0, 89.0])
     w = direction(np.radians(theta), 0.0)
-    got = two_layer.film_transmittance(w, film)
+    got = albedo.film_transmittance(w, film)
     sums = [ref.brute_force_albedo(_film_kernel(_scalar(film)), w, n, 2 * n) for n in (64, 128)]
     brute = (4 * sums[1] - sums[0]) / 3
     accuracy = np.abs(sums[1] - sums[0]) / 3 / brute
     np.testing.assert_allclose(got, brute, rtol=max(accuracy.max(), 1e-6))
-    np.testing.assert_allclose(two_layer.transmission_albedo(theta, film), got, rtol=1e-12)
+    np.testing.assert_allclose(albedo.transmission_albedo(theta, film), got, rtol=1e-12)
 
 
 def test_transmission_factor_fresnel():
@@ -223,11 +223,11 @@ def test_transmission_factor_fresnel():
     lossless = Dipole(sigma_s=1.0, sigma_a=0.0, eta=1.0)
     # eta_s = 1: no Fresnel at the skin, the factor is the film's transmittance.
     np.testing.assert_allclose(two_layer.transmission_factor(w, film, lossless),
-                               two_layer.film_transmittance(w, film), rtol=1e-12)
+                               albedo.film_transmittance(w, film), rtol=1e-12)
     dipole = presets.paper().dipole
     factor = two_layer.transmission_factor(w, film, dipole)
     assert factor.shape == (12, 3)
-    assert np.all(factor > 0) and np.all(factor < two_layer.film_transmittance(w, film))
+    assert np.all(factor > 0) and np.all(factor < albedo.film_transmittance(w, film))
     # Independent: Int f_t(w, -u) (1 - F_r(cos u, eta_s)) cos(theta_u) du, blue channel.
     eta_s = float(dipole.eta)
     film_b = _scalar(film, 2)
@@ -246,7 +246,7 @@ def test_film_transmittance_of_a_diffuse_film_is_pi_p_d():
     """A purely diffuse film (P_t = 0) transmits pi P_d at every incidence."""
     film = TransmissionLayer(P_d=0.2, P_t=0.0, n=0.05, eta=1.3)
     w = direction(np.radians(np.array([0.0, 45.0, 89.0, 90.0])), 1.0)
-    np.testing.assert_allclose(two_layer.film_transmittance(w, film), math.pi * 0.2, rtol=1e-12)
+    np.testing.assert_allclose(albedo.film_transmittance(w, film), math.pi * 0.2, rtol=1e-12)
 
 
 # --- the skins' own albedos ---------------------------------------------------------------
@@ -256,7 +256,7 @@ def test_bare_skin_albedo_against_brute_force():
     w = direction(np.radians(theta), 0.0)
     for name in presets.SKINS:
         surface, _ = presets.skin_layers(name)
-        got = np.reshape(two_layer.reflection_albedo(theta, surface), (4, -1))
+        got = np.reshape(albedo.reflection_albedo(theta, surface), (4, -1))
         for c in range(got.shape[1]):
             args = [float(np.broadcast_to(v, (3,))[c]) for v in surface.as_dict().values()]
             brute = ref.brute_force_albedo(lambda a, u, args=args: ref.vector_reflection(

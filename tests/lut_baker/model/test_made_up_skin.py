@@ -5,8 +5,7 @@ import numpy as np
 import pytest
 from support import reference_impl as ref
 
-from lut_baker.evaluate import two_layer
-from lut_baker.model import made_up_skin, presets
+from lut_baker.model import albedo, made_up_skin, presets
 from lut_baker.numerics.geometry import direction
 
 THETA_DEG = np.arange(0.0, 90.0)  # 0, 1, ..., 89 degrees
@@ -54,8 +53,8 @@ def test_k_is_the_films_brightest_total_albedo():
 
 def test_film_albedo_is_at_most_one_and_one_at_k():
     paper = presets.paper()
-    film = (two_layer.reflection_albedo(THETA_DEG, paper.film)
-            + two_layer.transmission_albedo(THETA_DEG, paper.film_transmission))
+    film = (albedo.reflection_albedo(THETA_DEG, paper.film)
+            + albedo.transmission_albedo(THETA_DEG, paper.film_transmission))
     print(f"film albedo: max {film.max():.9f}, min {film.min():.4f}")
     assert np.all(film <= 1.0 + 1e-12)
     assert film.max() == pytest.approx(1.0, abs=1e-9)

@@ -1,0 +1,127 @@
+"""One layer integrated over the hemisphere: the albedos and transmittances of a single
+reflecting or transmitting layer (paper eqs. 2 and 4 integrated; docs/model.md §2, §4).
+
+The integrals use the azimuthal Fourier expansion of :mod:`lut_baker.numerics.quadrature`: the
+order-0 coefficient of a layer's kernel, summed over polar nodes, is the azimuth-integrated
+value.  The grid is sized from the layer's lobe width (1/n degrees) and refined by ``level``.
+
+Functions
+---------
+- :func:`reflection_albedo` -- ``Int f_r(wi, wo) cos(theta_o) dwo`` of a reflecting layer.
+- :func:`film_transmittance`, :func:`transmission_albedo` -- ``Int f_t(w, -u) cos(theta_u) du``,
+  the film's directional transmittance (by direction, by incidence angle).
+- :func:`hemisphere_factor` -- the film's order-0 transmission row weighted by what lies below
+  (the two-layer evaluator's path-4 factor uses it).
+- :func:`reflection_kernel`, :func:`transmission_kernel`, :func:`layer_fourier_kernel` -- a
+  layer's kernel and its cosine coefficients between two polar grids.
+- :func:`transmission_rows` -- the film's coefficients from outer angles to the grid's nodes.
+- :func:`grid_for` -- the hemisphere grid that resolves the narrowest lobe of some layers.
+- :func:`with_channel_axis`, :func:`drop_channel_axis` -- the channel axis of scalar layers.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..numerics.geometry import direction
+from ..numerics.quadrature import HemisphereGrid, fourier_kernel, hemisphere_grid, order0_integral
+from .layers import ReflectionLayer, TransmissionLayer
+from .microfacet import check_directions, ts_reflection, ts_transmission
+
+__all__ = [
+    "reflection_albedo",
+    "film_transmittance",
+    "transmission_albedo",
+    "hemisphere_factor",
+    "reflection_kernel",
+    "transmission_kernel",
+    "layer_fourier_kernel",
+    "transmission_rows",
+    "grid_for",
+    "with_channel_axis",
+    "drop_channel_axis",
+]
+
+
+def with_channel_axis(values: np.ndarray, layer) -> np.ndarray:
+    """Give per-layer values a trailing channel axis (length 1 for scalar layers)."""
+    return values if layer.channels else values[..., None]
+
+
+def drop_channel_axis(values: np.ndarray, *layers) -> np.ndarray:
+    """Drop the channel axis again when every layer involved is scalar."""
+    return values if any(layer.channels for layer in layers) else values[..., 0]
+
+
+def grid_for(*layers, level: int = 0) -> HemisphereGrid:
+    """The hemisphere grid that resolves the narrowest lobe of ``layers`` at ``level``."""
+    widths = [1.0 / float(np.max(layer.n)) for layer in layers if hasattr(layer, "n")]
+    return hemisphere_grid(min(widths, default=90.0), level)
+
+
+def transmission_kernel(cosmetic: TransmissionLayer):
+    """``(w_top, u) -> f_t(w_top, -u)`` with channel axis: light from ``w_top`` leaving
+    downward along ``-u`` (both arguments upper-hemisphere directions)."""
+
+    def kernel(w_top, u):
+        return with_channel_axis(ts_transmission(w_top, -u, cosmetic, check=False), cosmetic)
+
+    return kernel
+
+
+def reflection_kernel(layer: ReflectionLayer):
+    """``(wi, wo) -> f_r(wi, wo)`` with channel axis."""
+
+    def kernel(wi, wo):
+        return with_channel_axis(ts_reflection(wi, wo, layer, check=False), layer)
+
+    return kernel
+
+
+def layer_fourier_kernel(layer, theta_a, theta_b, n_phi: int) -> np.ndarray:
+    """Cosine coefficients ``(orders, A, B, C)`` of a layer's kernel between polar angles
+    ``theta_a``, ``theta_b`` (radians): ``f_r(wa, wb)`` of a :class:`ReflectionLayer`,
+    ``f_t(wa, -wb)`` of a :class:`TransmissionLayer` (see :func:`quadrature.fourier_kernel`)."""
+    if isinstance(layer, ReflectionLayer):
+        return fourier_kernel(reflection_kernel(layer), theta_a, theta_b, n_phi)
+    return fourier_kernel(transmission_kernel(layer), theta_a, theta_b, n_phi)
+
+
+def transmission_rows(theta, grid: HemisphereGrid, cosmetic,
+                       fourier=layer_fourier_kernel) -> np.ndarray:
+    """``T_m(theta, theta_u)`` for outer polar angles ``theta``: shape ``(orders, P, N, C)``."""
+    return fourier(cosmetic, theta, grid.theta, grid.n_phi)
+
+
+def film_transmittance(w, cosmetic: TransmissionLayer, *, level: int = 0):
+    """The film's directional transmittance ``Int f_t(w, -u) cos(theta_u) du`` (eq. 4
+    integrated): how much of the light arriving from ``w`` crosses the film."""
+    w = check_directions("w", w)
+    grid = grid_for(cosmetic, level=level)
+    return hemisphere_factor(w, grid, cosmetic, np.ones((grid.theta.size, 1)), cosmetic)
+
+
+def hemisphere_factor(w, grid, cosmetic, below_weight, *layers):
+    """``2 pi sum_u T_0(theta_w, theta_u) below_weight(u) W_u`` (order 0: azimuth integrated)."""
+    batch = w.shape[:-1]
+    theta = np.arccos(np.clip(w.reshape(-1, 3)[:, 2], 0.0, 1.0))
+    t0 = transmission_rows(theta, grid, cosmetic)[0]  # (P, N, C)
+    value = order0_integral(t0, grid, below_weight)
+    value = np.where(w.reshape(-1, 3)[:, 2:3] >= 0.0, value, 0.0)
+    return drop_channel_axis(value.reshape(batch + (value.shape[-1],)), cosmetic, *layers)
+
+
+def reflection_albedo(theta_i_deg, layer: ReflectionLayer, *, level: int = 0):
+    """Directional albedo ``Int f_r(wi, wo) cos(theta_o) dwo`` of a reflecting layer (eq. 2
+    integrated) at incidence ``theta_i_deg`` (degrees, any shape)."""
+    theta = np.radians(np.asarray(theta_i_deg, float))
+    grid = grid_for(layer, level=level)
+    r0 = fourier_kernel(reflection_kernel(layer), theta.ravel(), grid.theta, grid.n_phi)[0]
+    value = order0_integral(r0, grid)
+    return drop_channel_axis(value.reshape(theta.shape + (value.shape[-1],)), layer)
+
+
+def transmission_albedo(theta_i_deg, cosmetic: TransmissionLayer, *, level: int = 0):
+    """Directional transmittance of the film at incidence ``theta_i_deg`` (degrees)."""
+    theta = np.radians(np.asarray(theta_i_deg, float))
+    return film_transmittance(direction(theta, 0.0), cosmetic, level=level)
