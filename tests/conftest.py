@@ -7,6 +7,9 @@ bpy is imported only by the fixtures below, on first use: tests of ``lut_baker``
   ``read_factory_settings(use_empty=True)``. Skips the test if bpy cannot be imported.
 - ``blank_scene`` (function): ``read_homefile(use_empty=True, use_factory_startup=True)``, which
   keeps enabled add-ons; returns the (empty) ``bpy.context.scene``.
+- ``paper_tables``, ``paper_fit`` (module): the paper preset's preview tables and their closure
+  fit; ``matte`` (module): ``(skin, tables, fit)`` of :func:`matte_film`, the paper's film at
+  index 1.01 (the Auto tier's tests, with and without Blender).
 
 Tests that use either fixture get the ``bpy`` marker automatically (select them with
 ``pytest -m bpy``, leave them out with ``-m "not bpy"``).
@@ -17,6 +20,10 @@ import sys
 import warnings
 
 import pytest
+
+from lut_baker import bake
+from lut_baker.closures import fitting
+from lut_baker.model import presets
 
 BPY_FIXTURES = frozenset({"bpy_factory", "blank_scene"})
 
@@ -54,3 +61,31 @@ def pytest_collection_modifyitems(config, items):
     for item in items:
         if BPY_FIXTURES.intersection(getattr(item, "fixturenames", ())):
             item.add_marker(pytest.mark.bpy)
+
+
+@pytest.fixture(scope="module")
+def paper_tables():
+    return bake.bake(presets.made_up_skin("paper_natural", "paper_bioplate"), "preview")
+
+
+@pytest.fixture(scope="module")
+def paper_fit(paper_tables):
+    return fitting.fit_closures(paper_tables)
+
+
+def matte_film(ior=1.01, coverage=1.0):
+    """The paper's film with its index set to ``ior`` (the panel's Override Film, Film IOR:
+    1.01 is its smallest), both lobes as measured: its gloss all but vanishes."""
+    skin = presets.made_up_skin("paper_natural", "paper_bioplate", coverage=coverage)
+    return skin.replace(
+        film=skin.film.scaled(eta=ior / float(skin.film.eta)),
+        film_transmission=skin.film_transmission.scaled(
+            eta=ior / float(skin.film_transmission.eta)))
+
+
+@pytest.fixture(scope="module")
+def matte():
+    """``(skin, tables, fit)`` of :func:`matte_film` (preview bake)."""
+    skin = matte_film()
+    tables = bake.bake(skin, "preview")
+    return skin, tables, fitting.fit_closures(tables)

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from lut_baker import auto_tier, bake
+from lut_baker import auto_tier
 from lut_baker.auto_tier import SceneDescription
 from lut_baker.model import presets
 from lut_baker.numerics import geometry
@@ -23,36 +23,6 @@ from lut_baker.offline.validation import compare, reference
 
 ROOT = Path(__file__).resolve().parents[2]
 
-@pytest.fixture(scope="module")
-def paper_tables():
-    return bake.bake(presets.made_up_skin("paper_natural", "paper_bioplate"), "preview")
-
-
-@pytest.fixture(scope="module")
-def paper_fit(paper_tables):
-    from lut_baker.closures import fitting
-
-    return fitting.fit_closures(paper_tables)
-
-
-def _matte_film(ior=1.01, coverage=1.0):
-    """The paper's film with its index set to ``ior`` (the panel's Override Film, Film IOR:
-    1.01 is its smallest), both lobes as measured: its gloss all but vanishes."""
-    skin = presets.made_up_skin("paper_natural", "paper_bioplate", coverage=coverage)
-    return skin.replace(
-        film=skin.film.scaled(eta=ior / float(skin.film.eta)),
-        film_transmission=skin.film_transmission.scaled(
-            eta=ior / float(skin.film_transmission.eta)))
-
-
-@pytest.fixture(scope="module")
-def matte():
-    """``(skin, tables, fit)`` of :func:`_matte_film` (preview bake)."""
-    from lut_baker.closures import fitting
-
-    skin = _matte_film()
-    tables = bake.bake(skin, "preview")
-    return skin, tables, fitting.fit_closures(tables)
 
 
 # --------------------------------------------------------------------------------------------

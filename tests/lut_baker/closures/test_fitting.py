@@ -15,16 +15,6 @@ from lut_baker.numerics.geometry import direction
 from lut_baker.tables.table_set import radius_nodes
 
 
-@pytest.fixture(scope="module")
-def paper_tables():
-    return bake.bake(presets.paper(), "preview")
-
-
-@pytest.fixture(scope="module")
-def paper_fit(paper_tables):
-    return fitting.fit_closures(paper_tables)
-
-
 @pytest.mark.slow  # a fit of ~0.5 s
 def test_fit_glossy_companion_recovers_a_lobe_plus_lambert(paper_tables):
     """A target that is 0.7 of a Beckmann lobe plus a Lambertian 0.2: the companion fit finds
