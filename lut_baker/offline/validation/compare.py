@@ -1,6 +1,6 @@
 """Comparing rendered sphere images with the reference images of :mod:`.reference`.
 
-Pure numpy: the Blender side (``bench/blender_scene.py``) renders, this module measures.  An
+Pure numpy: the Blender side (``tests/support/bench_scene.py``) renders, this module measures.  An
 image is ``(n, n, 3)`` float, rows top-down as :func:`.reference.sphere_points` lays them
 out; a render read from Blender (rows bottom-up) goes through :func:`from_blender_pixels`.
 
@@ -126,7 +126,8 @@ def reference_image(skin: MadeUpSkin, *, tables=None, resolution: int = 64,
     (:meth:`lut_baker.tables.table_set.Tables.made_up_reflection`, error <= 1e-3 of the peak at the
     "default" and "high" resolutions, docs/baking.md), everything else the same: the
     skin-diffuse part is spread by :func:`lut_baker.offline.validation.reference.spread_diffuse`
-    when ``spread``.  ``tests/test_render_compare.py`` checks that the two agree."""
+    when ``spread``.  ``tests/makeup_skin_addon/test_render_compare.py`` checks that the two
+    agree."""
     if tables is None:
         return reference.sphere_image(skin, resolution=resolution, radius_mm=radius_mm,
                                       light_angle_deg=light_angle_deg, irradiance=irradiance,
