@@ -4,7 +4,8 @@
 #   tools/test.sh [extra pytest args for the main run]
 #   tools/test.sh -m "not slow"    # the fast tier (no renders or exact-model sweeps)
 #
-# 1. Blender 5.0 venv: `ruff check .`, then the whole suite, `pytest -q`.
+# 1. Blender 5.0 venv: `ruff check .`, the import contract (tools/check_imports.py), then the
+#    whole suite, `pytest -q`.
 # 2. If MAKEUP_SKIN_BLENDER_LINES (default "5.0 4.5") names 4.5: the Blender-side tests,
 #    `pytest -q -m bpy`, on the 4.5 LTS venv.
 # Venvs come from tools/venv.sh (built once, then cached). Exits non-zero on any failure,
@@ -41,6 +42,8 @@ if [[ " $lines " == *" 5.0 "* ]]; then
     venv50="$(tools/venv.sh 5.0 | tail -n 1)"
     echo "== [5.0] ruff check ."
     "$venv50/bin/ruff" check .
+    echo "== [5.0] import contract (tools/check_imports.py)"
+    "$venv50/bin/python" tools/check_imports.py
     run_pytest "$venv50" 5.0 -q "$@"
 fi
 
