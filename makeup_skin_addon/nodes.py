@@ -324,22 +324,23 @@ def _build_layered(build: _Builder, fit, lut, method: str, radius_mm, ior: float
                build.vector("ADD", build.vector("MULTIPLY", through, tuple(fit.film_albedo)),
                             companion, label="film diffuse + gloss companion"))
     build.feed(film_diffuse.inputs["Normal"], film_normal)
-    # The skin seen through the film: the medium keeps the skin's own (bright) colour, tinted
-    # by the film's absorption relative to its weakest channel, and the film's transmittances
-    # scale the closure as a whole.  A dark colour instead would make the random walk both
-    # noisy (14% against 1% at 32 samples) and wrongly short.
-    separate = build.node("ShaderNodeSeparateXYZ", "absorption channels")
-    build.feed(separate.inputs[0], through2)
+    # The skin seen through the film, per channel (1 - A)^2 T(theta_o) T_mean times the skin:
+    # the closure's colour keeps the skin's own (bright) colour, tinted by that product
+    # relative to its strongest channel, and the strongest channel weights the closure.  A dark
+    # colour instead would make the random walk both noisy (14% against 1% at 32 samples) and
+    # wrongly short.
+    transmitted = build.vector("MULTIPLY", build.vector("MULTIPLY", through2,
+                                                        rows["film_transmittance"]),
+                               tuple(fit.transmittance_mean), label="(1 - A)^2 T(theta_o) T_mean")
+    separate = build.node("ShaderNodeSeparateXYZ", "transmitted channels")
+    build.feed(separate.inputs[0], transmitted)
     strongest = build.math("MAXIMUM", separate.outputs[0],
                            build.math("MAXIMUM", separate.outputs[1], separate.outputs[2]))
-    through_colour = build.scale(build.vector("MULTIPLY", through2, skin),
+    through_colour = build.scale(build.vector("MULTIPLY", transmitted, skin),
                                  build.math("DIVIDE", 1.0, build.math("MAXIMUM", strongest,
                                                                       1e-6)),
                                  label="skin through film colour")
-    transmit = build.vector("DOT_PRODUCT", rows["film_transmittance"],
-                            tuple(fit.transmittance_mean / 3.0))
-    through_weight = build.math("MULTIPLY", transmit, strongest,
-                                label="(1 - A)^2 T(theta_o) T_mean")
+    through_weight = strongest
     weighted = build.node("ShaderNodeMixShader", "skin through film (weight)")
     build.feed(socket(weighted.inputs, "Fac"), through_weight)
     build.tree.links.new(subsurface(through_colour, "skin through film"),

@@ -57,7 +57,8 @@ CLOSURES = {"BSDF_PRINCIPLED", "BSDF_GLOSSY", "BSDF_ANISOTROPIC", "BSDF_DIFFUSE"
 def baked():
     """``(skin, tables, fit)``: preview tables of a tinted skin, and a fit in which every term
     of the mix is non-zero (a specular lobe through the film and a tinted film albedo, which
-    this preset's fit leaves at 0 and grey), so that each weight reaches some probe."""
+    this preset's fit leaves at 0 and grey; a tinted film transmittance, which measured
+    foundations have), so that each weight reaches some probe and every channel its own."""
     skin = presets.made_up_skin("paper_natural", "jensen_skin2", coverage=1.0, absorption=0.0)
     tables = bake(skin, "preview")
     fit = cf.fit_closures(tables)
@@ -66,10 +67,8 @@ def baked():
         specular_film=dataclasses.replace(fit.specular_film, level=0.4, roughness=0.3),
         specular_albedo_mean=(fit.specular_albedo_mean[0], 0.03),
         gloss_to_diffuse=np.full(3, 0.02),
-        film_albedo=fit.film_albedo * np.array([1.0, 0.9, 0.8]))
-    # The LAYERED tier weights the skin through the film by the mean of T_mean T(theta_o) over
-    # the channels (nodes.py), the replica per channel: the same while the film is grey.
-    assert np.ptp(fit.transmittance_mean) == 0.0
+        film_albedo=fit.film_albedo * np.array([1.0, 0.9, 0.8]),
+        transmittance_mean=fit.transmittance_mean * np.array([1.0, 0.95, 0.8]))
     return skin, tables, fit
 
 
