@@ -61,6 +61,7 @@ def test_zip_contents(extension_zip):
     assert "lut_baker/__init__.py" in names
     assert "lut_baker/closures/fitting.py" in names
     assert not [n for n in names if n.startswith("tests/") or "/tests/" in n]
+    assert not [n for n in names if n.startswith("data/")]  # published measurements stay out
     # the runtime only: no scipy-backed validation, no command line
     assert not [n for n in names if n.startswith(("lut_baker/offline/", "lut_baker/__main__"))]
 

@@ -59,6 +59,9 @@ from .measured.protocols import (
 
 __all__ = [
     "DPI",
+    "GREY",
+    "styled_figure",
+    "sequence_colours",
     "FIGSIZE_IN",
     "RELATIVE_ANGLES_DEG",
     "INCIDENCES_DEG",
@@ -114,7 +117,7 @@ _STYLE = {
 }
 # Paper colours for figs. 14 and 15 (5.1, 5.2): film surface green, through the film blue,
 # their sum (the proposed model) light blue; the skin-only model of fig. 15 green.
-_GREEN, _BLUE, _LIGHT_BLUE, _GREY = "#2ca02c", "#1f5fbf", "#17b3e6", "#7f7f7f"
+_GREEN, _BLUE, _LIGHT_BLUE, GREY = "#2ca02c", "#1f5fbf", "#17b3e6", "#7f7f7f"
 
 
 # --------------------------------------------------------------------------------------------
@@ -281,7 +284,7 @@ def _parameter_text(layer) -> str:
 
 
 @contextmanager
-def _figure(title: str, xlabel: str, ylabel: str):
+def styled_figure(title: str, xlabel: str, ylabel: str):
     """A styled 6 x 4 in figure on an Agg canvas with one axes, built inside the style."""
     try:
         import matplotlib
@@ -301,7 +304,7 @@ def _figure(title: str, xlabel: str, ylabel: str):
         yield figure, axes
 
 
-def _sequence_colours(count: int):
+def sequence_colours(count: int):
     """``count`` colours along viridis, avoiding its pale yellow end."""
     from matplotlib import colormaps
 
@@ -309,14 +312,14 @@ def _sequence_colours(count: int):
 
 
 def _reflection_figure(curves: dict, title: str) -> object:
-    with _figure(title, r"reflection angle $\theta_r$ (degrees)",
+    with styled_figure(title, r"reflection angle $\theta_r$ (degrees)",
                  r"intensity $f_r\,(N\cdot L)$ (counts, 3 s exposure)") as (figure, axes):
-        for colour, (psi, curve) in zip(_sequence_colours(len(curves)), curves.items(),
+        for colour, (psi, curve) in zip(sequence_colours(len(curves)), curves.items(),
                                         strict=True):
             axes.plot(curve["theta_r_deg"], curve["intensity"], color=colour,
                       label=rf"$\psi$ = {psi:g}°", gid=f"psi={psi:g}")
             axes.axvline(-psi / 2.0, color=colour, linestyle=":", linewidth=0.9)
-        axes.plot([], [], color=_GREY, linestyle=":", linewidth=0.9,
+        axes.plot([], [], color=GREY, linestyle=":", linewidth=0.9,
                   label=r"mirror direction $\theta_r = -\psi/2$")
         axes.set_xlim(-90.0, 60.0)
         axes.set_ylim(bottom=0.0)
@@ -344,15 +347,15 @@ def fig07_film_transmission(layer: TransmissionLayer = PAPER_FILM_TRANSMISSION,
                             incidences_deg=INCIDENCES_DEG):
     """Paper fig. 7: the film's transmission (eq. 4, 4.1.2) against theta_t."""
     curves = transmission_curves(layer, incidences_deg)
-    with _figure("Fig. 7: foundation film, transmission (eq. 4)\n" + _parameter_text(layer),
+    with styled_figure("Fig. 7: foundation film, transmission (eq. 4)\n" + _parameter_text(layer),
                  r"transmission angle $\theta_t$ (degrees from $-N$)",
                  r"intensity $f_t\,(N\cdot L)$ (counts, 10 s exposure)") as (figure, axes):
-        for colour, (incidence, curve) in zip(_sequence_colours(len(curves)), curves.items(),
+        for colour, (incidence, curve) in zip(sequence_colours(len(curves)), curves.items(),
                                               strict=True):
             axes.plot(curve["theta_t_deg"], curve["intensity"], color=colour,
                       label=rf"$\theta_i$ = {incidence:g}°", gid=f"theta_i={incidence:g}")
             axes.axvline(incidence, color=colour, linestyle=":", linewidth=0.9)
-        axes.plot([], [], color=_GREY, linestyle=":", linewidth=0.9,
+        axes.plot([], [], color=GREY, linestyle=":", linewidth=0.9,
                   label=r"straight through $\theta_t = \theta_i$")
         axes.set_xlim(-90.0, 90.0)
         axes.set_ylim(bottom=0.0)
@@ -364,7 +367,7 @@ def fig13_skin_profile(dipole: Dipole = PAPER_SKIN_DIPOLE, max_mm: float = 3.0):
     """Paper fig. 13: the bio-plate's subsurface profile, ``R(d)/R(0)`` (eq. 6, 4.2.2)."""
     curve = profile_curve(dipole, max_mm)
     label = "dipole: " + _parameter_text(dipole)
-    with _figure("Fig. 13: skin (bio-plate), subsurface scattering profile (dipole, eq. 6)",
+    with styled_figure("Fig. 13: skin (bio-plate), subsurface scattering profile (dipole, eq. 6)",
                  "distance from the lit point $d$ (mm)",
                  r"$R(d)/R(0)$ (ratio to the lit pixel)") as (figure, axes):
         axes.plot(curve["d_mm"], curve["ratio"], color=_GREEN, label=label, gid="ratio")
@@ -382,9 +385,9 @@ def fig14_made_up_reflection(skin: MadeUpSkin | None = None, relative_angle_deg:
     theta = curves["theta_r_deg"]
     title = (f"Fig. 14: made-up skin, reflection at $\\psi$ = {relative_angle_deg:g}° (eq. 9)\n"
              "the paper weighted paths 1 and 3 by hand; here coverage $w$ mixes with bare skin")
-    with _figure(title, r"reflection angle $\theta_r$ (degrees)",
+    with styled_figure(title, r"reflection angle $\theta_r$ (degrees)",
                  r"intensity $f\,(N\cdot L)$ (albedo units, 1/sr)") as (figure, axes):
-        axes.plot(theta, curves["bare"], color=_GREY, linestyle=":",
+        axes.plot(theta, curves["bare"], color=GREY, linestyle=":",
                   label="bare skin (w = 0)", gid="bare")
         axes.plot(theta, curves["path1"], color=_GREEN, label="path 1: film surface",
                   gid="path1")
@@ -406,7 +409,7 @@ def fig15_made_up_profile(skin: MadeUpSkin | None = None, angle_deg: float = 30.
     """Paper fig. 15: made-up versus bare skin subsurface profile at incidence = view =
     ``angle_deg`` (specular geometry, 5.2), both divided by the bare skin's value at d = 0."""
     curves = made_up_profile_curves(skin, angle_deg, max_mm)
-    with _figure(f"Fig. 15: made-up vs bare skin, subsurface profile "
+    with styled_figure(f"Fig. 15: made-up vs bare skin, subsurface profile "
                  f"($\\theta_i = \\theta_r$ = {angle_deg:g}°)",
                  "distance from the lit point $d$ (mm)",
                  r"$S(d)\,/\,S_{\mathrm{bare}}(0)$ (log scale)") as (figure, axes):
@@ -433,14 +436,14 @@ def fig16_directional_albedo(foundations=None, skin: str = "paper_bioplate"):
     theta = curves["theta_deg"]
     names = [name for name in curves if name not in ("theta_deg", "bare")]
     channel_styles = (("R", "-"), ("G", "--"), ("B", ":"))
-    with _figure("Beyond the paper: white furnace, directional albedo of paths 1 + 3",
+    with styled_figure("Beyond the paper: white furnace, directional albedo of paths 1 + 3",
                  r"incidence $\theta_i$ (degrees)",
                  r"directional albedo $\int f\,\cos\theta_o\,d\omega_o$ (1 = lossless)"
                  ) as (figure, axes):
         axes.axhline(1.0, color="black", linewidth=0.8)
-        axes.plot(theta, curves["bare"][:, CHANNEL], color=_GREY, linewidth=1.2,
+        axes.plot(theta, curves["bare"][:, CHANNEL], color=GREY, linewidth=1.2,
                   label="bare bio-plate (w = 0)", gid="bare")
-        for colour, name in zip(_sequence_colours(len(names)), names, strict=True):
+        for colour, name in zip(sequence_colours(len(names)), names, strict=True):
             for index, (channel, style) in enumerate(channel_styles):
                 axes.plot(theta, curves[name][:, index], color=colour, linestyle=style,
                           label=FOUNDATIONS[name]["label"] if index == 0 else None,

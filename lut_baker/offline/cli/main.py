@@ -23,6 +23,7 @@ COMMANDS = {
     "bake": ".bake_command",
     "fit": ".fit_command",
     "figures": ".figures_command",
+    "foundations": ".foundations_command",
 }
 """Command name -> module (relative to this package) implementing it."""
 

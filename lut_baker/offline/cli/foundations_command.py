@@ -1,0 +1,47 @@
+"""Fit the paper's eq. 2 to published foundation measurements and write the comparison.
+
+    python -m lut_baker foundations [--out docs/foundations] [--data data/lanza2024]
+
+Reads the in-plane spectral measurements of four foundations (Lanza et al. 2024,
+data/lanza2024/README.md), converts them to linear Rec.709 reflectance factors, fits
+``ReflectionLayer(P_d, P_s, n, eta)`` (eq. 2, docs/model.md §2.1) per channel, and writes per
+product ``<product>.csv`` and ``<product>.png`` and one ``README.md`` report to the output
+folder.  Needs scipy, matplotlib and colour-science.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+__all__ = ["HELP", "configure", "run"]
+
+HELP = "fit eq. 2 to four published foundations; write CSVs, figures and a report"
+
+
+def configure(parser: argparse.ArgumentParser) -> None:
+    """Add the command's arguments (the fits and figures are imported only by :func:`run`)."""
+    parser.add_argument("--out", type=Path, default=Path("docs/foundations"), metavar="DIR",
+                        help="folder for the CSVs, PNGs and README.md (default "
+                             "docs/foundations; created if missing)")
+    parser.add_argument("--data", type=Path, default=Path("data/lanza2024"), metavar="DIR",
+                        help="folder holding the four measurement files (default "
+                             "data/lanza2024)")
+
+
+def run(args: argparse.Namespace) -> int:
+    """Write the outputs; print one path per line.  Bad input raises ``ValueError``."""
+    for module, package in (("matplotlib", "matplotlib"), ("colour", "colour-science"),
+                            ("scipy", "scipy")):
+        try:
+            __import__(module)
+        except ModuleNotFoundError as error:
+            raise ValueError(f"the foundations command needs {package}: "
+                             f"pip install {package}") from error
+    from ..foundations import write_all
+
+    if not args.data.is_dir():
+        raise ValueError(f"--data {args.data} is not a folder")
+    for path in write_all(args.data, args.out):
+        print(path)
+    return 0

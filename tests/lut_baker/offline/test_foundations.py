@@ -1,0 +1,72 @@
+"""Published foundations against eq. 2 (lut_baker.offline.foundations): one product analysed,
+its CSV (exact header, the measured rows, finite values), its figure and the report's sections;
+unknown products and missing files are one clear error."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+pytest.importorskip("scipy")
+pytest.importorskip("colour")
+pytest.importorskip("matplotlib")
+
+from lut_baker.offline import foundations as FD  # noqa: E402
+
+DATA = Path(__file__).parents[3] / "data" / "lanza2024"
+HEADER = "theta_i_deg,theta_o_deg,measured_R,measured_G,measured_B,model_R,model_G,model_B"
+
+
+@pytest.fixture(scope="module")
+def matte():
+    return FD.analyse("clarins_103", DATA)
+
+
+def test_every_product_file_is_in_the_repository():
+    for filename, finish in FD.PRODUCTS.values():
+        assert (DATA / filename).is_file(), filename
+        assert finish in ("matte", "dewy")
+    assert ",".join(FD.CSV_COLUMNS) == HEADER
+
+
+def test_an_analysis_fits_all_and_alternate_incidences(matte):
+    assert matte.finish == "matte"
+    assert matte.split == ((20.0, 40.0, 60.0), (30.0, 50.0, 70.0))
+    assert matte.fit.fitted_deg == (20.0, 30.0, 40.0, 50.0, 60.0, 70.0)
+    assert matte.held_out.fitted_deg == (20.0, 40.0, 60.0)
+    assert set(matte.misses) == set(matte.split[0] + matte.split[1])
+    rms, worst = matte.fit.error()
+    assert 0.0 < rms < worst < 1.0  # the matte product is within tens of percent
+
+
+def test_the_csv_has_the_exact_header_and_the_measured_rows(matte, tmp_path):
+    path = FD.write_csv(matte, tmp_path / "p.csv")
+    lines = path.read_text().splitlines()
+    assert lines[0] == HEADER
+    table = np.loadtxt(path, delimiter=",", skiprows=1)
+    assert table.shape == (115, 8)
+    assert np.all(np.isfinite(table)) and np.all(table[:, 2:] > 0)
+    np.testing.assert_allclose(table[:, 2:5], matte.data.rgb, rtol=1e-5)
+    np.testing.assert_allclose(table[:, 5:], matte.fit.model, rtol=1e-5)
+
+
+def test_the_figure_has_points_and_curves_per_incidence(matte):
+    figure = FD.product_figure(matte)
+    gids = {line.get_gid() for line in figure.axes[0].lines if line.get_gid()}
+    for incidence in (20, 30, 40, 50, 60, 70):
+        assert {f"model theta_i={incidence}", f"measured theta_i={incidence}"} <= gids
+
+
+def test_the_report_has_each_products_numbers(matte):
+    text = FD.report([matte], {"clarins_103": "NOTE 103", "conclusion": "THE END"})
+    assert text.startswith("# Published foundations against the paper's eq. 2")
+    assert "## clarins_103 (matte)" in text and "NOTE 103" in text
+    assert "## Conclusions" in text and "THE END" in text
+    assert text.count("| R |") == 1 and text.count("| 70° |") == 1
+
+
+def test_unknown_products_and_missing_files_are_one_line(tmp_path):
+    with pytest.raises(ValueError, match="unknown product 'x'"):
+        FD.analyse("x", DATA)
+    with pytest.raises(ValueError, match="no such file"):
+        FD.analyse("clarins_103", tmp_path)
