@@ -134,7 +134,8 @@ def validate(source_dir: Path | str = REPO_ROOT) -> str:
 def check_zip(zip_path: Path | str, source_dir: Path | str = REPO_ROOT) -> list[str]:
     """Return the problems of a built extension zip (an empty list if it is fine).
 
-    Every ``.py`` file of :data:`ADDON_PACKAGES` in ``source_dir`` (outside ``tests/``,
+    Every ``.py`` and ``.json`` file (the runtime's data, e.g. the measured foundation presets)
+    of :data:`ADDON_PACKAGES` in ``source_dir`` (outside ``tests/``,
     ``__pycache__/`` and :data:`OFFLINE`) must be in the zip, and nothing outside
     :data:`ALLOWED_TOP_LEVEL`, nothing of :data:`OFFLINE`, no ``tests/`` folder and no compiled
     Python.
@@ -149,7 +150,8 @@ def check_zip(zip_path: Path | str, source_dir: Path | str = REPO_ROOT) -> list[
     for package in ADDON_PACKAGES:
         sources = [
             p.relative_to(source_dir).as_posix()
-            for p in (source_dir / package).rglob("*.py")
+            for pattern in ("*.py", "*.json")  # modules and the runtime's data files
+            for p in (source_dir / package).rglob(pattern)
             if not {"tests", "__pycache__"} & set(p.relative_to(source_dir).parts)
             and not p.relative_to(source_dir).as_posix().startswith(OFFLINE)
         ]

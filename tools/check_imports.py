@@ -43,6 +43,7 @@ LAYERS: dict[str, list[tuple[str, ...]]] = {
         ("lut_baker.offline.exr_files", "lut_baker.offline.measured"),
         ("lut_baker.offline.validation",),
         ("lut_baker.offline.paper_figures",),
+        ("lut_baker.offline.foundation_presets",),
         ("lut_baker.offline.foundations",),
         ("lut_baker.offline.cli", "lut_baker.offline", "lut_baker.__main__"),
     ],

@@ -12,11 +12,19 @@ Functions
 - :func:`skin_layers` -- (surface reflection, dipole) of a named skin, albedo units.
 - :func:`skin_albedo` -- a named skin's diffuse albedo ``pi P_d`` per RGB channel.
 - :func:`made_up_skin` -- a named foundation on a named skin with coverage.
+- :func:`foundation_film` -- a named foundation's top-surface reflection (its gloss).
+
+Foundations are the paper's film with a per-channel absorption (docs/model.md §4): three shades
+picked by hand, and four products measured as thick layers (Lanza et al. 2024), whose thin film
+is derived offline (docs/model.md §4, "Presets from measured thick layers";
+lut_baker/offline/foundation_presets.py) and read here from :data:`MEASURED_FOUNDATIONS_FILE`.
 """
 
 from __future__ import annotations
 
+import json
 from functools import lru_cache
+from pathlib import Path
 
 import numpy as np
 
@@ -30,12 +38,14 @@ __all__ = [
     "PAPER_SKIN_REFLECTION",
     "PAPER_SKIN_DIPOLE",
     "FOUNDATIONS",
+    "MEASURED_FOUNDATIONS_FILE",
     "SKINS",
     "paper",
     "paper_layers",
     "skin_layers",
     "skin_albedo",
     "made_up_skin",
+    "foundation_film",
 ]
 
 # Baba, Mukaigawa, Yagi, section 4.1.1: liquid foundation ("natural"), reflection, 3 s shutter.
@@ -57,6 +67,30 @@ FOUNDATIONS: dict[str, dict] = {
     "medium_beige": {"absorption": (0.10, 0.24, 0.42), "label": "Medium beige"},
     "deep_mocha": {"absorption": (0.38, 0.56, 0.70), "label": "Deep mocha"},
 }
+# The hand-picked shades stay beside the measured products below: the golden digests, tests and
+# docs use them, and they cover shades the four products lack: deep_mocha absorbs far more red
+# (0.38) than any of them (at most 0.27), a deep brown rather than a beige.
+
+MEASURED_FOUNDATIONS_FILE = Path(__file__).with_name("measured_foundations.json")
+"""Foundations derived from measured thick layers (docs/model.md §4, "Presets from measured
+thick layers"), written by ``python -m lut_baker foundations``."""
+
+
+def _measured_foundations(path: Path) -> dict[str, dict]:
+    """The entries of the measured presets' file: label, absorption and the film's gloss
+    ``{"P_s", "n", "eta"}`` (1/sr, 1/degree, -) per product."""
+    if not path.is_file():
+        return {}
+    entries = json.loads(path.read_text(encoding="utf-8"))["foundations"]
+    return {name: {"absorption": tuple(float(a) for a in entry["absorption"]),
+                   "label": str(entry["label"]),
+                   "film": {key: float(entry["film"][key]) for key in ("P_s", "n", "eta")}}
+            for name, entry in entries.items()}
+
+
+# An entry's optional "film" replaces the paper film's top-surface lobe (P_s, n, eta of eq. 2);
+# P_d and the transmission (eq. 4) stay the paper film's.
+FOUNDATIONS.update(_measured_foundations(MEASURED_FOUNDATIONS_FILE))
 
 
 @lru_cache(maxsize=1)
@@ -127,5 +161,22 @@ def made_up_skin(foundation: str = "paper_natural", skin: str = "paper_bioplate"
         raise ValueError(f"foundation must be one of {sorted(FOUNDATIONS)}, got {foundation!r}")
     surface, dipole = skin_layers(skin)
     shade = FOUNDATIONS[foundation]["absorption"] if absorption is None else absorption
-    return paper().replace(skin=surface, dipole=dipole, coverage=coverage, absorption=shade,
-                           name=f"{foundation}+{skin}")
+    base = paper()
+    changes = {}
+    if "film" in FOUNDATIONS[foundation]:
+        changes["film"] = foundation_film(foundation)
+    return base.replace(skin=surface, dipole=dipole, coverage=coverage, absorption=shade,
+                        name=f"{foundation}+{skin}", **changes)
+
+
+def foundation_film(foundation: str) -> ReflectionLayer:
+    """A named foundation's top-surface reflection in albedo units (eq. 2, docs/model.md §4):
+    the paper film's ``P_d`` with the entry's own gloss ``P_s``, ``n``, ``eta`` where it has one
+    (the measured products), else the paper film's."""
+    if foundation not in FOUNDATIONS:
+        raise ValueError(f"foundation must be one of {sorted(FOUNDATIONS)}, got {foundation!r}")
+    film = paper().film
+    gloss = FOUNDATIONS[foundation].get("film")
+    if gloss is None:
+        return film
+    return ReflectionLayer(P_d=film.P_d, P_s=gloss["P_s"], n=gloss["n"], eta=gloss["eta"])

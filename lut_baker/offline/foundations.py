@@ -18,7 +18,9 @@ Functions and types
 - :func:`write_csv` -- the measured/model table of one product.
 - :func:`product_figure` -- the luminance figure of one product.
 - :func:`report` -- the Markdown report over the products.
-- :func:`write_all` -- everything above into one folder.
+- :func:`derived_presets` -- the thin-film presets the products imply
+  (:mod:`~lut_baker.offline.foundation_presets`, docs/model.md §4).
+- :func:`write_all` -- everything above into one folder, and the presets to the runtime's file.
 """
 
 from __future__ import annotations
@@ -29,6 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from ..model.albedo import reflection_albedo
+from .foundation_presets import derive_presets, film_exchange, stack_reflectance, write_presets
 from .measured.inplane import InPlaneData, read_inplane
 from .measured.inplane_fit import (
     ChannelFits,
@@ -47,6 +50,7 @@ __all__ = [
     "write_csv",
     "product_figure",
     "report",
+    "derived_presets",
     "write_all",
 ]
 
@@ -204,9 +208,54 @@ def _summary(analysis: ProductAnalysis) -> str:
             f"geometries).")
 
 
-def report(analyses: list[ProductAnalysis], notes: dict | None = None) -> str:
-    """The Markdown report: method, per product the parameters, errors and misses, and the
-    written ``notes`` (product name -> paragraph; key ``"conclusion"`` for the end)."""
+def derived_presets(analyses: list[ProductAnalysis]) -> dict:
+    """The presets' entries (:func:`~lut_baker.offline.foundation_presets.derive_presets`) from
+    the all-incidence fits."""
+    return derive_presets({a.name: (a.finish, a.fit.layers) for a in analyses})
+
+
+def _triple(values, digits: int = 3) -> str:
+    return " / ".join(f"{float(v):.{digits}f}" for v in values)
+
+
+def _preset_section(presets: dict) -> list[str]:
+    exchange = film_exchange()
+    out = ["## Presets for the model: the thin film each thick layer implies", "",
+           "Written to lut_baker/model/measured_foundations.json, which the presets read "
+           "(docs/model.md §4, \"Presets from measured thick layers\"). The film keeps the "
+           "paper film's P_d and transmission (eq. 4); its absorption A (R / G / B) is solved "
+           "so that the film stacked on itself without end (adding equation, uniform light) "
+           "reflects the target, the eq. 2 fit's bihemispherical reflectance (its directional "
+           "albedo averaged over uniform incident light); gloss: dewy, the luminance-weighted "
+           "mean of the fit's P_s, n, eta; matte, none (P_s = 0). The paper film's exchange: "
+           f"gloss {exchange.r_gloss:.4f}, diffuse {exchange.r_diffuse:.4f} (pi P_d), "
+           f"transmittance {exchange.t_0:.4f}; stacked, it reflects at most "
+           f"{_stack_max(exchange):.4f} (A = 0) and at least {exchange.r_gloss:.4f} (A = 1).",
+           "",
+           "| preset | label | target R / G / B | stack R / G / B | absorption A R / G / B | "
+           "gloss P_s (1/sr), n (1/deg), eta | clamped |",
+           "|---|---|---|---|---|---|---|"]
+    for name, entry in presets.items():
+        film = entry["film"]
+        clamped = ", ".join(c for c, flag in zip("RGB", entry["clamped"], strict=True) if flag)
+        out.append(f"| {name} | {entry['label']} | {_triple(entry['target'])} | "
+                   f"{_triple(entry['stack'])} | {_triple(entry['absorption'], 4)} | "
+                   f"{film['P_s']:.3g}, {film['n']:.3g}, {film['eta']:.3g} | "
+                   f"{clamped or 'no'} |")
+    out.append("")
+    return out
+
+
+def _stack_max(exchange) -> float:
+    return float(stack_reflectance(0.0, exchange))
+
+
+def report(analyses: list[ProductAnalysis], notes: dict | None = None,
+           presets: dict | None = None) -> str:
+    """The Markdown report: method, per product the parameters, errors and misses, the
+    derived ``presets`` (:func:`derived_presets`) if given, and the written ``notes`` (product
+    name -> paragraph; key ``"presets"`` below the presets' table, ``"conclusion"`` for the
+    end)."""
     notes = notes or {}
     out = [
         "# Published foundations against the paper's eq. 2",
@@ -242,6 +291,10 @@ def report(analyses: list[ProductAnalysis], notes: dict | None = None) -> str:
         out += _miss_table(analysis) + [""]
         if analysis.name in notes:
             out += [notes[analysis.name], ""]
+    if presets:
+        out += _preset_section(presets)
+        if "presets" in notes:
+            out += [notes["presets"], ""]
     if "conclusion" in notes:
         out += ["## Conclusions", "", notes["conclusion"], ""]
     return "\n".join(out)
@@ -286,6 +339,20 @@ NOTES: dict[str, str] = {
         "level falls with incidence (near-normal measured/model 0.87 at 30° to 0.56–0.59 at "
         "60–70°) where eq. 2's P_d is constant, and the data rise toward grazing view (2.2–2.5× "
         "at 30–50° incidence) where the model stays flat (1.00×)."),
+    "presets": (
+        "**Reading.** The stack of the paper's film reflects at most 0.834 (no absorption): "
+        "every target but 105's red lies below, and those are met to rounding. 105's red "
+        "(0.909) is brighter than the paper's film can be made by stacking, so its absorption "
+        "is clamped at 0 and its thick-layer limit reflects 0.834 (8% under). Absorption "
+        "rises from red to blue in every product, as in the hand-picked shades; 108 and 112, "
+        "the darker products, absorb 0.86-0.90 of the blue. The matte products get no gloss "
+        "(their fits have no determined lobe: n at its bound for 103, no consistent lobe for "
+        "108; the grazing rise their fits turn into a Fresnel term is not one, see above), the "
+        "dewy ones one achromatic lobe: 105 broad (n = 0.150 /deg), 112 narrow (n = 0.342 "
+        "/deg, the fit that misses its peaks 2-4x, so its gloss is a lower bound in height). "
+        "The hand-picked shades stay beside them: deep_mocha absorbs far more red (0.38) than "
+        "any product (at most 0.27), a deep brown none of the four is, though 108 and 112 "
+        "absorb more green and blue."),
     "conclusion": (
         "**Reflectance factors, R = pi f_r.** The matte products' levels settle it. Near the "
         "normal 103 measures R, G, B ≈ 0.74, 0.55, 0.43 and 108 ≈ 0.48, 0.29, 0.19, the "
@@ -315,9 +382,11 @@ NOTES: dict[str, str] = {
 (they quote the tables' numbers: rewrite them if the fits change)."""
 
 
-def write_all(data_dir, out_dir, products=None) -> list[Path]:
+def write_all(data_dir, out_dir, products=None, presets_path=None) -> list[Path]:
     """Analyse ``products`` (default all of :data:`PRODUCTS`) and write ``<product>.csv``,
-    ``<product>.png`` and ``README.md`` to ``out_dir``; returns the paths written."""
+    ``<product>.png`` and ``README.md`` (with the derived presets) to ``out_dir``, and the
+    presets' JSON to ``presets_path`` if given (the runtime reads
+    :data:`~lut_baker.offline.foundation_presets.PRESET_FILE`); returns the paths written."""
     from .paper_figures import DPI
 
     out = Path(out_dir)
@@ -331,7 +400,10 @@ def write_all(data_dir, out_dir, products=None) -> list[Path]:
         figure_path = out / f"{analysis.name}.png"
         product_figure(analysis).savefig(figure_path, dpi=DPI, metadata={"Software": None})
         paths.append(figure_path)
+    presets = derived_presets(analyses)
     readme = out / "README.md"
-    readme.write_text(report(analyses, NOTES), encoding="utf-8")
+    readme.write_text(report(analyses, NOTES, presets), encoding="utf-8")
     paths.append(readme)
+    if presets_path is not None:
+        paths.append(write_presets(presets, presets_path))
     return paths

@@ -102,7 +102,8 @@ def configure(parser: argparse.ArgumentParser) -> None:
                              "(default: %(default)s)")
     parser.add_argument("--foundation", choices=sorted(FOUNDATIONS), metavar="NAME",
                         help="foundation preset (the paper's film with a shade's per-channel "
-                             f"absorption): {', '.join(sorted(FOUNDATIONS))}")
+                             "absorption, or with a measured product's gloss and absorption, "
+                             f"docs/model.md §4): {', '.join(sorted(FOUNDATIONS))}")
     parser.add_argument("--skin", choices=sorted(SKINS), metavar="NAME",
                         help=f"skin preset (surface gloss and dipole): {', '.join(sorted(SKINS))}")
     parser.add_argument("--params", type=Path, metavar="FILE.toml",

@@ -1,12 +1,15 @@
 """Fit the paper's eq. 2 to published foundation measurements and write the comparison.
 
     python -m lut_baker foundations [--out docs/foundations] [--data data/lanza2024]
+                                    [--presets lut_baker/model/measured_foundations.json]
 
 Reads the in-plane spectral measurements of four foundations (Lanza et al. 2024,
 data/lanza2024/README.md), converts them to linear Rec.709 reflectance factors, fits
 ``ReflectionLayer(P_d, P_s, n, eta)`` (eq. 2, docs/model.md §2.1) per channel, and writes per
 product ``<product>.csv`` and ``<product>.png`` and one ``README.md`` report to the output
-folder.  Needs scipy, matplotlib and colour-science.
+folder, and derives from the fits the thin-film foundation presets (docs/model.md §4, "Presets
+from measured thick layers") into the runtime's preset file, which
+:mod:`lut_baker.model.presets` reads.  Needs scipy, matplotlib and colour-science.
 """
 
 from __future__ import annotations
@@ -16,7 +19,8 @@ from pathlib import Path
 
 __all__ = ["HELP", "configure", "run"]
 
-HELP = "fit eq. 2 to four published foundations; write CSVs, figures and a report"
+HELP = ("fit eq. 2 to four published foundations; write CSVs, figures, a report and the "
+        "foundation presets derived from them")
 
 
 def configure(parser: argparse.ArgumentParser) -> None:
@@ -27,6 +31,9 @@ def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--data", type=Path, default=Path("data/lanza2024"), metavar="DIR",
                         help="folder holding the four measurement files (default "
                              "data/lanza2024)")
+    parser.add_argument("--presets", type=Path, default=None, metavar="FILE",
+                        help="JSON file for the derived foundation presets (default: the "
+                             "runtime's, lut_baker/model/measured_foundations.json)")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -42,6 +49,9 @@ def run(args: argparse.Namespace) -> int:
 
     if not args.data.is_dir():
         raise ValueError(f"--data {args.data} is not a folder")
-    for path in write_all(args.data, args.out):
+    from ..foundation_presets import PRESET_FILE
+
+    presets = PRESET_FILE if args.presets is None else args.presets
+    for path in write_all(args.data, args.out, presets_path=presets):
         print(path)
     return 0

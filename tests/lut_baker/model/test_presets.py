@@ -2,6 +2,7 @@
 literature skins, the foundation shades, and the named bundles built from them."""
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -67,7 +68,8 @@ def test_bioplate_skin_is_the_papers():
 
 def test_foundations():
     assert set(presets.FOUNDATIONS) == {"paper_natural", "light_ivory", "medium_beige",
-                                        "deep_mocha"}
+                                        "deep_mocha", "clarins_103", "clarins_105",
+                                        "clarins_108", "clarins_112"}
     for entry in presets.FOUNDATIONS.values():
         absorption = np.asarray(entry["absorption"])
         assert absorption.shape == (3,) and np.all((absorption >= 0) & (absorption <= 1))
@@ -104,3 +106,66 @@ def test_made_up_skin():
 def test_preset_errors(call, message):
     with pytest.raises(ValueError, match=message):
         call()
+
+
+MEASURED = {"clarins_103": "matte", "clarins_105": "dewy", "clarins_108": "matte",
+            "clarins_112": "dewy"}
+
+
+def test_measured_foundations_come_from_the_shipped_file():
+    """The four measured products (docs/model.md §4, "Presets from measured thick layers"):
+    labelled by product and finish, read from the file shipped with the runtime."""
+    assert presets.MEASURED_FOUNDATIONS_FILE.is_file()
+    assert presets.MEASURED_FOUNDATIONS_FILE.parent == Path(presets.__file__).parent
+    for name, finish in MEASURED.items():
+        entry = presets.FOUNDATIONS[name]
+        assert entry["label"] == f"Clarins {name[-3:]} ({finish}, measured)"
+        assert set(entry["film"]) == {"P_s", "n", "eta"}
+        if finish == "matte":
+            assert entry["film"]["P_s"] == 0.0
+        else:
+            assert entry["film"]["P_s"] > 0 and 0.1 < entry["film"]["n"] < 0.4
+    # The measured products' red is brighter than their blue: absorption rises to blue.
+    for name in MEASURED:
+        absorption = presets.FOUNDATIONS[name]["absorption"]
+        assert absorption[0] < absorption[1] < absorption[2]
+    # 108 and 112 are darker than 103 and 105 in every channel.
+    for dark in ("clarins_108", "clarins_112"):
+        for light in ("clarins_103", "clarins_105"):
+            assert np.all(np.greater(presets.FOUNDATIONS[dark]["absorption"],
+                                     presets.FOUNDATIONS[light]["absorption"]))
+    assert presets._measured_foundations(Path("no such file.json")) == {}
+
+
+@pytest.mark.parametrize("name", sorted(MEASURED))
+def test_made_up_skin_applies_a_measured_film(name):
+    bundle = presets.made_up_skin(name, "jensen_skin1", coverage=0.5)
+    paper = presets.paper()
+    entry = presets.FOUNDATIONS[name]
+    film = presets.foundation_film(name)
+    assert bundle.film.as_dict() == film.as_dict()
+    assert film.as_dict() == {"P_d": float(paper.film.P_d), **entry["film"]}
+    assert bundle.film_transmission is paper.film_transmission
+    np.testing.assert_array_equal(bundle.absorption, entry["absorption"])
+    assert bundle.coverage == 0.5 and bundle.name == f"{name}+jensen_skin1"
+
+
+def test_hand_picked_shades_keep_the_papers_film():
+    for name in ("paper_natural", "light_ivory", "medium_beige", "deep_mocha"):
+        assert "film" not in presets.FOUNDATIONS[name]
+        assert presets.made_up_skin(name).film is presets.paper().film
+        assert presets.foundation_film(name) is presets.paper().film
+    with pytest.raises(ValueError, match="foundation must be one of"):
+        presets.foundation_film("lipstick")
+
+
+def test_measured_glosses_reflect_less_than_the_papers_film():
+    """The white furnace test's absorption cases use the paper film; a measured product's film
+    differs only in its gloss, which reflects less at every incidence (docs/model.md §4)."""
+    from lut_baker.model.albedo import reflection_albedo
+
+    theta = np.array([0.0, 30.0, 50.0, 70.0, 80.0, 85.0, 89.0])
+    paper_gloss = reflection_albedo(theta, presets.paper().film.scaled(P_d=0.0))
+    for name in MEASURED:
+        gloss = reflection_albedo(theta, presets.foundation_film(name).scaled(P_d=0.0))
+        assert np.all(gloss <= paper_gloss), name

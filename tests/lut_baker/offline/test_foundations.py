@@ -65,6 +65,22 @@ def test_the_report_has_each_products_numbers(matte):
     assert text.count("| R |") == 1 and text.count("| 70° |") == 1
 
 
+def test_the_report_lists_the_derived_presets(matte):
+    """The thin-film preset each product implies (docs/model.md §4): the same entry as the
+    runtime's file, in its own section with the absorption and gloss."""
+    from lut_baker.offline import foundation_presets
+
+    derived = FD.derived_presets([matte])
+    stored = foundation_presets.read_presets()["clarins_103"]
+    np.testing.assert_allclose(derived["clarins_103"]["absorption"], stored["absorption"],
+                               rtol=1e-6)
+    text = FD.report([matte], {"presets": "PRESET NOTE"}, derived)
+    assert "## Presets for the model" in text and "PRESET NOTE" in text
+    row = next(line for line in text.splitlines() if line.startswith("| clarins_103 |"))
+    assert "Clarins 103 (matte, measured)" in row and f"{stored['absorption'][0]:.4f}" in row
+    assert "## Presets for the model" not in FD.report([matte])
+
+
 def test_unknown_products_and_missing_files_are_one_line(tmp_path):
     with pytest.raises(ValueError, match="unknown product 'x'"):
         FD.analyse("x", DATA)

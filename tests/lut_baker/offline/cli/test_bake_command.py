@@ -160,6 +160,25 @@ def test_help_explains_every_option_with_units():
         assert option in text
     for unit in ("[0, 1]", "1/sr", "per RGB channel", "docs/baking.md"):
         assert unit in text
+    # Every foundation preset is listed, the measured products included.
+    for name in presets.FOUNDATIONS:
+        assert name in text
+    assert "clarins_105" in text
+
+
+def test_a_parameter_file_naming_a_measured_foundation_bakes(tmp_path):
+    """``foundation = "clarins_105"`` in a parameter file bakes the product's film: its gloss
+    and absorption (docs/model.md §4)."""
+    path = tmp_path / "dewy.toml"
+    path.write_text('foundation = "clarins_105"\nskin = "jensen_skin1"\n')
+    skin = bake_command.skin_from_args(parse("--params", path))
+    expected = presets.made_up_skin("clarins_105", "jensen_skin1")
+    assert float(skin.film.P_s) == presets.FOUNDATIONS["clarins_105"]["film"]["P_s"]
+    assert params_file.skin_to_dict(skin) == params_file.skin_to_dict(expected)
+    tables = bake.bake(skin, "preview")
+    assert codec.content_hash(tables) == codec.content_hash(bake.bake(expected, "preview"))
+    assert codec.content_hash(tables) != codec.content_hash(
+        bake.bake(presets.made_up_skin("paper_natural", "jensen_skin1"), "preview"))
 
 
 def test_progress_bar_only_on_a_terminal():

@@ -18,17 +18,28 @@ def test_the_command_is_registered():
     assert COMMANDS["foundations"] == ".foundations_command"
 
 
-@pytest.mark.slow  # four products fitted twice and drawn (~1.5 s alone, more under load)
+@pytest.mark.slow  # four products fitted twice and drawn (~13 s)
 def test_the_command_writes_the_csvs_figures_and_report(tmp_path, capsys):
     pytest.importorskip("scipy")
     pytest.importorskip("colour")
     pytest.importorskip("matplotlib")
     out = tmp_path / "foundations"
-    assert main(["foundations", "--out", str(out), "--data", str(DATA)]) == 0
+    stored = tmp_path / "presets.json"
+    assert main(["foundations", "--out", str(out), "--data", str(DATA),
+                 "--presets", str(stored)]) == 0
     printed = capsys.readouterr().out.split()
     expected = sorted([f"{p}.csv" for p in ROWS] + [f"{p}.png" for p in ROWS] + ["README.md"])
     assert sorted(p.name for p in out.iterdir()) == expected
-    assert sorted(Path(p).name for p in printed) == expected
+    assert sorted(Path(p).name for p in printed) == sorted(expected + ["presets.json"])
+    # The presets written are the runtime's (docs/model.md §4).
+    from lut_baker.offline import foundation_presets
+
+    written = foundation_presets.read_presets(stored)
+    assert list(written) == list(ROWS)
+    for name, entry in written.items():
+        np.testing.assert_allclose(entry["absorption"],
+                                   foundation_presets.read_presets()[name]["absorption"],
+                                   rtol=1e-6, atol=1e-9)
     for product, rows in ROWS.items():
         path = out / f"{product}.csv"
         assert path.read_text().splitlines()[0] == HEADER
@@ -39,6 +50,8 @@ def test_the_command_writes_the_csvs_figures_and_report(tmp_path, capsys):
     report = (out / "README.md").read_text()
     for product in ROWS:
         assert f"## {product} (" in report
+        assert f"| {product} | Clarins {product[-3:]} (" in report
+    assert "## Presets for the model" in report
 
 
 def test_a_missing_data_folder_exits_2_with_one_line(tmp_path, capsys):

@@ -1,0 +1,216 @@
+"""Foundation presets from measured thick layers: the thin film each measured product implies
+(docs/model.md §4, "Presets from measured thick layers"; paper eqs. 2 and 4).
+
+Lanza et al. 2024 measured thick layers of four foundations (data/lanza2024/README.md), not the
+thin film the model lays on skin.  Each product's preset film keeps the paper's film (its
+diffuse ``P_d`` and its transmission, eq. 4) and takes from the measurement:
+
+- **gloss** (the film's top surface, eq. 2's ``P_s``, ``n``, ``eta``, not absorbed): for a dewy
+  product, one achromatic lobe, the luminance-weighted mean (Rec.709 weights) of the per-channel
+  fit's ``P_s``, ``n`` and ``eta``; for a matte product, whose fit has no determined lobe,
+  ``P_s = 0`` (``n``, ``eta`` stay the paper film's, unused);
+- **absorption** ``A_c`` per channel (docs/model.md §4): the film stacked on itself without end
+  reflects what the thick layer reflects.  With the film's bihemispherical reflectance ``r(A) =
+  r_gloss + (1 - A) r_diffuse`` and transmittance ``t(A) = (1 - A) t_0`` (uniform incident
+  light, cosine-weighted), the adding equation ``R = r + t^2 R / (1 - r R)`` has the root
+  ``R_inf(A)`` of ``r R^2 - (1 + r^2 - t^2) R + r = 0`` below 1, which falls monotonically from
+  ``R_inf(0)`` to ``r_gloss`` at ``A = 1``; bisection finds ``A_c`` with ``R_inf(A_c)`` equal to
+  the target, the fitted eq. 2 layer's bihemispherical reflectance in channel ``c``.  A target
+  outside ``[r_gloss, R_inf(0)]`` is clamped (``A = 0`` or ``1``) and reported.
+
+The result is written to :data:`PRESET_FILE` (``lut_baker/model/measured_foundations.json``),
+which :mod:`lut_baker.model.presets` reads at import; ``python -m lut_baker foundations``
+rewrites it.
+
+Functions and types
+-------------------
+- :data:`PRESET_FILE` -- where the runtime reads the derived presets.
+- :func:`bihemispherical` -- a directional albedo averaged over uniform incident light.
+- :class:`FilmExchange` -- the paper film's ``r_gloss``, ``r_diffuse``, ``t_0``.
+- :func:`film_exchange` -- those three from the paper's normalised film.
+- :func:`stack_reflectance` -- ``R_inf(A)``, the film stacked on itself without end.
+- :func:`solve_absorption` -- ``A`` per channel reproducing a target ``R_inf`` (bisection).
+- :func:`preset_gloss` -- the preset's top-surface lobe from a product's fit.
+- :func:`derive_preset`, :func:`derive_presets` -- one or all products' preset entries.
+- :func:`write_presets`, :func:`read_presets` -- the JSON file.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..model.albedo import reflection_albedo, transmission_albedo
+from ..model.layers import ReflectionLayer
+from ..model.presets import MEASURED_FOUNDATIONS_FILE, paper
+
+__all__ = [
+    "PRESET_FILE",
+    "LUMINANCE_WEIGHTS",
+    "bihemispherical",
+    "FilmExchange",
+    "film_exchange",
+    "stack_reflectance",
+    "solve_absorption",
+    "preset_gloss",
+    "derive_preset",
+    "derive_presets",
+    "write_presets",
+    "read_presets",
+]
+
+PRESET_FILE = MEASURED_FOUNDATIONS_FILE
+"""The runtime's preset file (shipped with the extension)."""
+
+LUMINANCE_WEIGHTS = np.array([0.2126, 0.7152, 0.0722])
+"""Rec.709 luminance weights: how a dewy product's per-channel lobes become one."""
+
+QUADRATURE_NODES = 48
+"""Gauss-Legendre nodes in ``cos(theta)`` of :func:`bihemispherical`."""
+
+BISECTION_STEPS = 80
+"""Bisection steps of :func:`solve_absorption` (the interval halves each time: 2^-80)."""
+
+
+def bihemispherical(directional, nodes: int = QUADRATURE_NODES) -> np.ndarray:
+    """``2 Int_0^1 a(mu) mu dmu``: the directional albedo ``directional(theta_deg)`` (array in,
+    ``(N,)`` or ``(N, C)`` out) averaged over uniform (cosine-weighted) incident light."""
+    x, w = np.polynomial.legendre.leggauss(nodes)
+    mu, w = 0.5 * (x + 1.0), 0.5 * w
+    values = np.asarray(directional(np.degrees(np.arccos(mu))), dtype=float)
+    weight = (2.0 * w * mu).reshape((-1,) + (1,) * (values.ndim - 1))
+    return np.sum(weight * values, axis=0)
+
+
+@dataclass(frozen=True)
+class FilmExchange:
+    """The film's bihemispherical reflectance split into its gloss ``r_gloss`` (not absorbed)
+    and diffuse ``r_diffuse = pi P_d`` parts, and its transmittance ``t_0`` (docs/model.md §4,
+    no absorption)."""
+
+    r_gloss: float
+    r_diffuse: float
+    t_0: float
+
+    def r(self, absorption):
+        """``r(A) = r_gloss + (1 - A) r_diffuse``."""
+        return self.r_gloss + (1.0 - np.asarray(absorption, float)) * self.r_diffuse
+
+    def t(self, absorption):
+        """``t(A) = (1 - A) t_0``."""
+        return (1.0 - np.asarray(absorption, float)) * self.t_0
+
+
+def film_exchange() -> FilmExchange:
+    """:class:`FilmExchange` of the paper's normalised film (docs/model.md §4, §5)."""
+    base = paper()
+    gloss = base.film.scaled(P_d=0.0)
+    return FilmExchange(
+        r_gloss=float(bihemispherical(lambda t: reflection_albedo(t, gloss))),
+        r_diffuse=float(np.pi * base.film.P_d),
+        t_0=float(bihemispherical(lambda t: transmission_albedo(t, base.film_transmission))),
+    )
+
+
+def stack_reflectance(absorption, exchange: FilmExchange) -> np.ndarray:
+    """``R_inf(A)``: the film stacked on itself without end (the adding equation's fixed point,
+    the root below 1 of ``r R^2 - (1 + r^2 - t^2) R + r = 0``)."""
+    r = exchange.r(absorption)
+    t = exchange.t(absorption)
+    b = 1.0 + r**2 - t**2
+    disc = np.sqrt(np.maximum(b**2 - 4.0 * r**2, 0.0))
+    # 2r / (b + sqrt(...)) is the smaller root without cancellation; r = 0 gives 0.
+    return 2.0 * r / (b + disc)
+
+
+def solve_absorption(target, exchange: FilmExchange) -> tuple[np.ndarray, np.ndarray]:
+    """``(A, clamped)`` per entry of ``target``: ``R_inf(A) = target`` by bisection on [0, 1]
+    (``R_inf`` falls with ``A``).  Targets above ``R_inf(0)`` give ``A = 0``, below
+    ``R_inf(1) = r_gloss`` give ``A = 1``; ``clamped`` marks them."""
+    target = np.asarray(target, dtype=float)
+    low = np.zeros_like(target)
+    high = np.ones_like(target)
+    for _ in range(BISECTION_STEPS):
+        mid = 0.5 * (low + high)
+        above = stack_reflectance(mid, exchange) > target
+        low = np.where(above, mid, low)
+        high = np.where(above, high, mid)
+    absorption = 0.5 * (low + high)
+    clamped = (target > stack_reflectance(0.0, exchange)) | (
+        target < stack_reflectance(1.0, exchange))
+    absorption = np.where(target > stack_reflectance(0.0, exchange), 0.0, absorption)
+    absorption = np.where(target < stack_reflectance(1.0, exchange), 1.0, absorption)
+    return absorption, clamped
+
+
+def preset_gloss(layers, finish: str) -> dict:
+    """The preset film's top surface ``{"P_s", "n", "eta"}`` (1/sr, 1/degree, -) from a
+    product's per-channel eq. 2 fit ``layers`` (R, G, B :class:`ReflectionLayer`): dewy, the
+    luminance-weighted means; matte, no lobe (``P_s = 0``, the paper film's ``n`` and ``eta``)."""
+    if finish == "matte":
+        film = paper().film
+        return {"P_s": 0.0, "n": float(film.n), "eta": float(film.eta)}
+    if finish != "dewy":
+        raise ValueError(f"finish must be 'matte' or 'dewy', got {finish!r}")
+    return {name: float(LUMINANCE_WEIGHTS @ np.array([float(getattr(layer, name))
+                                                      for layer in layers]))
+            for name in ("P_s", "n", "eta")}
+
+
+def derive_preset(name: str, finish: str, layers, exchange: FilmExchange | None = None) -> dict:
+    """One product's preset entry from its per-channel fit ``layers``: ``label``,
+    ``absorption``, ``film`` (:func:`preset_gloss`), and for the record ``target`` (the fitted
+    layers' bihemispherical reflectance per channel), ``stack`` (``R_inf`` at the solved
+    absorption) and ``clamped``."""
+    _check_layers(layers)
+    exchange = exchange or film_exchange()
+    target = np.array([float(bihemispherical(lambda t, layer=layer: reflection_albedo(t, layer)))
+                       for layer in layers])
+    absorption, clamped = solve_absorption(target, exchange)
+    number = name.split("_")[-1]
+    return {
+        "label": f"Clarins {number} ({finish}, measured)",
+        "finish": finish,
+        "absorption": [float(a) for a in absorption],
+        "film": preset_gloss(layers, finish),
+        "target": [float(v) for v in target],
+        "stack": [float(v) for v in stack_reflectance(absorption, exchange)],
+        "clamped": [bool(v) for v in clamped],
+    }
+
+
+def derive_presets(fits: dict) -> dict:
+    """Preset entries for ``fits``: product name -> ``(finish, layers)``, in that order."""
+    exchange = film_exchange()
+    return {name: derive_preset(name, finish, layers, exchange)
+            for name, (finish, layers) in fits.items()}
+
+
+def write_presets(presets: dict, path=PRESET_FILE) -> Path:
+    """Write the entries with the film exchange they were derived with, as JSON."""
+    exchange = film_exchange()
+    document = {
+        "about": "Foundation presets derived from the measured thick layers of Lanza et al. "
+                 "2024 (docs/model.md §4, 'Presets from measured thick layers'). Generated by "
+                 "`python -m lut_baker foundations` (lut_baker/offline/foundation_presets.py); "
+                 "do not edit.",
+        "film_exchange": {"r_gloss": exchange.r_gloss, "r_diffuse": exchange.r_diffuse,
+                          "t_0": exchange.t_0},
+        "foundations": presets,
+    }
+    path = Path(path)
+    path.write_text(json.dumps(document, indent=2) + "\n", encoding="utf-8")
+    return path
+
+
+def read_presets(path=PRESET_FILE) -> dict:
+    """The ``foundations`` entries of a preset file."""
+    return json.loads(Path(path).read_text(encoding="utf-8"))["foundations"]
+
+
+def _check_layers(layers) -> None:
+    if len(layers) != 3 or not all(isinstance(layer, ReflectionLayer) for layer in layers):
+        raise ValueError("layers must be three ReflectionLayer fits (R, G, B)")

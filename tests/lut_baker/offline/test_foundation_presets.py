@@ -1,0 +1,130 @@
+"""Foundation presets from measured thick layers (lut_baker.offline.foundation_presets,
+docs/model.md §4): the stacked film's reflectance (adding equation), the absorption solve
+(monotone, clamped), the gloss per finish, and the stored preset file re-derived from the
+measurements."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from lut_baker.model import presets
+from lut_baker.model.albedo import reflection_albedo
+from lut_baker.model.layers import ReflectionLayer
+from lut_baker.offline import foundation_presets as FP
+
+DATA = Path(__file__).parents[3] / "data" / "lanza2024"
+PRODUCTS = ("clarins_103", "clarins_105", "clarins_108", "clarins_112")
+
+
+@pytest.fixture(scope="module")
+def exchange():
+    return FP.film_exchange()
+
+
+def test_the_film_exchange_is_the_paper_films(exchange):
+    film = presets.paper().film
+    assert exchange.r_diffuse == pytest.approx(np.pi * float(film.P_d), rel=1e-14)
+    # The lossless film (K, docs/model.md §4) reflects and transmits at most all it receives.
+    assert 0.9 < exchange.r_gloss + exchange.r_diffuse + exchange.t_0 <= 1.0
+    assert 0.0 < exchange.r_gloss < 0.2 and 0.2 < exchange.t_0 < 0.5
+    # A Lambertian albedo averages to itself.
+    assert FP.bihemispherical(lambda t: np.full(np.shape(t), 0.3)) == pytest.approx(0.3, 1e-14)
+
+
+def test_the_stack_is_the_adding_equations_fixed_point(exchange):
+    absorption = np.linspace(0.0, 1.0, 11)
+    stack = FP.stack_reflectance(absorption, exchange)
+    r, t = exchange.r(absorption), exchange.t(absorption)
+    np.testing.assert_allclose(stack, r + t**2 * stack / (1.0 - r * stack), rtol=1e-12)
+    # Adding film after film converges to it from below.
+    added = r.copy()
+    for _ in range(400):
+        added = r + t**2 * added / (1.0 - r * added)
+    np.testing.assert_allclose(added, stack, rtol=1e-9)
+    assert np.all(np.diff(stack) < 0)  # monotone: more absorption reflects less
+    assert stack[-1] == pytest.approx(exchange.r_gloss, rel=1e-14)  # A = 1: gloss alone
+    assert 0.8 < stack[0] < 1.0
+
+
+def test_the_solve_inverts_the_stack_and_clamps(exchange):
+    top = float(FP.stack_reflectance(0.0, exchange))
+    targets = np.array([exchange.r_gloss + 1e-3, 0.3, 0.5, 0.7, top - 1e-3])
+    absorption, clamped = FP.solve_absorption(targets, exchange)
+    assert not np.any(clamped) and np.all(np.diff(absorption) < 0)
+    np.testing.assert_allclose(FP.stack_reflectance(absorption, exchange), targets,
+                               rtol=0, atol=1e-12)
+    absorption, clamped = FP.solve_absorption([top + 0.05, 0.5 * exchange.r_gloss], exchange)
+    np.testing.assert_array_equal(absorption, [0.0, 1.0])
+    np.testing.assert_array_equal(clamped, [True, True])
+
+
+def test_the_gloss_per_finish():
+    layers = [ReflectionLayer(P_d=0.2, P_s=ps, n=n, eta=eta)
+              for ps, n, eta in ((10.0, 0.1, 1.1), (20.0, 0.2, 1.2), (30.0, 0.3, 1.3))]
+    dewy = FP.preset_gloss(layers, "dewy")
+    weights = FP.LUMINANCE_WEIGHTS
+    assert weights.sum() == pytest.approx(1.0)
+    assert dewy == pytest.approx({"P_s": weights @ [10, 20, 30], "n": weights @ [0.1, 0.2, 0.3],
+                                  "eta": weights @ [1.1, 1.2, 1.3]}, rel=1e-14)
+    film = presets.paper().film
+    assert FP.preset_gloss(layers, "matte") == {"P_s": 0.0, "n": float(film.n),
+                                                "eta": float(film.eta)}
+    with pytest.raises(ValueError, match="finish"):
+        FP.preset_gloss(layers, "satin")
+    with pytest.raises(ValueError, match="three"):
+        FP.derive_preset("x_1", "matte", layers[:2])
+
+
+def test_the_stored_presets_reproduce_their_targets(exchange):
+    """The thick-layer limit of each stored preset's film reflects its target per channel
+    (to 1e-6) unless clamped, where the target lies above the lossless stack."""
+    stored = FP.read_presets()
+    assert tuple(stored) == PRODUCTS
+    for name, entry in stored.items():
+        absorption = np.array(entry["absorption"])
+        stack = FP.stack_reflectance(absorption, exchange)
+        target = np.array(entry["target"])
+        clamped = np.array(entry["clamped"])
+        np.testing.assert_allclose(stack, entry["stack"], rtol=1e-12)
+        np.testing.assert_allclose(stack[~clamped], target[~clamped], rtol=0, atol=1e-6)
+        assert np.all(target[clamped] > FP.stack_reflectance(0.0, exchange))
+        assert np.all(absorption[clamped] == 0.0)
+        assert np.all((absorption >= 0) & (absorption <= 1))
+        assert presets.FOUNDATIONS[name]["absorption"] == tuple(absorption)
+    # Only 105's red exceeds what the paper's film can reflect stacked.
+    assert [n for n, e in stored.items() if any(e["clamped"])] == ["clarins_105"]
+
+
+@pytest.mark.slow  # four products fitted per channel (~15 s)
+def test_the_stored_presets_are_rederived_from_the_measurements():
+    pytest.importorskip("scipy")
+    pytest.importorskip("colour")
+    from lut_baker.offline.foundations import PRODUCTS as FILES
+    from lut_baker.offline.measured.inplane import read_inplane
+    from lut_baker.offline.measured.inplane_fit import fit_channels
+
+    fits = {}
+    for name, (filename, finish) in FILES.items():
+        data = read_inplane(DATA / filename)
+        fits[name] = (finish, fit_channels(data.theta_i_deg, data.theta_o_deg, data.rgb).layers)
+    derived = FP.derive_presets(fits)
+    stored = FP.read_presets()
+    assert derived.keys() == stored.keys()
+    for name, entry in derived.items():
+        assert entry["label"] == stored[name]["label"] and entry["clamped"] == stored[name][
+            "clamped"]
+        for key in ("absorption", "target", "stack"):
+            np.testing.assert_allclose(entry[key], stored[name][key], rtol=1e-6, atol=1e-9)
+        for key, value in entry["film"].items():
+            assert value == pytest.approx(stored[name]["film"][key], rel=1e-6)
+        # The target is the fitted layers' reflectance under uniform light.
+        layers = fits[name][1]
+        assert entry["target"][1] == pytest.approx(float(FP.bihemispherical(
+            lambda t, layer=layers[1]: reflection_albedo(t, layer))), rel=1e-12)
+
+
+def test_write_and_read_round_trip(tmp_path):
+    entries = FP.read_presets()
+    path = FP.write_presets(entries, tmp_path / "p.json")
+    assert FP.read_presets(path) == entries
