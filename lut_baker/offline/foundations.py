@@ -375,8 +375,16 @@ NOTES: dict[str, str] = {
         "grazing view at moderate incidence (1.3–2.5× measured against 1.0× modelled) that is "
         "not the Fresnel rise eq. 2 offers (which, when fitted, over-shoots at 60–70°), and on "
         "the back-scatter side measured/model ratios of 0.73–1.35 that change with incidence. "
-        "The model is not extended here; these numbers are what an extension would have to "
-        "remove."),
+        "**Why the model is not extended.** No small change closes most of the gap. (1) and "
+        "(2) are one offset of 2–3° on both glossy products, which is as likely the instrument's "
+        "or the sample's alignment as off-specular reflection: tilting 112's normal by 1.25° "
+        "takes its green residual from 77% to 42%, and these data cannot tell the two apart. "
+        "(3) and (4) need a second, incidence-dependent diffuse term (retro-reflection and a "
+        "grazing rise), which would add a closure to both tiers and a table to the bake for "
+        "errors that, on the matte and broad dewy products, are 12–15% of a reflectance a "
+        "render shows mostly through its colour, and the presets take that colour from the "
+        "measurement (the film stacked on itself reproduces each product's reflectance), not "
+        "from the lobe's shape. The limits are written here with their numbers instead."),
 }
 """Written observations per product and the conclusion, added below the generated tables
 (they quote the tables' numbers: rewrite them if the fits change)."""
