@@ -31,6 +31,7 @@ Functions and types
 - :func:`stack_reflectance` -- ``R_inf(A)``, the film stacked on itself without end.
 - :func:`solve_absorption` -- ``A`` per channel reproducing a target ``R_inf`` (bisection).
 - :func:`preset_gloss` -- the preset's top-surface lobe from a product's fit.
+- :func:`lobe_determined`, :func:`auto_finish` -- matte or dewy from the fit itself.
 - :func:`derive_preset`, :func:`derive_presets` -- one or all products' preset entries.
 - :func:`write_presets`, :func:`read_presets` -- the JSON file.
 """
@@ -39,6 +40,7 @@ from __future__ import annotations
 
 import json
 from dataclasses import dataclass
+from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
@@ -56,6 +58,9 @@ __all__ = [
     "stack_reflectance",
     "solve_absorption",
     "preset_gloss",
+    "LOBE_STDERR_LIMIT",
+    "lobe_determined",
+    "auto_finish",
     "derive_preset",
     "derive_presets",
     "write_presets",
@@ -70,6 +75,10 @@ LUMINANCE_WEIGHTS = np.array([0.2126, 0.7152, 0.0722])
 
 QUADRATURE_NODES = 48
 """Gauss-Legendre nodes in ``cos(theta)`` of :func:`bihemispherical`."""
+
+LOBE_STDERR_LIMIT = 0.10
+"""A channel's lobe counts as determined when the standard error of its roughness ``n`` is at
+most this fraction of ``n`` (the fits' own limit, ``layer_fit.Limits.relative_stderr``)."""
 
 BISECTION_STEPS = 80
 """Bisection steps of :func:`solve_absorption` (the interval halves each time: 2^-80)."""
@@ -104,8 +113,10 @@ class FilmExchange:
         return (1.0 - np.asarray(absorption, float)) * self.t_0
 
 
+@lru_cache(maxsize=1)
 def film_exchange() -> FilmExchange:
-    """:class:`FilmExchange` of the paper's normalised film (docs/model.md §4, §5)."""
+    """:class:`FilmExchange` of the paper's normalised film (docs/model.md §4, §5); computed
+    once (about a second of quadrature) and shared."""
     base = paper()
     gloss = base.film.scaled(P_d=0.0)
     return FilmExchange(
@@ -160,8 +171,39 @@ def preset_gloss(layers, finish: str) -> dict:
             for name in ("P_s", "n", "eta")}
 
 
-def derive_preset(name: str, finish: str, layers, exchange: FilmExchange | None = None) -> dict:
-    """One product's preset entry from its per-channel fit ``layers``: ``label``,
+def lobe_determined(fit) -> tuple[bool, str]:
+    """``(determined, why)`` for one channel's eq. 2 fit (a ``layer_fit.FitResult``): its lobe
+    is determined when the roughness ``n`` was fitted, did not end at its bound and has a
+    standard error of at most :data:`LOBE_STDERR_LIMIT` of ``n`` (docs/model.md §4, "Presets
+    from measured thick layers": a matte product's fit has no lobe to take)."""
+    if "n" not in fit.free:
+        return False, "n was not fitted"
+    if any(warning.startswith("n ended at its bound") for warning in fit.warnings):
+        return False, f"n ended at its bound ({float(fit.params.n):.4g} /deg)"
+    error = float(fit.relative_stderr["n"])
+    if not error <= LOBE_STDERR_LIMIT:
+        return False, (f"n = {float(fit.params.n):.4g} /deg has a standard error of "
+                       f"{100 * error:.3g}% (limit {100 * LOBE_STDERR_LIMIT:.3g}%)")
+    return True, (f"n = {float(fit.params.n):.4g} /deg to {100 * error:.3g}% "
+                  f"(limit {100 * LOBE_STDERR_LIMIT:.3g}%)")
+
+
+def auto_finish(fits) -> tuple[str, str]:
+    """``(finish, why)`` from the per-channel fits (R, G, B ``layer_fit.FitResult``): ``"dewy"``
+    when every channel's lobe is determined (:func:`lobe_determined`), else ``"matte"``.  On the
+    four published products this gives their published finishes (103, 108 matte; 105, 112
+    dewy)."""
+    verdicts = [lobe_determined(fit) for fit in fits]
+    finish = "dewy" if all(ok for ok, _ in verdicts) else "matte"
+    why = "; ".join(f"{channel}: {text}" for channel, (_, text) in zip("RGB", verdicts,
+                                                                         strict=True))
+    return finish, why
+
+
+def derive_preset(name: str, finish: str, layers, exchange: FilmExchange | None = None, *,
+                  label: str | None = None) -> dict:
+    """One product's preset entry from its per-channel fit ``layers``: ``label`` (default
+    ``Clarins <number> (<finish>, measured)`` from the name's last ``_`` part),
     ``absorption``, ``film`` (:func:`preset_gloss`), and for the record ``target`` (the fitted
     layers' bihemispherical reflectance per channel), ``stack`` (``R_inf`` at the solved
     absorption) and ``clamped``."""
@@ -170,9 +212,10 @@ def derive_preset(name: str, finish: str, layers, exchange: FilmExchange | None 
     target = np.array([float(bihemispherical(lambda t, layer=layer: reflection_albedo(t, layer)))
                        for layer in layers])
     absorption, clamped = solve_absorption(target, exchange)
-    number = name.split("_")[-1]
+    if label is None:
+        label = f"Clarins {name.split('_')[-1]} ({finish}, measured)"
     return {
-        "label": f"Clarins {number} ({finish}, measured)",
+        "label": label,
         "finish": finish,
         "absorption": [float(a) for a in absorption],
         "film": preset_gloss(layers, finish),

@@ -4,6 +4,8 @@
     python -m lut_baker fit transmission FILE.csv [--eta ETA]
     python -m lut_baker fit dipole FILE.csv [--g 0 --eta 1.26 --d-min 0.1 --free-scale]
     python -m lut_baker fit synthesize --preset paper --out DIR [--noise 0.02 --seed 0]
+    python -m lut_baker fit inplane FILE [--name NAME] [--finish auto|matte|dewy]
+                                         [--out params.toml] [--strict]
 
 Fits print a TOML (or ``--format json``) block on stdout, or write it to ``--out FILE``: the
 fitted layer under its kind (``[reflection]``, ``[transmission]``, ``[dipole]``: pass it to the
@@ -21,6 +23,10 @@ lut_baker.offline.measured.measurements):
 Exit codes: 0 done; 2 bad input (one line naming the problem); 3 the fit warned and --strict
 was given.  ``synthesize`` writes the paper's protocols (docs/model.md §6) from its parameters
 (docs/model.md §5) as CSV files plus ``truth.toml``, to try the round trip.
+
+``inplane`` turns in-plane measurements of a foundation's thick layer into a parameter file
+that ``python -m lut_baker bake --params FILE`` bakes (docs/model.md §4, "Presets from measured
+thick layers"; :mod:`lut_baker.offline.own_foundation`); see ``fit inplane --help``.
 """
 
 from __future__ import annotations
@@ -48,7 +54,8 @@ from ..measured.measurements import (
 
 __all__ = ["HELP", "STRICT_EXIT", "configure", "run", "result_document", "to_toml"]
 
-HELP = "fit reflection/transmission/dipole layers to CSV measurements, or synthesise them"
+HELP = ("fit reflection/transmission/dipole layers to CSV measurements, synthesise them, or "
+        "make a foundation's parameter file from in-plane measurements")
 STRICT_EXIT = 3
 """Exit code of a fit that warned when ``--strict`` is given."""
 
@@ -99,12 +106,67 @@ def configure(parser) -> None:
     synth.add_argument("--noise", type=float, default=0.02,
                        help=f"relative noise per sample, 0 to {MAX_NOISE:g} (default 0.02)")
     synth.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    _configure_inplane(sub)
+
+
+INPLANE_DESCRIPTION = """\
+Make a foundation's parameter file from in-plane measurements of a thick layer of it
+(docs/fitting.md, "Your own foundation: in-plane measurements"; docs/model.md §4).
+
+The file: plain text, tab-separated, no header, one geometry per row; blank lines and lines
+starting with # are skipped. Columns:
+  theta_i   incidence, degrees from the normal, 0 <= theta_i < 90
+  theta_o   signed viewing angle, degrees, |theta_o| < 90; > 0 on the specular side
+            (theta_o = theta_i is the mirror direction), < 0 on the light's side;
+            theta_i + theta_o > 0 on every row
+  then either 81 spectral reflectance factors at 380, 385, ..., 780 nm (5 nm steps;
+  converted to linear Rec.709 with CIE 1931 2 deg and D65, needs colour-science)
+  or 3 linear RGB reflectance factors R, G, B.
+Reflectance factors are dimensionless, relative to a white standard: R = pi f_r (pi times
+the BRDF in 1/sr; an ideal white Lambertian reads 1). At least 5 rows.
+
+Eq. 2 is fitted per channel to every row; the film is derived as the measured presets are:
+the paper's film (foundation = "paper_natural") with the product's gloss ([film] P_s, n, eta)
+and per-channel absorption whose endless stack reflects what the thick layer reflects. The
+TOML file holds name, foundation, absorption, [film], and comments with the fit's parameters
+and errors, target against stack per channel, clamping and warnings. Fit warnings and clamping
+also go to stderr.
+
+Exit codes: 0 done; 2 bad input (one line naming the file and the problem); 3 --strict given
+and the fit warned or an absorption was clamped.
+"""
+
+
+def _configure_inplane(sub) -> None:
+    import argparse
+
+    command = sub.add_parser("inplane", help="a foundation's parameter file from in-plane "
+                                             "measurements (theta_i, theta_o, spectra or RGB)",
+                             description=INPLANE_DESCRIPTION,
+                             formatter_class=argparse.RawDescriptionHelpFormatter)
+    command.add_argument("file", type=Path, help="in-plane measurements (tab-separated: "
+                                                 "theta_i, theta_o in degrees, then 81 "
+                                                 "spectral or 3 RGB reflectance factors)")
+    command.add_argument("--name", default=None,
+                         help="the parameter set's name (default: the file's stem)")
+    command.add_argument("--finish", choices=("auto", "matte", "dewy"), default="auto",
+                         help="matte: no gloss (P_s = 0); dewy: one lobe, the "
+                              "luminance-weighted mean of the channels' fits; auto (default): "
+                              "dewy when every channel's fit determined its lobe (roughness n "
+                              "not at its bound, standard error at most 10%% of n), else matte")
+    command.add_argument("--out", type=Path, metavar="FILE.toml",
+                         help="write the parameter file here, not to stdout")
+    command.add_argument("--strict", action="store_true",
+                         help=f"exit {STRICT_EXIT} when the fit warns or an absorption is "
+                              f"clamped")
 
 
 def run(args) -> int:
     """Run ``fit KIND``; returns the exit code."""
     if args.fit_kind == "synthesize":
         return _synthesize(args)
+    if args.fit_kind == "inplane":
+        return _inplane(args)
     data_type, fit = _FITS[args.fit_kind]
     options = {"eta": args.eta}
     if args.fit_kind == "dipole":
@@ -124,6 +186,30 @@ def run(args) -> int:
               f"{result.samples} samples, residual rms {100 * result.residual_rms:.3g}% "
               f"(relative), Jacobian condition number {result.condition_number:.3g}")
     text = json.dumps(document, indent=2) + "\n" if form == "json" else to_toml(document, header)
+    if args.out:
+        args.out.write_text(text, encoding="utf-8")
+        print(f"wrote {args.out}")
+    else:
+        sys.stdout.write(text)
+    for warning in result.warnings:
+        print(f"warning: {warning}", file=sys.stderr)
+    return STRICT_EXIT if (args.strict and result.warnings) else 0
+
+
+def _inplane(args) -> int:
+    """``fit inplane``: the parameter file on stdout or to ``--out``; warnings on stderr."""
+    from ..own_foundation import fit_own_foundation, params_text
+
+    if args.out is not None and args.out.is_dir():
+        raise ValueError(f"--out {args.out} is a folder; give a file name such as params.toml")
+    try:
+        result = fit_own_foundation(args.file, name=args.name, finish=args.finish)
+    except ModuleNotFoundError as error:
+        raise ValueError(f"{args.file}: {error}") from None
+    command = f"python -m lut_baker fit inplane {args.file} --finish {args.finish}"
+    if args.name is not None:
+        command += f" --name {json.dumps(args.name)}"
+    text = params_text(result, command)
     if args.out:
         args.out.write_text(text, encoding="utf-8")
         print(f"wrote {args.out}")

@@ -128,3 +128,24 @@ def test_write_and_read_round_trip(tmp_path):
     entries = FP.read_presets()
     path = FP.write_presets(entries, tmp_path / "p.json")
     assert FP.read_presets(path) == entries
+
+
+def _fit(n=0.15, relative_n=0.03, warnings=(), free=("P_d", "P_s", "n", "eta")):
+    from types import SimpleNamespace
+
+    return SimpleNamespace(free=free, warnings=list(warnings),
+                           params=ReflectionLayer(P_d=0.2, P_s=50.0, n=n, eta=1.1),
+                           relative_stderr={"n": relative_n})
+
+
+def test_auto_finish_asks_for_a_determined_lobe_in_every_channel():
+    assert FP.auto_finish([_fit(), _fit(), _fit()])[0] == "dewy"
+    assert FP.lobe_determined(_fit(relative_n=FP.LOBE_STDERR_LIMIT))[0]
+    bound = _fit(n=1e-4, relative_n=0.01,
+                 warnings=["n ended at its bound (0.0001): the data do not determine it"])
+    for odd, why in ((_fit(relative_n=0.15), "standard error of 15%"),
+                     (_fit(relative_n=float("nan")), "standard error of nan%"),
+                     (bound, "n ended at its bound"),
+                     (_fit(free=("P_d", "P_s", "eta")), "n was not fitted")):
+        finish, reason = FP.auto_finish([_fit(), odd, _fit()])
+        assert finish == "matte" and why in reason.split("; ")[1]
