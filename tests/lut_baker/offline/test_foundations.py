@@ -7,11 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-pytest.importorskip("scipy")
-pytest.importorskip("colour")
-pytest.importorskip("matplotlib")
-
-from lut_baker.offline import foundations as FD  # noqa: E402
+from lut_baker.offline import foundations as FD
 
 DATA = Path(__file__).parents[3] / "data" / "lanza2024"
 HEADER = "theta_i_deg,theta_o_deg,measured_R,measured_G,measured_B,model_R,model_G,model_B"

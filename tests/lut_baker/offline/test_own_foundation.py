@@ -8,17 +8,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-pytest.importorskip("scipy")
-pytest.importorskip("colour")
-
-from lut_baker import bake  # noqa: E402
-from lut_baker.model import presets  # noqa: E402
-from lut_baker.model.params_file import load_params  # noqa: E402
-from lut_baker.offline import own_foundation as O  # noqa: E402
-from lut_baker.offline.foundation_presets import auto_finish  # noqa: E402
-from lut_baker.offline.foundations import PRODUCTS  # noqa: E402
-from lut_baker.offline.measured.inplane import read_inplane  # noqa: E402
-from lut_baker.offline.measured.inplane_fit import fit_channels  # noqa: E402
+from lut_baker import bake
+from lut_baker.model import presets
+from lut_baker.model.params_file import load_params
+from lut_baker.offline import own_foundation as O
+from lut_baker.offline.foundation_presets import auto_finish
+from lut_baker.offline.foundations import PRODUCTS
+from lut_baker.offline.measured.inplane import read_inplane
+from lut_baker.offline.measured.inplane_fit import fit_channels
 
 DATA = Path(__file__).parents[3] / "data" / "lanza2024"
 

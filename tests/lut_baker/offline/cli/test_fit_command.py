@@ -170,7 +170,6 @@ def test_cli_inplane_rgb_file_round_trips(tmp_path, capsys):
 
 @pytest.mark.slow  # a published product fitted and derived (~2-4 s)
 def test_cli_inplane_product_warns_and_strict_exits_3(tmp_path, capsys):
-    pytest.importorskip("colour")
     path = DATA / "Clarinsfoundation103N_norm_thick_layer_tab.txt"
     assert main(["fit", "inplane", str(path), "--strict"]) == STRICT_EXIT
     captured = capsys.readouterr()

@@ -20,9 +20,6 @@ def test_the_command_is_registered():
 
 @pytest.mark.slow  # four products fitted twice and drawn (~13 s)
 def test_the_command_writes_the_csvs_figures_and_report(tmp_path, capsys):
-    pytest.importorskip("scipy")
-    pytest.importorskip("colour")
-    pytest.importorskip("matplotlib")
     out = tmp_path / "foundations"
     stored = tmp_path / "presets.json"
     assert main(["foundations", "--out", str(out), "--data", str(DATA),
