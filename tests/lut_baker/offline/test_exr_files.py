@@ -6,6 +6,7 @@ import json
 import os
 
 import numpy as np
+import OpenImageIO as oiio
 import pytest
 
 from lut_baker import bake
@@ -13,8 +14,6 @@ from lut_baker.model import presets
 from lut_baker.offline import exr_files
 from lut_baker.tables import codec
 from lut_baker.tables.table_set import ANGULAR, CONSTANT, DIRECTIONAL
-
-oiio = pytest.importorskip("OpenImageIO")
 
 
 @pytest.fixture(scope="module")

@@ -98,8 +98,6 @@ def test_the_stored_presets_reproduce_their_targets(exchange):
 
 @pytest.mark.slow  # four products fitted per channel (~15 s)
 def test_the_stored_presets_are_rederived_from_the_measurements():
-    pytest.importorskip("scipy")
-    pytest.importorskip("colour")
     from lut_baker.offline.foundations import PRODUCTS as FILES
     from lut_baker.offline.measured.inplane import read_inplane
     from lut_baker.offline.measured.inplane_fit import fit_channels

@@ -7,9 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-pytest.importorskip("colour")
-
-from lut_baker.offline.measured.inplane import read_inplane, write_inplane  # noqa: E402
+from lut_baker.offline.measured.inplane import read_inplane, write_inplane
 
 DATA = Path(__file__).parents[4] / "data" / "lanza2024"
 

@@ -6,15 +6,12 @@ the published layout and fitted back."""
 import numpy as np
 import pytest
 
-pytest.importorskip("scipy")
-pytest.importorskip("colour")
-
-from lut_baker.model.layers import ReflectionLayer  # noqa: E402
-from lut_baker.model.microfacet import ts_reflection  # noqa: E402
-from lut_baker.offline.measured import inplane_fit as F  # noqa: E402
-from lut_baker.offline.measured.inplane import read_inplane, write_inplane  # noqa: E402
-from lut_baker.offline.measured.measurements import reflection_counts  # noqa: E402
-from lut_baker.offline.measured.protocols import in_plane_direction  # noqa: E402
+from lut_baker.model.layers import ReflectionLayer
+from lut_baker.model.microfacet import ts_reflection
+from lut_baker.offline.measured import inplane_fit as F
+from lut_baker.offline.measured.inplane import read_inplane, write_inplane
+from lut_baker.offline.measured.measurements import reflection_counts
+from lut_baker.offline.measured.protocols import in_plane_direction
 
 LAYERS = (ReflectionLayer(P_d=0.22, P_s=6.0, n=0.12, eta=1.45),
           ReflectionLayer(P_d=0.16, P_s=6.0, n=0.12, eta=1.45),

@@ -4,10 +4,9 @@ computed directly (CIE 1931 2-degree observer, D65, sRGB primaries)."""
 
 from pathlib import Path
 
+import colour
 import numpy as np
 import pytest
-
-colour = pytest.importorskip("colour")
 
 from lut_baker.offline.measured import spectra as S  # noqa: E402
 from lut_baker.offline.measured.inplane import read_inplane  # noqa: E402
