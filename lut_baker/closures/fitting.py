@@ -97,6 +97,7 @@ __all__ = [
     "layered_tier_reflection",
     "TIER_REPLICAS",
     "tier_errors",
+    "ERROR_NODE_LIMIT",
 ]
 
 TIERS = ("PRINCIPLED", "LAYERED")
@@ -135,11 +136,13 @@ them all)."""
 # --------------------------------------------------------------------------------------------
 # Grid, weights and error measures
 # --------------------------------------------------------------------------------------------
-def node_directions(tables: Tables):
-    """``(wi, wo)`` unit vectors ``(n_theta, n_theta, n_phi, 3)`` of the angular nodes:
-    ``wo`` at azimuth 0, ``wi`` at the node's relative azimuth (:meth:`Tables.node_azimuths`)."""
+def node_directions(tables: Tables, theta_index=None, phi_index=None):
+    """``(wi, wo)`` unit vectors ``(n_theta, n_theta, n_phi, 3)`` of the angular nodes (or of
+    the sub-grid ``theta_index``, ``phi_index``): ``wo`` at azimuth 0, ``wi`` at the node's
+    relative azimuth (:meth:`Tables.node_azimuths`)."""
     theta = np.radians(np.asarray(tables.theta_deg, float))
-    phi = np.radians(tables.node_azimuths())
+    theta = theta if theta_index is None else theta[theta_index]
+    phi = np.radians(tables.node_azimuths(theta_index, phi_index))
     n = theta.size
     ti = np.broadcast_to(theta[:, None, None], phi.shape)
     to = np.broadcast_to(theta[None, :, None], phi.shape)
@@ -176,11 +179,13 @@ def angular_weights(tables: Tables, theta_index=None, phi_index=None) -> np.ndar
                                                                        phi_index)
 
 
-def relative_rms(f_fit, f_ref, tables: Tables, weights=None) -> float:
+def relative_rms(f_fit, f_ref, tables: Tables, weights=None, cos_i=None) -> float:
     """Relative RMS of the radiance ``f cos(theta_i)`` over the angular nodes (module
-    docstring), all channels pooled.  ``f_*``: ``(n_theta, n_theta, n_phi[, 3])``."""
+    docstring), all channels pooled.  ``f_*``: ``(n_theta, n_theta, n_phi[, 3])``, or a
+    sub-grid's with its ``weights`` and polar cosines ``cos_i``."""
     weights = angular_weights(tables) if weights is None else weights
-    cos_i = np.cos(np.radians(np.asarray(tables.theta_deg, float)))[:, None, None]
+    cos_i = np.cos(np.radians(np.asarray(tables.theta_deg, float))) if cos_i is None else cos_i
+    cos_i = cos_i[:, None, None]
     f_fit, f_ref = np.asarray(f_fit, float), np.asarray(f_ref, float)
     if f_ref.ndim == 4:
         cos_i, weights = cos_i[..., None], weights[..., None]
@@ -189,12 +194,14 @@ def relative_rms(f_fit, f_ref, tables: Tables, weights=None) -> float:
     return float(np.sqrt(num / den)) if den > 0 else float(np.sqrt(num))
 
 
-def view_albedo(f, tables: Tables) -> np.ndarray:
+def view_albedo(f, tables: Tables, theta_index=None, phi_index=None) -> np.ndarray:
     """``Int f cos(theta_i) dw_i`` per view angle ``theta_o`` of the nodes: ``(n_theta[, 3])``
-    (trapezoid rule on the tables' grid)."""
-    theta = np.radians(np.asarray(tables.theta_deg, float))
+    (trapezoid rule on the tables' grid, or on the sub-grid ``theta_index``, ``phi_index``
+    that ``f`` is given on)."""
+    every_theta = np.arange(tables.theta_deg.size) if theta_index is None else theta_index
+    every_phi = np.arange(tables.phi_deg.size) if phi_index is None else phi_index
+    theta = np.radians(np.asarray(tables.theta_deg, float))[every_theta]
     w_i = np.cos(theta) * np.sin(theta) * trapezoid_weights(theta)
-    every_theta, every_phi = np.arange(theta.size), np.arange(tables.phi_deg.size)
     weights = w_i[:, None, None] * _azimuth_weights(tables, every_theta, every_phi)
     f = np.asarray(f, float)
     if f.ndim == 4:
@@ -202,9 +209,10 @@ def view_albedo(f, tables: Tables) -> np.ndarray:
     return np.sum(f * weights, axis=(0, 2))
 
 
-def albedo_error(f_fit, f_ref, tables: Tables) -> float:
+def albedo_error(f_fit, f_ref, tables: Tables, theta_index=None, phi_index=None) -> float:
     """Largest relative error of :func:`view_albedo` over view angles and channels."""
-    fit, ref = view_albedo(f_fit, tables), view_albedo(f_ref, tables)
+    fit = view_albedo(f_fit, tables, theta_index, phi_index)
+    ref = view_albedo(f_ref, tables, theta_index, phi_index)
     return float(np.max(np.abs(fit - ref) / np.maximum(np.abs(ref), 1e-12)))
 
 
@@ -253,7 +261,6 @@ class NodeGrid:
     """Node directions, weights and the cosines the GGX fits reuse (optionally subsampled)."""
 
     def __init__(self, tables: Tables, max_points: int | None = None):
-        wi, wo = node_directions(tables)
         n, p = tables.theta_deg.size, tables.phi_deg.size
         m_theta, m_phi = n, p
         while max_points is not None and m_theta * m_theta * m_phi > max_points:
@@ -264,9 +271,9 @@ class NodeGrid:
         # Evenly spread node indices, both ends kept (normal and grazing, azimuth 0 and 180).
         it = np.unique(np.round(np.linspace(0, n - 1, m_theta)).astype(int))
         ip = np.unique(np.round(np.linspace(0, p - 1, m_phi)).astype(int))
-        pick = np.ix_(it, it, ip)
-        self.pick = pick
-        self.wi, self.wo = wi[pick], wo[pick]
+        self.pick = np.ix_(it, it, ip)
+        self.theta_index, self.phi_index = it, ip
+        self.wi, self.wo = node_directions(tables, it, ip)
         self.weights = angular_weights(tables, it, ip)
         self.cos_i = self.wi[..., 2]
         self.cos_o = self.wo[..., 2]
@@ -844,17 +851,35 @@ TIER_REPLICAS = {"PRINCIPLED": principled_tier_reflection, "LAYERED": layered_ti
 """Each tier's replica, ``(fit, tables, coverage, absorption, gloss=1, directions=None)``."""
 
 
+ERROR_NODE_LIMIT = 4_000_000
+"""Angular nodes beyond which :func:`tier_errors` measures on an evenly spread sub-grid of
+about this many nodes (both ends kept, as the fits' :class:`NodeGrid`).  Narrow lobes scale the
+default grids up to 64 times (:data:`lut_baker.bake.REFERENCE_LOBE_DEG`): a 3-degree gloss
+makes 38 million nodes, whose every-node errors took 60 s and 10 GB."""
+
+
 def tier_errors(fit: ClosureFit, tables: Tables, coverage: float, absorption,
                 gloss: float = 1.0) -> dict:
     """:class:`TierError` of every tier against the tables at one coverage and absorption
-    (``gloss``: the group's Gloss input; at 0 the error includes all of the gloss left out)."""
-    reference = tables.node_values(coverage, absorption)
-    weights = angular_weights(tables)
+    (``gloss``: the group's Gloss input; at 0 the error includes all of the gloss left out),
+    over every angular node up to :data:`ERROR_NODE_LIMIT` of them, else over a sub-grid."""
+    n, p = tables.theta_deg.size, tables.phi_deg.size
+    if n * n * p <= ERROR_NODE_LIMIT:
+        it = ip = directions = None
+        reference = tables.node_values(coverage, absorption)
+        weights = angular_weights(tables)
+    else:
+        grid = NodeGrid(tables, ERROR_NODE_LIMIT)
+        it, ip, directions = grid.theta_index, grid.phi_index, (grid.wi, grid.wo)
+        reference = tables.node_values(coverage, absorption, it, ip)
+        weights = grid.weights
+    cos_i = np.cos(np.radians(np.asarray(tables.theta_deg, float)))
+    cos_i = cos_i if it is None else cos_i[it]
     out = {}
     for tier, replica in TIER_REPLICAS.items():
-        f = replica(fit, tables, coverage, absorption, gloss)
+        f = replica(fit, tables, coverage, absorption, gloss, directions)
         out[tier] = TierError(tier=tier, coverage=float(coverage),
                               absorption=tuple(_absorption(absorption).tolist()),
-                              rms=relative_rms(f, reference, tables, weights),
-                              albedo=albedo_error(f, reference, tables))
+                              rms=relative_rms(f, reference, tables, weights, cos_i),
+                              albedo=albedo_error(f, reference, tables, it, ip))
     return out

@@ -340,10 +340,13 @@ class Tables:
         return radius_index(d_mm, self.radius_mm.size, self.radius_spacing,
                             float(self.radius_mm[-1]))
 
-    def node_azimuths(self) -> np.ndarray:
-        """Relative azimuth (degrees) of every angular node, ``(n_theta, n_theta, n_phi)``."""
+    def node_azimuths(self, theta_index=None, phi_index=None) -> np.ndarray:
+        """Relative azimuth (degrees) of every angular node, ``(n_theta, n_theta, n_phi)``, or
+        of the sub-grid of polar nodes ``theta_index`` and azimuth nodes ``phi_index``."""
+        theta = self.theta_deg if theta_index is None else self.theta_deg[theta_index]
+        phi = self.phi_deg if phi_index is None else self.phi_deg[phi_index]
         return np.degrees(np.arccos(node_cos_azimuths(
-            self.theta_deg[:, None], self.theta_deg[None, :], self.phi_deg, self.phi_spacing)))
+            theta[:, None], theta[None, :], phi, self.phi_spacing)))
 
     def angular(self, name: str, wi, wo) -> np.ndarray:
         """Angular table ``name`` interpolated trilinearly at unit directions ``(..., 3)``;
@@ -401,11 +404,18 @@ class Tables:
         upper = (wi[..., 2] >= 0.0) & (wo[..., 2] >= 0.0)
         return np.where(upper[..., None], value, 0.0)
 
-    def node_values(self, coverage=None, absorption=None) -> np.ndarray:
+    def node_values(self, coverage=None, absorption=None, theta_index=None,
+                    phi_index=None) -> np.ndarray:
         """:meth:`made_up_reflection` at the angular nodes, ``(n_theta, n_theta, n_phi, 3)``
-        (no interpolation: the directions of :meth:`node_azimuths`)."""
-        parts = {name: np.asarray(getattr(self, name)) for name in self._angular_names()}
-        t = np.asarray(self.film_transmittance)
+        (no interpolation: the directions of :meth:`node_azimuths`), or on the sub-grid
+        ``theta_index``, ``phi_index`` (integer arrays)."""
+        it = np.arange(self.theta_deg.size) if theta_index is None else theta_index
+        ip = np.arange(self.phi_deg.size) if phi_index is None else phi_index
+        whole = theta_index is None and phi_index is None
+        parts = {name: np.asarray(getattr(self, name)) if whole
+                 else np.asarray(getattr(self, name))[np.ix_(it, it, ip)]
+                 for name in self._angular_names()}
+        t = np.asarray(self.film_transmittance)[it]
         return self._combine(parts, t[:, None, None], t[None, :, None], coverage, absorption)
 
     def directional_albedo(self, theta_deg, coverage=None, absorption=None) -> np.ndarray:

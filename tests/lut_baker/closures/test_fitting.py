@@ -235,3 +235,17 @@ def test_fit_is_linear_in_the_skin_albedo(paper_tables, paper_fit):
     np.testing.assert_allclose(burley["error"], reference_burley["error"], rtol=1e-6)
     np.testing.assert_array_equal(fit.film_albedo, paper_fit.film_albedo)
     np.testing.assert_array_equal(fit.transmittance_mean, paper_fit.transmittance_mean)
+
+
+def test_oversized_tables_are_measured_on_a_sub_grid(paper_tables, paper_fit, monkeypatch):
+    """Beyond ERROR_NODE_LIMIT nodes the tier errors come from an evenly spread sub-grid (a
+    narrow gloss scales the default grids up to 64 times); they stay close to the every-node
+    errors."""
+    every = fitting.tier_errors(paper_fit, paper_tables, 1.0, 0.0)
+    nodes = paper_tables.theta_deg.size ** 2 * paper_tables.phi_deg.size
+    monkeypatch.setattr(fitting, "ERROR_NODE_LIMIT", nodes // 8)
+    sub = fitting.tier_errors(paper_fit, paper_tables, 1.0, 0.0)
+    for tier in fitting.TIERS:
+        assert sub[tier].rms != every[tier].rms  # measured elsewhere ...
+        assert sub[tier].rms == pytest.approx(every[tier].rms, rel=0.15)  # ... much the same
+        assert sub[tier].albedo == pytest.approx(every[tier].albedo, rel=0.5, abs=0.01)
