@@ -50,7 +50,7 @@ for _path in (REPO_ROOT, REPO_ROOT / "tests"):
 
 from support import character, sphere_scene  # noqa: E402  (tests/support/)
 
-__all__ = ["main"]
+__all__ = ["main", "WorkflowError", "check", "apply_foundation", "run_reporting"]
 
 FOUNDATIONS = ("light_ivory", "medium_beige", "deep_mocha")
 COVERAGE_OFFSET = (0.0, 0.35)
@@ -65,7 +65,7 @@ class WorkflowError(RuntimeError):
     """The artist's workflow did not do what it should (the script stops with this)."""
 
 
-def _check(condition: bool, message: str) -> None:
+def check(condition: bool, message: str) -> None:
     if not condition:
         raise WorkflowError(message)
 
@@ -73,7 +73,7 @@ def _check(condition: bool, message: str) -> None:
 def _render(out: Path, name: str, what: str, scene, keep_exr: bool = False) -> Path:
     path = out / f"{name}.png"
     seconds = sphere_scene.render(path)
-    _check(path.is_file(), f"the render of {name} wrote no {path}")
+    check(path.is_file(), f"the render of {name} wrote no {path}")
     if not keep_exr:
         path.with_suffix(".exr").unlink(missing_ok=True)
     print(f"render_character: {name + '.png':<26} {scene.render.resolution_x}x"
@@ -87,7 +87,7 @@ def _source(socket):
     return socket.links[0].from_socket if socket.is_linked else None
 
 
-def _apply(obj, foundation: str, args):
+def apply_foundation(obj, foundation: str, args):
     """Set the panel's settings and press Apply; check the textures are still linked."""
     import bpy
 
@@ -103,21 +103,21 @@ def _apply(obj, foundation: str, args):
     start = time.perf_counter()
     result = bpy.ops.makeup_skin.apply()
     seconds = time.perf_counter() - start
-    _check(result == {"FINISHED"}, f"Apply with {foundation} returned {result}")
-    _check(obj.active_material == material,
+    check(result == {"FINISHED"}, f"Apply with {foundation} returned {result}")
+    check(obj.active_material == material,
            f"Apply replaced the material {material.name!r} instead of converting it in place")
     node = material.node_tree.nodes.get(GROUP_NODE)
-    _check(node is not None and node.type == "GROUP",
+    check(node is not None and node.type == "GROUP",
            f"after Apply, {material.name!r} has no {GROUP_NODE!r} group node")
     output = material.node_tree.get_output_node("ALL")
-    _check(output.inputs["Surface"].is_linked
+    check(output.inputs["Surface"].is_linked
            and output.inputs["Surface"].links[0].from_node == node,
            "after Apply, the group is not the material's surface")
     albedo = material.node_tree.nodes["Albedo"].outputs["Color"]
     normal_map = material.node_tree.nodes["Normal Map"]
-    _check(_source(node.inputs["Skin Color"]) == albedo,
+    check(_source(node.inputs["Skin Color"]) == albedo,
            f"after Apply with {foundation}, the albedo texture is not linked to Skin Color")
-    _check(_source(node.inputs["Normal"]) == normal_map.outputs["Normal"],
+    check(_source(node.inputs["Normal"]) == normal_map.outputs["Normal"],
            f"after Apply with {foundation}, the pore normal map is not linked to Normal")
     print(f"render_character: Apply {foundation:<13} ({args.resolution} tables, Layered): "
           f"{seconds:6.2f} s", flush=True)
@@ -130,7 +130,7 @@ def _strip(paths, out_path: Path, gap: int = GAP_PX) -> None:
 
     panels = [sphere_scene.image_pixels(p) for p in paths]
     height = panels[0].shape[0]
-    _check(all(p.shape[0] == height for p in panels), "strip panels differ in height")
+    check(all(p.shape[0] == height for p in panels), "strip panels differ in height")
     width = sum(p.shape[1] for p in panels) + gap * (len(panels) - 1)
     strip = np.ones((height, width, 4), np.float32)
     x = 0
@@ -145,7 +145,7 @@ def _strip(paths, out_path: Path, gap: int = GAP_PX) -> None:
         image.save()
     finally:
         bpy.data.images.remove(image)
-    _check(out_path.is_file(), f"the strip {out_path} was not written")
+    check(out_path.is_file(), f"the strip {out_path} was not written")
     print(f"render_character: {out_path.name:<26} {len(paths)} panels, {width}x{height} px",
           flush=True)
 
@@ -165,7 +165,7 @@ def _surface_point(scene, obj, x: float, z: float):
         return (location, normal) if hit and hit_obj.name == obj.name else (None, None)
 
     point, _ = cast(x, z)
-    _check(point is not None, f"no surface of {obj.name!r} at x={x}, z={z} for the close-up")
+    check(point is not None, f"no surface of {obj.name!r} at x={x}, z={z} for the close-up")
     normals = [n for dx in (-0.004, 0.0, 0.004) for dz in (-0.004, 0.0, 0.004)
                for _, n in [cast(x + dx, z + dz)] if n is not None]
     return point, sum(normals, Vector()).normalized()
@@ -229,7 +229,7 @@ def _paint_coverage(material, node, seed: int) -> None:
     tree.links.new(uv.outputs["UV"], mapping.inputs["Vector"])
     tree.links.new(mapping.outputs["Vector"], mask.inputs["Vector"])
     tree.links.new(mask.outputs["Color"], node.inputs["Coverage"])
-    _check(_source(node.inputs["Coverage"]) == mask.outputs["Color"],
+    check(_source(node.inputs["Coverage"]) == mask.outputs["Color"],
            "the coverage mask is not linked to the group's Coverage")
 
 
@@ -241,8 +241,8 @@ def _film_normal_renders(shoot, material, node) -> list[Path]:
         tree.links.remove(link)
     node.inputs["Coverage"].default_value = 1.0
     skin_normal = _source(node.inputs["Normal"])
-    _check(skin_normal is not None, "the group's Normal lost its link before the close-up")
-    _check(not node.inputs["Film Normal"].is_linked,
+    check(skin_normal is not None, "the group's Normal lost its link before the close-up")
+    check(not node.inputs["Film Normal"].is_linked,
            "Film Normal is linked after Apply (the foundation should fill the pores)")
     pores = tree.nodes["Pores Normal"]
     soft = tree.nodes.new("ShaderNodeNormalMap")
@@ -254,12 +254,12 @@ def _film_normal_renders(shoot, material, node) -> list[Path]:
 
     paths = [shoot("film_normal_unlinked", "Film Normal unlinked: smooth film")]
     tree.links.new(soft.outputs["Normal"], node.inputs["Film Normal"])
-    _check(_source(node.inputs["Film Normal"]) == soft.outputs["Normal"],
+    check(_source(node.inputs["Film Normal"]) == soft.outputs["Normal"],
            "the soft Normal Map is not linked to Film Normal")
     paths.append(shoot("film_normal_soft",
                        f"Film Normal from a Normal Map at strength {SOFT_FILM_STRENGTH:g}"))
     tree.links.new(skin_normal, node.inputs["Film Normal"])
-    _check(_source(node.inputs["Film Normal"]) == skin_normal,
+    check(_source(node.inputs["Film Normal"]) == skin_normal,
            "the pore normal map is not linked to Film Normal")
     paths.append(shoot("film_normal_full", "Film Normal = the skin's normal map"))
     return paths
@@ -282,19 +282,19 @@ def run(args) -> None:
     strip = [shoot("before", "the artist's own material")]
     with sphere_scene.addon_registered():
         for foundation in FOUNDATIONS:
-            _apply(head, foundation, args)
+            apply_foundation(head, foundation, args)
             strip.append(shoot(foundation, f"after Apply, {foundation}"))
 
-        material, node = _apply(head, args.coverage_foundation, args)
+        material, node = apply_foundation(head, args.coverage_foundation, args)
         _paint_coverage(material, node, args.seed)
         strip.append(shoot("painted_coverage", f"{args.coverage_foundation}, painted coverage"))
 
-        material, node = _apply(head, FILM_FOUNDATION, args)
+        material, node = apply_foundation(head, FILM_FOUNDATION, args)
         _close_up(scene, head)
         film = _film_normal_renders(shoot, material, node)
 
     _strip(strip, out / "character_strip.png")
-    _check(len(film) == 3, "the Film Normal close-ups are incomplete")
+    check(len(film) == 3, "the Film Normal close-ups are incomplete")
 
 
 def main(argv=None) -> int:
@@ -316,20 +316,25 @@ def main(argv=None) -> int:
                         help="keep the float EXR written beside each PNG (default: removed)")
     parser.add_argument("--seed", type=int, default=0, help="texture and Cycles seed")
     args = parser.parse_args(argv)
-    os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="render_character_"))
+    return run_reporting("render_character", run, args)
+
+
+def run_reporting(name: str, run, args) -> int:
+    """``run(args)`` in a temporary Blender user folder; one line with the total time, or a
+    clear failure (exit 1) whatever went wrong."""
+    os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix=f"{name}_"))
     start = time.perf_counter()
     try:
         run(args)
     except WorkflowError as error:
-        print(f"render_character: FAILED: {error}", file=sys.stderr)
+        print(f"{name}: FAILED: {error}", file=sys.stderr)
         return 1
     except Exception:  # noqa: BLE001 -- any failure must end the run with a clear message
         traceback.print_exc()
-        print("render_character: FAILED (see the traceback above)", file=sys.stderr)
+        print(f"{name}: FAILED (see the traceback above)", file=sys.stderr)
         return 1
-    print(f"render_character: done in {time.perf_counter() - start:.1f} s -> {args.out}")
+    print(f"{name}: done in {time.perf_counter() - start:.1f} s -> {args.out}")
     return 0
-
 
 if __name__ == "__main__":
     sys.exit(main())

@@ -32,11 +32,9 @@ missing; an Apply that is not FINISHED or loses the texture links).
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 import tempfile
 import time
-import traceback
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -48,7 +46,7 @@ for _path in (REPO_ROOT, REPO_ROOT / "tests", REPO_ROOT / "tools"):
         sys.path.insert(0, str(_path))
 
 import render_character  # noqa: E402  (tools/render_character.py: Apply and its checks)
-from render_character import WorkflowError, _apply, _check  # noqa: E402
+from render_character import apply_foundation, check, run_reporting  # noqa: E402
 from support import character, sphere_scene  # noqa: E402  (tests/support/)
 
 __all__ = ["main", "PRODUCTS"]
@@ -62,17 +60,17 @@ def _tile(path: Path, name: str, what: str, seconds: float, scene) -> np.ndarray
     """Read the render ``path`` (PNG, float EXR beside it), check it, drop the files, and
     print one line; returns the PNG's pixels (rows bottom-up)."""
     exr = path.with_suffix(".exr")
-    _check(path.is_file() and exr.is_file(), f"the render of {name} wrote no {path}")
+    check(path.is_file() and exr.is_file(), f"the render of {name} wrote no {path}")
     linear = sphere_scene.image_pixels(exr)[..., :3]
     pixels = sphere_scene.image_pixels(path)
     path.unlink()
     exr.unlink()
-    _check(bool(np.isfinite(linear).all()),
+    check(bool(np.isfinite(linear).all()),
            f"{name}: {int((~np.isfinite(linear)).sum())} non-finite values in the render")
     h, w = pixels.shape[:2]
     centre = pixels[int(0.35 * h):int(0.65 * h), int(0.35 * w):int(0.65 * w), :3]
     mean = centre.reshape(-1, 3).mean(axis=0)  # the middle of the sphere or the face
-    _check(float(mean.max()) > 0.02,
+    check(float(mean.max()) > 0.02,
            f"{name}: the render is black (mean sRGB {tuple(round(float(v), 4) for v in mean)})")
     srgb = "(" + ", ".join(f"{round(255 * float(v)):3d}" for v in mean) + ")"
     print(f"render_foundations: {name:<36} {scene.render.resolution_x}x"
@@ -105,7 +103,7 @@ def _grid(rows, out_path: Path, gap: int = GAP_PX) -> None:
         for c, panel in enumerate(row):
             if panel is None:
                 continue
-            _check(panel.shape[:2] == (th, tw), "grid tiles differ in size")
+            check(panel.shape[:2] == (th, tw), "grid tiles differ in size")
             x = c * (tw + gap)
             grid[y:y + th, x:x + tw, :3] = panel[..., :3]
     image = bpy.data.images.new(out_path.stem, width, height, alpha=True, float_buffer=False)
@@ -116,7 +114,7 @@ def _grid(rows, out_path: Path, gap: int = GAP_PX) -> None:
         image.save()
     finally:
         bpy.data.images.remove(image)
-    _check(out_path.is_file(), f"the grid {out_path} was not written")
+    check(out_path.is_file(), f"the grid {out_path} was not written")
     print(f"render_foundations: {out_path.name:<36} {len(rows)} rows x {columns} columns, "
           f"{width}x{height} px", flush=True)
 
@@ -167,7 +165,8 @@ def characters(args, skins, tmp: Path) -> list[list[np.ndarray | None]]:
         for r, skin in enumerate(skins):
             row = [before if r == 0 else None]
             for product in PRODUCTS:
-                _apply(head, product, SimpleNamespace(skin=skin, resolution=args.resolution))
+                settings = SimpleNamespace(skin=skin, resolution=args.resolution)
+                apply_foundation(head, product, settings)
                 row.append(_shoot(tmp, f"head {product} on {skin}", "after Apply, Layered"))
             rows.append(row)
     return rows
@@ -177,7 +176,7 @@ def run(args) -> None:
     from lut_baker.model import presets
 
     missing = [p for p in PRODUCTS if p not in presets.FOUNDATIONS]
-    _check(not missing, f"no foundation preset {missing} in lut_baker.model.presets")
+    check(not missing, f"no foundation preset {missing} in lut_baker.model.presets")
     skins = tuple(presets.SKINS)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -208,20 +207,7 @@ def main(argv=None) -> int:
     parser.add_argument("--skip-character", action="store_true", help="no character.png")
     parser.add_argument("--seed", type=int, default=0, help="texture and Cycles seed")
     args = parser.parse_args(argv)
-    os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="render_foundations_"))
-    start = time.perf_counter()
-    try:
-        run(args)
-    except WorkflowError as error:
-        print(f"render_foundations: FAILED: {error}", file=sys.stderr)
-        return 1
-    except Exception:  # noqa: BLE001 -- any failure must end the run with a clear message
-        traceback.print_exc()
-        print("render_foundations: FAILED (see the traceback above)", file=sys.stderr)
-        return 1
-    print(f"render_foundations: done in {time.perf_counter() - start:.1f} s -> {args.out}")
-    return 0
-
+    return run_reporting("render_foundations", run, args)
 
 if __name__ == "__main__":
     sys.exit(main())

@@ -39,6 +39,7 @@ __all__ = [
     "PAPER_SKIN_DIPOLE",
     "FOUNDATIONS",
     "MEASURED_FOUNDATIONS_FILE",
+    "read_measured_foundations",
     "SKINS",
     "paper",
     "paper_layers",
@@ -76,7 +77,7 @@ MEASURED_FOUNDATIONS_FILE = Path(__file__).with_name("measured_foundations.json"
 thick layers"), written by ``python -m lut_baker foundations``."""
 
 
-def _measured_foundations(path: Path) -> dict[str, dict]:
+def read_measured_foundations(path: Path) -> dict[str, dict]:
     """The entries of the measured presets' file: label, absorption and the film's gloss
     ``{"P_s", "n", "eta"}`` (1/sr, 1/degree, -) per product."""
     if not path.is_file():
@@ -90,7 +91,7 @@ def _measured_foundations(path: Path) -> dict[str, dict]:
 
 # An entry's optional "film" replaces the paper film's top-surface lobe (P_s, n, eta of eq. 2);
 # P_d and the transmission (eq. 4) stay the paper film's.
-FOUNDATIONS.update(_measured_foundations(MEASURED_FOUNDATIONS_FILE))
+FOUNDATIONS.update(read_measured_foundations(MEASURED_FOUNDATIONS_FILE))
 
 
 @lru_cache(maxsize=1)

@@ -186,14 +186,19 @@ def run(args) -> int:
               f"{result.samples} samples, residual rms {100 * result.residual_rms:.3g}% "
               f"(relative), Jacobian condition number {result.condition_number:.3g}")
     text = json.dumps(document, indent=2) + "\n" if form == "json" else to_toml(document, header)
-    if args.out:
-        args.out.write_text(text, encoding="utf-8")
-        print(f"wrote {args.out}")
+    return _emit(text, args.out, result.warnings, args.strict)
+
+
+def _emit(text: str, out, warnings, strict: bool) -> int:
+    """Write ``text`` to ``out`` (or stdout), the warnings to stderr; the exit code."""
+    if out:
+        out.write_text(text, encoding="utf-8")
+        print(f"wrote {out}")
     else:
         sys.stdout.write(text)
-    for warning in result.warnings:
+    for warning in warnings:
         print(f"warning: {warning}", file=sys.stderr)
-    return STRICT_EXIT if (args.strict and result.warnings) else 0
+    return STRICT_EXIT if (strict and warnings) else 0
 
 
 def _inplane(args) -> int:
@@ -209,15 +214,7 @@ def _inplane(args) -> int:
     command = f"python -m lut_baker fit inplane {args.file} --finish {args.finish}"
     if args.name is not None:
         command += f" --name {json.dumps(args.name)}"
-    text = params_text(result, command)
-    if args.out:
-        args.out.write_text(text, encoding="utf-8")
-        print(f"wrote {args.out}")
-    else:
-        sys.stdout.write(text)
-    for warning in result.warnings:
-        print(f"warning: {warning}", file=sys.stderr)
-    return STRICT_EXIT if (args.strict and result.warnings) else 0
+    return _emit(params_text(result, command), args.out, result.warnings, args.strict)
 
 
 def _check_options(options: dict) -> None:

@@ -134,7 +134,7 @@ def test_measured_foundations_come_from_the_shipped_file():
         for light in ("clarins_103", "clarins_105"):
             assert np.all(np.greater(presets.FOUNDATIONS[dark]["absorption"],
                                      presets.FOUNDATIONS[light]["absorption"]))
-    assert presets._measured_foundations(Path("no such file.json")) == {}
+    assert presets.read_measured_foundations(Path("no such file.json")) == {}
 
 
 @pytest.mark.parametrize("name", sorted(MEASURED))
