@@ -48,6 +48,7 @@ import numpy as np
 from ..model.albedo import reflection_albedo, transmission_albedo
 from ..model.layers import ReflectionLayer
 from ..model.presets import MEASURED_FOUNDATIONS_FILE, paper
+from ..numerics.quadrature import gauss_legendre
 
 __all__ = [
     "PRESET_FILE",
@@ -87,8 +88,7 @@ BISECTION_STEPS = 80
 def bihemispherical(directional, nodes: int = QUADRATURE_NODES) -> np.ndarray:
     """``2 Int_0^1 a(mu) mu dmu``: the directional albedo ``directional(theta_deg)`` (array in,
     ``(N,)`` or ``(N, C)`` out) averaged over uniform (cosine-weighted) incident light."""
-    x, w = np.polynomial.legendre.leggauss(nodes)
-    mu, w = 0.5 * (x + 1.0), 0.5 * w
+    mu, w = gauss_legendre(nodes, 0.0, 1.0)
     values = np.asarray(directional(np.degrees(np.arccos(mu))), dtype=float)
     weight = (2.0 * w * mu).reshape((-1,) + (1,) * (values.ndim - 1))
     return np.sum(weight * values, axis=0)
