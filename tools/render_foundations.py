@@ -46,7 +46,7 @@ for _path in (REPO_ROOT, REPO_ROOT / "tests", REPO_ROOT / "tools"):
         sys.path.insert(0, str(_path))
 
 import render_character  # noqa: E402  (tools/render_character.py: Apply and its checks)
-from render_character import apply_foundation, check, run_reporting  # noqa: E402
+from render_character import apply_foundation, check, run_reporting, save_png  # noqa: E402
 from support import character, sphere_scene  # noqa: E402  (tests/support/)
 
 __all__ = ["main", "PRODUCTS"]
@@ -90,7 +90,6 @@ def _shoot(tmp: Path, name: str, what: str) -> np.ndarray:
 def _grid(rows, out_path: Path, gap: int = GAP_PX) -> None:
     """Tiles ``rows`` (lists of equal-sized pixel arrays, top row first; None: a white cell)
     as a grid with ``gap`` white pixels between cells, written as a PNG through a bpy image."""
-    import bpy
 
     tile = next(t for row in rows for t in row if t is not None)
     th, tw = tile.shape[:2]
@@ -106,15 +105,7 @@ def _grid(rows, out_path: Path, gap: int = GAP_PX) -> None:
             check(panel.shape[:2] == (th, tw), "grid tiles differ in size")
             x = c * (tw + gap)
             grid[y:y + th, x:x + tw, :3] = panel[..., :3]
-    image = bpy.data.images.new(out_path.stem, width, height, alpha=True, float_buffer=False)
-    try:
-        image.pixels.foreach_set(grid.ravel())
-        image.filepath_raw = str(out_path)
-        image.file_format = "PNG"
-        image.save()
-    finally:
-        bpy.data.images.remove(image)
-    check(out_path.is_file(), f"the grid {out_path} was not written")
+    save_png(grid, out_path)
     print(f"render_foundations: {out_path.name:<36} {len(rows)} rows x {columns} columns, "
           f"{width}x{height} px", flush=True)
 
