@@ -106,7 +106,7 @@ DEFAULT_LUT_SIZE = 64
 ROUGHNESS_RANGE = (0.02, 1.0)
 """Roughness (Blender's socket, alpha = roughness^2) searched by the fits: from a lobe about
 0.03 degrees wide to the broadest; searched in ``log(roughness)``."""
-ROUGHNESS_SCAN = 11
+ROUGHNESS_SCAN = 9
 """Evenly spaced ``log(roughness)`` samples that bracket the minimum before Brent's search."""
 SECOND_SCAN = 5
 """Samples that bracket the second parameter (Coat IOR, Specular IOR Level)."""
@@ -346,17 +346,15 @@ def fit_glossy(grid: ViewGrid, target, albedo_table: np.ndarray, theta_deg: np.n
             value = value + rows(diffuse) / np.pi
         return lut, diffuse, value
 
-    fits = {}
-    for distribution in cc.GLOSSY_DISTRIBUTIONS:
-        roughness, _ = _minimise_roughness(lambda r, d=distribution: grid.error(
-            weights(r, d, False)[2], target))
-        lut, diffuse, value = weights(roughness, distribution, True)
-        fits[distribution] = LobeFit(roughness=roughness, error=grid.error(value, target),
-                                     lut=lut, distribution=distribution, diffuse_lut=diffuse)
-    best = min(fits.values(), key=lambda fit: fit.error)
-    if best.error < (1.0 - DISTRIBUTION_MARGIN) * fits["GGX"].error:
-        return best
-    return fits["GGX"]
+    searched = {distribution: _minimise_roughness(lambda r, d=distribution: grid.error(
+        weights(r, d, False)[2], target)) for distribution in cc.GLOSSY_DISTRIBUTIONS}
+    distribution = min(searched, key=lambda d: searched[d][1])
+    if searched[distribution][1] >= (1.0 - DISTRIBUTION_MARGIN) * searched["GGX"][1]:
+        distribution = "GGX"
+    roughness = searched[distribution][0]
+    lut, diffuse, value = weights(roughness, distribution, True)
+    return LobeFit(roughness=roughness, error=grid.error(value, target), lut=lut,
+                   distribution=distribution, diffuse_lut=diffuse)
 
 
 # --------------------------------------------------------------------------------------------

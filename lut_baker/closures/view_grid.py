@@ -31,10 +31,13 @@ from . import cycles as cc
 
 __all__ = ["ViewGrid", "view_grid", "FIT_VIEWS", "ERROR_VIEWS"]
 
-FIT_VIEWS = 16
+FIT_VIEWS = 12
 """Views of the grids the closures are fitted on."""
 ERROR_VIEWS = 32
 """Views of the grids the tiers' errors are measured on."""
+LIGHT_POINTS = (5, 12)
+"""Half-vector polar nodes per panel and azimuths per view
+(:func:`lut_baker.numerics.quadrature.mirror_quadrature`)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -94,11 +97,14 @@ class ViewGrid:
 
 
 @lru_cache(maxsize=16)
-def view_grid(width_deg: float, views: int = FIT_VIEWS) -> ViewGrid:
+def view_grid(width_deg: float, views: int = FIT_VIEWS,
+              light_points: tuple[int, int] = LIGHT_POINTS) -> ViewGrid:
     """The :class:`ViewGrid` of ``views`` views that resolves lobes down to ``width_deg``
-    (degrees, 1/e half-width in the half vector's polar angle); arrays read-only (cached)."""
+    (degrees, 1/e half-width in the half vector's polar angle) with ``light_points`` (polar
+    nodes per panel, azimuths) per view; arrays read-only (cached)."""
     cos_view = (np.arange(views) + 0.5) / views
-    quad = mirror_quadrature(np.arccos(cos_view), float(width_deg))
+    quad = mirror_quadrature(np.arccos(cos_view), float(width_deg),
+                             alpha_points=light_points[0], phi_points=light_points[1])
     cos_o = cos_view[:, None, None]
     grid = ViewGrid(
         cos_view=cos_view,
