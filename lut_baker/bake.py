@@ -315,10 +315,10 @@ class _NodePairs:
         return [rgb_view(table) for table in out]
 
 
-GLOSS_ALBEDO_POINTS = (8, 32)
+GLOSS_ALBEDO_POINTS = (12, 48)
 """Half-vector polar nodes per panel and azimuths of :func:`gloss_albedos`
-(:func:`lut_baker.numerics.quadrature.mirror_quadrature`): within 0.05% of the converged
-albedo up to 80 degrees and 0.5% at 89, for lobes 1 to 30 degrees wide."""
+(:func:`lut_baker.numerics.quadrature.mirror_quadrature`): within 0.015% of the converged
+albedo up to 85 degrees and 0.4% at 89, for lobes 1 to 30 degrees wide."""
 
 
 def gloss_albedos(layers, theta_deg) -> list[np.ndarray]:

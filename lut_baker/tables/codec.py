@@ -11,8 +11,8 @@ as Blender's pixel rows are; pixel ``(x, y)`` has its centre at texture coordina
   also held ``film_gloss`` before and ``skin_gloss`` after ``path3_gloss``, which reading skips:
   the surface gloss is a closed form of the parameters): ``n_theta`` rows; pixel
   ``(j n_phi + k, row + i)`` holds ``table[theta_i = i, theta_o = j, phi = k]``.  Within a
-  block a bilinear fetch interpolates ``theta_i`` and the azimuth coordinate; ``theta_o`` takes two fetches (columns ``j`` and
-  ``j + 1``) mixed by its fraction;
+  block a bilinear fetch interpolates ``theta_i`` and the azimuth coordinate; ``theta_o``
+  takes two fetches (columns ``j`` and ``j + 1``) mixed by its fraction;
 - one row per directional table (``DIRECTIONAL`` order): pixel ``(i, row)`` = ``table[i]``;
 - one row for ``profile``: pixel ``(r, row)``;
 - one row of constants (``CONSTANT`` order): pixel ``(c, row)``.
