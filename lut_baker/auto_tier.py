@@ -301,6 +301,45 @@ class MaterialTraits:
         """:func:`profile_mean_radius_mm` with the Subsurface Scale applied."""
         return self.subsurface_scale * profile_mean_radius_mm(self.radius_mm, self.profile)
 
+    def as_dict(self) -> dict:
+        """Plain data (floats, lists, string keys), for a file; :meth:`from_dict` reads it."""
+        def by_angle(table):
+            return {repr(float(angle)): float(value) for angle, value in table.items()}
+
+        return {
+            "tier_errors": {tier: float(e) for tier, e in self.tier_errors.items()},
+            "radius_mm": np.asarray(self.radius_mm, float).tolist(),
+            "profile": np.asarray(self.profile, float).tolist(),
+            "profile_mismatch": float(self.profile_mismatch),
+            "skin_share": by_angle(self.skin_share),
+            "gloss_share": by_angle(self.gloss_share),
+            "subsurface_scale": float(self.subsurface_scale),
+            "gloss_omission": None if self.gloss_omission is None else {
+                tier: by_angle(table) for tier, table in self.gloss_omission.items()},
+            "gloss_scale": float(self.gloss_scale),
+        }
+
+    @classmethod
+    def from_dict(cls, data: dict) -> MaterialTraits:
+        """The traits :meth:`as_dict` wrote (``KeyError``, ``TypeError`` or ``ValueError``
+        when an entry is missing or malformed)."""
+        def by_angle(table):
+            return {float(angle): float(value) for angle, value in table.items()}
+
+        omission = data["gloss_omission"]
+        return cls(
+            tier_errors={str(tier): float(e) for tier, e in data["tier_errors"].items()},
+            radius_mm=np.asarray(data["radius_mm"], float),
+            profile=np.asarray(data["profile"], float),
+            profile_mismatch=float(data["profile_mismatch"]),
+            skin_share=by_angle(data["skin_share"]),
+            gloss_share=by_angle(data["gloss_share"]),
+            subsurface_scale=float(data["subsurface_scale"]),
+            gloss_omission=None if omission is None else {
+                str(tier): by_angle(table) for tier, table in omission.items()},
+            gloss_scale=float(data["gloss_scale"]),
+        )
+
 
 def _at_angle(table: dict, light_deg: float) -> float:
     """A per-light-angle table at ``light_deg`` (linear between its angles, held beyond)."""
@@ -391,13 +430,14 @@ shares."""
 
 
 def traits_from_tables(tables, fit, coverage=None, absorption=None, *,
-                       lights_deg=SHARE_LIGHTS_DEG, method: str | None = None
-                       ) -> MaterialTraits:
+                       lights_deg=SHARE_LIGHTS_DEG, method: str | None = None,
+                       errors: dict | None = None) -> MaterialTraits:
     """:class:`MaterialTraits` of baked ``tables`` and their
     :class:`lut_baker.closures.fitting.ClosureFit` ``fit`` at a coverage and absorption (default:
-    the tables')."""
+    the tables'); ``errors``: the fit's :func:`lut_baker.closures.fitting.tier_errors` there,
+    if already measured."""
     w, a = tables.coverage_and_absorption(coverage, absorption)
-    errors = tier_errors(fit, tables, w, a)
+    errors = tier_errors(fit, tables, w, a) if errors is None else errors
     shares = {float(angle): gloss_and_skin_shares(tables, angle, w, a) for angle in lights_deg}
     return MaterialTraits(
         tier_errors={tier: float(e.rms) for tier, e in errors.items()},

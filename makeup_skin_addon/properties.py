@@ -95,6 +95,8 @@ def _update_foundation(self, context):
         # Assigning runs _update_sockets once more: the shade reaches the material at once.
         self.absorption = entry["absorption"]
         self.foundation_colour = [1.0 - a for a in entry["absorption"]]
+    # The film's gloss, roughness and index change the tables: a debounced preview re-fit.
+    _update_tables(self, context)
 
 
 class MakeupSkinSettings(bpy.types.PropertyGroup):
