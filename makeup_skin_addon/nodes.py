@@ -231,7 +231,8 @@ def _common(build: _Builder):
 def _build_principled(build: _Builder, fit, method: str, radius_mm, ior: float):
     cf = lut_baker("closures.fitting")
     inputs, output, w, through, through2, skin, scale, gloss = _common(build)
-    coat_weight = build.math("MULTIPLY", w, gloss, label="coat weight")
+    coat_weight = build.math("MULTIPLY", build.math("MULTIPLY", w, gloss), fit.coat.level,
+                             label="coat weight")
     made_skin = build.vector("MULTIPLY", build.vector("MULTIPLY", through2, skin),
                              tuple(fit.transmittance_mean**2), label="skin through film")
     made_total = build.vector("ADD", build.vector("MULTIPLY", through, tuple(fit.film_albedo)),

@@ -7,9 +7,10 @@ tables of :mod:`lut_baker.tables.table_set`, with weights that may depend on the
 
 Tiers
 -----
-``PRINCIPLED``: one Principled BSDF.  Coat = the film's gloss (Coat Weight = coverage, Coat
-Roughness and Coat IOR fitted); specular = the skin's gloss, bare or through the film
-(Roughness and Specular IOR Level fitted per case, mixed by coverage); base colour = the
+``PRINCIPLED``: one Principled BSDF.  Coat = the film's gloss (Coat Weight = coverage; none
+for a film without gloss, or one no coat follows; Coat Roughness and Coat IOR fitted);
+specular = the skin's gloss, bare or through the film (Roughness and Specular IOR Level
+fitted per case, mixed by coverage); base colour = the
 diffuse albedo (film diffuse + skin seen through the film, or bare skin), divided by the mean
 attenuation of the layers above it; Subsurface Weight = the skin's share of it.
 ``LAYERED``: closures added with view-dependent weights: film gloss, path-3 gloss and skin gloss
@@ -227,7 +228,12 @@ def _fit_roughness_and(grid: ViewGrid, target, lobe_times, second_range):
 def fit_coat(grid: ViewGrid, target) -> LobeFit:
     """Coat Roughness and Coat IOR of a GGX coat (weight 1, dielectric Fresnel, Cycles'
     energy compensation) fitted to ``target`` (the film's gloss on ``grid``, ``(V, A, P[, 3])``,
-    channels averaged)."""
+    channels averaged).  ``level`` is the coat's weight per unit coverage: 1, or 0 when the
+    film has no gloss (a matte product) or no coat does much better than none
+    (:data:`NO_LOBE_ERROR`)."""
+    if not np.any(np.asarray(target, float)):
+        return LobeFit(roughness=ROUGHNESS_RANGE[1], ior=COAT_IOR_RANGE[0], level=0.0,
+                       error=0.0)
     def lobe_times(roughness):
         albedo = cc.microfacet_albedo(grid.cos_view, roughness, **SEARCH_QUADRATURE)
         average = cc.ggx_average_albedo(roughness)
@@ -238,7 +244,9 @@ def fit_coat(grid: ViewGrid, target) -> LobeFit:
         return factor
 
     roughness, ior, error = _fit_roughness_and(grid, target, lobe_times, COAT_IOR_RANGE)
-    return LobeFit(roughness=roughness, ior=ior, error=error)
+    if error >= NO_LOBE_ERROR:
+        return LobeFit(roughness=roughness, ior=ior, level=0.0, error=1.0)
+    return LobeFit(roughness=roughness, ior=ior, level=1.0, error=error)
 
 
 def _specular_fresnel(cos_hi, level):
@@ -317,6 +325,10 @@ def fit_glossy(grid: ViewGrid, target, albedo_table: np.ndarray, theta_deg: np.n
     target = target if target.ndim == 4 else target[..., None]
     target = target * np.ones(3)
     grey = _grey(target)
+    if not np.any(albedo_table):  # no gloss (a matte film): weights 0, nothing to fit
+        zeros = np.zeros((size, 3))
+        return LobeFit(roughness=ROUGHNESS_RANGE[1], error=0.0, lut=zeros,
+                       diffuse_lut=zeros.copy() if companion else None)
     texels = lut_nodes(size)
     tables = {False: _texel_albedo(albedo_table, theta_deg, grid.cos_view),
               True: _texel_albedo(albedo_table, theta_deg, texels)}
@@ -510,7 +522,7 @@ class ClosureFit:
         """Plain data (floats and lists) for metadata, the panel and the docs."""
         return {
             "coat": {"roughness": self.coat.roughness, "ior": self.coat.ior,
-                     "error": self.coat.error},
+                     "level": self.coat.level, "error": self.coat.error},
             "specular_bare": {"roughness": self.specular_bare.roughness,
                               "level": self.specular_bare.level,
                               "error": self.specular_bare.error},
@@ -685,7 +697,8 @@ def diffuse_albedo(fit: ClosureFit, coverage: float, absorption) -> tuple[np.nda
 def principled_inputs(fit: ClosureFit, coverage: float, absorption, gloss: float = 1.0):
     """``(PrincipledInputs, subsurface_weight)`` of the PRINCIPLED tier (the node group's math):
 
-    - Coat Weight ``g w``, Coat Roughness/IOR fitted;
+    - Coat Weight ``g w c`` (``c`` the coat's level: 1, or 0 without a coat), Coat
+      Roughness/IOR fitted;
     - Roughness ``mix(r_bare, r_film, w)``, Specular IOR Level
       ``g [(1 - w) l_bare + w l_film mean((1 - A)^2)]``;
     - Base Color = (:func:`diffuse_albedo` + ``g w (1 - A)^2 gloss_to_diffuse``) /
@@ -707,14 +720,15 @@ def principled_inputs(fit: ClosureFit, coverage: float, absorption, gloss: float
     total, skin = diffuse_albedo(fit, w, absorption)
     total = total + g * covered * weights.twice * fit.gloss_to_diffuse
     e_spec = bare * fit.specular_albedo_mean[0] + covered * fit.specular_albedo_mean[1]
-    base = total / ((1.0 - g * covered * fit.coat_albedo_mean) * (1.0 - g * e_spec))
+    coat = g * covered * fit.coat.level
+    base = total / ((1.0 - coat * fit.coat_albedo_mean) * (1.0 - g * e_spec))
     level = g * (bare * fit.specular_bare.level + covered * fit.specular_film.level * through2)
     inputs = cc.PrincipledInputs(
         base_color=tuple(np.clip(base, 0.0, 1.0)),
         roughness=bare * fit.specular_bare.roughness + covered * fit.specular_film.roughness,
         ior=SPECULAR_IOR,
         specular_ior_level=level,
-        coat_weight=g * covered,
+        coat_weight=coat,
         coat_roughness=fit.coat.roughness,
         coat_ior=fit.coat.ior,
     )
