@@ -62,6 +62,7 @@ from .closures.fitting import TIER_REPLICAS, TIERS, edge_response, profile_grid,
 from .model.dipole import dipole_profile, dipole_total_reflectance
 from .model.made_up_skin import coverage_weights
 from .model.presets import made_up_skin
+from .numerics.cache import LRUCache
 from .numerics.geometry import polar_angle_deg, sphere_directions, sphere_normals
 from .numerics.quadrature import trapezoid_weights
 from .tables.table_set import radius_nodes
@@ -590,19 +591,26 @@ class Prediction:
     cost: float
 
 
+OMISSION_CACHE_SIZE = 256
+_OMISSIONS = LRUCache(OMISSION_CACHE_SIZE)
+
+
 def _omission(scene: SceneDescription, traits: MaterialTraits) -> float:
-    """The largest :func:`subsurface_omission_error` over the scene's lights."""
-    return max(_omission_cached(scene.footprint_mm, scene.object_size_mm, float(light),
-                                traits)
-               for light in scene.lights_deg)
-
-
-@lru_cache(maxsize=256)
-def _omission_cached(footprint_mm, object_size_mm, light_deg, traits):
+    """The largest :func:`subsurface_omission_error` over the scene's lights, remembered by
+    everything it depends on (the same material read again from a file is the same)."""
     scale = traits.subsurface_scale
-    return subsurface_omission_error(footprint_mm, object_size_mm, light_deg,
-                                     scale * traits.radius_mm, traits.profile / scale**2,
-                                     traits.share("skin_share", light_deg))
+    radius = np.asarray(traits.radius_mm, float)
+    profile = np.asarray(traits.profile, float)
+
+    def at(light_deg):
+        share = traits.share("skin_share", light_deg)
+        key = (scene.footprint_mm, scene.object_size_mm, light_deg, scale, share,
+               radius.tobytes(), profile.tobytes())
+        return _OMISSIONS.get_or_compute(key, lambda: subsurface_omission_error(
+            scene.footprint_mm, scene.object_size_mm, light_deg, scale * radius,
+            profile / scale**2, share))
+
+    return max(at(float(light)) for light in scene.lights_deg)
 
 
 def predict(candidate: Candidate, scene: SceneDescription, traits: MaterialTraits,

@@ -72,11 +72,13 @@ def _same(a, b) -> bool:
                                     for x, y in zip(a, b, strict=True))
 
 
-def measure(tables, fit, coverage: float, absorption, method=None) -> dict:
+def measure(tables, fit, coverage: float, absorption, method=None, *,
+            with_traits: bool = True) -> dict:
     """What ``fit`` measures at ``coverage`` and ``absorption`` (per channel), as plain data:
-    ``{"coverage", "absorption", "method", "errors": {tier: {"rms", "albedo"}},
-    "traits": MaterialTraits.as_dict()}`` (the traits hold the gloss omissions too).  The
-    fit's own errors are reused when it was measured there."""
+    ``{"coverage", "absorption", "method", "errors": {tier: {"rms", "albedo"}}, "traits":
+    MaterialTraits.as_dict() or None}`` (the traits, which hold the gloss omissions too, only
+    ``with_traits``: the Auto tier's, a tenth of a second more).  The fit's own errors are
+    reused when it was measured there."""
     cf = lut_baker("closures.fitting")
     auto = lut_baker("auto_tier")
     coverage = float(coverage)
@@ -87,18 +89,19 @@ def measure(tables, fit, coverage: float, absorption, method=None) -> dict:
                              and _same(first.absorption, absorption)):
         errors = cf.tier_errors(fit, tables, coverage, absorption)
     traits = auto.traits_from_tables(tables, fit, coverage, absorption, method=method,
-                                     errors=errors)
+                                     errors=errors) if with_traits else None
     return {"coverage": coverage, "absorption": absorption, "method": method,
             "errors": {tier: {"rms": float(e.rms), "albedo": float(e.albedo)}
                        for tier, e in errors.items()},
-            "traits": traits.as_dict()}
+            "traits": None if traits is None else traits.as_dict()}
 
 
-def measured_at(meta: dict, coverage: float, absorption) -> dict | None:
+def measured_at(meta: dict, coverage: float, absorption, *,
+                with_traits: bool = False) -> dict | None:
     """The measurement a group's record keeps (``meta["measured"]``) if it was taken at this
-    coverage and absorption, else None."""
+    coverage and absorption (and holds the Auto tier's traits, ``with_traits``), else None."""
     measured = meta.get("measured") if isinstance(meta, dict) else None
-    if not isinstance(measured, dict):
+    if not isinstance(measured, dict) or (with_traits and not measured.get("traits")):
         return None
     try:
         if _same([measured["coverage"]], [coverage]) and _same(measured["absorption"],

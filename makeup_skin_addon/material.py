@@ -181,15 +181,19 @@ class _Bake:
                           bake_progress=_stage(self.progress, 0.0, BAKE_SHARE),
                           fit_progress=_stage(self.progress, BAKE_SHARE, MEASURE_SHARE))
 
-    def measured(self, meta=None) -> dict:
-        """What the fit measures at the coverage and absorption: kept in ``meta`` (a group's
-        record) if it was taken there, else measured (baking and fitting if need be)."""
-        if self._measured is None and meta is not None:
-            self._measured = fits.measured_at(meta, self.coverage, self.absorption)
-        if self._measured is None:
+    def adopt(self, measured: dict | None) -> None:
+        """Take a measurement a group's record kept at this coverage and absorption."""
+        if measured is not None:
+            self._measured = measured
+
+    def measured(self, *, with_traits: bool = False) -> dict:
+        """What the fit measures at the coverage and absorption (baking and fitting if need
+        be), the Auto tier's traits too if ``with_traits``."""
+        if self._measured is None or (with_traits and not self._measured["traits"]):
             tables, fit = self.fitted()
             self._measured = fits.measure(tables, fit, self.coverage, self.absorption,
-                                          self.method or fit.subsurface_method)
+                                          self.method or fit.subsurface_method,
+                                          with_traits=with_traits)
         return self._measured
 
 
@@ -203,12 +207,13 @@ def _existing(record: dict, tier: str, method, messages: list):
 
 def _stored_measurement(work: _Bake):
     """What any group of this bake (either tier) keeps measured at the coverage and
-    absorption, or None."""
+    absorption, with the Auto tier's traits, or None."""
     cf = lut_baker("closures.fitting")
     for tier in cf.TIERS:
         group = bpy.data.node_groups.get(group_name(tier, work.record["key"], work.method))
         if group is not None:
-            measured = fits.measured_at(nodes.read_meta(group), work.coverage, work.absorption)
+            measured = fits.measured_at(nodes.read_meta(group), work.coverage, work.absorption,
+                                        with_traits=True)
             if measured is not None:
                 return measured
     return None
@@ -229,8 +234,8 @@ def _group_for(material, settings, scene, work: _Bake, messages: list, group=Non
     auto = None
     tier = settings.tier
     if tier == "AUTO":
-        measured = _stored_measurement(work) or work.measured()
-        tier, auto = _auto_choice(material, scene, measured)
+        work.adopt(_stored_measurement(work))
+        tier, auto = _auto_choice(material, scene, work.measured(with_traits=True))
     existing = None if group is not None else _existing(work.record, tier, work.method,
                                                         messages)
     if existing is not None:

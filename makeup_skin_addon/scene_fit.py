@@ -152,7 +152,7 @@ def _measurement(meta: dict, coverage: float, absorption, *, may_fit: bool):
     """What the group's fit measured at this coverage and absorption: kept in its record, or
     measured now from this session's fit, or (``may_fit``) from a new bake and fit; None
     when none of these can be had."""
-    measured = fits.measured_at(meta, coverage, absorption)
+    measured = fits.measured_at(meta, coverage, absorption, with_traits=True)
     if measured is not None or "parameters" not in meta:
         return measured
     method = meta.get("forced_method")

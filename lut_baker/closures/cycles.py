@@ -446,25 +446,45 @@ def principled_reflection(wi, wo, inputs: PrincipledInputs):
     else:
         spec = microfacet_reflection(wi, wo, inputs.roughness,
                                      lambda c: schlick_ior_fresnel(c, eta, f0))
-        a_s = 1.0 - np.max(view_table(cos_o, lambda c: layering_albedo(
-            c, inputs.roughness, eta, f0)), axis=-1)
+        a_s = 1.0 - np.max(view_table(cos_o, _layering_nodes(
+            float(inputs.roughness), float(eta), tuple(np.atleast_1d(f0).tolist()))), axis=-1)
         lower = spec + a_s[..., None] * base
     if inputs.coat_weight <= 0.0:
         return lower
     coat = microfacet_reflection(wi, wo, inputs.coat_roughness,
                                  lambda c: dielectric_fresnel(c, inputs.coat_ior))
-    terms = view_table(cos_o, lambda c: np.stack(
-        coat_view_terms(c, inputs.coat_roughness, inputs.coat_ior), axis=-1))
+    terms = view_table(cos_o, _coat_nodes(float(inputs.coat_roughness),
+                                          float(inputs.coat_ior)))
     a_c = np.clip(1.0 - inputs.coat_weight * terms[..., 1], 0.0, 1.0)
     return (inputs.coat_weight * (coat * terms[..., 0])[..., None]
             + a_c[..., None] * lower)
 
 
-def view_table(cos_view: np.ndarray, function, size: int = 64) -> np.ndarray:
+VIEW_TABLE_SIZE = 64
+"""Nodes of :func:`view_table` on ``cos(theta_o)`` in [0, 1]."""
+
+
+@lru_cache(maxsize=64)
+def _layering_nodes(roughness: float, eta: float, f0: tuple) -> np.ndarray:
+    """:func:`layering_albedo` at :func:`view_table`'s nodes (cached: replicas of one fit
+    evaluate it many times)."""
+    f0 = f0[0] if len(f0) == 1 else np.asarray(f0)
+    return layering_albedo(np.linspace(0.0, 1.0, VIEW_TABLE_SIZE), roughness, eta, f0)
+
+
+@lru_cache(maxsize=64)
+def _coat_nodes(roughness: float, ior: float) -> np.ndarray:
+    """:func:`coat_view_terms` at :func:`view_table`'s nodes, ``(size, 2)`` (cached)."""
+    return np.stack(coat_view_terms(np.linspace(0.0, 1.0, VIEW_TABLE_SIZE), roughness, ior),
+                    axis=-1)
+
+
+def view_table(cos_view: np.ndarray, function, size: int = VIEW_TABLE_SIZE) -> np.ndarray:
     """``function`` of the view cosine, tabulated on ``size`` nodes and interpolated linearly
-    (the layering albedos are smooth; tabulating keeps a replica of a large grid cheap)."""
+    (the layering albedos are smooth; tabulating keeps a replica of a large grid cheap);
+    ``function`` may also be the table itself, at those nodes."""
     nodes = np.linspace(0.0, 1.0, size)
-    table = np.asarray(function(nodes))
+    table = np.asarray(function(nodes) if callable(function) else function)
     if table.ndim == 1:
         return np.interp(cos_view, nodes, table)
     return np.stack([np.interp(cos_view, nodes, table[:, c]) for c in range(table.shape[1])],
