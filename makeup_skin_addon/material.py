@@ -194,6 +194,9 @@ class _Bake:
             self._measured = fits.measure(tables, fit, self.coverage, self.absorption,
                                           self.method or fit.subsurface_method,
                                           with_traits=with_traits)
+            report = _stage(self.progress, MEASURE_SHARE, 1.0)
+            if report is not None:
+                report(1.0, "measured")
         return self._measured
 
 
