@@ -62,6 +62,7 @@ from .closures.fitting import TIER_REPLICAS, TIERS, edge_response, profile_grid,
 from .model.dipole import dipole_profile, dipole_total_reflectance
 from .model.made_up_skin import coverage_weights
 from .model.presets import made_up_skin
+from .numerics.cache import LRUCache
 from .numerics.geometry import polar_angle_deg, sphere_directions, sphere_normals
 from .numerics.quadrature import trapezoid_weights
 from .tables.table_set import radius_nodes
@@ -301,6 +302,45 @@ class MaterialTraits:
         """:func:`profile_mean_radius_mm` with the Subsurface Scale applied."""
         return self.subsurface_scale * profile_mean_radius_mm(self.radius_mm, self.profile)
 
+    def as_dict(self) -> dict:
+        """Plain data (floats, lists, string keys), for a file; :meth:`from_dict` reads it."""
+        def by_angle(table):
+            return {repr(float(angle)): float(value) for angle, value in table.items()}
+
+        return {
+            "tier_errors": {tier: float(e) for tier, e in self.tier_errors.items()},
+            "radius_mm": np.asarray(self.radius_mm, float).tolist(),
+            "profile": np.asarray(self.profile, float).tolist(),
+            "profile_mismatch": float(self.profile_mismatch),
+            "skin_share": by_angle(self.skin_share),
+            "gloss_share": by_angle(self.gloss_share),
+            "subsurface_scale": float(self.subsurface_scale),
+            "gloss_omission": None if self.gloss_omission is None else {
+                tier: by_angle(table) for tier, table in self.gloss_omission.items()},
+            "gloss_scale": float(self.gloss_scale),
+        }
+
+    @classmethod
+    def from_dict(cls, data: dict) -> MaterialTraits:
+        """The traits :meth:`as_dict` wrote (``KeyError``, ``TypeError`` or ``ValueError``
+        when an entry is missing or malformed)."""
+        def by_angle(table):
+            return {float(angle): float(value) for angle, value in table.items()}
+
+        omission = data["gloss_omission"]
+        return cls(
+            tier_errors={str(tier): float(e) for tier, e in data["tier_errors"].items()},
+            radius_mm=np.asarray(data["radius_mm"], float),
+            profile=np.asarray(data["profile"], float),
+            profile_mismatch=float(data["profile_mismatch"]),
+            skin_share=by_angle(data["skin_share"]),
+            gloss_share=by_angle(data["gloss_share"]),
+            subsurface_scale=float(data["subsurface_scale"]),
+            gloss_omission=None if omission is None else {
+                str(tier): by_angle(table) for tier, table in omission.items()},
+            gloss_scale=float(data["gloss_scale"]),
+        )
+
 
 def _at_angle(table: dict, light_deg: float) -> float:
     """A per-light-angle table at ``light_deg`` (linear between its angles, held beyond)."""
@@ -391,13 +431,14 @@ shares."""
 
 
 def traits_from_tables(tables, fit, coverage=None, absorption=None, *,
-                       lights_deg=SHARE_LIGHTS_DEG, method: str | None = None
-                       ) -> MaterialTraits:
+                       lights_deg=SHARE_LIGHTS_DEG, method: str | None = None,
+                       errors: dict | None = None) -> MaterialTraits:
     """:class:`MaterialTraits` of baked ``tables`` and their
     :class:`lut_baker.closures.fitting.ClosureFit` ``fit`` at a coverage and absorption (default:
-    the tables')."""
+    the tables'); ``errors``: the fit's :func:`lut_baker.closures.fitting.tier_errors` there,
+    if already measured."""
     w, a = tables.coverage_and_absorption(coverage, absorption)
-    errors = tier_errors(fit, tables, w, a)
+    errors = tier_errors(fit, tables, w, a) if errors is None else errors
     shares = {float(angle): gloss_and_skin_shares(tables, angle, w, a) for angle in lights_deg}
     return MaterialTraits(
         tier_errors={tier: float(e.rms) for tier, e in errors.items()},
@@ -550,19 +591,26 @@ class Prediction:
     cost: float
 
 
+OMISSION_CACHE_SIZE = 256
+_OMISSIONS = LRUCache(OMISSION_CACHE_SIZE)
+
+
 def _omission(scene: SceneDescription, traits: MaterialTraits) -> float:
-    """The largest :func:`subsurface_omission_error` over the scene's lights."""
-    return max(_omission_cached(scene.footprint_mm, scene.object_size_mm, float(light),
-                                traits)
-               for light in scene.lights_deg)
-
-
-@lru_cache(maxsize=256)
-def _omission_cached(footprint_mm, object_size_mm, light_deg, traits):
+    """The largest :func:`subsurface_omission_error` over the scene's lights, remembered by
+    everything it depends on (the same material read again from a file is the same)."""
     scale = traits.subsurface_scale
-    return subsurface_omission_error(footprint_mm, object_size_mm, light_deg,
-                                     scale * traits.radius_mm, traits.profile / scale**2,
-                                     traits.share("skin_share", light_deg))
+    radius = np.asarray(traits.radius_mm, float)
+    profile = np.asarray(traits.profile, float)
+
+    def at(light_deg):
+        share = traits.share("skin_share", light_deg)
+        key = (scene.footprint_mm, scene.object_size_mm, light_deg, scale, share,
+               radius.tobytes(), profile.tobytes())
+        return _OMISSIONS.get_or_compute(key, lambda: subsurface_omission_error(
+            scene.footprint_mm, scene.object_size_mm, light_deg, scale * radius,
+            profile / scale**2, share))
+
+    return max(at(float(light)) for light in scene.lights_deg)
 
 
 def predict(candidate: Candidate, scene: SceneDescription, traits: MaterialTraits,

@@ -13,7 +13,12 @@ outer angles and sums the cosine series on the table's azimuth grid.  What makes
 - every kernel table is computed once per bake (:class:`KernelCache`);
 - the bake's quadrature (:func:`lut_baker.numerics.quadrature.hemisphere_panels`) is coarser
   than the exact evaluator's, as coarse as the convergence study (``bench/bake.py --study``,
-  docs/baking.md) allows.
+  docs/baking.md) allows;
+- the surfaces' own gloss (paths 1 and the bare skin's, eq. 2's specular term) is a closed form
+  and is not tabulated (:data:`lut_baker.tables.table_set.SURFACE_GLOSS`); only its directional
+  albedo is, integrated through the half vector (:func:`gloss_albedos`), which costs the same
+  for a lobe of any width.  The grids are sized by what path 3 goes through, the film's
+  transmission and the skin's gloss (:meth:`Resolution.for_lobe`), never by the film's gloss.
 
 Functions and types
 -------------------
@@ -22,8 +27,9 @@ Functions and types
 - :func:`fourier_coefficients` -- cosine coefficients of a layer's kernel, fast.
 - :class:`KernelCache` -- memoises :func:`fourier_coefficients` within one bake.
 - :func:`gloss_layer` -- a layer's Torrance-Sparrow specular part alone.
-- :func:`gloss_tables` -- Torrance-Sparrow specular parts (eq. 2) on the table grid.
-- :func:`gloss_albedos` -- their directional albedos (order 0, azimuths adapted to the lobe).
+- :func:`gloss_albedos` -- the directional albedos of Torrance-Sparrow specular parts (eq. 2),
+  through the half vector (any lobe width).
+- :func:`path3_width_deg` -- the narrowest lobe path 3 goes through (degrees).
 - :func:`inter_reflection_albedo` -- what the inter-reflections add to the albedo.
 - :func:`profile_radius` -- where the dipole's R(d) falls to a fraction of its peak (mm).
 - :func:`rgb_view` -- a channel axis of 1 or 3 as 3, without a copy.
@@ -53,9 +59,8 @@ from .model.microfacet import (
 from .model.params_file import skin_to_dict
 from .numerics.cache import LRUCache
 from .numerics.quadrature import (
-    HemisphereGrid,
     hemisphere_panels,
-    mirror_weighted_azimuths,
+    mirror_quadrature,
     order0_integral,
     uniform_azimuths,
 )
@@ -71,8 +76,8 @@ __all__ = [
     "fresnel_tabulation",
     "fresnel_interpolated",
     "gloss_layer",
-    "gloss_tables",
     "gloss_albedos",
+    "path3_width_deg",
     "profile_radius",
     "inter_reflection_albedo",
     "rgb_view",
@@ -83,9 +88,10 @@ __all__ = [
 PROFILE_FLOOR = 1e-4
 """The radial table ends where R(d) falls below this fraction of R(0) (in every channel)."""
 REFERENCE_LOBE_DEG = 19.3
-"""The narrowest lobe (1/e half-width, 1/n degrees) among the presets the resolutions were
-chosen for (the Jensen skins' gloss).  Narrower lobes scale the angular grids up
-(:meth:`Resolution.for_lobe`), up to 4x."""
+"""The narrowest lobe path 3 goes through (1/e half-width, 1/n degrees) among the presets the
+resolutions were chosen for (the Jensen skins' gloss).  Narrower lobes in path 3 (a film
+transmission or a skin gloss of the user's) scale the angular grids up
+(:meth:`Resolution.for_lobe`), up to 4x; the film's own gloss never does."""
 
 
 @dataclass(frozen=True)
@@ -97,8 +103,7 @@ class Resolution:
     ``n_radius`` distances with ``radius_spacing`` (closed forms in
     :mod:`lut_baker.tables.table_set`). Quadrature of the path-3 integrals: ``quad_panels``
     Gauss-Legendre panels of ``quad_points`` nodes in polar angle, ``quad_phi`` (odd) azimuth
-    samples; the gloss albedos use ``albedo_azimuths`` azimuths concentrated at the mirror direction
-    (:func:`gloss_albedos`).
+    samples.  The gloss albedos (:func:`gloss_albedos`) need no grid of their own.
     """
 
     name: str
@@ -108,7 +113,6 @@ class Resolution:
     quad_panels: int
     quad_points: int
     quad_phi: int
-    albedo_azimuths: int = 16
     theta_spacing: str = "grazing"
     theta_offset: float = THETA_OFFSET
     phi_spacing: str = "half_vector"
@@ -131,11 +135,11 @@ class Resolution:
 
 RESOLUTIONS = {
     "preview": Resolution("preview", n_theta=48, n_phi=33, n_radius=128,
-                          quad_panels=2, quad_points=6, quad_phi=17, albedo_azimuths=12),
+                          quad_panels=2, quad_points=6, quad_phi=17),
     "default": Resolution("default", n_theta=96, n_phi=65, n_radius=320,
-                          quad_panels=3, quad_points=10, quad_phi=33, albedo_azimuths=16),
+                          quad_panels=3, quad_points=10, quad_phi=33),
     "high": Resolution("high", n_theta=112, n_phi=97, n_radius=512,
-                       quad_panels=4, quad_points=10, quad_phi=65, albedo_azimuths=24),
+                       quad_panels=4, quad_points=10, quad_phi=65),
 }
 """Named resolutions, chosen by the convergence study in docs/baking.md."""
 
@@ -311,51 +315,38 @@ class _NodePairs:
         return [rgb_view(table) for table in out]
 
 
-def _channel_count(*layers) -> int:
-    return 3 if any(layer.channels for layer in layers) else 1
+GLOSS_ALBEDO_POINTS = (12, 48)
+"""Half-vector polar nodes per panel and azimuths of :func:`gloss_albedos`
+(:func:`lut_baker.numerics.quadrature.mirror_quadrature`): within 0.015% of the converged
+albedo up to 85 degrees and 0.4% at 89, for lobes 1 to 30 degrees wide."""
 
 
-def gloss_tables(layers, theta_deg, phi_deg, phi_spacing: str = "half_vector",
-                 *, pairs: _NodePairs | None = None) -> list[np.ndarray]:
-    """Specular parts ``P_s D G F_r`` (eq. 2, 1/sr) of each reflecting layer on the table grid
-    (grids and spacing as :class:`lut_baker.tables.table_set.Tables`): ``(n_theta, n_theta, n_phi,
-    3)`` each, evaluated once per unordered (theta_i, theta_o)."""
-    pairs = pairs or _NodePairs(theta_deg, phi_deg, phi_spacing)
-    layers = [gloss_layer(layer) for layer in layers]
-
-    def values(chunk):
-        cos_a, cos_b = pairs.cos_a[chunk], pairs.cos_b[chunk]
-        n_dot_h, v_dot_h = half_vector_cosines(cos_a, pairs.sin_a[chunk], cos_b,
-                                               pairs.sin_b[chunk], pairs.cos_phi[chunk])
-        return [_reflection_values(layer, cos_a, cos_b, n_dot_h, v_dot_h) for layer in layers]
-
-    return pairs.tables(values, [_channel_count(layer) for layer in layers])
-
-
-AZIMUTH_POWER = 3
-"""Exponent of the azimuth substitution of :func:`gloss_albedos`
-(:func:`lut_baker.numerics.quadrature.mirror_weighted_azimuths`)."""
-
-
-def gloss_albedos(layers, theta_deg, grid: HemisphereGrid, azimuths: int) -> list[np.ndarray]:
+def gloss_albedos(layers, theta_deg) -> list[np.ndarray]:
     """Directional albedos ``Int P_s D G F_r cos(theta_o) dwo`` (eq. 2's specular part
     integrated) of each reflecting layer at incidences ``theta_deg``: ``(n_theta, 3)`` each.
 
-    Only the azimuth integral (order 0) is needed, so instead of uniform azimuths it uses
-    ``azimuths`` Gauss-Legendre nodes in ``s`` with ``phi = pi (1 - s^3)``: towards grazing the
-    gloss lobe narrows in azimuth like ``cos(theta_i) + cos(theta_o)`` (about 1 degree wide at 89
-    degrees), and the substitution resolves every width at once (polar nodes from ``grid``)."""
-    layers = [gloss_layer(layer) for layer in layers]
-    cos_phi, weight = mirror_weighted_azimuths(int(azimuths), AZIMUTH_POWER)
-    theta = np.radians(np.asarray(theta_deg, float))[:, None, None]
-    cos_a, sin_a = np.cos(theta), np.sin(theta)
-    cos_b, sin_b = np.cos(grid.theta)[:, None], np.sin(grid.theta)[:, None]
-    n_dot_h, v_dot_h = half_vector_cosines(cos_a, sin_a, cos_b, sin_b, cos_phi)
+    The integral runs over the half vector (:func:`lut_baker.numerics.quadrature.
+    mirror_quadrature`), in panels sized by the layer's own lobe (1/n degrees), so that a lobe
+    of any width is resolved at the same cost."""
+    theta = np.radians(np.asarray(theta_deg, float))
     out = []
-    for layer in layers:
-        values = _reflection_values(layer, cos_a, cos_b, n_dot_h, v_dot_h)  # (T, N, S, C)
-        out.append(rgb_view(np.einsum("tnsc,s,n->tc", values, weight, grid.weight)))
+    for layer in (gloss_layer(layer) for layer in layers):
+        quad = mirror_quadrature(theta, 1.0 / float(np.max(layer.n)),
+                                 alpha_points=GLOSS_ALBEDO_POINTS[0],
+                                 phi_points=GLOSS_ALBEDO_POINTS[1])
+        cos_o = quad.cos_other
+        values = ts_specular_from_cosines(
+            quad.cos_h[..., None], quad.cos_dh[..., None], cos_o[..., None],
+            quad.cos_fixed[..., None], layer.P_s, layer.n, layer.eta, fresnel_interpolated)
+        out.append(rgb_view(np.einsum("napc,nap->nc", values, quad.weight * cos_o)))
     return out
+
+
+def path3_width_deg(skin: MadeUpSkin) -> float:
+    """The narrowest lobe path 3 goes through (1/e half-width, degrees): the film's
+    transmission (eq. 4) and the skin's gloss (eq. 2), whose product path 3 integrates; the
+    film's own gloss (path 1) is not among them."""
+    return min(1.0 / float(np.max(layer.n)) for layer in (skin.film_transmission, skin.skin))
 
 
 def _cosine_series(matrices: np.ndarray, pairs: _NodePairs) -> np.ndarray:
@@ -406,16 +397,15 @@ def bake(skin: MadeUpSkin, resolution_name="default", *, inter_reflection: bool 
     meaning).
 
     ``resolution_name``: ``"preview"``, ``"default"``, ``"high"`` or a :class:`Resolution`;
-    it is scaled up for lobes narrower than the presets' (:meth:`Resolution.for_lobe`).
+    it is scaled up when path 3 goes through lobes narrower than the presets'
+    (:func:`path3_width_deg`, :meth:`Resolution.for_lobe`).
     ``inter_reflection``: also bake the film-skin inter-reflections beyond path 3 (the adding
     equation, film underside reflecting like its top, at the skin's absorption).
     ``progress(fraction, message)``: called as the bake advances (fraction 0..1).
     """
     if not isinstance(skin, MadeUpSkin):
         raise ValueError(f"skin must be a MadeUpSkin, got {type(skin).__name__}")
-    widths = [1.0 / float(np.max(layer.n)) for layer in (skin.film, skin.film_transmission,
-                                                          skin.skin)]
-    res = resolution(resolution_name).for_lobe(min(widths))
+    res = resolution(resolution_name).for_lobe(path3_width_deg(skin))
     _stage(progress, 0.0, f"grids ({res.name})")
     theta_deg = theta_nodes(res.n_theta, res.theta_spacing, res.theta_max_deg, res.theta_offset)
     phi_deg = np.linspace(0.0, 180.0, res.n_phi)
@@ -424,7 +414,7 @@ def bake(skin: MadeUpSkin, resolution_name="default", *, inter_reflection: bool 
     grid = hemisphere_panels(res.quad_panels, res.quad_points, res.quad_phi)
     kernels = KernelCache()
     film_t = skin.film_transmission  # absorption 0: the tables apply it afterwards
-    film_gloss_layer, skin_gloss = gloss_layer(skin.film), gloss_layer(skin.skin)
+    skin_gloss = gloss_layer(skin.skin)
 
     _stage(progress, 0.05, "path 3 (Fourier matrices)")
     outer = np.concatenate([theta, grid.theta])
@@ -437,12 +427,7 @@ def bake(skin: MadeUpSkin, resolution_name="default", *, inter_reflection: bool 
     fresnel_t = fresnel_transmittance(np.cos(grid.theta)[:, None],
                                       np.atleast_1d(skin.dipole.eta))
     inner_t = order0_integral(kernels(film_t, grid.theta, grid.theta, grid.n_phi)[0], grid)
-    albedos = gloss_albedos((film_gloss_layer, skin_gloss), theta_deg, grid,
-                            res.albedo_azimuths)
-
-    _stage(progress, 0.55, "surface gloss")
-    film_gloss, skin_gloss_table = gloss_tables((film_gloss_layer, skin_gloss), theta_deg,
-                                                  phi_deg, pairs=pairs)
+    albedos = gloss_albedos((skin.film, skin.skin), theta_deg)
 
     extra = None
     if inter_reflection:
@@ -463,9 +448,7 @@ def bake(skin: MadeUpSkin, resolution_name="default", *, inter_reflection: bool 
         theta_deg=theta_deg,
         phi_deg=phi_deg,
         radius_mm=radius_mm,
-        film_gloss=film_gloss,
         path3_gloss=path3,
-        skin_gloss=skin_gloss_table,
         film_transmittance=rgb_view(order0_integral(rows0, grid)),
         transmission_factor=rgb_view(order0_integral(rows0, grid, fresnel_t)),
         film_gloss_albedo=albedos[0],

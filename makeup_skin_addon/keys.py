@@ -20,6 +20,8 @@ Custom properties of a material (JSON strings unless said otherwise):
 - :data:`RECORD_KEY` -- the surface before Apply, for Revert (:mod:`.convert`).
 - :data:`ERRORS_KEY` -- the tiers' errors at the settings of the last Apply (:mod:`.material`).
 - :data:`CHOICE_KEY` -- the last Fit to Scene choice (:mod:`.scene_fit`).
+- :data:`AUTO_KEY` -- the tier the last Apply chose for Tier = Auto, for the panel
+  (:mod:`.material`).
 - :data:`SAVED_SCALE_KEY`, :data:`SAVED_GLOSS_KEY` -- floats: the Subsurface Scale and Gloss
   before Fit to Scene set them to 0.
 
@@ -50,6 +52,7 @@ __all__ = [
     "RECORD_KEY",
     "ERRORS_KEY",
     "CHOICE_KEY",
+    "AUTO_KEY",
     "SAVED_SCALE_KEY",
     "SAVED_GLOSS_KEY",
     "FIT_KEY",
@@ -84,9 +87,13 @@ ERRORS_KEY = "makeup_skin_errors"
 """Material custom property: the tiers' errors at the settings of the last Apply (JSON): per
 tier its angular ``rms`` and ``albedo`` errors, ``gloss_omission`` (per light angle, what
 Gloss 0 changes in a sphere's image, :func:`lut_baker.auto_tier.gloss_omissions`), the
-``coverage``, ``absorption`` and tables ``key`` they were measured for."""
+``coverage``, ``absorption`` and bake ``key`` they were measured for."""
 CHOICE_KEY = "makeup_skin_scene_fit"
 """Material custom property: the last Fit to Scene choice (JSON), shown in the panel."""
+AUTO_KEY = "makeup_skin_auto_tier"
+"""Material custom property: what the last Apply chose for Tier = Auto (JSON: ``tier``, the
+predicted ``error``, the ``engine`` it was chosen for), shown in the panel (which never
+computes)."""
 SAVED_SCALE_KEY = "makeup_skin_saved_subsurface_scale"
 """Material custom property: the Subsurface Scale before Fit to Scene set it to 0."""
 SAVED_GLOSS_KEY = "makeup_skin_saved_gloss"

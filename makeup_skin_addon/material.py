@@ -1,29 +1,35 @@
 """Apply: bake, fit, build or reuse the node group, and make it the surface of the artist's
 own material (converted in place, :mod:`.convert`); Revert and Check Tables.
 
+A bake is named by its record's key (:func:`.storage.bake_record`: the settings' parameters and
+resolution, hashed; no bake needed to know it) and a group by its tier, key and forced
+subsurface method (:func:`.keys.group_name`).  Apply with settings it has seen before finds the
+group by name and bakes, fits and hashes nothing; otherwise it bakes and fits once per session
+(:mod:`.fits`).  Tier = Auto decides from what the fit of the foundation being applied measured
+(kept in the group's record), so the same settings in the same scene give the same tier.
+
 - :func:`skin_from_settings` -- the panel's settings as a :class:`MadeUpSkin` (coverage 1,
   absorption 0: those two are socket values, applied after the bake).
-- :func:`resolve_tier` -- the tier for the settings and scene (Auto: from the scene).
+- :func:`resolve_tier` -- the tier for the settings and scene (Auto: from a measurement).
 - :func:`socket_values` -- the settings' group-node socket values; :func:`update_sockets`
   sets them on a material's group node.
 - :func:`refuse_linked` -- :class:`LinkedDataError` for data linked from a library.
-- :func:`group_for_tables` -- the group for baked tables (reused when the same tables, tier and
-  method were built before and its images are intact).
-- :func:`ensure_group` -- bake, then :func:`group_for_tables`.
+- :func:`group_for_tables` -- the group for baked tables (tests and tools; reused when the same
+  tables, tier and method were built before and its images are intact).
 - :func:`apply_to_object` -- the Apply operator's work; :func:`revert_material` Revert's.
+- :func:`rebuild_from_settings` -- the live preview's re-bake.
 - :func:`check_material` -- verify a made-up material against its bake record, repair it.
 """
 
 from __future__ import annotations
 
-import dataclasses
 import json
 import math
 
 import bpy
 
-from . import convert, nodes, scene_fit, storage
-from .keys import ERRORS_KEY, MATERIAL_NAME, group_name
+from . import convert, fits, nodes, scene_fit, storage
+from .keys import AUTO_KEY, ERRORS_KEY, MATERIAL_NAME, group_name
 from .package import lut_baker
 from .scene_fit import units_per_mm
 
@@ -36,7 +42,6 @@ __all__ = [
     "resolve_tier",
     "forced_method",
     "group_for_tables",
-    "ensure_group",
     "group_of",
     "apply_to_object",
     "setup_material",
@@ -48,28 +53,43 @@ __all__ = [
 
 
 def skin_from_settings(settings):
-    """The made-up skin the settings describe, at coverage 1 and absorption 0."""
+    """The made-up skin the settings describe, at coverage 1 and absorption 0.  Film Roughness
+    and Film IOR (with Override Film) replace the film surface's gloss (eq. 2: its lobe width
+    and index, also the index of its transmission's Fresnel term); the film's transmission lobe
+    stays the foundation's, since it is set by the pigment the light crosses, not by the
+    surface (docs/model.md §4)."""
     presets = lut_baker("model.presets")
     skin = presets.made_up_skin(settings.foundation, settings.skin, coverage=1.0,
                                 absorption=0.0)
     if settings.override_film:
         width_deg = math.degrees(settings.film_lobe_width)
-        reflection_n = 1.0 / width_deg
-        ratio = reflection_n / float(skin.film.n)
         skin = skin.replace(
-            film=skin.film.scaled(n=ratio, eta=settings.film_ior / float(skin.film.eta)),
+            film=skin.film.scaled(n=1.0 / width_deg / float(skin.film.n),
+                                  eta=settings.film_ior / float(skin.film.eta)),
             film_transmission=skin.film_transmission.scaled(
-                n=ratio, eta=settings.film_ior / float(skin.film_transmission.eta)))
+                eta=settings.film_ior / float(skin.film_transmission.eta)))
     return skin
 
 
-def resolve_tier(settings, scene) -> str:
+def resolve_tier(settings, scene, measured=None) -> str:
     """The tier to build: the settings' own, or for Auto the one
-    :func:`scene_fit.auto_tier` picks from the scene (:mod:`lut_baker.auto_tier`: the
-    cheapest within the tolerance of the best predicted error; EEVEE: Principled)."""
+    :func:`.scene_fit.choose_with` picks in ``scene`` for a material whose fit measured
+    ``measured`` (:func:`.fits.measure`; default: what the material's group keeps, never a new
+    bake; EEVEE: Principled)."""
     if settings.tier != "AUTO":
         return settings.tier
-    return scene_fit.auto_tier(settings, scene)
+    return _auto_choice(settings.id_data, scene, measured)[0]
+
+
+def _auto_choice(material, scene, measured) -> tuple[str, dict]:
+    """``(tier, record for the panel)`` of the Auto choice for ``material`` in ``scene``."""
+    traits = fits.traits(measured) if measured is not None else None
+    if traits is None:
+        traits = scene_fit.material_traits(material, may_fit=False)
+    choice, _ = scene_fit.choose_with(traits, material, scene)
+    chosen = choice.chosen
+    return chosen.candidate.tier, {"tier": chosen.candidate.tier, "error": chosen.error,
+                                   "engine": scene.render.engine}
 
 
 def forced_method(settings):
@@ -119,9 +139,11 @@ class _Progress:
         return False
 
 
-BAKE_SHARE = 0.2
-"""Share of Apply's progress bar the bake takes (the closure fit takes the rest: 0.1-0.2 s
-against 1-3 s)."""
+BAKE_SHARE = 0.15
+"""Share of Apply's progress bar the bake takes (the closure fit and its measurement take the
+rest)."""
+MEASURE_SHARE = 0.85
+"""Where on Apply's progress bar the fit ends and its measurement begins."""
 
 
 def _stage(progress, start, end):
@@ -129,7 +151,7 @@ def _stage(progress, start, end):
 
 
 def _reusable(group, key: str, tier: str, method, messages: list) -> bool:
-    """Whether ``group`` was built from these tables, tier and method by this version and its
+    """Whether ``group`` was built from this bake, tier and method by this version and its
     images are intact; a damaged image is reported in ``messages``."""
     meta = nodes.read_meta(group)
     if (meta.get("key"), meta.get("tier"), meta.get("forced_method")) != (key, tier, method):
@@ -142,64 +164,122 @@ def _reusable(group, key: str, tier: str, method, messages: list) -> bool:
     return not problems
 
 
-def group_for_tables(tables, tier: str, *, bake=None, group=None, errors_at=None,
-                     method=None, progress=None, messages=None):
-    """``(group, fit or None)`` of ``tier`` for baked ``tables``.
+class _Bake:
+    """One bake record's tables, fit and measurement, made when first asked for (a group that
+    can be reused needs none of them)."""
 
-    A group already built from the same tables, tier and ``method`` (a forced subsurface
-    method, or None for the fit's choice) whose images are intact is reused (no fit) unless
-    ``group`` is given, which is then rebuilt in place.  ``bake``: the tables' record
-    (:func:`storage.bake_record`; default: from the tables' own parameters at resolution
-    "default").  ``errors_at``: ``(coverage, absorption)`` at which to measure the tiers'
-    errors when fitting (default: the bake's).  ``progress(fraction, message)``: the fit's.
-    ``messages``: a list that gets a sentence for each damaged image found (then rebuilt).
-    """
+    def __init__(self, record: dict, method, coverage: float, absorption, progress=None):
+        self.record, self.method = record, method
+        self.coverage, self.absorption = float(coverage), [float(a) for a in absorption]
+        self.progress = progress
+        self._measured = None
+
+    def fitted(self):
+        """``(tables, fit)`` (:func:`.fits.baked`)."""
+        return fits.baked(self.record, method=self.method,
+                          errors_at=(self.coverage, self.absorption),
+                          bake_progress=_stage(self.progress, 0.0, BAKE_SHARE),
+                          fit_progress=_stage(self.progress, BAKE_SHARE, MEASURE_SHARE))
+
+    def adopt(self, measured: dict | None) -> None:
+        """Take a measurement a group's record kept at this coverage and absorption."""
+        if measured is not None:
+            self._measured = measured
+
+    def measured(self, *, with_traits: bool = False) -> dict:
+        """What the fit measures at the coverage and absorption (baking and fitting if need
+        be), the Auto tier's traits too if ``with_traits``."""
+        if self._measured is None or (with_traits and not self._measured["traits"]):
+            tables, fit = self.fitted()
+            self._measured = fits.measure(tables, fit, self.coverage, self.absorption,
+                                          self.method or fit.subsurface_method,
+                                          with_traits=with_traits)
+            report = _stage(self.progress, MEASURE_SHARE, 1.0)
+            if report is not None:
+                report(1.0, "measured")
+        return self._measured
+
+
+def _existing(record: dict, tier: str, method, messages: list):
+    """The group of this bake, tier and method if the file has it intact, else None."""
+    group = bpy.data.node_groups.get(group_name(tier, record["key"], method))
+    if group is not None and _reusable(group, record["key"], tier, method, messages):
+        return group
+    return None
+
+
+def _stored_measurement(work: _Bake):
+    """What any group of this bake (either tier) keeps measured at the coverage and
+    absorption, with the Auto tier's traits, or None."""
+    cf = lut_baker("closures.fitting")
+    for tier in cf.TIERS:
+        group = bpy.data.node_groups.get(group_name(tier, work.record["key"], work.method))
+        if group is not None:
+            measured = fits.measured_at(nodes.read_meta(group), work.coverage, work.absorption,
+                                        with_traits=True)
+            if measured is not None:
+                return measured
+    return None
+
+
+def _build(work: _Bake, tier: str, group=None):
+    """The group of ``tier`` built from the bake (rebuilt in place when ``group`` is given),
+    its record keeping the measurement."""
+    _, fit = work.fitted()
+    return nodes.build_group(tier, work.record, fit, group, method=work.method,
+                             measured=work.measured())
+
+
+def _group_for(material, settings, scene, work: _Bake, messages: list, group=None):
+    """``(group, measured, tier, auto record or None)`` for the settings: the existing group
+    of the tier reused when intact (nothing baked or fitted), else built (``group`` given:
+    rebuilt in place, always)."""
+    auto = None
+    tier = settings.tier
+    if tier == "AUTO":
+        work.adopt(_stored_measurement(work))
+        tier, auto = _auto_choice(material, scene, work.measured(with_traits=True))
+    existing = None if group is not None else _existing(work.record, tier, work.method,
+                                                        messages)
+    if existing is not None:
+        stored = fits.measured_at(nodes.read_meta(existing), work.coverage, work.absorption)
+        if stored is None:  # the group was built at another coverage or absorption
+            nodes.write_measured(existing, work.measured())
+        return existing, stored or work.measured(), tier, auto
+    if group is None:
+        group = bpy.data.node_groups.get(group_name(tier, work.record["key"], work.method))
+    return _build(work, tier, group), work.measured(), tier, auto
+
+
+def group_for_tables(tables, tier: str, *, resolution: str = "default", group=None,
+                     errors_at=None, method=None, messages=None):
+    """``(group, fit or None)`` of ``tier`` for baked ``tables`` baked at ``resolution`` (tests
+    and tools that bake themselves; Apply goes through the settings).
+
+    A group already built from the same bake, tier and ``method`` (a forced subsurface method,
+    or None for the fit's choice) whose images are intact is reused (no fit) unless ``group``
+    is given, which is then rebuilt in place.  ``errors_at``: ``(coverage, absorption)`` at
+    which to measure (default: the bake's).  ``messages``: a list that gets a sentence for
+    each damaged image found (then rebuilt)."""
     messages = [] if messages is None else messages
-    if bake is None:
-        skin = lut_baker("model.params_file").skin_from_dict(tables.parameters)
-        bake = storage.bake_record(skin, "default", tables)
-    key = bake["key"]
-    existing = bpy.data.node_groups.get(group_name(tier, key, method))
-    if group is None and existing is not None and _reusable(existing, key, tier, method,
-                                                            messages):
+    skin = lut_baker("model.params_file").skin_from_dict(tables.parameters)
+    record = storage.bake_record(skin, resolution)
+    storage.remember(record, tables)
+    coverage, absorption = errors_at if errors_at is not None else \
+        tables.coverage_and_absorption()
+    work = _Bake(record, method, coverage, absorption)
+    existing = None if group is not None else _existing(record, tier, method, messages)
+    if existing is not None:
         return existing, None
-    fit = _fit(tables, key, errors_at, progress)
-    target = group if group is not None else existing
-    return nodes.build_group(tier, bake, fit, target, method=method), fit
-
-
-FIT_CACHE_SIZE = 8
-"""Closure fits kept per tables key in this session (a fit takes seconds, a bake 0.2 s)."""
-_FITS = lut_baker("numerics.cache").LRUCache(FIT_CACHE_SIZE)
+    if group is None:
+        group = bpy.data.node_groups.get(group_name(tier, record["key"], method))
+    return _build(work, tier, group), work.fitted()[1]
 
 
 def clear_cache() -> None:
     """Forget the session's fits and re-baked tables (the add-on's unregister calls it)."""
-    _FITS.clear()
+    fits.clear()
     storage.clear_cache()
-
-
-def _fit(tables, key: str, errors_at, progress=None):
-    """The closure fit of ``tables`` (cached by key), its errors measured at ``errors_at``."""
-    cf = lut_baker("closures.fitting")
-    fit = _FITS.get(key)
-    if fit is None:
-        fit = cf.fit_closures(tables, errors_at=errors_at, progress=progress)
-    elif errors_at is not None:
-        fit = dataclasses.replace(fit, errors=cf.tier_errors(fit, tables, *errors_at))
-    _FITS.put(key, fit)
-    return fit
-
-
-def ensure_group(skin, tier: str, resolution: str = "default", *, progress=None, **options):
-    """Bake ``skin`` at ``resolution`` and return ``(group, tables, fit or None)``
-    (:func:`group_for_tables` for the rest); ``progress``: a :class:`_Progress` or None."""
-    tables = lut_baker("bake").bake(skin, resolution, progress=_stage(progress, 0.0,
-                                                                      BAKE_SHARE))
-    bake = storage.bake_record(skin, resolution, tables)
-    group, fit = group_for_tables(tables, tier, bake=bake,
-                                  progress=_stage(progress, BAKE_SHARE, 1.0), **options)
-    return group, tables, fit
 
 
 def group_of(material):
@@ -254,11 +334,33 @@ def _material_for(obj):
     return material
 
 
+def _record_errors(material, measured: dict, key: str) -> None:
+    """The measurement's tier errors and gloss omissions on the material
+    (:data:`.keys.ERRORS_KEY`), for the panel and the Auto tier."""
+    omission = (measured.get("traits") or {}).get("gloss_omission") or {}
+    material[ERRORS_KEY] = json.dumps({
+        tier: {"rms": e["rms"], "albedo": e["albedo"], "coverage": measured["coverage"],
+               "absorption": list(measured["absorption"]),
+               "gloss_omission": omission.get(tier, {}), "key": key}
+        for tier, e in measured["errors"].items()})
+
+
+def _record_auto(material, auto) -> None:
+    """What Tier = Auto chose (:data:`.keys.AUTO_KEY`), or nothing kept for a fixed tier."""
+    if auto is not None:
+        material[AUTO_KEY] = json.dumps(auto)
+    elif AUTO_KEY in material:
+        del material[AUTO_KEY]
+
+
 def apply_to_object(context, obj, *, resolution=None) -> tuple:
-    """Bake, fit, build or reuse the group, and make it the surface of ``obj``'s active
-    material, converted in place (:func:`setup_material`); an object without a material
-    gets a new one.  Returns ``(material, messages)``: the report's sentences (what was
-    carried over, how many objects share the material).
+    """Find or build the group for the settings of ``obj``'s active material and make it the
+    material's surface, converted in place (:func:`setup_material`); an object without a
+    material gets a new one.  Returns ``(material, messages)``: the report's sentences (what
+    was carried over, how many objects share the material).
+
+    Settings Apply has seen before (the same bake, tier and method, in this file) reuse their
+    group: nothing is baked, fitted or hashed.
 
     Raises
     ------
@@ -271,24 +373,15 @@ def apply_to_object(context, obj, *, resolution=None) -> tuple:
     settings = material.makeup_skin
     first = not settings.is_made_up or group_of(material) is None
     scene = context.scene
-    tier = resolve_tier(settings, scene)
-    absorption = settings.effective_absorption()
+    record = storage.bake_record(skin_from_settings(settings),
+                                 resolution or settings.resolution)
     messages = []
     with _Progress(context) as progress:
-        group, tables, fit = ensure_group(
-            skin_from_settings(settings), tier, resolution or settings.resolution,
-            progress=progress, errors_at=(settings.coverage, absorption),
-            method=forced_method(settings), messages=messages)
-    if fit is not None:
-        omission = lut_baker("auto_tier").gloss_omissions(tables, fit, settings.coverage,
-                                                            absorption)
-        key = nodes.read_meta(group)["key"]  # the group's bake: no second hash of the tables
-        material[ERRORS_KEY] = json.dumps({name: {"rms": e.rms, "albedo": e.albedo,
-                                                  "coverage": e.coverage,
-                                                  "absorption": list(e.absorption),
-                                                  "gloss_omission": omission[name],
-                                                  "key": key}
-                                           for name, e in fit.errors.items()})
+        work = _Bake(record, forced_method(settings), settings.coverage,
+                     settings.effective_absorption(), progress)
+        group, measured, _, auto = _group_for(material, settings, scene, work, messages)
+    _record_errors(material, measured, record["key"])
+    _record_auto(material, auto)
     carried = setup_material(material, group, scene)
     settings.is_made_up = True
     if first:
@@ -319,18 +412,23 @@ def rebuild_from_settings(context, material, group, resolution: str) -> None:
     of it) in place and make it the material's surface: the live preview's re-bake, and Check
     Tables' repair when the group's record cannot be used."""
     settings = material.makeup_skin
+    record = storage.bake_record(skin_from_settings(settings), resolution)
     with _Progress(context) as progress:
-        group, _, _ = ensure_group(skin_from_settings(settings),
-                                   resolve_tier(settings, context.scene), resolution,
-                                   progress=progress, group=group,
-                                   method=forced_method(settings))
+        work = _Bake(record, forced_method(settings), settings.coverage,
+                     settings.effective_absorption(), progress)
+        group, measured, _, auto = _group_for(material, settings, context.scene, work, [],
+                                              group=group)
+    _record_errors(material, measured, record["key"])
+    _record_auto(material, auto)
     setup_material(material, group, context.scene)
 
 
 def check_material(context, material) -> tuple[bool, str]:
-    """Verify a made-up material: its group's record re-bakes to the recorded tables and every
-    image the render reads matches its recorded hash; repair what is not by re-baking.
-    Returns ``(intact, one sentence for the report)``."""
+    """Verify a made-up material: its group's bake record is readable and its own (its key
+    is the hash of its parameters and resolution) and every image the render reads matches
+    its recorded hash; repair what is not, from the record (or, if it is unusable, from the
+    panel's settings).  Nothing is baked when all is intact.  Returns ``(intact, one
+    sentence for the report)``."""
     name = material.name
     node = group_of(material)
     if node is None or node.node_tree is None:
@@ -346,19 +444,19 @@ def check_material(context, material) -> tuple[bool, str]:
         return False, (f"{name!r}: its group's record is unreadable or from an older "
                        f"version; re-baked it from the panel's settings.")
     try:
-        tables, key = storage.rebake(meta)
-    except storage.StorageError as error:
+        key = storage.bake_key(meta["parameters"], meta.get("resolution", "default"))
+    except (TypeError, ValueError):
+        key = None
+    if key != meta.get("key"):
         rebuild_from_settings(context, material, group, material.makeup_skin.resolution)
-        return False, f"{name!r}: {error}; re-baked it from the panel's settings."
+        return False, (f"{name!r}: its group's bake record does not match its key; re-baked "
+                       f"it from the panel's settings.")
     problems = storage.image_problems(meta.get("images", []))
-    note = ("" if key == meta.get("key") else
-            " (the tables re-baked here differ from the recorded ones in their last bits: this "
-            "numpy rounds differently)")
     if not problems and nodes.has_interface(group):
-        return True, f"{name!r}: intact{note}."
-    bake = {"key": key, "parameters": meta["parameters"],
-            "resolution": meta.get("resolution", "default")}
-    group_for_tables(tables, meta.get("tier", "LAYERED"), bake=bake, group=group,
-                     method=meta.get("forced_method"))
+        return True, f"{name!r}: intact."
+    settings = material.makeup_skin
+    work = _Bake({k: meta[k] for k in ("key", "parameters", "resolution")},
+                 meta.get("forced_method"), settings.coverage, settings.effective_absorption())
+    _build(work, meta.get("tier", "LAYERED"), group)
     what = "; ".join(problems) if problems else "its inputs were of an older version"
-    return False, f"{name!r}: {what}; rebuilt it from a re-bake{note}."
+    return False, f"{name!r}: {what}; rebuilt it from a re-bake."

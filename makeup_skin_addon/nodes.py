@@ -45,8 +45,8 @@ from . import storage
 from .keys import FIT_KEY, LEGACY_TABLES_REF, group_name, lut_image_name
 from .package import lut_baker
 
-__all__ = ["INPUTS", "NORMAL_INPUTS", "build_group", "read_meta", "set_inputs", "socket",
-           "has_interface"]
+__all__ = ["INPUTS", "NORMAL_INPUTS", "build_group", "read_meta", "write_measured",
+           "set_inputs", "socket", "has_interface"]
 
 INPUTS = (
     # name, socket type, default, min, max, subtype, description
@@ -231,7 +231,8 @@ def _common(build: _Builder):
 def _build_principled(build: _Builder, fit, method: str, radius_mm, ior: float):
     cf = lut_baker("closures.fitting")
     inputs, output, w, through, through2, skin, scale, gloss = _common(build)
-    coat_weight = build.math("MULTIPLY", w, gloss, label="coat weight")
+    coat_weight = build.math("MULTIPLY", build.math("MULTIPLY", w, gloss), fit.coat.level,
+                             label="coat weight")
     made_skin = build.vector("MULTIPLY", build.vector("MULTIPLY", through2, skin),
                              tuple(fit.transmittance_mean**2), label="skin through film")
     made_total = build.vector("ADD", build.vector("MULTIPLY", through, tuple(fit.film_albedo)),
@@ -359,12 +360,14 @@ def _build_layered(build: _Builder, fit, lut, method: str, radius_mm, ior: float
     build.tree.links.new(mix.outputs[0], output.inputs["Shader"])
 
 
-def build_group(tier: str, bake: dict, fit, group=None, *, method=None):
+def build_group(tier: str, bake: dict, fit, group=None, *, method=None, measured=None):
     """Create (or, given ``group``, rebuild in place) the node group of ``tier`` from a
     :class:`ClosureFit` ``fit`` of the tables that ``bake`` describes (its record,
     :func:`storage.bake_record`).  ``method``: a subsurface method forced by the user, else the
-    fit's choice.  The group's :data:`.keys.FIT_KEY` holds the bake record, the fit's summary
-    and the SHA-256 of every image the group reads (:func:`storage.image_record`)."""
+    fit's choice.  The group's :data:`.keys.FIT_KEY` holds the bake record, the fit's summary,
+    the SHA-256 of every image the group reads (:func:`storage.image_record`) and
+    ``measured``, what the fit measured at the settings' coverage and absorption
+    (:func:`.fits.measure`), if given."""
     cf = lut_baker("closures.fitting")
     if tier not in cf.TIERS:
         raise ValueError(f"tier must be one of {cf.TIERS}, got {tier!r}")
@@ -391,10 +394,16 @@ def build_group(tier: str, bake: dict, fit, group=None, *, method=None):
         _build_layered(build, fit, lut, method, radius, ior)
     group[FIT_KEY] = json.dumps({**bake, "tier": tier, "forced_method": forced,
                                  "images": images, **fit.summary(),
-                                 "subsurface_method": method}, default=float)
+                                 "subsurface_method": method, "measured": measured},
+                                default=float)
     if LEGACY_TABLES_REF in group:  # an older add-on kept the whole tables in the file
         del group[LEGACY_TABLES_REF]
     return group
+
+
+def write_measured(group, measured: dict) -> None:
+    """Replace the measurement a group's record keeps (:func:`.fits.measure`)."""
+    group[FIT_KEY] = json.dumps({**read_meta(group), "measured": measured}, default=float)
 
 
 def read_meta(group) -> dict:

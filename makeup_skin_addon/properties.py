@@ -95,6 +95,8 @@ def _update_foundation(self, context):
         # Assigning runs _update_sockets once more: the shade reaches the material at once.
         self.absorption = entry["absorption"]
         self.foundation_colour = [1.0 - a for a in entry["absorption"]]
+    # The film's gloss, roughness and index change the tables: a debounced preview re-fit.
+    _update_tables(self, context)
 
 
 class MakeupSkinSettings(bpy.types.PropertyGroup):
@@ -154,8 +156,9 @@ class MakeupSkinSettings(bpy.types.PropertyGroup):
     film_lobe_width: bpy.props.FloatProperty(
         name="Film Roughness", default=math.radians(30.4), min=math.radians(5.0),
         max=math.radians(60.0), subtype="ANGLE", unit="ROTATION",
-        description="Width of the film's gloss lobe (1/n of the paper's Torrance-Sparrow "
-                    "lobe; measured 30.4 degrees; the transmission lobe scales with it)",
+        description="Width of the film's surface gloss (1/n of the paper's Torrance-Sparrow "
+                    "lobe; measured 30.4 degrees); the light crossing the film keeps the "
+                    "foundation's spread",
         update=_update_tables)
     film_ior: bpy.props.FloatProperty(
         name="Film IOR", default=1.19, min=1.01, max=2.5,

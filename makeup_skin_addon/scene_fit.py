@@ -3,16 +3,16 @@
 What the scene looks like to the model (:class:`lut_baker.auto_tier.SceneDescription`) comes
 from the active camera, the render resolution, the objects wearing the material (the nearest
 one: the largest on screen), the lights and the render engine; what the material is
-(:class:`lut_baker.auto_tier.MaterialTraits`) from its tables (re-baked from its group's
-record) and the tiers' errors of its last Apply.  :func:`lut_baker.auto_tier.choose` then
-picks the cheapest candidate within the tolerance.
+(:class:`lut_baker.auto_tier.MaterialTraits`) from what its closure fit measured at its
+coverage and absorption (kept in its group's record, :mod:`.fits`).
+:func:`lut_baker.auto_tier.choose` then picks the cheapest candidate within the tolerance.
 
 - :func:`units_per_mm` -- scene units in one millimetre, from the scene's unit scale.
-- :func:`auto_tier` -- the tier for ``Tier = Auto`` (called by
-  :func:`makeup_skin_addon.material.resolve_tier`; quick, never raises).
 - :func:`describe_scene` -- the scene as the model sees it (None without a camera or object).
-- :func:`material_traits` -- the material as the model sees it (cached per tables).
-- :func:`choose_for` -- the choice for a material in a scene.
+- :func:`material_traits` -- the material as the model sees it.
+- :func:`choose_with` -- the choice for a material of given traits in a scene (Apply's Auto
+  tier: the traits of the foundation being applied); :func:`choose_for` -- the same with the
+  material's own traits (Fit to Scene).
 - :func:`set_choice` -- a choice's settings on the material: the tier, Subsurface Scale 0 when
   the scene does not resolve the subsurface, Gloss 0 when the gloss lobes change the image by
   less than the tolerance allows (below the noise); the values before are kept and given back
@@ -30,12 +30,12 @@ from __future__ import annotations
 import json
 import math
 
-from . import convert, nodes, storage
-from .keys import CHOICE_KEY, ERRORS_KEY, SAVED_GLOSS_KEY, SAVED_SCALE_KEY
+from . import convert, fits, nodes, storage
+from .keys import CHOICE_KEY, SAVED_GLOSS_KEY, SAVED_SCALE_KEY
 from .package import lut_baker
 
-__all__ = ["ENVIRONMENT_LIGHT_DEG", "units_per_mm", "auto_tier", "describe_scene",
-           "material_traits", "choose_for", "set_choice", "record_choice", "last_choice",
+__all__ = ["ENVIRONMENT_LIGHT_DEG", "units_per_mm", "describe_scene", "material_traits",
+           "choose_with", "choose_for", "set_choice", "record_choice", "last_choice",
            "register", "unregister"]
 
 ENVIRONMENT_LIGHT_DEG = 45.0
@@ -142,58 +142,37 @@ def describe_scene(scene, material=None, obj=None):
                                engine=_engine(scene), samples=samples, denoise=denoise)
 
 
-TRAITS_CACHE_SIZE = 16
-"""Material traits kept in this session (:func:`material_traits`, by all they depend on)."""
-_TRAITS = lut_baker("numerics.cache").LRUCache(TRAITS_CACHE_SIZE)
-
-
-def _stored_errors(material, coverage, absorption, key=None):
-    """``(tier errors (rms), gloss omissions or None)`` of the last Apply if measured at this
-    coverage and absorption (and, when stored, for the tables ``key``: a preview re-bake
-    since then changed the tables), else ``(None, None)``."""
-    try:
-        errors = json.loads(material.get(ERRORS_KEY, "{}"))
-    except ValueError:
-        return None, None
-    if not errors:
-        return None, None
-    first = next(iter(errors.values()))
-    same = (first.get("key", key) == key
-            and math.isclose(first.get("coverage", -1.0), coverage, abs_tol=1e-6)
-            and all(math.isclose(a, b, abs_tol=1e-6)
-                    for a, b in zip(first.get("absorption", []), absorption, strict=False)))
-    if not same:
-        return None, None
-    omission = {tier: {float(angle): float(value)
-                       for angle, value in e["gloss_omission"].items()}
-                for tier, e in errors.items() if "gloss_omission" in e}
-    return ({tier: float(e["rms"]) for tier, e in errors.items()},
-            omission if len(omission) == len(errors) else None)
-
-
 def _meta(material) -> dict:
-    """The material's group's record (its bake, subsurface method, profile fits), or {}."""
+    """The material's group's record (its bake, subsurface method, measurement), or {}."""
     node = convert.group_node(material)
     return nodes.read_meta(node.node_tree) if node is not None else {}
 
 
-def _tables(meta):
-    """The tables re-baked from the record, or None if it has none or cannot be re-baked."""
+def _measurement(meta: dict, coverage: float, absorption, *, may_fit: bool):
+    """What the group's fit measured at this coverage and absorption: kept in its record, or
+    measured now from this session's fit, or (``may_fit``) from a new bake and fit; None
+    when none of these can be had."""
+    measured = fits.measured_at(meta, coverage, absorption, with_traits=True)
+    if measured is not None or "parameters" not in meta:
+        return measured
+    method = meta.get("forced_method")
     try:
-        return storage.rebake(meta)[0]
+        got = fits.cached(meta, method)
+        if got is None and may_fit:
+            got = fits.baked(meta, method=method, errors_at=(coverage, absorption))
     except storage.StorageError:
         return None
+    if got is None:
+        return None
+    return fits.measure(*got, coverage, absorption, method=meta.get("subsurface_method"))
 
 
 def material_traits(material, *, refit: bool = False, may_fit: bool = True):
     """The :class:`lut_baker.auto_tier.MaterialTraits` of a made-up material at its coverage
     and absorption, the Subsurface Scale and Gloss applied (the values Fit to Scene saved if
-    it set them to 0).  From its re-baked tables: the profile, the shares of gloss and skin
-    light, the profile mismatch of the group's subsurface method; the tier errors and gloss
-    omissions of the last Apply, or (``refit``, or none stored for this coverage and
-    absorption) of a new closure fit (a few seconds; without ``may_fit``, as when a panel
-    draws, the paper preset's tier errors and the tables' gloss share instead).  Without
-    tables: the paper preset's traits."""
+    it set them to 0): what its group's fit measured there (:mod:`.fits`; ``refit``: measured
+    again rather than read from the record; without ``may_fit`` never a new bake or fit).
+    Without either: the paper preset's traits."""
     sm = lut_baker("auto_tier")
     settings = material.makeup_skin
     coverage = float(settings.coverage)
@@ -201,64 +180,43 @@ def material_traits(material, *, refit: bool = False, may_fit: bool = True):
     scale = _kept_value(material, "subsurface_scale", SAVED_SCALE_KEY)
     gloss = _kept_value(material, "gloss", SAVED_GLOSS_KEY)
     meta = _meta(material)
-    errors, omission = (None, None) if refit else _stored_errors(material, coverage,
-                                                                 absorption, meta.get("key"))
-    key = (meta.get("key"), meta.get("subsurface_method"), coverage, tuple(absorption),
-           None if errors is None else tuple(sorted(errors.items())), omission is not None,
-           scale, gloss, may_fit)
-    traits = _TRAITS.get(key)
-    tables = _tables(meta) if traits is None and meta else None
-    if traits is None and tables is None:
-        traits = (sm.paper_traits() if (scale, gloss) == (1.0, 1.0)
-                  else sm.paper_traits().scaled(scale, gloss))
-    elif traits is None:
-        if errors is None and may_fit:
-            fit = lut_baker("closures.fitting").fit_closures(tables,
-                                                        errors_at=(coverage, absorption))
-            errors = {tier: float(e.rms) for tier, e in fit.errors.items()}
-            omission = sm.gloss_omissions(tables, fit, coverage, absorption)
-        elif errors is None:
-            errors = dict(sm.PAPER_TIER_ERRORS)
-        method = meta.get("subsurface_method")
-        profile_error = meta.get("profiles", {}).get(method, {}).get("error", [0.0])
-        shares = {angle: sm.gloss_and_skin_shares(tables, angle, coverage, absorption)
-                  for angle in sm.SHARE_LIGHTS_DEG}
-        traits = sm.MaterialTraits(
-            tier_errors=errors, radius_mm=tables.radius_mm, profile=tables.profile,
-            profile_mismatch=sm.profile_mismatch(tables, profile_error),
-            skin_share={a: v[1] for a, v in shares.items()},
-            gloss_share={a: v[0] for a, v in shares.items()}, subsurface_scale=scale,
-            gloss_omission=omission, gloss_scale=gloss)
-    _TRAITS.put(key, traits)
-    return traits
+    if refit:
+        meta = {key: value for key, value in meta.items() if key != "measured"}
+    measured = _measurement(meta, coverage, absorption, may_fit=may_fit)
+    traits = fits.traits(measured) if measured is not None else None
+    return (traits or sm.paper_traits()).scaled(scale, gloss)
 
 
-def choose_for(material, scene, *, obj=None, tolerance=None, refit=False, may_fit=True):
-    """``(Choice, SceneDescription or None)`` for ``material`` in ``scene`` (an unknown scene
-    counts as a close-up: :data:`UNKNOWN_SCENE`); ``refit``, ``may_fit``: as
-    :func:`material_traits`."""
+def _unknown_scene(scene):
+    samples, denoise = _samples(scene)
+    return lut_baker("auto_tier").SceneDescription(engine=_engine(scene), samples=samples,
+                                                   denoise=denoise, **UNKNOWN_SCENE)
+
+
+def choose_with(traits, material, scene, *, obj=None, tolerance=None):
+    """``(Choice, SceneDescription or None)`` for a material of ``traits`` (the Subsurface
+    Scale and Gloss of its settings applied here) in ``scene`` (an unknown scene counts as a
+    close-up: :data:`UNKNOWN_SCENE`)."""
     sm = lut_baker("auto_tier")
     description = describe_scene(scene, material, obj)
-    chosen_scene = description
-    if chosen_scene is None:
-        samples, denoise = _samples(scene)
-        chosen_scene = sm.SceneDescription(engine=_engine(scene), samples=samples,
-                                           denoise=denoise, **UNKNOWN_SCENE)
+    scale = _kept_value(material, "subsurface_scale", SAVED_SCALE_KEY)
+    gloss = _kept_value(material, "gloss", SAVED_GLOSS_KEY)
     tolerance = sm.DEFAULT_TOLERANCE if tolerance is None else tolerance
-    choice = sm.choose(chosen_scene, material_traits(material, refit=refit, may_fit=may_fit),
+    choice = sm.choose(description or _unknown_scene(scene), traits.scaled(scale, gloss),
                        tolerance=tolerance)
     return choice, description
 
 
-def auto_tier(settings, scene) -> str:
-    """The add-on tier of the Auto choice for the material of ``settings`` in ``scene``
-    (:func:`choose_for`); on any failure the former rule: Layered in Cycles, else
-    Principled."""
-    material = settings.id_data
-    try:
-        return choose_for(material, scene, may_fit=False)[0].candidate.tier
-    except Exception:  # the panel calls this while drawing: never fail there
-        return "LAYERED" if scene.render.engine == "CYCLES" else "PRINCIPLED"
+def choose_for(material, scene, *, obj=None, tolerance=None, refit=False, may_fit=True):
+    """:func:`choose_with` the material's own traits (:func:`material_traits`; ``refit``,
+    ``may_fit`` as there)."""
+    sm = lut_baker("auto_tier")
+    description = describe_scene(scene, material, obj)
+    tolerance = sm.DEFAULT_TOLERANCE if tolerance is None else tolerance
+    choice = sm.choose(description or _unknown_scene(scene),
+                       material_traits(material, refit=refit, may_fit=may_fit),
+                       tolerance=tolerance)
+    return choice, description
 
 
 def set_choice(material, candidate) -> list[str]:
@@ -337,5 +295,4 @@ def register():
 
 
 def unregister():
-    """Forget the session's material traits."""
-    _TRAITS.clear()
+    """Nothing to forget: the session's fits are :mod:`.fits`'."""

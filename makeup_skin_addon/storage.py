@@ -2,15 +2,17 @@
 its bake, never the tables themselves.
 
 A bake is identified by its record (:func:`bake_record`): the made-up skin's parameters, the
-resolution name and the tables' content hash.  Baking is deterministic and takes a fraction of
-a second, so the tables are re-baked from the record when Check Tables or a re-fit needs them
-(:func:`rebake`, cached for the session) instead of travelling in every saved file.  The
+resolution name and their key (:func:`bake_key`, a hash of those two and of the tables' format:
+the same settings give the same key on any machine, without baking).  Baking is deterministic
+and takes a fraction of a second, so the tables are re-baked from the record when Check Tables
+or a re-fit needs them (:func:`rebake`, cached for the session) instead of travelling in every
+saved file.  The
 images a group reads (the Layered tier's view-angle image) are packed, and the group records
 the SHA-256 of their pixels and of their packed bytes (:func:`image_record`), so damage is
 found before Blender decodes the image (:func:`image_problem`).
 
-- :func:`tables_key` -- content hash of tables (hex; :func:`lut_baker.tables.codec.content_hash`).
-- :func:`bake_record`, :func:`rebake` -- a bake's record, and the tables again from it.
+- :func:`bake_key`, :func:`bake_record`, :func:`rebake` -- a bake's key and record, and the
+  tables again from it.
 - :func:`lut_image` -- the Layered tier's view-angle image (named by
   :func:`.keys.lut_image_name`).
 - :func:`image_record`, :func:`image_problem` -- an image's hashes, and what is wrong with it;
@@ -30,8 +32,9 @@ from .package import lut_baker
 
 __all__ = [
     "StorageError",
-    "tables_key",
+    "bake_key",
     "bake_record",
+    "remember",
     "rebake",
     "clear_cache",
     "lut_image",
@@ -42,23 +45,31 @@ __all__ = [
 ]
 
 REBAKE_CACHE_SIZE = 8
-"""Re-baked tables kept per content hash in this session."""
+"""Re-baked tables kept per bake key in this session."""
+KEY_LENGTH = 16
+"""Hex digits of a bake key (64 bits: no two bakes of one file collide)."""
 
 
 class StorageError(ValueError):
     """A bake record cannot be re-baked; the message says why, as a sentence's end."""
 
 
-def tables_key(tables) -> str:
-    """The tables' content hash (SHA-256 hex of their float32 atlas,
-    :mod:`lut_baker.tables.codec`)."""
-    return lut_baker("tables.codec").content_hash(tables)
+def bake_key(parameters: dict, resolution: str) -> str:
+    """The key of a bake: SHA-256 (first :data:`KEY_LENGTH` hex digits) of the made-up skin's
+    ``parameters`` (:func:`lut_baker.model.params_file.skin_to_dict`), the resolution name and
+    the tables' format version, as canonical JSON (floats by ``repr``: the same on every
+    machine)."""
+    version = lut_baker("tables.table_set").FORMAT_VERSION
+    text = json.dumps({"parameters": parameters, "resolution": str(resolution),
+                       "format": version}, sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(text.encode("utf-8")).hexdigest()[:KEY_LENGTH]
 
 
-def bake_record(skin, resolution: str, tables) -> dict:
-    """What identifies a bake: ``{"key", "parameters", "resolution"}`` (plain data)."""
-    return {"key": tables_key(tables),
-            "parameters": lut_baker("model.params_file").skin_to_dict(skin),
+def bake_record(skin, resolution: str) -> dict:
+    """What identifies a bake: ``{"key", "parameters", "resolution"}`` (plain data, no bake
+    needed)."""
+    parameters = lut_baker("model.params_file").skin_to_dict(skin)
+    return {"key": bake_key(parameters, resolution), "parameters": parameters,
             "resolution": str(resolution)}
 
 
@@ -70,31 +81,40 @@ def clear_cache() -> None:
     _TABLES.clear()
 
 
-def rebake(record: dict):
-    """``(tables, key)``: the tables re-baked from a :func:`bake_record` and their content hash,
-    which a different numpy build may round to other than the recorded ``record["key"]``.
+def remember(record: dict, tables) -> None:
+    """Keep ``tables`` as this session's bake of ``record`` (for a caller that baked them
+    itself: tests and tools)."""
+    _TABLES.put(record["key"], tables)
+
+
+def rebake(record: dict, *, progress=None):
+    """The tables of a :func:`bake_record`, baked once per session (cached by key);
+    ``progress(fraction, message)``: the bake's, when it runs.
 
     Raises
     ------
     StorageError
-        If the record has no readable parameters or resolution.
+        If the record has no readable parameters or resolution, or its key is not theirs.
     """
-    key = record.get("key")
-    cache_key = json.dumps([key, record.get("parameters"), record.get("resolution")],
-                           sort_keys=True, default=str)
-    cached = _TABLES.get(cache_key)
-    if cached is not None:
-        return cached, key
+    try:
+        key = bake_key(record["parameters"], record["resolution"])
+    except (KeyError, TypeError, ValueError):
+        raise StorageError("its bake record cannot be read (a parameter or the resolution is "
+                           "missing)") from None
+    if key != record.get("key"):
+        raise StorageError("its bake record does not match its key (it was edited, or written "
+                           "by another version)")
+    tables = _TABLES.get(key)
+    if tables is not None:
+        return tables
     try:
         skin = lut_baker("model.params_file").skin_from_dict(record["parameters"])
-        tables = lut_baker("bake").bake(skin, record["resolution"])
+        tables = lut_baker("bake").bake(skin, record["resolution"], progress=progress)
     except (KeyError, TypeError, ValueError):
         raise StorageError("its bake record cannot be re-baked (a parameter is missing or "
                            "unreadable)") from None
-    rebaked = tables_key(tables)
-    if rebaked == key:
-        _TABLES.put(cache_key, tables)
-    return tables, rebaked
+    _TABLES.put(key, tables)
+    return tables
 
 
 def _new_float_image(name: str, width: int, height: int) -> bpy.types.Image:

@@ -12,7 +12,7 @@ import bpy
 
 from . import material as made_up
 from . import scene_fit
-from .keys import CLASS_PREFIX, ERRORS_KEY, FIT_KEY
+from .keys import AUTO_KEY, CLASS_PREFIX, ERRORS_KEY, FIT_KEY
 from .operators import (
     MAKEUPSKIN_MT_presets,
     MAKEUPSKIN_OT_add_preset,
@@ -36,6 +36,18 @@ def _errors_text(material) -> list[str]:
         lines.append(f"{tier.title()}: {100 * error['rms']:.1f}% RMS, "
                      f"albedo {100 * error['albedo']:.1f}%")
     return lines
+
+
+def _auto_text(material) -> str:
+    """What Tier = Auto chose at the last Apply (:data:`.keys.AUTO_KEY`): the panel shows it,
+    it never chooses (choosing may need a bake)."""
+    try:
+        auto = json.loads(material.get(AUTO_KEY, "{}"))
+    except ValueError:
+        auto = {}
+    if "tier" not in auto:
+        return "Auto: chosen at Apply"
+    return f"Auto: {auto['tier'].title()} (at the last Apply)"
 
 
 def node_input_linked(node, name: str) -> bool:
@@ -85,8 +97,7 @@ def draw_settings(layout, context) -> None:
     col.separator()
     col.prop(settings, "tier")
     if settings.tier == "AUTO":
-        col.label(text=f"Auto: {made_up.resolve_tier(settings, context.scene).title()}",
-                  icon="INFO")
+        col.label(text=_auto_text(material), icon="INFO")
     col.prop(settings, "resolution")
     col.prop(settings, "live_update")
     row = layout.row(align=True)

@@ -15,13 +15,15 @@ Functions
 - :func:`ashikhmin_shirley_reflection` -- Cycles' Ashikhmin-Shirley Glossy lobe.
 - :func:`microfacet_shadowing` -- height-correlated ``G2 = 1 / (1 + Lambda_i + Lambda_o)``.
 - :func:`microfacet_reflection` -- microfacet BRDF ``D G2 F / (4 cos_i cos_o)`` with a Fresnel
-  callable (Glossy BSDF: none; coat: dielectric; Principled specular: generalised Schlick).
+  callable (Glossy BSDF: none; coat: dielectric; Principled specular: generalised Schlick);
+  :func:`microfacet_from_cosines` -- the Fresnel-free lobe from the four cosines it needs.
 - :func:`dielectric_fresnel`, :func:`schlick_ior_fresnel` -- the Fresnel terms Cycles uses.
 - :func:`directional_albedo` -- ``Int f cos(theta_i) dwi`` of any BRDF at view angles.
 - :func:`microfacet_albedo` -- the same for a microfacet lobe, by quadrature over normals.
 - :func:`layering_albedo` -- Cycles' albedo estimate that attenuates the layers below a coat or
   a specular layer (``bsdf_microfacet_estimate_albedo``).
-- :func:`dielectric_fss`, :func:`ggx_energy_compensation`, :func:`coat_view_terms` -- the
+- :func:`dielectric_fss`, :func:`ggx_energy_compensation` (:func:`ggx_energy_scale` from
+  precomputed albedos, :func:`ggx_average_albedo`), :func:`coat_view_terms` -- the
   multiple-scattering compensation Cycles gives the Principled coat.
 - :func:`lambert_reflection` -- ``albedo / pi``.
 - :func:`view_table` -- a smooth function of the view cosine, tabulated and interpolated.
@@ -62,8 +64,11 @@ __all__ = [
     "ashikhmin_shirley_reflection",
     "microfacet_shadowing",
     "microfacet_reflection",
+    "microfacet_from_cosines",
     "dielectric_fss",
     "ggx_energy_compensation",
+    "ggx_energy_scale",
+    "ggx_average_albedo",
     "coat_view_terms",
     "dielectric_fresnel",
     "schlick_ior_fresnel",
@@ -146,17 +151,39 @@ def ashikhmin_shirley_exponent(roughness):
 
 
 def ashikhmin_shirley_reflection(wi, wo, roughness):
-    """Isotropic Ashikhmin-Shirley lobe without Fresnel (Cycles ``bsdf_ashikhmin_shirley_eval``):
-    ``(e + 1) / (8 pi) (N.H)^e / ((H.wi) max(cos_i, cos_o))``, no cosine; 0 below the surface."""
-    wi, wo = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
-    e = ashikhmin_shirley_exponent(roughness)
-    h = half_vector(wi, wo)
-    h_dot_i = np.maximum(np.abs(np.sum(h * wi, axis=-1)), 1e-6)
-    h_dot_n = np.maximum(h[..., 2], 1e-6)
-    upper = (wi[..., 2] > 0.0) & (wo[..., 2] > 0.0)
-    pump = 1.0 / np.maximum(1e-6, h_dot_i * np.maximum(np.maximum(wi[..., 2], wo[..., 2]),
-                                                           1e-6))
-    return np.where(upper, (e + 1.0) / (8.0 * np.pi) * h_dot_n**e * pump, 0.0)
+    """Isotropic Ashikhmin-Shirley lobe without Fresnel (Cycles ``bsdf_ashikhmin_shirley_eval``)
+    at unit vectors: :func:`microfacet_from_cosines` with ``ASHIKHMIN_SHIRLEY``."""
+    return microfacet_reflection(wi, wo, roughness, distribution="ASHIKHMIN_SHIRLEY")
+
+
+def microfacet_from_cosines(cos_h, cos_hi, cos_i, cos_o, roughness,
+                            distribution: str = "GGX"):
+    """A Glossy lobe without Fresnel (no cosine, 1/sr) from the cosines ``n.h``, ``h.wi``,
+    ``n.wi``, ``n.wo`` (broadcasting; ``roughness`` Blender's socket, clamped to
+    :data:`ROUGHNESS_EPS`); 0 where either direction is below the surface.
+
+    - ``GGX``, ``BECKMANN``: ``D G2 / (4 cos_i cos_o)`` (Cycles ``bsdf_microfacet_eval``);
+    - ``ASHIKHMIN_SHIRLEY``: ``(e + 1) / (8 pi) (n.h)^e / ((h.wi) max(cos_i, cos_o))``
+      (``bsdf_ashikhmin_shirley_eval``).
+    """
+    cos_i, cos_o = np.broadcast_arrays(np.asarray(cos_i, float), np.asarray(cos_o, float))
+    upper = (cos_i > 0.0) & (cos_o > 0.0)
+    if distribution == "ASHIKHMIN_SHIRLEY":
+        e = ashikhmin_shirley_exponent(roughness)
+        h_dot_i = np.maximum(np.abs(cos_hi), 1e-6)
+        h_dot_n = np.maximum(cos_h, 1e-6)
+        pump = 1.0 / np.maximum(1e-6, h_dot_i * np.maximum(np.maximum(cos_i, cos_o), 1e-6))
+        return np.where(upper, (e + 1.0) / (8.0 * np.pi) * h_dot_n**e * pump, 0.0)
+    if distribution not in DISTRIBUTIONS:
+        raise ValueError(f"distribution must be one of {GLOSSY_DISTRIBUTIONS}, got "
+                         f"{distribution!r}")
+    alpha = np.square(max(float(roughness), ROUGHNESS_EPS))
+    safe_i = np.where(upper, cos_i, 1.0)
+    safe_o = np.where(upper, cos_o, 1.0)
+    value = (DISTRIBUTIONS[distribution][0](cos_h, alpha)
+             * microfacet_shadowing(safe_i, safe_o, alpha, distribution)
+             / (4.0 * safe_i * safe_o))
+    return np.where(upper, value, 0.0)
 
 
 def microfacet_shadowing(cos_i, cos_o, alpha, distribution: str = "GGX"):
@@ -205,26 +232,16 @@ def microfacet_reflection(wi, wo, roughness, fresnel=None, distribution: str = "
     ``distribution``: ``GGX``, ``BECKMANN`` or ``ASHIKHMIN_SHIRLEY`` (which takes no Fresnel).
     0 where either direction is below the surface.
     """
-    if distribution == "ASHIKHMIN_SHIRLEY":
-        if fresnel is not None:
-            raise ValueError("the Ashikhmin-Shirley lobe takes no Fresnel in Cycles")
-        return ashikhmin_shirley_reflection(wi, wo, roughness)
+    if distribution == "ASHIKHMIN_SHIRLEY" and fresnel is not None:
+        raise ValueError("the Ashikhmin-Shirley lobe takes no Fresnel in Cycles")
     wi, wo = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
-    alpha = np.square(max(float(roughness), ROUGHNESS_EPS))
-    d_function = DISTRIBUTIONS[distribution][0]
-    cos_i = wi[..., 2]
-    cos_o = wo[..., 2]
     h = half_vector(wi, wo)
-    upper = (cos_i > 0.0) & (cos_o > 0.0)
-    safe_i = np.where(upper, cos_i, 1.0)
-    safe_o = np.where(upper, cos_o, 1.0)
-    value = (d_function(h[..., 2], alpha) * microfacet_shadowing(safe_i, safe_o, alpha,
-                                                                 distribution)
-             / (4.0 * safe_i * safe_o))
-    value = np.where(upper, value, 0.0)
+    cos_hi = np.sum(h * wi, axis=-1)
+    value = microfacet_from_cosines(h[..., 2], cos_hi, wi[..., 2], wo[..., 2], roughness,
+                                    distribution)
     if fresnel is None:
         return value
-    f = np.asarray(fresnel(np.clip(np.sum(h * wi, axis=-1), 0.0, 1.0)))
+    f = np.asarray(fresnel(np.clip(cos_hi, 0.0, 1.0)))
     return (value[..., None] if f.ndim > value.ndim else value) * f
 
 
@@ -344,10 +361,16 @@ def ggx_energy_compensation(cos_view, roughness, fss):
     that attenuates the layers below) and ``1 / E`` in its evaluation.
     """
     cos_view = np.asarray(cos_view, float)
-    e = microfacet_albedo(cos_view, roughness)
-    e_avg = _ggx_average_albedo(float(roughness))
+    return ggx_energy_scale(microfacet_albedo(cos_view, roughness),
+                            ggx_average_albedo(float(roughness)), fss)
+
+
+def ggx_energy_scale(albedo, average_albedo: float, fss):
+    """:func:`ggx_energy_compensation` from the Fresnel-free albedo ``E`` at the views and its
+    cosine-weighted mean ``E_avg`` (so that a fit varying only the Fresnel reuses them)."""
+    e = np.asarray(albedo, float)
     missing = (1.0 - e) / np.maximum(e, 1e-6)
-    f_ms = fss * e_avg / (1.0 - fss * (1.0 - e_avg))
+    f_ms = fss * average_albedo / (1.0 - fss * (1.0 - average_albedo))
     scale = 1.0 + f_ms * missing
     return scale, scale / (1.0 + missing)
 
@@ -363,7 +386,7 @@ def coat_view_terms(cos_view, roughness, ior):
 
 
 @lru_cache(maxsize=64)
-def _ggx_average_albedo(roughness: float) -> float:
+def ggx_average_albedo(roughness: float) -> float:
     """``2 Int E(mu) mu dmu`` of the Fresnel-free GGX albedo (Cycles' ``ggx_Eavg``)."""
     mu, w = gauss_legendre(32)
     return float(2.0 * np.sum(w * mu * microfacet_albedo(mu, roughness)))
@@ -423,25 +446,45 @@ def principled_reflection(wi, wo, inputs: PrincipledInputs):
     else:
         spec = microfacet_reflection(wi, wo, inputs.roughness,
                                      lambda c: schlick_ior_fresnel(c, eta, f0))
-        a_s = 1.0 - np.max(view_table(cos_o, lambda c: layering_albedo(
-            c, inputs.roughness, eta, f0)), axis=-1)
+        a_s = 1.0 - np.max(view_table(cos_o, _layering_nodes(
+            float(inputs.roughness), float(eta), tuple(np.atleast_1d(f0).tolist()))), axis=-1)
         lower = spec + a_s[..., None] * base
     if inputs.coat_weight <= 0.0:
         return lower
     coat = microfacet_reflection(wi, wo, inputs.coat_roughness,
                                  lambda c: dielectric_fresnel(c, inputs.coat_ior))
-    terms = view_table(cos_o, lambda c: np.stack(
-        coat_view_terms(c, inputs.coat_roughness, inputs.coat_ior), axis=-1))
+    terms = view_table(cos_o, _coat_nodes(float(inputs.coat_roughness),
+                                          float(inputs.coat_ior)))
     a_c = np.clip(1.0 - inputs.coat_weight * terms[..., 1], 0.0, 1.0)
     return (inputs.coat_weight * (coat * terms[..., 0])[..., None]
             + a_c[..., None] * lower)
 
 
-def view_table(cos_view: np.ndarray, function, size: int = 64) -> np.ndarray:
+VIEW_TABLE_SIZE = 64
+"""Nodes of :func:`view_table` on ``cos(theta_o)`` in [0, 1]."""
+
+
+@lru_cache(maxsize=64)
+def _layering_nodes(roughness: float, eta: float, f0: tuple) -> np.ndarray:
+    """:func:`layering_albedo` at :func:`view_table`'s nodes (cached: replicas of one fit
+    evaluate it many times)."""
+    f0 = f0[0] if len(f0) == 1 else np.asarray(f0)
+    return layering_albedo(np.linspace(0.0, 1.0, VIEW_TABLE_SIZE), roughness, eta, f0)
+
+
+@lru_cache(maxsize=64)
+def _coat_nodes(roughness: float, ior: float) -> np.ndarray:
+    """:func:`coat_view_terms` at :func:`view_table`'s nodes, ``(size, 2)`` (cached)."""
+    return np.stack(coat_view_terms(np.linspace(0.0, 1.0, VIEW_TABLE_SIZE), roughness, ior),
+                    axis=-1)
+
+
+def view_table(cos_view: np.ndarray, function, size: int = VIEW_TABLE_SIZE) -> np.ndarray:
     """``function`` of the view cosine, tabulated on ``size`` nodes and interpolated linearly
-    (the layering albedos are smooth; tabulating keeps a replica of a large grid cheap)."""
+    (the layering albedos are smooth; tabulating keeps a replica of a large grid cheap);
+    ``function`` may also be the table itself, at those nodes."""
     nodes = np.linspace(0.0, 1.0, size)
-    table = np.asarray(function(nodes))
+    table = np.asarray(function(nodes) if callable(function) else function)
     if table.ndim == 1:
         return np.interp(cos_view, nodes, table)
     return np.stack([np.interp(cos_view, nodes, table[:, c]) for c in range(table.shape[1])],

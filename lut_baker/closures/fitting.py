@@ -7,9 +7,10 @@ tables of :mod:`lut_baker.tables.table_set`, with weights that may depend on the
 
 Tiers
 -----
-``PRINCIPLED``: one Principled BSDF.  Coat = the film's gloss (Coat Weight = coverage, Coat
-Roughness and Coat IOR fitted); specular = the skin's gloss, bare or through the film
-(Roughness and Specular IOR Level fitted per case, mixed by coverage); base colour = the
+``PRINCIPLED``: one Principled BSDF.  Coat = the film's gloss (Coat Weight = coverage; none
+for a film without gloss, or one no coat follows; Coat Roughness and Coat IOR fitted);
+specular = the skin's gloss, bare or through the film (Roughness and Specular IOR Level
+fitted per case, mixed by coverage); base colour = the
 diffuse albedo (film diffuse + skin seen through the film, or bare skin), divided by the mean
 attenuation of the layers above it; Subsurface Weight = the skin's share of it.
 ``LAYERED``: closures added with view-dependent weights: film gloss, path-3 gloss and skin gloss
@@ -23,21 +24,22 @@ specular level; the Glossy colours), and at 0 Cycles allocates none of them.  Th
 below take it as ``gloss``, so the Auto tier predicts a gloss-free candidate from the same
 formulas as the node group (:func:`lut_baker.auto_tier.gloss_omission_error`).
 
-Errors
-------
-On the tables' own grid, with ``f`` the BRDF and ``L = f cos(theta_i)`` the radiance under a
-unit-irradiance light: relative RMS of ``L`` with weights ``sin(theta_i)`` (light directions
-uniform over the hemisphere) times ``cos(theta_o) sin(theta_o)`` (the area a sphere's image
-gives each view angle) times the azimuth step; and the largest relative error of the view
-albedo ``Int f cos(theta_i) dw_i``.
+Grids and errors
+----------------
+Fits and errors run on direction pairs organised by view, the lights around each view's mirror
+direction through their half vector (:mod:`lut_baker.closures.view_grid`), in panels sized by
+the narrowest lobe involved: a 1-degree film gloss costs what a 30-degree one does.  The
+surfaces' gloss is evaluated in closed form there, path 3 looked up in its table.  With ``f``
+the BRDF and ``L = f cos(theta_i)`` the radiance under a unit-irradiance light, the error is the
+relative RMS of ``L`` over lights uniform over the hemisphere and views weighted by the area a
+sphere's image gives them (``cos(theta_o) dw_o``), and the largest relative error of the view
+albedo ``Int f cos(theta_i) dw_i``.  Every search is Brent's, converged far enough
+(:data:`FIT_XTOL`) that a fitted number follows its data continuously.
 
 Functions and types
 -------------------
-- :func:`node_directions`, :func:`angular_weights` -- the tables' nodes as directions, and
-  quadrature weights on them; :class:`NodeGrid` -- both with the cosines the fits reuse.
-- :func:`relative_rms`, :func:`albedo_error`, :func:`view_albedo` -- the error measures.
-- :func:`golden_minimum` -- 1-D bounded minimisation (golden section).
-- :func:`fit_coat`, :func:`fit_specular`, :func:`fit_glossy` -- GGX lobes fitted to a table.
+- :func:`fit_coat`, :func:`fit_specular`, :func:`fit_glossy` -- lobes fitted to an angular
+  part on a :class:`lut_baker.closures.view_grid.ViewGrid`.
 - :func:`edge_response` -- a radial profile's response to a straight shadow edge, on the
   radii of :func:`profile_grid`.
 - :func:`fit_profile`, :func:`fit_profiles` -- Subsurface Radius per channel for a Blender
@@ -57,24 +59,18 @@ from dataclasses import asdict, dataclass, field, replace
 
 import numpy as np
 
-from ..closures import cycles as cc
 from ..model.made_up_skin import coverage_weights
-from ..numerics.geometry import half_vector
-from ..numerics.optimise import golden_minimum
+from ..numerics.cache import LRUCache
+from ..numerics.optimise import brent_minimum, least_squares
 from ..numerics.quadrature import trapezoid_weights
 from ..tables.table_set import Tables
+from . import cycles as cc
+from .view_grid import ERROR_VIEWS, FIT_VIEWS, ViewGrid, view_grid
 
 __all__ = [
     "TIERS",
     "LUT_ROWS",
     "DEFAULT_LUT_SIZE",
-    "node_directions",
-    "angular_weights",
-    "NodeGrid",
-    "relative_rms",
-    "view_albedo",
-    "albedo_error",
-    "golden_minimum",
     "lut_nodes",
     "sample_lut",
     "LobeFit",
@@ -97,7 +93,7 @@ __all__ = [
     "layered_tier_reflection",
     "TIER_REPLICAS",
     "tier_errors",
-    "ERROR_NODE_LIMIT",
+    "lobe_widths_deg",
 ]
 
 TIERS = ("PRINCIPLED", "LAYERED")
@@ -108,10 +104,20 @@ LUT_ROWS = ("film_gloss", "path3_gloss", "skin_gloss", "film_transmittance",
 transmittance ``T(theta_o)`` and the film gloss's Lambertian companion (:func:`fit_glossy`)."""
 DEFAULT_LUT_SIZE = 64
 """Texels per row of the view-angle image (linear filtering between texel centres)."""
-ROUGHNESS_RANGE = (0.2, 1.0)
-"""Roughness (Blender's socket, alpha = roughness^2) searched by the fits.  The lower end
-(alpha = 0.04, a lobe about 2 degrees wide) is below any lobe the tables resolve: the
-narrowest Torrance-Sparrow lobe the bake resolves is 5 degrees wide (alpha ~ 0.11)."""
+ROUGHNESS_RANGE = (0.02, 1.0)
+"""Roughness (Blender's socket, alpha = roughness^2) searched by the fits: from a lobe about
+0.03 degrees wide to the broadest; searched in ``log(roughness)``."""
+ROUGHNESS_SCAN = 7
+"""Evenly spaced ``log(roughness)`` samples that bracket the minimum before Brent's search."""
+SECOND_SCAN = 5
+"""Samples that bracket the second parameter (Coat IOR, Specular IOR Level)."""
+FIT_XTOL = 1e-7
+"""Absolute tolerance of the searches (``log(roughness)``, IOR, level): far below what a render
+shows and far above rounding, so that a fit moves continuously with its data (a 1e-9 change of
+the tables moves it by about 1e-9, never by a search's tolerance)."""
+DISTRIBUTION_MARGIN = 0.02
+"""A Glossy distribution other than GGX is chosen only when its error is this much (relative)
+lower than GGX's: a near tie keeps GGX, so the choice does not flip with rounding."""
 COAT_IOR_RANGE = (1.01, 4.0)
 """Coat IOR searched (the socket's range in Blender)."""
 SPECULAR_LEVEL_RANGE = (0.0, 8.0)
@@ -123,99 +129,14 @@ REPLICA_EDGE_ERROR = {"BURLEY": 0.0035, "RANDOM_WALK": 0.0068, "RANDOM_WALK_SKIN
 replica's at albedo 0.8 (tools/calibrate_subsurface.py, Cycles 5.0.1 and 4.5.15, 256 samples):
 Burley's is the Monte Carlo noise; the random walks add the mismatch of their Burley-shaped
 replica (0.6-1.3% over albedos 0.2-0.95)."""
-FIT_TOLERANCE = 2e-3
-"""Relative bracket width at which the golden-section searches stop."""
 NO_LOBE_ERROR = 0.9
 """A specular fit erring more than this (relative RMS; leaving the lobe out errs 1.0) is
 dropped and its albedo moved to the base colour."""
-FIT_POINTS = 5000
-"""The fits use a subsample of the angular nodes of about this size (the error report uses
-them all)."""
 
 
 # --------------------------------------------------------------------------------------------
-# Grid, weights and error measures
+# The view-angle image
 # --------------------------------------------------------------------------------------------
-def node_directions(tables: Tables, theta_index=None, phi_index=None):
-    """``(wi, wo)`` unit vectors ``(n_theta, n_theta, n_phi, 3)`` of the angular nodes (or of
-    the sub-grid ``theta_index``, ``phi_index``): ``wo`` at azimuth 0, ``wi`` at the node's
-    relative azimuth (:meth:`Tables.node_azimuths`)."""
-    theta = np.radians(np.asarray(tables.theta_deg, float))
-    theta = theta if theta_index is None else theta[theta_index]
-    phi = np.radians(tables.node_azimuths(theta_index, phi_index))
-    n = theta.size
-    ti = np.broadcast_to(theta[:, None, None], phi.shape)
-    to = np.broadcast_to(theta[None, :, None], phi.shape)
-    wi = np.stack([np.sin(ti) * np.cos(phi), np.sin(ti) * np.sin(phi), np.cos(ti)], axis=-1)
-    wo = np.stack([np.sin(to), np.zeros_like(to), np.cos(to)], axis=-1)
-    assert wi.shape == (n, n, phi.shape[-1], 3)
-    return wi, wo
-
-
-def _azimuth_weights(tables: Tables, theta_index, phi_index) -> np.ndarray:
-    """Trapezoid weights of the nodes' actual (warped) azimuths, ``(n, n, p)``, doubled for the
-    other half turn.  Where ``theta_i`` or ``theta_o`` is 0 nothing depends on azimuth and the
-    nodes collapse to one azimuth: they share the full turn evenly."""
-    azimuth = np.radians(tables.node_azimuths())[np.ix_(theta_index, theta_index, phi_index)]
-    weights = 2.0 * trapezoid_weights(azimuth, axis=-1)
-    even = 2.0 * trapezoid_weights(np.linspace(0.0, np.pi, len(phi_index)))
-    theta = np.asarray(tables.theta_deg, float)[theta_index]
-    flat = (theta[:, None] == 0.0) | (theta[None, :] == 0.0)
-    return np.where(flat[..., None], even, weights)
-
-
-def angular_weights(tables: Tables, theta_index=None, phi_index=None) -> np.ndarray:
-    """Quadrature weights ``(n_theta, n_theta, n_phi)`` of the angular nodes:
-    ``sin(theta_i) dtheta_i`` x ``cos(theta_o) sin(theta_o) dtheta_o`` x ``2 dphi`` (azimuth on
-    [0, 180] degrees counted twice), trapezoid rule on the actual (warped) azimuths.
-    ``theta_index``, ``phi_index``: integer arrays picking a sub-grid (its own weights)."""
-    theta_index = np.arange(tables.theta_deg.size) if theta_index is None else theta_index
-    phi_index = np.arange(tables.phi_deg.size) if phi_index is None else phi_index
-    theta = np.radians(np.asarray(tables.theta_deg, float))[theta_index]
-    dtheta = trapezoid_weights(theta)
-    w_i = np.sin(theta) * dtheta
-    w_o = np.cos(theta) * np.sin(theta) * dtheta
-    return w_i[:, None, None] * w_o[None, :, None] * _azimuth_weights(tables, theta_index,
-                                                                       phi_index)
-
-
-def relative_rms(f_fit, f_ref, tables: Tables, weights=None, cos_i=None) -> float:
-    """Relative RMS of the radiance ``f cos(theta_i)`` over the angular nodes (module
-    docstring), all channels pooled.  ``f_*``: ``(n_theta, n_theta, n_phi[, 3])``, or a
-    sub-grid's with its ``weights`` and polar cosines ``cos_i``."""
-    weights = angular_weights(tables) if weights is None else weights
-    cos_i = np.cos(np.radians(np.asarray(tables.theta_deg, float))) if cos_i is None else cos_i
-    cos_i = cos_i[:, None, None]
-    f_fit, f_ref = np.asarray(f_fit, float), np.asarray(f_ref, float)
-    if f_ref.ndim == 4:
-        cos_i, weights = cos_i[..., None], weights[..., None]
-    num = np.sum(weights * np.square((f_fit - f_ref) * cos_i))
-    den = np.sum(weights * np.square(f_ref * cos_i))
-    return float(np.sqrt(num / den)) if den > 0 else float(np.sqrt(num))
-
-
-def view_albedo(f, tables: Tables, theta_index=None, phi_index=None) -> np.ndarray:
-    """``Int f cos(theta_i) dw_i`` per view angle ``theta_o`` of the nodes: ``(n_theta[, 3])``
-    (trapezoid rule on the tables' grid, or on the sub-grid ``theta_index``, ``phi_index``
-    that ``f`` is given on)."""
-    every_theta = np.arange(tables.theta_deg.size) if theta_index is None else theta_index
-    every_phi = np.arange(tables.phi_deg.size) if phi_index is None else phi_index
-    theta = np.radians(np.asarray(tables.theta_deg, float))[every_theta]
-    w_i = np.cos(theta) * np.sin(theta) * trapezoid_weights(theta)
-    weights = w_i[:, None, None] * _azimuth_weights(tables, every_theta, every_phi)
-    f = np.asarray(f, float)
-    if f.ndim == 4:
-        weights = weights[..., None]
-    return np.sum(f * weights, axis=(0, 2))
-
-
-def albedo_error(f_fit, f_ref, tables: Tables, theta_index=None, phi_index=None) -> float:
-    """Largest relative error of :func:`view_albedo` over view angles and channels."""
-    fit = view_albedo(f_fit, tables, theta_index, phi_index)
-    ref = view_albedo(f_ref, tables, theta_index, phi_index)
-    return float(np.max(np.abs(fit - ref) / np.maximum(np.abs(ref), 1e-12)))
-
-
 def lut_nodes(size: int = DEFAULT_LUT_SIZE) -> np.ndarray:
     """``cos(theta_o)`` at the texel centres ``(i + 0.5) / size`` of a view-angle image."""
     return (np.arange(size) + 0.5) / size
@@ -237,7 +158,7 @@ def sample_lut(lut, cos_view) -> np.ndarray:
 # --------------------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class LobeFit:
-    """A GGX lobe fitted to an angular table.
+    """A GGX lobe fitted to an angular part of the tables.
 
     ``roughness``: Blender's Roughness; ``ior``: Coat IOR (coat) or the IOR whose F0 the
     Specular IOR Level sets (specular), None for a Glossy BSDF; ``level``: Specular IOR Level
@@ -245,7 +166,7 @@ class LobeFit:
     view-angle texel, ``(size, 3)`` (Glossy only); ``distribution``: ``GGX``, ``BECKMANN`` or
     ``ASHIKHMIN_SHIRLEY`` (Glossy only; the Principled BSDF is GGX); ``diffuse_lut``: the
     weight of its Lambertian companion per texel, ``(size, 3)``, or None (:func:`fit_glossy`);
-    ``error``: relative RMS of this lobe against its table (module docstring).
+    ``error``: relative RMS of this lobe against its target (module docstring).
     """
 
     roughness: float
@@ -257,83 +178,75 @@ class LobeFit:
     diffuse_lut: np.ndarray | None = None
 
 
-class NodeGrid:
-    """Node directions, weights and the cosines the GGX fits reuse (optionally subsampled)."""
-
-    def __init__(self, tables: Tables, max_points: int | None = None):
-        n, p = tables.theta_deg.size, tables.phi_deg.size
-        m_theta, m_phi = n, p
-        while max_points is not None and m_theta * m_theta * m_phi > max_points:
-            if m_theta * m_theta >= 4 * m_phi:
-                m_theta -= 1
-            else:
-                m_phi -= 1
-        # Evenly spread node indices, both ends kept (normal and grazing, azimuth 0 and 180).
-        it = np.unique(np.round(np.linspace(0, n - 1, m_theta)).astype(int))
-        ip = np.unique(np.round(np.linspace(0, p - 1, m_phi)).astype(int))
-        self.pick = np.ix_(it, it, ip)
-        self.theta_index, self.phi_index = it, ip
-        self.wi, self.wo = node_directions(tables, it, ip)
-        self.weights = angular_weights(tables, it, ip)
-        self.cos_i = self.wi[..., 2]
-        self.cos_o = self.wo[..., 2]
-        h = half_vector(self.wi, self.wo)
-        self.cos_h = h[..., 2]
-        self.cos_hi = np.clip(np.sum(h * self.wi, axis=-1), 0.0, 1.0)
-
-    def lobe(self, roughness: float, distribution: str = "GGX") -> np.ndarray:
-        """A microfacet lobe without Fresnel on the grid."""
-        return cc.microfacet_reflection(self.wi, self.wo, roughness, distribution=distribution)
-
-    def error(self, f_fit, f_ref) -> float:
-        """Relative RMS of ``f cos(theta_i)`` on this grid, channels pooled."""
-        diff = (f_fit - f_ref) * self.cos_i[..., None]
-        ref = f_ref * self.cos_i[..., None]
-        w = self.weights[..., None]
-        return float(np.sqrt(np.sum(w * diff * diff) / max(np.sum(w * ref * ref), 1e-300)))
-
-
-def _rgb(values: np.ndarray) -> np.ndarray:
-    """Give per-node values a trailing RGB axis."""
+def _grey(values) -> np.ndarray:
+    """Per-pair values ``(V, A, P[, C])`` with their channels averaged, ``(V, A, P)``."""
     values = np.asarray(values, float)
-    return values if values.shape[-1:] == (3,) and values.ndim == 4 else values[..., None]
+    return np.mean(values, axis=-1) if values.ndim == 4 else values
 
 
-def _fit_roughness_and(grid: NodeGrid, target: np.ndarray, fresnel, second_range, scale=1.0,
-                       view_factor=None):
-    """``(roughness, second, error)``: a GGX lobe with Fresnel ``fresnel(cos_hi, second)``
-    fitted to ``target`` (channels averaged) by nested golden-section searches, the second
-    parameter inside.  ``scale``: a factor per node applied to the lobe; ``view_factor``:
-    ``(roughness, second) -> factor per view node`` (the coat's energy compensation)."""
-    target = np.mean(np.asarray(target, float), axis=-1, keepdims=True)
-
-    def error_for(roughness):
-        base = grid.lobe(roughness)[..., None] * scale
-
-        def inner(second):
-            lobe = base * fresnel(grid.cos_hi, second)[..., None]
-            if view_factor is not None:
-                lobe = lobe * view_factor(roughness, second)[..., None]
-            return grid.error(lobe, target)
-
-        return golden_minimum(inner, *second_range, tol=2 * FIT_TOLERANCE, coarse=7)
-
-    roughness, _ = golden_minimum(lambda r: error_for(r)[1], *ROUGHNESS_RANGE,
-                                  tol=FIT_TOLERANCE, coarse=7)
-    return (roughness, *error_for(roughness))
+def _minimise_roughness(error_of) -> tuple[float, float]:
+    """``(roughness, error)``: ``error_of(roughness)`` minimised over :data:`ROUGHNESS_RANGE`,
+    in ``log(roughness)`` (a lobe's width goes as roughness squared)."""
+    log_r, error = brent_minimum(lambda x: error_of(float(np.exp(x))),
+                                 *np.log(ROUGHNESS_RANGE), coarse=ROUGHNESS_SCAN, xtol=FIT_XTOL)
+    return float(np.exp(log_r)), error
 
 
-def fit_coat(grid: NodeGrid, target: np.ndarray) -> LobeFit:
+def _fit_roughness_and(grid: ViewGrid, target, lobe_times, second_range):
+    """``(roughness, second, error)``: a GGX lobe times ``lobe_times(roughness)(second)`` (a
+    factor per pair) fitted to ``target`` (channels averaged).  A scan of
+    :data:`ROUGHNESS_SCAN` roughnesses by :data:`SECOND_SCAN` values of the second parameter
+    finds the start; bounded Levenberg-Marquardt on ``(log(roughness), second)`` converges
+    from it (:func:`lut_baker.numerics.optimise.least_squares`, to :data:`FIT_XTOL`)."""
+    target = _grey(target)
+    root_weight = np.sqrt(grid.weight) * grid.cos_i
+    scale = 1.0 / max(float(np.sqrt(np.sum(np.square(root_weight * target)))), 1e-300)
+
+    per_roughness = {}  # the lobe and its factor's set-up, once per roughness tried
+
+    def model(x):
+        roughness = float(np.exp(x[0]))
+        if roughness not in per_roughness:
+            per_roughness[roughness] = (grid.lobe(roughness), lobe_times(roughness))
+        lobe, factor = per_roughness[roughness]
+        return lobe * factor(float(x[1]))
+
+    def residuals(x):
+        return (scale * root_weight * (model(x) - target)).ravel()
+
+    seconds = np.linspace(*second_range, SECOND_SCAN)
+    starts = [(float(np.sum(np.square(residuals((log_r, second))))), log_r, second)
+              for log_r in np.linspace(*np.log(ROUGHNESS_RANGE), ROUGHNESS_SCAN)
+              for second in seconds]
+    _, log_r, second = min(starts)
+    x, cost = least_squares(residuals, (log_r, second), (np.log(ROUGHNESS_RANGE[0]),
+                                                         second_range[0]),
+                            (np.log(ROUGHNESS_RANGE[1]), second_range[1]), xtol=FIT_XTOL)
+    return float(np.exp(x[0])), float(x[1]), float(np.sqrt(cost))
+
+
+def fit_coat(grid: ViewGrid, target) -> LobeFit:
     """Coat Roughness and Coat IOR of a GGX coat (weight 1, dielectric Fresnel, Cycles'
-    energy compensation) fitted to ``target`` (the film's gloss, ``(n, n, p, 3)`` on ``grid``;
-    its channels averaged)."""
-    def compensation(roughness, ior):
-        return cc.view_table(grid.cos_o, lambda c: cc.ggx_energy_compensation(
-            c, roughness, float(cc.dielectric_fss(ior)))[0], size=17)
+    energy compensation) fitted to ``target`` (the film's gloss on ``grid``, ``(V, A, P[, 3])``,
+    channels averaged).  ``level`` is the coat's weight per unit coverage: 1, or 0 when the
+    film has no gloss (a matte product) or no coat does much better than none
+    (:data:`NO_LOBE_ERROR`)."""
+    if not np.any(np.asarray(target, float)):
+        return LobeFit(roughness=ROUGHNESS_RANGE[1], ior=COAT_IOR_RANGE[0], level=0.0,
+                       error=0.0)
+    def lobe_times(roughness):
+        albedo = cc.microfacet_albedo(grid.cos_view, roughness, **SEARCH_QUADRATURE)
+        average = cc.ggx_average_albedo(roughness)
 
-    roughness, ior, error = _fit_roughness_and(grid, target, cc.dielectric_fresnel,
-                                               COAT_IOR_RANGE, view_factor=compensation)
-    return LobeFit(roughness=roughness, ior=ior, error=error)
+        def factor(ior):
+            scale = cc.ggx_energy_scale(albedo, average, float(cc.dielectric_fss(ior)))[0]
+            return cc.dielectric_fresnel(grid.cos_hi, ior) * scale[:, None, None]
+        return factor
+
+    roughness, ior, error = _fit_roughness_and(grid, target, lobe_times, COAT_IOR_RANGE)
+    if error >= NO_LOBE_ERROR:
+        return LobeFit(roughness=roughness, ior=ior, level=0.0, error=1.0)
+    return LobeFit(roughness=roughness, ior=ior, level=1.0, error=error)
 
 
 def _specular_fresnel(cos_hi, level):
@@ -344,109 +257,116 @@ def _specular_fresnel(cos_hi, level):
     return cc.schlick_ior_fresnel(cos_hi, eta, f0)
 
 
-def fit_specular(grid: NodeGrid, target: np.ndarray, attenuation=None) -> LobeFit:
+def fit_specular(grid: ViewGrid, target, attenuation=None) -> LobeFit:
     """Roughness and Specular IOR Level (at IOR :data:`SPECULAR_IOR`) of the Principled
-    specular fitted to ``target`` ``(n, n, p, 3)`` (channels averaged).  ``attenuation``: the
-    factor the layers above apply to it per view node (the coat's ``1 - E_coat``), or None."""
-    scale = 1.0 if attenuation is None else np.asarray(attenuation, float)[..., None]
-    roughness, level, error = _fit_roughness_and(grid, target, _specular_fresnel,
-                                                 SPECULAR_LEVEL_RANGE, scale)
+    specular fitted to ``target`` ``(V, A, P[, 3])`` (channels averaged).  ``attenuation``:
+    the factor the layers above apply to it per view ``(V,)`` (the coat's ``1 - E_coat``), or
+    None."""
+    scale = 1.0 if attenuation is None else np.asarray(attenuation, float)[:, None, None]
+
+    def lobe_times(roughness):
+        return lambda level: scale * _specular_fresnel(grid.cos_hi, level)
+
+    roughness, level, error = _fit_roughness_and(grid, target, lobe_times,
+                                                 SPECULAR_LEVEL_RANGE)
     if error >= NO_LOBE_ERROR:  # no lobe does much better than none: leave it to the diffuse
         return LobeFit(roughness=roughness, ior=SPECULAR_IOR, level=0.0, error=1.0)
     return LobeFit(roughness=roughness, ior=SPECULAR_IOR, level=level, error=error)
 
 
-SEARCH_QUADRATURE = {"n_u": 24, "n_phi": 12, "n_mu": 17}
-"""Closure-albedo quadrature while searching (within 2%, at 17 view cosines interpolated to the
-texels); the final weights use :data:`FINAL_QUADRATURE` (within 0.1%, at every texel)."""
-FINAL_QUADRATURE = {"n_u": 96, "n_phi": 64, "n_mu": None}
+SEARCH_QUADRATURE = {"n_u": 24, "n_phi": 12}
+"""Closure-albedo quadrature while searching, at the grid's views (within 2%); the final
+weights use :data:`FINAL_QUADRATURE` (within 0.1%) at every texel."""
+FINAL_QUADRATURE = {"n_u": 96, "n_phi": 64}
 
 
-def _texel_albedo(albedo_table: np.ndarray, theta_deg: np.ndarray, size: int) -> np.ndarray:
-    """A directional albedo table ``(n_theta, 3)`` on ``theta_deg`` at the view-angle texels,
-    ``(size, 3)``."""
-    theta = np.degrees(np.arccos(lut_nodes(size)))
+def _texel_albedo(albedo_table: np.ndarray, theta_deg: np.ndarray, cos_view) -> np.ndarray:
+    """A directional albedo table ``(n_theta, 3)`` on ``theta_deg`` at view cosines
+    ``cos_view`` ``(K,)``: ``(K, 3)``."""
+    theta = np.degrees(np.arccos(np.clip(cos_view, 0.0, 1.0)))
     return np.stack([np.interp(theta, theta_deg, albedo_table[:, c]) for c in range(3)], -1)
 
 
-def _closure_albedo(roughness: float, distribution: str, size: int,
-                    quadrature=FINAL_QUADRATURE) -> np.ndarray:
-    """A Glossy closure's albedo at the view-angle texels, ``(size,)``."""
-    mu = lut_nodes(size)
-    n_mu = quadrature["n_mu"]
-    nodes = mu if n_mu is None else np.linspace(mu[0], mu[-1], n_mu)
-    closure = cc.microfacet_albedo(nodes, roughness, distribution=distribution,
-                                   n_u=quadrature["n_u"], n_phi=quadrature["n_phi"])
-    return closure if n_mu is None else np.interp(mu, nodes, closure)
-
-
-def _companion_share(grid: NodeGrid, lobe: np.ndarray, closure_albedo: np.ndarray,
-                     table_albedo: np.ndarray, target: np.ndarray, size: int) -> np.ndarray:
-    """The share ``s`` (per view-angle texel, in [0, 1]) of a table's albedo ``A`` that the
+def _companion_share(grid: ViewGrid, lobe: np.ndarray, closure_albedo: np.ndarray,
+                     table_albedo: np.ndarray, target: np.ndarray) -> np.ndarray:
+    """The share ``s`` (per view of ``grid``, in [0, 1]) of a table's albedo ``A`` that the
     Glossy lobe carries when a Lambertian companion carries the rest: weights ``a = s A / E``
     (Glossy, ``E`` its albedo) and ``b = (1 - s) A`` (Diffuse), so ``a E + b = A`` at every
     view.  ``s`` minimises ``|a lobe cos_i + b cos_i / pi - target cos_i|`` over the lights
-    of each view node of ``grid`` (closed form), then goes to the texels by ``cos(theta_o)``.
-    All arguments grey: ``lobe`` and ``target`` on the grid, albedos at the grid's views."""
-    g = lobe * grid.cos_i
+    of each view (closed form).  ``lobe`` and ``target`` grey ``(V, A, P)``, the albedos at
+    the views ``(V,)``."""
+    e = closure_albedo[:, None, None]
+    a = table_albedo[:, None, None]
     lam = grid.cos_i / np.pi
-    a_over_e = table_albedo / np.maximum(closure_albedo, 1e-6)
-    u = a_over_e * (g - closure_albedo * lam)
-    v = target * grid.cos_i - table_albedo * lam
-    w = grid.weights
-    num = np.sum(w * u * v, axis=(0, 2))
-    den = np.sum(w * u * u, axis=(0, 2))
-    share = np.clip(np.where(den > 0.0, num / np.where(den > 0.0, den, 1.0), 1.0), 0.0, 1.0)
-    cos_views = grid.cos_o[0, :, 0]
-    order = np.argsort(cos_views)
-    return np.interp(lut_nodes(size), cos_views[order], share[order])
+    u = a / np.maximum(e, 1e-6) * (lobe * grid.cos_i - e * lam)
+    v = target * grid.cos_i - a * lam
+    w = grid.weight
+    num = np.sum(w * u * v, axis=(1, 2))
+    den = np.sum(w * u * u, axis=(1, 2))
+    return np.clip(np.where(den > 0.0, num / np.where(den > 0.0, den, 1.0), 1.0), 0.0, 1.0)
 
 
-def fit_glossy(grid: NodeGrid, target: np.ndarray, albedo_table: np.ndarray,
-               theta_deg: np.ndarray, size: int = DEFAULT_LUT_SIZE, *,
-               companion: bool = False) -> LobeFit:
+def fit_glossy(grid: ViewGrid, target, albedo_table: np.ndarray, theta_deg: np.ndarray,
+               size: int = DEFAULT_LUT_SIZE, *, companion: bool = False) -> LobeFit:
     """Distribution (:data:`lut_baker.closures.cycles.GLOSSY_DISTRIBUTIONS`) and roughness of a
     Glossy BSDF whose view-dependent weight (table albedo / closure albedo, read from a
-    ``size``-texel image by ``cos(theta_o)``) best reproduces ``target`` ``(n, n, p, 3)``;
+    ``size``-texel image by ``cos(theta_o)``) best reproduces ``target`` ``(V, A, P[, 3])``;
     ``albedo_table`` ``(n_theta, 3)`` on ``theta_deg``.
 
     ``companion``: the albedo is shared with a Lambertian companion, in the proportion that
     fits each view best (:func:`_companion_share`); the weights are then ``lut`` (Glossy) and
     ``diffuse_lut`` (Diffuse), whose albedos still add up to the table's at every view.  A
     broad lobe whose radiance keeps a ``cos(theta_i)`` factor (the paper's film gloss) is
-    part Lambertian, which no Glossy closure alone reproduces."""
-    target = _rgb(target) * np.ones(3)
-    grey = np.mean(target, axis=-1)
-    theta_views = np.degrees(np.arccos(np.clip(grid.cos_o[0, :, 0], 0.0, 1.0)))
-    table_views = np.mean([np.interp(theta_views, theta_deg, albedo_table[:, c])
-                           for c in range(3)], axis=0)
-    texel_table = _texel_albedo(albedo_table, theta_deg, size)
-    best = None
-    for distribution in cc.GLOSSY_DISTRIBUTIONS:
-        def lobe(roughness, distribution=distribution, quadrature=SEARCH_QUADRATURE):
-            closure = _closure_albedo(roughness, distribution, size, quadrature)
-            # Glossy weight per texel: table albedo / closure albedo.
-            lut = texel_table / np.maximum(closure, 1e-6)[:, None]
-            shape = grid.lobe(roughness, distribution)
-            diffuse = None
-            if companion:
-                e_views = np.interp(grid.cos_o[0, :, 0], lut_nodes(size), closure)
-                share = _companion_share(grid, shape, e_views[None, :, None],
-                                         table_views[None, :, None], grey, size)
-                diffuse = (1.0 - share)[:, None] * texel_table
-                lut = share[:, None] * lut
-            value = shape[..., None] * sample_lut(lut, grid.cos_o)
-            if diffuse is not None:
-                value = value + sample_lut(diffuse, grid.cos_o) / np.pi
-            return value, lut, diffuse
+    part Lambertian, which no Glossy closure alone reproduces.
 
-        roughness, error = golden_minimum(lambda r, lobe=lobe: grid.error(lobe(r)[0], target),
-                                          *ROUGHNESS_RANGE, tol=FIT_TOLERANCE, coarse=7)
-        if best is None or error < best.error:
-            value, lut, diffuse = lobe(roughness, quadrature=FINAL_QUADRATURE)
-            best = LobeFit(roughness=roughness, error=grid.error(value, target), lut=lut,
-                           distribution=distribution, diffuse_lut=diffuse)
-    return best
+    The distribution is GGX unless another one's error is lower by more than
+    :data:`DISTRIBUTION_MARGIN` (relative): a near tie never flips the choice."""
+    target = np.asarray(target, float)
+    target = target if target.ndim == 4 else target[..., None]
+    target = target * np.ones(3)
+    grey = _grey(target)
+    if not np.any(albedo_table):  # no gloss (a matte film): weights 0, nothing to fit
+        zeros = np.zeros((size, 3))
+        return LobeFit(roughness=ROUGHNESS_RANGE[1], error=0.0, lut=zeros,
+                       diffuse_lut=zeros.copy() if companion else None)
+    texels = lut_nodes(size)
+    tables = {False: _texel_albedo(albedo_table, theta_deg, grid.cos_view),
+              True: _texel_albedo(albedo_table, theta_deg, texels)}
+
+    def weights(roughness, distribution, final: bool):
+        """``(lut, diffuse_lut or None, value on the grid)`` for one lobe: while searching
+        (``final`` False) the weights sit at the grid's views, with a coarser closure albedo;
+        the final ones at the image's texels, sampled as Blender samples them."""
+        shape = grid.lobe(roughness, distribution)
+        nodes = texels if final else grid.cos_view
+        closure = cc.microfacet_albedo(nodes, roughness, distribution=distribution,
+                                       **(FINAL_QUADRATURE if final else SEARCH_QUADRATURE))
+        table = tables[final]
+        lut = table / np.maximum(closure, 1e-6)[:, None]
+        diffuse = None
+        if companion:
+            e_views = np.interp(grid.cos_view, texels, closure) if final else closure
+            share = _companion_share(grid, shape, e_views, np.mean(tables[False], axis=-1),
+                                     grey)
+            share = np.interp(texels, grid.cos_view, share) if final else share
+            diffuse = (1.0 - share)[:, None] * table
+            lut = share[:, None] * lut
+        rows = ((lambda row: sample_lut(row, grid.cos_o)) if final
+                else (lambda row: row[:, None, None, :]))
+        value = shape[..., None] * rows(lut)
+        if diffuse is not None:
+            value = value + rows(diffuse) / np.pi
+        return lut, diffuse, value
+
+    searched = {distribution: _minimise_roughness(lambda r, d=distribution: grid.error(
+        weights(r, d, False)[2], target)) for distribution in cc.GLOSSY_DISTRIBUTIONS}
+    distribution = min(searched, key=lambda d: searched[d][1])
+    if searched[distribution][1] >= (1.0 - DISTRIBUTION_MARGIN) * searched["GGX"][1]:
+        distribution = "GGX"
+    roughness = searched[distribution][0]
+    lut, diffuse, value = weights(roughness, distribution, True)
+    return LobeFit(roughness=roughness, error=grid.error(value, target), lut=lut,
+                   distribution=distribution, diffuse_lut=diffuse)
 
 
 # --------------------------------------------------------------------------------------------
@@ -483,9 +403,13 @@ def edge_response(r_mm, profile, s_mm) -> np.ndarray:
     return (arc * (r * trapezoid_weights(r))) @ np.asarray(profile, float)
 
 
+PROFILE_RADII = 600
+"""Radii of :func:`profile_grid` (1200 moves the fitted radii by under 0.2%)."""
+
+
 def profile_grid(r_max: float) -> np.ndarray:
     """Integration radii (mm) for :func:`edge_response`: geometric, to 40 x the table's end."""
-    return np.concatenate([[0.0], np.geomspace(1e-5 * r_max, 40.0 * r_max, 1200)])
+    return np.concatenate([[0.0], np.geomspace(1e-5 * r_max, 40.0 * r_max, PROFILE_RADII)])
 
 
 def fit_profile(tables: Tables, method: str, *, albedo=None) -> ProfileFit:
@@ -519,7 +443,8 @@ def fit_profile(tables: Tables, method: str, *, albedo=None) -> ProfileFit:
 
         # Half the reference's mean spread (mm) centres the search window (log radius).
         centre = np.log(max(float(np.mean(reference[:, c]) * r_max), 1e-6))
-        log_radius, error = golden_minimum(rms, centre - 3.0, centre + 5.0, tol=1e-4, coarse=17)
+        log_radius, error = brent_minimum(rms, centre - 3.0, centre + 5.0, coarse=17,
+                                          xtol=FIT_XTOL)
         radii.append(float(np.exp(log_radius)))
         errors.append(error)
         worst.append(float(np.max(np.abs(difference(log_radius)))))
@@ -527,9 +452,22 @@ def fit_profile(tables: Tables, method: str, *, albedo=None) -> ProfileFit:
                       max_error=np.array(worst), albedo=None if method == "BURLEY" else albedo)
 
 
+PROFILE_FIT_CACHE_SIZE = 16
+"""Profile fits kept in this process: they depend on the skin alone (its profile and diffuse
+albedo), so every foundation on one skin shares them."""
+_PROFILE_FITS = LRUCache(PROFILE_FIT_CACHE_SIZE)
+
+
 def fit_profiles(tables: Tables, **options) -> dict[str, ProfileFit]:
-    """:func:`fit_profile` for every Blender subsurface method, by method name."""
-    return {method: fit_profile(tables, method, **options) for method in cc.SUBSURFACE_METHODS}
+    """:func:`fit_profile` for every Blender subsurface method, by method name; remembered by
+    the tables' radial grid, profile, skin albedo and ``options`` (the fits read nothing
+    else)."""
+    key = (np.asarray(tables.radius_mm, float).tobytes(),
+           np.asarray(tables.profile, float).tobytes(),
+           np.asarray(tables.skin_diffuse, float).tobytes(),
+           repr(sorted((name, np.asarray(value).tolist()) for name, value in options.items())))
+    return _PROFILE_FITS.get_or_compute(key, lambda: {
+        method: fit_profile(tables, method, **options) for method in cc.SUBSURFACE_METHODS})
 
 
 # --------------------------------------------------------------------------------------------
@@ -588,7 +526,7 @@ class ClosureFit:
         """Plain data (floats and lists) for metadata, the panel and the docs."""
         return {
             "coat": {"roughness": self.coat.roughness, "ior": self.coat.ior,
-                     "error": self.coat.error},
+                     "level": self.coat.level, "error": self.coat.error},
             "specular_bare": {"roughness": self.specular_bare.roughness,
                               "level": self.specular_bare.level,
                               "error": self.specular_bare.error},
@@ -646,28 +584,39 @@ def subsurface_ior(parameters: dict) -> float:
     return float(np.clip(eta, 1.01, 3.8))
 
 
+def lobe_widths_deg(tables: Tables) -> dict[str, float]:
+    """The 1/e half-widths (degrees, 1/n of eq. 2's D) of the film's and the skin's gloss, by
+    surface-gloss name; path 3 is at least as wide as the skin's (it is the skin's gloss seen
+    through the film's broad transmission)."""
+    return {name: 1.0 / float(np.max(tables.surface_layer(name).n))
+            for name in ("film_gloss", "skin_gloss")}
+
+
 def fit_closures(tables: Tables, *, lut_size: int = DEFAULT_LUT_SIZE,
-                 subsurface_method: str | None = None,
-                 max_points: int | None = FIT_POINTS, errors_at=None,
+                 subsurface_method: str | None = None, errors_at=None,
                  progress=None) -> ClosureFit:
     """Fit both tiers to ``tables`` and measure their errors at ``errors_at`` = ``(coverage,
     absorption)`` (default: those the tables were baked for).  ``subsurface_method``: force
     one (default: the method whose edge response, fitted error and replica error combined,
     is closest to the tables'; all three are fitted and reported).  ``progress(fraction,
-    message)``: called as the fit advances (fraction 0..1)."""
+    message)``: called as the fit advances (fraction 0..1).
+
+    The film's gloss is fitted on a grid sized by its own lobe, the skin's gloss and path 3 on
+    one sized by the skin's (:func:`lobe_widths_deg`, :func:`lut_baker.closures.view_grid.
+    view_grid`), so the cost does not depend on how narrow either lobe is."""
     report = progress or (lambda fraction, message="": None)
     report(0.0, "fitting the Principled tier")
-    grid = NodeGrid(tables, max_points)
-    pick = grid.pick
-    film_gloss = np.asarray(tables.film_gloss, float)[pick]
-    path3 = np.asarray(tables.path3_gloss, float)[pick]
-    skin_gloss = np.asarray(tables.skin_gloss, float)[pick]
+    widths = lobe_widths_deg(tables)
+    film_grid = view_grid(widths["film_gloss"], FIT_VIEWS)
+    skin_grid = view_grid(widths["skin_gloss"], FIT_VIEWS)
+    film_gloss = tables.surface_gloss("film_gloss", *film_grid.directions)
+    skin_gloss = tables.surface_gloss("skin_gloss", *skin_grid.directions)
+    path3 = tables.angular("path3_gloss", *skin_grid.directions)
 
-    coat = fit_coat(grid, film_gloss)
-    e_coat = cc.view_table(grid.cos_o, lambda c: cc.coat_view_terms(c, coat.roughness,
-                                                                      coat.ior)[1])
-    specular_bare = fit_specular(grid, skin_gloss)
-    specular_film = fit_specular(grid, path3, attenuation=1.0 - e_coat)
+    coat = fit_coat(film_grid, film_gloss)
+    e_coat = cc.coat_view_terms(skin_grid.cos_view, coat.roughness, coat.ior)[1]
+    specular_bare = fit_specular(skin_grid, skin_gloss)
+    specular_film = fit_specular(skin_grid, path3, attenuation=1.0 - e_coat)
     # The node group mixes the two roughnesses by coverage: a dropped lobe (level 0) takes the
     # other's, so that mixing never sharpens the remaining lobe.
     if specular_film.level == 0.0:
@@ -679,8 +628,9 @@ def fit_closures(tables: Tables, *, lut_size: int = DEFAULT_LUT_SIZE,
     theta_deg = np.asarray(tables.theta_deg, float)
     glossy = {name: fit_glossy(grid, table, np.asarray(getattr(tables, name + "_albedo")),
                                theta_deg, lut_size, companion=name == "film_gloss")
-              for name, table in (("film_gloss", film_gloss), ("path3_gloss", path3),
-                                  ("skin_gloss", skin_gloss))}
+              for name, grid, table in (("film_gloss", film_grid, film_gloss),
+                                        ("path3_gloss", skin_grid, path3),
+                                        ("skin_gloss", skin_grid, skin_gloss))}
     transmittance = np.asarray(tables.film_transmittance, float)
     mu = lut_nodes(lut_size)
     t_rows = np.stack([np.interp(np.degrees(np.arccos(mu)), theta_deg, transmittance[:, c])
@@ -751,7 +701,8 @@ def diffuse_albedo(fit: ClosureFit, coverage: float, absorption) -> tuple[np.nda
 def principled_inputs(fit: ClosureFit, coverage: float, absorption, gloss: float = 1.0):
     """``(PrincipledInputs, subsurface_weight)`` of the PRINCIPLED tier (the node group's math):
 
-    - Coat Weight ``g w``, Coat Roughness/IOR fitted;
+    - Coat Weight ``g w c`` (``c`` the coat's level: 1, or 0 without a coat), Coat
+      Roughness/IOR fitted;
     - Roughness ``mix(r_bare, r_film, w)``, Specular IOR Level
       ``g [(1 - w) l_bare + w l_film mean((1 - A)^2)]``;
     - Base Color = (:func:`diffuse_albedo` + ``g w (1 - A)^2 gloss_to_diffuse``) /
@@ -773,14 +724,15 @@ def principled_inputs(fit: ClosureFit, coverage: float, absorption, gloss: float
     total, skin = diffuse_albedo(fit, w, absorption)
     total = total + g * covered * weights.twice * fit.gloss_to_diffuse
     e_spec = bare * fit.specular_albedo_mean[0] + covered * fit.specular_albedo_mean[1]
-    base = total / ((1.0 - g * covered * fit.coat_albedo_mean) * (1.0 - g * e_spec))
+    coat = g * covered * fit.coat.level
+    base = total / ((1.0 - coat * fit.coat_albedo_mean) * (1.0 - g * e_spec))
     level = g * (bare * fit.specular_bare.level + covered * fit.specular_film.level * through2)
     inputs = cc.PrincipledInputs(
         base_color=tuple(np.clip(base, 0.0, 1.0)),
         roughness=bare * fit.specular_bare.roughness + covered * fit.specular_film.roughness,
         ior=SPECULAR_IOR,
         specular_ior_level=level,
-        coat_weight=g * covered,
+        coat_weight=coat,
         coat_roughness=fit.coat.roughness,
         coat_ior=fit.coat.ior,
     )
@@ -792,7 +744,7 @@ def principled_tier_reflection(fit: ClosureFit, tables: Tables, coverage: float,
                                gloss: float = 1.0, directions=None):
     """The PRINCIPLED tier's BRDF, ``(..., 3)``: at the angular nodes, or at ``directions``
     ``(wi, wo)`` (local unit vectors); ``gloss``: the group's Gloss input."""
-    wi, wo = node_directions(tables) if directions is None else directions
+    wi, wo = tables.node_directions() if directions is None else directions
     inputs, _ = principled_inputs(fit, coverage, absorption, gloss)
     return cc.principled_reflection(wi, wo, inputs)
 
@@ -829,7 +781,7 @@ def layered_tier_reflection(fit: ClosureFit, tables: Tables, coverage: float, ab
     """The LAYERED tier's BRDF, ``(..., 3)``, at the angular nodes or at ``directions``
     ``(wi, wo)``: every closure added with its weight and image row (linear texel
     interpolation, as Blender samples it); ``gloss``: the group's Gloss input."""
-    wi, wo = node_directions(tables) if directions is None else directions
+    wi, wo = tables.node_directions() if directions is None else directions
     cos_o = wo[..., 2]
     weights = layered_weights(fit, coverage, absorption, gloss)
     rows = dict(zip(LUT_ROWS, fit.lut, strict=True))
@@ -851,35 +803,20 @@ TIER_REPLICAS = {"PRINCIPLED": principled_tier_reflection, "LAYERED": layered_ti
 """Each tier's replica, ``(fit, tables, coverage, absorption, gloss=1, directions=None)``."""
 
 
-ERROR_NODE_LIMIT = 4_000_000
-"""Angular nodes beyond which :func:`tier_errors` measures on an evenly spread sub-grid of
-about this many nodes (both ends kept, as the fits' :class:`NodeGrid`).  Narrow lobes scale the
-default grids up to 64 times (:data:`lut_baker.bake.REFERENCE_LOBE_DEG`): a 3-degree gloss
-makes 38 million nodes, whose every-node errors took 60 s and 10 GB."""
-
-
 def tier_errors(fit: ClosureFit, tables: Tables, coverage: float, absorption,
                 gloss: float = 1.0) -> dict:
     """:class:`TierError` of every tier against the tables at one coverage and absorption
     (``gloss``: the group's Gloss input; at 0 the error includes all of the gloss left out),
-    over every angular node up to :data:`ERROR_NODE_LIMIT` of them, else over a sub-grid."""
-    n, p = tables.theta_deg.size, tables.phi_deg.size
-    if n * n * p <= ERROR_NODE_LIMIT:
-        it = ip = directions = None
-        reference = tables.node_values(coverage, absorption)
-        weights = angular_weights(tables)
-    else:
-        grid = NodeGrid(tables, ERROR_NODE_LIMIT)
-        it, ip, directions = grid.theta_index, grid.phi_index, (grid.wi, grid.wo)
-        reference = tables.node_values(coverage, absorption, it, ip)
-        weights = grid.weights
-    cos_i = np.cos(np.radians(np.asarray(tables.theta_deg, float)))
-    cos_i = cos_i if it is None else cos_i[it]
+    on a :class:`lut_baker.closures.view_grid.ViewGrid` of :data:`ERROR_VIEWS` views that
+    resolves the narrower of the two surfaces' gloss lobes."""
+    grid = view_grid(min(lobe_widths_deg(tables).values()), ERROR_VIEWS)
+    directions = grid.directions
+    reference = tables.made_up_reflection(*directions, coverage, absorption)
     out = {}
     for tier, replica in TIER_REPLICAS.items():
         f = replica(fit, tables, coverage, absorption, gloss, directions)
         out[tier] = TierError(tier=tier, coverage=float(coverage),
                               absorption=tuple(_absorption(absorption).tolist()),
-                              rms=relative_rms(f, reference, tables, weights, cos_i),
-                              albedo=albedo_error(f, reference, tables, it, ip))
+                              rms=grid.error(f, reference),
+                              albedo=grid.albedo_error(f, reference))
     return out

@@ -16,6 +16,9 @@ Functions
 - :func:`hemisphere_panels` -- Gauss-Legendre panels in polar angle, odd azimuth count.
 - :func:`hemisphere_grid` -- the same sized from the narrowest lobe (degrees), so sharp lobes
   are resolved.
+- :class:`MirrorQuadrature`, :func:`mirror_quadrature` -- direction pairs through their half
+  vector, for lobes of any width around the mirror direction; :func:`mirror_alpha_edges`, its
+  panels.
 - :func:`order0_integral` -- an order-0 kernel integrated over the hemisphere.
 - :func:`fourier_kernel` -- cosine coefficients ``K_m`` of an isotropic kernel on grids.
 - :func:`azimuth_convolution_factor` -- ``2 pi`` for m = 0, ``pi`` otherwise.
@@ -40,6 +43,9 @@ __all__ = [
     "HemisphereGrid",
     "hemisphere_panels",
     "hemisphere_grid",
+    "MirrorQuadrature",
+    "mirror_alpha_edges",
+    "mirror_quadrature",
     "order0_integral",
     "fourier_kernel",
     "azimuth_convolution_factor",
@@ -196,6 +202,88 @@ def grazing_azimuth_width_deg(lobe_width_deg: float, theta_deg: float = GRAZING_
     """
     width = np.radians(min(float(lobe_width_deg), 45.0))
     return float(np.degrees(2.0 * np.cos(np.radians(theta_deg)) * np.tan(width)))
+
+
+MIRROR_ALPHA_POINTS = 6
+"""Gauss-Legendre nodes per half-vector panel of :func:`mirror_quadrature`."""
+MIRROR_PHI_POINTS = 16
+"""Gauss-Legendre half-vector azimuths on [0, 180] degrees of :func:`mirror_quadrature`."""
+MIRROR_NARROWEST_DEG = 0.01
+"""Lobe widths below this (degrees) are resolved as this one."""
+
+
+@dataclass(frozen=True, eq=False)
+class MirrorQuadrature:
+    """Direction pairs for integrals of a lobe around the mirror direction, at any width.
+
+    For each fixed direction ``d`` (``fixed``, ``(N, 3)``, at polar angles ``theta`` and
+    azimuth 0) the other direction ``e = 2 (d.h) h - d`` (``other``, ``(N, A, P, 3)``) runs
+    over the upper hemisphere through its half vector ``h = normalize(d + e)``, at polar
+    angles ``alpha`` from the normal and azimuths ``phi`` in [0, 180] degrees (the other half
+    by symmetry):  ``Int g(d, e) dw_e ~ sum weight * g`` with ``dw_e = 4 (d.h) dw_h``.
+    ``cos_h`` is ``n.h`` and ``cos_dh`` is ``d.h = e.h``, each ``(N, A, P)``.
+    """
+
+    theta: np.ndarray
+    fixed: np.ndarray
+    other: np.ndarray
+    weight: np.ndarray
+    cos_h: np.ndarray
+    cos_dh: np.ndarray
+
+    @property
+    def cos_fixed(self) -> np.ndarray:
+        """``n.d`` broadcast to the nodes, ``(N, A, P)``."""
+        return np.broadcast_to(np.cos(self.theta)[:, None, None], self.weight.shape)
+
+    @property
+    def cos_other(self) -> np.ndarray:
+        """``n.e``, ``(N, A, P)`` (>= 0)."""
+        return self.other[..., 2]
+
+
+def mirror_alpha_edges(width_deg: float) -> np.ndarray:
+    """Panel edges (radians) in the half vector's polar angle for a lobe of 1/e half-width
+    ``width_deg`` (degrees): 0, w, 2w, 4w, ... doubling up to 90 degrees, so that panels are
+    narrow where the lobe is and wide where it is flat."""
+    width = max(float(width_deg), MIRROR_NARROWEST_DEG)
+    edges = [0.0, min(width, 90.0)]
+    while edges[-1] < 90.0:
+        edges.append(min(2.0 * edges[-1], 90.0))
+    return np.radians(np.array(edges))
+
+
+def mirror_quadrature(theta, width_deg: float, *, alpha_points: int = MIRROR_ALPHA_POINTS,
+                      phi_points: int = MIRROR_PHI_POINTS) -> MirrorQuadrature:
+    """:class:`MirrorQuadrature` for fixed directions at polar angles ``theta`` (radians) and
+    lobes no narrower than ``width_deg`` (degrees, the 1/e half-width in the half vector's
+    polar angle, 1/n for eq. 2's D).
+
+    The half vector's polar angle is split at :func:`mirror_alpha_edges`; for each azimuth
+    the panels stop where ``e`` meets the horizon, ``alpha_max = psi / 2 + 45 degrees`` with
+    ``tan(psi) = tan(theta) cos(phi)``, so every panel integrates a smooth function (a
+    Lambertian integrates to 1 within 1e-8 at 6 x 16 nodes per panel, up to 89 degrees).
+    Panels beyond ``alpha_max`` have zero length and zero weight."""
+    theta = np.atleast_1d(np.asarray(theta, float))
+    edges = mirror_alpha_edges(width_deg)
+    x, wx = gauss_legendre(alpha_points)
+    phi, wphi = gauss_legendre(phi_points, 0.0, np.pi)
+    sin_t, cos_t = np.sin(theta)[:, None], np.cos(theta)[:, None]
+    alpha_max = 0.5 * np.arctan2(sin_t * np.cos(phi), cos_t) + 0.25 * np.pi  # (N, P)
+    low = np.minimum(edges[None, :-1, None], alpha_max[:, None, :])  # (N, K, P)
+    length = np.minimum(edges[None, 1:, None], alpha_max[:, None, :]) - low
+    alpha = (low[:, :, None] + length[:, :, None] * x[None, None, :, None])
+    alpha = alpha.reshape(theta.size, -1, phi.size)
+    d_alpha = (length[:, :, None] * wx[None, None, :, None]).reshape(alpha.shape)
+    sin_a, cos_a = np.sin(alpha), np.cos(alpha)
+    h = np.stack([sin_a * np.cos(phi), sin_a * np.sin(phi), cos_a], axis=-1)
+    fixed = np.stack([sin_t[:, 0], np.zeros_like(theta), cos_t[:, 0]], axis=-1)
+    cos_dh = np.clip(np.einsum("nc,napc->nap", fixed, h), 0.0, 1.0)
+    other = 2.0 * cos_dh[..., None] * h - fixed[:, None, None, :]
+    other[..., 2] = np.maximum(other[..., 2], 0.0)  # rounding at the horizon
+    weight = 2.0 * 4.0 * cos_dh * sin_a * d_alpha * wphi
+    return MirrorQuadrature(theta=theta, fixed=fixed, other=other, weight=weight,
+                            cos_h=cos_a, cos_dh=cos_dh)
 
 
 def order0_integral(matrix0: np.ndarray, grid: HemisphereGrid, weight=None) -> np.ndarray:

@@ -7,11 +7,12 @@ interpolation, extension EXTEND, colour space Non-Color).  Rows are counted from
 as Blender's pixel rows are; pixel ``(x, y)`` has its centre at texture coordinates
 ``((x + 0.5) / width, (y + 0.5) / height)``.  Blocks, bottom-up:
 
-- each angular table (``film_gloss``, ``path3_gloss``, ``skin_gloss``, then
-  ``inter_reflection`` if baked): ``n_theta`` rows; pixel ``(j n_phi + k, row + i)`` holds
-  ``table[theta_i = i, theta_o = j, phi = k]``.  Within a block a bilinear fetch interpolates
-  ``theta_i`` and the azimuth coordinate; ``theta_o`` takes two fetches (columns ``j`` and
-  ``j + 1``) mixed by its fraction;
+- each angular table (``path3_gloss``, then ``inter_reflection`` if baked; format version 1
+  also held ``film_gloss`` before and ``skin_gloss`` after ``path3_gloss``, which reading skips:
+  the surface gloss is a closed form of the parameters): ``n_theta`` rows; pixel
+  ``(j n_phi + k, row + i)`` holds ``table[theta_i = i, theta_o = j, phi = k]``.  Within a
+  block a bilinear fetch interpolates ``theta_i`` and the azimuth coordinate; ``theta_o``
+  takes two fetches (columns ``j`` and ``j + 1``) mixed by its fraction;
 - one row per directional table (``DIRECTIONAL`` order): pixel ``(i, row)`` = ``table[i]``;
 - one row for ``profile``: pixel ``(r, row)``;
 - one row of constants (``CONSTANT`` order): pixel ``(c, row)``.
@@ -42,7 +43,7 @@ from .table_set import ANGULAR, CONSTANT, DIRECTIONAL, FORMAT_VERSION, RADIAL, T
 
 __all__ = ["atlas_layout", "atlas", "tables_from_atlas", "pixel_hash", "content_hash",
            "sidecar_data", "check_sidecar", "check_layout", "TableFileError",
-           "TableWriteError", "FORMAT_NAME", "UNITS"]
+           "TableWriteError", "FORMAT_NAME", "UNITS", "READABLE_VERSIONS"]
 
 FORMAT_NAME = "makeup-skin-tables"
 UNITS = {
@@ -68,6 +69,12 @@ class TableWriteError(OSError):
     """Tables that could not be written: a file where a folder should be, a folder without
     write permission, a full disk, any other failed write.  The message is one line naming the
     file and saying what is wrong."""
+
+
+READABLE_VERSIONS = (1, FORMAT_VERSION)
+"""Format versions :func:`check_sidecar` accepts."""
+VERSION_1_ANGULAR = ("film_gloss", "path3_gloss", "skin_gloss")
+"""The angular blocks of format version 1, in order."""
 
 
 def _angular_names(tables: Tables) -> tuple[str, ...]:
@@ -155,9 +162,10 @@ def check_sidecar(meta, where: str) -> dict:
     naming ``where`` (the sidecar's file)."""
     if not isinstance(meta, dict) or meta.get("format") != FORMAT_NAME:
         raise TableFileError(f"{where!r} is not a {FORMAT_NAME} sidecar")
-    if meta.get("format_version") != FORMAT_VERSION:
+    if meta.get("format_version") not in READABLE_VERSIONS:
         raise TableFileError(f"{where!r} has format version {meta.get('format_version')!r}; "
-                             f"this lut_baker reads version {FORMAT_VERSION}: re-bake the tables")
+                             f"this lut_baker reads versions "
+                             f"{', '.join(map(str, READABLE_VERSIONS))}: re-bake the tables")
     return meta
 
 
@@ -168,8 +176,9 @@ def _grids(meta: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 
 def _stored_angular_names(meta: dict) -> tuple[str, ...]:
-    """The angular tables the sidecar data's layout holds."""
-    return tuple(name for name in ANGULAR + ("inter_reflection",) if name in meta["layout"])
+    """The angular blocks the sidecar data's layout holds, in their order."""
+    names = VERSION_1_ANGULAR if meta.get("format_version") == 1 else ANGULAR
+    return tuple(name for name in names + ("inter_reflection",) if name in meta["layout"])
 
 
 def check_layout(meta: dict, where: str) -> None:
@@ -189,7 +198,8 @@ def tables_from_atlas(pixels: np.ndarray, meta: dict) -> Tables:
     values as float64 arrays (``KeyError``, ``TypeError`` or ``ValueError`` when an entry is
     missing or malformed)."""
     theta, phi, radius = _grids(meta)
-    angular = _stored_angular_names(meta)
+    angular = [name for name in _stored_angular_names(meta)
+               if name in ANGULAR + ("inter_reflection",)]
     pixels = np.asarray(pixels, np.float32).astype(float)
     blocks = meta["layout"]
     n, p = theta.size, phi.size

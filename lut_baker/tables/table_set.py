@@ -13,6 +13,13 @@ its pigment absorbs twice).  The weights ``w``, ``1 - w``, ``1 - A``, ``(1 - A)^
 the part that spreads under the surface with the dipole's normalised profile
 ``profile = R(d) / Rd`` (docs/model.md §4).
 
+``film_gloss`` and ``skin_gloss`` are the two surfaces' own gloss, eq. 2's specular term
+``P_s D G F_r`` of the film and of the skin: closed forms of the parameters, so they are evaluated
+where they are needed (:meth:`Tables.angular`) and never tabulated.  A lobe of any width then
+costs the same, and the tables hold only what needs an integral: path 3's gloss
+(``path3_gloss``, through the film and back, as wide as the film's transmission makes it),
+transmittances, albedos and the radial profile (docs/baking.md, "What is tabulated").
+
 Angular tables are indexed ``[theta_i, theta_o, phi]`` on the grids ``theta_deg`` (degrees
 from the normal) and ``phi_deg`` (relative azimuth, degrees, 0..180 by symmetry); radial ones by
 ``radius_mm``.
@@ -54,7 +61,8 @@ bake's error study measures it against the exact evaluator.
 Contents
 --------
 - :class:`Tables` -- the arrays, with the lookups ``angular``, ``directional``, ``radial``,
-  ``made_up_reflection`` and ``directional_albedo``.
+  ``made_up_reflection`` and ``directional_albedo``, and the closed-form surface gloss
+  (``surface_layer``).
 - :func:`theta_nodes`, :func:`theta_index`, :func:`radius_nodes`, :func:`radius_index`,
   :func:`phi_index`, :func:`node_cos_azimuths` -- the closed-form grids and their inverse.
 """
@@ -65,13 +73,16 @@ from dataclasses import dataclass, field, fields
 
 import numpy as np
 
+from ..model.layers import ReflectionLayer
 from ..model.made_up_skin import coverage_weights
-from ..numerics.geometry import folded_azimuth_deg, polar_angle_deg
+from ..model.microfacet import ts_reflection
+from ..numerics.geometry import direction, folded_azimuth_deg, polar_angle_deg
 
 __all__ = [
     "FORMAT_VERSION",
     "Tables",
     "ANGULAR",
+    "SURFACE_GLOSS",
     "DIRECTIONAL",
     "CONSTANT",
     "RADIAL",
@@ -87,10 +98,15 @@ __all__ = [
     "radius_index",
 ]
 
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2
+"""Version 2: the surface gloss is no longer tabulated (:data:`SURFACE_GLOSS`); version 1 held
+``film_gloss`` and ``skin_gloss`` tables too (:mod:`lut_baker.tables.codec` still reads it)."""
 
-ANGULAR = ("film_gloss", "path3_gloss", "skin_gloss")
+ANGULAR = ("path3_gloss",)
 """Tables of shape ``(n_theta, n_theta, n_phi, 3)``, 1/sr."""
+SURFACE_GLOSS = {"film_gloss": "film", "skin_gloss": "skin"}
+"""The angular parts evaluated in closed form (eq. 2's specular term, 1/sr) and the layer of
+``parameters`` each comes from."""
 DIRECTIONAL = (
     "film_transmittance",
     "transmission_factor",
@@ -252,7 +268,8 @@ class Tables:
     Grids: ``theta_deg`` (n_theta,), ``phi_deg`` (n_phi,), ``radius_mm`` (n_radius,), laid out
     as ``theta_spacing``, ``phi_spacing`` and ``radius_spacing`` say (closed forms in the module
     docstring).  ``parameters``: the MadeUpSkin as plain data (``MadeUpSkin`` fields via
-    ``as_dict``), including ``K``, ``coverage`` and ``absorption`` it was baked for.
+    ``as_dict``), including ``K``, ``coverage`` and ``absorption`` it was baked for; its
+    ``film`` and ``skin`` layers give the closed-form surface gloss (:data:`SURFACE_GLOSS`).
     ``inter_reflection``: optional angular table, the full adding-equation sum minus path 3
     (1/sr), or None; unlike the other tables it holds the film's absorption as baked
     (``parameters["absorption"]``).  Arrays may be read-only (the bake broadcasts a channel
@@ -262,9 +279,7 @@ class Tables:
     theta_deg: np.ndarray
     phi_deg: np.ndarray
     radius_mm: np.ndarray
-    film_gloss: np.ndarray
     path3_gloss: np.ndarray
-    skin_gloss: np.ndarray
     film_transmittance: np.ndarray
     transmission_factor: np.ndarray
     film_gloss_albedo: np.ndarray
@@ -298,6 +313,8 @@ class Tables:
                 value = value[..., :1]
             if not np.isfinite(np.sum(value)) and not np.all(np.isfinite(value)):
                 raise ValueError(f"table {name!r} holds NaN or Inf")
+        for name in SURFACE_GLOSS:
+            self.surface_layer(name)  # the parameters must give every surface's layer
         _check_spacing(self.phi_spacing, PHI_SPACINGS, "phi_spacing")
         self._check_grid("theta_deg", theta_nodes(n_theta, self.theta_spacing,
                                                   float(self.theta_deg[-1]), self.theta_offset))
@@ -319,6 +336,26 @@ class Tables:
             for f in fields(self)
             if f.name != "parameters" and isinstance(getattr(self, f.name), np.ndarray)
         }
+
+    def surface_layer(self, name: str) -> ReflectionLayer:
+        """The layer of surface gloss ``name`` (:data:`SURFACE_GLOSS`) from ``parameters``, its
+        diffuse part left out (``P_d = 0``): eq. 2's specular term alone."""
+        layer = self.parameters.get(SURFACE_GLOSS[name]) if isinstance(self.parameters,
+                                                                        dict) else None
+        if not isinstance(layer, dict):
+            raise ValueError(f"tables need the {SURFACE_GLOSS[name]!r} layer in their "
+                             f"parameters for {name!r} (eq. 2 in closed form)")
+        try:
+            return ReflectionLayer(**{**layer, "P_d": 0.0})
+        except TypeError as error:
+            raise ValueError(f"tables' {SURFACE_GLOSS[name]!r} parameters: {error}") from None
+
+    def surface_gloss(self, name: str, wi, wo) -> np.ndarray:
+        """Surface gloss ``name`` (:data:`SURFACE_GLOSS`, 1/sr) at unit directions ``(..., 3)``
+        in closed form (eq. 2's specular term), ``(..., 3)``; 0 below the surface."""
+        value = ts_reflection(wi, wo, self.surface_layer(name), check=False)
+        value = value if np.ndim(value) == np.ndim(wi) else value[..., None]
+        return np.broadcast_to(value, value.shape[:-1] + (3,))
 
     @property
     def spacings(self) -> dict:
@@ -348,10 +385,24 @@ class Tables:
         return np.degrees(np.arccos(node_cos_azimuths(
             theta[:, None], theta[None, :], phi, self.phi_spacing)))
 
+    def node_directions(self, theta_index=None, phi_index=None):
+        """``(wi, wo)`` unit vectors ``(n_theta, n_theta, n_phi, 3)`` of the angular nodes (or
+        of the sub-grid ``theta_index``, ``phi_index``): ``wo`` at azimuth 0, ``wi`` at the
+        node's relative azimuth (:meth:`node_azimuths`)."""
+        theta = np.radians(np.asarray(self.theta_deg, float))
+        theta = theta if theta_index is None else theta[theta_index]
+        phi = np.radians(self.node_azimuths(theta_index, phi_index))
+        wi = direction(theta[:, None, None], phi)
+        wo = direction(np.broadcast_to(theta[None, :, None], phi.shape), 0.0)
+        return wi, wo
+
     def angular(self, name: str, wi, wo) -> np.ndarray:
-        """Angular table ``name`` interpolated trilinearly at unit directions ``(..., 3)``;
-        shape ``(..., 3)``."""
+        """Angular part ``name`` at unit directions ``(..., 3)``, shape ``(..., 3)``: a
+        table interpolated trilinearly, or a surface gloss in closed form
+        (:data:`SURFACE_GLOSS`)."""
         wi, wo = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
+        if name in SURFACE_GLOSS:
+            return self.surface_gloss(name, wi, wo)
         return _trilinear(np.asarray(getattr(self, name)), self.theta_index(polar_angle_deg(wi)),
                           self.theta_index(polar_angle_deg(wo)),
                           phi_index(wi, wo, self.phi_deg.size, self.phi_spacing))
@@ -389,6 +440,7 @@ class Tables:
                 + weights.bare * (parts["skin_gloss"] + self.skin_diffuse))
 
     def _angular_names(self) -> tuple[str, ...]:
+        """The tabulated angular parts."""
         return ANGULAR + (("inter_reflection",) if self.inter_reflection is not None else ())
 
     def made_up_reflection(self, wi, wo, coverage=None, absorption=None) -> np.ndarray:
@@ -397,7 +449,8 @@ class Tables:
         absorption only).  ``coverage``, ``absorption`` default to the baked ones; 0 where
         ``wi`` or ``wo`` is below the surface."""
         wi, wo = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
-        parts = {name: self.angular(name, wi, wo) for name in self._angular_names()}
+        parts = {name: self.angular(name, wi, wo)
+                 for name in self._angular_names() + tuple(SURFACE_GLOSS)}
         t_i = self.directional("film_transmittance", polar_angle_deg(wi))
         t_o = self.directional("film_transmittance", polar_angle_deg(wo))
         value = self._combine(parts, t_i, t_o, coverage, absorption)
@@ -415,6 +468,8 @@ class Tables:
         parts = {name: np.asarray(getattr(self, name)) if whole
                  else np.asarray(getattr(self, name))[np.ix_(it, it, ip)]
                  for name in self._angular_names()}
+        wi, wo = self.node_directions(theta_index, phi_index)
+        parts.update({name: self.surface_gloss(name, wi, wo) for name in SURFACE_GLOSS})
         t = np.asarray(self.film_transmittance)[it]
         return self._combine(parts, t[:, None, None], t[None, :, None], coverage, absorption)
 

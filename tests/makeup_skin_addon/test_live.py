@@ -3,7 +3,10 @@ preview resolution, and no timer is left behind."""
 
 import json
 
+import pytest
 from support.addon_steps import apply_pipeline
+
+from lut_baker.model import presets
 
 
 def test_live_update_rebakes_at_preview_resolution(sphere):
@@ -21,3 +24,22 @@ def test_live_update_rebakes_at_preview_resolution(sphere):
     after = node.node_tree["makeup_skin_fit"]
     assert json.loads(after)["key"] != json.loads(before)["key"]
     assert not bpy.app.timers.is_registered(live.rebake_timer)
+
+
+def test_choosing_a_foundation_updates_its_gloss_live(sphere):
+    """The Foundation dropdown sets everything the product is: its absorption at once, its
+    gloss (the film's lobe: roughness, index) by the debounced preview re-fit."""
+    from makeup_skin_addon import live, nodes
+    from makeup_skin_addon import material as made_up
+
+    material, _ = apply_pipeline(sphere, "LAYERED", foundation="clarins_103")
+    matte = nodes.read_meta(made_up.group_of(material).node_tree)
+    material.makeup_skin.foundation = "clarins_112"
+    assert material.name in live.pending()
+    assert list(material.makeup_skin.absorption) == pytest.approx(
+        presets.FOUNDATIONS["clarins_112"]["absorption"])
+    live.flush()
+    dewy = nodes.read_meta(made_up.group_of(material).node_tree)
+    assert dewy["parameters"]["film"] != matte["parameters"]["film"]
+    assert dewy["parameters"]["film"]["P_s"] > 0.0 == matte["parameters"]["film"]["P_s"]
+    assert dewy["glossy"]["film_gloss"] != matte["glossy"]["film_gloss"]

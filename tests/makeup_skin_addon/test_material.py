@@ -155,3 +155,46 @@ def test_apply_progress_covers_bake_and_fit(head):
     bake_share = 100 * made_up.BAKE_SHARE
     assert values == sorted(values) and values[-1] == 100
     assert len([v for v in values if bake_share < v < 100]) >= 3  # the fit's stages
+
+
+def _count_calls(monkeypatch):
+    """Count the bakes, closure fits and content hashes from here on."""
+    from lut_baker import bake
+    from lut_baker.closures import fitting
+    from lut_baker.tables import codec
+
+    calls = []
+    for module, name in ((bake, "bake"), (fitting, "fit_closures"), (codec, "content_hash")):
+        original = getattr(module, name)
+        monkeypatch.setattr(module, name, lambda *a, _n=name, _f=original, **k: (
+            calls.append(_n), _f(*a, **k))[1])
+    return calls
+
+
+@pytest.mark.parametrize("tier", ["LAYERED", "AUTO"])
+def test_apply_again_with_the_same_settings_bakes_and_fits_nothing(sphere, monkeypatch, tier):
+    """The settings name their bake (a hash of the parameters, not of the tables): an Apply
+    that repeats one finds its group and bakes, fits and hashes nothing, and Tier Auto makes
+    the same choice."""
+    import bpy
+
+    from makeup_skin_addon import material as made_up
+
+    material, _ = apply_pipeline(sphere, tier, foundation="clarins_105")
+    group = made_up.group_of(material).node_tree
+    calls = _count_calls(monkeypatch)
+    again, _ = apply_pipeline(sphere, tier, foundation="clarins_105")
+    assert calls == [] and made_up.group_of(again).node_tree == group
+    assert bpy.data.node_groups.get(group.name) == group
+
+
+def test_auto_decides_from_the_foundation_being_applied(sphere):
+    """Tier Auto judges the foundation it applies, not the one the material had: after
+    another foundation, two Applies of the same settings build the same group."""
+    from makeup_skin_addon import material as made_up
+
+    apply_pipeline(sphere, "AUTO", foundation="paper_natural")
+    first, _ = apply_pipeline(sphere, "AUTO", foundation="clarins_103")
+    first_group = made_up.group_of(first).node_tree.name
+    second, _ = apply_pipeline(sphere, "AUTO", foundation="clarins_103")
+    assert made_up.group_of(second).node_tree.name == first_group

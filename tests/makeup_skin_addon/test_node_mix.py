@@ -76,7 +76,7 @@ def _group(tier, baked):
     from makeup_skin_addon import nodes, storage
 
     skin, tables, fit = baked
-    return nodes.build_group(tier, storage.bake_record(skin, "preview", tables), fit)
+    return nodes.build_group(tier, storage.bake_record(skin, "preview"), fit)
 
 
 def _source(target):

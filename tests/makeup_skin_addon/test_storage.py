@@ -85,8 +85,8 @@ def test_check_tables_reports_one_sentence_per_material(sphere):
     meta["parameters"]["film"]["n"] = "not a number"
     group[nodes.FIT_KEY] = json.dumps(meta)
     intact, sentence = made_up.check_material(bpy.context, material)
-    assert not intact and sentence.startswith(f"{material.name!r}: its bake record cannot be "
-                                              f"re-baked")
+    assert not intact and sentence.startswith(f"{material.name!r}: its group's bake record "
+                                              f"does not match its key")
     assert sentence.endswith("re-baked it from the panel's settings.")
     assert "\n" not in sentence and "Traceback" not in sentence
     assert "parameters" in json.loads(group[nodes.FIT_KEY])  # repaired: a readable record

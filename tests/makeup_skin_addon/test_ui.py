@@ -1,6 +1,8 @@
 """The panels (makeup_skin_addon.ui), drawn into a stand-in layout (headless Blender draws no
 panels): Apply before, Revert after, and a linked Skin Color shown as linked."""
 
+from types import SimpleNamespace
+
 from support.addon_steps import apply_operator
 
 
@@ -48,3 +50,29 @@ def test_panel_shows_revert_and_a_linked_skin_colour(head):
     ui.draw_settings(layout, bpy.context)
     assert ("operator", "makeup_skin.revert") in layout.drawn
     assert ("prop", "skin_colour", "Skin Color (linked)", False) in layout.drawn
+
+
+def test_drawing_the_panel_computes_nothing(head, monkeypatch):
+    """The panel only reads what Apply stored: drawing it (Tier Auto included) bakes, fits,
+    measures and chooses nothing, and says what the last Apply chose."""
+    import bpy
+
+    from lut_baker import auto_tier, bake
+    from lut_baker.closures import fitting
+    from makeup_skin_addon import ui
+
+    apply_operator(head, tier="AUTO", foundation="clarins_112")
+    calls = []
+    for module, name in ((bake, "bake"), (fitting, "fit_closures"), (fitting, "tier_errors"),
+                         (auto_tier, "choose"), (auto_tier, "traits_from_tables")):
+        original = getattr(module, name)
+        monkeypatch.setattr(module, name, lambda *a, _n=name, _f=original, **k: (
+            calls.append(_n), _f(*a, **k))[1])
+    layout = _Layout()
+    ui.draw_settings(layout, bpy.context)
+    # the Properties editor's context has the material; the test's does not
+    ui.draw_fit(layout, SimpleNamespace(material=head.active_material))
+    assert calls == []
+    chosen = [text for kind, *rest in layout.drawn if kind == "label"
+              for text in rest[:1] if text.startswith("Auto: ")]
+    assert chosen and "(at the last Apply)" in chosen[0], layout.drawn

@@ -203,7 +203,7 @@ def run(args) -> int:
         path = save_tables(tables, target)
     except OSError as error:
         return _failed(error)
-    shape = "x".join(str(n) for n in tables.film_gloss.shape[:3])
+    shape = "x".join(str(n) for n in tables.path3_gloss.shape[:3])
     print(f"baked {skin.name} ({args.resolution}, angular {shape}) in {seconds:.2f} s -> "
           f"{path} + {path.with_suffix('.json').name}, sha256 {content_hash(tables)[:16]}")
     return 0

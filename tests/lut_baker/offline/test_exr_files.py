@@ -39,13 +39,14 @@ def test_round_trip_is_float32_exact(baked, saved):
     assert loaded.spacings == baked.spacings
     assert codec.content_hash(loaded) == codec.content_hash(baked)
     # float32 storage moves values by at most half an ulp: ~6e-8 relative
-    relative = np.abs(loaded.film_gloss - baked.film_gloss) / np.maximum(baked.film_gloss, 1e-30)
+    relative = (np.abs(loaded.path3_gloss - baked.path3_gloss)
+                / np.maximum(baked.path3_gloss, 1e-30))
     assert relative.max() < 6e-8
 
 
 def test_sidecar_describes_the_file(baked, saved):
     meta = json.loads(saved.with_suffix(".json").read_text())
-    assert meta["format_version"] == 1 and meta["image"] == "skin.exr"
+    assert meta["format_version"] == 2 and meta["image"] == "skin.exr"
     assert meta["K"] == pytest.approx(presets.paper().K)
     assert meta["parameters"]["coverage"] == 0.7
     assert meta["grids"]["phi_spacing"] == "half_vector"

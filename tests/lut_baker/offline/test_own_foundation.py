@@ -58,7 +58,7 @@ def test_a_product_params_file_bakes(tmp_path):
     skin = load_params(path)
     _assert_same_film_as_preset(skin, "clarins_105")
     tables = bake.bake(skin, "preview")
-    assert np.all(np.isfinite(tables.film_gloss)) and np.all(np.isfinite(tables.profile))
+    assert np.all(np.isfinite(tables.path3_gloss)) and np.all(np.isfinite(tables.profile))
     np.testing.assert_allclose(tables.parameters["absorption"], skin.absorption)
 
 

@@ -78,12 +78,15 @@ def test_tables_apply_any_coverage_and_absorption_exactly_at_the_nodes(default_t
 # The table contract
 # --------------------------------------------------------------------------------------------
 def test_tables_validate_shapes_values_and_grids(default_tables):
-    with pytest.raises(ValueError, match="film_gloss"):
-        replace(default_tables, film_gloss=default_tables.film_gloss[:, :, :-1])
-    bad = np.array(default_tables.skin_gloss)
+    with pytest.raises(ValueError, match="path3_gloss"):
+        replace(default_tables, path3_gloss=default_tables.path3_gloss[:, :, :-1])
+    bad = np.array(default_tables.path3_gloss)
     bad[1, 2, 3, 0] = np.nan
     with pytest.raises(ValueError, match="NaN"):
-        replace(default_tables, skin_gloss=bad)
+        replace(default_tables, path3_gloss=bad)
+    with pytest.raises(ValueError, match="'film' layer"):
+        replace(default_tables, parameters={k: v for k, v in default_tables.parameters.items()
+                                            if k != "film"})
     with pytest.raises(ValueError, match="theta_deg"):
         replace(default_tables, theta_deg=default_tables.theta_deg * 1.001)
     with pytest.raises(ValueError, match="phi_spacing"):

@@ -1,0 +1,127 @@
+"""The session's tables and closure fits, and what a fit measured, by bake key (no bpy).
+
+A bake is named by its key (:func:`.storage.bake_key`: the made-up skin's parameters and the
+resolution, hashed), which the same settings give on every machine and in every session; an
+Apply that repeats a bake finds its group by that name and bakes, fits and hashes nothing.
+What a fit measured at a coverage and absorption (the tiers' errors, what Gloss 0 would change,
+the Auto tier's traits) is plain data that the group's record keeps (:mod:`.nodes`), so a
+reopened file knows it too.
+
+- :func:`baked` -- ``(tables, fit)`` of a bake record, baked and fitted once per session.
+- :func:`cached` -- the same if this session has them, else None (never bakes).
+- :func:`measure` -- what a fit measures at a coverage and absorption, as plain data.
+- :func:`measured_at` -- a stored measurement if it was taken at this coverage and absorption.
+- :func:`traits` -- the Auto tier's :class:`lut_baker.auto_tier.MaterialTraits` of one.
+- :func:`clear` -- forget the session's bakes and fits.
+"""
+
+from __future__ import annotations
+
+import math
+
+from .package import lut_baker
+from .storage import rebake
+
+__all__ = ["FIT_CACHE_SIZE", "baked", "cached", "measure", "measured_at", "traits", "clear"]
+
+FIT_CACHE_SIZE = 8
+"""Closure fits kept in this session, by bake key (with their tables, :mod:`.storage`)."""
+_FITS = lut_baker("numerics.cache").LRUCache(FIT_CACHE_SIZE)
+TOLERANCE = 1e-6
+"""How close a coverage or an absorption must be to count as the same (the panel's sliders
+store floats)."""
+
+
+def _fit_key(record: dict, method) -> tuple:
+    return (record["key"], method)
+
+
+def cached(record: dict, method=None):
+    """``(tables, fit)`` of ``record`` if this session baked and fitted them, else None."""
+    fit = _FITS.get(_fit_key(record, method))
+    if fit is None:
+        return None
+    return rebake(record), fit
+
+
+def baked(record: dict, *, method=None, errors_at=None, bake_progress=None,
+          fit_progress=None):
+    """``(tables, fit)`` of a bake record (:func:`.storage.bake_record`): re-baked (cached by
+    :func:`.storage.rebake`) and fitted (cached here) once per session.  ``method``: a
+    subsurface method forced by the user, else None; ``errors_at``: ``(coverage,
+    absorption)`` at which a new fit measures the tiers (default: the bake's).
+
+    Raises
+    ------
+    StorageError
+        If the record cannot be baked (:func:`.storage.rebake`).
+    """
+    tables = rebake(record, progress=bake_progress)
+    key = _fit_key(record, method)
+    fit = _FITS.get(key)
+    if fit is None:
+        fit = lut_baker("closures.fitting").fit_closures(
+            tables, subsurface_method=method, errors_at=errors_at, progress=fit_progress)
+        _FITS.put(key, fit)
+    return tables, fit
+
+
+def _same(a, b) -> bool:
+    a, b = list(a), list(b)
+    return len(a) == len(b) and all(math.isclose(x, y, abs_tol=TOLERANCE)
+                                    for x, y in zip(a, b, strict=True))
+
+
+def measure(tables, fit, coverage: float, absorption, method=None, *,
+            with_traits: bool = True) -> dict:
+    """What ``fit`` measures at ``coverage`` and ``absorption`` (per channel), as plain data:
+    ``{"coverage", "absorption", "method", "errors": {tier: {"rms", "albedo"}}, "traits":
+    MaterialTraits.as_dict() or None}`` (the traits, which hold the gloss omissions too, only
+    ``with_traits``: the Auto tier's, a tenth of a second more).  The fit's own errors are
+    reused when it was measured there."""
+    cf = lut_baker("closures.fitting")
+    auto = lut_baker("auto_tier")
+    coverage = float(coverage)
+    absorption = [float(a) for a in absorption]
+    errors = fit.errors
+    first = next(iter(errors.values()), None)
+    if first is None or not (_same([first.coverage], [coverage])
+                             and _same(first.absorption, absorption)):
+        errors = cf.tier_errors(fit, tables, coverage, absorption)
+    traits = auto.traits_from_tables(tables, fit, coverage, absorption, method=method,
+                                     errors=errors) if with_traits else None
+    return {"coverage": coverage, "absorption": absorption, "method": method,
+            "errors": {tier: {"rms": float(e.rms), "albedo": float(e.albedo)}
+                       for tier, e in errors.items()},
+            "traits": None if traits is None else traits.as_dict()}
+
+
+def measured_at(meta: dict, coverage: float, absorption, *,
+                with_traits: bool = False) -> dict | None:
+    """The measurement a group's record keeps (``meta["measured"]``) if it was taken at this
+    coverage and absorption (and holds the Auto tier's traits, ``with_traits``), else None."""
+    measured = meta.get("measured") if isinstance(meta, dict) else None
+    if not isinstance(measured, dict) or (with_traits and not measured.get("traits")):
+        return None
+    try:
+        if _same([measured["coverage"]], [coverage]) and _same(measured["absorption"],
+                                                              absorption):
+            return measured
+    except (KeyError, TypeError):
+        return None
+    return None
+
+
+def traits(measured: dict):
+    """The :class:`lut_baker.auto_tier.MaterialTraits` a measurement keeps, or None if they
+    cannot be read."""
+    try:
+        return lut_baker("auto_tier").MaterialTraits.from_dict(measured["traits"])
+    except (KeyError, TypeError, ValueError):
+        return None
+
+
+def clear() -> None:
+    """Forget the session's fits (the add-on's unregister calls it with
+    :func:`.storage.clear_cache`)."""
+    _FITS.clear()

@@ -1,0 +1,68 @@
+"""The session's bakes and fits by key, and what a fit measured (makeup_skin_addon.fits),
+without Blender state: a bake record is baked and fitted once, a measurement is found again
+only at its own coverage and absorption, and its traits read back as they were."""
+
+import numpy as np
+import pytest
+
+from lut_baker.model import presets
+
+
+@pytest.fixture
+def record():
+    from makeup_skin_addon import storage
+
+    return storage.bake_record(presets.made_up_skin("light_ivory", "jensen_skin1"), "preview")
+
+
+def test_a_record_is_baked_and_fitted_once(record, monkeypatch):
+    from lut_baker.closures import fitting
+    from makeup_skin_addon import fits
+
+    fits.clear()
+    calls = []
+    original = fitting.fit_closures
+    monkeypatch.setattr(fitting, "fit_closures",
+                        lambda *a, **k: (calls.append(1), original(*a, **k))[1])
+    assert fits.cached(record) is None
+    tables, fit = fits.baked(record)
+    again = fits.baked(record)
+    assert again[0] is tables and again[1] is fit and len(calls) == 1
+    assert fits.cached(record)[1] is fit
+    assert fits.cached(record, "RANDOM_WALK") is None  # a forced method is another fit
+
+
+def test_a_measurement_is_found_at_its_own_coverage_and_absorption(record):
+    from makeup_skin_addon import fits
+
+    tables, fit = fits.baked(record)
+    measured = fits.measure(tables, fit, 0.6, (0.1, 0.2, 0.3))
+    meta = {"measured": measured}
+    assert fits.measured_at(meta, 0.6, (0.1, 0.2, 0.3)) is measured
+    assert fits.measured_at(meta, 0.6 + 1e-9, (0.1, 0.2, 0.3)) is measured
+    assert fits.measured_at(meta, 0.7, (0.1, 0.2, 0.3)) is None
+    assert fits.measured_at(meta, 0.6, (0.1, 0.2, 0.4)) is None
+    assert fits.measured_at({}, 0.6, (0.1, 0.2, 0.3)) is None
+    assert set(measured["errors"]) == {"PRINCIPLED", "LAYERED"}
+    # Without traits a measurement does not serve the Auto tier.
+    bare = fits.measure(tables, fit, 0.6, (0.1, 0.2, 0.3), with_traits=False)
+    assert bare["traits"] is None
+    assert fits.measured_at({"measured": bare}, 0.6, (0.1, 0.2, 0.3), with_traits=True) is None
+    assert bare["errors"] == measured["errors"]
+
+
+def test_traits_read_back_as_they_were(record):
+    import json
+
+    from lut_baker import auto_tier
+    from makeup_skin_addon import fits
+
+    tables, fit = fits.baked(record)
+    measured = json.loads(json.dumps(fits.measure(tables, fit, 1.0, (0.0, 0.0, 0.0))))
+    traits = fits.traits(measured)
+    direct = auto_tier.traits_from_tables(tables, fit, 1.0, (0.0, 0.0, 0.0))
+    assert traits.tier_errors == pytest.approx(direct.tier_errors, rel=1e-12)
+    np.testing.assert_array_equal(traits.profile, direct.profile)
+    assert traits.skin_share == direct.skin_share and traits.gloss_share == direct.gloss_share
+    assert traits.gloss_omission == direct.gloss_omission
+    assert fits.traits({"traits": {"tier_errors": {}}}) is None
