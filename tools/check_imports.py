@@ -56,6 +56,7 @@ LAYERS: dict[str, list[tuple[str, ...]]] = {
         ("makeup_skin_addon.scene_fit",),
         ("makeup_skin_addon.material",),
         ("makeup_skin_addon.live",),
+        ("makeup_skin_addon.on_load",),
         ("makeup_skin_addon.properties",),
         ("makeup_skin_addon.operators",),
         ("makeup_skin_addon.ui",),
