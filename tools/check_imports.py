@@ -40,6 +40,7 @@ LAYERS: dict[str, list[tuple[str, ...]]] = {
         ("lut_baker.bake",),
         ("lut_baker.closures",),
         ("lut_baker.auto_tier",),
+        ("lut_baker.offline.atomic_files",),
         ("lut_baker.offline.exr_files", "lut_baker.offline.measured"),
         ("lut_baker.offline.validation",),
         ("lut_baker.offline.paper_figures",),
