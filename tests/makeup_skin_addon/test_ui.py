@@ -1,7 +1,7 @@
 """The panels (makeup_skin_addon.ui), drawn into a stand-in layout (headless Blender draws no
 panels): Apply before, Revert after, and a linked Skin Color shown as linked."""
 
-from support.addon_steps import apply_operator
+from support.addon_steps import apply_operator, lut_images
 
 
 class _Layout:
@@ -48,3 +48,24 @@ def test_panel_shows_revert_and_a_linked_skin_colour(head):
     ui.draw_settings(layout, bpy.context)
     assert ("operator", "makeup_skin.revert") in layout.drawn
     assert ("prop", "skin_colour", "Skin Color (linked)", False) in layout.drawn
+
+
+def test_panel_says_when_the_file_was_repaired_on_opening(head, tmp_path):
+    """The image deleted before saving: opening the file repairs it (makeup_skin_addon.on_load)
+    and the panel shows one line about it, read from what the repair kept."""
+    import bpy
+
+    from makeup_skin_addon import on_load, ui
+
+    apply_operator(head)
+    layout = _Layout()
+    ui.draw_settings(layout, bpy.context)
+    assert ("label", on_load.REPAIRED) not in layout.drawn
+    bpy.data.images.remove(lut_images()[0])
+    path = tmp_path / "missing_image.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(path))
+    bpy.ops.wm.open_mainfile(filepath=str(path), load_ui=False)
+    assert len(lut_images()) == 1  # rebuilt on opening
+    layout = _Layout()
+    ui.draw_settings(layout, bpy.context)
+    assert ("label", on_load.REPAIRED) in layout.drawn

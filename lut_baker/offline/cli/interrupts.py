@@ -110,7 +110,7 @@ def _take(replaced: dict) -> None:
 
 def _restore(replaced: dict) -> None:
     """Put back the handlers :func:`_take` replaced (the retry timer stopped first)."""
-    if signal.SIGALRM in replaced:
+    if _TIMER and signal.SIGALRM in replaced:  # (Windows has neither)
         signal.setitimer(signal.ITIMER_REAL, 0)
         _held.clear()
     for signum, handler in replaced.items():
