@@ -1,5 +1,7 @@
 """The command line's frame (lut_baker.offline.cli.main): the commands, bad input as one line
-with exit 2, and SIGINT/SIGTERM turned into an exception that unwinds the command."""
+with exit 2, SIGINT/SIGTERM turned into an exception that unwinds the command, and
+``python -m lut_baker`` signalled at any moment (an import, the bake, each step of the write)
+ending with the one line ``interrupted`` and 128 + n, or normally; never a traceback."""
 
 import os
 import shutil
@@ -116,7 +118,8 @@ setattr(os, {name!r}, signal_after)
 
 READY = """
 def hook(event, args, said=[]):  # the entry point's first line is about to run
-    if event == "exec" and args[0].co_filename.endswith("__main__.py") and not said:
+    name = getattr(args[0], "co_filename", "") if event == "exec" else ""
+    if name.endswith("lut_baker/__main__.py") and not said:
         said.append(True)
         print("ready", flush=True)
 sys.addaudithook(hook)
