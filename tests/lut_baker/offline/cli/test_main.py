@@ -116,6 +116,11 @@ def signal_after(*args, **kwargs):  # the signal arrives as the system call retu
 setattr(os, {name!r}, signal_after)
 """
 
+SIGNAL_AT_EXIT = """
+import atexit
+atexit.register(os.kill, os.getpid(), signal.SIGINT)  # the interpreter is shutting down
+"""
+
 READY = """
 def hook(event, args, said=[]):  # the entry point's first line is about to run
     name = getattr(args[0], "co_filename", "") if event == "exec" else ""
@@ -226,6 +231,14 @@ def test_sigint_at_any_moment_ends_cleanly_or_not_at_all(tmp_path):
             assert a_whole_pair_or_the_earlier(out, {})
         outcomes.append(code)
     assert 130 in outcomes, outcomes  # at least the early ones met the imports
+
+
+def test_sigint_during_the_shutdown_changes_nothing(tmp_path):
+    """A bake that has done its work and is exiting: a signal then is ignored (exit 0, the
+    pair in place, nothing on stderr)."""
+    code, out, err = finish(start(SIGNAL_AT_EXIT, *BAKE, tmp_path))
+    assert (code, err) == (0, ""), err[-2000:]
+    assert out.startswith("baked ") and sorted(listing(tmp_path)) == ["paper.exr", "paper.json"]
 
 
 @pytest.mark.slow  # four fresh Pythons bake (~6 s on 2 cores)
