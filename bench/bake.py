@@ -29,7 +29,7 @@ from doc_block import replace_block  # noqa: E402  (bench/doc_block.py)
 
 from lut_baker import bake  # noqa: E402
 from lut_baker.evaluate.made_up import made_up_reflection  # noqa: E402
-from lut_baker.model import microfacet, presets  # noqa: E402
+from lut_baker.model import presets  # noqa: E402
 from lut_baker.offline.validation import table_accuracy  # noqa: E402
 from lut_baker.tables.table_set import ANGULAR, DIRECTIONAL  # noqa: E402
 
@@ -237,7 +237,8 @@ def study(runs: int) -> str:
                      fmt(err["albedo"]), fmt(err["reflection"])])
         print("quadrature", rows[-1], file=sys.stderr)
     out.append("\n### 3. Quadrature of the integrals (tables at the default size)\n")
-    out.append(table(["polar panels x Gauss points", "azimuths (path 3)", "bake ms", "path 3 at nodes (of its peak)", "transmission factor",
+    out.append(table(["polar panels x Gauss points", "azimuths (path 3)", "bake ms",
+                      "path 3 at nodes (of its peak)", "transmission factor",
                       "directional albedo", "reflection (500 points)"], rows))
 
     # 4. radial

@@ -14,21 +14,24 @@ its own, and only at module level (no import inside a function, no cycle):
    settings (units per mm, Auto tier, Fit to Scene's settings and record).
 7. ``material`` -- the apply pipeline: Apply, Revert, Check Tables, the rebuild from settings.
 8. ``live`` -- the live preview: socket updates at once, debounced preview re-bakes.
-9. ``properties`` -- the panel's settings (PropertyGroup); their ``update=`` callbacks call
-   ``live``.
-10. ``operators`` -- Apply, Revert, Check Tables, Fit to Scene, the preset menu and its operator.
-11. ``ui`` -- the panels: settings, buttons, the group's record and errors, Fit to Scene.
+9. ``on_load`` -- on opening a file, the made-up materials' images checked (packed bytes'
+   hashes) and repaired before the first render (a ``load_post`` handler).
+10. ``properties`` -- the panel's settings (PropertyGroup); their ``update=`` callbacks call
+    ``live``.
+11. ``operators`` -- Apply, Revert, Check Tables, Fit to Scene, the preset menu and its operator.
+12. ``ui`` -- the panels: settings, buttons, the group's record and errors, Fit to Scene, a
+    repair on opening.
 
 This package (the top) registers the modules with classes or session state in that order
 (:data:`modules`) and unregisters them in reverse.  A new operator goes into ``operators``, a
 new panel or section into ``ui``; a new module takes its own place in the list above.
 """
 
-from . import live, operators, properties, scene_fit, ui
+from . import live, on_load, operators, properties, scene_fit, ui
 
 __all__ = ["modules", "register", "unregister"]
 
-modules = (scene_fit, live, properties, operators, ui)
+modules = (scene_fit, live, on_load, properties, operators, ui)
 
 
 def register():

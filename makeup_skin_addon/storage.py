@@ -151,12 +151,14 @@ def image_record(image) -> dict:
             "packed_sha256": _packed_digest(image)}
 
 
-def image_problem(record: dict) -> str | None:
+def image_problem(record: dict, *, decode: bool = True) -> str | None:
     """What is wrong with the image an :func:`image_record` describes, as the end of a
     sentence ("the view-angle image ... is missing"), or None if it is intact.
 
     The packed bytes are compared first: an image whose packed file changed is never decoded
-    (a damaged OpenEXR header can crash Blender while it reads the pixels)."""
+    (a damaged OpenEXR header can crash Blender while it reads the pixels).  ``decode=False``
+    stops there, never decoding (the check on opening a file: an image just loaded from its
+    packed bytes has the pixels those bytes hold)."""
     name = record.get("name", "")
     image = bpy.data.images.get(name)
     if image is None:
@@ -164,6 +166,8 @@ def image_problem(record: dict) -> str | None:
     expected = record.get("packed_sha256")
     if expected is not None and _packed_digest(image) != expected:
         return f"its lookup image {name!r} was damaged in the file (its packed data changed)"
+    if not decode:
+        return None
     if image.packed_file is None and not image.has_data:
         return f"its lookup image {name!r} holds no pixels"
     if _pixel_digest(image) != record.get("sha256"):
@@ -171,9 +175,10 @@ def image_problem(record: dict) -> str | None:
     return None
 
 
-def image_problems(records) -> list[str]:
+def image_problems(records, *, decode: bool = True) -> list[str]:
     """:func:`image_problem` of each record, the intact ones left out."""
-    return [problem for problem in map(image_problem, records) if problem]
+    problems = (image_problem(record, decode=decode) for record in records)
+    return [problem for problem in problems if problem]
 
 
 def lut_image(name: str, rows: np.ndarray) -> bpy.types.Image:

@@ -1,7 +1,8 @@
 """Panels: Material properties and the shader editor's sidebar (tab "Made-up Skin").
 
 Both draw :func:`draw_settings` (the settings, Apply and Revert, the group's record and
-errors) and then :func:`draw_fit` (the Fit to Scene button and the last choice).
+errors, a repair made when the file was opened) and then :func:`draw_fit` (the Fit to Scene
+button and the last choice).
 """
 
 from __future__ import annotations
@@ -11,7 +12,7 @@ import json
 import bpy
 
 from . import material as made_up
-from . import scene_fit
+from . import on_load, scene_fit
 from .keys import AUTO_KEY, CLASS_PREFIX, ERRORS_KEY, FIT_KEY
 from .operators import (
     MAKEUPSKIN_MT_presets,
@@ -121,6 +122,9 @@ def draw_settings(layout, context) -> None:
             box.label(text="Angular error against the tables:")
             for line in lines:
                 box.label(text=line)
+        notice = on_load.notice(material)  # set when the file was opened: nothing computed
+        if notice is not None:
+            box.label(text=notice, icon="ERROR")
         box.operator(MAKEUPSKIN_OT_check_tables.bl_idname, icon="CHECKMARK")
 
 

@@ -9,10 +9,12 @@ OpenImageIO (Blender ships it as the ``OpenImageIO`` module).
 
 Writing is atomic: both files go to temporaries in the target folder, are flushed to disk and
 renamed into place (image first); a crash never leaves a partial file under the final name.  A
-write that fails or is interrupted (``KeyboardInterrupt`` or any other exception) removes its
-temporaries and the folders it made, and leaves an earlier pair as it was: if the sidecar's
-rename fails after the image's, the earlier image is put back.  Only a crash between the two
-renames can leave a new image beside an old sidecar, and loading then reports the mismatch.
+write that fails or is interrupted (``KeyboardInterrupt`` or any other exception, at any point,
+also just as a rename's system call returns) removes its temporaries and the folders it made,
+and leaves an earlier pair as it was (if the sidecar was not renamed after the image, the
+earlier image is put back) or the whole new pair (if both renames went through).  Only a crash
+between the two renames can leave a new image beside an old sidecar, and loading then reports
+the mismatch.
 
 Functions
 ---------
@@ -199,18 +201,22 @@ def _keep_copy(path: Path, copy: Path) -> bool:
 
 
 def _replace_pair(image_tmp: Path, json_tmp: Path, path: Path, backup: Path) -> None:
-    """Rename the temporaries onto ``path`` and its sidecar, image first.  If the sidecar's
-    rename fails, the earlier image is put back (the new one removed if there was none), so an
-    earlier pair is never left half-replaced."""
+    """Rename the temporaries onto ``path`` and its sidecar, image first.  If anything stops it
+    between the two renames, the earlier image is put back (the new one removed if there was
+    none), so an earlier pair is never left half-replaced.  An interrupt can also arrive just
+    after a rename went through (as the system call returns): so what was renamed is read off
+    the temporaries left, not off where the exception came from; once both renames are done
+    the new pair stands."""
     had_image = _keep_copy(path, backup)
-    os.replace(image_tmp, path)
     try:
+        os.replace(image_tmp, path)
         os.replace(json_tmp, sidecar_path(path))
     except BaseException:
-        if had_image:
-            os.replace(backup, path)
-        else:
-            path.unlink(missing_ok=True)
+        if json_tmp.exists() and not image_tmp.exists():  # the image went in, the sidecar not
+            if had_image:
+                os.replace(backup, path)
+            else:
+                path.unlink(missing_ok=True)
         raise
 
 
@@ -243,7 +249,8 @@ def save_tables(tables: Tables, path) -> Path:
         if isinstance(error, OSError):
             raise _write_error(path, error) from error
         raise
-    backup.unlink(missing_ok=True)
+    finally:  # also when an interrupt comes just as the pair is in place
+        backup.unlink(missing_ok=True)
     with contextlib.suppress(OSError):  # the pair is in place; not every system syncs folders
         _fsync(path.parent)
     return path

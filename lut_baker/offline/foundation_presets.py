@@ -49,6 +49,7 @@ from ..model.albedo import reflection_albedo, transmission_albedo
 from ..model.layers import ReflectionLayer
 from ..model.presets import MEASURED_FOUNDATIONS_FILE, paper
 from ..numerics.quadrature import gauss_legendre
+from .atomic_files import write_text
 
 __all__ = [
     "PRESET_FILE",
@@ -244,9 +245,7 @@ def write_presets(presets: dict, path=PRESET_FILE) -> Path:
                           "t_0": exchange.t_0},
         "foundations": presets,
     }
-    path = Path(path)
-    path.write_text(json.dumps(document, indent=2) + "\n", encoding="utf-8")
-    return path
+    return write_text(path, json.dumps(document, indent=2) + "\n")
 
 
 def read_presets(path=PRESET_FILE) -> dict:

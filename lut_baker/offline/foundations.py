@@ -31,6 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from ..model.albedo import reflection_albedo
+from .atomic_files import replacing, write_text
 from .foundation_presets import derive_presets, film_exchange, stack_reflectance, write_presets
 from .measured.inplane import InPlaneData, read_inplane
 from .measured.inplane_fit import (
@@ -109,9 +110,7 @@ def write_csv(analysis: ProductAnalysis, path) -> Path:
     lines = [",".join(CSV_COLUMNS)]
     lines += [",".join([f"{row[0]:g}", f"{row[1]:g}"] + [f"{v:.6g}" for v in row[2:]])
               for row in table]
-    path = Path(path)
-    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
-    return path
+    return write_text(path, "\n".join(lines) + "\n")
 
 
 def product_figure(analysis: ProductAnalysis):
@@ -406,11 +405,12 @@ def write_all(data_dir, out_dir, products=None, presets_path=None) -> list[Path]
     for analysis in analyses:
         paths.append(write_csv(analysis, out / f"{analysis.name}.csv"))
         figure_path = out / f"{analysis.name}.png"
-        product_figure(analysis).savefig(figure_path, dpi=DPI, metadata={"Software": None})
+        with replacing(figure_path) as temporary:
+            product_figure(analysis).savefig(temporary, dpi=DPI, metadata={"Software": None})
         paths.append(figure_path)
     presets = derived_presets(analyses)
     readme = out / "README.md"
-    readme.write_text(report(analyses, NOTES, presets), encoding="utf-8")
+    write_text(readme, report(analyses, NOTES, presets))
     paths.append(readme)
     if presets_path is not None:
         paths.append(write_presets(presets, presets_path))

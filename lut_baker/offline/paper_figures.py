@@ -47,6 +47,7 @@ from ..model.presets import (
     made_up_skin,
     paper,
 )
+from .atomic_files import replacing
 from .measured.protocols import (
     ReflectionSweep,
     in_plane_direction,
@@ -482,6 +483,7 @@ def render_all(out_dir, names=None) -> list[Path]:
     for name in names:
         path = out / f"{name}.png"
         # No software/version stamp: the committed PNGs change only when the pictures do.
-        FIGURES[name]().savefig(path, dpi=DPI, metadata={"Software": None})
+        with replacing(path) as temporary:
+            FIGURES[name]().savefig(temporary, dpi=DPI, metadata={"Software": None})
         paths.append(path)
     return paths

@@ -3,7 +3,7 @@ panels): Apply before, Revert after, and a linked Skin Color shown as linked."""
 
 from types import SimpleNamespace
 
-from support.addon_steps import apply_operator
+from support.addon_steps import apply_operator, lut_images
 
 
 class _Layout:
@@ -76,3 +76,24 @@ def test_drawing_the_panel_computes_nothing(head, monkeypatch):
     chosen = [text for kind, *rest in layout.drawn if kind == "label"
               for text in rest[:1] if text.startswith("Auto: ")]
     assert chosen and "(at the last Apply)" in chosen[0], layout.drawn
+
+
+def test_panel_says_when_the_file_was_repaired_on_opening(head, tmp_path):
+    """The image deleted before saving: opening the file repairs it (makeup_skin_addon.on_load)
+    and the panel shows one line about it, read from what the repair kept."""
+    import bpy
+
+    from makeup_skin_addon import on_load, ui
+
+    apply_operator(head)
+    layout = _Layout()
+    ui.draw_settings(layout, bpy.context)
+    assert ("label", on_load.REPAIRED) not in layout.drawn
+    bpy.data.images.remove(lut_images()[0])
+    path = tmp_path / "missing_image.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(path))
+    bpy.ops.wm.open_mainfile(filepath=str(path), load_ui=False)
+    assert len(lut_images()) == 1  # rebuilt on opening
+    layout = _Layout()
+    ui.draw_settings(layout, bpy.context)
+    assert ("label", on_load.REPAIRED) in layout.drawn

@@ -39,6 +39,7 @@ import numpy as np
 
 from ...model.layers import Dipole, ReflectionLayer
 from ...model.presets import paper_layers
+from ..atomic_files import write_text
 from ..measured.layer_fit import D_MIN_MM, fit_dipole, fit_reflection, fit_transmission
 from ..measured.measurements import (
     MAX_NOISE,
@@ -192,7 +193,7 @@ def run(args) -> int:
 def _emit(text: str, out, warnings, strict: bool) -> int:
     """Write ``text`` to ``out`` (or stdout), the warnings to stderr; the exit code."""
     if out:
-        out.write_text(text, encoding="utf-8")
+        write_text(out, text)
         print(f"wrote {out}")
     else:
         sys.stdout.write(text)
@@ -301,9 +302,8 @@ def _synthesize(args) -> int:
                                   (origin, notes[name], f"truth: {truth[name].as_dict()}"))
         print(f"wrote {path}  (python -m lut_baker fit {commands[name]} {path})")
     truth_path = out / "truth.toml"
-    truth_path.write_text(to_toml({name: {k: float(v) for k, v in layer.as_dict().items()}
-                                   for name, layer in truth.items()},
-                                  (origin, "the parameters the CSV files were made from")),
-                          encoding="utf-8")
+    write_text(truth_path, to_toml({name: {k: float(v) for k, v in layer.as_dict().items()}
+                                    for name, layer in truth.items()},
+                                   (origin, "the parameters the CSV files were made from")))
     print(f"wrote {truth_path}")
     return 0

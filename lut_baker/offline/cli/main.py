@@ -1,23 +1,30 @@
 """The command line: ``python -m lut_baker <command> ...``.
 
 Each command lives in its own module exposing ``HELP`` (one line), ``configure(parser)`` (adds
-its arguments) and ``run(args) -> int`` (the exit code).  Modules are imported only when their
-command runs, so ``--help`` stays fast.  Bad input exits with code 2 and one line naming the
-argument (argparse's convention); a ``ValueError`` raised by the model is reported the same way.
+its arguments) and ``run(args) -> int`` (the exit code).  Modules are imported by :func:`main`,
+inside its handling of signals.  Bad input exits with code 2 and one line naming the argument
+(argparse's convention); a ``ValueError`` raised by the model is reported the same way.
 SIGINT and SIGTERM unwind the command like Ctrl-C (``finally`` blocks remove temporaries) and
 exit with 128 + the signal number after one line, ``interrupted``.
+
+This module and :mod:`.interrupts` (the signal handling) import little of the standard library
+(argparse only when the parser is built): ``lut_baker.__main__`` imports them first and
+:func:`command_line` installs the handlers before anything heavy (numpy, scipy, OpenImageIO) is
+imported, so that a signal at any moment of ``python -m lut_baker`` ends the same way.
 """
 
 from __future__ import annotations
 
-import argparse
-import contextlib
 import importlib
-import signal
-import sys
-import threading
 
-__all__ = ["COMMANDS", "main", "build_parser", "Interrupted", "signals_interrupt"]
+from . import interrupts
+from .interrupts import Interrupted, signals_interrupt
+
+TYPE_CHECKING = False  # (typing itself takes milliseconds to import)
+if TYPE_CHECKING:
+    import argparse
+
+__all__ = ["COMMANDS", "main", "command_line", "build_parser", "Interrupted", "signals_interrupt"]
 
 COMMANDS = {
     "bake": ".bake_command",
@@ -28,48 +35,14 @@ COMMANDS = {
 """Command name -> module (relative to this package) implementing it."""
 
 
-class Interrupted(KeyboardInterrupt):
-    """SIGINT or SIGTERM arrived (``signum``): raised where the program is, like Ctrl-C."""
-
-    def __init__(self, signum: int):
-        super().__init__(signum)
-        self.signum = signum
-
-
-SIGNALS = (signal.SIGINT, signal.SIGTERM)
-
-
-@contextlib.contextmanager
-def signals_interrupt():
-    """While inside, SIGINT and SIGTERM raise :class:`Interrupted`; later ones are ignored
-    until the block is left, so that clean-up is not cut short.  Signals the process was
-    started to ignore stay ignored; outside the main thread nothing changes."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    previous = {signum: signal.getsignal(signum) for signum in SIGNALS}
-    handled = [signum for signum, handler in previous.items()
-               if handler not in (signal.SIG_IGN, None)]
-
-    def interrupt(signum, frame):
-        for other in handled:
-            signal.signal(other, signal.SIG_IGN)
-        raise Interrupted(signum)
-
-    for signum in handled:
-        signal.signal(signum, interrupt)
-    try:
-        yield
-    finally:
-        for signum in handled:
-            signal.signal(signum, previous[signum])
-
-
 def _module(name: str):
     return importlib.import_module(COMMANDS[name], __package__)
 
 
 def build_parser() -> argparse.ArgumentParser:
+    """The parser of every command (which imports each command's module)."""
+    import argparse
+
     parser = argparse.ArgumentParser(
         prog="python -m lut_baker",
         description="Made-up skin model (Baba, Mukaigawa, Yagi): fit, bake, draw.",
@@ -88,13 +61,33 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = build_parser()
-    args = parser.parse_args(argv)
+    """Parse ``argv`` (default ``sys.argv[1:]``) and run its command; the exit code.  A signal
+    while the parser is built (the command modules imported), while arguments are parsed or
+    while the command runs is reported as ``interrupted``."""
     try:
         with signals_interrupt():
-            return int(_module(args.command).run(args) or 0)
-    except ValueError as error:
-        parser.exit(2, f"{parser.prog} {args.command}: error: {error}\n")
+            parser = build_parser()
+            interrupts.raise_held()  # one that came during the imports: stop before parsing
+            args = parser.parse_args(argv)
+            try:
+                return int(_module(args.command).run(args) or 0)
+            except ValueError as error:
+                parser.exit(2, f"{parser.prog} {args.command}: error: {error}\n")
     except KeyboardInterrupt as error:
-        print("interrupted", file=sys.stderr)
-        return 128 + int(getattr(error, "signum", signal.SIGINT))
+        return interrupts.report(error)
+
+
+def command_line() -> int:
+    """:func:`main` as the whole process (``python -m lut_baker``): SIGINT and SIGTERM are
+    handled from its first line (before any command module is imported; one held back by the
+    entry point until then arrives here) and, once the exit code is known, ignored, so that
+    none lands in the interpreter's shutdown."""
+    try:
+        interrupts.take_signals()
+        interrupts.release_signals()
+        code = main()
+        interrupts.ignore_signals()
+        return code
+    except KeyboardInterrupt as error:  # one arriving between main's handling and the ignoring
+        interrupts.ignore_signals()
+        return interrupts.report(error)

@@ -25,6 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..atomic_files import write_text
 from .spectra import WAVELENGTHS_NM, spectra_to_rgb
 
 __all__ = ["SPECTRAL_SAMPLES", "InPlaneData", "read_inplane", "write_inplane"]
@@ -118,7 +119,5 @@ def write_inplane(path, theta_i_deg, theta_o_deg, values) -> Path:
                              values])
     if table.shape[1] not in _LAYOUTS:
         raise ValueError(f"values need 81 spectral or 3 RGB columns, got {values.shape[1]}")
-    path = Path(path)
-    path.write_text("".join("\t".join(repr(float(v)) for v in row) + "\n" for row in table),
-                    encoding="utf-8")
-    return path
+    return write_text(path, "".join("\t".join(repr(float(v)) for v in row) + "\n"
+                                    for row in table))

@@ -45,6 +45,7 @@ from ...model.dipole import dipole_profile
 from ...model.layers import Dipole, ReflectionLayer, TransmissionLayer
 from ...model.microfacet import ts_reflection, ts_transmission
 from ...model.presets import paper_layers
+from ..atomic_files import replacing
 from .protocols import (
     profile_distances,
     reflection_geometry,
@@ -277,7 +278,8 @@ def write_measurements(path, data, comments: tuple[str, ...] = ()) -> Path:
     first); values to 7 significant digits.  Returns the path."""
     path = Path(path)
     columns = [getattr(data, name) for name in data.COLUMNS]
-    with path.open("w", newline="", encoding="utf-8") as handle:
+    with replacing(path) as temporary, temporary.open("w", newline="",
+                                                      encoding="utf-8") as handle:
         for comment in comments:
             handle.write(f"# {comment}\n")
         writer = csv.writer(handle, lineterminator="\n")

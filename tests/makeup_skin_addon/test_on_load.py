@@ -1,0 +1,104 @@
+"""Opening a file (makeup_skin_addon.on_load): a packed lookup image damaged in the .blend is
+repaired before the first render, reported on the console and in the panel; without the
+add-on the same file renders magenta; intact files and files without a made-up material are
+left as they are, nothing decoded."""
+
+import numpy as np
+import pytest
+from support.addon_steps import apply_pipeline, lut_images, render
+
+REPAIRED_LINE = "Made-up Skin: on opening the file: 'Skin': its lookup image "
+
+
+def magenta(pixels: np.ndarray) -> float:
+    """Fraction of the lit pixels that are magenta (Blender's colour for an image it cannot
+    load, (1, 0, 1), showing through the group: red and blue alike, green far below them)."""
+    red, green, blue = np.moveaxis(pixels, -1, 0)
+    lit = red + green + blue > 0.05
+    pink = (green < 0.5 * np.minimum(red, blue)) & (np.abs(red - blue) < 0.1 * (red + blue))
+    return float(pink[lit].mean()) if lit.any() else 0.0
+
+
+def damage(path, packed: bytes) -> None:
+    """Rename the OpenEXR header attribute ``channels`` of the image packed in the .blend at
+    ``path``: Blender then says "imb_load_openexr: Invalid or missing attribute" and renders
+    the image as missing (as a file damaged on a user's disk did)."""
+    data = bytearray(path.read_bytes())
+    at = data.index(b"channels\x00chlist\x00", data.index(packed))
+    data[at:at + len(b"channels")] = b"chbnnels"
+    path.write_bytes(bytes(data))
+
+
+@pytest.fixture
+def damaged_file(sphere, tmp_path):
+    """``(path, pixels)``: a made-up sphere (Layered: it reads a packed image) saved with that
+    image damaged, and its render before the damage."""
+    import bpy
+
+    apply_pipeline(sphere, "LAYERED")
+    before = render(tmp_path, "before")
+    packed = bytes(lut_images()[0].packed_file.data)
+    path = tmp_path / "damaged.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(path), compress=False)
+    damage(path, packed)
+    return path, before
+
+
+@pytest.mark.slow  # three renders
+def test_a_damaged_image_is_repaired_on_opening_and_renders_no_magenta(damaged_file, tmp_path,
+                                                                      capsys):
+    import bpy
+
+    import makeup_skin_addon
+    from makeup_skin_addon import on_load
+
+    path, before = damaged_file
+    assert magenta(before) == 0.0
+    makeup_skin_addon.unregister()  # as where the add-on is not installed: the damage shows
+    try:
+        bpy.ops.wm.open_mainfile(filepath=str(path), load_ui=False)
+        assert magenta(render(tmp_path, "without")) > 0.5
+    finally:
+        makeup_skin_addon.register()
+    capsys.readouterr()
+    bpy.ops.wm.open_mainfile(filepath=str(path), load_ui=False)
+    lines = [line for line in capsys.readouterr().out.splitlines()
+             if line.startswith("Made-up Skin")]
+    assert len(lines) == 1 and lines[0].startswith(REPAIRED_LINE), lines
+    assert "damaged in the file" in lines[0] and lines[0].endswith("rebuilt it from a re-bake.")
+    assert on_load.notice(bpy.data.materials["Skin"]) == on_load.REPAIRED
+    after = render(tmp_path, "after")
+    assert magenta(after) == 0.0
+    np.testing.assert_allclose(after, before, rtol=0, atol=1e-4 * before.max())
+    assert on_load.damaged_groups() == {}
+
+
+def test_an_intact_file_is_left_alone_and_nothing_is_decoded(sphere, tmp_path, capsys):
+    import bpy
+
+    from makeup_skin_addon import on_load
+
+    apply_pipeline(sphere, "LAYERED")
+    path = tmp_path / "intact.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(path))
+    capsys.readouterr()
+    bpy.ops.wm.open_mainfile(filepath=str(path), load_ui=False)
+    (image,) = lut_images()
+    assert not image.has_data  # checked by its packed bytes only: not decoded
+    assert on_load.notice(bpy.data.materials["Skin"]) is None
+    assert "Made-up Skin" not in capsys.readouterr().out
+
+
+def test_a_file_without_a_made_up_material_is_left_alone(addon, blank_scene, tmp_path):
+    import bpy
+
+    from makeup_skin_addon import on_load
+
+    bpy.data.node_groups.new("Made-up Skin look-alike", "ShaderNodeTree").use_fake_user = True
+    bpy.data.materials.new("Someone's material").use_fake_user = True
+    path = tmp_path / "plain.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(path))
+    bpy.ops.wm.open_mainfile(filepath=str(path), load_ui=False)
+    assert "Made-up Skin look-alike" in bpy.data.node_groups  # no record: not the add-on's
+    assert on_load.damaged_groups() == {} and on_load.repair_file(bpy.context) == []
+    assert on_load.notice(bpy.data.materials["Someone's material"]) is None
