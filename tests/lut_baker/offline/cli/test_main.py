@@ -243,14 +243,14 @@ def test_sigint_during_the_shutdown_changes_nothing(tmp_path):
 
 @pytest.mark.slow  # four fresh Pythons bake (~6 s on 2 cores)
 def test_sigint_during_the_bake_keeps_the_earlier_pair(tmp_path):
-    """SIGINT as the bake reaches a stage (Fourier matrices, surface gloss, done):
+    """SIGINT as the bake reaches a stage (Fourier matrices, albedos, done):
     ``interrupted``, 130, and the earlier pair as it was."""
     folder = tmp_path / "earlier"
     code, _, err = finish(start("", "bake", "--resolution", "preview", "--out", folder))
     assert code == 0, err
     before = listing(folder)
     runs = []
-    for fraction in (0.05, 0.55, 1.0):
+    for fraction in (0.05, 0.45, 1.0):
         out = tmp_path / f"at{fraction}"
         shutil.copytree(folder, out)
         runs.append((fraction, out, start(SIGNAL_AT_STAGE.format(fraction=fraction), *BAKE, out)))
