@@ -2,37 +2,7 @@
 panels): Apply before, Revert after, and a linked Skin Color shown as linked."""
 
 from support.addon_steps import apply_operator
-
-
-class _Layout:
-    """A stand-in for Blender's UILayout that records what a panel draws (headless Blender
-    draws no panels)."""
-
-    def __init__(self, drawn=None):
-        self.drawn = [] if drawn is None else drawn
-        self.use_property_split = self.use_property_decorate = False
-        self.enabled = self.active = True
-
-    def _child(self, *args, **kwargs):
-        return _Layout(self.drawn)
-
-    row = column = box = _child
-
-    def prop(self, data, name, **kwargs):
-        self.drawn.append(("prop", name, kwargs.get("text"), self.enabled))
-
-    def label(self, text="", **kwargs):
-        self.drawn.append(("label", text))
-
-    def operator(self, idname, **kwargs):
-        self.drawn.append(("operator", idname))
-        return type("Properties", (), {})()
-
-    def menu(self, *args, **kwargs):
-        self.drawn.append(("menu",))
-
-    def separator(self, *args, **kwargs):
-        pass
+from support.panel_layout import RecordingLayout
 
 
 def test_panel_shows_revert_and_a_linked_skin_colour(head):
@@ -40,11 +10,11 @@ def test_panel_shows_revert_and_a_linked_skin_colour(head):
 
     from makeup_skin_addon import ui
 
-    layout = _Layout()
+    layout = RecordingLayout()
     ui.draw_settings(layout, bpy.context)
     assert ("operator", "makeup_skin.apply") in layout.drawn
     apply_operator(head)
-    layout = _Layout()
+    layout = RecordingLayout()
     ui.draw_settings(layout, bpy.context)
     assert ("operator", "makeup_skin.revert") in layout.drawn
     assert ("prop", "skin_colour", "Skin Color (linked)", False) in layout.drawn

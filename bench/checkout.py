@@ -1,0 +1,62 @@
+"""Measuring another checkout: the benchmarks' ``--repo CHECKOUT`` (bench/character_files.py,
+bench/apply.py, bench/tier_accuracy.py).
+
+- :func:`use_checkout` -- put a checkout first on ``sys.path``, import packages from it and
+  check they came from there; then this repository's ``tests`` (for ``support``) last.
+- :func:`commit` -- the checkout's ``HEAD``, marked ``+changes`` when its packages differ from it;
+  :func:`packages_commit` -- the last commit that changed its packages.
+"""
+
+from __future__ import annotations
+
+import importlib
+import subprocess
+import sys
+from pathlib import Path
+
+OWN_ROOT = Path(__file__).resolve().parents[1]
+OWN_TESTS = OWN_ROOT / "tests"
+
+__all__ = ["OWN_ROOT", "OWN_TESTS", "use_checkout", "commit", "packages_commit"]
+
+
+def use_checkout(repo: Path, packages=("lut_baker",), *, who: str = "bench") -> list:
+    """Put ``repo`` first on ``sys.path``, import ``packages`` from it (``SystemExit`` naming
+    ``who`` if one comes from elsewhere), then append this repository's ``tests`` folder, after
+    everything the packages came from, so that ``support`` (tests/support) is this
+    repository's.  Returns the imported modules."""
+    repo = Path(repo).resolve()
+    sys.path.insert(0, str(repo))
+    modules = [importlib.import_module(name) for name in packages]
+    for module in modules:
+        if not Path(module.__file__).resolve().is_relative_to(repo):
+            raise SystemExit(f"{who}: {module.__name__} came from {module.__file__}, "
+                             f"not from {repo}")
+    if str(OWN_TESTS) not in sys.path:
+        sys.path.append(str(OWN_TESTS))
+    return modules
+
+
+def commit(repo: Path, packages=("makeup_skin_addon", "lut_baker")) -> str:
+    """``git rev-parse HEAD`` of the checkout, with ``+changes`` when ``packages`` differ from
+    it; ``unknown`` outside git."""
+    try:
+        head = subprocess.run(["git", "-C", str(repo), "rev-parse", "HEAD"], capture_output=True,
+                              text=True, check=True).stdout.strip()
+        dirty = subprocess.run(["git", "-C", str(repo), "status", "--porcelain", "--",
+                                *packages], capture_output=True,
+                               text=True, check=True).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        return "unknown"
+    return head + ("+changes" if dirty else "")
+
+
+def packages_commit(repo: Path, packages=("makeup_skin_addon", "lut_baker")) -> str:
+    """The last commit of the checkout that changed ``packages`` (what was measured, when
+    later commits touched only benchmarks or docs); ``unknown`` outside git."""
+    try:
+        return subprocess.run(["git", "-C", str(repo), "log", "-1", "--format=%H", "--",
+                               *packages], capture_output=True, text=True,
+                              check=True).stdout.strip() or "unknown"
+    except (OSError, subprocess.CalledProcessError):
+        return "unknown"
