@@ -59,7 +59,13 @@ import tempfile
 import time
 from pathlib import Path
 
-from checkout import commit, packages_commit, use_checkout  # bench/checkout.py
+from checkout import (  # bench/checkout.py
+    commit,
+    machine_load,
+    packages_commit,
+    use_checkout,
+    write_figures,
+)
 
 HERE = Path(__file__).resolve()
 FILM_MIN = "film_min"
@@ -296,23 +302,19 @@ def _foundations(repo: Path) -> list[str]:
     return json.loads(result.stdout)
 
 
-def _load() -> list[float]:
-    return [round(x, 2) for x in os.getloadavg()]
-
-
 def measure(repo: Path, cases: list[str], tier: str, repeats: int, single_above, cli: bool,
             progress=print) -> dict:
     results = {"repo": str(repo), "commit": commit(repo),
                "packages_commit": packages_commit(repo), "tier": tier, "repeats": repeats,
                "single_above_s": single_above, "python": sys.executable,
-               "machine": platform.node(), "cpus": os.cpu_count(), "load_start": _load(),
+               "machine": platform.node(), "cpus": os.cpu_count(), "load_start": machine_load(),
                "started": time.strftime("%Y-%m-%d %H:%M:%S"), "apply": {}, "cli": {}}
     start = time.perf_counter()
     for case in cases:
         runs = _repeated(lambda case=case: _run_worker(repo, case, tier), repeats,
                          single_above, "cold_s")
         results["apply"][case] = {"median": _medians(runs), "runs": runs,
-                                  "load": _load()}
+                                  "load": machine_load()}
         m = results["apply"][case]["median"]
         progress(f"  {case}: cold {m['cold_s']:.2f} s, {m['cold_mb']:.0f} MB, repeat "
                  f"{m['repeat_s']:.3f} s, draw {m['draw_ms']:.2f} ms ({len(runs)} runs, load "
@@ -321,11 +323,11 @@ def measure(repo: Path, cases: list[str], tier: str, repeats: int, single_above,
         for case in (c for c in cases if c != FILM_MIN):
             runs = _repeated(lambda case=case: cli_bake(repo, case), repeats, single_above,
                              "wall_s")
-            results["cli"][case] = {"median": _medians(runs), "runs": runs, "load": _load()}
+            results["cli"][case] = {"median": _medians(runs), "runs": runs, "load": machine_load()}
             m = results["cli"][case]["median"]
             progress(f"  cli {case}: {m['wall_s']:.2f} s, {m['peak_mb']:.0f} MB peak, "
                      f"{m['bytes'] / MB:.1f} MB written ({len(runs)} runs)")
-    results["load_end"] = _load()
+    results["load_end"] = machine_load()
     results["seconds"] = time.perf_counter() - start
     return results
 
@@ -359,6 +361,11 @@ def print_report(results: dict) -> None:
           f"<= {TARGETS['cli wall_s']} s and <= {TARGETS['cli mb written']:.0f} MB written.")
 
 
+def _label(results: dict) -> str:
+    """The commit that last changed the measured packages (short), else the checkout's."""
+    return results.get("packages_commit", results["commit"])[:12]
+
+
 def _cell(before, after, fmt: str) -> str:
     pick = [format(v, fmt) if v is not None else "-" for v in (before, after)]
     return " / ".join(pick)
@@ -372,8 +379,8 @@ def _median_of(results, kind, case, key):
 def markdown(before: dict, after: dict) -> str:
     """The before/after table (Markdown), targets in the header."""
     cases = list(dict.fromkeys([*before["apply"], *after["apply"]]))
-    lines = [f"Before: {before['commit'][:12]} (load {before['load_start'][0]}); after: "
-             f"{after['commit'][:12]} (load {after['load_start'][0]}); tier "
+    lines = [f"Before: {_label(before)} (load {before['load_start'][0]}); after: "
+             f"{_label(after)} (load {after['load_start'][0]}); tier "
              f"{before['tier']} / {after['tier']}; each cell before / after.", "",
              "| case | cold Apply s (<= 1; paper <= 0.5) | its CPU s | repeat Apply s (<= 0.05) "
              "| Apply MB (<= 300) | draw ms (<= 5) | first Auto draw ms (<= 5) "
@@ -408,8 +415,8 @@ def chart(before: dict, after: dict, path: Path) -> None:
     for ax, key, unit, title in ((axes[0], "cold_s", "s", "First Apply (cold), wall time"),
                                  (axes[1], "cold_mb", "MB", "Memory added by Apply (peak)")):
         for offset, (label, results, colour) in zip((-0.2, 0.2), (
-                (f"before {before['commit'][:7]}", before, "#c0504d"),
-                (f"after {after['commit'][:7]}", after, "#4f81bd")), strict=True):
+                (f"before {_label(before)[:7]}", before, "#c0504d"),
+                (f"after {_label(after)[:7]}", after, "#4f81bd")), strict=True):
             values = [_median_of(results, "apply", c, key) for c in cases]
             heights = [v if v is not None else np.nan for v in values]
             ax.bar(x + offset, heights, 0.4, label=label, color=colour)
@@ -470,10 +477,7 @@ def main(argv=None) -> int:
     cases = args.presets or [*_foundations(repo), FILM_MIN]
     results = measure(repo, cases, args.tier, args.repeats, args.single_above, not args.no_cli)
     print_report(results)
-    if args.json is not None:
-        args.json.parent.mkdir(parents=True, exist_ok=True)
-        args.json.write_text(json.dumps(results, indent=1) + "\n")
-        print(f"\n-> {args.json}")
+    write_figures(args.json, results)
     return 0
 
 

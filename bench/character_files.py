@@ -47,7 +47,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from checkout import commit, use_checkout  # bench/checkout.py
+from checkout import commit, use_checkout, write_figures  # bench/checkout.py
 
 HERE = Path(__file__).resolve()
 TIER = "LAYERED"
@@ -230,10 +230,7 @@ def main(argv=None) -> int:
         addon.unregister()  # bpy 4.5 hangs at exit while an add-on stays registered
     results["timings"] = measure_timings(repo, args.repeats)
     print_report(results)
-    if args.json is not None:
-        args.json.parent.mkdir(parents=True, exist_ok=True)
-        args.json.write_text(json.dumps(results, indent=1) + "\n")
-        print(f"\n-> {args.json}")
+    write_figures(args.json, results)
     return 0
 
 

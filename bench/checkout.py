@@ -5,11 +5,15 @@ bench/apply.py, bench/tier_accuracy.py).
   check they came from there; then this repository's ``tests`` (for ``support``) last.
 - :func:`commit` -- the checkout's ``HEAD``, marked ``+changes`` when its packages differ from it;
   :func:`packages_commit` -- the last commit that changed its packages.
+- :func:`machine_load` -- the load averages, recorded beside the figures.
+- :func:`write_figures` -- a benchmark's results as JSON (``--json FILE``).
 """
 
 from __future__ import annotations
 
 import importlib
+import json
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -17,7 +21,8 @@ from pathlib import Path
 OWN_ROOT = Path(__file__).resolve().parents[1]
 OWN_TESTS = OWN_ROOT / "tests"
 
-__all__ = ["OWN_ROOT", "OWN_TESTS", "use_checkout", "commit", "packages_commit"]
+__all__ = ["OWN_ROOT", "OWN_TESTS", "use_checkout", "commit", "packages_commit", "machine_load",
+           "write_figures"]
 
 
 def use_checkout(repo: Path, packages=("lut_baker",), *, who: str = "bench") -> list:
@@ -60,3 +65,18 @@ def packages_commit(repo: Path, packages=("makeup_skin_addon", "lut_baker")) -> 
                               check=True).stdout.strip() or "unknown"
     except (OSError, subprocess.CalledProcessError):
         return "unknown"
+
+
+def machine_load() -> list[float]:
+    """The 1, 5 and 15 minute load averages (rounded): how busy the machine was."""
+    return [round(x, 2) for x in os.getloadavg()]
+
+
+def write_figures(path: Path | None, results: dict) -> None:
+    """Write ``results`` to ``path`` as indented JSON (folders created) and say so; nothing
+    when ``path`` is None."""
+    if path is None:
+        return
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(json.dumps(results, indent=1) + "\n")
+    print(f"\n-> {path}")
