@@ -47,32 +47,23 @@ import tempfile
 import time
 from pathlib import Path
 
+from checkout import commit, use_checkout, write_figures  # bench/checkout.py
+
 HERE = Path(__file__).resolve()
-OWN_ROOT = HERE.parents[1]
-OWN_TESTS = OWN_ROOT / "tests"
 TIER = "LAYERED"
 RESOLUTIONS = ("preview", "default")
 THREE_SKINS = ("paper_bioplate", "paper_bioplate", "jensen_skin1")
 
 
 def _setup(repo: Path):
-    """Put ``repo`` first on sys.path, import the add-on and lut_baker from it (checked), then
-    tests/support/character.py of this script's repository (its ``tests`` folder appended to
-    sys.path, after everything the add-on came from); returns ``(bpy, addon, character)``.
-    BLENDER_USER_RESOURCES goes to a temporary folder before bpy is imported."""
+    """Import the add-on and lut_baker from ``repo`` (:func:`checkout.use_checkout`), then
+    tests/support/character.py of this script's repository; returns ``(bpy, addon,
+    character)``.  BLENDER_USER_RESOURCES goes to a temporary folder before bpy is imported."""
     os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="character_files_"))
-    sys.path.insert(0, str(repo))
     import bpy
 
-    import lut_baker
-    import makeup_skin_addon
-
-    for module in (lut_baker, makeup_skin_addon):
-        if not Path(module.__file__).resolve().is_relative_to(repo):
-            raise SystemExit(f"character_files: {module.__name__} came from {module.__file__}, "
-                             f"not from {repo}")
-    if str(OWN_TESTS) not in sys.path:
-        sys.path.append(str(OWN_TESTS))
+    _, makeup_skin_addon = use_checkout(repo, ("lut_baker", "makeup_skin_addon"),
+                                        who="character_files")
     from support import character
 
     return bpy, makeup_skin_addon, character
@@ -181,20 +172,6 @@ def measure_timings(repo: Path, repeats: int) -> dict:
     return timings
 
 
-def _commit(repo: Path) -> str:
-    """``git rev-parse HEAD`` of the checkout, with ``+changes`` when the add-on or lut_baker
-    differ from it."""
-    try:
-        head = subprocess.run(["git", "-C", str(repo), "rev-parse", "HEAD"], capture_output=True,
-                              text=True, check=True).stdout.strip()
-        dirty = subprocess.run(["git", "-C", str(repo), "status", "--porcelain", "--",
-                                "makeup_skin_addon", "lut_baker"], capture_output=True,
-                               text=True, check=True).stdout.strip()
-    except (OSError, subprocess.CalledProcessError):
-        return "unknown"
-    return head + ("+changes" if dirty else "")
-
-
 def print_report(results: dict) -> None:
     print(f"\nMade-up Skin on tests/support/character.py heads -- Blender {results['blender']}, "
           f"checkout {results['repo']} at {results['commit']}")
@@ -247,16 +224,13 @@ def main(argv=None) -> int:
             print("TIMINGS " + json.dumps(timing_worker(bpy, character, args.worker)))
             return 0
         results = {"blender": bpy.app.version_string, "repo": str(repo),
-                   "commit": _commit(repo), "character_py": character.__file__,
+                   "commit": commit(repo), "character_py": character.__file__,
                    "sizes": measure_sizes(bpy, character, args.out.resolve())}
     finally:
         addon.unregister()  # bpy 4.5 hangs at exit while an add-on stays registered
     results["timings"] = measure_timings(repo, args.repeats)
     print_report(results)
-    if args.json is not None:
-        args.json.parent.mkdir(parents=True, exist_ok=True)
-        args.json.write_text(json.dumps(results, indent=1) + "\n")
-        print(f"\n-> {args.json}")
+    write_figures(args.json, results)
     return 0
 
 

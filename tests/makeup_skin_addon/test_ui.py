@@ -4,37 +4,7 @@ panels): Apply before, Revert after, and a linked Skin Color shown as linked."""
 from types import SimpleNamespace
 
 from support.addon_steps import apply_operator, lut_images
-
-
-class _Layout:
-    """A stand-in for Blender's UILayout that records what a panel draws (headless Blender
-    draws no panels)."""
-
-    def __init__(self, drawn=None):
-        self.drawn = [] if drawn is None else drawn
-        self.use_property_split = self.use_property_decorate = False
-        self.enabled = self.active = True
-
-    def _child(self, *args, **kwargs):
-        return _Layout(self.drawn)
-
-    row = column = box = _child
-
-    def prop(self, data, name, **kwargs):
-        self.drawn.append(("prop", name, kwargs.get("text"), self.enabled))
-
-    def label(self, text="", **kwargs):
-        self.drawn.append(("label", text))
-
-    def operator(self, idname, **kwargs):
-        self.drawn.append(("operator", idname))
-        return type("Properties", (), {})()
-
-    def menu(self, *args, **kwargs):
-        self.drawn.append(("menu",))
-
-    def separator(self, *args, **kwargs):
-        pass
+from support.panel_layout import RecordingLayout
 
 
 def test_panel_shows_revert_and_a_linked_skin_colour(head):
@@ -42,11 +12,11 @@ def test_panel_shows_revert_and_a_linked_skin_colour(head):
 
     from makeup_skin_addon import ui
 
-    layout = _Layout()
+    layout = RecordingLayout()
     ui.draw_settings(layout, bpy.context)
     assert ("operator", "makeup_skin.apply") in layout.drawn
     apply_operator(head)
-    layout = _Layout()
+    layout = RecordingLayout()
     ui.draw_settings(layout, bpy.context)
     assert ("operator", "makeup_skin.revert") in layout.drawn
     assert ("prop", "skin_colour", "Skin Color (linked)", False) in layout.drawn
@@ -68,7 +38,7 @@ def test_drawing_the_panel_computes_nothing(head, monkeypatch):
         original = getattr(module, name)
         monkeypatch.setattr(module, name, lambda *a, _n=name, _f=original, **k: (
             calls.append(_n), _f(*a, **k))[1])
-    layout = _Layout()
+    layout = RecordingLayout()
     ui.draw_settings(layout, bpy.context)
     # the Properties editor's context has the material; the test's does not
     ui.draw_fit(layout, SimpleNamespace(material=head.active_material))
@@ -86,7 +56,7 @@ def test_panel_says_when_the_file_was_repaired_on_opening(head, tmp_path):
     from makeup_skin_addon import on_load, ui
 
     apply_operator(head)
-    layout = _Layout()
+    layout = RecordingLayout()
     ui.draw_settings(layout, bpy.context)
     assert ("label", on_load.REPAIRED) not in layout.drawn
     bpy.data.images.remove(lut_images()[0])
@@ -94,6 +64,6 @@ def test_panel_says_when_the_file_was_repaired_on_opening(head, tmp_path):
     bpy.ops.wm.save_as_mainfile(filepath=str(path))
     bpy.ops.wm.open_mainfile(filepath=str(path), load_ui=False)
     assert len(lut_images()) == 1  # rebuilt on opening
-    layout = _Layout()
+    layout = RecordingLayout()
     ui.draw_settings(layout, bpy.context)
     assert ("label", on_load.REPAIRED) in layout.drawn

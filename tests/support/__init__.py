@@ -15,5 +15,6 @@ functions that need it, after the caller has set ``BLENDER_USER_RESOURCES``.
   :func:`lut_baker.offline.validation.reference.sphere_image` pixel for pixel, and a
   :class:`~support.bench_scene.Stage` built once and changed between renders.
 - :mod:`support.character` -- an artist's textured head (albedo texture, pore normal map).
+- :mod:`support.panel_layout` -- a stand-in ``UILayout`` that records what a panel draws.
 - :mod:`support.subsurface_edge` -- Cycles' subsurface blur of a shadow edge, and its replica.
 """

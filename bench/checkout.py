@@ -1,0 +1,82 @@
+"""Measuring another checkout: the benchmarks' ``--repo CHECKOUT`` (bench/character_files.py,
+bench/apply.py, bench/tier_accuracy.py).
+
+- :func:`use_checkout` -- put a checkout first on ``sys.path``, import packages from it and
+  check they came from there; then this repository's ``tests`` (for ``support``) last.
+- :func:`commit` -- the checkout's ``HEAD``, marked ``+changes`` when its packages differ from it;
+  :func:`packages_commit` -- the last commit that changed its packages.
+- :func:`machine_load` -- the load averages, recorded beside the figures.
+- :func:`write_figures` -- a benchmark's results as JSON (``--json FILE``).
+"""
+
+from __future__ import annotations
+
+import importlib
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+OWN_ROOT = Path(__file__).resolve().parents[1]
+OWN_TESTS = OWN_ROOT / "tests"
+
+__all__ = ["OWN_ROOT", "OWN_TESTS", "use_checkout", "commit", "packages_commit", "machine_load",
+           "write_figures"]
+
+
+def use_checkout(repo: Path, packages=("lut_baker",), *, who: str = "bench") -> list:
+    """Put ``repo`` first on ``sys.path``, import ``packages`` from it (``SystemExit`` naming
+    ``who`` if one comes from elsewhere), then append this repository's ``tests`` folder, after
+    everything the packages came from, so that ``support`` (tests/support) is this
+    repository's.  Returns the imported modules."""
+    repo = Path(repo).resolve()
+    sys.path.insert(0, str(repo))
+    modules = [importlib.import_module(name) for name in packages]
+    for module in modules:
+        if not Path(module.__file__).resolve().is_relative_to(repo):
+            raise SystemExit(f"{who}: {module.__name__} came from {module.__file__}, "
+                             f"not from {repo}")
+    if str(OWN_TESTS) not in sys.path:
+        sys.path.append(str(OWN_TESTS))
+    return modules
+
+
+def commit(repo: Path, packages=("makeup_skin_addon", "lut_baker")) -> str:
+    """``git rev-parse HEAD`` of the checkout, with ``+changes`` when ``packages`` differ from
+    it; ``unknown`` outside git."""
+    try:
+        head = subprocess.run(["git", "-C", str(repo), "rev-parse", "HEAD"], capture_output=True,
+                              text=True, check=True).stdout.strip()
+        dirty = subprocess.run(["git", "-C", str(repo), "status", "--porcelain", "--",
+                                *packages], capture_output=True,
+                               text=True, check=True).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        return "unknown"
+    return head + ("+changes" if dirty else "")
+
+
+def packages_commit(repo: Path, packages=("makeup_skin_addon", "lut_baker")) -> str:
+    """The last commit of the checkout that changed ``packages`` (what was measured, when
+    later commits touched only benchmarks or docs); ``unknown`` outside git."""
+    try:
+        return subprocess.run(["git", "-C", str(repo), "log", "-1", "--format=%H", "--",
+                               *packages], capture_output=True, text=True,
+                              check=True).stdout.strip() or "unknown"
+    except (OSError, subprocess.CalledProcessError):
+        return "unknown"
+
+
+def machine_load() -> list[float]:
+    """The 1, 5 and 15 minute load averages (rounded): how busy the machine was."""
+    return [round(x, 2) for x in os.getloadavg()]
+
+
+def write_figures(path: Path | None, results: dict) -> None:
+    """Write ``results`` to ``path`` as indented JSON (folders created) and say so; nothing
+    when ``path`` is None."""
+    if path is None:
+        return
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(json.dumps(results, indent=1) + "\n")
+    print(f"\n-> {path}")
