@@ -5,8 +5,9 @@ its own, and only at module level (no import inside a function, no cycle):
 
 1. ``keys`` -- every name stored in users' files: custom-property keys, node group, node, frame,
    material and image names, the ``bl_idname`` prefixes, the presets folder (no bpy).
-2. ``package`` -- the add-on's package names and :func:`.package.lut_baker`, the only way to
-   ``lut_baker`` (``lut_baker("closures.fitting")``; no bpy).
+2. ``package`` -- the add-on's package names, and whether it runs installed (no bpy).
+   ``core`` -- lut_baker's runtime modules, imported by ordinary statements, from beside the
+   add-on when installed, top level from a checkout (no bpy).
 3. ``convert`` -- the artist's material converted in place and back (install, revert).
 4. ``storage`` -- what the .blend keeps: bake records, re-bakes, packed images and their hashes.
 5. ``nodes`` -- the node groups built from closure fits, and their records.

@@ -19,14 +19,14 @@ from __future__ import annotations
 
 import math
 
-from .package import lut_baker
+from .core import auto_tier, cache, fitting
 from .storage import rebake
 
 __all__ = ["FIT_CACHE_SIZE", "baked", "cached", "measure", "measured_at", "traits", "clear"]
 
 FIT_CACHE_SIZE = 8
 """Closure fits kept in this session, by bake key (with their tables, :mod:`.storage`)."""
-_FITS = lut_baker("numerics.cache").LRUCache(FIT_CACHE_SIZE)
+_FITS = cache.LRUCache(FIT_CACHE_SIZE)
 TOLERANCE = 1e-6
 """How close a coverage or an absorption must be to count as the same (the panel's sliders
 store floats)."""
@@ -60,7 +60,7 @@ def baked(record: dict, *, method=None, errors_at=None, bake_progress=None,
     key = _fit_key(record, method)
     fit = _FITS.get(key)
     if fit is None:
-        fit = lut_baker("closures.fitting").fit_closures(
+        fit = fitting.fit_closures(
             tables, subsurface_method=method, errors_at=errors_at, progress=fit_progress)
         _FITS.put(key, fit)
     return tables, fit
@@ -79,16 +79,14 @@ def measure(tables, fit, coverage: float, absorption, method=None, *,
     MaterialTraits.as_dict() or None}`` (the traits, which hold the gloss omissions too, only
     ``with_traits``: the Auto tier's, a tenth of a second more).  The fit's own errors are
     reused when it was measured there."""
-    cf = lut_baker("closures.fitting")
-    auto = lut_baker("auto_tier")
     coverage = float(coverage)
     absorption = [float(a) for a in absorption]
     errors = fit.errors
     first = next(iter(errors.values()), None)
     if first is None or not (_same([first.coverage], [coverage])
                              and _same(first.absorption, absorption)):
-        errors = cf.tier_errors(fit, tables, coverage, absorption)
-    traits = auto.traits_from_tables(tables, fit, coverage, absorption, method=method,
+        errors = fitting.tier_errors(fit, tables, coverage, absorption)
+    traits = auto_tier.traits_from_tables(tables, fit, coverage, absorption, method=method,
                                      errors=errors) if with_traits else None
     return {"coverage": coverage, "absorption": absorption, "method": method,
             "errors": {tier: {"rms": float(e.rms), "albedo": float(e.albedo)}
@@ -116,7 +114,7 @@ def traits(measured: dict):
     """The :class:`lut_baker.auto_tier.MaterialTraits` a measurement keeps, or None if they
     cannot be read."""
     try:
-        return lut_baker("auto_tier").MaterialTraits.from_dict(measured["traits"])
+        return auto_tier.MaterialTraits.from_dict(measured["traits"])
     except (KeyError, TypeError, ValueError):
         return None
 

@@ -29,8 +29,8 @@ import math
 import bpy
 
 from . import convert, fits, nodes, scene_fit, storage
+from .core import fitting, params_file, presets
 from .keys import AUTO_KEY, ERRORS_KEY, MATERIAL_NAME, group_name
-from .package import lut_baker
 from .scene_fit import units_per_mm
 
 __all__ = [
@@ -58,7 +58,6 @@ def skin_from_settings(settings):
     and index, also the index of its transmission's Fresnel term); the film's transmission lobe
     stays the foundation's, since it is set by the pigment the light crosses, not by the
     surface (docs/model.md §4)."""
-    presets = lut_baker("model.presets")
     skin = presets.made_up_skin(settings.foundation, settings.skin, coverage=1.0,
                                 absorption=0.0)
     if settings.override_film:
@@ -211,8 +210,7 @@ def _existing(record: dict, tier: str, method, messages: list):
 def _stored_measurement(work: _Bake):
     """What any group of this bake (either tier) keeps measured at the coverage and
     absorption, with the Auto tier's traits, or None."""
-    cf = lut_baker("closures.fitting")
-    for tier in cf.TIERS:
+    for tier in fitting.TIERS:
         group = bpy.data.node_groups.get(group_name(tier, work.record["key"], work.method))
         if group is not None:
             measured = fits.measured_at(nodes.read_meta(group), work.coverage, work.absorption,
@@ -262,7 +260,7 @@ def group_for_tables(tables, tier: str, *, resolution: str = "default", group=No
     which to measure (default: the bake's).  ``messages``: a list that gets a sentence for
     each damaged image found (then rebuilt)."""
     messages = [] if messages is None else messages
-    skin = lut_baker("model.params_file").skin_from_dict(tables.parameters)
+    skin = params_file.skin_from_dict(tables.parameters)
     record = storage.bake_record(skin, resolution)
     storage.remember(record, tables)
     coverage, absorption = errors_at if errors_at is not None else \

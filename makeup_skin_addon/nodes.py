@@ -42,8 +42,8 @@ import bpy
 import numpy as np
 
 from . import storage
+from .core import fitting
 from .keys import FIT_KEY, LEGACY_TABLES_REF, group_name, lut_image_name
-from .package import lut_baker
 
 __all__ = ["INPUTS", "NORMAL_INPUTS", "build_group", "read_meta", "write_measured",
            "set_inputs", "socket", "has_interface"]
@@ -229,7 +229,6 @@ def _common(build: _Builder):
 
 
 def _build_principled(build: _Builder, fit, method: str, radius_mm, ior: float):
-    cf = lut_baker("closures.fitting")
     inputs, output, w, through, through2, skin, scale, gloss = _common(build)
     coat_weight = build.math("MULTIPLY", build.math("MULTIPLY", w, gloss), fit.coat.level,
                              label="coat weight")
@@ -259,7 +258,7 @@ def _build_principled(build: _Builder, fit, method: str, radius_mm, ior: float):
     bsdf = build.node("ShaderNodeBsdfPrincipled", "Made-up skin", distribution="GGX",
                       subsurface_method=method)
     values = {
-        "Base Color": base, "Roughness": roughness, "IOR": cf.SPECULAR_IOR,
+        "Base Color": base, "Roughness": roughness, "IOR": fitting.SPECULAR_IOR,
         "Specular IOR Level": level, "Coat Weight": coat_weight,
         "Coat Roughness": fit.coat.roughness,
         "Coat IOR": fit.coat.ior, "Subsurface Weight": share,
@@ -274,7 +273,6 @@ def _build_principled(build: _Builder, fit, method: str, radius_mm, ior: float):
 
 
 def _build_layered(build: _Builder, fit, lut, method: str, radius_mm, ior: float):
-    cf = lut_baker("closures.fitting")
     inputs, output, w, through, through2, skin, scale, gloss = _common(build)
     geometry = build.node("ShaderNodeNewGeometry")
     film_normal, skin_normal = inputs.outputs["Film Normal"], inputs.outputs["Normal"]
@@ -283,10 +281,10 @@ def _build_layered(build: _Builder, fit, lut, method: str, radius_mm, ior: float
     cos_film = _cos_view(build, film_normal, geometry, "cos theta_o (film)")
     cos_skin = _cos_view(build, skin_normal, geometry, "cos theta_o (skin)")
     rows = {}
-    for j, name in enumerate(cf.LUT_ROWS):
+    for j, name in enumerate(fitting.LUT_ROWS):
         coordinate = build.node("ShaderNodeCombineXYZ", f"u = cos, row {name}")
         build.feed(coordinate.inputs["X"], cos_skin if name == "skin_gloss" else cos_film)
-        build.feed(coordinate.inputs["Y"], (j + 0.5) / len(cf.LUT_ROWS))
+        build.feed(coordinate.inputs["Y"], (j + 0.5) / len(fitting.LUT_ROWS))
         texture = build.node("ShaderNodeTexImage", name, image=lut, interpolation="Linear",
                              extension="EXTEND")
         build.tree.links.new(coordinate.outputs[0], texture.inputs["Vector"])
@@ -368,9 +366,8 @@ def build_group(tier: str, bake: dict, fit, group=None, *, method=None, measured
     the SHA-256 of every image the group reads (:func:`storage.image_record`) and
     ``measured``, what the fit measured at the settings' coverage and absorption
     (:func:`.fits.measure`), if given."""
-    cf = lut_baker("closures.fitting")
-    if tier not in cf.TIERS:
-        raise ValueError(f"tier must be one of {cf.TIERS}, got {tier!r}")
+    if tier not in fitting.TIERS:
+        raise ValueError(f"tier must be one of {fitting.TIERS}, got {tier!r}")
     key = bake["key"]
     name = group_name(tier, key, method)
     if group is None:

@@ -11,7 +11,6 @@ from bl_operators.presets import AddPresetBase
 from . import convert, live, scene_fit
 from . import material as made_up
 from .keys import OPERATOR_PREFIX, PRESET_SUBDIR, SETTINGS_ATTRIBUTE
-from .package import lut_baker
 
 __all__ = ["MAKEUPSKIN_OT_apply", "MAKEUPSKIN_OT_revert", "MAKEUPSKIN_OT_check_tables",
            "MAKEUPSKIN_OT_fit_to_scene", "MAKEUPSKIN_OT_add_preset", "MAKEUPSKIN_MT_presets",
@@ -202,5 +201,4 @@ _register, unregister = bpy.utils.register_classes_factory(classes)
 
 
 def register():
-    lut_baker()  # fail early (and clearly) if the bundled lut_baker cannot be imported
     _register()

@@ -7,14 +7,12 @@ preferences, ``bpy.utils.extension_path_user``) by the *root* package, the paren
 - :data:`ADDON_PACKAGE` -- this package's full dotted name.
 - :func:`root_package` -- the parent package name of a dotted package name.
 - :data:`ROOT_PACKAGE` -- the add-on's root package, e.g. ``bl_ext.user_default.makeup_skin``.
-- :func:`lut_baker` -- the add-on's own ``lut_baker`` (or one of its modules): the copy next to
-  this package when installed, the top-level one when ``makeup_skin_addon`` itself is top level
-  (run from a source checkout, as the tests do).
+- :data:`INSTALLED` -- whether the add-on runs inside its extension package (``lut_baker`` is
+  then its sibling, imported relatively by :mod:`.core`) or from a source checkout, where
+  ``makeup_skin_addon`` and ``lut_baker`` are both top level (the tests, the tools).
 """
 
-import importlib
-
-__all__ = ["ADDON_PACKAGE", "ROOT_PACKAGE", "root_package", "lut_baker"]
+__all__ = ["ADDON_PACKAGE", "ROOT_PACKAGE", "INSTALLED", "root_package"]
 
 
 def root_package(addon_package: str) -> str:
@@ -33,9 +31,4 @@ def root_package(addon_package: str) -> str:
 
 ADDON_PACKAGE: str = __package__ or __name__.rpartition(".")[0]
 ROOT_PACKAGE: str = root_package(ADDON_PACKAGE)
-
-
-def lut_baker(module: str = ""):
-    """Import ``lut_baker`` (or ``lut_baker.<module>``) from where this add-on lives."""
-    base = "lut_baker" if ROOT_PACKAGE == ADDON_PACKAGE else ROOT_PACKAGE + ".lut_baker"
-    return importlib.import_module(base + ("." + module if module else ""))
+INSTALLED: bool = ROOT_PACKAGE != ADDON_PACKAGE

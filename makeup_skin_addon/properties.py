@@ -14,8 +14,8 @@ import math
 import bpy
 
 from . import live
+from .core import presets
 from .keys import SETTINGS_ATTRIBUTE
-from .package import lut_baker
 
 __all__ = ["MakeupSkinSettings", "register", "unregister", "TIER_ITEMS"]
 
@@ -43,20 +43,17 @@ RESOLUTION_ITEMS = (
 
 
 def _foundation_items(self, context):
-    presets = lut_baker("model.presets")
     return [(key, value["label"], f"Foundation shade {value['label']}")
             for key, value in presets.FOUNDATIONS.items()]
 
 
 def _skin_items(self, context):
-    presets = lut_baker("model.presets")
     return [(key, value["label"], f"Skin {value['label']}") for key, value in
             presets.SKINS.items()]
 
 
 def _first_skin_albedo() -> tuple:
     """The albedo of the first skin preset: Skin Color's default."""
-    presets = lut_baker("model.presets")
     return tuple(presets.skin_albedo(next(iter(presets.SKINS))))
 
 
@@ -81,7 +78,6 @@ def _update_tables(self, context):
 
 
 def _update_skin(self, context):
-    presets = lut_baker("model.presets")
     if self.skin in presets.SKINS:
         # The preset's albedo goes to the socket at once (a linked texture overrides it).
         self.skin_colour = presets.skin_albedo(self.skin).tolist()
@@ -89,7 +85,6 @@ def _update_skin(self, context):
 
 
 def _update_foundation(self, context):
-    presets = lut_baker("model.presets")
     entry = presets.FOUNDATIONS.get(self.foundation)
     if entry is not None:
         # Assigning runs _update_sockets once more: the shade reaches the material at once.

@@ -31,8 +31,8 @@ import json
 import math
 
 from . import convert, fits, nodes, storage
+from .core import auto_tier
 from .keys import CHOICE_KEY, SAVED_GLOSS_KEY, SAVED_SCALE_KEY
-from .package import lut_baker
 
 __all__ = ["ENVIRONMENT_LIGHT_DEG", "units_per_mm", "describe_scene", "material_traits",
            "choose_with", "choose_for", "set_choice", "record_choice", "last_choice",
@@ -76,7 +76,6 @@ def _centre(obj):
 
 def _footprint_mm(scene, obj, mm_per_unit: float):
     """``(mm per pixel at the object, unit vector from the object to the camera)``."""
-    sm = lut_baker("auto_tier")
     camera = scene.camera
     data = camera.data
     scale = scene.render.resolution_percentage / 100.0
@@ -91,12 +90,12 @@ def _footprint_mm(scene, obj, mm_per_unit: float):
     axis = camera.matrix_world.to_3x3().col[2].normalized()  # the camera looks along -Z
     centre = _centre(obj)
     if data.type == "ORTHO":
-        footprint = sm.pixel_footprint_mm("ORTHO", max(int(resolution), 1),
+        footprint = auto_tier.pixel_footprint_mm("ORTHO", max(int(resolution), 1),
                                           ortho_scale_mm=data.ortho_scale * mm_per_unit)
         return footprint, axis
     offset = camera.matrix_world.translation - centre
     depth = max(offset.dot(axis), 1e-9)
-    footprint = sm.pixel_footprint_mm("PERSP", max(int(resolution), 1),
+    footprint = auto_tier.pixel_footprint_mm("PERSP", max(int(resolution), 1),
                                       distance_mm=depth * mm_per_unit, sensor_mm=sensor,
                                       focal_mm=data.lens)
     return footprint, offset.normalized()
@@ -120,7 +119,6 @@ def _light_angles(scene, obj, toward_camera) -> tuple:
 def describe_scene(scene, material=None, obj=None):
     """The :class:`lut_baker.auto_tier.SceneDescription` of ``scene`` for ``obj`` (default:
     the nearest object wearing ``material``), or None without a camera or an object."""
-    sm = lut_baker("auto_tier")
     samples, denoise = _samples(scene)
     objects = [obj] if obj is not None else (_wearers(material, scene) if material else [])
     if scene.camera is None or not objects:
@@ -137,7 +135,7 @@ def describe_scene(scene, material=None, obj=None):
     if best is None:
         return None
     item, footprint, size, toward_camera = best
-    return sm.SceneDescription(object_size_mm=size, footprint_mm=footprint,
+    return auto_tier.SceneDescription(object_size_mm=size, footprint_mm=footprint,
                                lights_deg=_light_angles(scene, item, toward_camera),
                                engine=_engine(scene), samples=samples, denoise=denoise)
 
@@ -173,7 +171,6 @@ def material_traits(material, *, refit: bool = False, may_fit: bool = True):
     it set them to 0): what its group's fit measured there (:mod:`.fits`; ``refit``: measured
     again rather than read from the record; without ``may_fit`` never a new bake or fit).
     Without either: the paper preset's traits."""
-    sm = lut_baker("auto_tier")
     settings = material.makeup_skin
     coverage = float(settings.coverage)
     absorption = [float(a) for a in settings.effective_absorption()]
@@ -184,12 +181,12 @@ def material_traits(material, *, refit: bool = False, may_fit: bool = True):
         meta = {key: value for key, value in meta.items() if key != "measured"}
     measured = _measurement(meta, coverage, absorption, may_fit=may_fit)
     traits = fits.traits(measured) if measured is not None else None
-    return (traits or sm.paper_traits()).scaled(scale, gloss)
+    return (traits or auto_tier.paper_traits()).scaled(scale, gloss)
 
 
 def _unknown_scene(scene):
     samples, denoise = _samples(scene)
-    return lut_baker("auto_tier").SceneDescription(engine=_engine(scene), samples=samples,
+    return auto_tier.SceneDescription(engine=_engine(scene), samples=samples,
                                                    denoise=denoise, **UNKNOWN_SCENE)
 
 
@@ -197,12 +194,11 @@ def choose_with(traits, material, scene, *, obj=None, tolerance=None):
     """``(Choice, SceneDescription or None)`` for a material of ``traits`` (the Subsurface
     Scale and Gloss of its settings applied here) in ``scene`` (an unknown scene counts as a
     close-up: :data:`UNKNOWN_SCENE`)."""
-    sm = lut_baker("auto_tier")
     description = describe_scene(scene, material, obj)
     scale = _kept_value(material, "subsurface_scale", SAVED_SCALE_KEY)
     gloss = _kept_value(material, "gloss", SAVED_GLOSS_KEY)
-    tolerance = sm.DEFAULT_TOLERANCE if tolerance is None else tolerance
-    choice = sm.choose(description or _unknown_scene(scene), traits.scaled(scale, gloss),
+    tolerance = auto_tier.DEFAULT_TOLERANCE if tolerance is None else tolerance
+    choice = auto_tier.choose(description or _unknown_scene(scene), traits.scaled(scale, gloss),
                        tolerance=tolerance)
     return choice, description
 
@@ -210,10 +206,9 @@ def choose_with(traits, material, scene, *, obj=None, tolerance=None):
 def choose_for(material, scene, *, obj=None, tolerance=None, refit=False, may_fit=True):
     """:func:`choose_with` the material's own traits (:func:`material_traits`; ``refit``,
     ``may_fit`` as there)."""
-    sm = lut_baker("auto_tier")
     description = describe_scene(scene, material, obj)
-    tolerance = sm.DEFAULT_TOLERANCE if tolerance is None else tolerance
-    choice = sm.choose(description or _unknown_scene(scene),
+    tolerance = auto_tier.DEFAULT_TOLERANCE if tolerance is None else tolerance
+    choice = auto_tier.choose(description or _unknown_scene(scene),
                        material_traits(material, refit=refit, may_fit=may_fit),
                        tolerance=tolerance)
     return choice, description

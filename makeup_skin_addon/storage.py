@@ -28,7 +28,7 @@ import json
 import bpy
 import numpy as np
 
-from .package import lut_baker
+from .core import bake, cache, codec, params_file, table_set
 
 __all__ = [
     "StorageError",
@@ -59,7 +59,7 @@ def bake_key(parameters: dict, resolution: str) -> str:
     ``parameters`` (:func:`lut_baker.model.params_file.skin_to_dict`), the resolution name and
     the tables' format version, as canonical JSON (floats by ``repr``: the same on every
     machine)."""
-    version = lut_baker("tables.table_set").FORMAT_VERSION
+    version = table_set.FORMAT_VERSION
     text = json.dumps({"parameters": parameters, "resolution": str(resolution),
                        "format": version}, sort_keys=True, separators=(",", ":"))
     return hashlib.sha256(text.encode("utf-8")).hexdigest()[:KEY_LENGTH]
@@ -68,12 +68,12 @@ def bake_key(parameters: dict, resolution: str) -> str:
 def bake_record(skin, resolution: str) -> dict:
     """What identifies a bake: ``{"key", "parameters", "resolution"}`` (plain data, no bake
     needed)."""
-    parameters = lut_baker("model.params_file").skin_to_dict(skin)
+    parameters = params_file.skin_to_dict(skin)
     return {"key": bake_key(parameters, resolution), "parameters": parameters,
             "resolution": str(resolution)}
 
 
-_TABLES = lut_baker("numerics.cache").LRUCache(REBAKE_CACHE_SIZE)
+_TABLES = cache.LRUCache(REBAKE_CACHE_SIZE)
 
 
 def clear_cache() -> None:
@@ -108,8 +108,8 @@ def rebake(record: dict, *, progress=None):
     if tables is not None:
         return tables
     try:
-        skin = lut_baker("model.params_file").skin_from_dict(record["parameters"])
-        tables = lut_baker("bake").bake(skin, record["resolution"], progress=progress)
+        skin = params_file.skin_from_dict(record["parameters"])
+        tables = bake.bake(skin, record["resolution"], progress=progress)
     except (KeyError, TypeError, ValueError):
         raise StorageError("its bake record cannot be re-baked (a parameter is missing or "
                            "unreadable)") from None
@@ -136,7 +136,7 @@ def _pixel_digest(image) -> str:
     width, height = image.size
     pixels = np.empty(width * height * image.channels, dtype=np.float32)
     image.pixels.foreach_get(pixels)
-    return lut_baker("tables.codec").pixel_hash(pixels)
+    return codec.pixel_hash(pixels)
 
 
 def _packed_digest(image) -> str | None:

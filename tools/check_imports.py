@@ -5,8 +5,8 @@ Usage::
     python tools/check_imports.py               # one line per broken rule; exit 1 if any
     python tools/check_imports.py --root DIR    # check another tree laid out like this one
 
-Rules (every ``import`` and ``from ... import`` counts, at module level or inside a function, and
-so does the add-on's ``lut_baker("dotted.module")`` call that imports the bundled lut_baker):
+Rules (every ``import`` and ``from ... import`` counts, at module level or inside a function;
+the add-on's ``from ..lut_baker.x import y`` in ``makeup_skin_addon/core.py`` is ``lut_baker.x``):
 
 1. **Layers.** :data:`LAYERS` lists each package's layers, lowest first. A module may import from
    its own layer and the layers below, never from a higher one. In the add-on each module is a
@@ -51,6 +51,7 @@ LAYERS: dict[str, list[tuple[str, ...]]] = {
     "makeup_skin_addon": [
         ("makeup_skin_addon.keys",),
         ("makeup_skin_addon.package",),
+        ("makeup_skin_addon.core",),
         ("makeup_skin_addon.convert",),
         ("makeup_skin_addon.storage",),
         ("makeup_skin_addon.fits",),
@@ -106,11 +107,6 @@ def imported_modules(source: str, name: str, package: bool,
             for alias in node.names:
                 candidate = f"{stem}.{alias.name}"
                 yield (candidate if candidate in known else stem), node.lineno
-        elif (isinstance(node, ast.Call) and isinstance(node.func, ast.Name)
-              and node.func.id == "lut_baker" and node.args
-              and isinstance(node.args[0], ast.Constant) and isinstance(node.args[0].value, str)):
-            dotted = node.args[0].value
-            yield "lut_baker" + (f".{dotted}" if dotted else ""), node.lineno
 
 
 def layer_of(module: str) -> tuple[str, int] | None:

@@ -1,0 +1,28 @@
+"""The add-on's way into lut_baker's runtime: ordinary import statements (no bpy).
+
+Installed as an extension, ``lut_baker`` sits beside this package, inside the extension's own
+package (``bl_ext.<repo>.makeup_skin.lut_baker``), and is imported relatively; run from a
+source checkout (the tests, the tools, ``bench/``), ``makeup_skin_addon`` is a top-level package
+and so is ``lut_baker``.  :data:`.package.INSTALLED` tells which, by the package's own name, and
+every module of the add-on imports lut_baker's modules from here, so that a reader, a type
+checker or a rename follows each name from the panel into the bake.  Only the runtime is
+imported (numpy only); nothing of ``lut_baker.offline`` ships.
+"""
+
+from .package import INSTALLED
+
+if INSTALLED:
+    from ..lut_baker import auto_tier, bake
+    from ..lut_baker.closures import fitting
+    from ..lut_baker.model import params_file, presets
+    from ..lut_baker.numerics import cache
+    from ..lut_baker.tables import codec, table_set
+else:
+    from lut_baker import auto_tier, bake
+    from lut_baker.closures import fitting
+    from lut_baker.model import params_file, presets
+    from lut_baker.numerics import cache
+    from lut_baker.tables import codec, table_set
+
+__all__ = ["auto_tier", "bake", "cache", "codec", "fitting", "params_file", "presets",
+           "table_set"]
