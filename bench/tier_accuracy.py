@@ -382,7 +382,7 @@ def measure_preset(foundation: str, coverages, cache, refine: bool, progress=pri
     entry["bake_s"] = time.perf_counter() - start
     fit = fitting.fit_closures(tables)
     entry["bake_fit_s"] = time.perf_counter() - start
-    entry["angular_grid"] = list(np.shape(tables.film_gloss)[:3])
+    entry["angular_grid"] = list(np.shape(getattr(tables, "film_gloss", tables.path3_gloss))[:3])
     absorption = presets.FOUNDATIONS[foundation]["absorption"]
     entry["absorption"] = list(absorption)
     exact_skin = presets.made_up_skin(foundation, SKIN, coverage=1.0)
