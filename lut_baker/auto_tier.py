@@ -60,7 +60,7 @@ import numpy as np
 from .bake import RESOLUTIONS, profile_radius
 from .closures.fitting import TIER_REPLICAS, TIERS, edge_response, profile_grid, tier_errors
 from .model.dipole import dipole_profile, dipole_total_reflectance
-from .model.made_up_skin import coverage_weights
+from .model.made_up_skin import combine, coverage_weights
 from .model.presets import made_up_skin
 from .numerics.cache import LRUCache
 from .numerics.geometry import polar_angle_deg, sphere_directions, sphere_normals
@@ -371,13 +371,13 @@ def gloss_and_skin_shares(tables, light_deg: float, coverage=None, absorption=No
     weights = coverage_weights(w, a)
     cos_i = wi[:, 2:3]
     total = tables.made_up_reflection(wi, wo, w, a) * cos_i
-    gloss = (weights.covered * tables.angular("film_gloss", wi, wo)
-             + weights.covered * weights.twice * tables.angular("path3_gloss", wi, wo)
-             + weights.bare * tables.angular("skin_gloss", wi, wo)) * cos_i
+    gloss = combine(weights, top=tables.angular("film_gloss", wi, wo),
+                    twice=tables.angular("path3_gloss", wi, wo),
+                    bare=tables.angular("skin_gloss", wi, wo)) * cos_i
     t_i = tables.directional("film_transmittance", polar_angle_deg(wi))
     t_o = tables.directional("film_transmittance", polar_angle_deg(wo))
-    skin = tables.skin_diffuse * (weights.covered * weights.twice * t_i * t_o
-                                  + weights.bare) * cos_i
+    skin = combine(weights, twice=tables.skin_diffuse * t_i * t_o,
+                   bare=tables.skin_diffuse) * cos_i
     norm = np.sqrt(np.mean(total**2))
     if not norm > 0:
         return 0.0, 0.0

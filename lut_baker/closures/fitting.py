@@ -59,7 +59,7 @@ from dataclasses import asdict, dataclass, field, replace
 
 import numpy as np
 
-from ..model.made_up_skin import coverage_weights
+from ..model.made_up_skin import combine, coverage_weights
 from ..numerics.cache import LRUCache
 from ..numerics.optimise import brent_minimum, least_squares
 from ..numerics.quadrature import trapezoid_weights
@@ -693,9 +693,9 @@ def diffuse_albedo(fit: ClosureFit, coverage: float, absorption) -> tuple[np.nda
     (:func:`~lut_baker.model.made_up_skin.coverage_weights`) and its skin terms (which the
     subsurface closure carries)."""
     weights = coverage_weights(coverage, _absorption(absorption))
-    skin_through = weights.twice * fit.skin_albedo * fit.transmittance_mean**2
-    skin = weights.bare * fit.skin_albedo + weights.covered * skin_through
-    return skin + weights.covered * weights.once * fit.film_albedo, skin
+    skin = combine(weights, twice=fit.skin_albedo * fit.transmittance_mean**2,
+                   bare=fit.skin_albedo)
+    return skin + combine(weights, once=fit.film_albedo), skin
 
 
 def principled_inputs(fit: ClosureFit, coverage: float, absorption, gloss: float = 1.0):
@@ -722,7 +722,7 @@ def principled_inputs(fit: ClosureFit, coverage: float, absorption, gloss: float
     bare, covered = weights.bare, weights.covered
     through2 = float(np.mean(weights.twice))
     total, skin = diffuse_albedo(fit, w, absorption)
-    total = total + g * covered * weights.twice * fit.gloss_to_diffuse
+    total = total + combine(weights, twice=g * fit.gloss_to_diffuse)
     e_spec = bare * fit.specular_albedo_mean[0] + covered * fit.specular_albedo_mean[1]
     coat = g * covered * fit.coat.level
     base = total / ((1.0 - coat * fit.coat_albedo_mean) * (1.0 - g * e_spec))

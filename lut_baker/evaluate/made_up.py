@@ -14,6 +14,7 @@ import numpy as np
 from ..model.albedo import grid_for, reflection_albedo
 from ..model.made_up_skin import (
     MadeUpSkin,
+    combine,
     coverage_weights,
     film_reflection_layer,
     film_transmission_layer,
@@ -47,8 +48,9 @@ def made_up_reflection(wi, wo, skin: MadeUpSkin, *, level: int = 0):
     bare = _rgb(ts_reflection(wi, wo, skin.skin, check=False), skin.skin)
     top = _rgb(ts_reflection(wi, wo, film, check=False), film)
     path3 = _rgb(layered_reflection(wi, wo, film_t, skin.skin, level=level), film_t, skin.skin)
-    weights = coverage_weights(skin.coverage, skin.absorption)
-    return weights.bare * bare + weights.covered * (top + path3)
+    # The layers hold the absorption already: everything the film covers is "top".
+    return combine(coverage_weights(skin.coverage, skin.absorption), top=top + path3,
+                   bare=bare)
 
 
 def directional_albedo(theta_i_deg, skin: MadeUpSkin, *, level: int = 0) -> np.ndarray:
@@ -65,8 +67,7 @@ def directional_albedo(theta_i_deg, skin: MadeUpSkin, *, level: int = 0) -> np.n
     film = film_reflection_layer(skin)
     top = reflection_albedo(np.degrees(theta), film, level=level)
     bare = reflection_albedo(np.degrees(theta), skin.skin, level=level)
-    weights = coverage_weights(skin.coverage, skin.absorption)
-    total = weights.bare * _rgb(bare, skin.skin) + weights.covered * (
-        _rgb(top, film) + _rgb(path3, film_t, skin.skin)
-    )
+    total = combine(coverage_weights(skin.coverage, skin.absorption),
+                    top=_rgb(top, film) + _rgb(path3, film_t, skin.skin),
+                    bare=_rgb(bare, skin.skin))
     return total.reshape(np.shape(theta_i_deg) + (3,))

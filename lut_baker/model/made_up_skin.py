@@ -14,7 +14,8 @@ Functions and types
 - :class:`MadeUpSkin` -- the bundle in albedo units: film, skin, dipole, coverage, absorption.
 - :func:`from_paper_counts` -- build a :class:`MadeUpSkin` from layers in pixel counts.
 - :func:`coverage_weights` -- the weights of coverage and absorption: how bare skin, the film
-  and the skin seen through the film are mixed.
+  and the skin seen through the film are mixed; :func:`combine` -- the mix itself, written
+  once.
 - :func:`film_reflection_layer`, :func:`film_transmission_layer` -- the film with its pigment
   absorption applied.
 
@@ -42,6 +43,7 @@ __all__ = [
     "from_paper_counts",
     "CoverageWeights",
     "coverage_weights",
+    "combine",
     "film_reflection_layer",
     "film_transmission_layer",
 ]
@@ -172,6 +174,19 @@ def coverage_weights(coverage, absorption) -> CoverageWeights:
     """
     once = 1.0 - np.asarray(absorption, dtype=float)
     return CoverageWeights(bare=1.0 - coverage, covered=coverage, once=once, twice=once**2)
+
+
+def combine(weights: CoverageWeights, *, top=0.0, once=0.0, twice=0.0, bare=0.0):
+    """The made-up skin's mix of its parts (docs/model.md §4, :func:`coverage_weights`)::
+
+        covered [top + once (1 - A) + twice (1 - A)^2] + bare (1 - w)
+
+    ``top``: what the film covers without crossing its pigment (its surface gloss, or parts
+    whose layers hold the absorption already); ``once``: what crosses it once (its diffuse
+    reflection); ``twice``: what crosses it twice (the skin seen through it, paths 3 and 4);
+    ``bare``: the bare skin.  Any unit, any broadcasting shapes (RGB last)."""
+    return (weights.covered * (top + weights.once * once + weights.twice * twice)
+            + weights.bare * bare)
 
 
 def film_reflection_layer(skin: MadeUpSkin) -> ReflectionLayer:

@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..numerics.geometry import half_vector
 from .layers import ReflectionLayer, TransmissionLayer, channel_axis
 
 __all__ = [
@@ -68,14 +69,6 @@ def check_directions(name: str, w) -> np.ndarray:
         worst = float(np.max(np.abs(norm - 1.0)))
         raise ValueError(f"{name} must be unit vectors (|w| = 1 within 1e-6), off by {worst:.3g}")
     return w
-
-
-def _half_vector(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Normalised ``a + b``; the normal where ``a + b`` vanishes (opposite horizontal pair)."""
-    h = a + b
-    length = np.linalg.norm(h, axis=-1, keepdims=True)
-    safe = length > 1e-12
-    return np.where(safe, h / np.where(safe, length, 1.0), np.array([0.0, 0.0, 1.0]))
 
 
 def half_vector_cosines(cos_a, sin_a, cos_b, sin_b, cos_phi):
@@ -229,7 +222,7 @@ def ts_reflection(wi, wo, layer: ReflectionLayer, *, check: bool = True):
         wi = check_directions("wi", wi)
         wo = check_directions("wo", wo)
     wi, wo = np.broadcast_arrays(wi, wo)
-    h = _half_vector(wi, wo)
+    h = half_vector(wi, wo)
     n_dot_l = wi[..., 2]
     n_dot_v = wo[..., 2]
     v_dot_h = np.clip(np.sum(wo * h, axis=-1), 0.0, 1.0)
@@ -253,7 +246,7 @@ def ts_transmission(wi, wt, layer: TransmissionLayer, *, check: bool = True):
     flip = np.where(wi[..., 2:3] < wt[..., 2:3], -1.0, 1.0)
     top = wi * np.concatenate([np.ones_like(flip), np.ones_like(flip), flip], axis=-1)
     mirrored = wt * np.concatenate([np.ones_like(flip), np.ones_like(flip), -flip], axis=-1)
-    h = _half_vector(top, mirrored)
+    h = half_vector(top, mirrored)
     v_dot_h = np.clip(np.sum(mirrored * h, axis=-1), 0.0, 1.0)
     value = ts_transmission_from_cosines(channel_axis(h[..., 2], layer),
                                          channel_axis(v_dot_h, layer), layer)

@@ -64,10 +64,12 @@ def folded_azimuth_deg(wi: np.ndarray, wo: np.ndarray) -> np.ndarray:
 
 
 def half_vector(wi: np.ndarray, wo: np.ndarray) -> np.ndarray:
-    """``(wi + wo) / |wi + wo|`` ``(..., 3)``, the length floored at 1e-12 (opposite
-    directions give a near-zero vector)."""
-    h = wi + wo
-    return h / np.maximum(np.sqrt(np.sum(h * h, axis=-1, keepdims=True)), 1e-12)
+    """``(wi + wo) / |wi + wo|`` ``(..., 3)``; the normal ``(0, 0, 1)`` where ``wi + wo``
+    vanishes (an opposite pair on the horizon: its limit from above the surface)."""
+    h = np.asarray(wi, float) + np.asarray(wo, float)
+    length = np.linalg.norm(h, axis=-1, keepdims=True)
+    safe = length > 1e-12
+    return np.where(safe, h / np.where(safe, length, 1.0), np.array([0.0, 0.0, 1.0]))
 
 
 def light_direction(angle_from_view_deg: float) -> np.ndarray:

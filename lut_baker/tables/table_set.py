@@ -74,9 +74,9 @@ from dataclasses import dataclass, field, fields
 import numpy as np
 
 from ..model.layers import ReflectionLayer
-from ..model.made_up_skin import coverage_weights
+from ..model.made_up_skin import combine, coverage_weights
 from ..model.microfacet import ts_reflection
-from ..numerics.geometry import direction, folded_azimuth_deg, polar_angle_deg
+from ..numerics.geometry import direction, folded_azimuth_deg, half_vector, polar_angle_deg
 
 __all__ = [
     "FORMAT_VERSION",
@@ -189,9 +189,7 @@ def phi_index(wi, wo, n: int, spacing: str = "half_vector") -> np.ndarray:
     if spacing == "uniform":
         return folded_azimuth_deg(wi, wo) / 180.0 * (n - 1)
     theta_i, theta_o = polar_angle_deg(wi), polar_angle_deg(wo)
-    h = wi + wo
-    length = np.linalg.norm(h, axis=-1)
-    alpha = polar_angle_deg(h / np.where(length > 1e-12, length, 1.0)[..., None])
+    alpha = polar_angle_deg(half_vector(wi, wo))
     span = np.minimum(theta_i, theta_o)
     fraction = (0.5 * (theta_i + theta_o) - alpha) / np.where(span > 1e-9, span, 1.0)
     return np.where(span > 1e-9, np.clip(fraction, 0.0, 1.0), 0.0) * (n - 1)
@@ -429,15 +427,14 @@ class Tables:
         transmittances ``t_i``, ``t_o``; the inter-reflection part, baked at one absorption,
         is scaled by ``((1 - A) / (1 - A_baked))^2``."""
         weights = coverage_weights(*self.coverage_and_absorption(coverage, absorption))
-        path3 = parts["path3_gloss"] + self.skin_diffuse * t_i * t_o
-        film = (parts["film_gloss"] + weights.once * self.film_diffuse
-                + weights.twice * path3)
+        top = parts["film_gloss"]
         if self.inter_reflection is not None:
             baked = coverage_weights(*self.coverage_and_absorption()).once
             ratio = np.where(baked > 0.0, weights.once / np.where(baked > 0.0, baked, 1.0), 0.0)
-            film = film + parts["inter_reflection"] * ratio**2
-        return (weights.covered * film
-                + weights.bare * (parts["skin_gloss"] + self.skin_diffuse))
+            top = top + parts["inter_reflection"] * ratio**2
+        return combine(weights, top=top, once=self.film_diffuse,
+                       twice=parts["path3_gloss"] + self.skin_diffuse * t_i * t_o,
+                       bare=parts["skin_gloss"] + self.skin_diffuse)
 
     def _angular_names(self) -> tuple[str, ...]:
         """The tabulated angular parts."""
@@ -480,7 +477,7 @@ class Tables:
         path3 = (self.directional("path3_gloss_albedo", theta_deg) + self.skin_diffuse
                  * self.directional("film_transmittance", theta_deg)
                  * self.film_transmittance_integral)
-        film = (self.directional("film_gloss_albedo", theta_deg)
-                + weights.once * np.pi * self.film_diffuse + weights.twice * path3)
-        bare = self.directional("skin_gloss_albedo", theta_deg) + np.pi * self.skin_diffuse
-        return weights.covered * film + weights.bare * bare
+        return combine(weights, top=self.directional("film_gloss_albedo", theta_deg),
+                       once=np.pi * self.film_diffuse, twice=path3,
+                       bare=self.directional("skin_gloss_albedo", theta_deg)
+                       + np.pi * self.skin_diffuse)

@@ -30,7 +30,12 @@ from scipy.spatial import cKDTree
 from ...evaluate.made_up import made_up_reflection
 from ...model.albedo import film_transmittance
 from ...model.dipole import dipole_profile, dipole_total_reflectance
-from ...model.made_up_skin import MadeUpSkin, coverage_weights, film_transmission_layer
+from ...model.made_up_skin import (
+    MadeUpSkin,
+    combine,
+    coverage_weights,
+    film_transmission_layer,
+)
 from ...numerics.cache import LRUCache
 from ...numerics.geometry import VIEW, direction, light_direction, local_directions, sphere_normals
 from ...numerics.quadrature import cumulative_trapezoid
@@ -129,9 +134,10 @@ def local_diffuse(normals: np.ndarray, light: np.ndarray, skin: MadeUpSkin,
     wo = local_directions(np.broadcast_to(VIEW, normals.shape), normals)
     through = _film_transmittance_rgb(wi, skin) * _film_transmittance_rgb(wo, skin)
     lit = ((wi[:, 2] > 0.0) & (wo[:, 2] > 0.0))[:, None]
+    # T_A holds the absorption already: the light through the film is "top".
     weights = coverage_weights(skin.coverage, skin.absorption)
     p_d = np.asarray(skin.skin.P_d) * np.ones(3)
-    return np.where(lit, p_d * (weights.covered * through + weights.bare) * irradiance
+    return np.where(lit, combine(weights, top=p_d * through, bare=p_d) * irradiance
                     * wi[:, 2:3], 0.0)
 
 
@@ -175,7 +181,7 @@ def spread_diffuse(exit_normals: np.ndarray, light: np.ndarray, skin: MadeUpSkin
             through[chunk, c] = np.bincount(owner, k * entry_film[neighbours, c], rows)
     weights = coverage_weights(skin.coverage, skin.absorption)
     p_d = np.asarray(skin.skin.P_d) * np.ones(3)
-    out = p_d * (weights.covered * exit_film * through + weights.bare * bare)
+    out = combine(weights, top=p_d * exit_film * through, bare=p_d * bare)
     return np.where(exit_local[:, 2:3] > 0.0, out, 0.0)
 
 

@@ -77,3 +77,17 @@ def test_paper_counts_become_albedo_units():
 def test_bundle_validation(field, value, message):
     with pytest.raises(ValueError, match=message):
         presets.paper().replace(**{field: value})
+
+
+def test_combine_is_the_coverage_and_absorption_mix():
+    """covered [top + (1 - A) once + (1 - A)^2 twice] + (1 - w) bare, per channel and
+    broadcasting."""
+    from lut_baker.model.made_up_skin import combine, coverage_weights
+
+    weights = coverage_weights(0.25, (0.0, 0.5, 1.0))
+    value = combine(weights, top=1.0, once=2.0, twice=4.0, bare=8.0)
+    np.testing.assert_allclose(value, 0.25 * (1.0 + np.array([2.0, 1.0, 0.0])
+                                              + np.array([4.0, 1.0, 0.0])) + 0.75 * 8.0)
+    parts = np.ones((5, 2, 3))
+    assert combine(weights, twice=parts).shape == (5, 2, 3)
+    assert np.all(combine(coverage_weights(0.0, 0.3), top=parts, bare=2 * parts) == 2.0)
