@@ -1,0 +1,278 @@
+"""The run-time fits audited: does a 1e-9 change of the inputs move what they ship by less
+than 1e-6, and how far is each discrete choice from flipping?
+
+Used by the perturbation tests (tests/test_fit_stability.py) and printed by
+``python bench/fit_stability.py`` (the table of docs/stability.md, "How far the fits move").
+
+- :data:`CASES` -- the made-up skins audited: the paper preset, a hand shade, the four
+  measured products.
+- :func:`case_tables` -- a case's skin and its tables.
+- :func:`criterion` -- whether a quantity's movement is measured relative to its size or
+  absolutely (errors: they are already fractions, and a small error's relative change is
+  large for no reason that reaches a render).
+- :func:`fit_movement` -- the largest movement of every shipped output when the skin (through
+  the bake) or the tables are perturbed.
+- :class:`SearchRecorder` -- every :func:`lut_baker.numerics.optimise.golden_minimum` call of a
+  fit, with its coarse samples: the margin between separated minima.
+- :func:`decision_margins` -- the margins of the fits' discrete choices: distribution per
+  Glossy lobe, the subsurface method, keeping a specular lobe (:data:`NO_LOBE_ERROR`), the
+  bake's node counts, the coarse scan's minimum.
+- :func:`choice_margins` -- the Auto tier's margins (error threshold, cost order, the
+  half-pixel subsurface rule).
+"""
+
+from __future__ import annotations
+
+import math
+from contextlib import contextmanager
+from dataclasses import dataclass
+
+import numpy as np
+
+from lut_baker import auto_tier, bake
+from lut_baker.closures import cycles as cc
+from lut_baker.closures import fitting
+from lut_baker.model import presets
+
+from .perturbation import movement, perturbed
+
+__all__ = ["CASES", "FAST_CASES", "case_skin", "case_tables", "criterion", "fit_movement",
+           "SearchRecorder", "recorded_searches", "decision_margins", "count_margin",
+           "SCENES", "choice_margins"]
+
+CASES = {
+    "paper": ("paper_natural", "paper_bioplate", 1.0),
+    "medium_beige+jensen_skin1": ("medium_beige", "jensen_skin1", 1.0),
+    "clarins_103": ("clarins_103", "paper_bioplate", 1.0),
+    "clarins_105": ("clarins_105", "paper_bioplate", 1.0),
+    "clarins_108": ("clarins_108", "paper_bioplate", 1.0),
+    "clarins_112": ("clarins_112", "paper_bioplate", 1.0),
+}
+"""Audited skins: ``name -> (foundation, skin, coverage)``; the measured products on the
+paper's bio-plate."""
+FAST_CASES = ("paper", "medium_beige+jensen_skin1", "clarins_103", "clarins_108")
+"""The cases whose preview tables fit in about a second (the narrow-gloss products, 105 and
+112, scale the grids up 3-4x and take 5-14 s)."""
+ABSOLUTE = ("error", "max_error", "rms", "albedo")
+"""Last name parts of error measures (relative RMS, largest albedo error, edge-response
+error): their movement is absolute (:func:`criterion`)."""
+
+
+def case_skin(name: str):
+    foundation, skin, coverage = CASES[name]
+    return presets.made_up_skin(foundation, skin, coverage=coverage)
+
+
+def case_tables(name: str, resolution: str = "preview"):
+    """``(skin, tables)`` of a case."""
+    skin = case_skin(name)
+    return skin, bake.bake(skin, resolution)
+
+
+def criterion(name: str) -> str:
+    """``"abs"`` for an error measure of a fit (the last part of ``name`` in
+    :data:`ABSOLUTE`, under ``errors``, or ending ``error``), ``"rel"`` for the rest."""
+    last = name.rsplit("/", 1)[-1]
+    if last.endswith("error") or (last in ABSOLUTE and "/errors/" in f"/{name}"):
+        return "abs"
+    return "rel"
+
+
+def _worst(into: dict, changes: dict) -> None:
+    for name, change in changes.items():
+        value = change.abs if criterion(name) == "abs" else change.rel
+        into[name] = max(into.get(name, 0.0), value)
+
+
+def fit_movement(name: str, seeds=(0, 1), resolution: str = "preview", *, rel: float = 1e-9,
+                 via_bake: bool = True, via_tables: bool = True) -> dict:
+    """The largest movement (:func:`criterion`) of every output, over ``seeds``: of the tables
+    and the closure fit when the skin's parameters are perturbed by ``rel`` and baked again
+    (``tables/...``, ``fit/...``), and of the closure fit when the tables themselves are
+    perturbed (``fit_of_tables/...``)."""
+    skin, tables = case_tables(name, resolution)
+    fit = fitting.fit_closures(tables)
+    worst: dict = {}
+    for seed in seeds:
+        if via_bake:
+            moved = bake.bake(perturbed(skin, rel, seed), resolution)
+            _worst(worst, movement(tables, moved, "tables"))
+            _worst(worst, movement(fit, fitting.fit_closures(moved), "fit"))
+        if via_tables:
+            refit = fitting.fit_closures(perturbed(tables, rel, 1000 + seed))
+            _worst(worst, movement(fit, refit, "fit_of_tables"))
+    return worst
+
+
+# --------------------------------------------------------------------------------------------
+# Discrete choices and their margins
+# --------------------------------------------------------------------------------------------
+@dataclass
+class Search:
+    """One recorded :func:`golden_minimum` call: its interval, coarse samples and result."""
+
+    low: float
+    high: float
+    coarse: list
+    x: float
+    value: float
+
+    def separated_gap(self) -> float:
+        """Relative gap between the lowest coarse sample and the lowest one not next to it
+        that is a local minimum of the samples (inf when the samples have one valley, or
+        are all equal: a flat function, whose search returns its first sample): how near
+        the coarse scan is to choosing another valley."""
+        v = np.asarray(self.coarse, float)
+        k = int(np.argmin(v))
+        if np.all(v == v[0]):
+            return math.inf
+        minima = [i for i in range(v.size)
+                  if (i == 0 or v[i] <= v[i - 1]) and (i == v.size - 1 or v[i] <= v[i + 1])
+                  and abs(i - k) > 1]
+        if not minima or not np.isfinite(v[k]):
+            return math.inf
+        other = min(v[i] for i in minima)
+        return float((other - v[k]) / max(abs(v[k]), 1e-300))
+
+
+class SearchRecorder:
+    """Wraps ``fitting.golden_minimum`` to keep every call (:class:`Search`) in ``searches``."""
+
+    def __init__(self, original):
+        self.original = original
+        self.searches: list[Search] = []
+
+    def __call__(self, function, low, high, *, tol=1e-4, coarse=9):
+        samples = []
+
+        def recorded(x):
+            value = function(x)
+            if len(samples) < coarse:
+                samples.append(float(value))
+            return value
+
+        x, value = self.original(recorded, low, high, tol=tol, coarse=coarse)
+        self.searches.append(Search(float(low), float(high), samples, x, value))
+        return x, value
+
+
+@contextmanager
+def recorded_searches():
+    """``with recorded_searches() as recorder:`` every golden-section search of
+    :mod:`lut_baker.closures.fitting` inside is kept in ``recorder.searches``."""
+    original = fitting.golden_minimum
+    recorder = SearchRecorder(original)
+    fitting.golden_minimum = recorder
+    try:
+        yield recorder
+    finally:
+        fitting.golden_minimum = original
+
+
+def _relative_gap(values) -> float:
+    """``(second lowest - lowest) / lowest`` of ``values``."""
+    ordered = sorted(float(v) for v in values)
+    return (ordered[1] - ordered[0]) / max(abs(ordered[0]), 1e-300)
+
+
+def count_margin(width_deg: float, resolution: str = "preview") -> float:
+    """The smallest relative change of a lobe width (1/e half-width, degrees) that changes the
+    grids :meth:`lut_baker.bake.Resolution.for_lobe` gives it (steps of 10^(1/8))."""
+    base = bake.RESOLUTIONS[resolution]
+    grids = base.for_lobe(width_deg)
+    for exponent in np.arange(-10.0, 0.01, 0.125):
+        step = 10.0**exponent
+        if any(base.for_lobe(width_deg * (1.0 + sign * step)) != grids for sign in (-1, 1)):
+            return float(step)
+    return math.inf
+
+
+def decision_margins(tables, skin=None) -> dict:
+    """Margins of the closure fit's discrete choices on ``tables`` (relative, unless said):
+
+    - ``distribution/<lobe>``: gap between the best and the second Glossy distribution's
+      fitted error (their searches' values) -- what fit_glossy chooses by;
+    - ``subsurface_method``: gap between the best and second method's
+      ``hypot(worst edge error, replica error)``;
+    - ``no_lobe/<lobe>``: ``|error - NO_LOBE_ERROR|`` (absolute) of each specular fit's best
+      error (the lobe is dropped at or above it);
+    - ``coarse_valley``: the smallest :meth:`Search.separated_gap` over every search;
+    - ``node_counts``: :func:`count_margin` of the skin's narrowest lobe (with ``skin``).
+    """
+    theta = np.asarray(tables.theta_deg, float)
+    grid = fitting.NodeGrid(tables, fitting.FIT_POINTS)
+    margins: dict = {}
+    every = []
+    for lobe in ("film_gloss", "path3_gloss", "skin_gloss"):
+        target = np.asarray(getattr(tables, lobe), float)[grid.pick]
+        with recorded_searches() as recorder:
+            fitting.fit_glossy(grid, target, np.asarray(getattr(tables, lobe + "_albedo")),
+                               theta, companion=lobe == "film_gloss")
+        assert len(recorder.searches) == len(cc.GLOSSY_DISTRIBUTIONS)
+        margins[f"distribution/{lobe}"] = _relative_gap(s.value for s in recorder.searches)
+        every += recorder.searches
+    film_gloss = np.asarray(tables.film_gloss, float)[grid.pick]
+    with recorded_searches() as recorder:
+        coat = fitting.fit_coat(grid, film_gloss)
+    every += recorder.searches
+    e_coat = cc.view_table(grid.cos_o, lambda c: cc.coat_view_terms(c, coat.roughness,
+                                                                      coat.ior)[1])
+    for lobe, table, attenuation in (("specular_bare", tables.skin_gloss, None),
+                                     ("specular_film", tables.path3_gloss, 1.0 - e_coat)):
+        with recorded_searches() as recorder:
+            fitting.fit_specular(grid, np.asarray(table, float)[grid.pick], attenuation)
+        outer = recorder.searches[-1]  # the roughness search, with the best error
+        margins[f"no_lobe/{lobe}"] = abs(outer.value - fitting.NO_LOBE_ERROR)
+        every += recorder.searches
+    with recorded_searches() as recorder:
+        profiles = fitting.fit_profiles(tables)
+    every += recorder.searches
+    margins["subsurface_method"] = _relative_gap(
+        np.hypot(p.worst_error, fitting.REPLICA_EDGE_ERROR[m]) for m, p in profiles.items())
+    margins["coarse_valley"] = min(s.separated_gap() for s in every)
+    if skin is not None:
+        width = min(1.0 / float(np.max(layer.n))
+                    for layer in (skin.film, skin.film_transmission, skin.skin))
+        margins["node_counts"] = min(count_margin(width, r) for r in ("preview", "default"))
+    return margins
+
+
+# --------------------------------------------------------------------------------------------
+# The Auto tier
+# --------------------------------------------------------------------------------------------
+SCENES = {
+    "close-up 0.2 mm/px, Cycles 16": auto_tier.SceneDescription(200.0, 0.2, samples=16),
+    "close-up 0.2 mm/px, Cycles 64": auto_tier.SceneDescription(200.0, 0.2, samples=64),
+    "close-up 0.2 mm/px, Cycles 256": auto_tier.SceneDescription(200.0, 0.2, samples=256),
+    "full figure 3 mm/px, Cycles 128": auto_tier.SceneDescription(1800.0, 3.0, samples=128),
+    "sphere 300 mm at 48 px, Cycles 256": auto_tier.SceneDescription(300.0, 6.25,
+                                                                     samples=256),
+    "grazing light 80, 1 mm/px, Cycles 128": auto_tier.SceneDescription(
+        200.0, 1.0, lights_deg=(80.0,), samples=128),
+    "close-up, EEVEE": auto_tier.SceneDescription(200.0, 0.2, engine="EEVEE"),
+}
+"""Scenes the Auto tier is audited in (those of docs/stability.md's table and a few more)."""
+
+
+def choice_margins(choice, scene, traits) -> dict:
+    """How far :func:`lut_baker.auto_tier.choose`'s ``choice`` is from flipping:
+
+    - ``error``: the smallest distance (absolute, in predicted relative RMS) between the
+      threshold ``best + tolerance`` and the predicted error of the chosen candidate or of a
+      cheaper one (crossing it changes the choice);
+    - ``cost``: the relative cost gap between the chosen candidate and the next one within
+      the threshold (inf when none);
+    - ``subsurface``: ``|mean radius / (half a pixel) - 1|``, the half-pixel rule's margin
+      (:func:`lut_baker.auto_tier.needs_subsurface`; inf without the subsurface).
+    """
+    threshold = choice.best_error + choice.tolerance
+    ordered = list(choice.predictions)
+    at = ordered.index(choice.chosen)
+    error = min(abs(p.error - threshold) for p in ordered[:at + 1])
+    within = [p for p in ordered[at + 1:] if p.error <= threshold]
+    cost = (min(p.cost for p in within) - choice.chosen.cost) / choice.chosen.cost \
+        if within else math.inf
+    subsurface = math.inf
+    if traits.subsurface_scale > 0.0:
+        subsurface = abs(traits.mean_radius_mm / (0.5 * scene.footprint_mm) - 1.0)
+    return {"error": float(error), "cost": float(cost), "subsurface": float(subsurface)}
