@@ -6,7 +6,7 @@ Used by the perturbation tests (tests/test_fit_stability.py) and printed by
 
 - :data:`CASES` -- the made-up skins audited: the paper preset, a hand shade, the four
   measured products.
-- :func:`case_tables` -- a case's skin and its tables.
+- :func:`case_tables`, :func:`case_fit` -- a case's skin, its tables and their closure fit.
 - :func:`criterion` -- whether a quantity's movement is measured relative to its size or
   absolutely (errors: they are already fractions, and a small error's relative change is
   large for no reason that reaches a render).
@@ -26,6 +26,7 @@ from __future__ import annotations
 import math
 from contextlib import contextmanager
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
@@ -36,7 +37,8 @@ from lut_baker.model import presets
 
 from .perturbation import movement, perturbed
 
-__all__ = ["CASES", "FAST_CASES", "case_skin", "case_tables", "criterion", "fit_movement",
+__all__ = ["CASES", "FAST_CASES", "case_skin", "case_tables", "case_fit", "criterion",
+           "DIAGNOSTIC", "DIAGNOSTIC_LIMIT", "fit_movement",
            "SearchRecorder", "recorded_searches", "decision_margins", "count_margin",
            "SCENES", "choice_margins"]
 
@@ -53,6 +55,15 @@ paper's bio-plate."""
 FAST_CASES = ("paper", "medium_beige+jensen_skin1", "clarins_103", "clarins_108")
 """The cases whose preview tables fit in about a second (the narrow-gloss products, 105 and
 112, scale the grids up 3-4x and take 5-14 s)."""
+DIAGNOSTIC = "errors/PRINCIPLED/albedo"
+"""The one output that moves by more than 1e-6 (up to 2.5e-6, absolute, for the measured
+matte products): the Principled tier's largest view-albedo error, a figure the panel reports
+and no render uses.  The presets sit at coverage 1, where it changes 2600 times as fast as
+the coverage: a coverage 1e-9 lower brings in the bare skin's specular lobe (Specular IOR
+Level 1e-9 of its fitted 0.72) and that figure, taken at an 89-degree view, moves by 2.6e-6;
+with that lobe's level at 0 it moves by 4e-10.  Cycles' closure, not a fit.  Held to
+:data:`DIAGNOSTIC_LIMIT`."""
+DIAGNOSTIC_LIMIT = 1e-5
 ABSOLUTE = ("error", "max_error", "rms", "albedo")
 """Last name parts of error measures (relative RMS, largest albedo error, edge-response
 error): their movement is absolute (:func:`criterion`)."""
@@ -67,6 +78,13 @@ def case_tables(name: str, resolution: str = "preview"):
     """``(skin, tables)`` of a case."""
     skin = case_skin(name)
     return skin, bake.bake(skin, resolution)
+
+
+@lru_cache(maxsize=8)
+def case_fit(name: str, resolution: str = "preview"):
+    """``(skin, tables, closure fit)`` of a case (kept: a fit takes 1-14 s)."""
+    skin, tables = case_tables(name, resolution)
+    return skin, tables, fitting.fit_closures(tables)
 
 
 def criterion(name: str) -> str:
@@ -90,8 +108,7 @@ def fit_movement(name: str, seeds=(0, 1), resolution: str = "preview", *, rel: f
     and the closure fit when the skin's parameters are perturbed by ``rel`` and baked again
     (``tables/...``, ``fit/...``), and of the closure fit when the tables themselves are
     perturbed (``fit_of_tables/...``)."""
-    skin, tables = case_tables(name, resolution)
-    fit = fitting.fit_closures(tables)
+    skin, tables, fit = case_fit(name, resolution)
     worst: dict = {}
     for seed in seeds:
         if via_bake:

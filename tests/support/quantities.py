@@ -73,8 +73,8 @@ def _flatten(value, prefix: str, out: dict) -> None:
 
 
 def is_numeric(value) -> bool:
-    """Whether a flattened quantity is compared with a tolerance (a float array)."""
-    return isinstance(value, np.ndarray)
+    """Whether a flattened quantity is compared with a tolerance (a float array or scalar)."""
+    return isinstance(value, (np.ndarray, np.floating))
 
 
 @dataclasses.dataclass(frozen=True)
