@@ -62,6 +62,16 @@ def group(name: str) -> str:
     return via + field
 
 
+def print_by_case(title: str, by_case: dict, form: str, missing: float) -> None:
+    """A Markdown table: a row per key of the cases' dicts, a column per case."""
+    keys = sorted({key for values in by_case.values() for key in values})
+    print(f"\n| {title} | {' | '.join(by_case)} |")
+    print("| --- |" + " --- |" * len(by_case))
+    for key in keys:
+        cells = [format(by_case[case].get(key, missing), form) for case in by_case]
+        print(f"| {key} | {' | '.join(cells)} |")
+
+
 def movement_table(cases, seeds, rel) -> None:
     print(f"\nLargest movement under a {rel:g} relative perturbation ({len(seeds)} seeds; "
           "relative, absolute for error measures; inf: a discrete output changed)")
@@ -74,12 +84,7 @@ def movement_table(cases, seeds, rel) -> None:
             groups[key] = max(groups.get(key, 0.0), value)
         results[name] = groups
         print(f"  {name}: {time.perf_counter() - start:.0f} s", flush=True)
-    keys = sorted({k for groups in results.values() for k in groups})
-    print(f"\n| output | {' | '.join(results)} |")
-    print("| --- |" + " --- |" * len(results))
-    for key in keys:
-        cells = [f"{results[n].get(key, 0.0):.1e}" for n in results]
-        print(f"| {key} | {' | '.join(cells)} |")
+    print_by_case("output", results, ".1e", 0.0)
 
 
 def margin_table(cases) -> None:
@@ -89,12 +94,7 @@ def margin_table(cases) -> None:
     for name in cases:
         skin, tables = fit_audit.case_tables(name)
         rows[name] = fit_audit.decision_margins(tables, skin)
-    keys = sorted({k for m in rows.values() for k in m})
-    print(f"\n| choice | {' | '.join(rows)} |")
-    print("| --- |" + " --- |" * len(rows))
-    for key in keys:
-        cells = [f"{rows[n].get(key, math.nan):.2g}" for n in rows]
-        print(f"| {key} | {' | '.join(cells)} |")
+    print_by_case("choice", rows, ".2g", math.nan)
 
 
 def auto_table(cases, seeds) -> None:

@@ -19,11 +19,14 @@ emulated; 1 and 2 BLAS threads), each in a process of its own (numpy and OpenBLA
 environment at import), stores this CPU's values, and sets each tolerance from the largest
 movement between them.  It prints the largest movement per part and configuration: the
 figures of docs/stability.md, "Golden values and how far results move between machines".
+A discrete quantity (a name, a count) or a shape that differs between the configurations
+has no golden value: then it names it and writes nothing.
 """
 
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import pickle
 import subprocess
@@ -63,6 +66,13 @@ def write() -> int:
                 for i, (name, env) in enumerate(gv.CONFIGS.items())}
     base = runs.pop(gv.BASELINE)
     moved = {name: largest_changes(values, base) for name, values in runs.items()}
+    differ = sorted({(config, name) for config, changes in moved.items()
+                     for name, change in changes.items() if not math.isfinite(change.rel)})
+    if differ:  # a count, a name or a shape that depends on the processor: no golden value
+        for config, name in differ:
+            print(f"ERROR: {name} differs under {config!r} (a discrete value or a shape)")
+        print("nothing written: make these quantities independent of the processor first")
+        return 1
     metadata = gv.write_reference(base, moved)
     quantities = metadata["quantities"]
     print(f"\nlargest movement against {gv.BASELINE!r} (relative), by part:")
