@@ -23,7 +23,8 @@ outer angles and sums the cosine series on the table's azimuth grid.  What makes
 Functions and types
 -------------------
 - :func:`bake` -- the tables of one :class:`~lut_baker.model.made_up_skin.MadeUpSkin`.
-- :class:`Resolution`, :data:`RESOLUTIONS`, :func:`resolution` -- grid sizes per name.
+- :class:`Resolution`, :data:`RESOLUTIONS`, :func:`resolution` -- grid sizes per name;
+  :func:`lobe_scale`, :func:`scaled_count` -- how narrow lobes scale them.
 - :func:`fourier_coefficients` -- cosine coefficients of a layer's kernel, fast.
 - :class:`KernelCache` -- memoises :func:`fourier_coefficients` within one bake.
 - :func:`gloss_layer` -- a layer's Torrance-Sparrow specular part alone.
@@ -82,16 +83,26 @@ __all__ = [
     "inter_reflection_albedo",
     "rgb_view",
     "PROFILE_FLOOR",
+    "RADIUS_PRECISION",
+    "COUNT_SLACK",
+    "lobe_scale",
+    "scaled_count",
     "REFERENCE_LOBE_DEG",
 ]
 
 PROFILE_FLOOR = 1e-4
 """The radial table ends where R(d) falls below this fraction of R(0) (in every channel)."""
+RADIUS_PRECISION = 1e-13
+"""Relative width of the bracket :func:`profile_radius` bisects the table's end down to."""
 REFERENCE_LOBE_DEG = 19.3
 """The narrowest lobe path 3 goes through (1/e half-width, 1/n degrees) among the presets the
 resolutions were chosen for (the Jensen skins' gloss).  Narrower lobes in path 3 (a film
 transmission or a skin gloss of the user's) scale the angular grids up
 (:meth:`Resolution.for_lobe`), up to 4x; the film's own gloss never does."""
+COUNT_SLACK = 0.1
+"""A scaled grid count is rounded up unless it exceeds a whole count by less than this
+(nodes, panels): the Jensen skins' lobe is the reference's, 19.3 degrees, to its last bit, and
+a lobe narrower by 1e-9 must not add a node to every grid (:func:`scaled_count`)."""
 
 
 @dataclass(frozen=True)
@@ -120,17 +131,36 @@ class Resolution:
     theta_max_deg: float = 89.0
 
     def for_lobe(self, width_deg: float) -> Resolution:
-        """This resolution scaled for a lobe of 1/e half-width ``width_deg`` (degrees)."""
-        scale = float(np.clip(REFERENCE_LOBE_DEG / width_deg, 1.0, 4.0))
+        """This resolution scaled for a lobe of 1/e half-width ``width_deg`` (degrees):
+        intervals, panels and azimuth pairs times ``REFERENCE_LOBE_DEG / width_deg`` (1 to 4),
+        by :func:`scaled_count`."""
+        scale = lobe_scale(width_deg)
         if scale == 1.0:
             return self
         return replace(
             self,
-            n_theta=int(np.ceil((self.n_theta - 1) * scale)) + 1,
-            n_phi=int(np.ceil((self.n_phi - 1) * scale)) + 1,
-            quad_panels=int(np.ceil(self.quad_panels * scale)),
-            quad_phi=2 * int(np.ceil((self.quad_phi // 2) * scale)) + 1,
+            n_theta=scaled_count(self.n_theta - 1, scale) + 1,
+            n_phi=scaled_count(self.n_phi - 1, scale) + 1,
+            quad_panels=scaled_count(self.quad_panels, scale),
+            quad_phi=2 * scaled_count(self.quad_phi // 2, scale) + 1,
         )
+
+    def scaled_counts(self) -> dict:
+        """The counts :meth:`for_lobe` scales, by name (intervals, panels, azimuth pairs)."""
+        return {"n_theta": self.n_theta - 1, "n_phi": self.n_phi - 1,
+                "quad_panels": self.quad_panels, "quad_phi": self.quad_phi // 2}
+
+
+def lobe_scale(width_deg: float) -> float:
+    """How much finer than the named resolutions a lobe of 1/e half-width ``width_deg``
+    (degrees) needs the grids: ``REFERENCE_LOBE_DEG / width_deg`` held to [1, 4]."""
+    return float(np.clip(REFERENCE_LOBE_DEG / width_deg, 1.0, 4.0))
+
+
+def scaled_count(count: int, scale: float) -> int:
+    """``count x scale`` rounded up, less :data:`COUNT_SLACK`: a whole count stays as it is
+    under a last-bit change of ``scale``."""
+    return int(np.ceil(count * scale - COUNT_SLACK))
 
 
 RESOLUTIONS = {
@@ -193,7 +223,7 @@ def _reflection_values(layer: ReflectionLayer, cos_a, cos_b, n_dot_h, v_dot_h):
     (1 or 3): :func:`~lut_baker.model.microfacet.ts_specular_from_cosines` of the unit lobe,
     its Fresnel term from :func:`fresnel_interpolated`."""
     # P_s times the unit lobe, P_s (D G F_r), rather than ts_reflection_from_cosines's
-    # (P_s D) G F_r: the tables' last bits follow this grouping (bench/golden_digests.py).
+    # (P_s D) G F_r: the two groupings differ in the last bits only.
     lobe = ts_specular_from_cosines(n_dot_h[..., None], v_dot_h[..., None], cos_b[..., None],
                                     cos_a[..., None], 1.0, layer.n, layer.eta, fresnel_interpolated)
     return layer.P_d + layer.P_s * lobe
@@ -368,8 +398,10 @@ def _cosine_series(matrices: np.ndarray, pairs: _NodePairs) -> np.ndarray:
 
 def profile_radius(dipole: Dipole, floor: float = PROFILE_FLOOR) -> float:
     """Distance (mm) beyond which the dipole's ``R(d)`` stays below ``floor`` times ``R(0)`` in
-    every channel (R decreases with d): bracketed on a geometric grid, refined once (relative
-    precision 2e-4; the value returned is the bracket's far end)."""
+    every channel (R decreases with d): bracketed on a geometric grid, refined once, then
+    bisected in ``log d`` to :data:`RADIUS_PRECISION` (the value returned is the last bracket's
+    far end).  A continuous function of the dipole: a grid's far end would jump a grid step
+    (2e-4) when the crossing moves past a node."""
     def above(d):  # d (K,) -> (K,): R(d) > floor R(0) in some channel
         values = np.reshape(dipole_profile(d, dipole), (np.size(d), -1))
         return np.any(values > limit, axis=1)
@@ -383,6 +415,12 @@ def profile_radius(dipole: Dipole, floor: float = PROFILE_FLOOR) -> float:
         grid = np.geomspace(low, high, 256)
         last = int(np.max(np.nonzero(above(grid))[0], initial=0))
         low, high = grid[last], grid[min(last + 1, grid.size - 1)]
+    while high > low * (1.0 + RADIUS_PRECISION):
+        middle = np.sqrt(low * high)
+        if above(np.array([middle]))[0]:
+            low = middle
+        else:
+            high = middle
     return float(high)
 
 

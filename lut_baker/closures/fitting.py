@@ -61,7 +61,7 @@ import numpy as np
 
 from ..model.made_up_skin import combine, coverage_weights
 from ..numerics.cache import LRUCache
-from ..numerics.optimise import brent_minimum, least_squares
+from ..numerics.optimise import brent_minimum, scanned_least_squares
 from ..numerics.quadrature import trapezoid_weights
 from ..tables.table_set import Tables
 from . import cycles as cc
@@ -166,7 +166,9 @@ class LobeFit:
     view-angle texel, ``(size, 3)`` (Glossy only); ``distribution``: ``GGX``, ``BECKMANN`` or
     ``ASHIKHMIN_SHIRLEY`` (Glossy only; the Principled BSDF is GGX); ``diffuse_lut``: the
     weight of its Lambertian companion per texel, ``(size, 3)``, or None (:func:`fit_glossy`);
-    ``error``: relative RMS of this lobe against its target (module docstring).
+    ``error``: relative RMS of this lobe against its target (module docstring);
+    ``searched``: each Glossy distribution's error in the search, by name (Glossy only: what
+    the choice of distribution compares).
     """
 
     roughness: float
@@ -176,6 +178,7 @@ class LobeFit:
     lut: np.ndarray | None = None
     distribution: str = "GGX"
     diffuse_lut: np.ndarray | None = None
+    searched: dict | None = None
 
 
 def _grey(values) -> np.ndarray:
@@ -214,14 +217,9 @@ def _fit_roughness_and(grid: ViewGrid, target, lobe_times, second_range):
     def residuals(x):
         return (scale * root_weight * (model(x) - target)).ravel()
 
-    seconds = np.linspace(*second_range, SECOND_SCAN)
-    starts = [(float(np.sum(np.square(residuals((log_r, second))))), log_r, second)
-              for log_r in np.linspace(*np.log(ROUGHNESS_RANGE), ROUGHNESS_SCAN)
-              for second in seconds]
-    _, log_r, second = min(starts)
-    x, cost = least_squares(residuals, (log_r, second), (np.log(ROUGHNESS_RANGE[0]),
-                                                         second_range[0]),
-                            (np.log(ROUGHNESS_RANGE[1]), second_range[1]), xtol=FIT_XTOL)
+    x, cost, _ = scanned_least_squares(
+        residuals, (np.linspace(*np.log(ROUGHNESS_RANGE), ROUGHNESS_SCAN),
+                    np.linspace(*second_range, SECOND_SCAN)), xtol=FIT_XTOL)
     return float(np.exp(x[0])), float(x[1]), float(np.sqrt(cost))
 
 
@@ -366,7 +364,8 @@ def fit_glossy(grid: ViewGrid, target, albedo_table: np.ndarray, theta_deg: np.n
     roughness = searched[distribution][0]
     lut, diffuse, value = weights(roughness, distribution, True)
     return LobeFit(roughness=roughness, error=grid.error(value, target), lut=lut,
-                   distribution=distribution, diffuse_lut=diffuse)
+                   distribution=distribution, diffuse_lut=diffuse,
+                   searched={name: float(found[1]) for name, found in searched.items()})
 
 
 # --------------------------------------------------------------------------------------------

@@ -68,7 +68,7 @@ FOUNDATIONS: dict[str, dict] = {
     "medium_beige": {"absorption": (0.10, 0.24, 0.42), "label": "Medium beige"},
     "deep_mocha": {"absorption": (0.38, 0.56, 0.70), "label": "Deep mocha"},
 }
-# The hand-picked shades stay beside the measured products below: the golden digests, tests and
+# The hand-picked shades stay beside the measured products below: the golden values, tests and
 # docs use them, and they cover shades the four products lack: deep_mocha absorbs far more red
 # (0.38) than any of them (at most 0.27), a deep brown rather than a beige.
 

@@ -187,6 +187,18 @@ def test_rgb_skin_bakes_per_channel():
     assert error["max"] < 1e-2, error
 
 
+def test_profile_radius_moves_continuously_with_the_dipole(paper):
+    """The table's end is the crossing itself, not the far end of a grid's bracket (which
+    stood still, then jumped by the grid's step, 2e-4, as the crossing passed a node)."""
+    scales = 1.0 + 1e-6 * np.arange(-50, 51)
+    radii = np.array([bake.profile_radius(paper.dipole.scaled(sigma_a=s)) for s in scales])
+    steps = np.diff(radii) / radii[:-1]
+    assert np.all(steps < 0.0)  # more absorption, a shorter profile, at every step
+    np.testing.assert_allclose(steps, np.mean(steps), rtol=1e-3)
+    profile = np.atleast_1d(dipole.dipole_profile(np.array([0.0, radii[50]]), paper.dipole))
+    assert profile[1] == pytest.approx(bake.PROFILE_FLOOR * profile[0], rel=1e-9)
+
+
 def test_narrow_lobes_in_path3_scale_the_grids_and_the_film_gloss_does_not(paper):
     """The grids follow what path 3 goes through (the film's transmission, the skin's gloss);
     the film's own gloss is a closed form and leaves them as they are."""
@@ -199,6 +211,33 @@ def test_narrow_lobes_in_path3_scale_the_grids_and_the_film_gloss_does_not(paper
     assert bake.path3_width_deg(sharp_film) == bake.path3_width_deg(paper)
     assert (bake.bake(sharp_film, "preview").theta_deg.size
             == bake.RESOLUTIONS["preview"].n_theta)
+
+
+@pytest.mark.parametrize("name", ["preview", "default", "high"])
+def test_a_lobe_a_last_bit_narrower_than_the_reference_keeps_the_grids(name):
+    """The Jensen skins' lobe is the reference width to its last bit: 1e-9 narrower must not
+    add a node to every grid (it did: the counts were rounded up from 47.00000005)."""
+    base = bake.RESOLUTIONS[name]
+    for width in bake.REFERENCE_LOBE_DEG * (1.0 + np.array([-1e-9, -1e-12, 0.0, 1e-9])):
+        assert base.for_lobe(width) == base
+    assert base.for_lobe(bake.REFERENCE_LOBE_DEG / 1.01).n_theta > base.n_theta
+
+
+def test_a_jensen_skin_with_a_last_bit_narrower_lobe_bakes_the_same_grids():
+    skin = presets.made_up_skin("medium_beige", "jensen_skin1")
+    narrower = skin.replace(skin=skin.skin.scaled(n=1.0 + 1e-9))
+    tables, moved = bake.bake(skin, "preview"), bake.bake(narrower, "preview")
+    for name in ("theta_deg", "phi_deg", "radius_mm"):
+        np.testing.assert_array_equal(getattr(moved, name), getattr(tables, name))
+
+
+def test_scaled_counts_round_up_beyond_the_slack():
+    assert bake.scaled_count(47, 1.0) == 47
+    assert bake.scaled_count(47, 1.0 + 1e-9) == 47
+    assert bake.scaled_count(47, 1.0 + 0.2 / 47) == 48  # 47.2 nodes: one more
+    assert bake.scaled_count(2, 2.9027) == 6 and bake.scaled_count(16, 2.9027) == 47
+    assert bake.lobe_scale(bake.REFERENCE_LOBE_DEG * 2) == 1.0
+    assert bake.lobe_scale(1.0) == 4.0
 
 
 def test_progress_is_reported_in_order(paper):

@@ -7,8 +7,12 @@ functions that need it, after the caller has set ``BLENDER_USER_RESOURCES``.
 
 - :mod:`support.reference_impl` -- an independent implementation of the model's formulas
   (docs/model.md §2-§4), written without ``lut_baker``.
-- :mod:`support.digests` -- SHA-256 digests of baked tables and fits
-  (``tests/data/golden_digests.json``).
+- :mod:`support.quantities` -- results as named quantities, and how far one moved.
+- :mod:`support.golden_values` -- the golden set, its stored reference
+  (``tests/data/golden_values.npz``, ``.json``) and the tolerance of each quantity.
+- :mod:`support.perturbation` -- inputs perturbed by 1e-9 relative, and what moved.
+- :mod:`support.fit_audit` -- the run-time fits audited: their movement under perturbation,
+  the margins of their discrete choices and of the Auto tier's.
 - :mod:`support.sphere_scene` -- the reference sphere scene (camera, sun, black world, Cycles
   settings), the add-on registered for a ``with`` block, made-up materials, renders.
 - :mod:`support.bench_scene` -- that scene made to match
