@@ -39,8 +39,11 @@ def _module(name: str):
     return importlib.import_module(COMMANDS[name], __package__)
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """The parser of every command (which imports each command's module)."""
+def build_parser(command: str | None = None) -> argparse.ArgumentParser:
+    """The parser of every command (which imports each command's module), or, given the
+    ``command`` being run, of that one alone: the others are named but their modules (and
+    what they import: scipy for ``fit``, OpenImageIO for ``bake``, matplotlib) are not
+    imported, so a command costs only its own imports."""
     import argparse
 
     parser = argparse.ArgumentParser(
@@ -49,14 +52,17 @@ def build_parser() -> argparse.ArgumentParser:
     )
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for name in COMMANDS:
+        if command is not None and name != command:
+            sub.add_parser(name, add_help=False)
+            continue
         try:
             module = _module(name)
         except ModuleNotFoundError as error:  # a command not built yet must say so, not vanish
             sub.add_parser(name, help=f"(unavailable: {error})")
             continue
-        command = sub.add_parser(name, help=module.HELP, description=module.__doc__,
-                                 formatter_class=argparse.RawDescriptionHelpFormatter)
-        module.configure(command)
+        command_parser = sub.add_parser(name, help=module.HELP, description=module.__doc__,
+                                        formatter_class=argparse.RawDescriptionHelpFormatter)
+        module.configure(command_parser)
     return parser
 
 
@@ -64,9 +70,13 @@ def main(argv: list[str] | None = None) -> int:
     """Parse ``argv`` (default ``sys.argv[1:]``) and run its command; the exit code.  A signal
     while the parser is built (the command modules imported), while arguments are parsed or
     while the command runs is reported as ``interrupted``."""
+    import sys
+
+    argv = sys.argv[1:] if argv is None else list(argv)
+    named = next((item for item in argv if not item.startswith("-")), None)
     try:
         with signals_interrupt():
-            parser = build_parser()
+            parser = build_parser(named if named in COMMANDS else None)
             interrupts.raise_held()  # one that came during the imports: stop before parsing
             args = parser.parse_args(argv)
             try:
