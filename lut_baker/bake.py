@@ -47,6 +47,7 @@ from functools import lru_cache
 import numpy as np
 
 from .evaluate.two_layer import inter_reflection_fourier_matrices, layered_fourier_matrices
+from .model.albedo import specular_albedo
 from .model.dipole import dipole_profile, dipole_total_reflectance
 from .model.layers import Dipole, ReflectionLayer
 from .model.made_up_skin import MadeUpSkin, film_reflection_layer, film_transmission_layer
@@ -61,7 +62,6 @@ from .model.params_file import skin_to_dict
 from .numerics.cache import LRUCache
 from .numerics.quadrature import (
     hemisphere_panels,
-    mirror_quadrature,
     order0_integral,
     uniform_azimuths,
 )
@@ -345,31 +345,15 @@ class _NodePairs:
         return [rgb_view(table) for table in out]
 
 
-GLOSS_ALBEDO_POINTS = (12, 48)
-"""Half-vector polar nodes per panel and azimuths of :func:`gloss_albedos`
-(:func:`lut_baker.numerics.quadrature.mirror_quadrature`): within 0.015% of the converged
-albedo up to 85 degrees and 0.4% at 89, for lobes 1 to 30 degrees wide."""
-
-
 def gloss_albedos(layers, theta_deg) -> list[np.ndarray]:
     """Directional albedos ``Int P_s D G F_r cos(theta_o) dwo`` (eq. 2's specular part
     integrated) of each reflecting layer at incidences ``theta_deg``: ``(n_theta, 3)`` each.
 
-    The integral runs over the half vector (:func:`lut_baker.numerics.quadrature.
-    mirror_quadrature`), in panels sized by the layer's own lobe (1/n degrees), so that a lobe
-    of any width is resolved at the same cost."""
-    theta = np.radians(np.asarray(theta_deg, float))
-    out = []
-    for layer in (gloss_layer(layer) for layer in layers):
-        quad = mirror_quadrature(theta, 1.0 / float(np.max(layer.n)),
-                                 alpha_points=GLOSS_ALBEDO_POINTS[0],
-                                 phi_points=GLOSS_ALBEDO_POINTS[1])
-        cos_o = quad.cos_other
-        values = ts_specular_from_cosines(
-            quad.cos_h[..., None], quad.cos_dh[..., None], cos_o[..., None],
-            quad.cos_fixed[..., None], layer.P_s, layer.n, layer.eta, fresnel_interpolated)
-        out.append(rgb_view(np.einsum("napc,nap->nc", values, quad.weight * cos_o)))
-    return out
+    The integral runs over the half vector (:func:`lut_baker.model.albedo.specular_albedo`),
+    in panels sized by the layer's own lobe (1/n degrees), so that a lobe of any width is
+    resolved at the same cost; the Fresnel term from :func:`fresnel_interpolated`."""
+    return [rgb_view(specular_albedo(np.asarray(theta_deg, float), layer,
+                                     fresnel=fresnel_interpolated)) for layer in layers]
 
 
 def path3_width_deg(skin: MadeUpSkin) -> float:

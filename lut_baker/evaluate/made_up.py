@@ -59,7 +59,7 @@ def directional_albedo(theta_i_deg, skin: MadeUpSkin, *, level: int = 0) -> np.n
     A white furnace test asserts it is <= 1.  Shape ``theta_i_deg.shape + (3,)``."""
     theta = np.radians(np.atleast_1d(np.asarray(theta_i_deg, float)))
     film_t = film_transmission_layer(skin)
-    grid = grid_for(film_t, skin.skin, skin.film, level=level)
+    grid = grid_for(film_t, skin.skin, level=level)  # path 3's layers (the film's top: below)
     path3 = layered_fourier_matrices(theta, grid.theta, film_t, skin.skin, grid,
                                      orders=1)[0]  # (P, N, C)
     path3 = 2.0 * np.pi * np.einsum("pnc,n->pc", path3, grid.weight)
