@@ -117,7 +117,8 @@ _GOOD_ROWS = "".join(f"30\t{o}\t0.5\t0.4\t0.3\n" for o in (0, 10, 20, 30, 40))
     ("cell.txt", _GOOD_ROWS + "30\t50\tgrey\t0.4\t0.3\n", "cell.txt: line 6, column 3: "
                                                            "not a number"),
     ("empty.txt", "# nothing\n", "empty.txt: no data rows"),
-    ("few.txt", "30\t0\t0.5\t0.4\t0.3\n", "few.txt: a reflection fit needs at least 5"),
+    ("few.txt", "30\t0\t0.5\t0.4\t0.3\n", "few.txt: a joint reflection fit of 3 data sets "
+                                          "needs at least 14 samples, got 3"),
     ("apart.txt", _GOOD_ROWS + "30\t-30\t0.5\t0.4\t0.3\n", "apart.txt: theta_i + theta_o "
                                                             "must be > 0"),
 ])

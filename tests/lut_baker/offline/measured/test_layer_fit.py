@@ -97,10 +97,11 @@ def test_round_trip_median_error_within_target(round_trips, name):
         assert median <= TARGETS[parameter], f"{name} {parameter}: median {median:.3%}"
 
 
-@pytest.mark.parametrize("name", sorted(TRUTH))
+@pytest.mark.parametrize("name", sorted(set(TRUTH) - {"film transmission"}))
 def test_round_trip_errors_match_reported_standard_errors(round_trips, name):
     """The covariance is honest: no error beyond 4 standard errors, and the errors' spread in
-    standard-error units is about 1 (neither hidden nor inflated)."""
+    standard-error units is about 1 (neither hidden nor inflated).  (Transmission with eta
+    free has two minima the data do not choose between: test_transmission_flags_eta.)"""
     for parameter in _fitted_parameters(round_trips, name):
         z = np.array([errors[parameter] / stderr[parameter]
                       for _, errors, stderr in round_trips[name]])
@@ -123,10 +124,19 @@ def test_paper_protocols_raise_no_warning(round_trips):
 
 
 def test_transmission_flags_eta(round_trips):
-    """Eta enters transmission only through F_t = 1 - F_r (about 1% here): the fit says so."""
+    """Eta enters transmission only through F_t = 1 - F_r (about 1% here): the fit says so.
+    Its starts end in two minima, near the true eta and near eta = 3, whose chi-squares differ
+    by less than the noise: every fit names the rival (its covariance describes one basin)."""
     for result, _, _ in round_trips["film transmission"]:
-        assert result.warnings and all(w.startswith("eta ") for w in result.warnings)
+        assert result.warnings and all(w.startswith(("eta ", "another minimum"))
+                                       for w in result.warnings)
+        assert any(w.startswith("another minimum") for w in result.warnings)
+        assert result.starts.reached < result.starts.count
         assert result.relative_stderr["eta"] > 0.10
+    for name in ("film reflection", "film transmission, eta fixed", "skin reflection",
+                 "skin dipole"):  # the others: every start ends in the same minimum
+        for result, _, _ in round_trips[name]:
+            assert result.starts.reached == result.starts.count >= 2, name
 
 
 # --------------------------------------------------------------------------------------------
