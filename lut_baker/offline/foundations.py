@@ -3,17 +3,20 @@
 
 For each of the four products of Lanza et al. 2024 (doi:10.1111/cgf.15148), the spectral rows
 are converted to linear Rec.709 reflectance factors
-(:mod:`~lut_baker.offline.measured.spectra`), eq. 2 is fitted per channel to every incidence and,
-for the held-out test, to alternate incidences
-(:mod:`~lut_baker.offline.measured.inplane_fit`); the outputs are, per product,
-``<product>.csv`` (measured and all-incidence model factors at the measured geometries),
+(:mod:`~lut_baker.offline.measured.spectra`), and eq. 2 is fitted to the three channels at once
+in the well-posed form the data determine (:func:`~lut_baker.offline.measured.inplane_fit.
+well_posed`: the full eq. 2 with the sample's tilt, reduced where a parameter is not
+determined) to every incidence and, for the held-out test, each form tried to alternate
+incidences (:mod:`~lut_baker.offline.measured.inplane_fit`); the outputs are, per product,
+``<product>.csv`` (measured and model factors of the chosen fit at the measured geometries),
 ``<product>.png`` (luminance: measured points, model curves per incidence, in the style of
 :mod:`~lut_baker.offline.paper_figures`' fig. 5) and one ``README.md`` with the numbers.
 
 Functions and types
 -------------------
 - :data:`PRODUCTS` -- product name -> file and finish.
-- :class:`ProductAnalysis` -- one product's data, fits and misses.
+- :class:`ProductAnalysis` -- one product's data, fits (the forms tried and the chosen one)
+  and misses.
 - :func:`analyse` -- read, convert and fit one product.
 - :func:`write_csv` -- the measured/model table of one product.
 - :func:`product_figure` -- the luminance figure of one product.
@@ -34,10 +37,13 @@ from ..model.albedo import reflection_albedo
 from .foundation_presets import derive_presets, film_exchange, stack_reflectance, write_presets
 from .measured.inplane import InPlaneData, read_inplane
 from .measured.inplane_fit import (
+    CHANNELS,
     ChannelFits,
+    ModelChoice,
     alternate_incidences,
     fit_channels,
     misses,
+    well_posed,
 )
 from .measured.spectra import luminance
 from .paper_figures import GREY, sequence_colours, styled_figure
@@ -72,17 +78,29 @@ CURVE_STEP_DEG = 0.25
 
 @dataclass(frozen=True, eq=False)
 class ProductAnalysis:
-    """One product: ``data`` as read, ``fit`` on every incidence, ``held_out`` fitted on
-    ``split[0]`` and judged on ``split[1]``, ``misses`` of ``fit``
-    (:func:`~lut_baker.offline.measured.inplane_fit.misses`)."""
+    """One product: ``data`` as read, ``choice`` (the forms of eq. 2 tried on every incidence
+    and the well-posed one, :func:`~lut_baker.offline.measured.inplane_fit.well_posed`),
+    ``held_out_steps`` (each form fitted on ``split[0]``, to be judged on ``split[1]``) and
+    ``misses`` of the chosen fit (:func:`~lut_baker.offline.measured.inplane_fit.misses`)."""
 
     name: str
     finish: str
     data: InPlaneData
-    fit: ChannelFits
-    held_out: ChannelFits
+    choice: ModelChoice
+    held_out_steps: tuple[ChannelFits, ...]
     split: tuple[tuple[float, ...], tuple[float, ...]]
     misses: dict
+
+    @property
+    def fit(self) -> ChannelFits:
+        """The chosen (well-posed) fit on every incidence: the one the preset is derived
+        from."""
+        return self.choice.fit
+
+    @property
+    def held_out(self) -> ChannelFits:
+        """The chosen form fitted on ``split[0]``."""
+        return self.held_out_steps[-1]
 
 
 def analyse(name: str, data_dir) -> ProductAnalysis:
@@ -95,10 +113,11 @@ def analyse(name: str, data_dir) -> ProductAnalysis:
         raise ValueError(f"{path}: no such file (the data folder needs {filename})")
     data = read_inplane(path)
     rgb = data.rgb
-    fit = fit_channels(data.theta_i_deg, data.theta_o_deg, rgb)
+    choice = well_posed(data.theta_i_deg, data.theta_o_deg, rgb)
     split = alternate_incidences(data.incidences_deg)
-    held_out = fit_channels(data.theta_i_deg, data.theta_o_deg, rgb, split[0])
-    return ProductAnalysis(name, finish, data, fit, held_out, split, misses(fit))
+    held_out = tuple(fit_channels(data.theta_i_deg, data.theta_o_deg, rgb, split[0],
+                                  fits.fit_model) for fits, _ in choice.steps)
+    return ProductAnalysis(name, finish, data, choice, held_out, split, misses(choice.fit))
 
 
 def write_csv(analysis: ProductAnalysis, path) -> Path:
@@ -116,12 +135,15 @@ def write_csv(analysis: ProductAnalysis, path) -> Path:
 
 def product_figure(analysis: ProductAnalysis):
     """Luminance (Rec.709 ``Y``) of the reflectance factor against theta_o: measured points and
-    the all-incidence fit's curve per incidence, mirror directions dotted, log scale."""
+    the chosen fit's curve per incidence (the tilt included), mirror directions dotted, log
+    scale; where the chosen form is a reduced one, the last form before it dashed (the one
+    whose parameters the data did not determine)."""
     fit = analysis.fit
+    before = analysis.choice.steps[-2][0] if len(analysis.choice.steps) > 1 else None
     incidences = np.unique(fit.theta_i_deg)
     y_measured = luminance(fit.measured)
     title = (f"{analysis.name} ({analysis.finish}), Lanza et al. 2024, against eq. 2 "
-             f"(fit per channel)")
+             f"({fit.fit_model.describe()})")
     with styled_figure(title, r"viewing angle $\theta_o$ (degrees; > 0: specular side)",
                  r"reflectance factor $\pi f_r$ (luminance $Y$)") as (figure, axes):
         for colour, incidence in zip(sequence_colours(incidences.size), incidences,
@@ -133,12 +155,20 @@ def product_figure(analysis: ProductAnalysis):
             curve = luminance(fit.predict(np.full_like(dense, incidence), dense))
             axes.plot(dense, curve, color=colour, gid=f"model theta_i={incidence:g}",
                       label=rf"$\theta_i$ = {incidence:g}°")
+            if before is not None:
+                axes.plot(dense, luminance(before.predict(np.full_like(dense, incidence),
+                                                          dense)),
+                          color=colour, linestyle="--", linewidth=0.8,
+                          gid=f"not determined theta_i={incidence:g}")
             axes.plot(theta_o, y_measured[rows], linestyle="none", marker="o", markersize=2.5,
                       color=colour, gid=f"measured theta_i={incidence:g}")
             axes.axvline(incidence, color=colour, linestyle=":", linewidth=0.9)
         axes.plot([], [], linestyle="none", marker="o", markersize=2.5, color=GREY,
                   label="measured")
-        axes.plot([], [], color=GREY, label="eq. 2 fit")
+        axes.plot([], [], color=GREY, label="eq. 2 fit (well-posed)")
+        if before is not None:
+            axes.plot([], [], color=GREY, linestyle="--", linewidth=0.8,
+                      label=f"{before.fit_model.describe()}: not determined")
         axes.plot([], [], color=GREY, linestyle=":", linewidth=0.9,
                   label=r"mirror $\theta_o = \theta_i$")
         axes.set_yscale("log")
@@ -156,10 +186,13 @@ def _pct(value: float) -> str:
 
 def _param(fit, name: str) -> str:
     value = float(getattr(fit.params, name))
-    stderr = fit.stderr.get(name)
-    bound = any(w.startswith(f"{name} ended at its bound") for w in fit.warnings)
-    text = f"{value:.3g}" if stderr is None else f"{value:.3g} ± {stderr:.2g}"
-    return text + (" (at bound)" if bound else "")
+    if name not in fit.free:
+        if name == "P_s" and value == 0.0:
+            return "0 (no lobe)"
+        return "–" if float(fit.params.P_s) == 0.0 else f"{value:.3g} (held)"
+    stderr = fit.stderr[name]
+    text = f"{value:.3g} ± {stderr:.2g}"
+    return text + (" (at bound)" if fit.at_bound(name) else "")
 
 
 def _parameter_table(analysis: ProductAnalysis) -> list[str]:
@@ -167,7 +200,7 @@ def _parameter_table(analysis: ProductAnalysis) -> list[str]:
              "held-out rms / worst | albedo at 0° / 60° | warnings |",
              "|---|---|---|---|---|---|---|---|---|"]
     held = analysis.split[1]
-    for c, channel in enumerate("RGB"):
+    for c, channel in enumerate(CHANNELS):
         fit = analysis.fit.fits[c]
         rms, worst = analysis.fit.channel_error(c)
         h_rms, h_worst = analysis.held_out.channel_error(c, held)
@@ -179,8 +212,53 @@ def _parameter_table(analysis: ProductAnalysis) -> list[str]:
     return lines
 
 
+def _tilt_text(fits: ChannelFits) -> str:
+    if fits.tilt is None:
+        return "–"
+    value, stderr = fits.tilt
+    bound = " (at bound)" if fits.joint.at_bound("tilt_deg") else ""
+    return f"{value:+.3f} ± {stderr:.3f}{bound}"
+
+
+def _starts_text(fits: ChannelFits) -> str:
+    starts = fits.joint.starts
+    text = f"{starts.reached} of {starts.count}, within {starts.spread:.1g}"
+    if starts.next_excess is not None:
+        text += f"; next end +{_pct(starts.next_excess)}"
+    return text
+
+
+def _checks_text(decisions) -> str:
+    if not decisions:
+        return "– (linear in log P_d)"
+    return "; ".join(("passed" if d.passed else "**failed**") + f": {d.why}"
+                     for d in decisions)
+
+
+def _model_table(analysis: ProductAnalysis) -> list[str]:
+    """The forms of eq. 2 tried (:func:`~lut_baker.offline.measured.inplane_fit.well_posed`),
+    each with its errors, tilt, starts and checks."""
+    lines = ["| form of eq. 2 | fit rms / worst | held-out rms / worst | tilt (degrees) | "
+             "starts reaching the best (parameter spread; next end) | checks | |",
+             "|---|---|---|---|---|---|---|"]
+    held = analysis.split[1]
+    steps = analysis.choice.steps
+    for index, ((fits, decisions), held_out) in enumerate(zip(steps, analysis.held_out_steps,
+                                                              strict=True)):
+        rms, worst = fits.error()
+        h_rms, h_worst = held_out.error(held)
+        verdict = "**chosen**" if index == len(steps) - 1 else "reduced"
+        lines.append(f"| {fits.fit_model.describe()} | {_pct(rms)} / {_pct(worst)} | "
+                     f"{_pct(h_rms)} / {_pct(h_worst)} | {_tilt_text(fits)} | "
+                     f"{_starts_text(fits)} | {_checks_text(decisions)} | {verdict} |")
+    return lines
+
+
 def _miss_table(analysis: ProductAnalysis) -> list[str]:
-    lines = ["| theta_i | peak theta_o measured / model | peak Y measured / model | "
+    tilted = analysis.fit.tilt is not None
+    lines = ["| theta_i | peak theta_o measured / model"
+             + (" (sample's mirror theta_i + 2 tilt)" if tilted else "")
+             + " | peak Y measured / model | "
              "back-scatter measured / model (mean, range) | at theta_o ≈ 0: measured / model | "
              "at largest theta_o: measured / model | rise from theta_o ≈ 0 to there: "
              "measured, model |",
@@ -189,9 +267,11 @@ def _miss_table(analysis: ProductAnalysis) -> list[str]:
         back = m.get("back_ratio")
         back_text = (f"{back[0]:.2f} ({back[1]:.2f}–{back[2]:.2f})" if back else "not measured")
         g = m["grazing"]
-        lines.append(f"| {incidence:g}° | {m['peak_deg'][0]:g}° / {m['peak_deg'][1]:.1f}° | "
-                     f"{m['peak_ratio']:.2f} | {back_text} | {g['near_normal_ratio']:.2f} "
-                     f"(at {g['from_deg']:g}°) | {g['ratio']:.2f} "
+        mirror = f" ({m['tilted_mirror_deg']:.1f}°)" if tilted else ""
+        model_peak = "flat" if m["peak_deg"][1] is None else f"{m['peak_deg'][1]:.1f}°"
+        lines.append(f"| {incidence:g}° | {m['peak_deg'][0]:g}° / {model_peak}"
+                     f"{mirror} | {m['peak_ratio']:.2f} | {back_text} | "
+                     f"{g['near_normal_ratio']:.2f} (at {g['from_deg']:g}°) | {g['ratio']:.2f} "
                      f"(at {g['theta_o_deg']:g}°) | {g['measured_rise']:.2f}, "
                      f"{g['model_rise']:.2f} |")
     return lines
@@ -202,7 +282,11 @@ def _summary(analysis: ProductAnalysis) -> str:
     h_rms, h_worst = analysis.held_out.error(analysis.split[1])
     fitted = "/".join(f"{v:g}" for v in analysis.split[0])
     judged = "/".join(f"{v:g}" for v in analysis.split[1])
-    return (f"All channels: fit on every incidence {_pct(rms)} rms, {_pct(worst)} worst; "
+    tilt = analysis.fit.tilt
+    tilt_text = (f"; the sample's tilt {tilt[0]:+.3f} ± {tilt[1]:.3f}° (a nuisance parameter: "
+                 "not in the preset)" if tilt else "")
+    return (f"Chosen form: {analysis.fit.fit_model.describe()}{tilt_text}. All channels: fit on "
+            f"every incidence {_pct(rms)} rms, {_pct(worst)} worst; "
             f"fitted on {fitted}° and predicting {judged}°: {_pct(h_rms)} rms, "
             f"{_pct(h_worst)} worst (relative errors `model/measured - 1` over the measured "
             f"geometries).")
@@ -273,12 +357,27 @@ def report(analyses: list[ProductAnalysis], notes: dict | None = None,
         "reflectance factors R = pi f_r, so the paper's signal (eq. 1) is "
         "I = R cos(theta_i)/pi and the fitted P_d, P_s are in 1/sr (docs/model.md §4). "
         "`ReflectionLayer(P_d, P_s, n, eta)` (eq. 2, n in 1/degree, docs/model.md §2.1) is "
-        "fitted per channel with `fit_reflection` (relative residuals); ± is one standard "
-        "error; \"warnings\" counts the fit's own diagnostics (ill-conditioned or degenerate "
-        "parameters, bounds, residual > 20%). Albedo: the fitted layer's directional albedo "
-        "(eq. 2 integrated over the hemisphere). Misses are in luminance Y, for the "
-        "all-incidence fit; the model's peak is searched on a 0.1° grid over the measured "
-        "theta_o range.",
+        "fitted to the three channels at once (`fit_reflection_sets`, relative residuals), one "
+        "layer per channel and, shared by the channels and every incidence, the tilt of the "
+        "sample in the plane of incidence: a sample tilted by tau sees the light at "
+        "theta_i + tau and the camera at theta_o - tau, so its mirror direction lies at "
+        "theta_o = theta_i + 2 tau (fitted within ±5° with its standard error; a nuisance "
+        "parameter, not part of the presets). Every fit is refined from 9 starts (eta 1.05, "
+        "1.5, 5 at tilts -1.5°, 0°, +1.5°; P_d and P_s by non-negative least squares on a "
+        "grid of n), and the best end is polished by Gauss-Newton steps, so that the "
+        "parameters move by about 1e-9 when the data move by 1e-9. The form of eq. 2 is then "
+        "reduced until the data determine every parameter (`inplane_fit.well_posed`): the "
+        "tilt is left out when it runs to its bound or its standard error exceeds its size; "
+        "the lobe is left out (P_d alone, no tilt) when in some channel P_s or n sits at a "
+        "bound or has a standard error beyond its value; eta is held at the paper film's "
+        "1.19 when it is not determined or P_s and eta correlate beyond 0.99. ± is one "
+        "standard error; \"starts\" counts the starts that ended within 1e-6 (relative) of "
+        "the best cost, the largest difference of their (logarithmic) parameters, and how "
+        "much higher the best other end lies; \"warnings\" counts the fit's own diagnostics "
+        "(ill-conditioned or degenerate parameters, bounds, residual > 20%). Albedo: the "
+        "fitted layer's directional albedo (eq. 2 integrated over the hemisphere). Misses are "
+        "in luminance Y, for the chosen fit; the model's peak is searched on a 0.1° grid over "
+        "the measured theta_o range.",
         "",
     ]
     for analysis in analyses:
@@ -286,8 +385,13 @@ def report(analyses: list[ProductAnalysis], notes: dict | None = None,
                 f"![{analysis.name}]({analysis.name}.png) — data and model at the measured "
                 f"geometries: [{analysis.name}.csv]({analysis.name}.csv)", "",
                 _summary(analysis), ""]
+        out += ["The forms of eq. 2 tried, from the full one down (each fitted to every "
+                "incidence, and to alternate incidences for the held-out column):", ""]
+        out += _model_table(analysis) + [""]
+        out += ["The chosen fit per channel:", ""]
         out += _parameter_table(analysis) + [""]
-        out += ["Where eq. 2 misses (luminance; mirror direction theta_o = theta_i):", ""]
+        out += ["Where the chosen fit misses (luminance; mirror direction theta_o = theta_i):",
+                ""]
         out += _miss_table(analysis) + [""]
         if analysis.name in notes:
             out += [notes[analysis.name], ""]

@@ -40,10 +40,15 @@ after each change until none applies:
 1. the tilt is left out when it runs to its bound (+-5 degrees) or its standard error exceeds
    its size;
 2. the lobe is left out (``P_d`` alone, no tilt: a constant has no direction to align) when in
-   some channel ``P_s`` or ``n`` sits at a bound or has a standard error beyond its value;
+   some channel its roughness ``n`` sits at a bound or has a standard error beyond its value;
 3. eta is held at the paper film's 1.19 (P_s then carries ``P_s F``) when in some channel eta
    sits at a bound, ``eta - 1`` has a standard error beyond its value, or P_s and eta correlate
-   beyond 0.99 (only their product is determined).
+   beyond 0.99 (only their product is determined);
+4. the lobe is left out when in some channel ``P_s`` (with eta held, if it was) sits at a bound
+   or has a standard error beyond its value.
+
+(``P_s`` is judged after eta: while the two are degenerate, P_s alone is not determined even
+where the lobe's height ``P_s F`` is.)
 
 Every decision is reported with its deciding number and threshold (:class:`Decision`).
 
@@ -267,13 +272,14 @@ class ModelChoice:
         return self.fit.fit_model
 
     def summary(self) -> str:
-        """One sentence: the form chosen and why the others were left."""
+        """One phrase: the form chosen and why each form before it was reduced, e.g. ``"P_d
+        alone (no lobe); reduced from eq. 2 (...) + tilt (the tilt ran to its bound (-5
+        degrees)), eq. 2 (...) (R n sits at its bound (0.0001))"``."""
         parts = []
         for fits, decisions in self.steps[:-1]:
             failed = [d for d in decisions if not d.passed]
-            parts.append(f"{fits.fit_model.describe()}: {failed[0].why}")
-        chosen = f"fitted {self.model.describe()}"
-        return chosen + (" (" + "; ".join(parts) + ")" if parts else "")
+            parts.append(f"{fits.fit_model.describe()} ({failed[0].why})")
+        return self.model.describe() + ("; reduced from " + ", ".join(parts) if parts else "")
 
 
 def _worst(fits: ChannelFits, names) -> tuple[float, str, bool]:
@@ -302,14 +308,15 @@ def _check_tilt(fits: ChannelFits) -> Decision:
     return Decision("tilt", bool(ratio <= WELL_POSED_STDERR), text, ratio, WELL_POSED_STDERR)
 
 
-def _check_lobe(fits: ChannelFits) -> Decision:
-    value, where, bound = _worst(fits, ("P_s", "n"))
+def _check_lobe(fits: ChannelFits, name: str) -> Decision:
+    """The lobe's ``n`` (its shape) or ``P_s`` (its height) in every channel."""
+    value, where, bound = _worst(fits, (name,))
     if bound:
-        return Decision("lobe", False, f"{where} sits at its bound ({value:.3g})", value,
+        return Decision(name, False, f"{where} sits at its bound ({value:.3g})", value,
                         WELL_POSED_STDERR, True)
-    text = (f"largest relative standard error of P_s and n: {value:.3g} ({where}; limit "
+    text = (f"largest relative standard error of {name}: {value:.3g} ({where}; limit "
             f"{WELL_POSED_STDERR:g})")
-    return Decision("lobe", bool(value <= WELL_POSED_STDERR), text, value, WELL_POSED_STDERR)
+    return Decision(name, bool(value <= WELL_POSED_STDERR), text, value, WELL_POSED_STDERR)
 
 
 def _check_eta(fits: ChannelFits) -> tuple[Decision, Decision]:
@@ -331,21 +338,23 @@ def _check_eta(fits: ChannelFits) -> tuple[Decision, Decision]:
 
 
 def _decisions(fits: ChannelFits) -> tuple[Decision, ...]:
+    """The checks of :func:`well_posed`, in the order they are acted on."""
     model = fits.fit_model
     out = []
     if model.tilt:
         out.append(_check_tilt(fits))
     if model.lobe:
-        out.append(_check_lobe(fits))
+        out.append(_check_lobe(fits, "n"))
         if model.eta is None:
             out += _check_eta(fits)
+        out.append(_check_lobe(fits, "P_s"))
     return tuple(out)
 
 
 def _reduced(model: FitModel, failed: Decision) -> FitModel:
     if failed.what == "tilt":
         return replace(model, tilt=False)
-    if failed.what == "lobe":
+    if failed.what in ("n", "P_s"):
         return FitModel(lobe=False, eta=None, tilt=False)
     return replace(model, eta=float(paper().film.eta))
 
@@ -377,7 +386,8 @@ def misses(fits: ChannelFits) -> dict:
     """Where the all-incidence fit misses, in luminance (Rec.709 ``Y``) per incidence.
 
     - ``peak_deg``: ``(measured, model)`` theta_o of the maximum; the model's on a
-      :data:`CURVE_STEP_DEG` grid over the measured theta_o range (the tilt included).
+      :data:`CURVE_STEP_DEG` grid over the measured theta_o range (the tilt included), ``None``
+      where the model is flat (``P_d`` alone).
     - ``peak_ratio``: measured maximum over the model's maximum.
     - ``mirror_deg``: the mirror direction ``theta_o = theta_i``, for reference, and
       ``tilted_mirror_deg``: the tilted sample's, ``theta_i + 2 tilt``.
@@ -399,7 +409,9 @@ def misses(fits: ChannelFits) -> dict:
         entry = {
             "mirror_deg": float(incidence),
             "tilted_mirror_deg": float(incidence + 2.0 * fits.tilt_deg),
-            "peak_deg": (float(fits.theta_o_deg[top]), float(dense[np.argmax(curve)])),
+            "peak_deg": (float(fits.theta_o_deg[top]),
+                         float(dense[np.argmax(curve)]) if np.ptp(curve) > 1e-12 * curve.max()
+                         else None),
             "peak_ratio": float(y_meas[top] / curve.max()),
         }
         back = rows[theta_o < 0.0]

@@ -19,11 +19,14 @@ the layer.
 Starting points (multi-start).  The intensity is linear in ``P_d`` and ``P_s``/``P_t``, so for
 each ``n`` on a coarse logarithmic grid they are solved by non-negative least squares at a
 given eta; the best ``n`` per eta of :data:`ETA_STARTS` (and per tilt of
-:data:`TILT_STARTS_DEG` when the tilt is fitted) is one start, the caller's start, if any, one
-more.  The dipole's starts are the local minima of a coarse ``(sigma_s, sigma_a)`` grid (at
-most :data:`DIPOLE_STARTS`).  Every start is refined; the lowest cost wins, and
-:class:`Starts` records how many starts reached it (within :data:`SAME_COST` relative), how far
-their parameters spread and how much higher the best other end lies.
+:data:`TILT_STARTS_DEG` when the tilt is fitted) is one start; with eta held fixed, the best
+``n`` in each of :data:`N_GRID_PARTS` parts of the grid is; the caller's start, if any, is one
+more.  Without lobe the problem is linear in ``log P_d``: its one start is the solution.  The
+dipole's starts are the local minima of a coarse ``(sigma_s, sigma_a)`` grid (at most
+:data:`DIPOLE_STARTS`).  Every start is refined; the lowest cost wins, is polished (Gauss-Newton
+steps, central differences) and :class:`Starts` records how many starts reached it (within
+:data:`SAME_COST` relative), how far their parameters spread and how much higher the best other
+end lies.
 
 Uncertainty: ``cov = (J^T J)^-1 s^2`` with ``J`` the Jacobian of the residuals in the conditioned
 parameters at the solution and ``s^2`` the residual variance.  Since every conditioned parameter
@@ -76,6 +79,7 @@ __all__ = [
     "TILT",
     "TILT_LIMIT_DEG",
     "ETA_STARTS",
+    "N_GRID_PARTS",
     "TILT_STARTS_DEG",
     "SAME_COST",
     "Limits",
@@ -104,6 +108,9 @@ N_GRID_PER_DEG = np.geomspace(2e-3, 0.5, 25)
 """Roughness grid (1/degree) of the starting search: lobe half-widths 500 to 2 degrees."""
 ETA_STARTS = (1.05, 1.5, 5.0)
 """Eta of the linear starts (one start each): weak to strong Fresnel reflection."""
+N_GRID_PARTS = 3
+"""With eta held fixed, the roughness grid is cut into this many parts (wide to narrow
+lobes), one start each."""
 TILT_STARTS_DEG = (-1.5, 0.0, 1.5)
 """Tilts (degrees) of the starts when the tilt is fitted."""
 SIGMA_S_GRID_PER_MM = np.geomspace(0.05, 200.0, 10)
@@ -122,6 +129,9 @@ _STEP = np.finfo(float).eps ** 0.5
 """Forward-difference step in the conditioned parameters (the optimiser's Jacobian)."""
 _CENTRAL_STEP = np.finfo(float).eps ** (1.0 / 3.0)
 """Central-difference step (the polish's and the covariance's Jacobian)."""
+_EVALUATIONS = 40
+"""``least_squares`` stops after this many evaluations per parameter (a start that has not
+converged by then crawls along a valley of undetermined parameters)."""
 POLISH_STEPS = 30
 """At most this many Gauss-Newton steps polish the optimiser's best end."""
 
@@ -135,8 +145,9 @@ _BOUNDS = {
     "scale": (1e-6, 1e6),
     TILT: (-TILT_LIMIT_DEG, TILT_LIMIT_DEG),
 }
-_NO_LOBE = {"n": 1.0, "eta": 1.0}
-"""``n`` and ``eta`` of a layer fitted without lobe (``P_s = 0``; unused, reported as fixed)."""
+_NO_LOBE = {"n": _BOUNDS["n"][0], "eta": 1.0}
+"""``n`` and ``eta`` of a layer fitted without lobe (``P_s = 0``; unused, reported as fixed): the
+widest lobe (integrals over the hemisphere need no fine grid) and no interface."""
 
 
 @dataclass(frozen=True)
@@ -597,27 +608,31 @@ def _fit_pair(datasets, layer_type, lobe: str, predict, start, eta, limits, *,
     _check_size(problem, problem.samples)
     if eta is not None:
         layer_type(P_d=1.0, **{lobe: 1.0}, n=1.0, eta=eta)  # validates a fixed eta
+    etas = (eta,) if eta is not None else ETA_STARTS
+    grids = np.array_split(N_GRID_PER_DEG, 1 if len(etas) > 1 else N_GRID_PARTS)
     starts = []
     for tilt_deg in (TILT_STARTS_DEG if tilt else (0.0,)):
-        for eta0 in ((eta,) if eta is not None else ETA_STARTS):
-            layers = _linear_starts(problem, lobe, eta0, tilt_deg, lobe_free)
-            starts.append(problem.x_of(layers, {TILT: tilt_deg}))
+        for eta0 in (etas if lobe_free else etas[:1]):
+            for grid in (grids if lobe_free else grids[:1]):
+                layers = _linear_starts(problem, lobe, eta0, tilt_deg, lobe_free, grid)
+                starts.append(problem.x_of(layers, {TILT: tilt_deg}))
     if start is not None:
         starts.append(problem.x_of([start] * problem.sets))
     return _solve(problem, starts, limits)
 
 
 def _linear_starts(problem: _Problem, lobe: str, eta: float, tilt_deg: float,
-                   lobe_free: bool) -> list[SimpleNamespace]:
-    """One start per set at ``eta`` and ``tilt_deg``: for each ``n`` of :data:`N_GRID_PER_DEG`,
-    ``P_d`` and the lobe's P by non-negative least squares on relative residuals; the ``n`` of
-    lowest cost.  A lobe the least squares drop starts at 1% of the diffuse level at its peak
-    (from 0 the optimiser could not grow it).  Without lobe: ``P_d`` by least squares in log."""
+                   lobe_free: bool, grid) -> list[SimpleNamespace]:
+    """One start per set at ``eta`` and ``tilt_deg``: for each ``n`` of ``grid``, ``P_d`` and
+    the lobe's P by non-negative least squares on relative residuals; the ``n`` of lowest cost.
+    A lobe the least squares drop starts at 1% of the diffuse level at its peak (from 0 the
+    optimiser could not grow it).  Without lobe: ``P_d`` by least squares in log (the
+    solution: the problem is linear)."""
     nuisance = {TILT: tilt_deg}
     diffuse = problem.predict(_Values(channels=(), P_d=1.0, **{lobe: 0.0}, n=1.0, eta=eta),
                               nuisance)
     bases = [problem.predict(_Values(channels=(), P_d=0.0, **{lobe: 1.0}, n=n, eta=eta),
-                             nuisance) for n in N_GRID_PER_DEG]
+                             nuisance) for n in grid]
     starts = []
     for s in range(problem.sets):
         measured = problem.measured[:, s]
@@ -628,7 +643,7 @@ def _linear_starts(problem: _Problem, lobe: str, eta: float, tilt_deg: float,
             continue
         weight = 1.0 / measured
         best = None
-        for n, basis in zip(N_GRID_PER_DEG, bases, strict=True):
+        for n, basis in zip(grid, bases, strict=True):
             p, _ = nnls(np.stack([diffuse, basis], axis=1) * weight[:, None],
                         np.ones_like(weight))
             p = np.clip(p, low, high)
@@ -671,7 +686,7 @@ def _solve(problem: _Problem, starts, limits: Limits) -> JointFit:
         runs.append(least_squares(problem.residuals, x0, jac=problem.jacobian,
                                   bounds=(low, high), method="trf", x_scale=1.0,
                                   ftol=_TOLERANCE, xtol=_TOLERANCE, gtol=_TOLERANCE,
-                                  max_nfev=200 * x0.size))
+                                  max_nfev=_EVALUATIONS * x0.size))
     best = min(runs, key=lambda run: run.cost)
     x, cost = _polish(problem, best.x, low, high)
     end = SimpleNamespace(x=x, cost=cost, success=best.success, message=best.message)
