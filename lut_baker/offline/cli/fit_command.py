@@ -11,8 +11,8 @@ Fits print a TOML (or ``--format json``) block on stdout, or write it to ``--out
 fitted layer under its kind (``[reflection]``, ``[transmission]``, ``[dipole]``: pass it to the
 layer type as keywords), then ``[stderr]``, ``[relative_stderr]`` (eta: relative to eta - 1),
 ``[derived]`` (the P ratio as [value, stderr]) and ``[fit]`` (samples, residual rms, Jacobian
-condition number, correlation matrix over ``free``, warnings).  Warnings (ill-conditioned or
-degenerate parameters, poor fit) also go to stderr, one per line.
+condition number, correlation matrix over ``free``, how the starts ended, warnings).  Warnings
+(ill-conditioned or degenerate parameters, poor fit) also go to stderr, one per line.
 
 CSV columns (units in the names; ``#`` lines are comments; see
 lut_baker.offline.measured.measurements):
@@ -240,7 +240,8 @@ def result_document(result) -> dict:
         "relative_stderr": data["relative_stderr"],
         "derived": data["derived"],
         "fit": {key: data[key] for key in ("samples", "residual_rms", "condition_number",
-                                           "free", "fixed", "correlation", "warnings")},
+                                           "free", "fixed", "correlation", "starts",
+                                           "warnings") if key in data},
     }
 
 

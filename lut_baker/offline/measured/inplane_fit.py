@@ -147,14 +147,16 @@ class FitModel:
     eta: float | None = None
     tilt: bool = True
 
-    def describe(self) -> str:
-        """E.g. ``"eq. 2 (P_d, P_s, n, eta per channel) + tilt"``."""
+    def describe(self, short: bool = False) -> str:
+        """E.g. ``"eq. 2 (P_d, P_s, n, eta per channel) + tilt"``; ``short``: ``"eq. 2 +
+        tilt"``."""
         if not self.lobe:
-            text = "P_d alone (no lobe)"
+            text = "P_d alone" if short else "P_d alone (no lobe)"
         elif self.eta is None:
-            text = "eq. 2 (P_d, P_s, n, eta per channel)"
+            text = "eq. 2" if short else "eq. 2 (P_d, P_s, n, eta per channel)"
         else:
-            text = f"eq. 2 with eta = {self.eta:g} (P_d, P_s, n per channel)"
+            text = (f"eq. 2, eta = {self.eta:g}" if short
+                    else f"eq. 2 with eta = {self.eta:g} (P_d, P_s, n per channel)")
         return text + (" + tilt" if self.tilt else "")
 
 
