@@ -746,10 +746,10 @@ def _rival(problem: _Problem, others, result, s2: float, se_x, limits: Limits) -
         distance = np.where(np.isfinite(distance), distance, 0.0)
         i = int(np.argmax(distance))
         if distance[i] > 1.0:
-            return (f"another minimum fits as well within the noise (chi-square higher by "
-                    f"{chi2:.2g}, limit {limits.rival_chi2:g}) with {names[i]} = "
+            return (f"another minimum fits as well within the noise: its chi-square is higher "
+                    f"by {chi2:.2g} (limit {limits.rival_chi2:g}), with {names[i]} = "
                     f"{_from_x(problem.parameter(i), run.x[i]):.4g}, {distance[i]:.3g} standard "
-                    "errors away: the data do not choose between the two")
+                    "errors away; the data do not choose between the two")
     return None
 
 
