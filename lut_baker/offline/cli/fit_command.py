@@ -125,7 +125,10 @@ starting with # are skipped. Columns:
 Reflectance factors are dimensionless, relative to a white standard: R = pi f_r (pi times
 the BRDF in 1/sr; an ideal white Lambertian reads 1). At least 5 rows.
 
-Eq. 2 is fitted per channel to every row; the film is derived as the measured presets are:
+Eq. 2 is fitted to every row, the three channels at once with one tilt of the sample (a
+nuisance, not in the film), in the form whose every parameter the data determine (the tilt,
+the lobe or eta left out or held where they are not determined; a matte product keeps P_d
+alone); the film is derived as the measured presets are:
 the paper's film (foundation = "paper_natural") with the product's gloss ([film] P_s, n, eta)
 and per-channel absorption whose endless stack reflects what the thick layer reflects. The
 TOML file holds name, foundation, absorption, [film], and comments with the fit's parameters

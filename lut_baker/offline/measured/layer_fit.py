@@ -169,9 +169,10 @@ class Starts:
     """How the starts of a fit ended (module docstring).
 
     ``count``: starts refined; ``reached``: how many ended within :data:`SAME_COST` (relative)
-    of the best cost ``best_cost`` (half the sum of squared residuals); ``spread``: the largest
-    difference of a conditioned parameter (the logarithm of a value, of ``eta - 1``; the tilt
-    in degrees) between the best end and another that reached it; ``next_excess``: ``(cost -
+    of the best cost ``best_cost`` (half the sum of squared residuals, at the polished optimum);
+    ``spread``: the largest difference of a conditioned parameter (the logarithm of a value, of
+    ``eta - 1``; the tilt in degrees) between the optimum and the end of a start that reached it
+    (the optimiser's tolerance); ``next_excess``: ``(cost -
     best) / best`` of the best end that did not reach it (another local minimum), ``None``
     when every start reached the best."""
 
@@ -678,7 +679,8 @@ def _dipole_starts(problem: _Problem) -> list[np.ndarray]:
 
 
 def _solve(problem: _Problem, starts, limits: Limits) -> JointFit:
-    """Refine every start with ``least_squares``; keep the lowest cost and diagnose it."""
+    """Refine every start with ``least_squares``; polish the lowest cost's end (:func:`_polish`)
+    and diagnose it."""
     low, high = problem.x_bounds()
     runs = []
     for x0 in starts:

@@ -32,7 +32,7 @@ def _assert_same_film_as_preset(skin, product):
             np.testing.assert_allclose(getattr(getattr(skin, name), key), value, rtol=1e-6)
 
 
-@pytest.mark.slow  # fit, then the film derived by quadrature (~3-5 s)
+@pytest.mark.slow  # well-posed fit, then the film derived by quadrature (~10-20 s)
 @pytest.mark.parametrize(("product", "finish"), [("clarins_105", "dewy"),
                                                  ("clarins_108", "matte")])
 def test_a_product_file_gives_its_shipped_preset(tmp_path, product, finish):
