@@ -21,6 +21,8 @@ Functions
 - :func:`ts_reflection_from_cosines` -- the BRDF ``P_d + P_s D G F_r`` (eq. 2).
 - :func:`ts_transmission_from_cosines` -- the film's BTDF ``P_d + P_t D(beta) F_t`` (eq. 4).
 - :func:`ts_reflection`, :func:`ts_transmission` -- the same at unit vectors.
+- :func:`reflection_cosines`, :func:`transmission_cosines` -- the cosines eqs. 2 and 4 take,
+  at unit vectors.
 - :func:`half_vector_cosines` -- ``(n.h, v.h)`` from polar angles and a relative azimuth.
 - :func:`check_directions` -- unit vectors ``(..., 3)`` or ``ValueError``.
 """
@@ -46,7 +48,9 @@ __all__ = [
     "ts_reflection_from_cosines",
     "ts_transmission_from_cosines",
     "ts_reflection",
+    "reflection_cosines",
     "ts_transmission",
+    "transmission_cosines",
     "half_vector_cosines",
 ]
 
@@ -221,15 +225,21 @@ def ts_reflection(wi, wo, layer: ReflectionLayer, *, check: bool = True):
     if check:
         wi = check_directions("wi", wi)
         wo = check_directions("wo", wo)
-    wi, wo = np.broadcast_arrays(wi, wo)
-    h = half_vector(wi, wo)
-    n_dot_l = wi[..., 2]
-    n_dot_v = wo[..., 2]
-    v_dot_h = np.clip(np.sum(wo * h, axis=-1), 0.0, 1.0)
-    cosines = (channel_axis(x, layer) for x in (h[..., 2], v_dot_h, n_dot_v, n_dot_l))
+    n_dot_h, v_dot_h, n_dot_v, n_dot_l = reflection_cosines(wi, wo)
+    cosines = (channel_axis(x, layer) for x in (n_dot_h, v_dot_h, n_dot_v, n_dot_l))
     value = ts_reflection_from_cosines(*cosines, layer)
     upper = (n_dot_l >= 0.0) & (n_dot_v >= 0.0)
     return np.where(channel_axis(upper, layer), value, 0.0)
+
+
+def reflection_cosines(wi, wo) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """``(n.h, v.h, n.v, n.l)``, the cosines eq. 2 takes, at unit vectors ``wi``, ``wo``
+    ``(..., 3)`` (unchecked): ``h`` their half vector (the normal where they are opposite and
+    horizontal), ``v.h`` clipped to [0, 1]; ``n.v``, ``n.l`` signed (< 0 below the surface)."""
+    wi, wo = np.broadcast_arrays(wi, wo)
+    h = half_vector(wi, wo)
+    v_dot_h = np.clip(np.sum(wo * h, axis=-1), 0.0, 1.0)
+    return h[..., 2], v_dot_h, wo[..., 2], wi[..., 2]
 
 
 def ts_transmission(wi, wt, layer: TransmissionLayer, *, check: bool = True):
@@ -240,6 +250,16 @@ def ts_transmission(wi, wt, layer: TransmissionLayer, *, check: bool = True):
     if check:
         wi = check_directions("wi", wi)
         wt = check_directions("wt", wt)
+    n_dot_h, v_dot_h, crossing = transmission_cosines(wi, wt)
+    value = ts_transmission_from_cosines(channel_axis(n_dot_h, layer),
+                                         channel_axis(v_dot_h, layer), layer)
+    return np.where(channel_axis(crossing, layer), value, 0.0)
+
+
+def transmission_cosines(wi, wt) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(n.h', v'.h', crossing)`` at unit vectors ``wi``, ``wt`` ``(..., 3)`` (unchecked): the
+    cosines eq. 4 takes (:func:`ts_transmission_from_cosines`) and whether the pair lies on
+    opposite sides of the film (else the BTDF is 0)."""
     wi, wt = np.broadcast_arrays(wi, wt)
     crossing = wi[..., 2] * wt[..., 2] <= 0.0
     # Upward crossing (``wi`` below, or on the horizon with ``wt`` above): mirror the pair.
@@ -248,6 +268,4 @@ def ts_transmission(wi, wt, layer: TransmissionLayer, *, check: bool = True):
     mirrored = wt * np.concatenate([np.ones_like(flip), np.ones_like(flip), -flip], axis=-1)
     h = half_vector(top, mirrored)
     v_dot_h = np.clip(np.sum(mirrored * h, axis=-1), 0.0, 1.0)
-    value = ts_transmission_from_cosines(channel_axis(h[..., 2], layer),
-                                         channel_axis(v_dot_h, layer), layer)
-    return np.where(channel_axis(crossing, layer), value, 0.0)
+    return h[..., 2], v_dot_h, crossing

@@ -7,15 +7,18 @@ diffuse ``P_d`` and its transmission, eq. 4) and takes from the measurement:
 
 - **gloss** (the film's top surface, eq. 2's ``P_s``, ``n``, ``eta``, not absorbed): for a dewy
   product, one achromatic lobe, the luminance-weighted mean (Rec.709 weights) of the per-channel
-  fit's ``P_s``, ``n`` and ``eta``; for a matte product, whose fit has no determined lobe,
-  ``P_s = 0`` (``n``, ``eta`` stay the paper film's, unused);
+  fit's ``P_s``, ``n`` and ``eta`` (the fit's tilt of the sample, a nuisance of the measurement,
+  is not part of it); for a matte product, whose well-posed fit has no lobe (``P_d`` alone,
+  :func:`~lut_baker.offline.measured.inplane_fit.well_posed`), ``P_s = 0`` (``n``, ``eta`` stay
+  the paper film's, unused);
 - **absorption** ``A_c`` per channel (docs/model.md §4): the film stacked on itself without end
   reflects what the thick layer reflects.  With the film's bihemispherical reflectance ``r(A) =
   r_gloss + (1 - A) r_diffuse`` and transmittance ``t(A) = (1 - A) t_0`` (uniform incident
   light, cosine-weighted), the adding equation ``R = r + t^2 R / (1 - r R)`` has the root
   ``R_inf(A)`` of ``r R^2 - (1 + r^2 - t^2) R + r = 0`` below 1, which falls monotonically from
   ``R_inf(0)`` to ``r_gloss`` at ``A = 1``; bisection finds ``A_c`` with ``R_inf(A_c)`` equal to
-  the target, the fitted eq. 2 layer's bihemispherical reflectance in channel ``c``.  A target
+  the target, the fitted eq. 2 layer's bihemispherical reflectance in channel ``c`` (``pi P_d``
+  for a layer without lobe).  A target
   outside ``[r_gloss, R_inf(0)]`` is clamped (``A = 0`` or ``1``) and reported.
 
 The result is written to :data:`PRESET_FILE` (``lut_baker/model/measured_foundations.json``),

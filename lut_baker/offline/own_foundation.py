@@ -6,8 +6,10 @@ applied to one file of the published layout (:mod:`~lut_baker.offline.measured.i
 ``theta_i``, ``theta_o``, then 81 spectral or 3 linear RGB reflectance factors):
 
 1. read the file; spectra become linear Rec.709 RGB (:mod:`~lut_baker.offline.measured.spectra`);
-2. fit eq. 2 per channel to every row
-   (:func:`~lut_baker.offline.measured.inplane_fit.fit_channels`);
+2. fit eq. 2 to the three channels at once, in the form the data determine
+   (:func:`~lut_baker.offline.measured.inplane_fit.well_posed`: the full eq. 2 with the
+   sample's tilt, reduced where a parameter is not determined; a matte product keeps ``P_d``
+   alone);
 3. decide the finish: given, or ``"auto"``, dewy when every channel's fit determined its lobe
    (:func:`~lut_baker.offline.foundation_presets.auto_finish`), else matte;
 4. derive the thin film (:func:`~lut_baker.offline.foundation_presets.derive_preset`): the
@@ -39,7 +41,7 @@ from pathlib import Path
 
 from .foundation_presets import auto_finish, derive_preset, film_exchange, stack_reflectance
 from .measured.inplane import SPECTRAL_SAMPLES, InPlaneData, read_inplane
-from .measured.inplane_fit import CHANNELS, ChannelFits, fit_channels
+from .measured.inplane_fit import CHANNELS, ChannelFits, ModelChoice, well_posed
 
 __all__ = ["BASE_FOUNDATION", "FINISHES", "OwnFoundation", "fit_own_foundation",
            "params_mapping", "params_text"]
@@ -53,18 +55,24 @@ FINISHES = ("auto", "matte", "dewy")
 
 @dataclass(frozen=True, eq=False)
 class OwnFoundation:
-    """One measurement file turned into a foundation: ``data`` as read, ``fits`` (eq. 2 per
-    channel), the ``finish`` used and ``finish_reason`` (why), and ``preset`` (the entry of
+    """One measurement file turned into a foundation: ``data`` as read, ``choice`` (the forms
+    of eq. 2 tried and the well-posed one), ``fits`` (the chosen fit), the ``finish`` used and
+    ``finish_reason`` (why), and ``preset`` (the entry of
     :func:`~lut_baker.offline.foundation_presets.derive_preset`: ``absorption``, ``film``,
     ``target``, ``stack``, ``clamped``)."""
 
     path: Path
     name: str
     data: InPlaneData
-    fits: ChannelFits
+    choice: ModelChoice
     finish: str
     finish_reason: str
     preset: dict
+
+    @property
+    def fits(self) -> ChannelFits:
+        """The well-posed fit the film is derived from."""
+        return self.choice.fit
 
     @property
     def fit_warnings(self) -> list[str]:
@@ -88,34 +96,43 @@ class OwnFoundation:
         return out
 
     @property
+    def finish_warnings(self) -> list[str]:
+        """A dewy finish given for a fit without lobe: the film gets no gloss."""
+        if self.finish == "dewy" and not self.fits.fit_model.lobe:
+            return ["finish: dewy was given, but the data determine no lobe "
+                    f"({self.choice.summary()}): the film's P_s is 0"]
+        return []
+
+    @property
     def warnings(self) -> list[str]:
-        """:attr:`fit_warnings` then :attr:`clamp_warnings`."""
-        return self.fit_warnings + self.clamp_warnings
+        """:attr:`fit_warnings`, :attr:`clamp_warnings`, then :attr:`finish_warnings`."""
+        return self.fit_warnings + self.clamp_warnings + self.finish_warnings
 
 
 def fit_own_foundation(path, name: str | None = None, finish: str = "auto") -> OwnFoundation:
-    """Read ``path``, fit eq. 2 per channel to every row and derive the film (module
-    docstring).  ``name`` defaults to the file's stem.  ``finish``: ``"matte"`` (no gloss),
-    ``"dewy"`` (the luminance-weighted mean lobe) or ``"auto"``: dewy when every channel's
-    roughness ``n`` is determined (not at its bound, standard error at most 10% of ``n``), else
-    matte.  Every problem is one ``ValueError`` line naming the file."""
+    """Read ``path``, fit eq. 2 to every row in its well-posed form and derive the film
+    (module docstring).  ``name`` defaults to the file's stem.  ``finish``: ``"matte"`` (no
+    gloss), ``"dewy"`` (the luminance-weighted mean lobe) or ``"auto"``: dewy when every
+    channel's roughness ``n`` is determined (fitted, not at its bound, standard error at most
+    10% of ``n``), else matte.  Every problem is one ``ValueError`` line naming the file."""
     path = Path(path)
     if finish not in FINISHES:
         raise ValueError(f"finish must be one of {', '.join(FINISHES)}, got {finish!r}")
     data = read_inplane(path)
     try:
         rgb = data.rgb
-        fits = fit_channels(data.theta_i_deg, data.theta_o_deg, rgb)
+        choice = well_posed(data.theta_i_deg, data.theta_o_deg, rgb)
     except ValueError as error:
         raise ValueError(f"{path}: {error}") from None
     if finish == "auto":
-        used, determined = auto_finish(fits.fits)
-        reason = f"auto: {determined}"
+        used, determined = auto_finish(choice.fit.fits)
+        reason = (f"auto: {determined}" if choice.model.lobe else
+                  f"auto: the data determine no lobe; {choice.summary()}")
     else:
         used, reason = finish, "given"
     name = path.stem if name is None else name
-    preset = derive_preset(name, used, fits.layers, label=name)
-    return OwnFoundation(path, name, data, fits, used, reason, preset)
+    preset = derive_preset(name, used, choice.fit.layers, label=name)
+    return OwnFoundation(path, name, data, choice, used, reason, preset)
 
 
 def params_mapping(result: OwnFoundation) -> dict:
@@ -135,14 +152,26 @@ def _triple(values, digits: int = 4) -> str:
 
 def _fit_lines(result: OwnFoundation) -> list[str]:
     fits = result.fits
-    out = ["eq. 2 fitted per channel to every row (reflectance factors R = pi f_r; P_d, P_s in "
-           "1/sr, n in 1/degree; +- relative standard error, eta's relative to eta - 1; error "
-           "= model / measured - 1):"]
+    out = ["eq. 2 fitted to every row, the three channels at once, in the form the data "
+           "determine (forms tried: "
+           + "; ".join(f"{step.fit_model.describe()}, error rms {100 * step.error()[0]:.3g}%"
+                       for step, _ in result.choice.steps) + ")"]
+    tilt = fits.tilt
+    out.append(f"chosen: {fits.fit_model.describe()}"
+               + (f"; the sample's tilt {tilt[0]:+.3f} +- {tilt[1]:.3f} degrees (not in the "
+                  "film)" if tilt else "")
+               + f"; {fits.joint.starts.summary()}")
+    out.append("per channel (reflectance factors R = pi f_r; P_d, P_s in 1/sr, n in 1/degree; "
+               "+- relative standard error, eta's relative to eta - 1; error = model / "
+               "measured - 1):")
     for c, (channel, fit) in enumerate(zip(CHANNELS, fits.fits, strict=True)):
         se = fit.relative_stderr
+        keys = ("P_d", "P_s", "n", "eta") if fits.fit_model.lobe else ("P_d",)
         parts = [f"{key} = {float(getattr(fit.params, key)):.4g} (+-{100 * se[key]:.3g}%)"
-                 if key in se else f"{key} = {float(getattr(fit.params, key)):.4g} (fixed)"
-                 for key in ("P_d", "P_s", "n", "eta")]
+                 if key in se else f"{key} = {float(getattr(fit.params, key)):.4g} (held)"
+                 for key in keys]
+        if not fits.fit_model.lobe:
+            parts.append("no lobe (P_s = 0)")
         rms, worst = fits.channel_error(c)
         out.append(f"  {channel}: {', '.join(parts)}; error rms {100 * rms:.3g}%, worst "
                    f"{100 * worst:.3g}%")

@@ -11,8 +11,8 @@ Fits print a TOML (or ``--format json``) block on stdout, or write it to ``--out
 fitted layer under its kind (``[reflection]``, ``[transmission]``, ``[dipole]``: pass it to the
 layer type as keywords), then ``[stderr]``, ``[relative_stderr]`` (eta: relative to eta - 1),
 ``[derived]`` (the P ratio as [value, stderr]) and ``[fit]`` (samples, residual rms, Jacobian
-condition number, correlation matrix over ``free``, warnings).  Warnings (ill-conditioned or
-degenerate parameters, poor fit) also go to stderr, one per line.
+condition number, correlation matrix over ``free``, how the starts ended, warnings).  Warnings
+(ill-conditioned or degenerate parameters, poor fit) also go to stderr, one per line.
 
 CSV columns (units in the names; ``#`` lines are comments; see
 lut_baker.offline.measured.measurements):
@@ -126,7 +126,10 @@ starting with # are skipped. Columns:
 Reflectance factors are dimensionless, relative to a white standard: R = pi f_r (pi times
 the BRDF in 1/sr; an ideal white Lambertian reads 1). At least 5 rows.
 
-Eq. 2 is fitted per channel to every row; the film is derived as the measured presets are:
+Eq. 2 is fitted to every row, the three channels at once with one tilt of the sample (a
+nuisance, not in the film), in the form whose every parameter the data determine (the tilt,
+the lobe or eta left out or held where they are not determined; a matte product keeps P_d
+alone); the film is derived as the measured presets are:
 the paper's film (foundation = "paper_natural") with the product's gloss ([film] P_s, n, eta)
 and per-channel absorption whose endless stack reflects what the thick layer reflects. The
 TOML file holds name, foundation, absorption, [film], and comments with the fit's parameters
@@ -241,7 +244,8 @@ def result_document(result) -> dict:
         "relative_stderr": data["relative_stderr"],
         "derived": data["derived"],
         "fit": {key: data[key] for key in ("samples", "residual_rms", "condition_number",
-                                           "free", "fixed", "correlation", "warnings")},
+                                           "free", "fixed", "correlation", "starts",
+                                           "warnings") if key in data},
     }
 
 

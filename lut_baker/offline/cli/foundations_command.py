@@ -5,7 +5,8 @@
 
 Reads the in-plane spectral measurements of four foundations (Lanza et al. 2024,
 data/lanza2024/README.md), converts them to linear Rec.709 reflectance factors, fits
-``ReflectionLayer(P_d, P_s, n, eta)`` (eq. 2, docs/model.md §2.1) per channel, and writes per
+``ReflectionLayer(P_d, P_s, n, eta)`` (eq. 2, docs/model.md §2.1) to the three channels at once
+with the sample's tilt, in the form whose every parameter the data determine, and writes per
 product ``<product>.csv`` and ``<product>.png`` and one ``README.md`` report to the output
 folder, and derives from the fits the thin-film foundation presets (docs/model.md §4, "Presets
 from measured thick layers") into the runtime's preset file, which

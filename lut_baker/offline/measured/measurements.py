@@ -22,8 +22,11 @@ profile            ``distance_mm``, ``ratio`` (to the lit pixel)
 Functions and types
 -------------------
 - :class:`ReflectionData`, :class:`TransmissionData`, :class:`ProfileData` -- samples.
-- :func:`reflection_counts` -- ``f_r (N.L)`` of a layer at a data set's geometry (eq. 2).
+- :func:`reflection_counts` -- ``f_r (N.L)`` of a layer at a data set's geometry (eq. 2),
+  the sample optionally tilted.
+- :class:`ReflectionCounts` -- the same for many layers at one data set (cosines kept).
 - :func:`transmission_counts` -- ``f_t (N.L)`` of a layer at a data set's geometry (eq. 4).
+- :class:`TransmissionCounts` -- the same for many layers at one data set (cosines kept).
 - :func:`profile_ratio` -- ``R(d) / R(0)`` of a dipole (eq. 6).
 - :func:`read_measurements` -- a CSV file as one of the data types (kind from its columns).
 - :func:`write_measurements` -- a data set as a CSV file.
@@ -42,14 +45,20 @@ from pathlib import Path
 import numpy as np
 
 from ...model.dipole import dipole_profile
-from ...model.layers import Dipole, ReflectionLayer, TransmissionLayer
-from ...model.microfacet import ts_reflection, ts_transmission
+from ...model.layers import Dipole, ReflectionLayer, TransmissionLayer, channel_axis
+from ...model.microfacet import (
+    reflection_cosines,
+    transmission_cosines,
+    ts_reflection_from_cosines,
+    ts_transmission_from_cosines,
+)
 from ...model.presets import paper_layers
 from ..atomic_files import replacing
 from .protocols import (
     profile_distances,
     reflection_geometry,
     reflection_sweep,
+    tilted,
     transmission_geometry,
     transmission_sweep,
 )
@@ -62,7 +71,9 @@ __all__ = [
     "TransmissionData",
     "ProfileData",
     "reflection_counts",
+    "ReflectionCounts",
     "transmission_counts",
+    "TransmissionCounts",
     "profile_ratio",
     "read_measurements",
     "write_measurements",
@@ -184,20 +195,61 @@ def _freeze(data) -> None:
 # --------------------------------------------------------------------------------------------
 # Forward model
 # --------------------------------------------------------------------------------------------
-def reflection_counts(data: ReflectionData, layer: ReflectionLayer) -> np.ndarray:
+def reflection_counts(data: ReflectionData, layer: ReflectionLayer,
+                      tilt_deg: float = 0.0) -> np.ndarray:
     """What the camera records, ``I = f_r(wi, wo) (N.L)`` (paper eqs. 1, 2), at the samples'
-    geometry; in the unit of ``layer.P_d`` (counts for the paper's values)."""
-    return ts_reflection(data.wi, data.wo, layer) * _cosine(data.wi, layer)
+    geometry; in the unit of ``layer.P_d`` (counts for the paper's values).
+
+    ``tilt_deg``: the sample sits tilted by that angle in the plane (an offset of alpha,
+    :func:`~lut_baker.offline.measured.protocols.tilted`), so it reflects ``f_r`` at the
+    tilted directions; ``N.L`` stays the nominal one, as in data normalised by a white
+    reference measured in the same mount (whose own cosine cancels the sample's: reflectance
+    factors ``R = pi f_r`` at the sample's angles)."""
+    return ReflectionCounts(data)(layer, tilt_deg)
+
+
+class ReflectionCounts:
+    """:func:`reflection_counts` at one data set's geometry for many layers: the cosines of
+    eq. 2 are computed once per tilt (the last one is kept; a fit changes the layer far more
+    often than the tilt).  ``layer`` may be any object with the fields ``P_d``, ``P_s``, ``n``,
+    ``eta`` and ``channels``."""
+
+    def __init__(self, data: ReflectionData):
+        self._wi, self._wo = data.wi, data.wo
+        self._tilt = None
+        self._cosines = None
+
+    def __call__(self, layer, tilt_deg: float = 0.0) -> np.ndarray:
+        tilt = float(tilt_deg)
+        if tilt != self._tilt:
+            wi, wo = (self._wi, self._wo) if tilt == 0.0 else (tilted(self._wi, tilt),
+                                                                 tilted(self._wo, tilt))
+            self._cosines = reflection_cosines(wi, wo)
+            self._tilt = tilt
+        n_dot_h, v_dot_h, n_dot_v, n_dot_l = (channel_axis(c, layer) for c in self._cosines)
+        value = ts_reflection_from_cosines(n_dot_h, v_dot_h, n_dot_v, n_dot_l, layer)
+        nominal = channel_axis(self._wi[:, 2], layer)
+        return np.where((n_dot_l >= 0.0) & (n_dot_v >= 0.0), value * nominal, 0.0)
 
 
 def transmission_counts(data: TransmissionData, layer: TransmissionLayer) -> np.ndarray:
     """What the camera below the film records, ``I = f_t(wi, wt) (N.L)`` (paper eqs. 3, 4)."""
-    return ts_transmission(data.wi, data.wt, layer) * _cosine(data.wi, layer)
+    return TransmissionCounts(data)(layer)
 
 
-def _cosine(wi: np.ndarray, layer) -> np.ndarray:
-    """``N.L`` per sample, with a channel axis when the layer is RGB."""
-    return wi[:, 2, None] if layer.channels else wi[:, 2]
+class TransmissionCounts:
+    """:func:`transmission_counts` at one data set's geometry for many layers (the cosines of
+    eq. 4 computed once); ``layer`` may be any object with the fields ``P_d``, ``P_t``, ``n``,
+    ``eta`` and ``channels``."""
+
+    def __init__(self, data: TransmissionData):
+        self._cosines = transmission_cosines(data.wi, data.wt)
+        self._n_dot_l = data.wi[:, 2]
+
+    def __call__(self, layer) -> np.ndarray:
+        n_dot_h, v_dot_h, crossing = (channel_axis(c, layer) for c in self._cosines)
+        value = ts_transmission_from_cosines(n_dot_h, v_dot_h, layer)
+        return np.where(crossing, value, 0.0) * channel_axis(self._n_dot_l, layer)
 
 
 def profile_ratio(distance_mm, dipole: Dipole) -> np.ndarray:

@@ -16,6 +16,7 @@ Functions
 ---------
 - :func:`step_angles` -- the paper's signed sampling of alpha or beta (degrees).
 - :func:`in_plane_direction` -- unit vector at a signed in-plane angle (degrees).
+- :func:`tilted` -- directions seen from a sample tilted in the plane (an offset of alpha).
 - :func:`reflection_geometry` -- directions of given samples alpha at relative angle psi.
 - :func:`transmission_geometry` -- directions of given samples theta_t at incidence theta_i.
 - :func:`reflection_sweep` -- geometry of a reflection experiment at relative angle psi.
@@ -33,6 +34,7 @@ __all__ = [
     "STEP_RULE",
     "step_angles",
     "in_plane_direction",
+    "tilted",
     "ReflectionSweep",
     "TransmissionSweep",
     "reflection_geometry",
@@ -64,6 +66,20 @@ def in_plane_direction(angle_deg) -> np.ndarray:
     """Unit vectors ``(..., 3)`` in the x-z plane at signed angle ``angle_deg`` from +z."""
     a = np.radians(np.asarray(angle_deg, float))
     return np.stack([np.sin(a), np.zeros_like(a), np.cos(a)], axis=-1)
+
+
+def tilted(w, tilt_deg: float) -> np.ndarray:
+    """Directions ``w`` ``(..., 3)`` in the frame of a sample tilted by ``tilt_deg`` (degrees)
+    about the y axis: every signed in-plane angle grows by ``tilt_deg``.  In the reflection
+    protocol this is an offset of alpha (``theta_i`` and ``theta_r`` both grow); for in-plane
+    rows (light at ``theta_i``, camera at ``theta_o`` on the other side) the sample sees
+    ``theta_i + tilt`` and ``theta_o - tilt``, so its mirror direction lies at
+    ``theta_o = theta_i + 2 tilt``."""
+    w = np.asarray(w, dtype=float)
+    a = np.radians(float(tilt_deg))
+    c, s = np.cos(a), np.sin(a)
+    x, z = w[..., 0], w[..., 2]
+    return np.stack([x * c + z * s, w[..., 1], z * c - x * s], axis=-1)
 
 
 @dataclass(frozen=True)

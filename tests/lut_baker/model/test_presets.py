@@ -123,8 +123,8 @@ def test_measured_foundations_come_from_the_shipped_file():
         assert set(entry["film"]) == {"P_s", "n", "eta"}
         if finish == "matte":
             assert entry["film"]["P_s"] == 0.0
-        else:
-            assert entry["film"]["P_s"] > 0 and 0.1 < entry["film"]["n"] < 0.4
+        else:  # a lobe 1/e at 1 to 10 degrees of alpha (105: 6.0, 112: 2.1)
+            assert entry["film"]["P_s"] > 0 and 0.1 < entry["film"]["n"] < 1.0
     # The measured products' red is brighter than their blue: absorption rises to blue.
     for name in MEASURED:
         absorption = presets.FOUNDATIONS[name]["absorption"]

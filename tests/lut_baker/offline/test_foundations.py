@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from lut_baker.offline import foundations as FD
+from lut_baker.offline.measured.inplane_fit import FitModel
 
 DATA = Path(__file__).parents[3] / "data" / "lanza2024"
 HEADER = "theta_i_deg,theta_o_deg,measured_R,measured_G,measured_B,model_R,model_G,model_B"
@@ -33,6 +34,12 @@ def test_an_analysis_fits_all_and_alternate_incidences(matte):
     assert set(matte.misses) == set(matte.split[0] + matte.split[1])
     rms, worst = matte.fit.error()
     assert 0.0 < rms < worst < 1.0  # the matte product is within tens of percent
+    # The well-posed form of a matte product: P_d alone, reached from the full eq. 2 with
+    # the tilt; every form tried is also fitted to alternate incidences.
+    models = [fits.fit_model for fits, _ in matte.choice.steps]
+    assert models[0] == FitModel() and models[-1] == FitModel(lobe=False, tilt=False)
+    assert [h.fit_model for h in matte.held_out_steps] == models
+    assert matte.untilted is None and matte.fit.tilt is None
 
 
 def test_the_csv_has_the_exact_header_and_the_measured_rows(matte, tmp_path):
@@ -50,7 +57,8 @@ def test_the_figure_has_points_and_curves_per_incidence(matte):
     figure = FD.product_figure(matte)
     gids = {line.get_gid() for line in figure.axes[0].lines if line.get_gid()}
     for incidence in (20, 30, 40, 50, 60, 70):
-        assert {f"model theta_i={incidence}", f"measured theta_i={incidence}"} <= gids
+        assert {f"model theta_i={incidence}", f"measured theta_i={incidence}",
+                f"not determined theta_i={incidence}"} <= gids
 
 
 def test_the_report_has_each_products_numbers(matte):
@@ -59,6 +67,13 @@ def test_the_report_has_each_products_numbers(matte):
     assert "## clarins_103 (matte)" in text and "NOTE 103" in text
     assert "## Conclusions" in text and "THE END" in text
     assert text.count("| R |") == 1 and text.count("| 70° |") == 1
+    # The forms tried, each with its errors, tilt, starts and checks; the chosen one marked.
+    rows = [line for line in text.splitlines() if line.startswith(("| eq. 2", "| P_d alone"))]
+    assert len(rows) == len(matte.choice.steps)
+    assert rows[0].startswith("| eq. 2 (P_d, P_s, n, eta per channel) + tilt |")
+    assert "(at bound)" in rows[0] and "**failed**: the tilt ran to its bound" in rows[0]
+    assert rows[-1].startswith("| P_d alone (no lobe) |") and rows[-1].endswith("**chosen** |")
+    assert "Chosen form: P_d alone (no lobe)." in text
 
 
 def test_the_report_lists_the_derived_presets(matte):

@@ -15,7 +15,7 @@ from lut_baker.offline import own_foundation as O
 from lut_baker.offline.foundation_presets import auto_finish
 from lut_baker.offline.foundations import PRODUCTS
 from lut_baker.offline.measured.inplane import read_inplane
-from lut_baker.offline.measured.inplane_fit import fit_channels
+from lut_baker.offline.measured.inplane_fit import well_posed
 
 DATA = Path(__file__).parents[3] / "data" / "lanza2024"
 
@@ -32,7 +32,7 @@ def _assert_same_film_as_preset(skin, product):
             np.testing.assert_allclose(getattr(getattr(skin, name), key), value, rtol=1e-6)
 
 
-@pytest.mark.slow  # fit, then the film derived by quadrature (~3-5 s)
+@pytest.mark.slow  # well-posed fit, then the film derived by quadrature (~10-20 s)
 @pytest.mark.parametrize(("product", "finish"), [("clarins_105", "dewy"),
                                                  ("clarins_108", "matte")])
 def test_a_product_file_gives_its_shipped_preset(tmp_path, product, finish):
@@ -62,15 +62,17 @@ def test_a_product_params_file_bakes(tmp_path):
     np.testing.assert_allclose(tables.parameters["absorption"], skin.absorption)
 
 
-@pytest.mark.slow  # four products fitted per channel (~2-4 s)
+@pytest.mark.slow  # four products fitted in their well-posed forms (~20-30 s)
 def test_auto_finish_reproduces_the_published_finishes():
-    """The rule ``--finish auto`` applies (foundation_presets.auto_finish, on the fits
-    fit_own_foundation makes) gives each product its published finish."""
+    """The rule ``--finish auto`` applies (foundation_presets.auto_finish, on the well-posed
+    fits fit_own_foundation makes) gives each product its published finish: the matte ones
+    keep no lobe, the dewy ones a lobe in every channel."""
     for name, (filename, finish) in PRODUCTS.items():
         data = read_inplane(DATA / filename)
-        fits = fit_channels(data.theta_i_deg, data.theta_o_deg, data.rgb)
-        decided, why = auto_finish(fits.fits)
+        choice = well_posed(data.theta_i_deg, data.theta_o_deg, data.rgb)
+        decided, why = auto_finish(choice.fit.fits)
         assert decided == finish, (name, why)
+        assert choice.model.lobe == (finish == "dewy"), (name, choice.summary())
 
 
 def test_a_bad_finish_is_refused(tmp_path):

@@ -58,6 +58,8 @@ def test_cli_fit_round_trip_toml(synthesized, tmp_path, capsys, kind, file, laye
     assert document["fit"]["warnings"] == [] and captured.err == ""
     n = len(document["fit"]["free"])
     assert np.array(document["fit"]["correlation"]).shape == (n, n)
+    starts = document["fit"]["starts"]  # every start ended in the one minimum
+    assert starts["reached"] == starts["count"] >= 3 and "next_excess" not in starts
 
 
 def test_cli_transmission_warns_and_strict_fails(synthesized, tmp_path, capsys):
@@ -117,7 +119,8 @@ _GOOD_ROWS = "".join(f"30\t{o}\t0.5\t0.4\t0.3\n" for o in (0, 10, 20, 30, 40))
     ("cell.txt", _GOOD_ROWS + "30\t50\tgrey\t0.4\t0.3\n", "cell.txt: line 6, column 3: "
                                                            "not a number"),
     ("empty.txt", "# nothing\n", "empty.txt: no data rows"),
-    ("few.txt", "30\t0\t0.5\t0.4\t0.3\n", "few.txt: a reflection fit needs at least 5"),
+    ("few.txt", "30\t0\t0.5\t0.4\t0.3\n", "few.txt: a joint reflection fit of 3 data sets "
+                                          "needs at least 14 samples, got 3"),
     ("apart.txt", _GOOD_ROWS + "30\t-30\t0.5\t0.4\t0.3\n", "apart.txt: theta_i + theta_o "
                                                             "must be > 0"),
 ])
@@ -179,10 +182,13 @@ def test_cli_inplane_product_warns_and_strict_exits_3(tmp_path, capsys):
     shipped = FOUNDATIONS["clarins_103"]  # matte: auto finds no lobe, so no gloss
     np.testing.assert_allclose(skin.absorption, shipped["absorption"], rtol=1e-6)
     assert float(skin.film.P_s) == shipped["film"]["P_s"] == 0.0
-    assert "finish: matte (auto: R: n ended at its bound" in captured.out
+    assert "finish: matte (auto: the data determine no lobe; P_d alone (no lobe); reduced " \
+           "from eq. 2 (P_d, P_s, n, eta per channel) + tilt (the tilt ran to its bound" \
+           in captured.out
     warnings = captured.err.splitlines()
     assert warnings and all(line.startswith("warning: ") for line in warnings)
-    assert "warning: R: n ended at its bound" in captured.err
+    # P_d alone describes the blue channel to 29% (log residual): beyond the 20% limit.
+    assert "warning: B: the residual rms" in captured.err
     # Each warning is also a comment of the file.
     for line in warnings:
         assert f"#   {line.removeprefix('warning: ')}" in captured.out

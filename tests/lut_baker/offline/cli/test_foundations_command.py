@@ -18,7 +18,7 @@ def test_the_command_is_registered():
     assert COMMANDS["foundations"] == ".foundations_command"
 
 
-@pytest.mark.slow  # four products fitted twice and drawn (~13 s)
+@pytest.mark.slow  # four products fitted in every form tried, held out, derived, drawn (~70 s)
 def test_the_command_writes_the_csvs_figures_and_report(tmp_path, capsys):
     out = tmp_path / "foundations"
     stored = tmp_path / "presets.json"

@@ -97,10 +97,11 @@ def test_round_trip_median_error_within_target(round_trips, name):
         assert median <= TARGETS[parameter], f"{name} {parameter}: median {median:.3%}"
 
 
-@pytest.mark.parametrize("name", sorted(TRUTH))
+@pytest.mark.parametrize("name", sorted(set(TRUTH) - {"film transmission"}))
 def test_round_trip_errors_match_reported_standard_errors(round_trips, name):
     """The covariance is honest: no error beyond 4 standard errors, and the errors' spread in
-    standard-error units is about 1 (neither hidden nor inflated)."""
+    standard-error units is about 1 (neither hidden nor inflated).  (Transmission with eta
+    free has two minima the data do not choose between: test_transmission_flags_eta.)"""
     for parameter in _fitted_parameters(round_trips, name):
         z = np.array([errors[parameter] / stderr[parameter]
                       for _, errors, stderr in round_trips[name]])
@@ -123,10 +124,22 @@ def test_paper_protocols_raise_no_warning(round_trips):
 
 
 def test_transmission_flags_eta(round_trips):
-    """Eta enters transmission only through F_t = 1 - F_r (about 1% here): the fit says so."""
+    """Eta enters transmission only through F_t = 1 - F_r (about 1% here): the fit says so.
+    Its starts end in two minima, near the true eta and near eta = 3, whose chi-squares differ
+    by less than the noise: every fit names the rival (its covariance describes one basin)."""
     for result, _, _ in round_trips["film transmission"]:
-        assert result.warnings and all(w.startswith("eta ") for w in result.warnings)
+        assert result.warnings and all(w.startswith(("eta ", "another minimum"))
+                                       for w in result.warnings)
+        assert any(w.startswith("another minimum") for w in result.warnings)
+        assert result.starts.reached < result.starts.count
         assert result.relative_stderr["eta"] > 0.10
+    counts = {"film reflection": len(F.ETA_STARTS) + 1, "skin reflection": len(F.ETA_STARTS) + 1,
+              "film transmission, eta fixed": F.N_GRID_PARTS + 1, "skin dipole": None}
+    for name, count in counts.items():  # the others: every start ends in the same minimum
+        for result, _, _ in round_trips[name]:
+            assert result.starts.reached == result.starts.count >= 3, name
+            assert count is None or result.starts.count == count, name
+            assert result.starts.spread < 1e-4 and result.starts.next_excess is None
 
 
 # --------------------------------------------------------------------------------------------
@@ -242,3 +255,102 @@ def test_poor_start_is_poor():
     assert float(start.n) == pytest.approx(3 * float(FILM.n))
     assert float(start.eta) == 1.5
     assert float(F.poor_start(DIPOLE).sigma_a) == pytest.approx(float(DIPOLE.sigma_a) / 3)
+
+
+# --------------------------------------------------------------------------------------------
+# Several data sets at once, the tilt, no lobe
+# --------------------------------------------------------------------------------------------
+CHANNEL_LAYERS = (FILM.scaled(P_d=1.3, P_s=0.8), FILM, FILM.scaled(P_d=0.6, P_s=1.2))
+
+
+def _channels(tilt_deg, noise, seed, layers=CHANNEL_LAYERS):
+    geometry = M.synthesize_reflection(FILM, (60.0, 120.0), noise=0.0)
+    rng = np.random.default_rng(seed)
+    return [M.ReflectionData(geometry.psi_deg, geometry.alpha_deg,
+                             M.reflection_counts(geometry, layer, tilt_deg)
+                             * (1.0 + noise * rng.standard_normal(geometry.psi_deg.size)))
+            for layer in layers]
+
+
+def test_a_shared_tilt_is_fitted_with_its_standard_error():
+    joint = F.fit_reflection_sets(_channels(1.2, NOISE, 3), tilt=True)
+    tilt, stderr = joint.nuisance[F.TILT]
+    assert 0.0 < stderr < 0.1 and abs(tilt - 1.2) < 4 * stderr
+    assert joint.labels == ("R", "G", "B") and joint.names[-1] == F.TILT
+    assert joint.names[:4] == ("R.P_d", "R.P_s", "R.n", "R.eta")
+    assert joint.starts.count == len(F.ETA_STARTS) * len(F.TILT_STARTS_DEG)
+    assert joint.starts.reached == joint.starts.count and not joint.warnings
+    for fit, truth in zip(joint.fits, CHANNEL_LAYERS, strict=True):
+        assert fit.derived[F.TILT] == (tilt, stderr) and fit.ok
+        errors = F.relative_errors(fit.params, truth)
+        assert abs(errors["n"]) < 0.05 and abs(errors["P_s/P_d"]) < 0.10
+    # Untilted data, tilt fitted: zero within its error; exact data give the truth.
+    exact = F.fit_reflection_sets(_channels(0.0, 0.0, 0), tilt=True)
+    assert abs(exact.nuisance[F.TILT][0]) < 1e-8
+    for fit, truth in zip(exact.fits, CHANNEL_LAYERS, strict=True):
+        assert all(abs(e) < 1e-7 for e in F.relative_errors(fit.params, truth).values())
+
+
+def test_without_lobe_only_P_d_is_fitted():
+    data = _channels(0.0, NOISE, 5, [FILM.scaled(P_s=0.0)] * 3)
+    joint = F.fit_reflection_sets(data, lobe=False)
+    assert joint.starts.count == 1  # linear in log P_d: the start is the solution
+    for fit, one in zip(joint.fits, data, strict=True):
+        assert fit.free == ("P_d",) and float(fit.params.P_s) == 0.0
+        # Least squares in log: the geometric mean of measured over the unit diffuse signal.
+        unit = M.reflection_counts(one, FILM.scaled(P_d=1.0 / float(FILM.P_d), P_s=0.0))
+        expected = np.exp(np.mean(np.log(one.intensity_counts / unit)))
+        assert float(fit.params.P_d) == pytest.approx(expected, rel=1e-12)
+        assert fit.relative_stderr["P_d"] == pytest.approx(NOISE / np.sqrt(unit.size), rel=0.2)
+
+
+def test_joint_data_sets_must_share_their_geometry():
+    one = M.synthesize_reflection(FILM, noise=0.0)
+    other = M.synthesize_reflection(FILM, (60.0,), noise=0.0)
+    with pytest.raises(ValueError, match="share their geometry"):
+        F.fit_reflection_sets([one, other])
+    with pytest.raises(ValueError, match="2 labels for 3 data sets"):
+        F.fit_reflection_sets([one] * 3, labels=("a", "b"))
+
+
+# --------------------------------------------------------------------------------------------
+# Determined by the data: a 1e-9 change of the data moves the fit by about as much
+# --------------------------------------------------------------------------------------------
+def _perturbed(data, size=1e-9, seed=0):
+    """``data`` with its measured column times ``1 + size s``, ``s`` a fixed +-1 pattern."""
+    columns = [getattr(data, name) for name in data.COLUMNS]
+    sign = np.random.default_rng(seed).choice([-1.0, 1.0], columns[-1].size)
+    return type(data)(*columns[:-1], columns[-1] * (1.0 + size * sign))
+
+
+def _values(fit):
+    values = {name: float(getattr(fit.params, name)) for name in fit.free}
+    values.update({name: value for name, (value, _) in fit.derived.items()})
+    return values
+
+
+@pytest.mark.parametrize(("name", "fit"), [
+    ("film_reflection", F.fit_reflection),
+    ("film_transmission", F.fit_transmission),
+    ("film_transmission", lambda data: F.fit_transmission(data, eta=1.19)),
+    ("skin_reflection", F.fit_reflection),
+    ("skin_profile", F.fit_dipole),
+    ("skin_profile", lambda data: F.fit_dipole(data, free_scale=True)),
+])
+def test_the_fits_are_determined_by_their_data(name, fit):
+    """Every fitted value moves by less than 1e-6 (relative) when the data move by 1e-9 (it
+    moves by about 1e-9: the optimum is polished to that)."""
+    data = M.paper_protocols(NOISE, 8)[name]
+    reference, moved = _values(fit(data)), _values(fit(_perturbed(data)))
+    for key, value in reference.items():
+        assert abs(moved[key] / value - 1.0) < 1e-6, (key, value, moved[key])
+
+
+def test_a_joint_tilted_fit_is_determined_by_its_data():
+    data = _channels(1.2, NOISE, 4)
+    reference = F.fit_reflection_sets(data, tilt=True)
+    moved = F.fit_reflection_sets([_perturbed(d, seed=s) for s, d in enumerate(data)], tilt=True)
+    assert abs(moved.nuisance[F.TILT][0] - reference.nuisance[F.TILT][0]) < 1e-6
+    for a, b in zip(reference.fits, moved.fits, strict=True):
+        for key, value in _values(a).items():
+            assert abs(_values(b)[key] / value - 1.0) < 1e-6, key

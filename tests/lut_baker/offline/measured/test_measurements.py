@@ -79,3 +79,18 @@ def test_csv_problems_raise_one_line(tmp_path, text, message):
     with pytest.raises(ValueError, match=message) as info:
         M.read_measurements(path)
     assert "\n" not in str(info.value) and str(path) in str(info.value)
+
+
+def test_a_tilted_sample_reflects_f_r_at_the_offset_alpha_with_the_nominal_cosine():
+    data = M.synthesize_reflection(FILM, noise=0.0)
+    tilt = 1.7
+    shifted = M.ReflectionData(data.psi_deg, data.alpha_deg + tilt, data.intensity_counts)
+    expected = M.reflection_counts(shifted, FILM) * data.wi[:, 2] / shifted.wi[:, 2]
+    np.testing.assert_allclose(M.reflection_counts(data, FILM, tilt), expected, rtol=1e-12)
+    # One model for many layers and tilts gives what the one-off function gives.
+    model = M.ReflectionCounts(data)
+    for value in (0.0, tilt, -0.5, tilt):
+        np.testing.assert_array_equal(model(FILM, value), M.reflection_counts(data, FILM, value))
+    transmission = M.synthesize_transmission(FILM_T, noise=0.0)
+    np.testing.assert_array_equal(M.TransmissionCounts(transmission)(FILM_T),
+                                  M.transmission_counts(transmission, FILM_T))

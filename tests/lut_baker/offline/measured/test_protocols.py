@@ -49,3 +49,14 @@ def test_bad_geometry_is_a_clear_error(call, message):
 def test_profile_distances_include_both_ends():
     d = protocols.profile_distances(1.0, 0.25)
     np.testing.assert_allclose(d, [0.0, 0.25, 0.5, 0.75, 1.0])
+
+
+def test_a_tilt_adds_to_every_in_plane_angle_and_offsets_alpha():
+    angles = np.array([-40.0, 0.0, 25.0, 80.0])
+    np.testing.assert_allclose(protocols.tilted(protocols.in_plane_direction(angles), 1.5),
+                               protocols.in_plane_direction(angles + 1.5), atol=1e-15)
+    # In the reflection protocol a tilted sample is one rotated further: alpha + tilt.
+    sweep = protocols.reflection_geometry(60.0, np.array([-10.0, 0.0, 7.0]))
+    shifted = protocols.reflection_geometry(60.0, sweep.alpha_deg + 2.0)
+    np.testing.assert_allclose(protocols.tilted(sweep.wi, 2.0), shifted.wi, atol=1e-15)
+    np.testing.assert_allclose(protocols.tilted(sweep.wo, 2.0), shifted.wo, atol=1e-15)
