@@ -111,11 +111,21 @@ def _skin(name):
     return presets.made_up_skin(foundation, skin, coverage=coverage)
 
 
+SEARCH_DIAGNOSTICS = "/starts/"
+"""A measurement fit's account of its starts (how many reached the best cost, how far their
+ends spread, the next minimum's excess) describes the search, not the result: the spread is
+the noise of nearly equal ends (about 1e-9, moving by its own size between processors).  Left
+out of the set; the fitted values and their uncertainties are in it."""
+
+
 def reduce(name: str, value):
-    """What is stored of a quantity (module docstring): ``{stored name: value}``."""
+    """What is stored of a quantity (module docstring): ``{stored name: value}``; nothing of
+    the searches' diagnostics (:data:`SEARCH_DIAGNOSTICS`)."""
+    if SEARCH_DIAGNOSTICS in name:
+        return {}
     parts = name.split("/")
     angular = parts[0] == "tables" and parts[2] == "default" and parts[-1] in (
-        "film_gloss", "path3_gloss", "skin_gloss")
+        "path3_gloss", "inter_reflection")
     if not (angular and is_numeric(value)):
         return {name: value}
     s = ANGULAR_STRIDE
