@@ -106,9 +106,7 @@ def test_the_auto_tier_keeps_its_choices_for_the_paper_traits():
 def test_what_the_fits_ship_moves_less_than_the_limit(case):
     worst = fit_audit.fit_movement(case, seeds=(0,))
     assert any(name.startswith("fit_of_tables/") for name in worst)
-    too_far = {name: value for name, value in worst.items()
-               if value >= (fit_audit.DIAGNOSTIC_LIMIT if name.endswith(fit_audit.DIAGNOSTIC)
-                            else LIMIT)}
+    too_far = {name: value for name, value in worst.items() if value >= LIMIT}
     assert not too_far, too_far
 
 

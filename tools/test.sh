@@ -9,20 +9,25 @@
 # 2. If MAKEUP_SKIN_BLENDER_LINES (default "5.0 4.5") names 4.5: the Blender-side tests,
 #    `pytest -q -m bpy`, on the 4.5 LTS venv.
 # Venvs come from tools/venv.sh (built once, then cached). Exits non-zero on any failure,
-# including a pytest run that collects no test (exit 5). Each pytest run is limited to
-# MAKEUP_SKIN_PYTEST_TIMEOUT seconds (default 1200) so that a hung Blender cannot stall CI.
+# including a pytest run that collects no test (exit 5). Each pytest run prints its wall time
+# and is limited to MAKEUP_SKIN_PYTEST_TIMEOUT seconds (default 2700) so that a hung Blender
+# cannot stall CI: the whole of this script takes about 8 minutes on a quiet 2-core machine
+# (docs/architecture.md, "Tests"), so the limit leaves room for a machine four times slower
+# and busy, and the whole CI run (90 minutes) for both Blender lines.
 set -euo pipefail
 
 repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$repo"
 lines="${MAKEUP_SKIN_BLENDER_LINES:-5.0 4.5}"
-limit="${MAKEUP_SKIN_PYTEST_TIMEOUT:-1200}"
+limit="${MAKEUP_SKIN_PYTEST_TIMEOUT:-2700}"
 
 run_pytest() { # run_pytest <venv> <label> <pytest args...>
     local venv="$1" label="$2" rc=0
     shift 2
     echo "== [$label] pytest $*"
+    local began=$SECONDS
     timeout --kill-after=30 "$limit" "$venv/bin/python" -m pytest "$@" || rc=$?
+    echo "== [$label] pytest took $((SECONDS - began)) s (limit $limit s)"
     case $rc in
         0) ;;
         5) echo "== [$label] FAILED: pytest collected no test" >&2 ;;

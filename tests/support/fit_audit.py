@@ -35,8 +35,8 @@ from lut_baker.model import presets
 
 from .perturbation import movement, perturbed
 
-__all__ = ["CASES", "FAST_CASES", "case_skin", "case_tables", "case_fit", "criterion",
-           "DIAGNOSTIC", "DIAGNOSTIC_LIMIT", "fit_movement",
+__all__ = ["CASES", "case_skin", "case_tables", "case_fit", "criterion",
+           "fit_movement",
            "SearchRecorder", "recorded_searches", "decision_margins", "count_margin",
            "distribution_margin",
            "SCENES", "choice_margins"]
@@ -51,18 +51,6 @@ CASES = {
 }
 """Audited skins: ``name -> (foundation, skin, coverage)``; the measured products on the
 paper's bio-plate."""
-FAST_CASES = ("paper", "medium_beige+jensen_skin1", "clarins_103", "clarins_108")
-"""The cases whose preview tables fit in about a second (the narrow-gloss products, 105 and
-112, scale the grids up 3-4x and take 5-14 s)."""
-DIAGNOSTIC = "errors/PRINCIPLED/albedo"
-"""The one output that moves by more than 1e-6 (up to 2.5e-6, absolute, for the measured
-matte products): the Principled tier's largest view-albedo error, a figure the panel reports
-and no render uses.  The presets sit at coverage 1, where it changes 2600 times as fast as
-the coverage: a coverage 1e-9 lower brings in the bare skin's specular lobe (Specular IOR
-Level 1e-9 of its fitted 0.72) and that figure, taken at an 89-degree view, moves by 2.6e-6;
-with that lobe's level at 0 it moves by 4e-10.  Cycles' closure, not a fit.  Held to
-:data:`DIAGNOSTIC_LIMIT`."""
-DIAGNOSTIC_LIMIT = 1e-5
 ABSOLUTE = ("error", "max_error", "rms", "albedo")
 """Last name parts of error measures (relative RMS, largest albedo error, edge-response
 error): their movement is absolute (:func:`criterion`)."""
