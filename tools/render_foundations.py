@@ -3,7 +3,7 @@
 Usage::
 
     "$(tools/venv.sh)/bin/python" tools/render_foundations.py [--out docs/renders/foundations]
-        [--sphere-size 144 --character-size 224 --samples 64 --resolution preview]
+        [--sphere-size 144 --character-size 224 --samples 64 --resolution default]
 
 One process, Cycles CPU, view transform Standard, no denoiser, coverage 1, tier Layered.
 Writes two grids to ``--out`` (rows: the skins of ``presets.SKINS``, top to bottom
@@ -14,9 +14,8 @@ white gaps, no text):
 - ``spheres.png`` -- the reference sphere of ``tools/render_sphere.py`` (30 mm radius,
   orthographic camera, one sun ``--light-deg`` from the view, black world), each product
   baked here on each skin, Skin Color set to the skin's albedo as the panel does
-  (``--resolution`` tables, "preview" by default: on "default" tables the closure fit of the
-  glossiest product, clarins_112, takes about a minute and 10 GB, which would put the script
-  far over three minutes);
+  (``--resolution`` tables, "default" by default: every product bakes and fits in well under a
+  second, whatever its gloss);
 - ``character.png`` -- the textured head of ``tests/support/character.py`` after Apply with
   each product, the panel's skin set to each skin, as ``tools/render_character.py --skin``
   does: the head's albedo texture stays linked to Skin Color, so the skin preset changes the
@@ -189,11 +188,9 @@ def main(argv=None) -> int:
     parser.add_argument("--samples", type=int, default=64, help="Cycles samples, default 64")
     parser.add_argument("--light-deg", type=float, default=45.0,
                         help="spheres: angle between light and view direction, default 45")
-    parser.add_argument("--resolution", default="preview",
+    parser.add_argument("--resolution", default="default",
                         choices=("preview", "default", "high"),
-                        help="tables baked for the spheres and by Apply, default 'preview' (on "
-                             "'default' tables the closure fit of clarins_112 alone takes "
-                             "~60 s and ~10 GB)")
+                        help="tables baked for the spheres and by Apply, default 'default'")
     parser.add_argument("--skip-spheres", action="store_true", help="no spheres.png")
     parser.add_argument("--skip-character", action="store_true", help="no character.png")
     parser.add_argument("--seed", type=int, default=0, help="texture and Cycles seed")
