@@ -4,7 +4,7 @@
     python bench/bake.py --study              # convergence study (markdown tables)
     python bench/bake.py --study --write-docs # ... and put them into docs/baking.md
 
-Errors are those of :func:`lut_baker.table_accuracy.table_error`: the largest of
+Errors are those of :func:`lut_baker.offline.validation.table_accuracy.table_error`: the largest of
 ``|table - exact| / max(|exact|, 0.1 peak)`` over 500 random points (20% with theta_i and 20% with
 both angles in the grazing rows 80..89 degrees), so <= 1e-3 meets "1e-3 relative or 1e-4 of the
 peak, whichever is larger".  The machine is shared: timings are medians, and ratios measured in

@@ -30,7 +30,6 @@ Functions
 - :func:`principled_reflection` -- the Principled BSDF's coat, specular and diffuse layers
   (``svm_node_closure_bsdf``), for the inputs in :class:`PrincipledInputs`.
 - :func:`burley_profile` -- Christensen-Burley radial profile as Cycles scales it.
-- :func:`burley_radius_for_length` -- the Subsurface Radius giving a Burley shape length ``d``.
 - :func:`random_walk_scale` -- the measured radius factor that makes a Burley profile match a
   random walk's (Cycles' random walk is a Monte Carlo simulation with no closed form).
 - :func:`subsurface_profile` -- the profile of any of Blender's three methods.
@@ -80,7 +79,6 @@ __all__ = [
     "PrincipledInputs",
     "principled_reflection",
     "burley_profile",
-    "burley_radius_for_length",
     "BURLEY_MFP_SCALE",
     "RANDOM_WALK_BURLEY_SCALE",
     "random_walk_scale",
@@ -507,11 +505,6 @@ def burley_profile(r_mm, radius_mm):
     value = (np.exp(-r_safe / d) + np.exp(-r_safe / (3.0 * d))) / (8.0 * np.pi * d * r_safe)
     cdf = 1.0 - 0.25 * np.exp(-BURLEY_TRUNCATE) - 0.75 * np.exp(-BURLEY_TRUNCATE / 3.0)
     return np.where(r < BURLEY_TRUNCATE * d, value / cdf, 0.0)
-
-
-def burley_radius_for_length(d_mm):
-    """The Subsurface Radius x Scale (mm) whose Burley shape length is ``d_mm``."""
-    return np.asarray(d_mm, float) / BURLEY_MFP_SCALE
 
 
 RANDOM_WALK_BURLEY_SCALE = {

@@ -18,14 +18,15 @@ Functions
 - :func:`layered_reflection` -- ``f_cs`` (paper eq. 7, docs/model.md §3) at given directions.
 - :func:`layered_reflection_converged` -- the same, refined until two levels agree.
 - :func:`transmission_factor` -- path 4's angular factor (paper eq. 8, docs/model.md §3).
-- :func:`film_transmittance` -- ``Int f_t(w, -u) cos(theta_u) du``, the film's directional
-  transmittance.
-- :func:`reflection_albedo` -- ``Int f_r(wi, wo) cos(theta_o) dwo`` of a reflecting layer.
-- :func:`layered_fourier_matrices` -- the per-order matrices of ``f_cs`` between two polar grids.
-- :func:`layer_fourier_kernel` -- cosine coefficients of one layer's kernel (the default
-  ``fourier`` of the matrix functions; a faster one with the same signature may be passed).
-- :func:`inner_matrices`, :func:`transmission_rows` -- the skin bounce and the film crossings
-  of those matrices.
+- :func:`layered_fourier_matrices` -- the per-order matrices of ``f_cs`` between two polar grids
+  (the layers' kernels from :func:`lut_baker.model.albedo.layer_fourier_kernel` by default; a
+  faster one with the same signature may be passed as ``fourier``).
+- :func:`inter_reflection_fourier_matrices` -- the adding equation's terms beyond path 3.
+- :func:`inner_matrices` -- the skin bounce of those matrices (the film's crossings are
+  :func:`lut_baker.model.albedo.transmission_rows`).
+
+The single layer's integrals (its albedo, the film's transmittance) are in
+:mod:`lut_baker.model.albedo`.
 """
 
 from __future__ import annotations

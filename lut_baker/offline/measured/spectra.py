@@ -12,7 +12,6 @@ white point, so a last per-channel scale (a few parts in 10^4) makes the perfect
 Functions
 ---------
 - :data:`WAVELENGTHS_NM` -- the measured grid, 380..780 nm in 5 nm steps (81 samples).
-- :func:`rgb_weights` -- the ``(81, 3)`` matrix: spectrum rows times it give linear RGB.
 - :func:`spectra_to_rgb` -- reflectance spectra ``(..., 81)`` to linear Rec.709 RGB ``(..., 3)``.
 - :func:`luminance` -- Rec.709 luminance ``Y`` of linear RGB.
 """
@@ -23,7 +22,7 @@ from functools import lru_cache
 
 import numpy as np
 
-__all__ = ["WAVELENGTHS_NM", "REC709_LUMINANCE", "rgb_weights", "spectra_to_rgb", "luminance"]
+__all__ = ["WAVELENGTHS_NM", "REC709_LUMINANCE", "spectra_to_rgb", "luminance"]
 
 WAVELENGTHS_NM = np.linspace(380.0, 780.0, 81)
 """Wavelengths (nm) of the spectral columns: 380, 385, ..., 780."""
@@ -68,12 +67,6 @@ def _weights() -> np.ndarray:
     to_rgb = to_rgb / np.sum(to_rgb, axis=0)  # white reflector -> (1, 1, 1) exactly
     to_rgb.setflags(write=False)
     return to_rgb
-
-
-def rgb_weights() -> np.ndarray:
-    """``(81, 3)`` weights: ``spectrum @ rgb_weights()`` is linear Rec.709 RGB; each column sums
-    to exactly 1 (module docstring)."""
-    return _weights()
 
 
 def spectra_to_rgb(spectra) -> np.ndarray:
