@@ -22,7 +22,8 @@ for Subsurface Light Transport", SIGGRAPH 2001.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import Field, dataclass, fields
+from typing import Any, cast
 
 import numpy as np
 
@@ -53,13 +54,18 @@ def check_parameter(name: str, value, low: float, high: float, *, low_open: bool
     return array
 
 
+def _fields(layer) -> tuple[Field, ...]:
+    """The dataclass fields of a layer (every subclass of :class:`Layer` is a dataclass)."""
+    return fields(cast(Any, layer))
+
+
 class Layer:
     """Shared behaviour of the parameter types: validation and channel shape."""
 
     _ranges: dict[str, tuple[float, float, bool, bool]] = {}
 
     def __post_init__(self):
-        for field in fields(self):
+        for field in _fields(self):
             low, high, low_open, high_open = self._ranges[field.name]
             checked = check_parameter(
                 field.name, getattr(self, field.name), low, high,
@@ -70,26 +76,26 @@ class Layer:
     @property
     def channels(self) -> tuple[int, ...]:
         """``()`` when every field is scalar, ``(3,)`` when any is RGB."""
-        return (3,) if any(getattr(self, f.name).shape == (3,) for f in fields(self)) else ()
+        return (3,) if any(getattr(self, f.name).shape == (3,) for f in _fields(self)) else ()
 
     def channel(self, index: int):
         """The same layer restricted to one RGB channel (scalars stay as they are)."""
         values = {
             f.name: (v[index] if (v := getattr(self, f.name)).shape == (3,) else v)
-            for f in fields(self)
+            for f in _fields(self)
         }
         return type(self)(**values)
 
     def scaled(self, **factors):
         """A copy with the named fields multiplied by ``factors`` (scalar or RGB)."""
-        values = {f.name: getattr(self, f.name) for f in fields(self)}
+        values = {f.name: getattr(self, f.name) for f in _fields(self)}
         for name, factor in factors.items():
             values[name] = values[name] * np.asarray(factor, dtype=float)
         return type(self)(**values)
 
     def as_dict(self) -> dict:
         """Fields as plain floats or lists, for metadata and parameter files."""
-        return {f.name: getattr(self, f.name).tolist() for f in fields(self)}
+        return {f.name: getattr(self, f.name).tolist() for f in _fields(self)}
 
 
 _POSITIVE = (0.0, np.inf, True, True)
@@ -105,10 +111,10 @@ class ReflectionLayer(Layer):
     degrees); ``eta``: relative refractive index.
     """
 
-    P_d: object
-    P_s: object
-    n: object
-    eta: object
+    P_d: Any
+    P_s: Any
+    n: Any
+    eta: Any
 
     _ranges = {"P_d": _NON_NEGATIVE, "P_s": _NON_NEGATIVE, "n": _POSITIVE, "eta": _POSITIVE}
 
@@ -119,10 +125,10 @@ class TransmissionLayer(Layer):
     ``n`` (1/degree) around the straight-through direction, with Fresnel transmission at
     ``eta``."""
 
-    P_d: object
-    P_t: object
-    n: object
-    eta: object
+    P_d: Any
+    P_t: Any
+    n: Any
+    eta: Any
 
     _ranges = {"P_d": _NON_NEGATIVE, "P_t": _NON_NEGATIVE, "n": _POSITIVE, "eta": _POSITIVE}
 
@@ -133,10 +139,10 @@ class Dipole(Layer):
     asymmetry ``g`` in (-1, 1), relative refractive index ``eta`` >= 1 (the ``F_dr`` fit of
     eq. 6 holds for eta >= 1)."""
 
-    sigma_s: object
-    sigma_a: object
-    g: object = 0.0
-    eta: object = 1.3
+    sigma_s: Any
+    sigma_a: Any
+    g: Any = 0.0
+    eta: Any = 1.3
 
     _ranges = {
         "sigma_s": _NON_NEGATIVE,

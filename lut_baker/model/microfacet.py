@@ -96,7 +96,7 @@ def _angle_from_normal_deg(cos_angle: np.ndarray) -> np.ndarray:
 # --------------------------------------------------------------------------------------------
 # The terms of eqs. 2 and 4
 # --------------------------------------------------------------------------------------------
-def fresnel_term(c: np.ndarray, eta: np.ndarray) -> np.ndarray:
+def fresnel_term(c: np.ndarray | float, eta: np.ndarray | float) -> np.ndarray:
     """Unpolarised dielectric Fresnel reflectance ``F_r(c, eta)`` (paper eq. 2, dimensionless)
     at cosines ``c`` in [0, 1] and relative index ``eta`` > 0, without argument checks (for
     inner loops; :func:`fresnel_reflectance` checks).  Total internal reflection gives 1;
@@ -226,8 +226,9 @@ def ts_reflection(wi, wo, layer: ReflectionLayer, *, check: bool = True):
         wi = check_directions("wi", wi)
         wo = check_directions("wo", wo)
     n_dot_h, v_dot_h, n_dot_v, n_dot_l = reflection_cosines(wi, wo)
-    cosines = (channel_axis(x, layer) for x in (n_dot_h, v_dot_h, n_dot_v, n_dot_l))
-    value = ts_reflection_from_cosines(*cosines, layer)
+    value = ts_reflection_from_cosines(channel_axis(n_dot_h, layer), channel_axis(v_dot_h, layer),
+                                       channel_axis(n_dot_v, layer), channel_axis(n_dot_l, layer),
+                                       layer)
     upper = (n_dot_l >= 0.0) & (n_dot_v >= 0.0)
     return np.where(channel_axis(upper, layer), value, 0.0)
 

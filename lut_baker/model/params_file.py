@@ -31,6 +31,7 @@ Functions
 from __future__ import annotations
 
 import tomllib
+from dataclasses import fields
 from pathlib import Path
 
 import numpy as np
@@ -122,7 +123,7 @@ def _section(mapping: dict, name: str) -> dict:
     if not isinstance(section, dict):
         raise ValueError(f"[{name}] must be a table of fields")
     kind = LAYERS[SECTIONS[name]]
-    allowed = set(kind.__dataclass_fields__)
+    allowed = {f.name for f in fields(kind)}
     unknown = sorted(set(section) - allowed)
     if unknown:
         raise ValueError(f"[{name}] has unknown field(s) {unknown}; allowed: {sorted(allowed)}")
@@ -158,13 +159,13 @@ def params_from_mapping(mapping: dict) -> MadeUpSkin:
     units = mapping.get("units", "albedo")
     sections = {SECTIONS[name]: (name, _section(mapping, name)) for name in SECTIONS}
     if units == "counts":
-        layers = [_layer(LAYERS[field], *sections[field])
-                  for field in ("film", "film_transmission", "skin")]
+        film, film_transmission, skin = (_layer(LAYERS[field], *sections[field])
+                                         for field in ("film", "film_transmission", "skin"))
         dipole = _layer(Dipole, "dipole", {**base.dipole.as_dict(), **sections["dipole"][1]})
         shutters = {key: mapping[key] for key in ("reflection_shutter_s", "transmission_shutter_s")
                     if key in mapping}
-        base = from_paper_counts(*layers, dipole, **shutters, name=base.name,
-                                 absorption=base.absorption)
+        base = from_paper_counts(film, film_transmission, skin, dipole, **shutters,
+                                 name=base.name, absorption=base.absorption)
     elif units == "albedo":
         changed = {field: _layer(LAYERS[field], name, {**getattr(base, field).as_dict(), **values})
                    for field, (name, values) in sections.items() if values}

@@ -79,7 +79,9 @@ def gauss_legendre(points: int, start: float = 0.0, stop: float = 1.0,
     half = (stop - start) / 2.0 / panels
     mid = start + half * (2.0 * np.arange(panels) + 1.0)
     nodes = (mid[:, None] + half * x[None, :]).ravel()
-    return _read_only(nodes, np.tile(half * w, panels))
+    weights = np.tile(half * w, panels)
+    _read_only(nodes, weights)
+    return nodes, weights
 
 
 def midpoint_nodes(count: int, start: float, stop: float) -> np.ndarray:
@@ -120,7 +122,9 @@ def mirror_weighted_azimuths(count: int, power: int) -> tuple[np.ndarray, np.nda
     mirror azimuth ``pi`` (read-only arrays)."""
     s, w = gauss_legendre(count)
     weight = 2.0 * np.pi * power * s ** (power - 1) * w
-    return _read_only(np.cos(np.pi * (1.0 - s**power)), weight)
+    cos_phi = np.cos(np.pi * (1.0 - s**power))
+    _read_only(cos_phi, weight)
+    return cos_phi, weight
 
 
 @dataclass(frozen=True)

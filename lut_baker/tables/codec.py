@@ -36,6 +36,7 @@ Functions
 from __future__ import annotations
 
 import hashlib
+from typing import Any
 
 import numpy as np
 
@@ -172,7 +173,9 @@ def check_sidecar(meta, where: str) -> dict:
 def _grids(meta: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(theta_deg, phi_deg, radius_mm)`` of sidecar data."""
     grids = meta["grids"]
-    return tuple(np.asarray(grids[k], float) for k in ("theta_deg", "phi_deg", "radius_mm"))
+    theta, phi, radius = (np.asarray(grids[k], float) for k in ("theta_deg", "phi_deg",
+                                                              "radius_mm"))
+    return theta, phi, radius
 
 
 def _stored_angular_names(meta: dict) -> tuple[str, ...]:
@@ -203,8 +206,9 @@ def tables_from_atlas(pixels: np.ndarray, meta: dict) -> Tables:
     pixels = np.asarray(pixels, np.float32).astype(float)
     blocks = meta["layout"]
     n, p = theta.size, phi.size
-    arrays = {name: pixels[blocks[name]["row"]:blocks[name]["row"] + n, :n * p].reshape(
-        n, n, p, 3) for name in angular}
+    arrays: dict[str, Any] = {
+        name: pixels[blocks[name]["row"]:blocks[name]["row"] + n, :n * p].reshape(n, n, p, 3)
+        for name in angular}
     arrays.update({name: pixels[blocks[name]["row"], :blocks[name]["columns"]]
                    for name in DIRECTIONAL + RADIAL})
     constants = pixels[blocks["constants"]["row"], :len(CONSTANT)]

@@ -251,7 +251,7 @@ def _trilinear(table: np.ndarray, xi: np.ndarray, xo: np.ndarray, xp: np.ndarray
     i, ti = _corners(xi, table.shape[0])
     j, tj = _corners(xo, table.shape[1])
     k, tk = _corners(xp, table.shape[2])
-    out = 0.0
+    out = np.zeros(np.shape(ti) + table.shape[3:])
     for di, wi in ((0, 1.0 - ti), (1, ti)):
         for dj, wj in ((0, 1.0 - tj), (1, tj)):
             for dk, wk in ((0, 1.0 - tk), (1, tk)):
