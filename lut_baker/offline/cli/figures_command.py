@@ -4,7 +4,7 @@
 
 Writes the model curves of the paper's figs. 5, 7, 11, 13, 14 and 15 and a white-furnace chart
 (fig16, beyond the paper) to DIR as figNN_<name>.png (150 dpi, 6 x 4 in), with the paper's
-parameters (docs/model.md §5).  The README's figures are made with --out docs/figures.  Needs
+parameters (docs/model.md §5).  docs/figures.md's figures are made with --out docs/figures.  Needs
 matplotlib.
 """
 
