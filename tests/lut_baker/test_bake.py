@@ -146,6 +146,7 @@ def test_a_coarse_bake_fails_the_goal(paper, samples):
     assert table_accuracy.table_error(bake.bake(paper, coarse), samples=samples)["max"] > 1e-2
 
 
+@pytest.mark.slow  # exact albedos at many directions
 def test_directional_tables(default_tables, paper):
     theta = np.array([0.0, 33.0, 66.0, 88.0])
     w = direction(np.radians(theta), 0.0)
@@ -177,6 +178,7 @@ def test_radial_table(default_tables, paper):
                                dipole.dipole_total_reflectance(paper.dipole))
 
 
+@pytest.mark.slow  # exact albedos at many directions
 def test_rgb_skin_bakes_per_channel():
     skin = presets.made_up_skin("medium_beige", "jensen_skin1", coverage=0.5)
     t = bake.bake(skin, "preview")

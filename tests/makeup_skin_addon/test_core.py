@@ -5,7 +5,8 @@ is exercised by tests/test_extension_package.py)."""
 import importlib
 
 
-def test_core_hands_out_the_runtime_modules_of_this_checkout():
+def test_core_hands_out_the_runtime_modules_of_this_checkout(bpy_factory):
+    # the add-on's package imports bpy: only through the fixture (tests/conftest.py)
     from makeup_skin_addon import core, package
 
     assert not package.INSTALLED

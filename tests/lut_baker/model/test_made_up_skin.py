@@ -23,6 +23,7 @@ def _film_per_second():
 
 
 # --- K -------------------------------------------------------------------------------------
+@pytest.mark.slow  # brute-force hemisphere sums
 def test_k_is_the_films_brightest_total_albedo():
     """A dense independent scan (0..89.5 degrees every 0.5, brute-force hemisphere sums of the
     reference formulas, Richardson-extrapolated) finds the same maximum and where it is."""

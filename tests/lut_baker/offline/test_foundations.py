@@ -26,6 +26,7 @@ def test_every_product_file_is_in_the_repository():
     assert ",".join(FD.CSV_COLUMNS) == HEADER
 
 
+@pytest.mark.slow  # one product analysed, ~3 s
 def test_an_analysis_fits_all_and_alternate_incidences(matte):
     assert matte.finish == "matte"
     assert matte.split == ((20.0, 40.0, 60.0), (30.0, 50.0, 70.0))
@@ -42,6 +43,7 @@ def test_an_analysis_fits_all_and_alternate_incidences(matte):
     assert matte.untilted is None and matte.fit.tilt is None
 
 
+@pytest.mark.slow  # one product analysed, ~3 s
 def test_the_csv_has_the_exact_header_and_the_measured_rows(matte, tmp_path):
     path = FD.write_csv(matte, tmp_path / "p.csv")
     lines = path.read_text().splitlines()
@@ -53,6 +55,7 @@ def test_the_csv_has_the_exact_header_and_the_measured_rows(matte, tmp_path):
     np.testing.assert_allclose(table[:, 5:], matte.fit.model, rtol=1e-5)
 
 
+@pytest.mark.slow  # one product analysed, ~3 s
 def test_the_figure_has_points_and_curves_per_incidence(matte):
     figure = FD.product_figure(matte)
     gids = {line.get_gid() for line in figure.axes[0].lines if line.get_gid()}
@@ -61,6 +64,7 @@ def test_the_figure_has_points_and_curves_per_incidence(matte):
                 f"not determined theta_i={incidence}"} <= gids
 
 
+@pytest.mark.slow  # one product analysed, ~3 s
 def test_the_report_has_each_products_numbers(matte):
     text = FD.report([matte], {"clarins_103": "NOTE 103", "conclusion": "THE END"})
     assert text.startswith("# Published foundations against the paper's eq. 2")
@@ -76,6 +80,7 @@ def test_the_report_has_each_products_numbers(matte):
     assert "Chosen form: P_d alone (no lobe)." in text
 
 
+@pytest.mark.slow  # one product analysed, ~3 s
 def test_the_report_lists_the_derived_presets(matte):
     """The thin-film preset each product implies (docs/model.md §4): the same entry as the
     runtime's file, in its own section with the absorption and gloss."""

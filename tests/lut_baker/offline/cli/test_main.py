@@ -197,6 +197,7 @@ IMPORTS = [
 ]
 
 
+@pytest.mark.slow  # interpreters started and interrupted
 def test_a_signal_during_any_import_is_one_line_and_128_plus_it(tmp_path):
     """SIGINT (and SIGTERM) while a module is being imported, at every stage of every command:
     one line, ``interrupted``, exit 128 + n, nothing written.  (The children run side by side.)"""
@@ -219,6 +220,7 @@ def test_a_signal_during_any_import_is_one_line_and_128_plus_it(tmp_path):
 DELAYS_S = (0, 0.05, 0.1, 0.2, 0.4, 0.8)
 
 
+@pytest.mark.slow  # interpreters started and interrupted
 def test_sigint_at_any_moment_ends_cleanly_or_not_at_all(tmp_path):
     """SIGINT after 0 ... 0.8 s of a preview bake (imports, bake and write, whatever each delay
     meets on this machine): every child either prints ``interrupted`` alone and exits 130 leaving
@@ -247,6 +249,7 @@ def test_sigint_at_any_moment_ends_cleanly_or_not_at_all(tmp_path):
     assert 130 in outcomes, outcomes  # at least the early ones met the imports
 
 
+@pytest.mark.slow  # interpreters started and interrupted
 def test_sigint_during_the_shutdown_changes_nothing(tmp_path):
     """A bake that has done its work and is exiting: a signal then is ignored (exit 0, the
     pair in place, nothing on stderr)."""

@@ -56,6 +56,7 @@ def test_light_and_camera_together_is_refused():
         F.reflection_data([30.0], [-30.0], [1.0])
 
 
+@pytest.mark.slow  # the full fit from every start
 def test_a_synthetic_layer_in_the_published_layout_fits_back(tmp_path):
     theta_i, theta_o = _geometry()
     rgb = np.stack([F.model_factor(layer, theta_i, theta_o) for layer in LAYERS], axis=-1)

@@ -82,12 +82,14 @@ def _fitted_parameters(round_trips, name):
 # --------------------------------------------------------------------------------------------
 # Round trip
 # --------------------------------------------------------------------------------------------
+@pytest.mark.slow  # the 20-seed round trip, ~5 s
 @pytest.mark.parametrize(("name", "parameter"), sorted(PINNED))
 def test_round_trip_meets_target_on_every_seed(round_trips, name, parameter):
     worst = np.max(np.abs(_errors(round_trips, name, parameter)))
     assert worst <= TARGETS[parameter], f"{name} {parameter}: worst error {worst:.3%}"
 
 
+@pytest.mark.slow  # the 20-seed round trip, ~5 s
 @pytest.mark.parametrize("name", sorted(TRUTH))
 def test_round_trip_median_error_within_target(round_trips, name):
     for parameter in _fitted_parameters(round_trips, name):
@@ -97,6 +99,7 @@ def test_round_trip_median_error_within_target(round_trips, name):
         assert median <= TARGETS[parameter], f"{name} {parameter}: median {median:.3%}"
 
 
+@pytest.mark.slow  # the 20-seed round trip, ~5 s
 @pytest.mark.parametrize("name", sorted(set(TRUTH) - {"film transmission"}))
 def test_round_trip_errors_match_reported_standard_errors(round_trips, name):
     """The covariance is honest: no error beyond 4 standard errors, and the errors' spread in
@@ -109,6 +112,7 @@ def test_round_trip_errors_match_reported_standard_errors(round_trips, name):
         assert 0.5 < np.sqrt(np.mean(z * z)) < 1.6, f"{name} {parameter}: {z}"
 
 
+@pytest.mark.slow  # the 20-seed round trip, ~5 s
 def test_round_trip_reaches_the_noise_floor(round_trips):
     """Every fit ends in the right basin: its residual rms is the 2% noise."""
     for name, runs in round_trips.items():
@@ -116,6 +120,7 @@ def test_round_trip_reaches_the_noise_floor(round_trips):
         assert np.all(np.abs(rms - NOISE) < 0.004), f"{name}: {rms}"
 
 
+@pytest.mark.slow  # the 20-seed round trip, ~5 s
 def test_paper_protocols_raise_no_warning(round_trips):
     for name in ("film reflection", "film transmission, eta fixed", "skin reflection",
                  "skin dipole"):
@@ -123,6 +128,7 @@ def test_paper_protocols_raise_no_warning(round_trips):
             assert result.ok, f"{name}: {result.warnings}"
 
 
+@pytest.mark.slow  # the 20-seed round trip, ~5 s
 def test_transmission_flags_eta(round_trips):
     """Eta enters transmission only through F_t = 1 - F_r (about 1% here): the fit says so.
     Its starts end in two minima, near the true eta and near eta = 3, whose chi-squares differ
