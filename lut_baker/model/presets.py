@@ -78,14 +78,17 @@ thick layers"), written by ``python -m lut_baker foundations``."""
 
 
 def read_measured_foundations(path: Path) -> dict[str, dict]:
-    """The entries of the measured presets' file: label, absorption and the film's gloss
-    ``{"P_s", "n", "eta"}`` (1/sr, 1/degree, -) per product."""
+    """The entries of the measured presets' file: label, absorption, the film's gloss
+    ``{"P_s", "n", "eta"}`` (1/sr, 1/degree, -) and ``colour``, the measured thick layer's
+    colour under uniform light (linear Rec.709: what the product looks like in the bottle, the
+    target its absorption was solved for) per product."""
     if not path.is_file():
         return {}
     entries = json.loads(path.read_text(encoding="utf-8"))["foundations"]
     return {name: {"absorption": tuple(float(a) for a in entry["absorption"]),
                    "label": str(entry["label"]),
-                   "film": {key: float(entry["film"][key]) for key in ("P_s", "n", "eta")}}
+                   "film": {key: float(entry["film"][key]) for key in ("P_s", "n", "eta")},
+                   "colour": tuple(float(c) for c in entry["target"])}
             for name, entry in entries.items()}
 
 
