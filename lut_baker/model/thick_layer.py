@@ -26,6 +26,8 @@ Functions and types
 - :func:`film_exchange` -- those three for any film (reflection and transmission layers),
   computed once per film.
 - :func:`paper_film_exchange` -- the paper's film's: what the thick layer stacks.
+- :func:`preset_film_exchange` -- the same as the shipped presets were derived with (stored
+  beside them): what the panel solves a picked colour against.
 - :func:`stack_reflectance` -- ``R_inf(A)``, the film stacked on itself without end.
 - :func:`solve_absorption` -- ``A`` per channel whose ``R_inf`` is a target (bisection),
   clamped to [0, 1] where out of reach.
@@ -45,6 +47,7 @@ __all__ = [
     "FilmExchange",
     "film_exchange",
     "paper_film_exchange",
+    "preset_film_exchange",
     "stack_reflectance",
     "solve_absorption",
     "BISECTION_STEPS",
@@ -114,6 +117,19 @@ def paper_film_exchange() -> FilmExchange:
 
     base = paper()
     return film_exchange(base.film, base.film_transmission)
+
+
+def preset_film_exchange() -> FilmExchange:
+    """The exchange the shipped measured presets were derived with
+    (:data:`lut_baker.model.presets.MEASURED_FILM_EXCHANGE`, written by the derivation from
+    :func:`paper_film_exchange`, which it equals): read, not integrated, so a colour picked in
+    the panel costs nothing to solve and a measured product's own colour gives back its preset
+    to the last bit.  Without a preset file, :func:`paper_film_exchange`."""
+    from .presets import MEASURED_FILM_EXCHANGE
+
+    if MEASURED_FILM_EXCHANGE is None:
+        return paper_film_exchange()
+    return FilmExchange(**MEASURED_FILM_EXCHANGE)
 
 
 def stack_reflectance(absorption, exchange: FilmExchange) -> np.ndarray:

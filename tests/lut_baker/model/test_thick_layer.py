@@ -29,6 +29,14 @@ def test_the_paper_films_exchange(exchange):
     assert TL.paper_film_exchange() is exchange  # computed once
 
 
+def test_the_stored_exchange_is_the_computed_one(exchange):
+    """What the panel solves against (stored beside the presets) is what the derivation
+    computes and wrote."""
+    stored = TL.preset_film_exchange()
+    for name in ("r_gloss", "r_diffuse", "t_0"):
+        assert getattr(stored, name) == pytest.approx(getattr(exchange, name), rel=1e-15)
+
+
 def test_any_films_exchange_is_its_gloss_diffuse_and_transmission():
     """The exchange of a measured product's film (its own gloss on the paper's diffuse part
     and transmission) against the albedos integrated directly; a matte film has no gloss; a
@@ -90,11 +98,11 @@ def test_a_picked_colour_is_reproduced_where_reachable(exchange):
 
 
 @pytest.mark.parametrize("name", PRODUCTS)
-def test_a_products_own_colour_gives_back_its_preset(exchange, name):
+def test_a_products_own_colour_gives_back_its_preset(name):
     """The measured thick layer's colour (what the product looks like in the bottle) picked
     as the shade gives the preset's absorption (Clarins 105's red, beyond the stack, clamps to
     0 as the preset does)."""
     entry = presets.FOUNDATIONS[name]
-    absorption, clamped = TL.solve_absorption(entry["colour"], exchange)
-    np.testing.assert_allclose(absorption, entry["absorption"], rtol=0, atol=1e-9)
+    absorption, clamped = TL.solve_absorption(entry["colour"], TL.preset_film_exchange())
+    np.testing.assert_allclose(absorption, entry["absorption"], rtol=0, atol=1e-12)
     assert list(clamped) == [name == "clarins_105", False, False]
