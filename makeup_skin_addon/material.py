@@ -271,15 +271,18 @@ def group_of(material):
 def setup_material(material, group, scene):
     """Make ``group`` the surface of ``material`` (:func:`convert.install`: the artist's tree is
     converted in place, their shader kept and framed, what it takes carried over; an unlinked
-    Base Color's value becomes Skin Color) and set the group node's inputs from the settings.
+    Base Color's value becomes Skin Color unless it is Blender's default grey or Skin Color
+    was set in the panel, :func:`.shade.base_colour_value`) and set the group node's inputs
+    from the settings.
     Returns what was carried over (:class:`.convert.Installed`)."""
     settings = material.makeup_skin
     installed = convert.install(material, group, film_strength=settings.film_normal_strength,
                                 film_follows=settings.film_follows_pores)
-    if "Skin Color" in installed.values:
+    value = shade.base_colour_value(settings, installed)
+    installed.values = {} if value is None else {"Skin Color": value}
+    if value is not None:
         with shade.assigning():
-            settings.skin_colour = [min(max(float(c), 0.0), 1.0)
-                                    for c in installed.values["Skin Color"]]
+            settings.skin_colour = value
     nodes.set_inputs(group_of(material), {"Units per mm": units_per_mm(scene)})
     update_sockets(material)
     return installed

@@ -42,6 +42,8 @@ __all__ = [
     "preset_colour",
     "colour_note",
     "skin_colour",
+    "base_colour_value",
+    "BLENDER_DEFAULT_BASE",
     "image_mean",
     "light_for",
     "matched",
@@ -288,6 +290,22 @@ def _uv_map(texture) -> tuple[str, str]:
     return "", f"; its coordinates come from {node.name!r}: read at the mesh's UVs"
 
 
+BLENDER_DEFAULT_BASE = (0.8, 0.8, 0.8)
+"""The Base Color of a new Principled BSDF: a material never coloured, not a skin colour."""
+
+
+def base_colour_value(settings, sources) -> tuple | None:
+    """The unlinked Base Color value the artist's shader gives Skin Color
+    (:func:`.convert.surface_sources`), or None: none, Blender's default grey
+    (:data:`BLENDER_DEFAULT_BASE`), or Skin Color (or the skin) already set in the panel."""
+    value = sources.values.get("Skin Color")
+    if value is None or settings.is_property_set("skin_colour"):
+        return None
+    if np.allclose(value, BLENDER_DEFAULT_BASE, atol=1e-6):
+        return None
+    return tuple(min(max(float(c), 0.0), 1.0) for c in value)
+
+
 def skin_colour(material) -> SkinColour:
     """The skin's own diffuse albedo: what feeds the group's Skin Color (or, before Apply, the
     artist's Base Color, :func:`.convert.surface_sources`): an image texture's mean over the
@@ -298,9 +316,9 @@ def skin_colour(material) -> SkinColour:
     socket = node.inputs["Skin Color"] if node is not None else None
     if socket is None:
         sources = convert.surface_sources(material)
-        if "Skin Color" in sources.values:
-            return SkinColour(np.asarray(sources.values["Skin Color"], float),
-                              "the value of the shader's Base Color")
+        base = base_colour_value(settings, sources)
+        if base is not None:
+            return SkinColour(np.asarray(base, float), "the value of the shader's Base Color")
         link = sources.links.get("Skin Color")
         socket = link[1].links[0].to_socket if link is not None and link[1].links else None
     if socket is None or not socket.is_linked:
