@@ -65,6 +65,7 @@ SAMPLES = ((1 / 3, 1 / 3, 1 / 3), (2 / 3, 1 / 6, 1 / 6), (1 / 6, 2 / 3, 1 / 6),
            (1 / 6, 1 / 6, 2 / 3))
 """Barycentric points at which :func:`image_mean` reads each face's triangles."""
 _LIGHT = cache.LRUCache(8)
+_ROUGHENED = cache.LRUCache(32)
 _assigning = [0]
 
 
@@ -86,10 +87,12 @@ def has_film_gloss(name: str) -> bool:
 
 
 def _roughened(layer, value: float, own: float):
-    """``layer`` at roughness ``value`` unless that is its own ``own``."""
+    """``layer`` at roughness ``value`` unless that is its own ``own`` (kept for the session:
+    a repeated Apply integrates nothing)."""
     if abs(float(value) - own) <= ROUGHNESS_TOLERANCE:
         return layer
-    return roughness.with_roughness(layer, float(value))
+    key = (repr(sorted(layer.as_dict().items())), float(value))
+    return _ROUGHENED.get_or_compute(key, lambda: roughness.with_roughness(layer, float(value)))
 
 
 def skin_from_settings(settings, foundation: str | None = None):
@@ -502,6 +505,8 @@ def assign(settings, shade: Shade, source: str) -> None:
 
 
 def clear_cache() -> None:
-    """Forget the session's uniform-light parts (the add-on's unregister calls it)."""
+    """Forget the session's uniform-light parts and roughened layers (the add-on's unregister
+    calls it)."""
     _LIGHT.clear()
+    _ROUGHENED.clear()
 
