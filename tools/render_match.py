@@ -139,7 +139,7 @@ def _strip(rows, out_path: Path) -> None:
         for panel in row:
             image[y:y + height, x:x + panel.shape[1], :3] = panel[..., :3]
             x += panel.shape[1] + GAP_PX
-    picture = bpy.data.images.new("match strip", width, total, alpha=True)
+    picture = bpy.data.images.new("match strip", width, total, alpha=False)
     picture.pixels.foreach_set(image.ravel())
     picture.filepath_raw = str(out_path)
     picture.file_format = "PNG"
