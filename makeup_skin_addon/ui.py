@@ -12,7 +12,7 @@ import json
 import bpy
 
 from . import material as made_up
-from . import on_load, scene_fit
+from . import on_load, scene_fit, shade
 from .core import presets
 from .keys import AUTO_KEY, CLASS_PREFIX, ERRORS_KEY, FIT_KEY
 from .operators import (
@@ -84,8 +84,8 @@ def _draw_film(col, settings) -> None:
     """Film Roughness (inactive for a matte product: no surface gloss), the film's normal,
     the index and its override."""
     rough = col.row()
-    matte = not presets.FOUNDATIONS.get(settings.foundation, {}).get("film", {"P_s": 1.0})[
-        "P_s"] > 0.0
+    matte = settings.foundation in presets.FOUNDATIONS and not shade.has_film_gloss(
+        settings.foundation)
     rough.active = not matte
     rough.prop(settings, "film_roughness", slider=True,
                **({"text": "Film Roughness (matte: no gloss)"} if matte else {}))
