@@ -236,6 +236,8 @@ def image_mean(image, material, *, uv_map: str = "", extension: str = "REPEAT"):
     ``material`` on every mesh object, weighted by their area, read at :data:`SAMPLES` of each
     triangle at the UV map ``uv_map`` (the active render map when empty) with the texture's
     ``extension``; None for ``rgb`` when no face uses it."""
+    if not image.has_data and (image.size[0] == 0 or image.size[1] == 0):
+        return None, 0, f"; image {image.name!r} has no pixels (its file is missing)"
     pixels, note = _image_pixels(image)
     height, width = pixels.shape[:2]
     total, weight, faces = np.zeros(3), 0.0, 0
@@ -335,7 +337,8 @@ def skin_colour(material) -> SkinColour:
     rgb, faces, note = image_mean(texture.image, material, uv_map=uv_map,
                                   extension=texture.extension)
     if rgb is None:
-        value.source = f"Skin Color's value (no face uses {material.name!r})"
+        why = note.lstrip("; ") or f"no face uses {material.name!r}"
+        value.source = f"Skin Color's value ({why})"
         return value
     through = f" through {', '.join(repr(n) for n in route)}" if route else ""
     return SkinColour(rgb, f"the mean of image {texture.image.name!r} over the {faces} faces "
