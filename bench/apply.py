@@ -9,9 +9,11 @@ Measures the add-on of ``CHECKOUT`` (its ``makeup_skin_addon`` and ``lut_baker``
 ``sys.path``: bench/checkout.py) on the scene of *this* repository: the textured head of
 tests/support/character.py (seed 0) with its portrait camera and lights, resolution
 ``default``, skin ``paper_bioplate`` (the default), tier ``--tier`` (default Layered).  Cases:
-every foundation of the checkout's ``lut_baker.model.presets.FOUNDATIONS``, and ``film_min``:
-Film Roughness at its minimum (``override_film`` on, ``film_lobe_width`` = the property's
-minimum, the default foundation).
+every foundation of the checkout's ``lut_baker.model.presets.FOUNDATIONS`` (chosen in the panel:
+its own shade), ``film_min``: Film Roughness at its minimum (the default foundation; in older
+checkouts ``override_film`` on and ``film_lobe_width`` at the property's minimum), and where the
+checkout has them ``skin_min``: Skin Roughness at its minimum, and ``defaults``: every setting
+at its default (the first Apply matches the shade to the skin).
 
 Per case, one fresh process per repeat (so the first Apply is truly cold: first imports,
 bake, closure fit, group, material):
@@ -69,7 +71,15 @@ from checkout import (  # bench/checkout.py
 
 HERE = Path(__file__).resolve()
 FILM_MIN = "film_min"
-"""The case of Film Roughness at its minimum (the default foundation, film overridden)."""
+"""The case of Film Roughness at its minimum (the default foundation; older checkouts: Override
+Film on and the film's lobe width at its minimum)."""
+SKIN_MIN = "skin_min"
+"""The case of Skin Roughness at its minimum (the default foundation and skin), in checkouts
+that have it: the narrowest skin gloss path 3 goes through, the largest grids."""
+DEFAULTS = "defaults"
+"""The case of every setting at its default, in checkouts whose first Apply matches the shade to
+the skin (the mean of the head's albedo texture) before baking."""
+NEW_CASES = (SKIN_MIN, DEFAULTS)
 DRAWS = 20
 REPEATS_IN_PROCESS = 3
 TARGETS = {
@@ -207,14 +217,21 @@ def worker(bpy, support, case: str, tier: str) -> dict:
     settings = material.makeup_skin
     settings.tier = tier
     settings.resolution = "default"
-    if case == FILM_MIN:
+    has_roughness = "film_roughness" in settings.bl_rna.properties
+    if case == FILM_MIN and has_roughness:
+        settings.film_roughness = settings.bl_rna.properties["film_roughness"].hard_min
+    elif case == FILM_MIN:
         settings.override_film = True
         settings.film_lobe_width = settings.bl_rna.properties["film_lobe_width"].hard_min
-    else:
+    elif case == SKIN_MIN:
+        settings.skin_roughness = settings.bl_rna.properties["skin_roughness"].hard_min
+    elif case != DEFAULTS:
         settings.foundation = case
     out = {"case": case, "tier": tier, "foundation": settings.foundation,
            "film_lobe_width_deg": (float(settings.film_lobe_width) * 180.0 / 3.141592653589793
-                                   if settings.override_film else None)}
+                                   if settings.override_film and not has_roughness else None),
+           "film_roughness": float(settings.film_roughness) if has_roughness else None,
+           "skin_roughness": float(settings.skin_roughness) if has_roughness else None}
     with _Memory() as memory:
         out["cold_s"] = _apply_once(bpy)
     out["cold_cpu_s"] = CPU_SECONDS[-1]
@@ -291,6 +308,13 @@ def _repeated(measure, repeats: int, single_above: float | None, key: str) -> li
 def _medians(runs: list[dict]) -> dict:
     keys = [k for k, v in runs[0].items() if isinstance(v, int | float) and not isinstance(v, bool)]
     return {k: statistics.median(run[k] for run in runs) for k in keys}
+
+
+def _new_cases(repo: Path) -> list[str]:
+    """:data:`NEW_CASES` when the checkout's settings have Skin Roughness (and a first Apply
+    that matches the skin), else none."""
+    text = (repo / "makeup_skin_addon" / "properties.py").read_text(encoding="utf-8")
+    return list(NEW_CASES) if "skin_roughness" in text else []
 
 
 def _foundations(repo: Path) -> list[str]:
@@ -474,7 +498,7 @@ def main(argv=None) -> int:
             result = worker(bpy, support, args.worker, args.tier)
         print("RESULT " + json.dumps(result))
         return 0
-    cases = args.presets or [*_foundations(repo), FILM_MIN]
+    cases = args.presets or [*_foundations(repo), FILM_MIN, *_new_cases(repo)]
     results = measure(repo, cases, args.tier, args.repeats, args.single_above, not args.no_cli)
     print_report(results)
     write_figures(args.json, results)

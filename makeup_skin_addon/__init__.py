@@ -8,18 +8,24 @@ its own, and only at module level (no import inside a function, no cycle):
 2. ``package`` -- the add-on's package names, and whether it runs installed (no bpy).
    ``core`` -- lut_baker's runtime modules, imported by ordinary statements, from beside the
    add-on when installed, top level from a checkout (no bpy).
-3. ``convert`` -- the artist's material converted in place and back (install, revert).
+3. ``convert`` -- the artist's material converted in place and back (install, revert): the
+   skin shader followed through mixes and groups, its albedo, normal and film normal carried.
 4. ``storage`` -- what the .blend keeps: bake records, re-bakes, packed images and their hashes.
+   ``fits`` -- the session's tables and closure fits by bake key.
+   ``shade`` -- the settings as the model (roughness, IOR), the colour seen, the skin's own
+   colour, Match Skin and the shade steps.
 5. ``nodes`` -- the node groups built from closure fits, and their records.
 6. ``scene_fit`` -- the scene and the material as the Auto tier sees them, the choice, and its
    settings (units per mm, Auto tier, Fit to Scene's settings and record).
 7. ``material`` -- the apply pipeline: Apply, Revert, Check Tables, the rebuild from settings.
 8. ``live`` -- the live preview: socket updates at once, debounced preview re-bakes.
-9. ``on_load`` -- on opening a file, the made-up materials' images checked (packed bytes'
-   hashes) and repaired before the first render (a ``load_post`` handler).
+9. ``on_load`` -- on opening a file, older settings upgraded and the made-up materials'
+   images checked (packed bytes' hashes) and repaired before the first render (a
+   ``load_post`` handler).
 10. ``properties`` -- the panel's settings (PropertyGroup); their ``update=`` callbacks call
     ``live``.
-11. ``operators`` -- Apply, Revert, Check Tables, Fit to Scene, the preset menu and its operator.
+11. ``operators`` -- Apply, Revert, Check Tables, Fit to Scene, Match Skin, Lighter / Darker,
+    the preset menu and its operator.
 12. ``ui`` -- the panels: settings, buttons, the group's record and errors, Fit to Scene, a
     repair on opening.
 

@@ -14,15 +14,15 @@ from .package import INSTALLED
 if INSTALLED:
     from ..lut_baker import auto_tier, bake
     from ..lut_baker.closures import fitting
-    from ..lut_baker.model import params_file, presets
+    from ..lut_baker.model import params_file, presets, roughness, thick_layer
     from ..lut_baker.numerics import cache
-    from ..lut_baker.tables import codec, table_set
+    from ..lut_baker.tables import codec, table_set, uniform_light
 else:
     from lut_baker import auto_tier, bake
     from lut_baker.closures import fitting
-    from lut_baker.model import params_file, presets
+    from lut_baker.model import params_file, presets, roughness, thick_layer
     from lut_baker.numerics import cache
-    from lut_baker.tables import codec, table_set
+    from lut_baker.tables import codec, table_set, uniform_light
 
 __all__ = ["auto_tier", "bake", "cache", "codec", "fitting", "params_file", "presets",
-           "table_set"]
+           "roughness", "table_set", "thick_layer", "uniform_light"]

@@ -14,6 +14,8 @@ Identifiers (``bl_idname``):
   (:class:`makeup_skin_addon.properties.MakeupSkinSettings`); its ID properties are stored
   under this name.
 - :data:`PRESET_SUBDIR` -- the folder under Blender's ``presets`` where parameter sets are saved.
+- :data:`SETTINGS_VERSION` -- what the settings mean, stamped on them (older files are
+  upgraded when opened).
 
 Custom properties of a material (JSON strings unless said otherwise):
 
@@ -37,6 +39,8 @@ group"; Apply finds groups and images by name and reuses them):
 - :data:`MATERIAL_NAME` -- the material Apply adds to an object that has none.
 - :data:`GROUP_NODE` -- name and label of the group node in a made-up material's tree.
 - :data:`FRAME_NAME`, :data:`FRAME_LABEL` -- the frame around the previous surface shader.
+- :data:`FILM_NORMAL_NODE` -- the film's own Normal Map (or Bump) node, a weaker copy of the
+  skin's, and :data:`BASE_STRENGTH_KEY`, the strength of the skin's it scales.
 - :func:`group_name` -- ``Made-up Skin <Tier> [<method>] <key>`` (:data:`GROUP_PREFIX`,
   :data:`METHOD_LABELS`).
 - :func:`lut_image_name` -- ``MakeupSkin LUT <Tier> <key>`` (:data:`LUT_PREFIX`).
@@ -49,6 +53,7 @@ __all__ = [
     "CLASS_PREFIX",
     "SETTINGS_ATTRIBUTE",
     "PRESET_SUBDIR",
+    "SETTINGS_VERSION",
     "RECORD_KEY",
     "ERRORS_KEY",
     "CHOICE_KEY",
@@ -61,6 +66,8 @@ __all__ = [
     "GROUP_NODE",
     "FRAME_NAME",
     "FRAME_LABEL",
+    "FILM_NORMAL_NODE",
+    "BASE_STRENGTH_KEY",
     "GROUP_PREFIX",
     "METHOD_LABELS",
     "LUT_PREFIX",
@@ -78,6 +85,11 @@ SETTINGS_ATTRIBUTE = "makeup_skin"
 ``material.makeup_skin``)."""
 PRESET_SUBDIR = "makeup_skin"
 """Folder under Blender's ``presets`` where parameter sets are saved."""
+SETTINGS_VERSION = 2
+"""What the settings mean, stamped on every change (``settings_version``).  1 (never stamped):
+Shade By Colour was the colour the pigment passes (1 - absorption), Film Roughness a width in
+degrees under Override Film, Coverage 1 and Shade By Absorption the defaults; 2: Colour is the
+colour seen (the thick layer), Film and Skin Roughness are Blender roughness."""
 
 # --- custom properties of a material ---------------------------------------------------------
 RECORD_KEY = "makeup_skin_previous_surface"
@@ -115,6 +127,12 @@ FRAME_NAME = "Made-up Skin: previous surface"
 """Name of the frame around the previous surface shader."""
 FRAME_LABEL = "Before Made-up Skin (Revert restores it)"
 """Label of that frame."""
+FILM_NORMAL_NODE = "Made-up Skin Film Normal"
+"""Name and label of the Normal Map (or Bump) node Apply adds for the film: a copy of the one
+feeding the skin's Normal, at a fraction of its strength (Revert removes it)."""
+BASE_STRENGTH_KEY = "makeup_skin_base_strength"
+"""Float custom property of that node: the skin's own strength, which the panel's Film Normal
+strength multiplies."""
 GROUP_PREFIX = "Made-up Skin"
 """Start of every node group name (:func:`group_name`)."""
 METHOD_LABELS = {"BURLEY": "Burley", "RANDOM_WALK": "RW", "RANDOM_WALK_SKIN": "RW Skin"}

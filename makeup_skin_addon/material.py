@@ -9,7 +9,7 @@ group by name and bakes, fits and hashes nothing; otherwise it bakes and fits on
 (kept in the group's record), so the same settings in the same scene give the same tier.
 
 - :func:`skin_from_settings` -- the panel's settings as a :class:`MadeUpSkin` (coverage 1,
-  absorption 0: those two are socket values, applied after the bake).
+  absorption 0: those two are socket values, applied after the bake; :mod:`.shade`).
 - :func:`resolve_tier` -- the tier for the settings and scene (Auto: from a measurement).
 - :func:`socket_values` -- the settings' group-node socket values; :func:`update_sockets`
   sets them on a material's group node.
@@ -24,14 +24,14 @@ group by name and bakes, fits and hashes nothing; otherwise it bakes and fits on
 from __future__ import annotations
 
 import json
-import math
 
 import bpy
 
-from . import convert, fits, nodes, scene_fit, storage
-from .core import fitting, params_file, presets
-from .keys import AUTO_KEY, ERRORS_KEY, MATERIAL_NAME, group_name
+from . import convert, fits, nodes, scene_fit, shade, storage
+from .core import fitting, params_file
+from .keys import AUTO_KEY, ERRORS_KEY, MATERIAL_NAME, SETTINGS_VERSION, group_name
 from .scene_fit import units_per_mm
+from .shade import skin_from_settings
 
 __all__ = [
     "LinkedDataError",
@@ -50,24 +50,6 @@ __all__ = [
     "update_sockets",
     "socket_values",
 ]
-
-
-def skin_from_settings(settings):
-    """The made-up skin the settings describe, at coverage 1 and absorption 0.  Film Roughness
-    and Film IOR (with Override Film) replace the film surface's gloss (eq. 2: its lobe width
-    and index, also the index of its transmission's Fresnel term); the film's transmission lobe
-    stays the foundation's, since it is set by the pigment the light crosses, not by the
-    surface (docs/model.md §4)."""
-    skin = presets.made_up_skin(settings.foundation, settings.skin, coverage=1.0,
-                                absorption=0.0)
-    if settings.override_film:
-        width_deg = math.degrees(settings.film_lobe_width)
-        skin = skin.replace(
-            film=skin.film.scaled(n=1.0 / width_deg / float(skin.film.n),
-                                  eta=settings.film_ior / float(skin.film.eta)),
-            film_transmission=skin.film_transmission.scaled(
-                eta=settings.film_ior / float(skin.film_transmission.eta)))
-    return skin
 
 
 def resolve_tier(settings, scene, measured=None) -> str:
@@ -278,6 +260,7 @@ def clear_cache() -> None:
     """Forget the session's fits and re-baked tables (the add-on's unregister calls it)."""
     fits.clear()
     storage.clear_cache()
+    shade.clear_cache()
 
 
 def group_of(material):
@@ -285,14 +268,24 @@ def group_of(material):
     return convert.group_node(material)
 
 
-def setup_material(material, group, scene) -> list[str]:
+def setup_material(material, group, scene):
     """Make ``group`` the surface of ``material`` (:func:`convert.install`: the artist's tree is
-    converted in place, their shader kept and framed) and set the group node's inputs from the
-    settings.  Returns the inputs carried over from the previous shader."""
-    carried = convert.install(material, group)
+    converted in place, their shader kept and framed, what it takes carried over; an unlinked
+    Base Color's value becomes Skin Color unless it is Blender's default grey or Skin Color
+    was set in the panel, :func:`.shade.base_colour_value`) and set the group node's inputs
+    from the settings.
+    Returns what was carried over (:class:`.convert.Installed`)."""
+    settings = material.makeup_skin
+    installed = convert.install(material, group, film_strength=settings.film_normal_strength,
+                                film_follows=settings.film_follows_pores)
+    value = shade.base_colour_value(settings, installed)
+    installed.values = {} if value is None else {"Skin Color": value}
+    if value is not None:
+        with shade.assigning():
+            settings.skin_colour = value
     nodes.set_inputs(group_of(material), {"Units per mm": units_per_mm(scene)})
     update_sockets(material)
-    return carried
+    return installed
 
 
 def socket_values(settings) -> dict:
@@ -307,10 +300,14 @@ def socket_values(settings) -> dict:
 
 
 def update_sockets(material) -> None:
-    """Copy the material's socket-level settings onto its group node."""
+    """Copy the material's socket-level settings onto its group node, and the film's normal
+    settings onto its normal node (:func:`.convert.set_film_normal`)."""
     node = group_of(material)
     if node is not None:
-        nodes.set_inputs(node, socket_values(material.makeup_skin))
+        settings = material.makeup_skin
+        nodes.set_inputs(node, socket_values(settings))
+        convert.set_film_normal(material, settings.film_follows_pores,
+                                settings.film_normal_strength)
 
 
 def _users(material) -> list:
@@ -319,17 +316,41 @@ def _users(material) -> list:
             if any(slot.material == material for slot in getattr(obj, "material_slots", ()))]
 
 
-def _material_for(obj):
-    """The object's active material, or a new one in its active slot (the object had none)."""
+def _material_for(obj) -> tuple:
+    """``(material, created)``: the object's active material, or a new one in its active slot
+    (the object had none)."""
     material = obj.active_material
     if material is not None:
-        return material
+        return material, False
     material = bpy.data.materials.new(MATERIAL_NAME)
     if obj.material_slots:
         obj.active_material = material
     else:
         obj.data.materials.append(material)
-    return material
+    return material, True
+
+
+def _conversion_sentences(material, installed, created: bool, obj) -> list[str]:
+    """The report's sentences about a first conversion: what was kept, carried over, taken as
+    a value, not carried over, and the film's normal."""
+    if created:
+        return [f"{obj.name!r} had no material: created {material.name!r} with the skin "
+                f"preset's Skin Color."]
+    if convert.can_revert(material):
+        kept = "its previous surface is kept, framed and disconnected (Revert restores it)"
+    else:
+        kept = "it had no surface before"
+    linked = f"; linked {', '.join(installed.carried)}" if installed.carried else ""
+    sentences = [f"Converted {material.name!r} in place: {kept}{linked}."]
+    if "Skin Color" in installed.values:
+        value = ", ".join(f"{float(c):.3f}" for c in installed.values["Skin Color"])
+        sentences.append(f"Skin Color is the value of its Base Color ({value}).")
+    if installed.missing:
+        sentences.append(f"Not carried over: {'; '.join(installed.missing)}: Skin Color stays "
+                         f"the panel's value and Normal the surface's.")
+    if installed.film_normal:
+        sentences.append(installed.film_normal + ".")
+    return sentences
 
 
 def _record_errors(material, measured: dict, key: str) -> None:
@@ -367,26 +388,34 @@ def apply_to_object(context, obj, *, resolution=None) -> tuple:
         a library (nothing is changed).
     """
     refuse_linked(obj, obj.active_material)
-    material = _material_for(obj)
+    material, created = _material_for(obj)
     settings = material.makeup_skin
     first = not settings.is_made_up or group_of(material) is None
     scene = context.scene
+    messages = []
+    if first and settings.shade_source == "DEFAULT":
+        # A shade never chosen: match the skin (the artist's first step), before the fit
+        # measures the tiers at the absorption.
+        film, matched = shade.first_shade(material)
+        if film is not None:
+            with shade.assigning():
+                settings.foundation = film
+                settings.film_roughness = shade.foundation_roughness(film)
+        shade.assign(settings, matched, "MATCH")
+        messages += matched.sentences
     record = storage.bake_record(skin_from_settings(settings),
                                  resolution or settings.resolution)
-    messages = []
     with _Progress(context) as progress:
         work = _Bake(record, forced_method(settings), settings.coverage,
                      settings.effective_absorption(), progress)
         group, measured, _, auto = _group_for(material, settings, scene, work, messages)
     _record_errors(material, measured, record["key"])
     _record_auto(material, auto)
-    carried = setup_material(material, group, scene)
+    installed = setup_material(material, group, scene)
     settings.is_made_up = True
-    if first:
-        kept = ("its previous surface is kept, framed and disconnected (Revert restores it)"
-                if convert.can_revert(material) else "it had no surface before")
-        linked = f"; linked {', '.join(carried)}" if carried else ""
-        messages.append(f"Converted {material.name!r} in place: {kept}{linked}.")
+    settings.settings_version = SETTINGS_VERSION
+    if installed.first or created:
+        messages[:0] = _conversion_sentences(material, installed, created, obj)
     users = len(_users(material))
     if users > 1:
         messages.append(f"{material.name!r} is shared by {users} objects: all of them show "

@@ -12,6 +12,13 @@ changes.  Each repair is printed as one line on the console and kept for the pan
 (:func:`notice`), since a handler has no operator report.  A file without a made-up group costs
 one pass over its node groups.
 
+The same handler first upgrades the settings of files saved by an earlier add-on
+(:func:`upgrade_settings`, :data:`.keys.SETTINGS_VERSION`): their Shade By Colour meant the
+colour the pigment passes (now the colour seen), their film width was in degrees under Override
+Film (now Film Roughness, always on), and their Coverage and Shade By defaulted to 1 and
+Absorption; every value they meant is kept.
+
+- :func:`upgrade_settings` -- one material's settings of an older file, upgraded.
 - :func:`damaged_groups` -- the add-on's groups whose images are missing or damaged (no decode).
 - :func:`repair_file` -- repair the materials using them; the sentences.
 - :func:`check_on_load` -- the persistent ``load_post`` handler.
@@ -20,14 +27,24 @@ one pass over its node groups.
 
 from __future__ import annotations
 
+import math
+
 import bpy
 
 from . import material as made_up
-from . import nodes, storage
-from .keys import FIT_KEY
+from . import nodes, shade, storage
+from .core import presets, roughness
+from .keys import FIT_KEY, SETTINGS_VERSION
 
-__all__ = ["damaged_groups", "repair_file", "check_on_load", "notice", "register",
-           "unregister"]
+__all__ = ["upgrade_settings", "upgrade_file", "damaged_groups", "repair_file", "check_on_load",
+           "notice", "register", "unregister"]
+
+OLD_DEFAULTS = {"coverage": 1.0, "absorption_mode": "ABSORPTION"}
+"""Settings whose default changed with version 2, and their version-1 defaults."""
+OLD_PROPERTIES = ("is_made_up", "foundation", "skin", "coverage", "absorption_mode",
+                  "absorption", "foundation_colour", "override_film", "film_lobe_width",
+                  "film_ior", "skin_colour", "gloss", "subsurface_scale", "tier")
+"""A version-1 material's settings hold at least one of these."""
 
 REPAIRED = "Repaired damaged lookup image on load"
 NOT_REPAIRED = "Damaged lookup image on load: not repaired (see the console)"
@@ -39,6 +56,40 @@ _notices: dict[str, str] = {}
 def _problems(group) -> list[str]:
     """What is wrong with the images ``group`` records, found without decoding them."""
     return storage.image_problems(nodes.read_meta(group).get("images", ()), decode=False)
+
+
+def upgrade_settings(settings) -> bool:
+    """Upgrade one material's settings written by an earlier add-on (no
+    ``settings_version``, some setting stored) to :data:`.keys.SETTINGS_VERSION`, keeping what
+    they meant; returns whether it did.  Settings of this version, or never touched, are left
+    alone."""
+    if settings.is_property_set("settings_version") or not any(
+            settings.is_property_set(name) for name in OLD_PROPERTIES):
+        return False
+    with shade.assigning():
+        for name, value in OLD_DEFAULTS.items():
+            if not settings.is_property_set(name):
+                setattr(settings, name, value)
+        if settings.absorption_mode == "COLOUR":  # it meant the colour passed: 1 - A
+            settings.absorption = [1.0 - c for c in settings.foundation_colour]
+        settings.shade_colour = [float(c) for c in shade.colour_seen(settings.absorption)]
+        if settings.foundation in presets.FOUNDATIONS:
+            own = shade.foundation_roughness(settings.foundation)
+            if settings.override_film and settings.is_property_set("film_lobe_width"):
+                width = min(max(math.degrees(settings.film_lobe_width), 1.0), 60.0)
+                own = float(roughness.roughness_for_width(width))
+            settings.film_roughness = own
+        if settings.skin in presets.SKINS:
+            settings.skin_roughness = shade.skin_roughness(settings.skin)
+        settings.shade_source = "USER"
+        settings.settings_version = SETTINGS_VERSION
+    return True
+
+
+def upgrade_file() -> list[str]:
+    """:func:`upgrade_settings` for every local material; the names of those upgraded."""
+    return [material.name for material in bpy.data.materials
+            if material.library is None and upgrade_settings(material.makeup_skin)]
 
 
 def damaged_groups() -> dict:
@@ -80,8 +131,13 @@ def repair_file(context) -> list[str]:
 
 @bpy.app.handlers.persistent
 def check_on_load(*_args) -> None:
-    """The ``load_post`` handler: :func:`repair_file`, each sentence printed on the console."""
+    """The ``load_post`` handler: :func:`upgrade_file`, then :func:`repair_file`, each
+    sentence printed on the console."""
     _notices.clear()
+    upgraded = upgrade_file()
+    if upgraded:
+        print(f"Made-up Skin: on opening the file: upgraded the settings of "
+              f"{', '.join(repr(name) for name in upgraded)} from an earlier version.")
     for sentence in repair_file(bpy.context):
         print(f"Made-up Skin: on opening the file: {sentence}")
 

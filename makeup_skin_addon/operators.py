@@ -1,6 +1,7 @@
-"""Operators: Apply, Revert, Check Tables, Fit to Scene, and the preset menu with its add/remove
-operator.  Each operator's work is a function of a lower module (:mod:`.material`,
-:mod:`.scene_fit`, :mod:`.live`); here it is run and reported.  Idnames are
+"""Operators: Apply, Revert, Check Tables, Fit to Scene, Match Skin and the shade steps
+(Lighter / Darker), and the preset menu with its add/remove operator.  Each operator's work is
+a function of a lower module (:mod:`.material`, :mod:`.scene_fit`, :mod:`.live`,
+:mod:`.shade`); here it is run and reported.  Idnames are
 ``makeup_skin.<name>`` (:data:`.keys.OPERATOR_PREFIX`)."""
 
 from __future__ import annotations
@@ -8,13 +9,14 @@ from __future__ import annotations
 import bpy
 from bl_operators.presets import AddPresetBase
 
-from . import convert, live, scene_fit
+from . import convert, live, scene_fit, shade
 from . import material as made_up
 from .keys import OPERATOR_PREFIX, PRESET_SUBDIR, SETTINGS_ATTRIBUTE
 
 __all__ = ["MAKEUPSKIN_OT_apply", "MAKEUPSKIN_OT_revert", "MAKEUPSKIN_OT_check_tables",
-           "MAKEUPSKIN_OT_fit_to_scene", "MAKEUPSKIN_OT_add_preset", "MAKEUPSKIN_MT_presets",
-           "PRESET_SUBDIR", "register", "unregister"]
+           "MAKEUPSKIN_OT_fit_to_scene", "MAKEUPSKIN_OT_match_skin", "MAKEUPSKIN_OT_shade_step",
+           "MAKEUPSKIN_OT_add_preset", "MAKEUPSKIN_MT_presets", "PRESET_SUBDIR", "register",
+           "unregister"]
 
 
 class _ObjectPoll:
@@ -156,6 +158,66 @@ class MAKEUPSKIN_OT_fit_to_scene(bpy.types.Operator):
         return {"FINISHED"}
 
 
+class _MaterialPoll:
+    @classmethod
+    def poll(cls, context):
+        obj = context.active_object
+        return obj is not None and obj.active_material is not None
+
+
+def _set_shade(operator, context, solve) -> set:
+    """Solve a shade for the active material with ``solve(material)`` (:func:`.shade.matched`
+    or a step), store it and report; the material's group takes it at once."""
+    material = context.active_object.active_material
+    try:
+        made_up.refuse_linked(None, material)
+        result = solve(material)
+    except (ValueError, RuntimeError) as error:
+        operator.report({"ERROR"}, f"Made-up Skin: {_sentence(error)}")
+        return {"CANCELLED"}
+    shade.assign(material.makeup_skin, result, "MATCH")
+    made_up.update_sockets(material)
+    for sentence in result.sentences:
+        operator.report({"WARNING"} if "out of reach" in sentence else {"INFO"},
+                        f"Made-up Skin: {sentence}")
+    return {"FINISHED"}
+
+
+class MAKEUPSKIN_OT_match_skin(_MaterialPoll, bpy.types.Operator):
+    """Set the shade so that the made-up skin has the skin's own colour at any coverage: Skin
+    Color's value, or the mean of the image feeding it over the faces that use the material"""
+
+    bl_idname = f"{OPERATOR_PREFIX}.match_skin"
+    bl_label = "Match Skin"
+    bl_options = {"REGISTER", "UNDO"}
+
+    def execute(self, context):
+        return _set_shade(self, context, shade.matched)
+
+
+class MAKEUPSKIN_OT_shade_step(_MaterialPoll, bpy.types.Operator):
+    """One shade lighter or darker: the covered skin's colour 10% up or down in luminance"""
+
+    bl_idname = f"{OPERATOR_PREFIX}.shade_step"
+    bl_label = "Shade Step"
+    bl_options = {"REGISTER", "UNDO"}
+
+    direction: bpy.props.EnumProperty(
+        name="Direction", items=(("LIGHTER", "Lighter", "One shade lighter"),
+                                 ("DARKER", "Darker", "One shade darker")),
+        default="LIGHTER")
+
+    @classmethod
+    def description(cls, context, properties):
+        return (f"One shade {properties.direction.lower()}: the covered skin's colour "
+                f"{'times' if properties.direction == 'LIGHTER' else 'divided by'} "
+                f"{shade.SHADE_STEP:g}")
+
+    def execute(self, context):
+        steps = 1 if self.direction == "LIGHTER" else -1
+        return _set_shade(self, context, lambda material: shade.stepped(material, steps))
+
+
 def _sentence(error) -> str:
     """An exception's message as a sentence: capital first letter, final full stop."""
     text = str(error).strip() or type(error).__name__
@@ -186,15 +248,17 @@ class MAKEUPSKIN_OT_add_preset(AddPresetBase, bpy.types.Operator):
     preset_defines = [f"settings = bpy.context.object.active_material.{SETTINGS_ATTRIBUTE}"]
     preset_values = [
         "settings.foundation", "settings.skin", "settings.coverage", "settings.absorption_mode",
-        "settings.absorption", "settings.foundation_colour", "settings.skin_colour",
+        "settings.absorption", "settings.skin_colour", "settings.skin_roughness",
         "settings.subsurface_scale", "settings.gloss", "settings.subsurface_method",
-        "settings.override_film", "settings.film_lobe_width", "settings.film_ior",
+        "settings.film_roughness", "settings.override_film", "settings.film_ior",
+        "settings.film_follows_pores", "settings.film_normal_strength",
         "settings.tier", "settings.resolution",
     ]
 
 
 classes = (MAKEUPSKIN_OT_apply, MAKEUPSKIN_OT_revert, MAKEUPSKIN_OT_check_tables,
-           MAKEUPSKIN_OT_fit_to_scene, MAKEUPSKIN_MT_presets, MAKEUPSKIN_OT_add_preset)
+           MAKEUPSKIN_OT_fit_to_scene, MAKEUPSKIN_OT_match_skin, MAKEUPSKIN_OT_shade_step,
+           MAKEUPSKIN_MT_presets, MAKEUPSKIN_OT_add_preset)
 
 
 _register, unregister = bpy.utils.register_classes_factory(classes)

@@ -1,10 +1,19 @@
 """The panel's settings: one :class:`MakeupSkinSettings` per material (``material.makeup_skin``).
 
-Coverage, absorption, skin colour, subsurface scale and gloss are socket values of the material's
-group node: moving them updates the material at once.  Foundation and skin presets, film overrides,
-tier and resolution change the tables: with live update on, moving them schedules a preview
-re-bake (:mod:`.live`); Apply bakes at full resolution.  The settings are registered as
-``Material.makeup_skin`` (:data:`.keys.SETTINGS_ATTRIBUTE`).
+Coverage, absorption (or the foundation's colour, solved into it), skin colour, subsurface
+scale, gloss and the film's normal are socket values of the material's group node (or of its
+nodes): moving them updates the material at once.  Foundation and skin presets, Film and Skin
+Roughness, the film's index, tier and resolution change the tables: with live update on, moving
+them schedules a preview re-bake (:mod:`.live`); Apply bakes at full resolution.  The settings
+are registered as ``Material.makeup_skin`` (:data:`.keys.SETTINGS_ATTRIBUTE`).
+
+The shade is kept as its absorption; the Foundation Colour is its colour seen (the thick
+layer, :func:`.shade.colour_seen`) and picking a colour solves the absorption
+(:func:`.shade.absorption_for_colour`), both at once in the update callbacks, never while the
+panel draws.  Choosing a foundation sets its shade, colour and film roughness; choosing a skin
+its albedo and roughness.  Every change stamps :data:`SETTINGS_VERSION`; :mod:`.on_load`
+upgrades the settings of older files (whose Colour meant the colour the pigment passes, and
+whose film width was in degrees).
 """
 
 from __future__ import annotations
@@ -13,11 +22,12 @@ import math
 
 import bpy
 
-from . import live
-from .core import presets
-from .keys import SETTINGS_ATTRIBUTE
+from . import live, shade
+from .core import presets, roughness
+from .keys import SETTINGS_ATTRIBUTE, SETTINGS_VERSION
 
-__all__ = ["MakeupSkinSettings", "register", "unregister", "TIER_ITEMS"]
+__all__ = ["MakeupSkinSettings", "register", "unregister", "TIER_ITEMS", "SETTINGS_VERSION",
+           "ROUGHNESS_MAX", "FILM_ROUGHNESS_MIN", "SKIN_ROUGHNESS_MIN"]
 
 TIER_ITEMS = (
     ("AUTO", "Auto", "The cheapest tier within 2% of the best one's error in this scene (camera, "
@@ -57,6 +67,21 @@ def _first_skin_albedo() -> tuple:
     return tuple(presets.skin_albedo(next(iter(presets.SKINS))))
 
 
+FIRST_FOUNDATION = next(iter(presets.FOUNDATIONS))
+"""The default foundation (the first preset: the paper's film, matched to the skin at the first
+Apply, docs/addon.md "A first Apply")."""
+FIRST_SKIN = next(iter(presets.SKINS))
+ROUGHNESS_MAX = float(roughness.roughness_for_width(60.0))
+"""The roughest lobe the panel offers (0.856: 60 degrees wide); beyond it the Layered tier's
+film lobe breaks the white furnace (docs/stability.md, the "rougher" regime)."""
+FILM_ROUGHNESS_MIN = float(roughness.roughness_for_width(1.0))
+"""The smoothest film gloss (0.147: a lobe 1 degree wide)."""
+SKIN_ROUGHNESS_MIN = 0.5
+"""The smoothest skin gloss (a lobe 12 degrees wide): path 3 goes through the skin's gloss, so
+a narrower lobe scales the bake's grids (``bake.path3_width_deg``); at 0.5 a first Apply still
+takes under a second (docs/addon.md, "Skin Roughness")."""
+
+
 # Enum items must stay referenced while Blender shows them.
 _ITEMS_CACHE: dict[str, list] = {}
 
@@ -69,27 +94,64 @@ def _cached(name, function):
     return items
 
 
+def _stamp(settings) -> None:
+    """Mark the settings as of this version (a change made here, not in an older file)."""
+    if settings.settings_version != SETTINGS_VERSION or not settings.is_property_set(
+            "settings_version"):
+        settings.settings_version = SETTINGS_VERSION
+
+
 def _update_sockets(self, context):
+    _stamp(self)
     live.sockets_changed(self)
 
 
 def _update_tables(self, context):
+    _stamp(self)
     live.tables_changed(self)
+
+
+def _update_absorption(self, context):
+    if not shade.is_assigning():
+        with shade.assigning():
+            self.shade_colour = [float(c) for c in shade.colour_seen(self.absorption)]
+            self.shade_note = ""
+            self.shade_source = "USER"
+    _update_sockets(self, context)
+
+
+def _update_shade_colour(self, context):
+    if shade.is_assigning():
+        return
+    absorption, clamped = shade.absorption_for_colour(self.shade_colour)
+    with shade.assigning():
+        self.absorption = [float(a) for a in absorption]
+        self.shade_note = shade.colour_note(self.shade_colour, clamped)
+        self.shade_source = "USER"
+    _update_sockets(self, context)
 
 
 def _update_skin(self, context):
     if self.skin in presets.SKINS:
-        # The preset's albedo goes to the socket at once (a linked texture overrides it).
-        self.skin_colour = presets.skin_albedo(self.skin).tolist()
+        with shade.assigning():
+            # The preset's albedo and roughness go to the settings at once (a linked texture
+            # overrides the albedo).
+            self.skin_colour = presets.skin_albedo(self.skin).tolist()
+            self.skin_roughness = shade.skin_roughness(self.skin)
     _update_tables(self, context)
 
 
 def _update_foundation(self, context):
-    entry = presets.FOUNDATIONS.get(self.foundation)
-    if entry is not None:
-        # Assigning runs _update_sockets once more: the shade reaches the material at once.
-        self.absorption = entry["absorption"]
-        self.foundation_colour = [1.0 - a for a in entry["absorption"]]
+    if self.foundation in presets.FOUNDATIONS and not shade.is_assigning():
+        with shade.assigning():
+            # The preset's shade reaches the material at once (its sockets), its colour seen
+            # and its film's own roughness come with it.
+            self.absorption = presets.FOUNDATIONS[self.foundation]["absorption"]
+            self.shade_colour = [float(c) for c in shade.preset_colour(self.foundation)]
+            self.film_roughness = shade.foundation_roughness(self.foundation)
+            self.shade_note = ""
+            self.shade_source = "PRESET"
+        _update_sockets(self, context)
     # The film's gloss, roughness and index change the tables: a debounced preview re-fit.
     _update_tables(self, context)
 
@@ -100,39 +162,71 @@ class MakeupSkinSettings(bpy.types.PropertyGroup):
     is_made_up: bpy.props.BoolProperty(
         name="Made-up Skin Material", default=False,
         description="This material's node tree was made by Apply (internal)")
+    settings_version: bpy.props.IntProperty(
+        name="Settings Version", default=SETTINGS_VERSION, min=0,
+        description="What the settings mean (internal: files of older add-ons are upgraded "
+                    "when opened)")
     foundation: bpy.props.EnumProperty(
         name="Foundation", items=_cached("foundation", _foundation_items),
-        description="Foundation preset: the paper's measured film and its shades",
+        description="Foundation preset: the paper's measured film, its shades and measured "
+                    "products (sets the shade, and the film's gloss and roughness)",
         update=_update_foundation)
     skin: bpy.props.EnumProperty(
         name="Skin", items=_cached("skin", _skin_items),
         description="Skin under the film: the paper's bio-plate or measured human skin (sets "
-                    "Skin Color to its albedo)",
+                    "Skin Color to its albedo and Skin Roughness to its own)",
         update=_update_skin)
     coverage: bpy.props.FloatProperty(
-        name="Coverage", default=1.0, min=0.0, max=1.0, subtype="FACTOR",
-        description="Fraction of the surface the film covers (0 bare skin, 1 full film); link "
-                    "a texture to the group's Coverage socket to paint it",
+        name="Coverage", default=0.6, min=0.0, max=1.0, subtype="FACTOR",
+        description="Fraction of the surface the film covers (0 bare skin, 1 full film; 0.6 "
+                    "lets the skin read through); link a texture to the group's Coverage "
+                    "socket to paint it",
         update=_update_sockets)
     absorption_mode: bpy.props.EnumProperty(
-        name="Shade By", items=(("ABSORPTION", "Absorption", "Pigment absorption per channel"),
-                                ("COLOUR", "Colour", "Colour the pigment passes (1 - absorption)")),
-        default="ABSORPTION", update=_update_sockets)
+        name="Shade By", items=(
+            ("ABSORPTION", "Absorption", "Pigment absorption per channel"),
+            ("COLOUR", "Colour", "The colour the foundation has in the bottle or as a swatch "
+                                 "(linear; sample a product photo with the picker)")),
+        default="COLOUR", update=_update_sockets)
     absorption: bpy.props.FloatVectorProperty(
         name="Absorption", size=3, default=(0.0, 0.0, 0.0), min=0.0, max=1.0, subtype="NONE",
         description="Fraction of the light crossing the film's pigment absorbed, per R, G, B "
-                    "(the foundation's shade)", update=_update_sockets)
+                    "(the foundation's shade)", update=_update_absorption)
+    shade_colour: bpy.props.FloatVectorProperty(
+        name="Foundation Colour", size=3, min=0.0, max=1.0, subtype="COLOR",
+        default=tuple(float(c) for c in shade.colour_seen((0.0, 0.0, 0.0))),
+        description="The colour of a thick layer of the foundation (in the bottle, a swatch on "
+                    "a card), linear: the absorption is solved so that the film stacked on "
+                    "itself has it; colours the film cannot reach are clamped (the panel says "
+                    "so)", update=_update_shade_colour)
     foundation_colour: bpy.props.FloatVectorProperty(
-        name="Foundation Colour", size=3, default=(1.0, 1.0, 1.0), min=0.0, max=1.0,
-        subtype="COLOR", description="Colour the pigment lets through (1 - absorption)",
-        update=_update_sockets)
+        name="Colour Passed (old)", size=3, default=(1.0, 1.0, 1.0), min=0.0, max=1.0,
+        subtype="COLOR", description="Files of older versions: the colour the pigment let "
+                                     "through (1 - absorption); upgraded when opened")
+    shade_note: bpy.props.StringProperty(
+        name="Shade Note", default="",
+        description="What the last colour pick or match could not reach (internal, shown)")
+    shade_source: bpy.props.EnumProperty(
+        name="Shade Source", items=(
+            ("DEFAULT", "Default", "Never chosen: the first Apply matches the skin"),
+            ("PRESET", "Preset", "The foundation preset's"),
+            ("MATCH", "Match Skin", "Matched to the skin, or stepped from there"),
+            ("USER", "User", "Set by hand")),
+        default="DEFAULT", description="Where the shade came from (internal)")
     skin_colour: bpy.props.FloatVectorProperty(
         name="Skin Color", size=3, min=0.0, max=1.0,
         default=_first_skin_albedo(),
         subtype="COLOR",
-        description="The skin's diffuse albedo (the skin preset's by default); an albedo "
-                    "texture linked to the group's Skin Color input replaces it",
+        description="The skin's diffuse albedo (the skin preset's by default, or the value of "
+                    "the artist's Base Color); an albedo texture linked to the group's Skin "
+                    "Color input replaces it",
         update=_update_sockets)
+    skin_roughness: bpy.props.FloatProperty(
+        name="Skin Roughness", default=shade.skin_roughness(FIRST_SKIN),
+        min=SKIN_ROUGHNESS_MIN, max=ROUGHNESS_MAX, subtype="FACTOR",
+        description="Roughness of the skin's gloss, as Blender shows roughness (the skin "
+                    "preset's by default); the gloss keeps its strength, only its spread "
+                    "changes", update=_update_tables)
     subsurface_scale: bpy.props.FloatProperty(
         name="Subsurface Scale", default=1.0, min=0.0, soft_max=4.0, max=100.0,
         description="Multiplies the subsurface radius fitted to the skin's measured profile "
@@ -144,20 +238,35 @@ class MakeupSkinSettings(bpy.types.PropertyGroup):
                     "as measured, 0 leaves them out and Cycles allocates none (cheaper; Fit "
                     "to Scene sets 0 when the gloss is below the noise)",
         update=_update_sockets)
+    film_roughness: bpy.props.FloatProperty(
+        name="Film Roughness", default=shade.foundation_roughness(FIRST_FOUNDATION),
+        min=FILM_ROUGHNESS_MIN, max=ROUGHNESS_MAX, subtype="FACTOR",
+        description="Roughness of the film's surface gloss, as Blender shows roughness (the "
+                    "foundation's own by default, reset by choosing it); the gloss keeps its "
+                    "strength, the light crossing the film keeps the foundation's spread. A "
+                    "matte product has no surface gloss: nothing to roughen",
+        update=_update_tables)
     override_film: bpy.props.BoolProperty(
-        name="Override Film", default=False,
-        description="Replace the film's measured roughness and index of refraction",
+        name="Override Film IOR", default=False,
+        description="Replace the film's measured index of refraction",
         update=_update_tables)
     film_lobe_width: bpy.props.FloatProperty(
-        name="Film Roughness", default=math.radians(30.4), min=math.radians(5.0),
+        name="Film Lobe Width (old)", default=math.radians(30.4), min=math.radians(5.0),
         max=math.radians(60.0), subtype="ANGLE", unit="ROTATION",
-        description="Width of the film's surface gloss (1/n of the paper's Torrance-Sparrow "
-                    "lobe; measured 30.4 degrees); the light crossing the film keeps the "
-                    "foundation's spread",
-        update=_update_tables)
+        description="Files of older versions: the film's gloss width in degrees, with Override "
+                    "Film; upgraded to Film Roughness when opened")
     film_ior: bpy.props.FloatProperty(
         name="Film IOR", default=1.19, min=1.01, max=2.5,
         description="Film index of refraction (measured 1.19)", update=_update_tables)
+    film_follows_pores: bpy.props.BoolProperty(
+        name="Film Follows Pores", default=True,
+        description="The film takes a weaker copy of the skin's normal map (the pores show "
+                    "through, softened); off: a smooth film that fills the pores",
+        update=_update_sockets)
+    film_normal_strength: bpy.props.FloatProperty(
+        name="Film Normal Strength", default=0.5, min=0.0, max=1.0, subtype="FACTOR",
+        description="Strength of the film's normal map relative to the skin's",
+        update=_update_sockets)
     subsurface_method: bpy.props.EnumProperty(
         name="Subsurface", items=SUBSURFACE_ITEMS, default="AUTO",
         description="Blender subsurface method (its radius is fitted to the skin's profile)",
@@ -173,9 +282,7 @@ class MakeupSkinSettings(bpy.types.PropertyGroup):
         description="Re-bake at preview resolution while sliders move (Apply bakes in full)")
 
     def effective_absorption(self):
-        """Absorption per channel, from the absorption or the colour field."""
-        if self.absorption_mode == "COLOUR":
-            return [1.0 - c for c in self.foundation_colour]
+        """Absorption per channel (a picked colour is solved into it when picked)."""
         return list(self.absorption)
 
 

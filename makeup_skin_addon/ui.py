@@ -12,7 +12,8 @@ import json
 import bpy
 
 from . import material as made_up
-from . import on_load, scene_fit
+from . import on_load, scene_fit, shade
+from .core import presets
 from .keys import AUTO_KEY, CLASS_PREFIX, ERRORS_KEY, FIT_KEY
 from .operators import (
     MAKEUPSKIN_MT_presets,
@@ -20,7 +21,9 @@ from .operators import (
     MAKEUPSKIN_OT_apply,
     MAKEUPSKIN_OT_check_tables,
     MAKEUPSKIN_OT_fit_to_scene,
+    MAKEUPSKIN_OT_match_skin,
     MAKEUPSKIN_OT_revert,
+    MAKEUPSKIN_OT_shade_step,
 )
 
 __all__ = ["MAKEUPSKIN_PT_material", "MAKEUPSKIN_PT_node_editor", "draw_settings", "draw_fit",
@@ -57,6 +60,45 @@ def node_input_linked(node, name: str) -> bool:
     return bool(socket is not None and socket.is_linked)
 
 
+def _draw_shade(col, settings) -> None:
+    """Shade By, the colour or the absorption, Match Skin and the steps, and what the last
+    pick or match could not reach (stored when it ran: nothing is solved here)."""
+    col.prop(settings, "absorption_mode", expand=True)
+    if settings.absorption_mode == "COLOUR":
+        col.prop(settings, "shade_colour")
+    else:
+        col.prop(settings, "absorption", text="Absorption RGB")
+    row = col.row(align=True)
+    row.operator(MAKEUPSKIN_OT_match_skin.bl_idname, icon="EYEDROPPER")
+    row.operator(MAKEUPSKIN_OT_shade_step.bl_idname, text="Lighter").direction = "LIGHTER"
+    row.operator(MAKEUPSKIN_OT_shade_step.bl_idname, text="Darker").direction = "DARKER"
+    if settings.shade_source == "DEFAULT":
+        col.label(text="Shade: matched to the skin at the first Apply", icon="INFO")
+    elif settings.shade_source == "MATCH":
+        col.label(text="Shade: matched to the skin", icon="INFO")
+    if settings.shade_note:
+        col.label(text=settings.shade_note, icon="ERROR")
+
+
+def _draw_film(col, settings) -> None:
+    """Film Roughness (inactive for a matte product: no surface gloss), the film's normal,
+    the index and its override."""
+    rough = col.row()
+    matte = settings.foundation in presets.FOUNDATIONS and not shade.has_film_gloss(
+        settings.foundation)
+    rough.active = not matte
+    rough.prop(settings, "film_roughness", slider=True,
+               **({"text": "Film Roughness (matte: no gloss)"} if matte else {}))
+    col.prop(settings, "film_follows_pores")
+    strength = col.row()
+    strength.active = settings.film_follows_pores
+    strength.prop(settings, "film_normal_strength", slider=True)
+    col.prop(settings, "override_film")
+    ior = col.row()
+    ior.active = settings.override_film
+    ior.prop(settings, "film_ior")
+
+
 def draw_settings(layout, context) -> None:
     """The panel body, shared by both panels (the active object's material)."""
     obj = context.active_object
@@ -75,26 +117,19 @@ def draw_settings(layout, context) -> None:
     col = layout.column()
     col.prop(settings, "foundation")
     col.prop(settings, "coverage", slider=True)
-    col.prop(settings, "absorption_mode", expand=True)
-    if settings.absorption_mode == "COLOUR":
-        col.prop(settings, "foundation_colour")
-    else:
-        col.prop(settings, "absorption", text="Absorption RGB")
+    _draw_shade(col, settings)
     col.separator()
     col.prop(settings, "skin")
     colour = col.row()
     linked = node_input_linked(made_up.group_of(material), "Skin Color")
     colour.enabled = not linked
     colour.prop(settings, "skin_colour", **({"text": "Skin Color (linked)"} if linked else {}))
+    col.prop(settings, "skin_roughness", slider=True)
     col.prop(settings, "subsurface_scale")
     col.prop(settings, "gloss", slider=True)
     col.prop(settings, "subsurface_method")
     col.separator()
-    col.prop(settings, "override_film")
-    sub = col.column()
-    sub.active = settings.override_film
-    sub.prop(settings, "film_lobe_width")
-    sub.prop(settings, "film_ior")
+    _draw_film(col, settings)
     col.separator()
     col.prop(settings, "tier")
     if settings.tier == "AUTO":

@@ -17,8 +17,7 @@ from support.perturbation import LIMIT, PERTURBATION, movement, perturbed
 from lut_baker import auto_tier
 from lut_baker.closures import fitting
 from lut_baker.closures.view_grid import view_grid
-from lut_baker.model import presets
-from lut_baker.offline import foundation_presets
+from lut_baker.model import presets, thick_layer
 
 MARGIN = 1e-4
 """Smallest margin a discrete choice may have: 100 times the rule's 1e-6, 1e5 times the
@@ -75,14 +74,14 @@ def test_the_glossy_and_profile_fits_move_less_than_the_limit(paper_tables):
 
 def test_solve_absorption_is_determined_by_its_targets():
     """The measured presets' absorption (bisection to 2^-80) from their stack reflectances."""
-    exchange = foundation_presets.film_exchange()
+    exchange = thick_layer.paper_film_exchange()
     targets = np.array([[0.7091498284963302, 0.5294756633239771, 0.4113938637765513],
                         [0.55, 0.4, 0.3]])
-    absorption, clamped = foundation_presets.solve_absorption(targets, exchange)
+    absorption, clamped = thick_layer.solve_absorption(targets, exchange)
     assert not np.any(clamped)
     for seed in range(3):
-        moved, _ = foundation_presets.solve_absorption(perturbed(targets, seed=seed),
-                                                       perturbed(exchange, seed=seed))
+        moved, _ = thick_layer.solve_absorption(perturbed(targets, seed=seed),
+                                                perturbed(exchange, seed=seed))
         assert np.max(np.abs(moved - absorption) / absorption) < LIMIT
 
 

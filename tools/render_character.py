@@ -19,10 +19,10 @@ float EXR beside each only with ``--keep-exr``):
   image (:func:`character.add_coverage_mask`: a bare band and a bare spot, moved on the UVs
   onto the visible face) in the group's Coverage;
 - ``film_normal_unlinked.png``, ``film_normal_soft.png``, ``film_normal_full.png`` -- a
-  close-up of the forehead under a grazing key light, medium beige: Film Normal unlinked (a
-  smooth film over pore-detailed skin), fed by a second Normal Map node on the pore image at
-  strength 0.2 (a softer film bump), and fed by the skin's own normal map (the film follows
-  the pores);
+  close-up of the forehead under a grazing key light, medium beige: Film Normal unlinked (Film
+  Follows Pores off: a smooth film over pore-detailed skin), fed by a second Normal Map node on
+  the pore image at strength 0.2 (a softer film bump), and fed by the skin's own normal map
+  (the film follows the pores);
 - ``character_strip.png`` -- before, the three foundations and the painted coverage side by
   side (composed from the PNGs with numpy, written through a bpy image).
 
@@ -233,8 +233,11 @@ def _film_normal_renders(shoot, material, node) -> list[Path]:
     node.inputs["Coverage"].default_value = 1.0
     skin_normal = _source(node.inputs["Normal"])
     check(skin_normal is not None, "the group's Normal lost its link before the close-up")
+    check(node.inputs["Film Normal"].is_linked,
+           "Film Normal is not linked after Apply (the film should follow the pores, softened)")
+    material.makeup_skin.film_follows_pores = False  # a smooth film: the pores filled
     check(not node.inputs["Film Normal"].is_linked,
-           "Film Normal is linked after Apply (the foundation should fill the pores)")
+           "Film Normal is still linked with Film Follows Pores off")
     pores = tree.nodes["Pores Normal"]
     soft = tree.nodes.new("ShaderNodeNormalMap")
     soft.name = soft.label = "Film Normal (soft)"

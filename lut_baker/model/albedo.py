@@ -16,6 +16,8 @@ Functions
 - :func:`reflection_kernel`, :func:`transmission_kernel`, :func:`layer_fourier_kernel` -- a
   layer's kernel and its cosine coefficients between two polar grids.
 - :func:`transmission_rows` -- the film's coefficients from outer angles to the grid's nodes.
+- :func:`bihemispherical` -- a directional albedo averaged over uniform (cosine-weighted)
+  incident light.
 - :func:`grid_for` -- the hemisphere grid that resolves the narrowest lobe of some layers.
 - :func:`with_channel_axis`, :func:`drop_channel_axis` -- the channel axis of scalar layers.
 """
@@ -28,6 +30,7 @@ from ..numerics.geometry import direction
 from ..numerics.quadrature import (
     HemisphereGrid,
     fourier_kernel,
+    gauss_legendre,
     hemisphere_grid,
     mirror_quadrature,
     order0_integral,
@@ -51,6 +54,8 @@ __all__ = [
     "transmission_kernel",
     "layer_fourier_kernel",
     "transmission_rows",
+    "bihemispherical",
+    "BIHEMISPHERICAL_NODES",
     "grid_for",
     "with_channel_axis",
     "drop_channel_axis",
@@ -176,3 +181,18 @@ def transmission_albedo(theta_i_deg, cosmetic: TransmissionLayer, *, level: int 
     """Directional transmittance of the film at incidence ``theta_i_deg`` (degrees)."""
     theta = np.radians(np.asarray(theta_i_deg, float))
     return film_transmittance(direction(theta, 0.0), cosmetic, level=level)
+
+
+BIHEMISPHERICAL_NODES = 48
+"""Gauss-Legendre nodes in ``cos(theta)`` of :func:`bihemispherical`."""
+
+
+def bihemispherical(directional, nodes: int = BIHEMISPHERICAL_NODES) -> np.ndarray:
+    """``2 Int_0^1 a(mu) mu dmu``: the directional albedo ``directional(theta_deg)`` (degrees
+    in, ``(N,)`` or ``(N, C)`` out) averaged over uniform, cosine-weighted incident light (the
+    bihemispherical albedo; by reciprocity also the mean radiance a convex object shows under a
+    uniform white sky)."""
+    mu, w = gauss_legendre(nodes, 0.0, 1.0)
+    values = np.asarray(directional(np.degrees(np.arccos(mu))), dtype=float)
+    weight = (2.0 * w * mu).reshape((-1,) + (1,) * (values.ndim - 1))
+    return np.sum(weight * values, axis=0)

@@ -40,6 +40,8 @@ __all__ = [
     "FOUNDATIONS",
     "MEASURED_FOUNDATIONS_FILE",
     "read_measured_foundations",
+    "read_measured_film_exchange",
+    "MEASURED_FILM_EXCHANGE",
     "SKINS",
     "paper",
     "paper_layers",
@@ -78,16 +80,33 @@ thick layers"), written by ``python -m lut_baker foundations``."""
 
 
 def read_measured_foundations(path: Path) -> dict[str, dict]:
-    """The entries of the measured presets' file: label, absorption and the film's gloss
-    ``{"P_s", "n", "eta"}`` (1/sr, 1/degree, -) per product."""
+    """The entries of the measured presets' file: label, absorption, the film's gloss
+    ``{"P_s", "n", "eta"}`` (1/sr, 1/degree, -) and ``colour``, the measured thick layer's
+    colour under uniform light (linear Rec.709: what the product looks like in the bottle, the
+    target its absorption was solved for) per product."""
     if not path.is_file():
         return {}
     entries = json.loads(path.read_text(encoding="utf-8"))["foundations"]
     return {name: {"absorption": tuple(float(a) for a in entry["absorption"]),
                    "label": str(entry["label"]),
-                   "film": {key: float(entry["film"][key]) for key in ("P_s", "n", "eta")}}
+                   "film": {key: float(entry["film"][key]) for key in ("P_s", "n", "eta")},
+                   "colour": tuple(float(c) for c in entry["target"])}
             for name, entry in entries.items()}
 
+
+def read_measured_film_exchange(path: Path) -> dict | None:
+    """The film exchange ``{"r_gloss", "r_diffuse", "t_0"}`` the measured presets were derived
+    with (:func:`lut_baker.model.thick_layer.paper_film_exchange`, stored beside them), or None
+    without a preset file."""
+    if not path.is_file():
+        return None
+    stored = json.loads(path.read_text(encoding="utf-8")).get("film_exchange")
+    return None if stored is None else {key: float(stored[key])
+                                        for key in ("r_gloss", "r_diffuse", "t_0")}
+
+
+MEASURED_FILM_EXCHANGE = read_measured_film_exchange(MEASURED_FOUNDATIONS_FILE)
+"""The film exchange the shipped measured presets were derived with, or None."""
 
 # An entry's optional "film" replaces the paper film's top-surface lobe (P_s, n, eta of eq. 2);
 # P_d and the transmission (eq. 4) stay the paper film's.

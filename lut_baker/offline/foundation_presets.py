@@ -25,14 +25,14 @@ The result is written to :data:`PRESET_FILE` (``lut_baker/model/measured_foundat
 which :mod:`lut_baker.model.presets` reads at import; ``python -m lut_baker foundations``
 rewrites it.
 
+The thick layer itself (the film's exchange under uniform light, the stack, the solve) is the
+runtime's :mod:`lut_baker.model.thick_layer`, which the add-on also uses to read a picked
+colour: each formula exists once, and a measured product's own colour picked in the panel gives
+back its preset.
+
 Functions and types
 -------------------
 - :data:`PRESET_FILE` -- where the runtime reads the derived presets.
-- :func:`bihemispherical` -- a directional albedo averaged over uniform incident light.
-- :class:`FilmExchange` -- the paper film's ``r_gloss``, ``r_diffuse``, ``t_0``.
-- :func:`film_exchange` -- those three from the paper's normalised film.
-- :func:`stack_reflectance` -- ``R_inf(A)``, the film stacked on itself without end.
-- :func:`solve_absorption` -- ``A`` per channel reproducing a target ``R_inf`` (bisection).
 - :func:`preset_gloss` -- the preset's top-surface lobe from a product's fit.
 - :func:`lobe_determined`, :func:`auto_finish` -- matte or dewy from the fit itself.
 - :func:`derive_preset`, :func:`derive_presets` -- one or all products' preset entries.
@@ -42,26 +42,24 @@ Functions and types
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
-from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
 
-from ..model.albedo import reflection_albedo, transmission_albedo
+from ..model.albedo import bihemispherical, reflection_albedo
 from ..model.layers import ReflectionLayer
 from ..model.presets import MEASURED_FOUNDATIONS_FILE, paper
-from ..numerics.quadrature import gauss_legendre
+from ..model.thick_layer import (
+    FilmExchange,
+    paper_film_exchange,
+    solve_absorption,
+    stack_reflectance,
+)
 from .atomic_files import write_text
 
 __all__ = [
     "PRESET_FILE",
     "LUMINANCE_WEIGHTS",
-    "bihemispherical",
-    "FilmExchange",
-    "film_exchange",
-    "stack_reflectance",
-    "solve_absorption",
     "preset_gloss",
     "LOBE_STDERR_LIMIT",
     "lobe_determined",
@@ -78,87 +76,9 @@ PRESET_FILE = MEASURED_FOUNDATIONS_FILE
 LUMINANCE_WEIGHTS = np.array([0.2126, 0.7152, 0.0722])
 """Rec.709 luminance weights: how a dewy product's per-channel lobes become one."""
 
-QUADRATURE_NODES = 48
-"""Gauss-Legendre nodes in ``cos(theta)`` of :func:`bihemispherical`."""
-
 LOBE_STDERR_LIMIT = 0.10
 """A channel's lobe counts as determined when the standard error of its roughness ``n`` is at
 most this fraction of ``n`` (the fits' own limit, ``layer_fit.Limits.relative_stderr``)."""
-
-BISECTION_STEPS = 80
-"""Bisection steps of :func:`solve_absorption` (the interval halves each time: 2^-80)."""
-
-
-def bihemispherical(directional, nodes: int = QUADRATURE_NODES) -> np.ndarray:
-    """``2 Int_0^1 a(mu) mu dmu``: the directional albedo ``directional(theta_deg)`` (array in,
-    ``(N,)`` or ``(N, C)`` out) averaged over uniform (cosine-weighted) incident light."""
-    mu, w = gauss_legendre(nodes, 0.0, 1.0)
-    values = np.asarray(directional(np.degrees(np.arccos(mu))), dtype=float)
-    weight = (2.0 * w * mu).reshape((-1,) + (1,) * (values.ndim - 1))
-    return np.sum(weight * values, axis=0)
-
-
-@dataclass(frozen=True)
-class FilmExchange:
-    """The film's bihemispherical reflectance split into its gloss ``r_gloss`` (not absorbed)
-    and diffuse ``r_diffuse = pi P_d`` parts, and its transmittance ``t_0`` (docs/model.md §4,
-    no absorption)."""
-
-    r_gloss: float
-    r_diffuse: float
-    t_0: float
-
-    def r(self, absorption):
-        """``r(A) = r_gloss + (1 - A) r_diffuse``."""
-        return self.r_gloss + (1.0 - np.asarray(absorption, float)) * self.r_diffuse
-
-    def t(self, absorption):
-        """``t(A) = (1 - A) t_0``."""
-        return (1.0 - np.asarray(absorption, float)) * self.t_0
-
-
-@lru_cache(maxsize=1)
-def film_exchange() -> FilmExchange:
-    """:class:`FilmExchange` of the paper's normalised film (docs/model.md §4, §5); computed
-    once (about a second of quadrature) and shared."""
-    base = paper()
-    gloss = base.film.scaled(P_d=0.0)
-    return FilmExchange(
-        r_gloss=float(bihemispherical(lambda t: reflection_albedo(t, gloss))),
-        r_diffuse=float(np.pi * base.film.P_d),
-        t_0=float(bihemispherical(lambda t: transmission_albedo(t, base.film_transmission))),
-    )
-
-
-def stack_reflectance(absorption, exchange: FilmExchange) -> np.ndarray:
-    """``R_inf(A)``: the film stacked on itself without end (the adding equation's fixed point,
-    the root below 1 of ``r R^2 - (1 + r^2 - t^2) R + r = 0``)."""
-    r = exchange.r(absorption)
-    t = exchange.t(absorption)
-    b = 1.0 + r**2 - t**2
-    disc = np.sqrt(np.maximum(b**2 - 4.0 * r**2, 0.0))
-    # 2r / (b + sqrt(...)) is the smaller root without cancellation; r = 0 gives 0.
-    return 2.0 * r / (b + disc)
-
-
-def solve_absorption(target, exchange: FilmExchange) -> tuple[np.ndarray, np.ndarray]:
-    """``(A, clamped)`` per entry of ``target``: ``R_inf(A) = target`` by bisection on [0, 1]
-    (``R_inf`` falls with ``A``).  Targets above ``R_inf(0)`` give ``A = 0``, below
-    ``R_inf(1) = r_gloss`` give ``A = 1``; ``clamped`` marks them."""
-    target = np.asarray(target, dtype=float)
-    low = np.zeros_like(target)
-    high = np.ones_like(target)
-    for _ in range(BISECTION_STEPS):
-        mid = 0.5 * (low + high)
-        above = stack_reflectance(mid, exchange) > target
-        low = np.where(above, mid, low)
-        high = np.where(above, high, mid)
-    absorption = 0.5 * (low + high)
-    clamped = (target > stack_reflectance(0.0, exchange)) | (
-        target < stack_reflectance(1.0, exchange))
-    absorption = np.where(target > stack_reflectance(0.0, exchange), 0.0, absorption)
-    absorption = np.where(target < stack_reflectance(1.0, exchange), 1.0, absorption)
-    return absorption, clamped
 
 
 def preset_gloss(layers, finish: str) -> dict:
@@ -212,7 +132,7 @@ def derive_preset(name: str, finish: str, layers, exchange: FilmExchange | None 
     layers' bihemispherical reflectance per channel), ``stack`` (``R_inf`` at the solved
     absorption) and ``clamped``."""
     _check_layers(layers)
-    exchange = exchange or film_exchange()
+    exchange = exchange or paper_film_exchange()
     target = np.array([float(bihemispherical(lambda t, layer=layer: reflection_albedo(t, layer)))
                        for layer in layers])
     absorption, clamped = solve_absorption(target, exchange)
@@ -231,14 +151,14 @@ def derive_preset(name: str, finish: str, layers, exchange: FilmExchange | None 
 
 def derive_presets(fits: dict) -> dict:
     """Preset entries for ``fits``: product name -> ``(finish, layers)``, in that order."""
-    exchange = film_exchange()
+    exchange = paper_film_exchange()
     return {name: derive_preset(name, finish, layers, exchange)
             for name, (finish, layers) in fits.items()}
 
 
 def write_presets(presets: dict, path=PRESET_FILE) -> Path:
     """Write the entries with the film exchange they were derived with, as JSON."""
-    exchange = film_exchange()
+    exchange = paper_film_exchange()
     document = {
         "about": "Foundation presets derived from the measured thick layers of Lanza et al. "
                  "2024 (docs/model.md §4, 'Presets from measured thick layers'). Generated by "

@@ -34,8 +34,9 @@ from pathlib import Path
 import numpy as np
 
 from ..model.albedo import reflection_albedo
+from ..model.thick_layer import paper_film_exchange, stack_reflectance
 from .atomic_files import replacing, write_text
-from .foundation_presets import derive_presets, film_exchange, stack_reflectance, write_presets
+from .foundation_presets import derive_presets, write_presets
 from .measured.inplane import InPlaneData, read_inplane
 from .measured.inplane_fit import (
     CHANNELS,
@@ -334,7 +335,7 @@ def _triple(values, digits: int = 3) -> str:
 
 
 def _preset_section(presets: dict) -> list[str]:
-    exchange = film_exchange()
+    exchange = paper_film_exchange()
     out = ["## Presets for the model: the thin film each thick layer implies", "",
            "Written to lut_baker/model/measured_foundations.json, which the presets read "
            "(docs/model.md §4, \"Presets from measured thick layers\"). The film keeps the "

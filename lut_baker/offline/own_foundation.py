@@ -39,7 +39,8 @@ import json
 from dataclasses import dataclass
 from pathlib import Path
 
-from .foundation_presets import auto_finish, derive_preset, film_exchange, stack_reflectance
+from ..model.thick_layer import paper_film_exchange, stack_reflectance
+from .foundation_presets import auto_finish, derive_preset
 from .measured.inplane import SPECTRAL_SAMPLES, InPlaneData, read_inplane
 from .measured.inplane_fit import CHANNELS, ChannelFits, ModelChoice, well_posed
 
@@ -187,7 +188,7 @@ def _header(result: OwnFoundation, command: str | None) -> list[str]:
               else "3 linear RGB values per row")
     incidences = ", ".join(f"{v:g}" for v in data.incidences_deg)
     preset = result.preset
-    exchange = film_exchange()
+    exchange = paper_film_exchange()
     top = float(stack_reflectance(0.0, exchange))
     lines = [command] if command else []
     lines += [

@@ -43,3 +43,29 @@ def test_choosing_a_foundation_updates_its_gloss_live(sphere):
     assert dewy["parameters"]["film"] != matte["parameters"]["film"]
     assert dewy["parameters"]["film"]["P_s"] > 0.0 == matte["parameters"]["film"]["P_s"]
     assert dewy["glossy"]["film_gloss"] != matte["glossy"]["film_gloss"]
+
+
+def test_roughness_moves_the_gloss_live_and_a_picked_colour_at_once(sphere):
+    """Film and Skin Roughness re-fit the preview (the film's and the skin's lobe in the bake);
+    a colour picked sets the group's absorption at once, with no re-bake."""
+    from support.addon_steps import counts
+
+    from makeup_skin_addon import live, nodes
+    from makeup_skin_addon import material as made_up
+
+    material, _ = apply_pipeline(sphere, "LAYERED", resolution="preview")
+    settings = material.makeup_skin
+    before = nodes.read_meta(made_up.group_of(material).node_tree)["parameters"]
+    settings.film_roughness = 0.4
+    settings.skin_roughness = 0.55
+    assert material.name in live.pending()
+    live.flush()
+    after = nodes.read_meta(made_up.group_of(material).node_tree)["parameters"]
+    assert after["film"]["n"] > before["film"]["n"] and after["skin"]["n"] > before["skin"]["n"]
+    groups = counts()[0]
+    settings.absorption_mode = "COLOUR"
+    settings.shade_colour = presets.FOUNDATIONS["clarins_108"]["colour"]
+    node = made_up.group_of(material)
+    assert tuple(node.inputs["Foundation Absorption"].default_value)[:3] == pytest.approx(
+        presets.FOUNDATIONS["clarins_108"]["absorption"], abs=1e-6)
+    assert not live.pending() and counts()[0] == groups

@@ -102,3 +102,49 @@ def test_a_file_without_a_made_up_material_is_left_alone(addon, blank_scene, tmp
     assert "Made-up Skin look-alike" in bpy.data.node_groups  # no record: not the add-on's
     assert on_load.damaged_groups() == {} and on_load.repair_file(bpy.context) == []
     assert on_load.notice(bpy.data.materials["Someone's material"]) is None
+
+
+def test_settings_of_an_older_file_are_upgraded(sphere, tmp_path):
+    """A file of the previous version (its settings as that version stored them: no settings
+    version, Shade By Colour meaning the colour the pigment passes, the film's width in degrees
+    under Override Film, Coverage and Shade By left at their old defaults 1 and Absorption):
+    opened, the settings mean what they meant, and Apply's sockets are those it had."""
+    import math
+
+    import bpy
+
+    from lut_baker.model import roughness
+    from makeup_skin_addon.keys import SETTINGS_VERSION
+
+    material, _ = apply_pipeline(sphere, "PRINCIPLED")
+    settings = material.makeup_skin
+    settings.live_update = False
+    settings.absorption_mode = "COLOUR"
+    settings.foundation_colour = (0.9, 0.8, 0.7)
+    settings.override_film = True
+    settings.film_lobe_width = math.radians(20.0)
+    node = material.node_tree.nodes["Made-up Skin"]
+    node.inputs["Coverage"].default_value = 1.0
+    node.inputs["Foundation Absorption"].default_value = (0.1, 0.2, 0.3, 1.0)
+    for name in ("settings_version", "coverage", "film_roughness", "skin_roughness",
+                 "shade_colour"):
+        settings.property_unset(name)
+    path = tmp_path / "old.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(path))
+    bpy.ops.wm.open_mainfile(filepath=str(path))
+    material = bpy.data.materials["Skin"]
+    settings = material.makeup_skin
+    assert settings.settings_version == SETTINGS_VERSION
+    assert settings.is_property_set("settings_version")
+    assert settings.coverage == 1.0
+    assert tuple(settings.absorption) == pytest.approx((0.1, 0.2, 0.3), abs=1e-6)
+    assert settings.film_roughness == pytest.approx(float(roughness.roughness_for_width(20.0)),
+                                                    abs=1e-6)
+    node = material.node_tree.nodes["Made-up Skin"]
+    assert node.inputs["Coverage"].default_value == 1.0
+    assert tuple(node.inputs["Foundation Absorption"].default_value)[:3] == pytest.approx(
+        (0.1, 0.2, 0.3), abs=1e-6)
+    # Opened again, nothing more to upgrade.
+    from makeup_skin_addon import on_load
+
+    assert on_load.upgrade_file() == []

@@ -16,16 +16,24 @@ def test_presets_save_and_load_a_parameter_set(sphere):
     settings.foundation = "deep_mocha"
     settings.coverage = 0.35
     settings.subsurface_scale = 2.5
+    settings.film_roughness, settings.skin_roughness = 0.5, 0.6
+    settings.film_follows_pores = False
     assert bpy.ops.makeup_skin.add_preset(name="Test Shade") == {"FINISHED"}
     folder = bpy.utils.user_resource("SCRIPTS", path=f"presets/{PRESET_SUBDIR}")
     path = f"{folder}/Test_Shade.py"  # Blender's file name for the preset "Test Shade"
     settings.foundation = "light_ivory"
     settings.coverage = 1.0
     settings.subsurface_scale = 1.0
+    settings.film_roughness, settings.skin_roughness = 0.7, 0.7
+    settings.film_follows_pores = True
     assert bpy.ops.script.execute_preset(filepath=path,
                                          menu_idname="MAKEUPSKIN_MT_presets") == {"FINISHED"}
     assert (settings.foundation, settings.coverage, settings.subsurface_scale) == (
         "deep_mocha", pytest.approx(0.35), pytest.approx(2.5))
+    # Saved after the foundation, the roughness it set is overridden as it was saved.
+    assert (settings.film_roughness, settings.skin_roughness) == (pytest.approx(0.5),
+                                                                  pytest.approx(0.6))
+    assert not settings.film_follows_pores
     node = material.node_tree.nodes["Made-up Skin"]
     assert node.inputs["Coverage"].default_value == pytest.approx(0.35)  # live to the socket
 

@@ -16,7 +16,9 @@ def test_unregister_leaves_nothing(addon, bpy_factory):
         return [handler for handlers in lists for handler in handlers
                 if getattr(handler, "__module__", "").startswith("makeup_skin_addon")]
 
-    assert len(ours()) == 8 and hasattr(bpy.types.Material, "makeup_skin")  # + Fit to Scene, Revert
+    # Apply, Revert, Check Tables, Fit to Scene, Match Skin, Shade Step, the preset operator and
+    # menu, two panels.
+    assert len(ours()) == 10 and hasattr(bpy.types.Material, "makeup_skin")
     assert our_handlers() == [on_load.check_on_load]
     addon.unregister()
     try:

@@ -73,14 +73,17 @@ Layered tier's Ashikhmin-Shirley film lobe renders brighter than its replica (br
 
 @pytest.mark.slow
 def test_the_panel_stops_where_the_furnace_holds(stage):
-    """The film lobe width the panel offers ends at 60 degrees: beyond it (90 degrees, the
-    "rougher" regime) the Layered tier renders brighter than the white furnace allows."""
-    import math
-
+    """The roughest lobe the panel offers (Film and Skin Roughness) is 60 degrees wide: beyond
+    it (90 degrees, the "rougher" regime) the Layered tier renders brighter than the white
+    furnace allows."""
     import bpy
 
+    from lut_baker.model import roughness
+
     settings = bpy.types.Material.bl_rna.properties["makeup_skin"].fixed_type
-    assert settings.properties["film_lobe_width"].hard_max <= math.radians(60.0) + 1e-6
+    for name in ("film_roughness", "skin_roughness"):
+        width = float(roughness.lobe_width_deg(settings.properties[name].hard_max))
+        assert width <= 60.0 + 1e-6, name
 
 
 @pytest.mark.slow

@@ -67,3 +67,26 @@ def test_panel_says_when_the_file_was_repaired_on_opening(head, tmp_path):
     layout = RecordingLayout()
     ui.draw_settings(layout, bpy.context)
     assert ("label", on_load.REPAIRED) in layout.drawn
+
+
+def test_panel_shows_the_shade_buttons_and_what_is_out_of_reach(head):
+    """Match Skin, Lighter and Darker beside the shade; after the first Apply matched the head
+    (whose red the film cannot reach) the panel says so in words, read from what Apply
+    stored; a matte product's Film Roughness says it has no gloss to roughen."""
+    import bpy
+
+    from makeup_skin_addon import ui
+
+    material = apply_operator(head)
+    layout = RecordingLayout()
+    ui.draw_settings(layout, bpy.context)
+    assert ("operator", "makeup_skin.match_skin") in layout.drawn
+    assert sum(1 for item in layout.drawn if item[:2] == ("operator", "makeup_skin.shade_step"))\
+        == 2
+    labels = [item[1] for item in layout.drawn if item[0] == "label"]
+    assert "Shade: matched to the skin" in labels
+    assert any(text.startswith("Red out of the film's reach") for text in labels), labels
+    material.makeup_skin.foundation = "clarins_103"
+    layout = RecordingLayout()
+    ui.draw_settings(layout, bpy.context)
+    assert ("prop", "film_roughness", "Film Roughness (matte: no gloss)", True) in layout.drawn

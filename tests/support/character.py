@@ -39,10 +39,17 @@ from support.sphere_scene import cycles_settings
 
 __all__ = ["build_character", "skin_albedo_image", "pore_normal_image", "add_coverage_mask",
            "portrait_camera_and_lights", "albedo_pixels", "pore_normal_pixels",
-           "coverage_pixels", "SKIN_SRGB"]
+           "coverage_pixels", "SKIN_SRGB", "SKIN_TONES"]
 
 SKIN_SRGB = (0.85, 0.64, 0.53)
 """Mean skin tone of the albedo texture, sRGB-encoded (a light-medium warm skin)."""
+SKIN_TONES = {
+    "medium": SKIN_SRGB,
+    "darker": (0.58, 0.40, 0.30),
+    "lighter": (0.92, 0.75, 0.66),
+}
+"""Skin tones of the albedo texture by name (sRGB-encoded): the head's own, a darker (brown)
+and a lighter (fair) skin, for the pictures and figures of Match Skin."""
 
 ALBEDO_SIZE = 512
 NORMAL_SIZE = 1024
@@ -77,12 +84,13 @@ def _rgba(rgb: np.ndarray) -> np.ndarray:
     return out
 
 
-def albedo_pixels(seed: int = 0, size: int = ALBEDO_SIZE) -> np.ndarray:
-    """A skin albedo texture, sRGB-encoded: :data:`SKIN_SRGB` with blotchy variation at two
-    scales, patches of redness, and freckles (small brown spots of varied size and depth)."""
+def albedo_pixels(seed: int = 0, size: int = ALBEDO_SIZE, tone=SKIN_SRGB) -> np.ndarray:
+    """A skin albedo texture, sRGB-encoded: ``tone`` (default :data:`SKIN_SRGB`) with blotchy
+    variation at two scales, patches of redness, and freckles (small brown spots of varied size
+    and depth)."""
     rng = np.random.default_rng([seed, 1])
     scale = size / 512.0
-    tone = np.array(SKIN_SRGB)
+    tone = np.array(tone, float)
     blotch = 0.6 * _smooth_noise(rng, size, 24 * scale) + 0.4 * _smooth_noise(rng, size, 6 * scale)
     rgb = tone * (1.0 + 0.045 * blotch[..., None])
     # Redness: a warm, slightly darker flush where a low-frequency field is high.
@@ -176,16 +184,21 @@ def _packed_image(name: str, pixels: np.ndarray, colorspace: str):
     return image
 
 
-@functools.lru_cache(maxsize=4)
-def _texture_pixels(kind: str, seed: int, size: int) -> np.ndarray:
-    """:func:`albedo_pixels` or :func:`pore_normal_pixels`, generated once per process (~0.35 s
-    for both; a test builds a new head after each fresh file).  Never changed by its callers."""
-    return albedo_pixels(seed, size) if kind == "albedo" else pore_normal_pixels(seed, size)
+@functools.lru_cache(maxsize=8)
+def _texture_pixels(kind: str, seed: int, size: int, tone: str = "medium") -> np.ndarray:
+    """:func:`albedo_pixels` (of the named :data:`SKIN_TONES` tone) or
+    :func:`pore_normal_pixels`, generated once per process (~0.35 s for both; a test builds a
+    new head after each fresh file).  Never changed by its callers."""
+    if kind == "albedo":
+        return albedo_pixels(seed, size, SKIN_TONES[tone])
+    return pore_normal_pixels(seed, size)
 
 
-def skin_albedo_image(seed: int = 0, size: int = ALBEDO_SIZE):
-    """The packed sRGB albedo ``Skin Albedo {seed}`` (:func:`albedo_pixels`), reused by name."""
-    return _packed_image(f"Skin Albedo {seed}", _texture_pixels("albedo", seed, size), "sRGB")
+def skin_albedo_image(seed: int = 0, size: int = ALBEDO_SIZE, tone: str = "medium"):
+    """The packed sRGB albedo ``Skin Albedo {seed}`` (``Skin Albedo {seed} {tone}`` for a tone
+    other than the head's own, :data:`SKIN_TONES`; :func:`albedo_pixels`), reused by name."""
+    name = f"Skin Albedo {seed}" + ("" if tone == "medium" else f" {tone}")
+    return _packed_image(name, _texture_pixels("albedo", seed, size, tone), "sRGB")
 
 
 def pore_normal_image(seed: int = 0, size: int = NORMAL_SIZE):
@@ -204,7 +217,8 @@ def _input(node, name):
     raise KeyError(f"{node.name} has none of the inputs {name!r}")
 
 
-def skin_material(name: str, seed: int = 0, *, normal_strength: float = 0.6):
+def skin_material(name: str, seed: int = 0, *, normal_strength: float = 0.6,
+                  tone: str = "medium"):
     """A new material ``name``: Principled BSDF with Base Color from the albedo texture, Normal
     from a Normal Map node (tangent space, the mesh's UVs) fed by the pore normal map, Roughness
     0.45, Subsurface Weight 0.1 (radius a skin's red-scattering-furthest default, scale 5 mm),
@@ -225,7 +239,7 @@ def skin_material(name: str, seed: int = 0, *, normal_strength: float = 0.6):
     uv.location = (-650, 150)
     albedo = nodes.new("ShaderNodeTexImage")
     albedo.name = albedo.label = "Albedo"
-    albedo.image = skin_albedo_image(seed)
+    albedo.image = skin_albedo_image(seed, tone=tone)
     albedo.location = (-350, 400)
     normal_texture = nodes.new("ShaderNodeTexImage")
     normal_texture.name = normal_texture.label = "Pores Normal"
@@ -252,7 +266,7 @@ def skin_material(name: str, seed: int = 0, *, normal_strength: float = 0.6):
 
 
 def build_character(name: str = "Head", location=(0.0, 0.0, 0.0), size_m: float = 0.2,
-                    seed: int = 0):
+                    seed: int = 0, tone: str = "medium"):
     """Add a textured head to the current scene and return the object.
 
     Suzanne (``primitive_monkey_add`` with UVs), its mesh scaled so its widest extent is
@@ -278,7 +292,7 @@ def build_character(name: str = "Head", location=(0.0, 0.0, 0.0), size_m: float 
     subsurf = obj.modifiers.new("Subdivision", "SUBSURF")
     subsurf.levels = 2
     subsurf.render_levels = 2
-    obj.data.materials.append(skin_material(f"{name} Skin", seed))
+    obj.data.materials.append(skin_material(f"{name} Skin", seed, tone=tone))
     obj.select_set(True)
     bpy.context.view_layer.objects.active = obj
     return obj

@@ -1,7 +1,7 @@
 """Foundation presets from measured thick layers (lut_baker.offline.foundation_presets,
-docs/model.md §4): the stacked film's reflectance (adding equation), the absorption solve
-(monotone, clamped), the gloss per finish, and the stored preset file re-derived from the
-measurements."""
+docs/model.md §4): the gloss per finish, the stored presets against their targets (the thick
+layer of lut_baker.model.thick_layer, tested in tests/lut_baker/model/test_thick_layer.py), and
+the stored preset file re-derived from the measurements."""
 
 import json
 import os
@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 from support import measured_presets
 
-from lut_baker.model import presets
-from lut_baker.model.albedo import reflection_albedo
+from lut_baker.model import presets, thick_layer
+from lut_baker.model.albedo import bihemispherical, reflection_albedo
 from lut_baker.model.layers import ReflectionLayer
 from lut_baker.offline import foundation_presets as FP
 
@@ -24,44 +24,7 @@ PRODUCTS = ("clarins_103", "clarins_105", "clarins_108", "clarins_112")
 
 @pytest.fixture(scope="module")
 def exchange():
-    return FP.film_exchange()
-
-
-def test_the_film_exchange_is_the_paper_films(exchange):
-    film = presets.paper().film
-    assert exchange.r_diffuse == pytest.approx(np.pi * float(film.P_d), rel=1e-14)
-    # The lossless film (K, docs/model.md §4) reflects and transmits at most all it receives.
-    assert 0.9 < exchange.r_gloss + exchange.r_diffuse + exchange.t_0 <= 1.0
-    assert 0.0 < exchange.r_gloss < 0.2 and 0.2 < exchange.t_0 < 0.5
-    # A Lambertian albedo averages to itself.
-    assert FP.bihemispherical(lambda t: np.full(np.shape(t), 0.3)) == pytest.approx(0.3, 1e-14)
-
-
-def test_the_stack_is_the_adding_equations_fixed_point(exchange):
-    absorption = np.linspace(0.0, 1.0, 11)
-    stack = FP.stack_reflectance(absorption, exchange)
-    r, t = exchange.r(absorption), exchange.t(absorption)
-    np.testing.assert_allclose(stack, r + t**2 * stack / (1.0 - r * stack), rtol=1e-12)
-    # Adding film after film converges to it from below.
-    added = r.copy()
-    for _ in range(400):
-        added = r + t**2 * added / (1.0 - r * added)
-    np.testing.assert_allclose(added, stack, rtol=1e-9)
-    assert np.all(np.diff(stack) < 0)  # monotone: more absorption reflects less
-    assert stack[-1] == pytest.approx(exchange.r_gloss, rel=1e-14)  # A = 1: gloss alone
-    assert 0.8 < stack[0] < 1.0
-
-
-def test_the_solve_inverts_the_stack_and_clamps(exchange):
-    top = float(FP.stack_reflectance(0.0, exchange))
-    targets = np.array([exchange.r_gloss + 1e-3, 0.3, 0.5, 0.7, top - 1e-3])
-    absorption, clamped = FP.solve_absorption(targets, exchange)
-    assert not np.any(clamped) and np.all(np.diff(absorption) < 0)
-    np.testing.assert_allclose(FP.stack_reflectance(absorption, exchange), targets,
-                               rtol=0, atol=1e-12)
-    absorption, clamped = FP.solve_absorption([top + 0.05, 0.5 * exchange.r_gloss], exchange)
-    np.testing.assert_array_equal(absorption, [0.0, 1.0])
-    np.testing.assert_array_equal(clamped, [True, True])
+    return thick_layer.paper_film_exchange()
 
 
 def test_the_gloss_per_finish():
@@ -88,12 +51,12 @@ def test_the_stored_presets_reproduce_their_targets(exchange):
     assert tuple(stored) == PRODUCTS
     for name, entry in stored.items():
         absorption = np.array(entry["absorption"])
-        stack = FP.stack_reflectance(absorption, exchange)
+        stack = thick_layer.stack_reflectance(absorption, exchange)
         target = np.array(entry["target"])
         clamped = np.array(entry["clamped"])
         np.testing.assert_allclose(stack, entry["stack"], rtol=1e-12)
         np.testing.assert_allclose(stack[~clamped], target[~clamped], rtol=0, atol=1e-6)
-        assert np.all(target[clamped] > FP.stack_reflectance(0.0, exchange))
+        assert np.all(target[clamped] > thick_layer.stack_reflectance(0.0, exchange))
         assert np.all(absorption[clamped] == 0.0)
         assert np.all((absorption >= 0) & (absorption <= 1))
         assert presets.FOUNDATIONS[name]["absorption"] == tuple(absorption)
@@ -124,7 +87,7 @@ def test_the_stored_presets_are_rederived_from_the_measurements():
     for name, entry in derived.items():
         # The target is the fitted layers' reflectance under uniform light.
         layers = fits[name][1]
-        assert entry["target"][1] == pytest.approx(float(FP.bihemispherical(
+        assert entry["target"][1] == pytest.approx(float(bihemispherical(
             lambda t, layer=layers[1]: reflection_albedo(t, layer))), rel=1e-12)
         # Matte: a fit without lobe, whose target is pi P_d; dewy: a lobe in every channel.
         lobes = [float(layer.P_s) > 0.0 for layer in layers]

@@ -1,0 +1,270 @@
+"""Match Skin on the textured head: the pictures and the figures of docs/addon.md ("Match Skin",
+"A first Apply") and the README.
+
+Usage::
+
+    "$(tools/venv.sh)/bin/python" tools/render_match.py [--out docs/renders/match]
+        [--size 200 --samples 64] [--measure-size 96 --measure-samples 128]
+        [--tones medium darker lighter] [--no-pictures] [--json FILE]
+
+One process, Cycles CPU, view transform Standard, no denoiser.  For each skin tone of
+tests/support/character.py (``SKIN_TONES``: the head's own, a darker and a lighter skin) it
+builds the textured head with its portrait camera and lights and:
+
+- renders ``<tone>_before.png``: the artist's own material (Principled BSDF, albedo texture,
+  pore normal map);
+- presses Apply with every setting at its default: the first Apply matches the shade to the
+  skin (Match Skin: the mean of the albedo texture over the head's faces; it takes the matte
+  film when the skin is darker than the default film's own gloss), Film Normal a weaker copy of
+  the skin's normal map; then renders ``<tone>_<coverage>_pores.png`` at coverage 0.3, 0.6
+  and 1, and ``<tone>_<coverage>_smooth.png`` with Film Follows Pores off (Film Normal
+  unlinked: the film fills the pores);
+- composes ``match_strip.png`` (one row per tone and film normal: before, 0.3, 0.6, 1);
+- measures, under uniform white light (a white world, lamps off: the light the match is
+  exact for) and under the portrait lights, the mean colour over the head's pixels of the
+  model's bare skin (coverage 0) and of the made-up skin at each coverage, and the blotches'
+  contrast: the standard deviation of the luminance of the render divided by the render of
+  the same head with Skin Color at the texture's mean (the albedo texture as the render shows
+  it; same seed, so the noise mostly divides out), at coverage 0, 0.3, 0.6 and 1.
+
+Prints a Markdown table of the figures and writes them to ``--json`` (default
+``<out>/match.json``).  Exits non-zero with a message if a step fails.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+import traceback
+from pathlib import Path
+
+import numpy as np
+
+REPO_ROOT = Path(__file__).resolve().parent.parent
+for _path in (REPO_ROOT, REPO_ROOT / "tests"):
+    if str(_path) not in sys.path:
+        sys.path.insert(0, str(_path))
+
+from support import character, sphere_scene  # noqa: E402  (tests/support/)
+
+__all__ = ["main", "measure_means", "blotch_contrast", "uniform_light", "COVERAGES"]
+
+COVERAGES = (0.3, 0.6, 1.0)
+GROUP_NODE = "Made-up Skin"
+GAP_PX = 4
+LUMINANCE = np.array([0.2126, 0.7152, 0.0722])
+
+
+def _render_rgba(scene, path: Path) -> np.ndarray:
+    """Render to a float EXR (film transparent) and return RGBA, rows bottom-up."""
+    import bpy
+
+    scene.render.film_transparent = True
+    scene.render.image_settings.file_format = "OPEN_EXR"
+    scene.render.image_settings.color_depth = "32"
+    scene.render.filepath = str(path)
+    bpy.ops.render.render(write_still=True)
+    return sphere_scene.image_pixels(path)
+
+
+def _mask(rgba: np.ndarray) -> np.ndarray:
+    return rgba[..., 3] > 0.999
+
+
+def uniform_light(scene, on: bool) -> None:
+    """White world of strength 1 with the lamps hidden (``on``), or the portrait lights back."""
+    world = scene.world.node_tree.nodes["Background"]
+    world.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0) if on else (0.05, 0.05, 0.05,
+                                                                             1.0)
+    for obj in scene.objects:
+        if obj.type == "LIGHT":
+            obj.hide_render = on
+
+
+def measure_means(scene, settings, work: Path, tag: str) -> dict:
+    """Mean colour over the head's pixels at coverage 0 (the model's bare skin) and at
+    :data:`COVERAGES`: ``{coverage: [r, g, b]}``."""
+    means = {}
+    for coverage in (0.0,) + COVERAGES:
+        settings.coverage = coverage
+        rgba = _render_rgba(scene, work / f"{tag}_{coverage}.exr")
+        means[coverage] = rgba[_mask(rgba)][:, :3].mean(axis=0).tolist()
+    return means
+
+
+def blotch_contrast(scene, material, settings, work: Path, tag: str) -> dict:
+    """``{coverage: contrast}``: the standard deviation over the head's pixels of the
+    luminance of the render divided by the render with Skin Color at the texture's mean."""
+    from makeup_skin_addon import shade
+
+    node = material.node_tree.nodes[GROUP_NODE]
+    socket = node.inputs["Skin Color"]
+    source = socket.links[0].from_socket
+    mean = shade.skin_colour(material).rgb
+    contrast = {}
+    for coverage in (0.0,) + COVERAGES:
+        settings.coverage = coverage
+        textured = _render_rgba(scene, work / f"{tag}_tex_{coverage}.exr")
+        material.node_tree.links.remove(socket.links[0])
+        socket.default_value = (*mean, 1.0)
+        flat = _render_rgba(scene, work / f"{tag}_flat_{coverage}.exr")
+        material.node_tree.links.new(source, socket)
+        mask = _mask(textured) & _mask(flat)
+        ratio = (textured[mask][:, :3] @ LUMINANCE) / np.maximum(flat[mask][:, :3] @ LUMINANCE,
+                                                                 1e-6)
+        contrast[coverage] = float(np.std(ratio))
+    return contrast
+
+
+def _save_png(path: Path, scene) -> float:
+    seconds = sphere_scene.render(path)
+    path.with_suffix(".exr").unlink(missing_ok=True)
+    return seconds
+
+
+def _strip(rows, out_path: Path) -> None:
+    """PNG rows (lists of paths) as one image, ``GAP_PX`` white pixels between panels."""
+    import bpy
+
+    panels = [[sphere_scene.image_pixels(p) for p in row] for row in rows]
+    height = panels[0][0].shape[0]
+    width = max(sum(p.shape[1] for p in row) + GAP_PX * (len(row) - 1) for row in panels)
+    total = len(panels) * height + GAP_PX * (len(panels) - 1)
+    image = np.ones((total, width, 4), np.float32)
+    for r, row in enumerate(panels):
+        y = total - (r + 1) * height - r * GAP_PX  # rows are bottom-up
+        x = 0
+        for panel in row:
+            image[y:y + height, x:x + panel.shape[1], :3] = panel[..., :3]
+            x += panel.shape[1] + GAP_PX
+    picture = bpy.data.images.new("match strip", width, total, alpha=False)
+    picture.pixels.foreach_set(image.ravel())
+    picture.filepath_raw = str(out_path)
+    picture.file_format = "PNG"
+    picture.save()
+    bpy.data.images.remove(picture)
+
+
+def run_tone(tone: str, args, out: Path, work: Path) -> dict:
+    """Build the head of one tone, render and measure it (see the module docstring)."""
+    import bpy
+
+    bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
+    scene = bpy.context.scene
+    obj = character.build_character("Head", tone=tone)
+    character.portrait_camera_and_lights(scene, obj, size=args.size, samples=args.samples)
+    material = obj.active_material
+    pictures = {}
+    if args.pictures:
+        pictures["before"] = out / f"{tone}_before.png"
+        _save_png(pictures["before"], scene)
+    settings = material.makeup_skin
+    settings.live_update = False
+    start = time.perf_counter()
+    result = bpy.ops.makeup_skin.apply()
+    apply_s = time.perf_counter() - start
+    if result != {"FINISHED"}:
+        raise RuntimeError(f"Apply on the {tone} head returned {result}")
+    figures = {"tone": tone, "apply_s": apply_s, "foundation": settings.foundation,
+               "absorption": list(settings.absorption), "shade_colour": list(
+                   settings.shade_colour), "note": settings.shade_note,
+               "tier": settings.tier}
+    print(f"render_match: {tone}: first Apply {apply_s:.2f} s, foundation "
+          f"{settings.foundation}, absorption {np.round(settings.absorption, 3).tolist()}"
+          f"{' (' + settings.shade_note + ')' if settings.shade_note else ''}", flush=True)
+    if args.pictures:
+        for follows, label in ((True, "pores"), (False, "smooth")):
+            settings.film_follows_pores = follows
+            for coverage in COVERAGES:
+                settings.coverage = coverage
+                pictures[(coverage, label)] = out / f"{tone}_{coverage:g}_{label}.png"
+                seconds = _save_png(pictures[(coverage, label)], scene)
+                print(f"render_match: {pictures[(coverage, label)].name}: {seconds:.1f} s",
+                      flush=True)
+        settings.film_follows_pores = True
+    scene.render.resolution_x = scene.render.resolution_y = args.measure_size
+    scene.cycles.samples = args.measure_samples
+    for lighting in ("uniform", "portrait"):
+        uniform_light(scene, lighting == "uniform")
+        figures[f"means_{lighting}"] = measure_means(scene, settings, work, f"{tone}_{lighting}")
+        figures[f"blotch_{lighting}"] = blotch_contrast(scene, material, settings, work,
+                                                        f"{tone}_{lighting}")
+    uniform_light(scene, False)
+    figures["pictures"] = {(k if isinstance(k, str) else f"{k[0]:g}_{k[1]}"): str(v)
+                           for k, v in pictures.items()}
+    return figures
+
+
+def _table(results) -> str:
+    lines = ["| skin | foundation | light | bare (coverage 0) | coverage 0.3 | 0.6 | 1 | "
+             "blotch contrast 0 / 0.3 / 0.6 / 1 |",
+             "|---|---|---|---|---|---|---|---|"]
+    for figures in results:
+        for lighting in ("uniform", "portrait"):
+            means = figures[f"means_{lighting}"]
+            bare = np.array(means[0.0] if 0.0 in means else means["0.0"])
+
+            def cell(coverage, bare=bare, means=means):
+                value = np.array(means[coverage] if coverage in means else means[str(coverage)])
+                moved = 100.0 * (value / bare - 1.0)
+                return (", ".join(f"{v:.3f}" for v in value) + " ("
+                        + " / ".join(f"{m:+.1f}%" for m in moved) + ")")
+
+            blotch = figures[f"blotch_{lighting}"]
+            contrast = " / ".join(f"{blotch[c]:.4f}" for c in blotch)
+            lines.append(f"| {figures['tone']} | {figures['foundation']} | {lighting} | "
+                         + ", ".join(f"{v:.3f}" for v in bare) + " | "
+                         + " | ".join(cell(c) for c in COVERAGES) + f" | {contrast} |")
+    return "\n".join(lines)
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--out", type=Path, default=REPO_ROOT / "docs" / "renders" / "match")
+    parser.add_argument("--size", type=int, default=200)
+    parser.add_argument("--samples", type=int, default=64)
+    parser.add_argument("--measure-size", type=int, default=96)
+    parser.add_argument("--measure-samples", type=int, default=128)
+    parser.add_argument("--tones", nargs="+", default=list(character.SKIN_TONES),
+                        choices=list(character.SKIN_TONES))
+    parser.add_argument("--no-pictures", dest="pictures", action="store_false")
+    parser.add_argument("--json", type=Path)
+    args = parser.parse_args(argv)
+    import tempfile
+
+    import bpy  # noqa: F401  (Blender as a module)
+
+    import makeup_skin_addon
+
+    args.out.mkdir(parents=True, exist_ok=True)
+    results = []
+    makeup_skin_addon.register()
+    try:
+        with tempfile.TemporaryDirectory() as work:
+            for tone in args.tones:
+                results.append(run_tone(tone, args, args.out, Path(work)))
+        if args.pictures:
+            rows = []
+            for figures in results:
+                pictures = figures["pictures"]
+                for label in ("pores", "smooth"):
+                    rows.append([Path(pictures["before"])] + [Path(pictures[f"{c:g}_{label}"])
+                                                              for c in COVERAGES])
+            _strip(rows, args.out / "match_strip.png")
+    except Exception:  # noqa: BLE001  (a tool: say what failed and exit non-zero)
+        traceback.print_exc()
+        return 1
+    finally:
+        makeup_skin_addon.unregister()
+    table = _table(results)
+    print(table)
+    path = args.json or args.out / "match.json"
+    path.write_text(json.dumps(results, indent=1, default=str) + "\n")
+    print(f"render_match: figures -> {path}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
