@@ -466,8 +466,8 @@ VIEW_TABLE_SIZE = 64
 def _layering_nodes(roughness: float, eta: float, f0: tuple) -> np.ndarray:
     """:func:`layering_albedo` at :func:`view_table`'s nodes (cached: replicas of one fit
     evaluate it many times)."""
-    f0 = f0[0] if len(f0) == 1 else np.asarray(f0)
-    return layering_albedo(np.linspace(0.0, 1.0, VIEW_TABLE_SIZE), roughness, eta, f0)
+    reflectance = f0[0] if len(f0) == 1 else np.asarray(f0)
+    return layering_albedo(np.linspace(0.0, 1.0, VIEW_TABLE_SIZE), roughness, eta, reflectance)
 
 
 @lru_cache(maxsize=64)
