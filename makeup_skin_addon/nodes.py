@@ -17,16 +17,19 @@ first-order paths (bare skin, and path 3 through the film) as a factor, and the 
 are per unit albedo, so a texture scales them exactly.  What stays the preset's: the subsurface
 radius (fitted to the skin's profile), the skin's gloss and the film.
 
-PRINCIPLED: one Principled BSDF (GGX, coat = the film, specular and base/subsurface = the skin)
-whose inputs follow :func:`lut_baker.closures.fitting.principled_inputs` in math nodes (Gloss
-scales Coat Weight and Specular IOR Level: at 0 ``svm_node_closure_bsdf`` skips the coat,
-``coat_weight > CLOSURE_WEIGHT_CUTOFF``, and the specular, ``eta != 1``).
-LAYERED: Glossy, Diffuse and Subsurface closures weighted as
-:func:`lut_baker.closures.fitting.layered_weights` (Gloss scales the three Glossy colours: a closure
-of weight 0 is never allocated, ``bsdf_alloc``), view-dependent factors read from one float image
-(rows :data:`lut_baker.closures.fitting.LUT_ROWS`) at ``u = cos(theta_o)``, and a Mix Shader by
-Coverage between bare skin and made-up skin: an areal mix of closures, so a painted coverage
-fades out without fringe or halo.
+Each tier's formulas are :mod:`lut_baker.closures.tier_formulas`, emitted as Math and Vector
+Math nodes by :mod:`.node_algebra`: the group computes exactly what the replicas (and so the
+measured errors and the Auto tier) compute.
+PRINCIPLED: one Principled BSDF (GGX, coat = the film, specular and base/subsurface = the skin),
+its sockets :func:`lut_baker.closures.tier_formulas.principled_sockets` (Gloss scales Coat Weight
+and Specular IOR Level: at 0 ``svm_node_closure_bsdf`` skips the coat, ``coat_weight >
+CLOSURE_WEIGHT_CUTOFF``, and the specular, ``eta != 1``).
+LAYERED: the Glossy, Diffuse and Subsurface closures of
+:func:`lut_baker.closures.tier_formulas.view_weighted_closures` (Gloss scales the three Glossy
+colours: a closure of weight 0 is never allocated, ``bsdf_alloc``), view-dependent factors read
+from one float image (rows :data:`lut_baker.closures.view_image.LUT_ROWS`) at ``u =
+cos(theta_o)``, and a Mix Shader by Coverage between bare skin and made-up skin: an areal mix
+of closures, so a painted coverage fades out without fringe or halo.
 
 - :func:`build_group` -- create or rebuild (in place) a group from a fit and its bake record,
   named by :func:`.keys.group_name` (tier, tables key, a forced subsurface method).
@@ -39,11 +42,11 @@ from __future__ import annotations
 import json
 
 import bpy
-import numpy as np
 
 from . import storage
-from .core import fitting
+from .core import fitting, tier_formulas, view_image
 from .keys import FIT_KEY, LEGACY_TABLES_REF, group_name, lut_image_name
+from .node_algebra import Builder, NodeAlgebra, NodeValue, socket
 
 __all__ = ["INPUTS", "NORMAL_INPUTS", "build_group", "read_meta", "write_measured",
            "set_inputs", "socket", "has_interface"]
@@ -76,79 +79,6 @@ NORMAL_INPUTS = ("Normal", "Film Normal")
 """Vector inputs whose value is hidden: unlinked, a closure's Normal is the shading normal
 (Blender leaves a hidden-value group input unlinked inside the group), and the view-angle
 lookups use the Geometry node's normal instead (:func:`_normal_or_shading`)."""
-
-
-def socket(sockets, identifier: str):
-    """A node socket by identifier (display names differ between Blender versions)."""
-    for item in sockets:
-        if item.identifier == identifier:
-            return item
-    raise KeyError(identifier)
-
-
-class _Builder:
-    """Adds nodes to a tree and links them; values may be sockets or constants."""
-
-    def __init__(self, tree):
-        self.tree = tree
-        self.count = 0
-
-    def node(self, kind: str, label: str = "", **props):
-        node = self.tree.nodes.new(kind)
-        node.location = (200 * (self.count // 10) - 400, -160 * (self.count % 10))
-        self.count += 1
-        if label:
-            node.label = label
-        for name, value in props.items():
-            setattr(node, name, value)
-        return node
-
-    def feed(self, target, value):
-        """Link a socket into ``target`` or set its default value."""
-        if isinstance(value, bpy.types.NodeSocket):
-            self.tree.links.new(value, target)
-        elif target.type in ("VECTOR", "RGBA") and np.ndim(value) == 0:
-            n = len(target.default_value)
-            target.default_value = (float(value),) * n
-        elif target.type == "RGBA" and len(value) == 3:
-            target.default_value = (*map(float, value), 1.0)
-        else:
-            target.default_value = value if np.ndim(value) == 0 else tuple(map(float, value))
-
-    def math(self, operation: str, a, b=0.0, label: str = ""):
-        node = self.node("ShaderNodeMath", label, operation=operation)
-        self.feed(node.inputs[0], a)
-        self.feed(node.inputs[1], b)
-        return node.outputs[0]
-
-    def vector(self, operation: str, a, b=(0.0, 0.0, 0.0), label: str = ""):
-        node = self.node("ShaderNodeVectorMath", label, operation=operation)
-        self.feed(socket(node.inputs, "Vector"), a)
-        self.feed(socket(node.inputs, "Vector_001"), b)
-        return node.outputs["Value" if operation in ("DOT_PRODUCT", "LENGTH") else "Vector"]
-
-    def scale(self, vector, factor, label: str = ""):
-        """``vector * factor`` (a float)."""
-        node = self.node("ShaderNodeVectorMath", label, operation="SCALE")
-        self.feed(socket(node.inputs, "Vector"), vector)
-        self.feed(socket(node.inputs, "Scale"), factor)
-        return node.outputs["Vector"]
-
-    def mix_float(self, factor, a, b, label: str = ""):
-        """``a + factor (b - a)``, factor unclamped."""
-        return self._mix("FLOAT", factor, a, b, label)
-
-    def mix_vector(self, factor, a, b, label: str = ""):
-        return self._mix("VECTOR", factor, a, b, label)
-
-    def _mix(self, data_type: str, factor, a, b, label: str):
-        node = self.node("ShaderNodeMix", label, data_type=data_type)
-        node.clamp_factor = False
-        suffix = "Float" if data_type == "FLOAT" else "Vector"
-        self.feed(socket(node.inputs, "Factor_Float"), factor)
-        self.feed(socket(node.inputs, "A_" + suffix), a)
-        self.feed(socket(node.inputs, "B_" + suffix), b)
-        return socket(node.outputs, "Result_" + suffix)
 
 
 def _input_names(group) -> list[str]:
@@ -199,7 +129,7 @@ def has_interface(group) -> bool:
     return _input_names(group) == [name for name, *_ in INPUTS]
 
 
-def _normal_or_shading(build: _Builder, normal, geometry):
+def _normal_or_shading(build: Builder, normal, geometry):
     """The Normal input where linked, else the Geometry node's shading normal: an unlinked
     hidden vector input reads (0, 0, 0) in math nodes, so a length below 0.5 means unlinked
     (a mix at factor 0 returns the shading normal exactly)."""
@@ -207,61 +137,38 @@ def _normal_or_shading(build: _Builder, normal, geometry):
     return build.mix_vector(linked, geometry.outputs["Normal"], normal, label="normal or shading")
 
 
-def _cos_view(build: _Builder, normal, geometry, label: str):
+def _cos_view(build: Builder, normal, geometry, label: str):
     """``max(0, I . N)``: the cosine of the view angle against ``normal``."""
     return build.math("MAXIMUM", build.vector("DOT_PRODUCT", geometry.outputs["Incoming"],
                                               _normal_or_shading(build, normal, geometry)),
                       0.0, label=label)
 
 
-def _common(build: _Builder):
-    """Group input/output nodes and the terms both tiers use."""
+def _group_io(build: Builder):
+    """The group's input and output nodes, the tier formulas' inputs as node values
+    (:class:`lut_baker.closures.tier_formulas.TierInputs`) and the subsurface scale in scene
+    units (Subsurface Scale x Units per mm)."""
     inputs = build.node("NodeGroupInput")
     output = build.node("NodeGroupOutput")
-    w = inputs.outputs["Coverage"]
-    through = build.vector("SUBTRACT", (1.0, 1.0, 1.0), inputs.outputs["Foundation Absorption"],
-                           label="1 - A")
-    through2 = build.vector("MULTIPLY", through, through, label="(1 - A)^2")
-    skin = inputs.outputs["Skin Color"]
-    scale = build.math("MULTIPLY", inputs.outputs["Subsurface Scale"],
-                       inputs.outputs["Units per mm"], label="subsurface scale")
-    return inputs, output, w, through, through2, skin, scale, inputs.outputs["Gloss"]
+    out = inputs.outputs
+    x = tier_formulas.TierInputs(
+        coverage=NodeValue(build, out["Coverage"], False),
+        absorption=NodeValue(build, out["Foundation Absorption"], True),
+        skin_color=NodeValue(build, out["Skin Color"], True),
+        gloss=NodeValue(build, out["Gloss"], False))
+    scale = build.math("MULTIPLY", out["Subsurface Scale"], out["Units per mm"],
+                       label="subsurface scale")
+    return inputs, output, x, scale
 
 
-def _build_principled(build: _Builder, fit, method: str, radius_mm, ior: float):
-    inputs, output, w, through, through2, skin, scale, gloss = _common(build)
-    coat_weight = build.math("MULTIPLY", build.math("MULTIPLY", w, gloss), fit.coat.level,
-                             label="coat weight")
-    made_skin = build.vector("MULTIPLY", build.vector("MULTIPLY", through2, skin),
-                             tuple(fit.transmittance_mean**2), label="skin through film")
-    made_total = build.vector("ADD", build.vector("MULTIPLY", through, tuple(fit.film_albedo)),
-                              build.vector("ADD", made_skin, build.scale(build.vector(
-                                  "MULTIPLY", through2, tuple(fit.gloss_to_diffuse)), gloss)))
-    total = build.mix_vector(w, skin, made_total, label="diffuse albedo")
-    skin_part = build.mix_vector(w, skin, made_skin, label="skin part")
-    e_spec = build.mix_float(w, fit.specular_albedo_mean[0], fit.specular_albedo_mean[1])
-    attenuation = build.math("MULTIPLY",
-                             build.math("SUBTRACT", 1.0, build.math("MULTIPLY", coat_weight,
-                                                                     fit.coat_albedo_mean)),
-                             build.math("SUBTRACT", 1.0, build.math("MULTIPLY", e_spec, gloss)),
-                             label="layer attenuation")
-    base = build.scale(total, build.math("DIVIDE", 1.0, attenuation), label="base colour")
-    share = build.vector("DOT_PRODUCT", build.vector("DIVIDE", skin_part, total),
-                         (1 / 3, 1 / 3, 1 / 3), label="subsurface weight")
-    mean_through2 = build.vector("DOT_PRODUCT", through2, (1 / 3, 1 / 3, 1 / 3))
-    level = build.math("MULTIPLY", build.mix_float(
-        w, fit.specular_bare.level, build.math("MULTIPLY", mean_through2,
-                                               fit.specular_film.level)), gloss,
-        label="specular level")
-    roughness = build.mix_float(w, fit.specular_bare.roughness, fit.specular_film.roughness)
-
+def _build_principled(build: Builder, fit, method: str, radius_mm, ior: float):
+    """One Principled BSDF whose formula sockets are
+    :func:`lut_baker.closures.tier_formulas.principled_sockets` emitted as nodes."""
+    inputs, output, x, scale = _group_io(build)
     bsdf = build.node("ShaderNodeBsdfPrincipled", "Made-up skin", distribution="GGX",
                       subsurface_method=method)
     values = {
-        "Base Color": base, "Roughness": roughness, "IOR": fitting.SPECULAR_IOR,
-        "Specular IOR Level": level, "Coat Weight": coat_weight,
-        "Coat Roughness": fit.coat.roughness,
-        "Coat IOR": fit.coat.ior, "Subsurface Weight": share,
+        **tier_formulas.principled_sockets(fit, x, NodeAlgebra(build)),
         "Subsurface Radius": tuple(map(float, radius_mm)), "Subsurface Scale": scale,
         "Subsurface IOR": ior, "Normal": inputs.outputs["Normal"],
         "Coat Normal": inputs.outputs["Film Normal"],
@@ -272,89 +179,78 @@ def _build_principled(build: _Builder, fit, method: str, radius_mm, ior: float):
     build.tree.links.new(bsdf.outputs[0], output.inputs["Shader"])
 
 
-def _build_layered(build: _Builder, fit, lut, method: str, radius_mm, ior: float):
-    inputs, output, w, through, through2, skin, scale, gloss = _common(build)
-    geometry = build.node("ShaderNodeNewGeometry")
-    film_normal, skin_normal = inputs.outputs["Film Normal"], inputs.outputs["Normal"]
-    # Each row is read at the view angle against the normal of the surface it describes: the
-    # skin's own gloss against the skin's, the film and the light through it against the film's.
-    cos_film = _cos_view(build, film_normal, geometry, "cos theta_o (film)")
-    cos_skin = _cos_view(build, skin_normal, geometry, "cos theta_o (skin)")
+def _lut_rows(build: Builder, lut, coordinates: dict) -> dict:
+    """Every row of the view-angle image ``lut`` (rows :data:`view_image.LUT_ROWS`), read at
+    ``u = coordinates[name]`` (a socket per row name): Linear, EXTEND, as
+    :func:`lut_baker.closures.view_image.sample_lut` reads it.  Colour :class:`NodeValue` by
+    row name."""
     rows = {}
-    for j, name in enumerate(fitting.LUT_ROWS):
+    for j, name in enumerate(view_image.LUT_ROWS):
         coordinate = build.node("ShaderNodeCombineXYZ", f"u = cos, row {name}")
-        build.feed(coordinate.inputs["X"], cos_skin if name == "skin_gloss" else cos_film)
-        build.feed(coordinate.inputs["Y"], (j + 0.5) / len(fitting.LUT_ROWS))
+        build.feed(coordinate.inputs["X"], coordinates[name])
+        build.feed(coordinate.inputs["Y"], (j + 0.5) / len(view_image.LUT_ROWS))
         texture = build.node("ShaderNodeTexImage", name, image=lut, interpolation="Linear",
                              extension="EXTEND")
         build.tree.links.new(coordinate.outputs[0], texture.inputs["Vector"])
-        rows[name] = texture.outputs["Color"]
+        rows[name] = NodeValue(build, texture.outputs["Color"], True)
+    return rows
 
-    def glossy(name, colour, normal):
-        lobe = fit.glossy[name]
-        node = build.node("ShaderNodeBsdfGlossy", name.replace("_", " "),
-                          distribution=lobe.distribution)
-        # Gloss 0: colour 0, a closure Cycles does not allocate (bsdf_alloc's weight cutoff).
-        build.feed(node.inputs["Color"], build.scale(colour, gloss, label=f"{name} x Gloss"))
-        build.feed(node.inputs["Roughness"], lobe.roughness)
-        build.feed(node.inputs["Normal"], normal)
-        return node.outputs[0]
 
-    def subsurface(colour, label):  # the skin's: its normal
-        node = build.node("ShaderNodeSubsurfaceScattering", label, falloff=method)
-        build.feed(socket(node.inputs, "Color"), colour)
-        build.feed(socket(node.inputs, "Radius"), tuple(map(float, radius_mm)))
-        build.feed(socket(node.inputs, "Scale"), scale)
-        build.feed(socket(node.inputs, "IOR"), ior)
-        build.feed(socket(node.inputs, "Normal"), skin_normal)
-        return node.outputs[0]
-
-    def add(a, b):
+def _add(build: Builder, shaders: list):
+    """The sum of shader sockets (Add Shader nodes)."""
+    total = shaders[0]
+    for shader in shaders[1:]:
         node = build.node("ShaderNodeAddShader")
-        build.tree.links.new(a, node.inputs[0])
-        build.tree.links.new(b, node.inputs[1])
-        return node.outputs[0]
+        build.tree.links.new(total, node.inputs[0])
+        build.tree.links.new(shader, node.inputs[1])
+        total = node.outputs[0]
+    return total
 
-    # The film's diffuse and the Lambertian companion of its gloss (closures.fitting.fit_glossy)
-    # share one Diffuse closure: no extra closure to sample.
-    film_diffuse = build.node("ShaderNodeBsdfDiffuse", "film diffuse")
-    companion = build.scale(rows["film_gloss_diffuse"], gloss, label="gloss companion x Gloss")
-    build.feed(film_diffuse.inputs["Color"],
-               build.vector("ADD", build.vector("MULTIPLY", through, tuple(fit.film_albedo)),
-                            companion, label="film diffuse + gloss companion"))
-    build.feed(film_diffuse.inputs["Normal"], film_normal)
-    # The skin seen through the film, per channel (1 - A)^2 T(theta_o) T_mean times the skin:
-    # the closure's colour keeps the skin's own (bright) colour, tinted by that product
-    # relative to its strongest channel, and the strongest channel weights the closure.  A dark
-    # colour instead would make the random walk both noisy (14% against 1% at 32 samples) and
-    # wrongly short.
-    transmitted = build.vector("MULTIPLY", build.vector("MULTIPLY", through2,
-                                                        rows["film_transmittance"]),
-                               tuple(fit.transmittance_mean), label="(1 - A)^2 T(theta_o) T_mean")
-    separate = build.node("ShaderNodeSeparateXYZ", "transmitted channels")
-    build.feed(separate.inputs[0], transmitted)
-    strongest = build.math("MAXIMUM", separate.outputs[0],
-                           build.math("MAXIMUM", separate.outputs[1], separate.outputs[2]))
-    through_colour = build.scale(build.vector("MULTIPLY", transmitted, skin),
-                                 build.math("DIVIDE", 1.0, build.math("MAXIMUM", strongest,
-                                                                      1e-6)),
-                                 label="skin through film colour")
-    through_weight = strongest
-    weighted = build.node("ShaderNodeMixShader", "skin through film (weight)")
-    build.feed(socket(weighted.inputs, "Fac"), through_weight)
-    build.tree.links.new(subsurface(through_colour, "skin through film"),
-                         socket(weighted.inputs, "Shader_001"))
-    made_up = add(add(glossy("film_gloss", rows["film_gloss"], film_normal),
-                      film_diffuse.outputs[0]),
-                  add(glossy("path3_gloss", build.vector("MULTIPLY", rows["path3_gloss"],
-                                                         through2), skin_normal),
-                      weighted.outputs[0]))
-    bare = add(glossy("skin_gloss", rows["skin_gloss"], skin_normal),
-               subsurface(skin, "bare skin"))
+
+def _build_layered(build: Builder, fit, lut, method: str, radius_mm, ior: float):
+    """The closures of :func:`lut_baker.closures.tier_formulas.view_weighted_closures`: a
+    Glossy, Diffuse or Subsurface node per closure, its colour and weight emitted as nodes,
+    each side's closures added, the two sides mixed by Coverage (a Mix Shader: an areal mix,
+    so a painted coverage fades out without fringe or halo)."""
+    inputs, output, x, scale = _group_io(build)
+    geometry = build.node("ShaderNodeNewGeometry")
+    normals = {"film": inputs.outputs["Film Normal"], "skin": inputs.outputs["Normal"]}
+    # Each row is read at the view angle against the normal of the surface it describes.
+    cosines = {surface: _cos_view(build, normal, geometry, f"cos theta_o ({surface})")
+               for surface, normal in normals.items()}
+    rows = _lut_rows(build, lut, {
+        name: cosines[tier_formulas.ROW_SURFACE.get(name, "film")] for name in view_image.LUT_ROWS})
+    closures = tier_formulas.view_weighted_closures(fit, x, NodeAlgebra(build, rows))
+
+    def emit(closure):
+        if closure.kind == "glossy":
+            lobe = fit.glossy[closure.name]
+            node = build.node("ShaderNodeBsdfGlossy", closure.name.replace("_", " "),
+                              distribution=lobe.distribution)
+            build.feed(node.inputs["Roughness"], lobe.roughness)
+        elif closure.kind == "diffuse":
+            node = build.node("ShaderNodeBsdfDiffuse", closure.name)
+        else:
+            node = build.node("ShaderNodeSubsurfaceScattering", closure.name, falloff=method)
+            build.feed(socket(node.inputs, "Radius"), tuple(map(float, radius_mm)))
+            build.feed(socket(node.inputs, "Scale"), scale)
+            build.feed(socket(node.inputs, "IOR"), ior)
+        # A colour of 0 (Gloss 0) is a closure Cycles does not allocate (bsdf_alloc's cutoff).
+        build.feed(socket(node.inputs, "Color"), closure.colour)
+        build.feed(socket(node.inputs, "Normal"), normals[closure.surface])
+        if closure.weight is None:
+            return node.outputs[0]
+        weighted = build.node("ShaderNodeMixShader", f"{closure.name} (weight)")
+        build.feed(socket(weighted.inputs, "Fac"), closure.weight)
+        build.tree.links.new(node.outputs[0], socket(weighted.inputs, "Shader_001"))
+        return weighted.outputs[0]
+
     mix = build.node("ShaderNodeMixShader", "coverage (areal mix)")
-    build.feed(socket(mix.inputs, "Fac"), w)
-    build.tree.links.new(bare, socket(mix.inputs, "Shader"))
-    build.tree.links.new(made_up, socket(mix.inputs, "Shader_001"))
+    build.feed(socket(mix.inputs, "Fac"), closures.coverage)
+    build.tree.links.new(_add(build, [emit(c) for c in closures.bare]),
+                         socket(mix.inputs, "Shader"))
+    build.tree.links.new(_add(build, [emit(c) for c in closures.covered]),
+                         socket(mix.inputs, "Shader_001"))
     build.tree.links.new(mix.outputs[0], output.inputs["Shader"])
 
 
@@ -377,7 +273,7 @@ def build_group(tier: str, bake: dict, fit, group=None, *, method=None, measured
         group.name = name
     _interface(group, fit.skin_albedo)
     group.nodes.clear()
-    build = _Builder(group)
+    build = Builder(group)
     forced = method
     method = method or fit.subsurface_method
     radius = fit.profiles[method].radius_mm

@@ -56,6 +56,7 @@ LAYERS: dict[str, list[tuple[str, ...]]] = {
         ("makeup_skin_addon.storage",),
         ("makeup_skin_addon.fits",),
         ("makeup_skin_addon.shade",),
+        ("makeup_skin_addon.node_algebra",),
         ("makeup_skin_addon.nodes",),
         ("makeup_skin_addon.scene_fit",),
         ("makeup_skin_addon.material",),

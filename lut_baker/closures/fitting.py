@@ -44,13 +44,13 @@ Functions and types
   radii of :func:`profile_grid`.
 - :func:`fit_profile`, :func:`fit_profiles` -- Subsurface Radius per channel for a Blender
   subsurface method, fitted to the radial profile's edge response.
-- :func:`lut_nodes`, :func:`sample_lut` -- the 1-D image's texel centres and its sampling.
 - :class:`LobeFit`, :class:`ProfileFit`, :class:`TierError`, :class:`ClosureFit`.
 - :func:`fit_closures` -- every fit of one set of tables.
 - :func:`principled_inputs`, :func:`principled_tier_reflection` -- the PRINCIPLED tier at a
-  coverage, absorption and Gloss; :func:`layered_weights`, :func:`layered_tier_reflection` --
-  the LAYERED tier; :data:`TIER_REPLICAS` -- both by name; :func:`tier_errors` -- both
-  against the tables.
+  coverage, absorption and Gloss; :func:`layered_tier_reflection` -- the LAYERED tier;
+  :func:`view_weighted_reflection` -- a view-weighted tier's closures as a BRDF (both from
+  :mod:`lut_baker.closures.tier_formulas`, the formulas the node group emits);
+  :data:`TIER_REPLICAS` -- both by name; :func:`tier_errors` -- both against the tables.
 """
 
 from __future__ import annotations
@@ -65,14 +65,19 @@ from ..numerics.optimise import brent_minimum, scanned_least_squares
 from ..numerics.quadrature import trapezoid_weights
 from ..tables.table_set import Tables
 from . import cycles as cc
+from .tier_formulas import (
+    SPECULAR_IOR,
+    NumpyAlgebra,
+    TierInputs,
+    ViewWeightedClosures,
+    principled_sockets,
+    view_weighted_closures,
+)
 from .view_grid import ERROR_VIEWS, FIT_VIEWS, ViewGrid, view_grid
+from .view_image import DEFAULT_LUT_SIZE, LUT_ROWS, lut_nodes, sample_lut
 
 __all__ = [
     "TIERS",
-    "LUT_ROWS",
-    "DEFAULT_LUT_SIZE",
-    "lut_nodes",
-    "sample_lut",
     "LobeFit",
     "ProfileFit",
     "TierError",
@@ -86,10 +91,9 @@ __all__ = [
     "fit_profiles",
     "subsurface_ior",
     "fit_closures",
-    "diffuse_albedo",
     "principled_inputs",
     "principled_tier_reflection",
-    "layered_weights",
+    "view_weighted_reflection",
     "layered_tier_reflection",
     "TIER_REPLICAS",
     "tier_errors",
@@ -98,12 +102,6 @@ __all__ = [
 
 TIERS = ("PRINCIPLED", "LAYERED")
 """The node group's tiers, cheapest first."""
-LUT_ROWS = ("film_gloss", "path3_gloss", "skin_gloss", "film_transmittance",
-            "film_gloss_diffuse")
-"""Rows of the LAYERED tier's view-angle image: three Glossy weights, the film's
-transmittance ``T(theta_o)`` and the film gloss's Lambertian companion (:func:`fit_glossy`)."""
-DEFAULT_LUT_SIZE = 64
-"""Texels per row of the view-angle image (linear filtering between texel centres)."""
 ROUGHNESS_RANGE = (0.02, 1.0)
 """Roughness (Blender's socket, alpha = roughness^2) searched by the fits: from a lobe about
 0.03 degrees wide to the broadest; searched in ``log(roughness)``."""
@@ -122,8 +120,6 @@ COAT_IOR_RANGE = (1.01, 4.0)
 """Coat IOR searched (the socket's range in Blender)."""
 SPECULAR_LEVEL_RANGE = (0.0, 8.0)
 """Specular IOR Level searched (0.5 leaves IOR 1.5 as it is; F0 = 0.04 * 2 level)."""
-SPECULAR_IOR = 1.5
-"""The Principled IOR the specular fits assume (Specular IOR Level scales its F0)."""
 REPLICA_EDGE_ERROR = {"BURLEY": 0.0035, "RANDOM_WALK": 0.0068, "RANDOM_WALK_SKIN": 0.0067}
 """RMS difference (fraction of the lit level) between a rendered edge response and the
 replica's at albedo 0.8 (tools/calibrate_subsurface.py, Cycles 5.0.1 and 4.5.15, 256 samples):
@@ -137,20 +133,6 @@ dropped and its albedo moved to the base colour."""
 # --------------------------------------------------------------------------------------------
 # The view-angle image
 # --------------------------------------------------------------------------------------------
-def lut_nodes(size: int = DEFAULT_LUT_SIZE) -> np.ndarray:
-    """``cos(theta_o)`` at the texel centres ``(i + 0.5) / size`` of a view-angle image."""
-    return (np.arange(size) + 0.5) / size
-
-
-def sample_lut(lut, cos_view) -> np.ndarray:
-    """What Blender's Image Texture (Linear, EXTEND) returns for a row ``lut`` ``(size[, C])``
-    at ``u = cos_view``: linear between texel centres, the edge texel beyond them."""
-    lut = np.asarray(lut, float)
-    nodes = lut_nodes(lut.shape[0])
-    cos_view = np.asarray(cos_view, float)
-    if lut.ndim == 1:
-        return np.interp(cos_view, nodes, lut)
-    return np.stack([np.interp(cos_view, nodes, lut[:, c]) for c in range(lut.shape[1])], -1)
 
 
 # --------------------------------------------------------------------------------------------
@@ -686,57 +668,27 @@ def _absorption(absorption) -> np.ndarray:
     return np.broadcast_to(np.asarray(absorption, float), (3,)).copy()
 
 
-def diffuse_albedo(fit: ClosureFit, coverage: float, absorption) -> tuple[np.ndarray, np.ndarray]:
-    """``(total, skin part)`` of the diffuse albedo per channel at coverage ``w`` and
-    absorption ``A``: ``(1 - w) pi P_d,s + w [(1 - A) pi P_d,f + (1 - A)^2 pi P_d,s T_mean^2]``
-    (:func:`~lut_baker.model.made_up_skin.coverage_weights`) and its skin terms (which the
-    subsurface closure carries)."""
-    weights = coverage_weights(coverage, _absorption(absorption))
-    skin = combine(weights, twice=fit.skin_albedo * fit.transmittance_mean**2,
-                   bare=fit.skin_albedo)
-    return skin + combine(weights, once=fit.film_albedo), skin
+def _inputs(fit: ClosureFit, coverage: float, absorption, gloss: float) -> TierInputs:
+    """The group's inputs a replica takes: the fitted skin's albedo as Skin Color."""
+    return TierInputs.numpy(coverage, _absorption(absorption), fit.skin_albedo, gloss)
 
 
 def principled_inputs(fit: ClosureFit, coverage: float, absorption, gloss: float = 1.0):
-    """``(PrincipledInputs, subsurface_weight)`` of the PRINCIPLED tier (the node group's math):
+    """``(PrincipledInputs, subsurface_weight)`` of the PRINCIPLED tier at a coverage,
+    absorption and Gloss, Skin Color the fitted skin's albedo:
+    :func:`lut_baker.closures.tier_formulas.principled_sockets`, which the node group
+    emits as nodes."""
+    sockets = principled_sockets(fit, _inputs(fit, coverage, absorption, gloss), NumpyAlgebra())
 
-    - Coat Weight ``g w c`` (``c`` the coat's level: 1, or 0 without a coat), Coat
-      Roughness/IOR fitted;
-    - Roughness ``mix(r_bare, r_film, w)``, Specular IOR Level
-      ``g [(1 - w) l_bare + w l_film mean((1 - A)^2)]``;
-    - Base Color = (:func:`diffuse_albedo` + ``g w (1 - A)^2 gloss_to_diffuse``) /
-      ``((1 - g w E_coat) (1 - g E_spec(w)))`` with the mean layering albedos,
-      ``E_spec(w) = mix(E_bare, E_film, w)``;
-    - Subsurface Weight = the skin's share of the diffuse albedo (channel mean).
+    def scalar(name):
+        return float(np.ravel(sockets[name])[0])
 
-    ``gloss`` (the group's Gloss input, 0..1) scales the gloss lobes: at 0 the coat weight
-    and the specular level are 0, so Cycles allocates neither closure (``coat_weight >
-    CLOSURE_WEIGHT_CUTOFF`` and ``eta != 1`` guard them in ``svm_node_closure_bsdf``), and the
-    base colour is the diffuse albedo alone.  Between 0 and 1 the layer attenuation is taken
-    linear in ``g`` (exact at both ends).
-    """
-    w = float(coverage)
-    g = float(gloss)
-    weights = coverage_weights(w, _absorption(absorption))
-    bare, covered = weights.bare, weights.covered
-    through2 = float(np.mean(weights.twice))
-    total, skin = diffuse_albedo(fit, w, absorption)
-    total = total + combine(weights, twice=g * fit.gloss_to_diffuse)
-    e_spec = bare * fit.specular_albedo_mean[0] + covered * fit.specular_albedo_mean[1]
-    coat = g * covered * fit.coat.level
-    base = total / ((1.0 - coat * fit.coat_albedo_mean) * (1.0 - g * e_spec))
-    level = g * (bare * fit.specular_bare.level + covered * fit.specular_film.level * through2)
     inputs = cc.PrincipledInputs(
-        base_color=tuple(np.clip(base, 0.0, 1.0)),
-        roughness=bare * fit.specular_bare.roughness + covered * fit.specular_film.roughness,
-        ior=SPECULAR_IOR,
-        specular_ior_level=level,
-        coat_weight=coat,
-        coat_roughness=fit.coat.roughness,
-        coat_ior=fit.coat.ior,
-    )
-    weight = float(np.mean(skin / np.maximum(total, 1e-12)))
-    return inputs, weight
+        base_color=tuple(np.ravel(sockets["Base Color"]).tolist()),
+        roughness=scalar("Roughness"), ior=scalar("IOR"),
+        specular_ior_level=scalar("Specular IOR Level"), coat_weight=scalar("Coat Weight"),
+        coat_roughness=scalar("Coat Roughness"), coat_ior=scalar("Coat IOR"))
+    return inputs, scalar("Subsurface Weight")
 
 
 def principled_tier_reflection(fit: ClosureFit, tables: Tables, coverage: float, absorption,
@@ -748,54 +700,44 @@ def principled_tier_reflection(fit: ClosureFit, tables: Tables, coverage: float,
     return cc.principled_reflection(wi, wo, inputs)
 
 
-def layered_weights(fit: ClosureFit, coverage: float, absorption, gloss: float = 1.0) -> dict:
-    """The LAYERED tier's constant weights (RGB) at coverage ``w`` and absorption ``A``;
-    view-dependent factors come from the image rows :data:`LUT_ROWS`:
+def view_weighted_reflection(closures: ViewWeightedClosures, lobe_of, wi, wo) -> np.ndarray:
+    """A view-weighted tier's BRDF, ``(..., 3)``, at ``(wi, wo)`` from its closures
+    (:func:`lut_baker.closures.tier_formulas.view_weighted_closures`, evaluated by the numpy
+    algebra at ``wo``'s view angles): each Glossy closure's white lobe ``lobe_of(name, wi,
+    wo)`` ``(...)`` times its colour, Diffuse and Subsurface closures Lambertian, each side
+    summed and the sides mixed by coverage."""
+    def side(closures_of_side):
+        value = 0.0
+        for closure in closures_of_side:
+            colour = closure.colour if closure.weight is None else closure.colour * closure.weight
+            if not np.any(colour):
+                continue  # a closure of weight 0 is never allocated
+            if closure.kind == "glossy":
+                value = value + lobe_of(closure.name, wi, wo)[..., None] * colour
+            else:
+                value = value + cc.lambert_reflection(colour)
+        return value
 
-    - ``film_gloss``: ``g w``; ``path3_gloss``: ``g w (1 - A)^2``; ``skin_gloss``: ``g (1 - w)``
-      (each times its row; ``g`` the group's Gloss input: at 0 the Glossy colours are 0 and
-      Cycles allocates no Glossy closure, ``bsdf_alloc``'s weight cutoff);
-    - ``film_diffuse``: ``w (1 - A) pi P_d,f`` (Diffuse); ``film_gloss_diffuse``: ``g w`` times
-      its row, the film gloss's Lambertian companion, in the same Diffuse closure;
-    - ``skin_through``: ``w (1 - A)^2 pi P_d,s T_mean`` (times row ``T``); ``skin_bare``:
-      ``(1 - w) pi P_d,s`` (Subsurface).
-    """
-    g = float(gloss)
-    weights = coverage_weights(float(coverage), _absorption(absorption))
-    bare, covered = weights.bare, weights.covered
-    one = np.ones(3)
-    return {
-        "film_gloss": g * covered * one,
-        "path3_gloss": g * covered * weights.twice,
-        "skin_gloss": g * bare * one,
-        "film_diffuse": covered * weights.once * fit.film_albedo,
-        "film_gloss_diffuse": g * covered * one,
-        "skin_through": covered * weights.twice * fit.skin_albedo * fit.transmittance_mean,
-        "skin_bare": bare * fit.skin_albedo,
-    }
+    weights = coverage_weights(closures.coverage, 0.0)
+    return combine(weights, top=side(closures.covered), bare=side(closures.bare))
 
 
 def layered_tier_reflection(fit: ClosureFit, tables: Tables, coverage: float, absorption,
                             gloss: float = 1.0, directions=None):
     """The LAYERED tier's BRDF, ``(..., 3)``, at the angular nodes or at ``directions``
-    ``(wi, wo)``: every closure added with its weight and image row (linear texel
-    interpolation, as Blender samples it); ``gloss``: the group's Gloss input."""
+    ``(wi, wo)``: its closures (:func:`lut_baker.closures.tier_formulas.view_weighted_closures`)
+    with the image rows read as Blender reads them (linear between texel centres) and Cycles'
+    Glossy lobes; ``gloss``: the group's Gloss input."""
     wi, wo = tables.node_directions() if directions is None else directions
-    cos_o = wo[..., 2]
-    weights = layered_weights(fit, coverage, absorption, gloss)
-    rows = dict(zip(LUT_ROWS, fit.lut, strict=True))
-    value = 0.0
-    for name in LUT_ROWS[:3]:
-        if not np.any(weights[name]):
-            continue  # Cycles allocates no closure of weight 0
+    algebra = NumpyAlgebra(dict(zip(LUT_ROWS, fit.lut, strict=True)), wo[..., 2])
+    closures = view_weighted_closures(fit, _inputs(fit, coverage, absorption, gloss), algebra)
+
+    def lobe(name, wi, wo):
         glossy = fit.glossy[name]
-        lobe = cc.microfacet_reflection(wi, wo, glossy.roughness,
-                                        distribution=glossy.distribution)[..., None]
-        value = value + lobe * weights[name] * sample_lut(rows[name], cos_o)
-    diffuse = (weights["film_diffuse"] + weights["skin_bare"]
-               + weights["film_gloss_diffuse"] * sample_lut(rows["film_gloss_diffuse"], cos_o)
-               + weights["skin_through"] * sample_lut(rows["film_transmittance"], cos_o))
-    return value + cc.lambert_reflection(diffuse)
+        return cc.microfacet_reflection(wi, wo, glossy.roughness,
+                                        distribution=glossy.distribution)
+
+    return view_weighted_reflection(closures, lobe, wi, wo)
 
 
 TIER_REPLICAS = {"PRINCIPLED": principled_tier_reflection, "LAYERED": layered_tier_reflection}

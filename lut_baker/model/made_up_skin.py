@@ -172,11 +172,15 @@ def coverage_weights(coverage, absorption) -> CoverageWeights:
     reference images.  The add-on's node group (makeup_skin_addon/nodes.py) builds the same mix
     from math nodes and must follow it.
     """
-    once = 1.0 - np.asarray(absorption, dtype=float)
+    if isinstance(absorption, (list, tuple)):
+        absorption = np.asarray(absorption, dtype=float)
+    # Plain arithmetic: the weights of numpy arrays are arrays, those of a node group's sockets
+    # are sockets (lut_baker.closures.tier_formulas).
+    once = 1.0 - absorption
     return CoverageWeights(bare=1.0 - coverage, covered=coverage, once=once, twice=once**2)
 
 
-def combine(weights: CoverageWeights, *, top=0.0, once=0.0, twice=0.0, bare=0.0):
+def combine(weights: CoverageWeights, *, top=None, once=None, twice=None, bare=None):
     """The made-up skin's mix of its parts (docs/model.md §4, :func:`coverage_weights`)::
 
         covered [top + once (1 - A) + twice (1 - A)^2] + bare (1 - w)
@@ -184,9 +188,18 @@ def combine(weights: CoverageWeights, *, top=0.0, once=0.0, twice=0.0, bare=0.0)
     ``top``: what the film covers without crossing its pigment (its surface gloss, or parts
     whose layers hold the absorption already); ``once``: what crosses it once (its diffuse
     reflection); ``twice``: what crosses it twice (the skin seen through it, paths 3 and 4);
-    ``bare``: the bare skin.  Any unit, any broadcasting shapes (RGB last)."""
-    return (weights.covered * (top + weights.once * once + weights.twice * twice)
-            + weights.bare * bare)
+    ``bare``: the bare skin.  Any unit, any broadcasting shapes (RGB last); a part not given
+    is no term at all, so a grey part stays a scalar (and a node group's Math node)."""
+    def times(weight, part):
+        return None if part is None else weight * part
+
+    def total(parts):
+        given = [part for part in parts if part is not None]
+        return sum(given[1:], given[0]) if given else None
+
+    covered = total([top, times(weights.once, once), times(weights.twice, twice)])
+    mixed = total([times(weights.covered, covered), times(weights.bare, bare)])
+    return 0.0 if mixed is None else mixed
 
 
 def film_reflection_layer(skin: MadeUpSkin) -> ReflectionLayer:

@@ -1,11 +1,11 @@
-"""The node group's coverage/absorption mix, evaluated by Cycles, against the closure fits.
+"""The node group's formulas, evaluated by Cycles, against the same formulas in numpy.
 
-:func:`lut_baker.model.made_up_skin.coverage_weights` is the one rule that mixes coverage and
-absorption; :func:`lut_baker.closures.fitting.principled_inputs` and
-:func:`~lut_baker.closures.fitting.layered_weights` apply it, and the add-on's node group
-(makeup_skin_addon/nodes.py) rebuilds it from math nodes.  These tests read what the group
-computes and compare it with those functions at several coverages, absorptions (grey and RGB)
-and one Gloss below 1.
+Each tier's formulas are written once (:mod:`lut_baker.closures.tier_formulas`); the add-on
+emits them as nodes (makeup_skin_addon/node_algebra.py) and the replicas evaluate them with
+numpy.  These tests read what the built group computes at random coverages, absorptions,
+Skin Colors, Gloss values and view angles, and compare it with the numpy evaluation: any
+operation the node algebra emits wrongly, or a closure wired to the wrong colour, weight or
+mix, shows.
 
 How a value is read: each probe is a COPY of the built group (the built group itself is never
 changed) in which one closure is replaced by an Emission shader of the same colour, in the same
@@ -15,14 +15,14 @@ place of the shader tree (Add and Mix Shaders kept), and the copy's other closur
   Subsurface Weight, Specular IOR Level, Coat Weight, Roughness), so the pixel is that input;
 - LAYERED: the Emission replaces one closure (film gloss, path-3 gloss, skin gloss, film
   diffuse, skin through the film, bare skin), so the pixel is that closure's colour times every
-  Mix Shader factor above it: its weight in the tier, as ``layered_tier_reflection`` adds it.
+  Mix Shader factor above it: its weight in the tier, as the replica adds it.
 
-Every (probe, case) pair is one 3x3-pixel face of one plane, with its own material, seen
-head-on by an orthographic camera (1 pixel per unit): Cycles CPU, 1 sample, box filter, no
-light, film exposure 1 (neutral), view exposure 0, view transform Standard; the float32
-OpenEXR it writes holds the emitted values unchanged, and the centre pixel of each face is
-compared with numpy's value.  The view is along the normal, so the LAYERED tier's view-angle
-rows are read at ``cos(theta_o) = 1`` (:func:`~lut_baker.closures.fitting.sample_lut`).
+Every (probe, case) pair is one face of one plane, with its own material, tilted by the case's
+view angle about the x axis so that it fills a 3x3-pixel cell of an orthographic camera looking
+down (1 pixel per unit): the LAYERED tier reads its view-angle rows at that angle's cosine.
+Cycles CPU, 1 sample, box filter, no light, film exposure 1 (neutral), view exposure 0, view
+transform Standard; the float32 OpenEXR it writes holds the emitted values unchanged, and the
+centre pixel of each face is compared with numpy's value.
 """
 
 import dataclasses
@@ -32,23 +32,35 @@ import pytest
 
 from lut_baker.bake import bake
 from lut_baker.closures import fitting as cf
+from lut_baker.closures import tier_formulas, view_image
 from lut_baker.model import presets
 
 CELL = 3
-"""Pixels (and scene units) per side of each probe's face."""
+"""Pixels (and scene units) per side of each probe's cell."""
 RTOL, ATOL = 1e-5, 1e-6
-"""Cycles evaluates the nodes in float32 (the differences seen are below 1e-7)."""
-RGB = (0.1, 0.4, 0.8)
-CASES = [*((coverage, absorption, 1.0) for coverage in (0.0, 0.3, 1.0)
-           for absorption in ((0.0,) * 3, (0.5,) * 3, RGB)),
-         (0.3, RGB, 0.5)]
-"""``(coverage, absorption, gloss)``: every weight at both ends of coverage and between, and
-Gloss below 1 (where a product of Coverage and Gloss differs from, e.g., their minimum)."""
+"""Cycles evaluates the nodes in float32 (the differences seen are below 1e-6)."""
+
+
+def _cases(count=14, seed=7):
+    """``(coverage, absorption RGB, gloss, skin colour RGB, view angle in degrees)``: random
+    ones, plus bare skin, full coverage and Gloss 0 (where a product of Coverage and Gloss
+    differs from, e.g., their minimum)."""
+    rng = np.random.default_rng(seed)
+    cases = [(float(rng.uniform()), tuple(rng.uniform(0.0, 1.0, 3)), float(rng.uniform()),
+              tuple(rng.uniform(0.05, 0.95, 3)), float(rng.uniform(0.0, 75.0)))
+             for _ in range(count)]
+    return [*cases, (0.0, (0.2, 0.4, 0.6), 1.0, (0.7, 0.5, 0.4), 30.0),
+            (1.0, (0.0, 0.0, 0.0), 1.0, (0.8, 0.6, 0.5), 60.0),
+            (0.5, (0.1, 0.4, 0.8), 0.0, (0.6, 0.4, 0.3), 0.0)]
+
+
+CASES = _cases()
 PRINCIPLED_PROBES = ("Base Color", "Subsurface Weight", "Specular IOR Level", "Coat Weight",
                      "Roughness")
 LAYERED_PROBES = ("film gloss", "path3 gloss", "skin gloss", "film diffuse",
-                  "skin through film", "bare skin")
-"""The LAYERED group's closures by node label (nodes.py)."""
+                  "skin through film", "bare skin", "skin through film weight")
+"""The LAYERED group's closures by node label (nodes.py), and the weight of the one that has
+its own."""
 CLOSURES = {"BSDF_PRINCIPLED", "BSDF_GLOSSY", "BSDF_ANISOTROPIC", "BSDF_DIFFUSE",
             "SUBSURFACE_SCATTERING"}
 
@@ -130,10 +142,33 @@ def _layered_probe(group, label):
     return probe
 
 
-def _material(probe, coverage, absorption, gloss, skin_colour):
+def _weight_probe(group, label):
+    """A copy of the LAYERED ``group`` in which the Mix Shader weighting the closure
+    labelled ``label`` is an Emission of its factor, in its place, and every closure is
+    gone: the pixel is the weight times the coverage mix above it."""
+    from makeup_skin_addon import nodes
+
+    probe = group.copy()
+    probe.name = f"probe {label} weight"
+    mix = next(node for node in probe.nodes if node.label == f"{label} (weight)")
+    emission = _emission(probe, nodes.socket(mix.inputs, "Fac"))
+    for link in list(mix.outputs[0].links):
+        probe.links.new(emission.outputs[0], link.to_socket)
+    for node in [n for n in probe.nodes if n.type in CLOSURES] + [mix]:
+        probe.nodes.remove(node)
+    return probe
+
+
+def _layered_or_weight_probe(group, name):
+    if name.endswith(" weight"):
+        return _weight_probe(group, name.removesuffix(" weight"))
+    return _layered_probe(group, name)
+
+
+def _material(probe, coverage, absorption, gloss, skin_colour, view_deg):
     import bpy
 
-    material = bpy.data.materials.new(f"{probe.name} {coverage} {absorption} {gloss}")
+    material = bpy.data.materials.new(f"{probe.name} {coverage} {absorption} {view_deg}")
     if material.node_tree is None:  # Blender 4.5 (5.0 gives every material a tree)
         material.use_nodes = True
     tree = material.node_tree
@@ -148,9 +183,9 @@ def _material(probe, coverage, absorption, gloss, skin_colour):
     return material
 
 
-def _render_grid(scene, materials, tmp_path):
-    """Render ``materials`` (rows of columns) as the faces of one plane and return each face's
-    centre pixel, ``(rows, columns, 3)``."""
+def _render_grid(scene, materials, views_deg, tmp_path):
+    """Render ``materials`` (rows of columns, column ``j`` seen at ``views_deg[j]`` degrees)
+    as the faces of one plane and return each face's centre pixel, ``(rows, columns, 3)``."""
     import bpy
 
     rows, columns = len(materials), len(materials[0])
@@ -158,9 +193,10 @@ def _render_grid(scene, materials, tmp_path):
     for row in range(rows):
         for column in range(columns):
             x, y = CELL * column, CELL * row
+            rise = CELL * np.tan(np.radians(views_deg[column]))  # normal at the view angle
             start = len(vertices)
-            vertices += [(x, y, 0.0), (x + CELL, y, 0.0), (x + CELL, y + CELL, 0.0),
-                         (x, y + CELL, 0.0)]
+            vertices += [(x, y, 0.0), (x + CELL, y, 0.0), (x + CELL, y + CELL, rise),
+                         (x, y + CELL, rise)]
             faces.append(tuple(range(start, start + 4)))
     mesh = bpy.data.meshes.new("probes")
     mesh.from_pydata(vertices, [], faces)
@@ -175,7 +211,7 @@ def _render_grid(scene, materials, tmp_path):
     camera.data.type = "ORTHO"
     camera.data.ortho_scale = max(width, height)
     camera.data.sensor_fit = "AUTO"
-    camera.location = (width / 2, height / 2, 10.0)  # looking down -Z at the plane
+    camera.location = (width / 2, height / 2, 100.0)  # looking down -Z at the plane
     scene.collection.objects.link(camera)
     scene.camera = camera
 
@@ -210,49 +246,69 @@ def _render_grid(scene, materials, tmp_path):
     return pixels[CELL // 2::CELL, CELL // 2::CELL]
 
 
-def _principled_expected(fit, coverage, absorption, gloss):
-    inputs, subsurface_weight = cf.principled_inputs(fit, coverage, absorption, gloss)
-    assert max(inputs.base_color) < 1.0  # the node group does not clip it; the fit does
-    values = {"Base Color": inputs.base_color, "Subsurface Weight": subsurface_weight,
-              "Specular IOR Level": inputs.specular_ior_level,
-              "Coat Weight": inputs.coat_weight, "Roughness": inputs.roughness}
-    return {name: np.broadcast_to(np.asarray(value, float), (3,)) for name, value in
-            values.items()}
+def _numpy(fit, case):
+    """The tier formulas' inputs and algebra for one case, as the replicas take them."""
+    coverage, absorption, gloss, skin_colour, view_deg = case
+    x = tier_formulas.TierInputs.numpy(coverage, absorption, skin_colour, gloss)
+    rows = dict(zip(view_image.LUT_ROWS, fit.lut, strict=True))
+    return x, tier_formulas.NumpyAlgebra(rows, np.cos(np.radians(view_deg)))
 
 
-def _layered_expected(fit, coverage, absorption, gloss):
-    weights = cf.layered_weights(fit, coverage, absorption, gloss)
-    rows = {name: cf.sample_lut(row, 1.0) for name, row in zip(cf.LUT_ROWS, fit.lut,
-                                                                strict=True)}
-    return {
-        "film gloss": weights["film_gloss"] * rows["film_gloss"],
-        "path3 gloss": weights["path3_gloss"] * rows["path3_gloss"],
-        "skin gloss": weights["skin_gloss"] * rows["skin_gloss"],
-        "film diffuse": (weights["film_diffuse"]
-                         + weights["film_gloss_diffuse"] * rows["film_gloss_diffuse"]),
-        "skin through film": weights["skin_through"] * rows["film_transmittance"],
-        "bare skin": weights["skin_bare"],
-    }
+def _principled_expected(fit, case):
+    x, algebra = _numpy(fit, case)
+    sockets = tier_formulas.principled_sockets(fit, x, algebra)
+    return {name: np.broadcast_to(np.ravel(sockets[name]), (3,)) for name in PRINCIPLED_PROBES}
+
+
+def _layered_expected(fit, case):
+    """Each closure's colour times its weight and its side's share of the coverage mix."""
+    x, algebra = _numpy(fit, case)
+    closures = tier_formulas.view_weighted_closures(fit, x, algebra)
+    coverage = case[0]
+    out = {}
+    for share, side in ((coverage, closures.covered), (1.0 - coverage, closures.bare)):
+        for closure in side:
+            weight = 1.0 if closure.weight is None else closure.weight
+            out[closure.name.replace("_", " ")] = np.ravel(share * closure.colour * weight)
+            if closure.weight is not None:
+                out[f"{closure.name} weight"] = np.broadcast_to(np.ravel(share * weight), (3,))
+    return out
 
 
 @pytest.mark.parametrize("tier", cf.TIERS)
-def test_node_group_mix_follows_coverage_weights(blank_scene, baked, tmp_path, tier):
-    """Every probe of ``tier`` in every case equals the fit's value to a relative 1e-5."""
+def test_node_group_follows_the_tier_formulas(blank_scene, baked, tmp_path, tier):
+    """Every probe of ``tier`` in every case equals numpy's value to a relative 1e-5."""
     fit = baked[2]
     group = _group(tier, baked)
     probes, make_probe, expected_of = {
         "PRINCIPLED": (PRINCIPLED_PROBES, _principled_probe, _principled_expected),
-        "LAYERED": (LAYERED_PROBES, _layered_probe, _layered_expected),
+        "LAYERED": (LAYERED_PROBES, _layered_or_weight_probe, _layered_expected),
     }[tier]
     copies = [make_probe(group, name) for name in probes]
-    materials = [[_material(copy, *case, fit.skin_albedo) for case in CASES]
-                 for copy in copies]
-    measured = _render_grid(blank_scene, materials, tmp_path)
-    expected = np.array([[expected_of(fit, *case)[name] for case in CASES]
-                         for name in probes])
+    materials = [[_material(copy, *case) for case in CASES] for copy in copies]
+    measured = _render_grid(blank_scene, materials, [case[4] for case in CASES], tmp_path)
+    expected = np.array([[expected_of(fit, case)[name] for case in CASES] for name in probes])
     assert np.ptp(expected) > 0.1  # the cases give the probes different values
     excess = np.abs(measured - expected) / (ATOL + RTOL * np.abs(expected))
     worst = np.unravel_index(np.argmax(excess), excess.shape)
     assert excess.max() <= 1.0, (
-        f"{tier} {probes[worst[0]]} at (coverage, absorption, gloss) = {CASES[worst[1]]}: "
-        f"node group {measured[worst[:2]]}, fit {expected[worst[:2]]}")
+        f"{tier} {probes[worst[0]]} at (coverage, absorption, gloss, skin, view) = "
+        f"{CASES[worst[1]]}: node group {measured[worst[:2]]}, numpy {expected[worst[:2]]}")
+
+
+def test_the_principled_base_colour_is_clipped_in_both(blank_scene, baked, tmp_path):
+    """A diffuse albedo the layers above would push past 1 (a white skin under a strong coat)
+    is clipped to 1 by the formulas, so numpy and the nodes agree, and Cycles' own clamp of
+    the colour its subsurface closure takes changes nothing."""
+    skin, tables, fit = baked
+    bright = dataclasses.replace(fit, coat_albedo_mean=0.6)
+    case = (1.0, (0.0, 0.0, 0.0), 1.0, (1.0, 1.0, 1.0), 0.0)
+    x, algebra = _numpy(bright, case)
+    unclipped = tier_formulas.principled_sockets(bright, x, algebra)
+    assert np.max(unclipped["Base Color"]) == 1.0
+    group = _group("PRINCIPLED", (skin, tables, bright))
+    material = _material(_principled_probe(group, "Base Color"), *case)
+    # 2 x 2 cells: Blender renders no image under 4 pixels a side
+    measured = _render_grid(blank_scene, [[material] * 2] * 2, [0.0, 0.0], tmp_path)[0, 0]
+    np.testing.assert_allclose(measured, np.ravel(unclipped["Base Color"]), rtol=RTOL,
+                               atol=ATOL)

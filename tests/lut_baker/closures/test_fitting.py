@@ -9,7 +9,7 @@ import pytest
 
 from lut_baker import bake
 from lut_baker.closures import cycles as cc
-from lut_baker.closures import fitting
+from lut_baker.closures import fitting, tier_formulas, view_image
 from lut_baker.closures.view_grid import view_grid
 from lut_baker.model import presets
 from lut_baker.numerics.geometry import direction
@@ -34,7 +34,7 @@ def test_fit_glossy_companion_recovers_a_lobe_plus_lambert(paper_tables):
     inner = slice(4, -4)  # texels away from the ends, where interpolation holds them
     np.testing.assert_allclose(fit.lut[inner], 0.7, atol=0.03)
     np.testing.assert_allclose(fit.diffuse_lut[inner], 0.2, atol=0.02)
-    mu = fitting.lut_nodes(fitting.DEFAULT_LUT_SIZE)
+    mu = view_image.lut_nodes(view_image.DEFAULT_LUT_SIZE)
     texel_e = cc.microfacet_albedo(mu, fit.roughness, distribution=fit.distribution)
     texel_table = np.interp(np.degrees(np.arccos(mu)), theta, albedo[:, 0])
     np.testing.assert_allclose(fit.lut[:, 0] * texel_e + fit.diffuse_lut[:, 0], texel_table,
@@ -119,7 +119,7 @@ def test_paper_fit_parameters_are_in_blender_ranges(paper_fit):
     for lobe in paper_fit.glossy.values():
         assert lobe.distribution in cc.GLOSSY_DISTRIBUTIONS
         assert np.all(np.isfinite(lobe.lut)) and np.all(lobe.lut >= 0.0)
-    assert paper_fit.lut.shape == (len(fitting.LUT_ROWS), fitting.DEFAULT_LUT_SIZE, 3)
+    assert paper_fit.lut.shape == (len(view_image.LUT_ROWS), view_image.DEFAULT_LUT_SIZE, 3)
     assert np.all(paper_fit.subsurface_radius_mm > 0.0)
     assert paper_fit.subsurface_method in cc.SUBSURFACE_METHODS
     # Burley's edge response follows the dipole's within 1% RMS of the lit level.
@@ -175,7 +175,10 @@ def test_gloss_zero_leaves_only_the_diffuse_closures(paper_tables, paper_fit):
     gloss, each tier misses the tables' gloss."""
     w, a = 0.5, (0.1, 0.2, 0.4)
     inputs, weight = fitting.principled_inputs(paper_fit, w, a, gloss=0.0)
-    total, skin = fitting.diffuse_albedo(paper_fit, w, a)
+    once = 1.0 - np.array(a)  # the diffuse albedo, docs/model.md §4: film once, skin twice
+    skin = (1 - w) * paper_fit.skin_albedo + w * once**2 * paper_fit.skin_albedo \
+        * paper_fit.transmittance_mean**2
+    total = skin + w * once * paper_fit.film_albedo
     assert inputs.coat_weight == 0.0 and inputs.specular_ior_level == 0.0
     assert inputs.specular_eta_f0()[0] == 1.0
     np.testing.assert_allclose(inputs.base_color, np.clip(total, 0.0, 1.0), rtol=1e-12)
@@ -183,8 +186,13 @@ def test_gloss_zero_leaves_only_the_diffuse_closures(paper_tables, paper_fit):
     matte = fitting.principled_tier_reflection(paper_fit, paper_tables, w, a, gloss=0.0)
     np.testing.assert_allclose(matte, np.broadcast_to(np.clip(total, 0, 1) / np.pi,
                                                       matte.shape), rtol=1e-12)
-    weights = fitting.layered_weights(paper_fit, w, a, gloss=0.0)
-    assert not any(np.any(weights[name]) for name in fitting.LUT_ROWS[:3])
+    algebra = tier_formulas.NumpyAlgebra(dict(zip(view_image.LUT_ROWS, paper_fit.lut,
+                                                  strict=True)),
+                                         np.linspace(0.0, 1.0, 9))
+    closures = tier_formulas.view_weighted_closures(
+        paper_fit, tier_formulas.TierInputs.numpy(w, a, paper_fit.skin_albedo, 0.0), algebra)
+    glossy = [c for c in closures.covered + closures.bare if c.kind == "glossy"]
+    assert len(glossy) == 3 and not any(np.any(c.colour) for c in glossy)
     layered = {g: fitting.layered_tier_reflection(paper_fit, paper_tables, w, a, gloss=g)
                for g in (0.0, 0.5, 1.0)}
     np.testing.assert_allclose(layered[0.5], 0.5 * (layered[0.0] + layered[1.0]), rtol=1e-9)

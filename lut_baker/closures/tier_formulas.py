@@ -1,0 +1,213 @@
+"""Each tier's formulas, written once for numpy and for Blender's nodes.
+
+A tier is a set of closures whose colours and weights are arithmetic on the node group's inputs
+(Coverage ``w``, Foundation Absorption ``A``, Skin Color ``S``, Gloss ``g``), on constants of
+the :class:`~lut_baker.closures.fitting.ClosureFit` and on the view-angle image's rows.  The
+functions here compute them from those values with Python's operators and the few functions of
+an *algebra* (:class:`Algebra`), so the same code runs on two kinds of value:
+
+- numpy arrays (:class:`NumpyAlgebra`): the replicas, the tiers' errors, the Auto tier;
+- node sockets (the add-on's node algebra, makeup_skin_addon/node_algebra.py): the node group
+  is generated from these functions, so it cannot drift from what is measured.
+
+Scalars (Coverage, Gloss, weights) and colours (RGB) mix freely, as they do in numpy (scalars
+broadcast) and in nodes (a float socket linked to a colour input is grey).  Every mix of the
+made-up skin's parts goes through :func:`lut_baker.model.made_up_skin.coverage_weights` and
+:func:`~lut_baker.model.made_up_skin.combine` (docs/model.md §4).
+
+- :class:`TierInputs` -- the group's inputs.
+- :func:`principled_sockets` -- the PRINCIPLED tier's Principled BSDF sockets.
+- :func:`view_weighted_closures` -- the LAYERED (and EEVEE) tier's closures, by side of the
+  coverage mix.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Protocol
+
+import numpy as np
+
+from ..model.made_up_skin import combine, coverage_weights
+from .view_image import sample_lut
+
+__all__ = ["Algebra", "NumpyAlgebra", "TierInputs", "Closure", "ViewWeightedClosures",
+           "principled_sockets", "view_weighted_closures", "SPECULAR_IOR", "ROW_SURFACE",
+           "THROUGH_WEIGHT_FLOOR"]
+
+SPECULAR_IOR = 1.5
+"""The Principled BSDF's IOR in the PRINCIPLED tier (its specular level carries the fit)."""
+ROW_SURFACE = {"skin_gloss": "skin"}
+"""The surface whose normal gives the view angle a row is read at: the skin's own gloss
+against the skin's normal, every other row (the film and the light through it) against the
+film's (``"film"``)."""
+THROUGH_WEIGHT_FLOOR = 1e-6
+"""Below this strongest channel the skin seen through the film keeps its colour's scale (no
+division by a vanishing weight)."""
+
+
+class Algebra(Protocol):
+    """What a formula needs beyond ``+ - * /`` and ``** 2``: each call takes scalars or colours
+    of the algebra's kind (or plain numbers) and returns one."""
+
+    def maximum(self, a, b): ...
+    def minimum(self, a, b): ...
+    def channel_mean(self, colour): ...
+    def channel_max(self, colour): ...
+    def row(self, name: str): ...
+
+
+class NumpyAlgebra:
+    """The numpy algebra: scalars are arrays with a trailing axis of 1, colours of 3 (any
+    leading shape, broadcast), rows read at ``cos_view`` (``(...,)``) from ``rows`` (name ->
+    ``(size, 3)``) as Blender's Image Texture samples them."""
+
+    def __init__(self, rows: dict | None = None, cos_view=None):
+        self._rows = rows or {}
+        self._cos = None if cos_view is None else np.asarray(cos_view, float)
+
+    maximum = staticmethod(np.maximum)
+    minimum = staticmethod(np.minimum)
+
+    @staticmethod
+    def channel_mean(colour):
+        return np.mean(np.asarray(colour, float) * np.ones(3), axis=-1, keepdims=True)
+
+    @staticmethod
+    def channel_max(colour):
+        return np.max(np.asarray(colour, float) * np.ones(3), axis=-1, keepdims=True)
+
+    def row(self, name: str):
+        return sample_lut(self._rows[name], self._cos)
+
+
+@dataclass(frozen=True)
+class TierInputs:
+    """The node group's inputs a tier's formulas read: ``coverage`` ``w`` (scalar),
+    ``absorption`` ``A`` (colour), ``skin_color`` ``S`` (colour, the skin's diffuse albedo),
+    ``gloss`` ``g`` (scalar, 0..1)."""
+
+    coverage: Any
+    absorption: Any
+    skin_color: Any
+    gloss: Any = 1.0
+
+    @classmethod
+    def numpy(cls, coverage, absorption, skin_color, gloss=1.0) -> TierInputs:
+        """Inputs as the numpy algebra takes them: scalars with a trailing axis of 1, colours
+        of 3 (a scalar absorption is grey)."""
+        def scalar(x):
+            return np.asarray(x, float)[..., None]
+
+        def colour(x):
+            return np.asarray(x, float) * np.ones(3)
+
+        return cls(scalar(coverage), colour(absorption), colour(skin_color), scalar(gloss))
+
+
+def principled_sockets(fit, x: TierInputs, ops: Algebra) -> dict:
+    """The PRINCIPLED tier's Principled BSDF sockets (by name) at inputs ``x``:
+
+    - Coat Weight ``g w c`` (``c`` the coat's level: 1, or 0 without a coat), Coat
+      Roughness/IOR fitted;
+    - Roughness ``mix(r_bare, r_film, w)``, Specular IOR Level
+      ``g [(1 - w) l_bare + w l_film mean((1 - A)^2)]``;
+    - Base Color: the diffuse albedo ``combine(once: pi P_d,f, twice: S T_mean^2 + g
+      gloss_to_diffuse, bare: S)`` divided by the mean attenuation of the layers above it,
+      ``(1 - g w c E_coat) (1 - g E_spec(w))``, ``E_spec(w) = mix(E_bare, E_film, w)``, and
+      clipped to [0, 1] (Cycles clamps the colour its subsurface closure takes to 1, not its
+      diffuse one: clipped, both take the same);
+    - Subsurface Weight: the skin's share of the diffuse albedo (channel mean).
+
+    ``g`` (the group's Gloss input, 0..1) scales the gloss lobes: at 0 the coat weight and the
+    specular level are 0, so Cycles allocates neither closure (``coat_weight >
+    CLOSURE_WEIGHT_CUTOFF`` and ``eta != 1`` guard them in ``svm_node_closure_bsdf``), and the
+    base colour is the diffuse albedo alone.  Between 0 and 1 the layer attenuation is taken
+    linear in ``g`` (exact at both ends)."""
+    weights = coverage_weights(x.coverage, x.absorption)
+    g = x.gloss
+    skin = combine(weights, twice=x.skin_color * fit.transmittance_mean**2, bare=x.skin_color)
+    total = skin + combine(weights, once=fit.film_albedo, twice=g * fit.gloss_to_diffuse)
+    e_spec = combine(weights, top=fit.specular_albedo_mean[1], bare=fit.specular_albedo_mean[0])
+    coat = g * weights.covered * fit.coat.level
+    base = total / ((1.0 - coat * fit.coat_albedo_mean) * (1.0 - g * e_spec))
+    return {
+        "Base Color": ops.minimum(ops.maximum(base, 0.0), 1.0),
+        "Roughness": combine(weights, top=fit.specular_film.roughness,
+                             bare=fit.specular_bare.roughness),
+        "IOR": SPECULAR_IOR,
+        "Specular IOR Level": g * combine(
+            weights, top=fit.specular_film.level * ops.channel_mean(weights.twice),
+            bare=fit.specular_bare.level),
+        "Coat Weight": coat,
+        "Coat Roughness": fit.coat.roughness,
+        "Coat IOR": fit.coat.ior,
+        "Subsurface Weight": ops.channel_mean(skin / ops.maximum(total, 1e-12)),
+    }
+
+
+@dataclass(frozen=True)
+class Closure:
+    """One closure of a view-weighted tier: ``kind`` (``"glossy"``, ``"diffuse"`` or
+    ``"subsurface"``), ``name`` (a glossy lobe's key in the fit, else a label), ``colour``,
+    ``weight`` (a scalar factor, or None), ``surface`` (whose normal it takes: ``"film"`` or
+    ``"skin"``)."""
+
+    kind: str
+    name: str
+    colour: Any
+    surface: str
+    weight: Any = None
+
+
+@dataclass(frozen=True)
+class ViewWeightedClosures:
+    """A view-weighted tier's closures: ``covered`` (where the film is) and ``bare`` (bare
+    skin), mixed by ``coverage`` as areas (a Mix Shader)."""
+
+    covered: tuple
+    bare: tuple
+    coverage: Any
+
+
+def view_weighted_closures(fit, x: TierInputs, ops: Algebra, *,
+                           tinted_subsurface: bool = True) -> ViewWeightedClosures:
+    """The LAYERED tier's closures at inputs ``x``, their view-dependent factors read from the
+    image rows (``ops.row``, :data:`lut_baker.closures.view_image.LUT_ROWS`):
+
+    - where the film is: its gloss (Glossy, ``g`` times row ``film_gloss``), its diffuse and
+      the gloss's Lambertian companion (one Diffuse, ``(1 - A) pi P_d,f + g`` row
+      ``film_gloss_diffuse``), the skin's gloss through it (Glossy, ``g (1 - A)^2`` row
+      ``path3_gloss``), the skin through it (Subsurface, ``(1 - A)^2 T(theta_o) T_mean S``);
+    - bare skin: its gloss (Glossy, ``g`` row ``skin_gloss``) and its subsurface (``S``).
+
+    ``g`` (the group's Gloss input) scales the Glossy colours: at 0 no Glossy closure is
+    allocated.  ``tinted_subsurface``: the skin through the film keeps the skin's own
+    (bright) colour, tinted by ``(1 - A)^2 T(theta_o) T_mean`` relative to its strongest
+    channel, and that channel weights the closure (a dark colour would make Cycles' random
+    walk both noisy, 14% against 1% at 32 samples, and wrongly short); else its colour is the
+    product itself (EEVEE's screen-space subsurface and Burley take it as it is).  Both give
+    the same product."""
+    weights = coverage_weights(x.coverage, x.absorption)
+    g = x.gloss
+    transmitted = weights.twice * ops.row("film_transmittance") * fit.transmittance_mean
+    if tinted_subsurface:
+        strongest = ops.channel_max(transmitted)
+        through = Closure("subsurface", "skin through film",
+                          transmitted * x.skin_color / ops.maximum(strongest,
+                                                                   THROUGH_WEIGHT_FLOOR),
+                          "skin", weight=strongest)
+    else:
+        through = Closure("subsurface", "skin through film", transmitted * x.skin_color, "skin")
+    covered = (
+        Closure("glossy", "film_gloss", g * ops.row("film_gloss"), "film"),
+        Closure("diffuse", "film diffuse",
+                weights.once * fit.film_albedo + g * ops.row("film_gloss_diffuse"), "film"),
+        Closure("glossy", "path3_gloss", g * ops.row("path3_gloss") * weights.twice, "skin"),
+        through,
+    )
+    bare = (
+        Closure("glossy", "skin_gloss", g * ops.row("skin_gloss"), "skin"),
+        Closure("subsurface", "bare skin", x.skin_color, "skin"),
+    )
+    return ViewWeightedClosures(covered=covered, bare=bare, coverage=x.coverage)

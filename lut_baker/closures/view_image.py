@@ -1,0 +1,38 @@
+"""The view-angle image of the view-weighted tiers: its rows, its texel centres and how
+Blender's Image Texture samples it.
+
+A tier's view-dependent weights are 1-D functions of ``cos(theta_o)``, one per row of a small
+float image that the node group reads at ``u = cos(theta_o)``: :data:`LUT_ROWS` names the rows,
+:func:`lut_nodes` gives the texel centres, :func:`sample_lut` reads a row as Blender does
+(Linear, EXTEND).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["LUT_ROWS", "DEFAULT_LUT_SIZE", "lut_nodes", "sample_lut"]
+
+LUT_ROWS = ("film_gloss", "path3_gloss", "skin_gloss", "film_transmittance",
+            "film_gloss_diffuse")
+"""Rows of the LAYERED tier's view-angle image: three Glossy weights, the film's
+transmittance ``T(theta_o)`` and the film gloss's Lambertian companion
+(:func:`lut_baker.closures.fitting.fit_glossy`)."""
+DEFAULT_LUT_SIZE = 64
+"""Texels per row of the view-angle image (linear filtering between texel centres)."""
+
+
+def lut_nodes(size: int = DEFAULT_LUT_SIZE) -> np.ndarray:
+    """``cos(theta_o)`` at the texel centres ``(i + 0.5) / size`` of a view-angle image."""
+    return (np.arange(size) + 0.5) / size
+
+
+def sample_lut(lut, cos_view) -> np.ndarray:
+    """What Blender's Image Texture (Linear, EXTEND) returns for a row ``lut`` ``(size[, C])``
+    at ``u = cos_view``: linear between texel centres, the edge texel beyond them."""
+    lut = np.asarray(lut, float)
+    nodes = lut_nodes(lut.shape[0])
+    cos_view = np.asarray(cos_view, float)
+    if lut.ndim == 1:
+        return np.interp(cos_view, nodes, lut)
+    return np.stack([np.interp(cos_view, nodes, lut[:, c]) for c in range(lut.shape[1])], -1)

@@ -1,0 +1,219 @@
+"""Shader-node arithmetic: the tiers' formulas (lut_baker.closures.tier_formulas) emitted as
+Math and Vector Math nodes.
+
+- :class:`Builder` -- adds nodes to a tree, lays them out, links sockets or sets values.
+- :class:`NodeValue` -- a node socket that takes part in ``+ - * /`` and ``** 2`` with other
+  sockets and with constants (numbers, numpy arrays of 1 or 3 values): each operation adds one
+  node, or none when the result is known (``x * 1``, ``x + 0``, ``x * 0``, two constants).
+  Scalars are float sockets (Math nodes), colours vector sockets (Vector Math nodes); a scalar
+  meeting a colour is linked into the vector input, where Blender reads it as grey.
+- :class:`NodeAlgebra` -- the tier formulas' algebra on :class:`NodeValue`: ``maximum``,
+  ``minimum``, ``channel_mean``, ``channel_max``, ``row``.
+"""
+
+from __future__ import annotations
+
+import bpy
+import numpy as np
+
+__all__ = ["Builder", "NodeValue", "NodeAlgebra", "socket", "value_of"]
+
+
+def socket(sockets, identifier: str):
+    """A node socket by identifier (display names differ between Blender versions)."""
+    for item in sockets:
+        if item.identifier == identifier:
+            return item
+    raise KeyError(identifier)
+
+
+class Builder:
+    """Adds nodes to a tree and links them; values may be sockets, :class:`NodeValue` or
+    constants."""
+
+    def __init__(self, tree):
+        self.tree = tree
+        self.count = 0
+
+    def node(self, kind: str, label: str = "", **props):
+        node = self.tree.nodes.new(kind)
+        node.location = (200 * (self.count // 10) - 400, -160 * (self.count % 10))
+        self.count += 1
+        if label:
+            node.label = label
+        for name, value in props.items():
+            setattr(node, name, value)
+        return node
+
+    def feed(self, target, value):
+        """Link a socket into ``target`` or set its default value."""
+        value = value_of(value)
+        if isinstance(value, bpy.types.NodeSocket):
+            self.tree.links.new(value, target)
+        elif target.type in ("VECTOR", "RGBA") and np.size(value) == 1:
+            n = len(target.default_value)
+            target.default_value = (float(np.ravel(value)[0]),) * n
+        elif target.type == "RGBA" and len(value) == 3:
+            target.default_value = (*map(float, value), 1.0)
+        elif np.ndim(value) == 0 or np.size(value) == 1:
+            target.default_value = float(np.ravel(value)[0])
+        else:
+            target.default_value = tuple(map(float, value))
+
+    def math(self, operation: str, a, b=0.0, label: str = ""):
+        node = self.node("ShaderNodeMath", label, operation=operation)
+        self.feed(node.inputs[0], a)
+        self.feed(node.inputs[1], b)
+        return node.outputs[0]
+
+    def vector(self, operation: str, a, b=(0.0, 0.0, 0.0), label: str = ""):
+        node = self.node("ShaderNodeVectorMath", label, operation=operation)
+        self.feed(socket(node.inputs, "Vector"), a)
+        self.feed(socket(node.inputs, "Vector_001"), b)
+        return node.outputs["Value" if operation in ("DOT_PRODUCT", "LENGTH") else "Vector"]
+
+    def mix_vector(self, factor, a, b, label: str = ""):
+        """``a + factor (b - a)``, factor unclamped."""
+        node = self.node("ShaderNodeMix", label, data_type="VECTOR")
+        node.clamp_factor = False
+        self.feed(socket(node.inputs, "Factor_Float"), factor)
+        self.feed(socket(node.inputs, "A_Vector"), a)
+        self.feed(socket(node.inputs, "B_Vector"), b)
+        return socket(node.outputs, "Result_Vector")
+
+
+def _constant(value):
+    """A constant as a float (one value) or an RGB tuple (three)."""
+    array = np.asarray(value, float).ravel()
+    if array.size == 1:
+        return float(array[0])
+    if array.size == 3:
+        return tuple(float(v) for v in array)
+    raise ValueError(f"a node constant is 1 or 3 values, got {array.size}")
+
+
+def value_of(value):
+    """What :meth:`Builder.feed` takes for ``value``: a :class:`NodeValue`'s socket, else the
+    value."""
+    return value.socket if isinstance(value, NodeValue) else value
+
+
+def _is_colour(value) -> bool:
+    if isinstance(value, NodeValue):
+        return value.colour
+    return np.size(value) == 3
+
+
+def _equals(value, number: float) -> bool:
+    """Whether a constant is ``number`` in every channel (never for a socket)."""
+    return not isinstance(value, NodeValue) and bool(np.all(np.asarray(value) == number))
+
+
+class NodeValue:
+    """A node output socket in the tier formulas' arithmetic (see the module's docstring)."""
+
+    __array_ufunc__ = None  # numpy's operators hand an array * NodeValue to __rmul__
+
+    def __init__(self, build: Builder, output, colour: bool):
+        self.build = build
+        self.socket = output
+        self.colour = colour
+
+    # --- one node per operation, or none when the result is known ---------------------------
+    def _op(self, operation: str, a, b, label: str = ""):
+        build = self.build
+        if _is_colour(a) or _is_colour(b):
+            return NodeValue(build, build.vector(operation, _operand(a), _operand(b), label),
+                             True)
+        return NodeValue(build, build.math(operation, _operand(a), _operand(b), label), False)
+
+    def __add__(self, other):
+        return self if _equals(other, 0.0) and not (_is_colour(other) and not self.colour) \
+            else self._op("ADD", self, other)
+
+    def __radd__(self, other):
+        return self.__add__(other)
+
+    def __sub__(self, other):
+        return self if _equals(other, 0.0) and not (_is_colour(other) and not self.colour) \
+            else self._op("SUBTRACT", self, other)
+
+    def __rsub__(self, other):
+        return self._op("SUBTRACT", other, self)
+
+    def __mul__(self, other):
+        if _equals(other, 0.0):
+            return np.zeros(3) if self.colour or _is_colour(other) else 0.0
+        if _equals(other, 1.0) and not (_is_colour(other) and not self.colour):
+            return self
+        return self._op("MULTIPLY", self, other)
+
+    def __rmul__(self, other):
+        return self.__mul__(other)
+
+    def __truediv__(self, other):
+        if _equals(other, 1.0) and not (_is_colour(other) and not self.colour):
+            return self
+        return self._op("DIVIDE", self, other)
+
+    def __rtruediv__(self, other):
+        return self._op("DIVIDE", other, self)
+
+    def __pow__(self, exponent):
+        if exponent != 2:
+            raise ValueError("node values are only squared")
+        return self._op("MULTIPLY", self, self)
+
+    def __neg__(self):
+        return self._op("MULTIPLY", self, -1.0)
+
+
+def _operand(value):
+    return value.socket if isinstance(value, NodeValue) else _constant(value)
+
+
+class NodeAlgebra:
+    """The algebra of :mod:`lut_baker.closures.tier_formulas` on :class:`NodeValue`: each
+    function adds the nodes that compute it; ``rows`` maps a view-angle image row's name to
+    its (colour) :class:`NodeValue`."""
+
+    def __init__(self, build: Builder, rows: dict | None = None):
+        self.build = build
+        self._rows = rows or {}
+
+    def _either(self, operation: str, a, b, fold):
+        if not isinstance(a, NodeValue) and not isinstance(b, NodeValue):
+            return fold(np.asarray(a, float), np.asarray(b, float))
+        node = a if isinstance(a, NodeValue) else b
+        return node._op(operation, a, b)
+
+    def maximum(self, a, b):
+        return self._either("MAXIMUM", a, b, np.maximum)
+
+    def minimum(self, a, b):
+        return self._either("MINIMUM", a, b, np.minimum)
+
+    def channel_mean(self, colour):
+        if not isinstance(colour, NodeValue):
+            return float(np.mean(np.asarray(colour, float) * np.ones(3)))
+        if not colour.colour:
+            return colour
+        return NodeValue(self.build, self.build.vector("DOT_PRODUCT", colour.socket,
+                                                       (1 / 3, 1 / 3, 1 / 3),
+                                                       label="channel mean"), False)
+
+    def channel_max(self, colour):
+        if not isinstance(colour, NodeValue):
+            return float(np.max(np.asarray(colour, float) * np.ones(3)))
+        if not colour.colour:
+            return colour
+        build = self.build
+        separate = build.node("ShaderNodeSeparateXYZ", "channels")
+        build.feed(separate.inputs[0], colour.socket)
+        strongest = build.math("MAXIMUM", separate.outputs[0],
+                               build.math("MAXIMUM", separate.outputs[1], separate.outputs[2]),
+                               label="strongest channel")
+        return NodeValue(build, strongest, False)
+
+    def row(self, name: str):
+        return self._rows[name]
