@@ -172,7 +172,7 @@ def path3_node_error(tables, skin, n_nodes=300, seed=0) -> float:
     wi = direction(np.radians(tables.theta_deg[i]), azimuth)
     wo = direction(np.radians(tables.theta_deg[j]), 0.0)
     exact = np.reshape(layered_reflection(wi, wo, skin.film_transmission,
-                                          bake.gloss_layer(skin.skin)), (n_nodes, -1))
+                                          bake.gloss_layer(skin.skin_reflection)), (n_nodes, -1))
     peak = np.max(tables.path3_gloss)
     return float(np.max(np.abs(tables.path3_gloss[i, j, k] - exact)) / peak)
 

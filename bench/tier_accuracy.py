@@ -247,9 +247,9 @@ def exact_reflection(skin, pairs) -> np.ndarray:
 
     wi, wo, node = pairs["wi"], pairs["wo"], pairs["node"]
     film_t = film_transmission_layer(skin)
-    grid = grid_for(film_t, skin.skin)
+    grid = grid_for(film_t, skin.skin_reflection)
     views = np.radians(np.linspace(0.0, 90.0, VIEW_NODES))
-    matrices = layered_fourier_matrices(pairs["theta_i"], views, film_t, skin.skin, grid)
+    matrices = layered_fourier_matrices(pairs["theta_i"], views, film_t, skin.skin_reflection, grid)
     orders = np.arange(matrices.shape[0])
     theta_o = np.arccos(np.clip(wo[:, 2], 0.0, 1.0))
     phi = np.arctan2(wo[:, 1], wo[:, 0])  # wi lies at azimuth 0
@@ -261,7 +261,7 @@ def exact_reflection(skin, pairs) -> np.ndarray:
                                 np.cos(orders[:, None] * phi[None, pick]))
     path3 = np.maximum(path3, 0.0)  # (P, 1) or (P, 3)
     weights = coverage_weights(skin.coverage, skin.absorption)
-    bare = _rgb(ts_reflection(wi, wo, skin.skin, check=False))
+    bare = _rgb(ts_reflection(wi, wo, skin.skin_reflection, check=False))
     top = _rgb(ts_reflection(wi, wo, film_reflection_layer(skin), check=False))
     return weights.bare * bare + weights.covered * (top + path3)
 
@@ -323,7 +323,7 @@ def known_integrals(skin, pairs) -> dict:
     from lut_baker.model.layers import ReflectionLayer
     from lut_baker.model.microfacet import ts_reflection
 
-    layer = skin.film if np.any(skin.film.P_s) else skin.skin
+    layer = skin.film if np.any(skin.film.P_s) else skin.skin_reflection
     gloss = ReflectionLayer(P_d=0.0, P_s=layer.P_s, n=layer.n, eta=layer.eta)
     ours = directional_sums(_rgb(ts_reflection(pairs["wi"], pairs["wo"], gloss,
                                                check=False)), pairs)
@@ -353,7 +353,7 @@ def albedo_check(skin, pairs, exact) -> float:
 def narrowest_lobe_deg(skin) -> float:
     """The narrowest 1/e half-width (1/n degrees) of the film, its transmission and the skin."""
     return min(1.0 / float(np.max(layer.n)) for layer in (skin.film, skin.film_transmission,
-                                                          skin.skin))
+                                                          skin.skin_reflection))
 
 
 def _tier_errors(fit, tables, coverage, absorption, pairs, exact, albedo_pairs,

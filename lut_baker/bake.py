@@ -360,7 +360,8 @@ def path3_width_deg(skin: MadeUpSkin) -> float:
     """The narrowest lobe path 3 goes through (1/e half-width, degrees): the film's
     transmission (eq. 4) and the skin's gloss (eq. 2), whose product path 3 integrates; the
     film's own gloss (path 1) is not among them."""
-    return min(1.0 / float(np.max(layer.n)) for layer in (skin.film_transmission, skin.skin))
+    return min(1.0 / float(np.max(layer.n)) for layer in (skin.film_transmission,
+                                                          skin.skin_reflection))
 
 
 def _cosine_series(matrices: np.ndarray, pairs: _NodePairs) -> np.ndarray:
@@ -435,30 +436,33 @@ def bake(skin: MadeUpSkin, resolution_name="default", *, inter_reflection: bool 
     theta = np.radians(theta_deg)
     grid = hemisphere_panels(res.quad_panels, res.quad_points, res.quad_phi)
     kernels = KernelCache()
-    film_t = skin.film_transmission  # absorption 0: the tables apply it afterwards
-    skin_gloss = gloss_layer(skin.skin)
+    film_transmission = skin.film_transmission  # absorption 0: the tables apply it afterwards
+    skin_gloss = gloss_layer(skin.skin_reflection)
 
     _stage(progress, 0.05, "path 3 (Fourier matrices)")
     outer = np.concatenate([theta, grid.theta])
-    path3_m = layered_fourier_matrices(theta, outer, film_t, skin_gloss, grid, fourier=kernels)
+    path3_m = layered_fourier_matrices(theta, outer, film_transmission, skin_gloss, grid,
+                                       fourier=kernels)
     path3 = _cosine_series(path3_m[:, :, :theta.size], pairs)
     path3_albedo = order0_integral(path3_m[0, :, theta.size:], grid)
 
     _stage(progress, 0.45, "transmittances and albedos")
-    rows0 = kernels(film_t, theta, grid.theta, grid.n_phi)[0]
+    rows0 = kernels(film_transmission, theta, grid.theta, grid.n_phi)[0]
     fresnel_t = fresnel_transmittance(np.cos(grid.theta)[:, None],
                                       np.atleast_1d(skin.dipole.eta))
-    inner_t = order0_integral(kernels(film_t, grid.theta, grid.theta, grid.n_phi)[0], grid)
-    albedos = gloss_albedos((skin.film, skin.skin), theta_deg)
+    inner_t = order0_integral(kernels(film_transmission, grid.theta, grid.theta, grid.n_phi)[0],
+                              grid)
+    albedos = gloss_albedos((skin.film, skin.skin_reflection), theta_deg)
 
     extra = None
     if inter_reflection:
         _stage(progress, 0.7, "inter-reflections (adding equation)")
         film_t_a = film_transmission_layer(skin)
         full = inter_reflection_fourier_matrices(
-            theta, theta, film_t_a, skin.skin, grid, film_below=film_reflection_layer(skin),
-            fourier=kernels)
-        first = layered_fourier_matrices(theta, theta, film_t_a, skin.skin, grid, fourier=kernels)
+            theta, theta, film_t_a, skin.skin_reflection, grid,
+            film_below=film_reflection_layer(skin), fourier=kernels)
+        first = layered_fourier_matrices(theta, theta, film_t_a, skin.skin_reflection, grid,
+                                         fourier=kernels)
         extra = _cosine_series(full - first, pairs)
 
     _stage(progress, 0.9, "radial profile")
@@ -477,7 +481,7 @@ def bake(skin: MadeUpSkin, resolution_name="default", *, inter_reflection: bool 
         path3_gloss_albedo=rgb_view(path3_albedo),
         skin_gloss_albedo=albedos[1],
         film_diffuse=rgb_view(np.atleast_1d(skin.film.P_d)),
-        skin_diffuse=rgb_view(np.atleast_1d(skin.skin.P_d)),
+        skin_diffuse=rgb_view(np.atleast_1d(skin.skin_reflection.P_d)),
         total_reflectance=rgb_view(total),
         film_transmittance_integral=rgb_view(order0_integral(inner_t[None], grid)[0]),
         profile=rgb_view(profile),
@@ -499,10 +503,12 @@ def inter_reflection_albedo(skin: MadeUpSkin, theta_deg, resolution_name="defaul
     res = resolution(resolution_name)
     grid = hemisphere_panels(res.quad_panels, res.quad_points, res.quad_phi)
     theta = np.radians(np.atleast_1d(np.asarray(theta_deg, float)))
-    film_t = film_transmission_layer(skin)
+    film_transmission = film_transmission_layer(skin)
     kernels = KernelCache()
-    full = inter_reflection_fourier_matrices(theta, grid.theta, film_t, skin.skin, grid,
+    full = inter_reflection_fourier_matrices(theta, grid.theta, film_transmission,
+                                             skin.skin_reflection, grid,
                                              film_below=film_reflection_layer(skin),
                                              fourier=kernels)
-    first = layered_fourier_matrices(theta, grid.theta, film_t, skin.skin, grid, fourier=kernels)
+    first = layered_fourier_matrices(theta, grid.theta, film_transmission, skin.skin_reflection,
+                                     grid, fourier=kernels)
     return rgb_view(order0_integral(full[0] - first[0], grid))

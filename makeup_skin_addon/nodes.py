@@ -254,17 +254,17 @@ def _build_layered(build: Builder, fit, lut, method: str, radius_mm, ior: float)
     build.tree.links.new(mix.outputs[0], output.inputs["Shader"])
 
 
-def build_group(tier: str, bake: dict, fit, group=None, *, method=None, measured=None):
+def build_group(tier: str, record: dict, fit, group=None, *, method=None, measured=None):
     """Create (or, given ``group``, rebuild in place) the node group of ``tier`` from a
-    :class:`ClosureFit` ``fit`` of the tables that ``bake`` describes (its record,
-    :func:`storage.bake_record`).  ``method``: a subsurface method forced by the user, else the
+    :class:`ClosureFit` ``fit`` of the tables that the bake record ``record`` describes
+    (:func:`storage.bake_record`).  ``method``: a subsurface method forced by the user, else the
     fit's choice.  The group's :data:`.keys.FIT_KEY` holds the bake record, the fit's summary,
     the SHA-256 of every image the group reads (:func:`storage.image_record`) and
     ``measured``, what the fit measured at the settings' coverage and absorption
     (:func:`.fits.measure`), if given."""
     if tier not in fitting.TIERS:
         raise ValueError(f"tier must be one of {fitting.TIERS}, got {tier!r}")
-    key = bake["key"]
+    key = record["key"]
     name = group_name(tier, key, method)
     if group is None:
         group = bpy.data.node_groups.get(name) or bpy.data.node_groups.new(name,
@@ -285,7 +285,7 @@ def build_group(tier: str, bake: dict, fit, group=None, *, method=None, measured
         lut = storage.lut_image(lut_image_name(key), fit.lut)
         images.append(storage.image_record(lut))
         _build_layered(build, fit, lut, method, radius, ior)
-    group[FIT_KEY] = json.dumps({**bake, "tier": tier, "forced_method": forced,
+    group[FIT_KEY] = json.dumps({**record, "tier": tier, "forced_method": forced,
                                  "images": images, **fit.summary(),
                                  "subsurface_method": method, "measured": measured},
                                 default=float)

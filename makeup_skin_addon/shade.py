@@ -109,8 +109,9 @@ def skin_from_settings(settings, foundation: str | None = None):
     skin = presets.made_up_skin(name, settings.skin, coverage=1.0, absorption=0.0)
     own = foundation_roughness(name)
     film = _roughened(skin.film, settings.film_roughness if foundation is None else own, own)
-    surface = _roughened(skin.skin, settings.skin_roughness, skin_roughness(settings.skin))
-    skin = skin.replace(film=film, skin=surface)
+    surface = _roughened(skin.skin_reflection, settings.skin_roughness,
+                         skin_roughness(settings.skin))
+    skin = skin.replace(film=film, skin_reflection=surface)
     if settings.override_film:
         skin = skin.replace(
             film=skin.film.scaled(eta=settings.film_ior / float(skin.film.eta)),

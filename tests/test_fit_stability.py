@@ -31,7 +31,7 @@ def test_perturbed_moves_every_parameter_by_at_most_the_perturbation_and_stays_v
     skin = presets.made_up_skin("medium_beige", "jensen_skin1")  # coverage 1: at its bound
     moved = perturbed(skin, seed=3)
     assert moved.coverage < 1.0 and 1.0 - moved.coverage <= PERTURBATION
-    for layer in ("film", "film_transmission", "skin", "dipole"):
+    for layer in ("film", "film_transmission", "skin_reflection", "dipole"):
         for field in dataclasses.fields(getattr(skin, layer)):
             before = np.asarray(getattr(getattr(skin, layer), field.name))
             after = np.asarray(getattr(getattr(moved, layer), field.name))

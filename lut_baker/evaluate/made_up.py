@@ -44,10 +44,11 @@ def made_up_reflection(wi, wo, skin: MadeUpSkin, *, level: int = 0):
     wi = check_directions("wi", wi)
     wo = check_directions("wo", wo)
     film = film_reflection_layer(skin)
-    film_t = film_transmission_layer(skin)
-    bare = _rgb(ts_reflection(wi, wo, skin.skin, check=False), skin.skin)
+    film_transmission = film_transmission_layer(skin)
+    bare = _rgb(ts_reflection(wi, wo, skin.skin_reflection, check=False), skin.skin_reflection)
     top = _rgb(ts_reflection(wi, wo, film, check=False), film)
-    path3 = _rgb(layered_reflection(wi, wo, film_t, skin.skin, level=level), film_t, skin.skin)
+    path3 = _rgb(layered_reflection(wi, wo, film_transmission, skin.skin_reflection, level=level),
+                 film_transmission, skin.skin_reflection)
     # The layers hold the absorption already: everything the film covers is "top".
     return combine(coverage_weights(skin.coverage, skin.absorption), top=top + path3,
                    bare=bare)
@@ -58,16 +59,19 @@ def directional_albedo(theta_i_deg, skin: MadeUpSkin, *, level: int = 0) -> np.n
     ``Int f(wi, wo) cos(theta_o) dwo`` (dimensionless) at incidence ``theta_i_deg`` (degrees).
     A white furnace test asserts it is <= 1.  Shape ``theta_i_deg.shape + (3,)``."""
     theta = np.radians(np.atleast_1d(np.asarray(theta_i_deg, float)))
-    film_t = film_transmission_layer(skin)
-    grid = grid_for(film_t, skin.skin, level=level)  # path 3's layers (the film's top: below)
-    path3 = layered_fourier_matrices(theta, grid.theta, film_t, skin.skin, grid,
+    film_transmission = film_transmission_layer(skin)
+    grid = grid_for(film_transmission, skin.skin_reflection,
+                    level=level)  # path 3's layers (the film's top: below)
+    path3 = layered_fourier_matrices(theta, grid.theta, film_transmission, skin.skin_reflection,
+                                     grid,
                                      orders=1)[0]  # (P, N, C)
     path3 = 2.0 * np.pi * np.einsum("pnc,n->pc", path3, grid.weight)
-    path3 = path3 if (film_t.channels or skin.skin.channels) else path3[..., 0]
+    path3 = path3 if (film_transmission.channels or skin.skin_reflection.channels) else path3[...,
+                                                                                              0]
     film = film_reflection_layer(skin)
     top = reflection_albedo(np.degrees(theta), film, level=level)
-    bare = reflection_albedo(np.degrees(theta), skin.skin, level=level)
+    bare = reflection_albedo(np.degrees(theta), skin.skin_reflection, level=level)
     total = combine(coverage_weights(skin.coverage, skin.absorption),
-                    top=_rgb(top, film) + _rgb(path3, film_t, skin.skin),
-                    bare=_rgb(bare, skin.skin))
+                    top=_rgb(top, film) + _rgb(path3, film_transmission, skin.skin_reflection),
+                    bare=_rgb(bare, skin.skin_reflection))
     return total.reshape(np.shape(theta_i_deg) + (3,))

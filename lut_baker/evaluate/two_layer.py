@@ -58,10 +58,10 @@ POINT_CHUNK = 64
 """Evaluation points processed together (bounds memory at a few tens of MB)."""
 
 
-def inner_matrices(grid: HemisphereGrid, cosmetic, skin: ReflectionLayer,
+def inner_matrices(grid: HemisphereGrid, film_transmission, skin_reflection: ReflectionLayer,
                     fourier=layer_fourier_kernel) -> np.ndarray:
     """``c_m^2 W B_m W`` on the grid's polar nodes: shape ``(orders, N, N, C)``."""
-    b = fourier(skin, grid.theta, grid.theta, grid.n_phi)
+    b = fourier(skin_reflection, grid.theta, grid.theta, grid.n_phi)
     w = grid.weight
     factor = azimuth_convolution_factor(grid.orders) ** 2
     return factor[:, None, None, None] * w[None, :, None, None] * b * w[None, None, :, None]
@@ -74,7 +74,8 @@ def _batched_matmul(left: np.ndarray, right: np.ndarray) -> np.ndarray:
     return np.moveaxis(left_c @ right_c, 1, -1)  # (M, P, Q, C)
 
 
-def layered_fourier_matrices(theta_i, theta_o, cosmetic, skin, grid: HemisphereGrid, *,
+def layered_fourier_matrices(theta_i, theta_o, film_transmission, skin_reflection,
+                             grid: HemisphereGrid, *,
                              fourier=layer_fourier_kernel, orders: int | None = None):
     """Fourier matrices ``F_m(theta_i, theta_o)`` of path 3: ``f_cs = sum_m F_m cos(m phi)``.
 
@@ -86,13 +87,14 @@ def layered_fourier_matrices(theta_i, theta_o, cosmetic, skin, grid: HemisphereG
     albedos: the kernels are still sampled at every azimuth, but the products run once).
     """
     keep = slice(None, orders)
-    inner = inner_matrices(grid, cosmetic, skin, fourier)[keep]
-    rows = transmission_rows(theta_i, grid, cosmetic, fourier)[keep]
-    cols = transmission_rows(theta_o, grid, cosmetic, fourier)[keep]
+    inner = inner_matrices(grid, film_transmission, skin_reflection, fourier)[keep]
+    rows = transmission_rows(theta_i, grid, film_transmission, fourier)[keep]
+    cols = transmission_rows(theta_o, grid, film_transmission, fourier)[keep]
     return _batched_matmul(_batched_matmul(rows, inner), np.swapaxes(cols, 1, 2))
 
 
-def inter_reflection_fourier_matrices(theta_i, theta_o, cosmetic, skin, grid, *, film_below=None,
+def inter_reflection_fourier_matrices(theta_i, theta_o, film_transmission, skin_reflection, grid,
+                                      *, film_below=None,
                                       fourier=layer_fourier_kernel):
     """Fourier matrices of all inter-reflections between film and skin (the adding equation).
 
@@ -101,10 +103,11 @@ def inter_reflection_fourier_matrices(theta_i, theta_o, cosmetic, skin, grid, *,
     path 3 alone).  Shapes and ``fourier`` as :func:`layered_fourier_matrices`.
     """
     if film_below is None:
-        return layered_fourier_matrices(theta_i, theta_o, cosmetic, skin, grid, fourier=fourier)
+        return layered_fourier_matrices(theta_i, theta_o, film_transmission, skin_reflection,
+                                        grid, fourier=fourier)
     # S = c_m^2 W B_m W carries the two azimuth integrals around a skin bounce; each further
     # bounce off the film's underside adds R_f S, so the sum is S (I - R_f S)^-1 = (I - S R_f)^-1 S.
-    skin_m = inner_matrices(grid, cosmetic, skin, fourier)
+    skin_m = inner_matrices(grid, film_transmission, skin_reflection, fourier)
     film_m = fourier(film_below, grid.theta, grid.theta, grid.n_phi)
     channels = max(film_m.shape[-1], skin_m.shape[-1])
     skin_m = np.broadcast_to(skin_m, skin_m.shape[:3] + (channels,))
@@ -115,8 +118,8 @@ def inter_reflection_fourier_matrices(theta_i, theta_o, cosmetic, skin, grid, *,
         for c in range(channels):
             s_m = skin_m[m, :, :, c]
             adding[m, :, :, c] = np.linalg.solve(eye - s_m @ film_m[m, :, :, c], s_m)
-    rows = transmission_rows(theta_i, grid, cosmetic, fourier)
-    cols = transmission_rows(theta_o, grid, cosmetic, fourier)
+    rows = transmission_rows(theta_i, grid, film_transmission, fourier)
+    cols = transmission_rows(theta_o, grid, film_transmission, fourier)
     return _batched_matmul(_batched_matmul(rows, adding), np.swapaxes(cols, 1, 2))
 
 
@@ -127,12 +130,13 @@ def _fourier_sum(matrices_diag: np.ndarray, phi: np.ndarray) -> np.ndarray:
     return np.einsum("mpc,mp->pc", matrices_diag, cosines)
 
 
-def layered_reflection(wi, wo, cosmetic: TransmissionLayer, skin: ReflectionLayer, *,
+def layered_reflection(wi, wo, film_transmission: TransmissionLayer,
+                       skin_reflection: ReflectionLayer, *,
                        level: int = 0, grid: HemisphereGrid | None = None):
     """Path 3 of made-up skin, ``f_cs(wi, wo)`` (paper eq. 7, docs/model.md §3), without the cosine.
 
     ``wi``, ``wo``: unit vectors ``(..., 3)``; 0 where either is below the surface.  Units:
-    cosmetic units squared times skin units (albedo units in, albedo units out).
+    film_transmission units squared times skin units (albedo units in, albedo units out).
     """
     wi = check_directions("wi", wi)
     wo = check_directions("wo", wo)
@@ -140,33 +144,35 @@ def layered_reflection(wi, wo, cosmetic: TransmissionLayer, skin: ReflectionLaye
     batch = wi.shape[:-1]
     wi = wi.reshape(-1, 3)
     wo = wo.reshape(-1, 3)
-    grid = grid or grid_for(cosmetic, skin, level=level)
-    inner = inner_matrices(grid, cosmetic, skin)
+    grid = grid or grid_for(film_transmission, skin_reflection, level=level)
+    inner = inner_matrices(grid, film_transmission, skin_reflection)
     theta_i = np.arccos(np.clip(wi[:, 2], 0.0, 1.0))
     theta_o = np.arccos(np.clip(wo[:, 2], 0.0, 1.0))
     phi = relative_azimuth(wi, wo)
-    out = np.empty((wi.shape[0], 3 if (cosmetic.channels or skin.channels) else 1))
+    out = np.empty((wi.shape[0],
+                    3 if (film_transmission.channels or skin_reflection.channels) else 1))
     for start in range(0, wi.shape[0], POINT_CHUNK):
         s = slice(start, start + POINT_CHUNK)
-        rows = transmission_rows(theta_i[s], grid, cosmetic)  # (M, P, N, C)
-        cols = transmission_rows(theta_o[s], grid, cosmetic)  # (M, P, N, C)
+        rows = transmission_rows(theta_i[s], grid, film_transmission)  # (M, P, N, C)
+        cols = transmission_rows(theta_o[s], grid, film_transmission)  # (M, P, N, C)
         through = _batched_matmul(rows, inner)  # (M, P, N, C)
         diag = np.einsum("mpnc,mpnc->mpc", through, cols)
         out[s] = _fourier_sum(diag, phi[s])
     upper = (wi[:, 2] >= 0.0) & (wo[:, 2] >= 0.0)
     out = np.where(upper[:, None], np.maximum(out, 0.0), 0.0)
-    return drop_channel_axis(out.reshape(batch + (out.shape[-1],)), cosmetic, skin)
+    return drop_channel_axis(out.reshape(batch + (out.shape[-1],)), film_transmission,
+                             skin_reflection)
 
 
-def layered_reflection_converged(wi, wo, cosmetic, skin, *, rtol: float = 1e-4,
+def layered_reflection_converged(wi, wo, film_transmission, skin_reflection, *, rtol: float = 1e-4,
                                  max_level: int = 3):
     """The exact evaluator of path 3: :func:`layered_reflection` at increasing ``level`` until
     two successive levels agree within ``rtol`` relative (of the larger of the value and 1e-3
     of the batch's peak).  Returns ``(values, achieved_relative_change, level)``; raises
     ``RuntimeError`` if ``max_level`` is reached without convergence."""
-    previous = layered_reflection(wi, wo, cosmetic, skin, level=0)
+    previous = layered_reflection(wi, wo, film_transmission, skin_reflection, level=0)
     for level in range(1, max_level + 1):
-        current = layered_reflection(wi, wo, cosmetic, skin, level=level)
+        current = layered_reflection(wi, wo, film_transmission, skin_reflection, level=level)
         scale = np.maximum(np.abs(current), 1e-3 * np.max(np.abs(current)))
         change = float(np.max(np.abs(current - previous) / np.where(scale > 0, scale, 1.0)))
         if change <= rtol:
@@ -178,14 +184,14 @@ def layered_reflection_converged(wi, wo, cosmetic, skin, *, rtol: float = 1e-4,
     )
 
 
-def transmission_factor(w, cosmetic: TransmissionLayer, skin: Dipole, *, level: int = 0):
+def transmission_factor(w, film_transmission: TransmissionLayer, dipole: Dipole, *, level: int = 0):
     """Path 4's angular factor ``t(w) = Int f_t(w, -u) F_t(eta_s, u) cos(theta_u) du``
     (paper eq. 8, docs/model.md §3): light through the film into the skin (or out of it, by
     reciprocity).  ``w``: unit vectors ``(..., 3)``, 0 below the surface."""
     w = check_directions("w", w)
-    grid = grid_for(cosmetic, level=level)
+    grid = grid_for(film_transmission, level=level)
     # (N, C): the dipole may be RGB through its coefficients with a scalar eta.
-    fresnel_t = fresnel_transmittance(np.cos(grid.theta)[:, None], np.atleast_1d(skin.eta))
-    fresnel_t = np.broadcast_to(fresnel_t, (grid.theta.size, 3 if skin.channels else 1))
-    return hemisphere_factor(w, grid, cosmetic, fresnel_t, skin)
+    fresnel_t = fresnel_transmittance(np.cos(grid.theta)[:, None], np.atleast_1d(dipole.eta))
+    fresnel_t = np.broadcast_to(fresnel_t, (grid.theta.size, 3 if dipole.channels else 1))
+    return hemisphere_factor(w, grid, film_transmission, fresnel_t, dipole)
 

@@ -78,12 +78,13 @@ def grid_for(*layers, level: int = 0) -> HemisphereGrid:
     return hemisphere_grid(min(widths, default=90.0), level)
 
 
-def transmission_kernel(cosmetic: TransmissionLayer):
+def transmission_kernel(film_transmission: TransmissionLayer):
     """``(w_top, u) -> f_t(w_top, -u)`` with channel axis: light from ``w_top`` leaving
     downward along ``-u`` (both arguments upper-hemisphere directions)."""
 
     def kernel(w_top, u):
-        return with_channel_axis(ts_transmission(w_top, -u, cosmetic, check=False), cosmetic)
+        return with_channel_axis(ts_transmission(w_top, -u, film_transmission, check=False),
+                                 film_transmission)
 
     return kernel
 
@@ -106,28 +107,29 @@ def layer_fourier_kernel(layer, theta_a, theta_b, n_phi: int) -> np.ndarray:
     return fourier_kernel(transmission_kernel(layer), theta_a, theta_b, n_phi)
 
 
-def transmission_rows(theta, grid: HemisphereGrid, cosmetic,
+def transmission_rows(theta, grid: HemisphereGrid, film_transmission,
                        fourier=layer_fourier_kernel) -> np.ndarray:
     """``T_m(theta, theta_u)`` for outer polar angles ``theta``: shape ``(orders, P, N, C)``."""
-    return fourier(cosmetic, theta, grid.theta, grid.n_phi)
+    return fourier(film_transmission, theta, grid.theta, grid.n_phi)
 
 
-def film_transmittance(w, cosmetic: TransmissionLayer, *, level: int = 0):
+def film_transmittance(w, film_transmission: TransmissionLayer, *, level: int = 0):
     """The film's directional transmittance ``Int f_t(w, -u) cos(theta_u) du`` (eq. 4
     integrated): how much of the light arriving from ``w`` crosses the film."""
     w = check_directions("w", w)
-    grid = grid_for(cosmetic, level=level)
-    return hemisphere_factor(w, grid, cosmetic, np.ones((grid.theta.size, 1)), cosmetic)
+    grid = grid_for(film_transmission, level=level)
+    return hemisphere_factor(w, grid, film_transmission, np.ones((grid.theta.size, 1)),
+                             film_transmission)
 
 
-def hemisphere_factor(w, grid, cosmetic, below_weight, *layers):
+def hemisphere_factor(w, grid, film_transmission, below_weight, *layers):
     """``2 pi sum_u T_0(theta_w, theta_u) below_weight(u) W_u`` (order 0: azimuth integrated)."""
     batch = w.shape[:-1]
     theta = np.arccos(np.clip(w.reshape(-1, 3)[:, 2], 0.0, 1.0))
-    t0 = transmission_rows(theta, grid, cosmetic)[0]  # (P, N, C)
+    t0 = transmission_rows(theta, grid, film_transmission)[0]  # (P, N, C)
     value = order0_integral(t0, grid, below_weight)
     value = np.where(w.reshape(-1, 3)[:, 2:3] >= 0.0, value, 0.0)
-    return drop_channel_axis(value.reshape(batch + (value.shape[-1],)), cosmetic, *layers)
+    return drop_channel_axis(value.reshape(batch + (value.shape[-1],)), film_transmission, *layers)
 
 
 SPECULAR_POINTS = (12, 48)
@@ -177,10 +179,10 @@ def reflection_albedo(theta_i_deg, layer: ReflectionLayer, *, level: int = 0):
     return drop_channel_axis(value.reshape(theta.shape + (value.shape[-1],)), layer)
 
 
-def transmission_albedo(theta_i_deg, cosmetic: TransmissionLayer, *, level: int = 0):
+def transmission_albedo(theta_i_deg, film_transmission: TransmissionLayer, *, level: int = 0):
     """Directional transmittance of the film at incidence ``theta_i_deg`` (degrees)."""
     theta = np.radians(np.asarray(theta_i_deg, float))
-    return film_transmittance(direction(theta, 0.0), cosmetic, level=level)
+    return film_transmittance(direction(theta, 0.0), film_transmission, level=level)
 
 
 BIHEMISPHERICAL_NODES = 48

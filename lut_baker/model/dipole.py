@@ -34,19 +34,19 @@ def fresnel_diffuse_reflectance(eta):
     return -1.440 / eta**2 + 0.710 / eta + 0.668 + 0.0636 * eta
 
 
-def _dipole_terms(skin: Dipole):
+def _dipole_terms(dipole: Dipole):
     """Derived dipole quantities of eq. 6: reduced albedo a', reduced extinction s_t' (1/mm),
     ``k = s_tr / s_t' = sqrt(3 (1 - a'))`` and A.  (z_r = 1/s_t', z_v = z_r (1 + 4A/3).)"""
-    sigma_s_reduced = skin.sigma_s * (1.0 - skin.g)
-    sigma_t_reduced = sigma_s_reduced + skin.sigma_a
+    sigma_s_reduced = dipole.sigma_s * (1.0 - dipole.g)
+    sigma_t_reduced = sigma_s_reduced + dipole.sigma_a
     albedo = sigma_s_reduced / sigma_t_reduced
-    k = np.sqrt(3.0 * skin.sigma_a / sigma_t_reduced)
-    f_dr = fresnel_diffuse_reflectance(skin.eta)
+    k = np.sqrt(3.0 * dipole.sigma_a / sigma_t_reduced)
+    f_dr = fresnel_diffuse_reflectance(dipole.eta)
     a = (1.0 + f_dr) / (1.0 - f_dr)
     return albedo, sigma_t_reduced, k, a
 
 
-def dipole_profile(d_mm, skin: Dipole):
+def dipole_profile(d_mm, dipole: Dipole):
     """Dipole diffuse reflectance ``R(d)`` in 1/mm^2 at distance ``d_mm`` >= 0 (paper eq. 6).
 
     ``d_mm`` of any shape; RGB dipoles add a trailing channel axis.  Finite at d = 0.
@@ -54,11 +54,11 @@ def dipole_profile(d_mm, skin: Dipole):
     d = np.asarray(d_mm, dtype=float)
     if np.any(np.isnan(d)) or np.any(d < 0.0):
         raise ValueError("d_mm must be distances >= 0 (mm)")
-    albedo, sigma_t_reduced, k, a = _dipole_terms(skin)
+    albedo, sigma_t_reduced, k, a = _dipole_terms(dipole)
     # Lengths in reduced mean free paths 1/s' (s' = sigma_t' in 1/mm): z_r s' = 1, z_v s' =
     # 1 + 4A/3, s_tr / s' = k, so R = a' s'^2 / (4 pi) sum z (k + 1/r) e^(-k r) / r^2 with
     # dimensionless r = hypot(d s', z): no overflow as s' -> 0 (z_r -> inf).
-    x = channel_axis(d, skin) * sigma_t_reduced
+    x = channel_axis(d, dipole) * sigma_t_reduced
     total = 0.0
     for z in (1.0, 1.0 + 4.0 * a / 3.0):
         r = np.hypot(x, z)
@@ -68,9 +68,9 @@ def dipole_profile(d_mm, skin: Dipole):
     return albedo * sigma_t_reduced**2 / (4.0 * np.pi) * total
 
 
-def dipole_total_reflectance(skin: Dipole):
+def dipole_total_reflectance(dipole: Dipole):
     """Total diffuse reflectance ``Rd = 2 pi Int_0^inf R(d) d dd`` (dimensionless) in closed
     form (Jensen 2001 eq. 6 integrated):
     ``Rd = a'/2 (1 + exp(-4/3 A sqrt(3(1 - a')))) exp(-sqrt(3(1 - a')))``."""
-    albedo, _, root, a = _dipole_terms(skin)
+    albedo, _, root, a = _dipole_terms(dipole)
     return 0.5 * albedo * (1.0 + np.exp(-4.0 / 3.0 * a * root)) * np.exp(-root)

@@ -86,9 +86,10 @@ class MadeUpSkin:
     """Made-up skin in albedo units (1/sr): the film over the skin, plus coverage and absorption.
 
     ``film``: the film's top-surface reflection (path 1); ``film_transmission``: the film's
-    transmission (paths 3 and 4); ``skin``: the skin surface's Torrance-Sparrow reflection;
-    ``dipole``: the skin's subsurface scattering (its profile shape spreads the skin's diffuse
-    light); ``coverage`` in [0, 1]: 0 bare skin, 1 the full two-layer result, areal mix between;
+    transmission (paths 3 and 4); ``skin_reflection``: the skin surface's Torrance-Sparrow
+    reflection; ``dipole``: the skin's subsurface scattering (its profile shape spreads the
+    skin's diffuse light); ``coverage`` in [0, 1]: 0 bare skin, 1 the full two-layer result,
+    areal mix between;
     ``absorption`` in [0, 1] per channel: the fraction of light crossing the film's pigment
     (its diffuse reflection and its transmission) that is absorbed; ``K``: the normalisation
     constant these values were divided by (counts per second per unit albedo), if any.
@@ -96,7 +97,7 @@ class MadeUpSkin:
 
     film: ReflectionLayer
     film_transmission: TransmissionLayer
-    skin: ReflectionLayer
+    skin_reflection: ReflectionLayer
     dipole: Dipole
     coverage: float = 1.0
     absorption: object = 0.0
@@ -113,7 +114,7 @@ class MadeUpSkin:
                                      low_open=False, high_open=False)
         object.__setattr__(self, "absorption", absorption)
         for name, kind in (("film", ReflectionLayer), ("film_transmission", TransmissionLayer),
-                           ("skin", ReflectionLayer), ("dipole", Dipole)):
+                           ("skin_reflection", ReflectionLayer), ("dipole", Dipole)):
             if not isinstance(getattr(self, name), kind):
                 raise ValueError(f"{name} must be a {kind.__name__}")
 
@@ -138,7 +139,7 @@ def from_paper_counts(film: ReflectionLayer, film_transmission: TransmissionLaye
     return MadeUpSkin(
         film=film_s.scaled(P_d=1 / k, P_s=1 / k),
         film_transmission=transmission_s.scaled(P_d=1 / k, P_t=1 / k),
-        skin=skin_s.scaled(P_d=1 / k, P_s=1 / k),
+        skin_reflection=skin_s.scaled(P_d=1 / k, P_s=1 / k),
         dipole=dipole,
         K=k,
         **options,

@@ -41,17 +41,21 @@ from .made_up_skin import MadeUpSkin, from_paper_counts
 from .presets import FOUNDATIONS, SKINS, made_up_skin, paper
 
 __all__ = ["skin_to_dict", "skin_from_dict", "load_params", "read_mapping",
-           "params_from_mapping", "LAYERS", "SECTIONS"]
+           "params_from_mapping", "LAYERS", "RECORD_KEYS", "SECTIONS"]
 
 LAYERS = {
     "film": ReflectionLayer,
     "film_transmission": TransmissionLayer,
-    "skin": ReflectionLayer,
+    "skin_reflection": ReflectionLayer,
     "dipole": Dipole,
 }
-"""The layers of a made-up skin (keys of :func:`skin_to_dict`) and their types."""
-SECTIONS = {"film": "film", "film_transmission": "film_transmission", "skin_surface": "skin",
-            "dipole": "dipole"}
+"""The layers of a made-up skin (its fields) and their types."""
+RECORD_KEYS = {"film": "film", "film_transmission": "film_transmission",
+               "skin_reflection": "skin", "dipole": "dipole"}
+"""Each layer's key in :func:`skin_to_dict`'s data (the bake records, sidecars and files of
+every version keep the skin's reflection under ``skin``)."""
+SECTIONS = {"film": "film", "film_transmission": "film_transmission",
+            "skin_surface": "skin_reflection", "dipole": "dipole"}
 """Tables of a parameter file -> the layer they set (``skin`` names the skin preset)."""
 TOP_LEVEL = {"name", "foundation", "skin", "coverage", "absorption", "units",
              "reflection_shutter_s", "transmission_shutter_s", "format"}
@@ -63,7 +67,7 @@ RGB = "a number or 3 numbers [R, G, B]"
 
 def skin_to_dict(skin: MadeUpSkin) -> dict:
     """Plain data (floats, lists, str) of a made-up skin, for metadata and sidecars."""
-    data = {name: getattr(skin, name).as_dict() for name in LAYERS}
+    data = {RECORD_KEYS[name]: getattr(skin, name).as_dict() for name in LAYERS}
     data.update(coverage=float(skin.coverage), absorption=np.asarray(skin.absorption).tolist(),
                 K=None if skin.K is None else float(skin.K), name=skin.name)
     return data
@@ -72,7 +76,7 @@ def skin_to_dict(skin: MadeUpSkin) -> dict:
 def skin_from_dict(data: dict) -> MadeUpSkin:
     """Rebuild a :class:`MadeUpSkin` from :func:`skin_to_dict` data (validated)."""
     try:
-        layers = {name: kind(**data[name]) for name, kind in LAYERS.items()}
+        layers = {name: kind(**data[RECORD_KEYS[name]]) for name, kind in LAYERS.items()}
         return MadeUpSkin(**layers, coverage=data["coverage"], absorption=data["absorption"],
                           K=data.get("K"), name=data.get("name", "custom"))
     except (KeyError, TypeError) as error:
@@ -159,8 +163,9 @@ def params_from_mapping(mapping: dict) -> MadeUpSkin:
     units = mapping.get("units", "albedo")
     sections = {SECTIONS[name]: (name, _section(mapping, name)) for name in SECTIONS}
     if units == "counts":
-        film, film_transmission, skin = (_layer(LAYERS[field], *sections[field])
-                                         for field in ("film", "film_transmission", "skin"))
+        film, film_transmission, skin = (
+            _layer(LAYERS[field], *sections[field])
+            for field in ("film", "film_transmission", "skin_reflection"))
         dipole = _layer(Dipole, "dipole", {**base.dipole.as_dict(), **sections["dipole"][1]})
         shutters = {key: mapping[key] for key in ("reflection_shutter_s", "transmission_shutter_s")
                     if key in mapping}

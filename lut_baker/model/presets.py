@@ -117,8 +117,8 @@ FOUNDATIONS.update(read_measured_foundations(MEASURED_FOUNDATIONS_FILE))
 def paper() -> MadeUpSkin:
     """The paper's made-up skin: foundation "natural" on the bio-plate, coverage 1, albedo
     units with K from docs/model.md §4."""
-    film, film_t, skin, dipole = paper_layers()
-    return from_paper_counts(film, film_t, skin, dipole, name="paper")
+    film, film_transmission, skin, dipole = paper_layers()
+    return from_paper_counts(film, film_transmission, skin, dipole, name="paper")
 
 
 def paper_layers():
@@ -138,7 +138,7 @@ def _literature_skin(sigma_s_reduced, sigma_a, eta=1.3):
     """
     dipole = Dipole(sigma_s=sigma_s_reduced, sigma_a=sigma_a, g=0.0, eta=eta)
     p_d = dipole_total_reflectance(dipole) / np.pi
-    bioplate = paper().skin
+    bioplate = paper().skin_reflection
     surface = ReflectionLayer(P_d=p_d, P_s=float(bioplate.P_s), n=1.0 / 19.3, eta=eta)
     return surface, dipole
 
@@ -161,7 +161,7 @@ def skin_layers(name: str):
         raise ValueError(f"skin must be one of {sorted(SKINS)}, got {name!r}")
     if name == "paper_bioplate":
         base = paper()
-        return base.skin, base.dipole
+        return base.skin_reflection, base.dipole
     entry = SKINS[name]
     return _literature_skin(entry["sigma_s"], entry["sigma_a"])
 
@@ -185,7 +185,7 @@ def made_up_skin(foundation: str = "paper_natural", skin: str = "paper_bioplate"
     changes = {}
     if "film" in FOUNDATIONS[foundation]:
         changes["film"] = foundation_film(foundation)
-    return base.replace(skin=surface, dipole=dipole, coverage=coverage, absorption=shade,
+    return base.replace(skin_reflection=surface, dipole=dipole, coverage=coverage, absorption=shade,
                         name=f"{foundation}+{skin}", **changes)
 
 

@@ -203,8 +203,8 @@ def made_up_reflection_curves(skin: MadeUpSkin | None = None, relative_angle_deg
     sweep = _dense_reflection(relative_angle_deg, MADE_UP_STEP_DEG)
     wi, wo, cosine = sweep.wi, sweep.wo, sweep.wi[..., 2]
     path1 = _red(ts_reflection(wi, wo, film_reflection_layer(skin)))
-    path3 = _red(layered_reflection(wi, wo, film_transmission_layer(skin), skin.skin))
-    bare = _red(ts_reflection(wi, wo, skin.skin))
+    path3 = _red(layered_reflection(wi, wo, film_transmission_layer(skin), skin.skin_reflection))
+    bare = _red(ts_reflection(wi, wo, skin.skin_reflection))
     total = {float(w): _red(made_up_reflection(wi, wo, skin.replace(coverage=w)))
              for w in coverages}
     return {

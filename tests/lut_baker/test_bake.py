@@ -46,7 +46,8 @@ def test_fast_fourier_coefficients_equal_the_exact_evaluators(n_phi):
     shaded_film = made_up_skin.film_transmission_layer(jensen)  # RGB through absorption
     grid = hemisphere_panels(2, 6, 17)
     outer = np.radians([0.0, 12.0, 47.0, 80.0, 89.0])
-    for layer in (paper.skin, paper.film, paper.film_transmission, jensen.skin, shaded_film):
+    for layer in (paper.skin_reflection, paper.film, paper.film_transmission,
+                  jensen.skin_reflection, shaded_film):
         for theta_a in (outer, grid.theta):
             fast = bake.fourier_coefficients(layer, theta_a, grid.theta, n_phi)
             reference = albedo.layer_fourier_kernel(layer, theta_a, grid.theta, n_phi)
@@ -59,9 +60,11 @@ def test_fast_fourier_coefficients_equal_the_exact_evaluators(n_phi):
 def test_layered_matrices_with_fast_kernels_equal_the_default(paper):
     grid = hemisphere_panels(2, 6, 17)
     theta = np.radians([0.0, 30.0, 60.0, 85.0])
-    fast = two_layer.layered_fourier_matrices(theta, theta, paper.film_transmission, paper.skin,
+    fast = two_layer.layered_fourier_matrices(theta, theta, paper.film_transmission,
+                                              paper.skin_reflection,
                                            grid, fourier=bake.KernelCache())
-    slow = two_layer.layered_fourier_matrices(theta, theta, paper.film_transmission, paper.skin,
+    slow = two_layer.layered_fourier_matrices(theta, theta, paper.film_transmission,
+                                              paper.skin_reflection,
                                            grid)
     np.testing.assert_allclose(fast, slow, rtol=2e-8, atol=1e-15)
 
@@ -71,23 +74,23 @@ def test_skin_diffuse_part_of_path3_is_pd_times_both_transmittances(paper):
     rng = np.random.default_rng(3)
     wi = direction(np.radians(rng.uniform(0, 89, 20)), rng.uniform(0, 2 * np.pi, 20))
     wo = direction(np.radians(rng.uniform(0, 89, 20)), rng.uniform(0, 2 * np.pi, 20))
-    diffuse_only = paper.skin.scaled(P_s=0.0)
+    diffuse_only = paper.skin_reflection.scaled(P_s=0.0)
     path3 = two_layer.layered_reflection(wi, wo, paper.film_transmission, diffuse_only)
     t_i = albedo.film_transmittance(wi, paper.film_transmission)
     t_o = albedo.film_transmittance(wo, paper.film_transmission)
-    np.testing.assert_allclose(path3, paper.skin.P_d * t_i * t_o, rtol=1e-10)
+    np.testing.assert_allclose(path3, paper.skin_reflection.P_d * t_i * t_o, rtol=1e-10)
     # and the gloss part is what remains of the full path 3
-    full = two_layer.layered_reflection(wi, wo, paper.film_transmission, paper.skin)
+    full = two_layer.layered_reflection(wi, wo, paper.film_transmission, paper.skin_reflection)
     gloss = two_layer.layered_reflection(wi, wo, paper.film_transmission,
-                                      bake.gloss_layer(paper.skin))
-    np.testing.assert_allclose(full, gloss + paper.skin.P_d * t_i * t_o, rtol=1e-10)
+                                      bake.gloss_layer(paper.skin_reflection))
+    np.testing.assert_allclose(full, gloss + paper.skin_reflection.P_d * t_i * t_o, rtol=1e-10)
 
 
 def test_surface_gloss_is_eq2_in_closed_form_at_every_node(default_tables, paper):
     """The surfaces' gloss is not tabulated: the tables evaluate eq. 2's specular term of the
     layers they were baked from, exactly."""
     wi, wo = node_directions(default_tables)
-    for name, layer in (("film_gloss", paper.film), ("skin_gloss", paper.skin)):
+    for name, layer in (("film_gloss", paper.film), ("skin_gloss", paper.skin_reflection)):
         exact = microfacet.ts_reflection(wi, wo, bake.gloss_layer(layer))
         np.testing.assert_allclose(default_tables.angular(name, wi, wo)[..., 0], exact,
                                    rtol=1e-12, atol=1e-15)
@@ -204,7 +207,7 @@ def test_profile_radius_moves_continuously_with_the_dipole(paper):
 def test_narrow_lobes_in_path3_scale_the_grids_and_the_film_gloss_does_not(paper):
     """The grids follow what path 3 goes through (the film's transmission, the skin's gloss);
     the film's own gloss is a closed form and leaves them as they are."""
-    sharp_skin = paper.replace(skin=paper.skin.scaled(n=2.5))  # 10 degrees
+    sharp_skin = paper.replace(skin_reflection=paper.skin_reflection.scaled(n=2.5))  # 10 degrees
     assert bake.path3_width_deg(sharp_skin) == pytest.approx(10.0)
     res = bake.RESOLUTIONS["preview"].for_lobe(bake.path3_width_deg(sharp_skin))
     assert res.n_theta > bake.RESOLUTIONS["preview"].n_theta
@@ -227,7 +230,7 @@ def test_a_lobe_a_last_bit_narrower_than_the_reference_keeps_the_grids(name):
 
 def test_a_jensen_skin_with_a_last_bit_narrower_lobe_bakes_the_same_grids():
     skin = presets.made_up_skin("medium_beige", "jensen_skin1")
-    narrower = skin.replace(skin=skin.skin.scaled(n=1.0 + 1e-9))
+    narrower = skin.replace(skin_reflection=skin.skin_reflection.scaled(n=1.0 + 1e-9))
     tables, moved = bake.bake(skin, "preview"), bake.bake(narrower, "preview")
     for name in ("theta_deg", "phi_deg", "radius_mm"):
         np.testing.assert_array_equal(getattr(moved, name), getattr(tables, name))
@@ -283,9 +286,10 @@ def test_inter_reflection_equals_its_neumann_series(paper):
     theta = np.radians([10.0, 50.0, 85.0])
     film_t = made_up_skin.film_transmission_layer(paper)
     below = made_up_skin.film_reflection_layer(paper)
-    full = two_layer.inter_reflection_fourier_matrices(theta, theta, film_t, paper.skin, grid,
+    full = two_layer.inter_reflection_fourier_matrices(theta, theta, film_t,
+                                                       paper.skin_reflection, grid,
                                                     film_below=below)
-    skin_m = two_layer.inner_matrices(grid, film_t, paper.skin)[..., 0]
+    skin_m = two_layer.inner_matrices(grid, film_t, paper.skin_reflection)[..., 0]
     film_m = albedo.layer_fourier_kernel(below, grid.theta, grid.theta, grid.n_phi)[..., 0]
     rows = albedo.transmission_rows(theta, grid, film_t)[..., 0]
     term, total = skin_m, skin_m.copy()
@@ -306,9 +310,9 @@ def test_inter_reflection_table(paper):
     theta = np.radians(t.theta_deg[[4, 30]])
     film_t = made_up_skin.film_transmission_layer(paper)
     extra = (two_layer.inter_reflection_fourier_matrices(
-        theta, theta, film_t, paper.skin, grid,
+        theta, theta, film_t, paper.skin_reflection, grid,
         film_below=made_up_skin.film_reflection_layer(paper))
-        - two_layer.layered_fourier_matrices(theta, theta, film_t, paper.skin, grid))
+        - two_layer.layered_fourier_matrices(theta, theta, film_t, paper.skin_reflection, grid))
     cos_phi = np.cos(np.radians(t.node_azimuths()[4, 30]))
     series = sum(extra[m, 0, 1, 0] * np.cos(m * np.arccos(cos_phi)) for m in range(len(extra)))
     np.testing.assert_allclose(t.inter_reflection[4, 30, :, 0], series, rtol=1e-9, atol=1e-14)

@@ -130,7 +130,7 @@ def test_film_factors_stable(w, film, dipole):
 @given(THETA, FILM_T, SKIN, ALBEDO_P, st.floats(0.0, 1.0), st.floats(0.0, 1.0))
 def test_directional_albedo_stable(theta, film_t, skin, film_p_s, coverage, absorption):
     film = ReflectionLayer(P_d=film_t.P_d, P_s=film_p_s, n=film_t.n, eta=film_t.eta)
-    bundle = made_up_skin.MadeUpSkin(film=film, film_transmission=film_t, skin=skin,
+    bundle = made_up_skin.MadeUpSkin(film=film, film_transmission=film_t, skin_reflection=skin,
                                   dipole=Dipole(sigma_s=1.0, sigma_a=0.1), coverage=coverage,
                                   absorption=absorption)
     value = made_up.directional_albedo(np.array([0.0, theta, 90.0]), bundle)

@@ -104,7 +104,8 @@ def test_skin_colour_texture_matches_a_bake_at_that_albedo(addon, blank_scene, t
                                  made_up.group_of(material).inputs["Skin Color"])
     textured = render(tmp_path, "textured")
 
-    own = skin.replace(skin=dataclasses.replace(skin.skin, P_d=colour / np.pi))
+    own = skin.replace(skin_reflection=dataclasses.replace(skin.skin_reflection,
+                                                           P_d=colour / np.pi))
     group, _ = made_up.group_for_tables(bake.bake(own, "preview"), tier, resolution="preview")
     material.node_tree.nodes.remove(texture)
     made_up.group_of(material).node_tree = group

@@ -82,7 +82,7 @@ def test_roughness_settings_in_the_model(addon, blank_scene):
         reference = presets.made_up_skin(foundation, settings.skin, coverage=1.0,
                                          absorption=0.0)
         assert skin.film.as_dict() == reference.film.as_dict()
-        assert skin.skin.as_dict() == reference.skin.as_dict()
+        assert skin.skin_reflection.as_dict() == reference.skin_reflection.as_dict()
     settings.film_roughness = 0.4  # a matte product: no gloss, nothing changes
     assert shade.skin_from_settings(settings).film.as_dict() == presets.foundation_film(
         "clarins_103").as_dict()
@@ -94,8 +94,8 @@ def test_roughness_settings_in_the_model(addon, blank_scene):
     skin = shade.skin_from_settings(settings)
     assert 1.0 / float(skin.film.n) == pytest.approx(float(roughness.lobe_width_deg(0.4)),
                                                      rel=1e-6)
-    assert 1.0 / float(skin.skin.n) == pytest.approx(float(roughness.lobe_width_deg(0.55)),
-                                                     rel=1e-6)
+    assert 1.0 / float(skin.skin_reflection.n) == pytest.approx(
+        float(roughness.lobe_width_deg(0.55)), rel=1e-6)
     assert float(skin.film.P_s) > float(presets.paper().film.P_s)  # narrower, brighter peak
     settings.foundation = "paper_natural"
     assert settings.film_roughness == pytest.approx(0.7294, abs=1e-4)

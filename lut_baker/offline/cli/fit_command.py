@@ -286,8 +286,8 @@ def _synthesize(args) -> int:
         raise ValueError(f"--out {out} exists and is not a folder")
     datasets = paper_protocols(args.noise, args.seed)
     out.mkdir(parents=True, exist_ok=True)
-    film, film_t, skin, dipole = paper_layers()
-    truth = {"film_reflection": film, "film_transmission": film_t,
+    film, film_transmission, skin, dipole = paper_layers()
+    truth = {"film_reflection": film, "film_transmission": film_transmission,
              "skin_reflection": skin, "skin_profile": dipole}
     origin = (f"python -m lut_baker fit synthesize --preset {args.preset} "
               f"--noise {args.noise:g} --seed {args.seed}")

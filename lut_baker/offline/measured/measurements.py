@@ -386,11 +386,11 @@ def paper_protocols(noise: float = 0.02, seed=None) -> dict:
     """The paper's experiments on its fitted layers in counts (docs/model.md §5, 6):
     ``{"film_reflection", "film_transmission", "skin_reflection", "skin_profile"}`` -> data set.
     The four draw independent noise from one seed."""
-    film, film_t, skin, dipole = paper_layers()
+    film, film_transmission, skin, dipole = paper_layers()
     rngs = np.random.default_rng(seed).spawn(4)
     return {
         "film_reflection": synthesize_reflection(film, noise=noise, rng=rngs[0]),
-        "film_transmission": synthesize_transmission(film_t, noise=noise, rng=rngs[1]),
+        "film_transmission": synthesize_transmission(film_transmission, noise=noise, rng=rngs[1]),
         "skin_reflection": synthesize_reflection(skin, noise=noise, rng=rngs[2]),
         "skin_profile": synthesize_profile(dipole, noise=noise, rng=rngs[3]),
     }

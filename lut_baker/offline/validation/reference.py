@@ -116,10 +116,11 @@ tabulation takes seconds and one spread image needs it four times."""
 
 def _film_transmittance_rgb(local: np.ndarray, skin: MadeUpSkin) -> np.ndarray:
     """``(1 - A) T(w)`` per point for local directions (P, 3): the film crossed once, RGB."""
-    film_t = film_transmission_layer(skin)
+    film_transmission = film_transmission_layer(skin)
     theta = np.linspace(0.0, np.pi / 2, TRANSMITTANCE_NODES)
-    nodes = _TRANSMITTANCE_CACHE.get_or_compute(repr(film_t.as_dict()), lambda: np.reshape(
-        film_transmittance(direction(theta, 0.0), film_t), (theta.size, -1)))
+    nodes = _TRANSMITTANCE_CACHE.get_or_compute(repr(film_transmission.as_dict()),
+                                                lambda: np.reshape(
+        film_transmittance(direction(theta, 0.0), film_transmission), (theta.size, -1)))
     polar = np.arccos(np.clip(local[:, 2], 0.0, 1.0))
     t = np.stack([np.interp(polar, theta, nodes[:, c % nodes.shape[1]]) for c in range(3)], -1)
     return np.where(local[:, 2:3] > 0.0, t, 0.0)
@@ -136,7 +137,7 @@ def local_diffuse(normals: np.ndarray, light: np.ndarray, skin: MadeUpSkin,
     lit = ((wi[:, 2] > 0.0) & (wo[:, 2] > 0.0))[:, None]
     # T_A holds the absorption already: the light through the film is "top".
     weights = coverage_weights(skin.coverage, skin.absorption)
-    p_d = np.asarray(skin.skin.P_d) * np.ones(3)
+    p_d = np.asarray(skin.skin_reflection.P_d) * np.ones(3)
     return np.where(lit, combine(weights, top=p_d * through, bare=p_d) * irradiance
                     * wi[:, 2:3], 0.0)
 
@@ -180,7 +181,7 @@ def spread_diffuse(exit_normals: np.ndarray, light: np.ndarray, skin: MadeUpSkin
             bare[chunk, c] = np.bincount(owner, k, rows)
             through[chunk, c] = np.bincount(owner, k * entry_film[neighbours, c], rows)
     weights = coverage_weights(skin.coverage, skin.absorption)
-    p_d = np.asarray(skin.skin.P_d) * np.ones(3)
+    p_d = np.asarray(skin.skin_reflection.P_d) * np.ones(3)
     out = combine(weights, top=p_d * exit_film * through, bare=p_d * bare)
     return np.where(exit_local[:, 2:3] > 0.0, out, 0.0)
 

@@ -147,16 +147,16 @@ def with_film(skin: MadeUpSkin, width_deg: float | None = None,
     """``skin`` with the film's reflection lobe ``width_deg`` wide (1/e half-width, degrees:
     ``n = 1/width``), the transmission lobe scaled alike, and the film's index ``ior``; the
     other parameters (``P_s`` included) kept, as the add-on's Override Film does."""
-    film, film_t = skin.film, skin.film_transmission
+    film, film_transmission = skin.film, skin.film_transmission
     if width_deg is not None:
         if not width_deg > 0:
             raise ValueError(f"width_deg must be > 0 (degrees), got {width_deg}")
         ratio = (1.0 / width_deg) / float(np.max(film.n))
-        film, film_t = film.scaled(n=ratio), film_t.scaled(n=ratio)
+        film, film_transmission = film.scaled(n=ratio), film_transmission.scaled(n=ratio)
     if ior is not None:
         film = film.scaled(eta=ior / float(np.max(film.eta)))
-        film_t = film_t.scaled(eta=ior / float(np.max(film_t.eta)))
-    return skin.replace(film=film, film_transmission=film_t)
+        film_transmission = film_transmission.scaled(eta=ior / float(np.max(film_transmission.eta)))
+    return skin.replace(film=film, film_transmission=film_transmission)
 
 
 def regime_skin(item: Regime) -> MadeUpSkin:
@@ -165,7 +165,7 @@ def regime_skin(item: Regime) -> MadeUpSkin:
                         absorption=item.absorption)
     skin = with_film(skin, item.film_width_deg, item.film_ior)
     if item.skin_ior is not None:
-        skin = skin.replace(skin=replace(skin.skin, eta=item.skin_ior),
+        skin = skin.replace(skin_reflection=replace(skin.skin_reflection, eta=item.skin_ior),
                             dipole=replace(skin.dipole, eta=item.skin_ior))
     return skin
 

@@ -230,7 +230,8 @@ def test_fit_is_linear_in_the_skin_albedo(paper_tables, paper_fit):
     skin's closures exactly (the bake leaves the inter-reflections out)."""
     colour = np.array([0.62, 0.41, 0.33])
     skin = presets.paper()
-    other = skin.replace(skin=dataclasses.replace(skin.skin, P_d=colour / np.pi))
+    other = skin.replace(skin_reflection=dataclasses.replace(skin.skin_reflection,
+                                                             P_d=colour / np.pi))
     fit = fitting.fit_closures(bake.bake(other, "preview"))
     np.testing.assert_allclose(fit.skin_albedo, colour, rtol=1e-12)
     np.testing.assert_array_equal(fit.lut, paper_fit.lut)

@@ -88,7 +88,7 @@ def test_coverage_zero_is_bare_skin_exactly():
     wi, wo = _pairs(10, 1)
     for name in presets.SKINS:
         skin = presets.made_up_skin("deep_mocha", name, coverage=0.0)
-        bare = np.reshape(microfacet.ts_reflection(wi, wo, skin.skin), (10, -1))
+        bare = np.reshape(microfacet.ts_reflection(wi, wo, skin.skin_reflection), (10, -1))
         np.testing.assert_array_equal(made_up.made_up_reflection(wi, wo, skin),
                                       np.broadcast_to(bare, (10, 3)))
 
@@ -115,7 +115,7 @@ def test_full_absorption_leaves_gloss_and_bare_skin():
         gloss = np.array([ref.ts_reflection(a, b, 0.0, float(film.P_s),
                                                          float(film.n), float(film.eta))
                                        for a, b in zip(wi, wo, strict=True)])
-        bare = microfacet.ts_reflection(wi, wo, skin.skin)
+        bare = microfacet.ts_reflection(wi, wo, skin.skin_reflection)
         expected = (1 - coverage) * bare + coverage * gloss[:, None]
         np.testing.assert_allclose(made_up.made_up_reflection(wi, wo, skin), expected,
                                    rtol=1e-10)
@@ -141,7 +141,7 @@ def test_measured_foundations_coverage_is_continuous(foundation):
     linear in coverage between the ends (docs/model.md §4, "Coverage")."""
     wi, wo = _pairs(12, 5)
     skin = presets.made_up_skin(foundation, "jensen_skin1")
-    bare = np.reshape(microfacet.ts_reflection(wi, wo, skin.skin), (12, -1))
+    bare = np.reshape(microfacet.ts_reflection(wi, wo, skin.skin_reflection), (12, -1))
     ends = [made_up.made_up_reflection(wi, wo, skin.replace(coverage=c)) for c in (0.0, 1.0)]
     np.testing.assert_array_equal(ends[0], np.broadcast_to(bare, (12, 3)))
     small = made_up.made_up_reflection(wi, wo, skin.replace(coverage=1e-6))

@@ -19,7 +19,7 @@ CONVERGENCE_RTOL = 1e-4
 
 def _film_and_skin(foundation, skin_name):
     skin = presets.made_up_skin(foundation, skin_name)
-    return made_up_skin.film_transmission_layer(skin), skin.skin
+    return made_up_skin.film_transmission_layer(skin), skin.skin_reflection
 
 
 def _random_pairs(count, seed):
@@ -171,7 +171,7 @@ def test_layered_reciprocity():
 @pytest.mark.slow
 def test_layered_rgb_channels_and_shapes():
     film, skin = _film_and_skin("deep_mocha", "jensen_skin1")  # both RGB
-    scalar_skin = presets.paper().skin  # scalar skin under an RGB film
+    scalar_skin = presets.paper().skin_reflection  # scalar skin under an RGB film
     wi, wo = _random_pairs(20, seed=14)
     for this_skin in (skin, scalar_skin):
         rgb = two_layer.layered_reflection(wi.reshape(4, 5, 3), wo.reshape(4, 5, 3), film,

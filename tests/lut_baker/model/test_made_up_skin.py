@@ -65,7 +65,7 @@ def test_paper_counts_become_albedo_units():
     paper = presets.paper()
     film, _ = _film_per_second()
     np.testing.assert_allclose(paper.film.P_s, film.P_s / paper.K, rtol=1e-14)
-    np.testing.assert_allclose(paper.skin.P_d, 2.00e4 / 3.0 / paper.K, rtol=1e-14)
+    np.testing.assert_allclose(paper.skin_reflection.P_d, 2.00e4 / 3.0 / paper.K, rtol=1e-14)
     np.testing.assert_allclose(paper.film_transmission.P_t, 1.08e4 / 10.0 / paper.K, rtol=1e-14)
 
 

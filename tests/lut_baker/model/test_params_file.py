@@ -18,7 +18,7 @@ def test_parameter_file_schema():
     assert float(skin.film.n) == 0.036 and float(skin.film_transmission.P_t) == 0.04
     base = presets.made_up_skin("medium_beige", "jensen_skin1")
     assert float(skin.film.P_s) == float(base.film.P_s)  # not overridden
-    np.testing.assert_array_equal(skin.skin.P_d, base.skin.P_d)
+    np.testing.assert_array_equal(skin.skin_reflection.P_d, base.skin_reflection.P_d)
     again = params_file.skin_from_dict(params_file.skin_to_dict(skin))
     assert params_file.skin_to_dict(again) == params_file.skin_to_dict(skin)
     assert params_file.params_from_mapping({}).name == "paper"

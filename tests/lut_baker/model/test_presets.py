@@ -41,7 +41,7 @@ def test_paper_bundle():
     assert paper.coverage == 1.0 and np.all(paper.absorption == 0.0)
     assert paper.K == pytest.approx(27697, rel=1e-4)
     # Skin and film share K: the ratio of their diffuse terms is the counts' ratio.
-    assert paper.skin.P_d / paper.film.P_d == pytest.approx(2.00e4 / 1.29e4, rel=1e-14)
+    assert paper.skin_reflection.P_d / paper.film.P_d == pytest.approx(2.00e4 / 1.29e4, rel=1e-14)
     assert paper.dipole is presets.PAPER_SKIN_DIPOLE
 
 
@@ -63,7 +63,7 @@ def test_jensen_skins(name):
 
 def test_bioplate_skin_is_the_papers():
     surface, dipole = presets.skin_layers("paper_bioplate")
-    assert surface is presets.paper().skin and dipole is presets.PAPER_SKIN_DIPOLE
+    assert surface is presets.paper().skin_reflection and dipole is presets.PAPER_SKIN_DIPOLE
 
 
 def test_foundations():
@@ -87,7 +87,7 @@ def test_made_up_skin():
     np.testing.assert_array_equal(bundle.absorption, presets.FOUNDATIONS["medium_beige"][
         "absorption"])
     surface, dipole = presets.skin_layers("jensen_skin2")
-    np.testing.assert_array_equal(bundle.skin.P_d, surface.P_d)
+    np.testing.assert_array_equal(bundle.skin_reflection.P_d, surface.P_d)
     assert bundle.dipole.as_dict() == dipole.as_dict()
     assert bundle.K == presets.paper().K
     override = presets.made_up_skin("deep_mocha", absorption=0.2)

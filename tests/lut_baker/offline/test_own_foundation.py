@@ -27,7 +27,7 @@ def _assert_same_film_as_preset(skin, product):
         assert float(getattr(skin.film, key)) == pytest.approx(value, rel=1e-6)
     # The whole film, P_d and transmission included, is the preset's.
     preset = presets.made_up_skin(product)
-    for name in ("film", "film_transmission", "skin", "dipole"):
+    for name in ("film", "film_transmission", "skin_reflection", "dipole"):
         for key, value in getattr(preset, name).as_dict().items():
             np.testing.assert_allclose(getattr(getattr(skin, name), key), value, rtol=1e-6)
 

@@ -37,7 +37,7 @@ def test_the_mix_follows_the_exact_evaluator():
     absorption = np.array([0.1, 0.4, 0.6])
     exact = bihemispherical(lambda t: made_up.directional_albedo(
         t, skin.replace(coverage=0.7, absorption=absorption)))
-    colour = U.made_up_colour(light, 0.7, absorption, np.pi * skin.skin.P_d)
+    colour = U.made_up_colour(light, 0.7, absorption, np.pi * skin.skin_reflection.P_d)
     np.testing.assert_allclose(colour, exact, rtol=3e-3)
 
 
