@@ -8,7 +8,7 @@ benchmark, not a test).
 For each foundation of the checkout's ``lut_baker.model.presets.FOUNDATIONS`` on the skin
 ``paper_bioplate``: bake and fit as Apply does (``bake(made_up_skin(foundation, skin, coverage=1,
 absorption=0), "default")``, ``fit_closures(tables)``), then compare each tier's BRDF replica
-(``closures.fitting.TIER_REPLICAS[tier](fit, tables, coverage, absorption, 1, directions)``) with
+(``closures.tiers.TIER_REPLICAS[tier](fit, tables, coverage, absorption, 1, directions)``) with
 the exact made-up skin (``evaluate.made_up.made_up_reflection`` of ``made_up_skin(foundation,
 skin, coverage=w, absorption=the preset's)``) at coverages 1 and 0.5.
 
@@ -204,7 +204,7 @@ def _pairs(theta_i, w_i, quadrature: HalfVectorQuadrature) -> dict:
 
 def relative_rms(f_fit, f_ref, pairs) -> float:
     """Relative RMS of ``f cos(theta_i)`` with the quadrature's weights, channels pooled (the
-    measure of ``closures.fitting.relative_rms``)."""
+    measure of ``lut_baker.closures.view_grid.ViewGrid.error``)."""
     w = (pairs["weight"] * pairs["wi"][:, 2] ** 2)[:, None]
     return float(np.sqrt(np.sum(w * (f_fit - f_ref) ** 2) / np.sum(w * f_ref**2)))
 
@@ -372,7 +372,7 @@ def _tier_errors(fit, tables, coverage, absorption, pairs, exact, albedo_pairs,
 
 def measure_preset(foundation: str, coverages, cache, refine: bool, progress=print) -> dict:
     from lut_baker.bake import bake
-    from lut_baker.closures import fitting
+    from lut_baker.closures import fitting, tiers
     from lut_baker.model import presets
 
     entry = {"foundation": foundation}
@@ -413,7 +413,7 @@ def measure_preset(foundation: str, coverages, cache, refine: bool, progress=pri
                 result[name]["directional_albedo_check"] = albedo_check(skin, albedo_pairs,
                                                                         albedo_exact)
         if hasattr(fitting, "tier_errors"):  # against the tables, as the add-on reports
-            grid = fitting.tier_errors(fit, tables, coverage, absorption)
+            grid = tiers.tier_errors(fit, tables, coverage, absorption)
             result["table_grid"] = {tier: {"rms": e.rms, "albedo": e.albedo}
                                     for tier, e in grid.items()}
         if refine:
@@ -446,7 +446,7 @@ def print_report(results: dict) -> None:
           f"load {results['load_start']} -> {results['load_end']}; "
           f"{results['seconds'] / 60:.1f} min")
     print("\nrelative RMS of f cos(theta_i) / largest view-albedo error; 'grid': the same "
-          "against the tables on their own grid (closures.fitting.tier_errors); '2x': relative "
+          "against the tables on their own grid (closures.tiers.tier_errors); '2x': relative "
           "change of the RMS with twice the nodes\n")
     print("| preset | coverage | lobe deg | pairs | Principled RMS | Layered RMS "
           "| Principled albedo | Layered albedo | grid P / L RMS | 2x P / L | bake+fit s |")

@@ -11,7 +11,7 @@ exact image)::
     E = sqrt(e_angle^2 + e_subsurface^2 + e_gloss^2 + noise^2)
 
 - ``e_angle``: the tier's angular error against the tables
-  (:func:`lut_baker.closures.fitting.tier_errors`, relative RMS of ``f cos(theta_i)``);
+  (:func:`lut_baker.closures.tiers.tier_errors`, relative RMS of ``f cos(theta_i)``);
 - ``e_subsurface``: without the subsurface closure, the light the skin spreads under the
   surface stays where it entered; how much that changes the image is the pixel-footprint blur
   argument, computed by :func:`subsurface_omission_error` (the profile's blur of a sphere's
@@ -42,7 +42,7 @@ Functions and types
 - :func:`gloss_and_skin_shares` -- shares of the gloss and of the spreading skin light in a
   sphere's image.
 - :func:`gloss_omission_error`, :func:`gloss_omissions` -- what the tiers' Gloss input at 0
-  changes in a sphere's image (their replicas in :mod:`lut_baker.closures.fitting`).
+  changes in a sphere's image (their replicas in :mod:`lut_baker.closures.tiers`).
 - :func:`profile_mismatch` -- how far a fitted closure's edge response is from the tables'.
 - :func:`blur_kernel`, :func:`subsurface_omission_error` -- the pixel-footprint blur argument.
 - :func:`relative_cost`, :func:`noise`, :func:`predict`, :class:`Prediction`,
@@ -58,7 +58,8 @@ from functools import lru_cache
 import numpy as np
 
 from .bake import RESOLUTIONS, profile_radius
-from .closures.fitting import TIER_REPLICAS, TIERS, edge_response, profile_grid, tier_errors
+from .closures.profiles import edge_response, profile_grid
+from .closures.tiers import TIER_REPLICAS, TIERS, tier_errors
 from .model.dipole import dipole_profile, dipole_total_reflectance
 from .model.made_up_skin import combine, coverage_weights
 from .model.presets import made_up_skin
@@ -256,7 +257,7 @@ class SceneDescription:
 class MaterialTraits:
     """What the Auto tier needs of a made-up material at its coverage and absorption.
 
-    ``tier_errors``: angular relative RMS per tier (:func:`lut_baker.closures.fitting.tier_errors`);
+    ``tier_errors``: angular relative RMS per tier (:func:`lut_baker.closures.tiers.tier_errors`);
     ``radius_mm``, ``profile``: the normalised radial profile ``R(d)/Rd`` (1/mm^2, ``(n, 3)``)
     on distances (mm), the tables' ``radius_mm`` and ``profile``; ``profile_mismatch``: the
     fitted closure's relative edge-response error (:func:`profile_mismatch`);
@@ -388,7 +389,7 @@ def gloss_omission_error(tables, fit, tier: str, light_deg: float, coverage=None
                          absorption=None, *, resolution: int = 48) -> float:
     """Relative RMS change of a sphere's image (orthographic, one distant light ``light_deg``
     from the view, the lit pixels) when ``tier``'s Gloss input goes from 1 to 0: the tier's
-    replica (:data:`lut_baker.closures.fitting.TIER_REPLICAS` with the closure fit ``fit``) with
+    replica (:data:`lut_baker.closures.tiers.TIER_REPLICAS` with the closure fit ``fit``) with
     and without its gloss lobes, over the RMS of the tables' radiance ``f cos(theta_i)``, at
     the coverage and absorption (default: the tables')."""
     _, wi, wo = sphere_directions(resolution, light_deg)
@@ -415,7 +416,7 @@ def gloss_omissions(tables, fit, coverage=None, absorption=None, *,
 def profile_mismatch(tables, fit_error) -> float:
     """Relative error of a fitted subsurface closure's blur: ``fit_error`` (per channel, the
     RMS difference of its edge response and the tables', a fraction of the lit level:
-    :class:`lut_baker.closures.fitting.ProfileFit` ``error``) over the RMS of the tables' edge
+    :class:`lut_baker.closures.profiles.ProfileFit` ``error``) over the RMS of the tables' edge
     response's departure from a sharp edge, largest over channels."""
     r_max = float(tables.radius_mm[-1])
     r = profile_grid(r_max)
@@ -434,8 +435,9 @@ def traits_from_tables(tables, fit, coverage=None, absorption=None, *,
                        lights_deg=SHARE_LIGHTS_DEG, method: str | None = None,
                        errors: dict | None = None) -> MaterialTraits:
     """:class:`MaterialTraits` of baked ``tables`` and their
-    :class:`lut_baker.closures.fitting.ClosureFit` ``fit`` at a coverage and absorption (default:
-    the tables'); ``errors``: the fit's :func:`lut_baker.closures.fitting.tier_errors` there,
+    :class:`lut_baker.closures.closure_fit.ClosureFit` ``fit`` at a coverage and absorption
+    (default:
+    the tables'); ``errors``: the fit's :func:`lut_baker.closures.tiers.tier_errors` there,
     if already measured."""
     w, a = tables.coverage_and_absorption(coverage, absorption)
     errors = tier_errors(fit, tables, w, a) if errors is None else errors

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import math
 
-from .core import auto_tier, cache, fitting
+from .core import auto_tier, cache, closure_fit, fitting, table_set, tiers
 from .storage import rebake
 
 __all__ = ["FIT_CACHE_SIZE", "baked", "cached", "measure", "measured_at", "traits", "clear"]
@@ -36,7 +36,7 @@ def _fit_key(record: dict, method) -> tuple:
     return (record["key"], method)
 
 
-def cached(record: dict, method=None):
+def cached(record: dict, method=None) -> tuple[table_set.Tables, closure_fit.ClosureFit] | None:
     """``(tables, fit)`` of ``record`` if this session baked and fitted them, else None."""
     fit = _FITS.get(_fit_key(record, method))
     if fit is None:
@@ -45,7 +45,7 @@ def cached(record: dict, method=None):
 
 
 def baked(record: dict, *, method=None, errors_at=None, bake_progress=None,
-          fit_progress=None):
+          fit_progress=None) -> tuple[table_set.Tables, closure_fit.ClosureFit]:
     """``(tables, fit)`` of a bake record (:func:`.storage.bake_record`): re-baked (cached by
     :func:`.storage.rebake`) and fitted (cached here) once per session.  ``method``: a
     subsurface method forced by the user, else None; ``errors_at``: ``(coverage,
@@ -85,7 +85,7 @@ def measure(tables, fit, coverage: float, absorption, method=None, *,
     first = next(iter(errors.values()), None)
     if first is None or not (_same([first.coverage], [coverage])
                              and _same(first.absorption, absorption)):
-        errors = fitting.tier_errors(fit, tables, coverage, absorption)
+        errors = tiers.tier_errors(fit, tables, coverage, absorption)
     traits = auto_tier.traits_from_tables(tables, fit, coverage, absorption, method=method,
                                      errors=errors) if with_traits else None
     return {"coverage": coverage, "absorption": absorption, "method": method,

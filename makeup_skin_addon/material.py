@@ -28,7 +28,7 @@ import json
 import bpy
 
 from . import convert, fits, nodes, scene_fit, shade, storage
-from .core import fitting, params_file
+from .core import params_file, tiers
 from .keys import AUTO_KEY, ERRORS_KEY, MATERIAL_NAME, SETTINGS_VERSION, group_name
 from .scene_fit import units_per_mm
 from .shade import skin_from_settings
@@ -153,7 +153,7 @@ class _Bake:
         self.record, self.method = record, method
         self.coverage, self.absorption = float(coverage), [float(a) for a in absorption]
         self.progress = progress
-        self._measured = None
+        self._measured: dict | None = None
 
     def fitted(self):
         """``(tables, fit)`` (:func:`.fits.baked`)."""
@@ -172,12 +172,14 @@ class _Bake:
         be), the Auto tier's traits too if ``with_traits``."""
         if self._measured is None or (with_traits and not self._measured["traits"]):
             tables, fit = self.fitted()
-            self._measured = fits.measure(tables, fit, self.coverage, self.absorption,
-                                          self.method or fit.subsurface_method,
-                                          with_traits=with_traits)
+            measured = fits.measure(tables, fit, self.coverage, self.absorption,
+                                    self.method or fit.subsurface_method,
+                                    with_traits=with_traits)
+            self._measured = measured
             report = _stage(self.progress, MEASURE_SHARE, 1.0)
             if report is not None:
                 report(1.0, "measured")
+            return measured
         return self._measured
 
 
@@ -192,7 +194,7 @@ def _existing(record: dict, tier: str, method, messages: list):
 def _stored_measurement(work: _Bake):
     """What any group of this bake (either tier) keeps measured at the coverage and
     absorption, with the Auto tier's traits, or None."""
-    for tier in fitting.TIERS:
+    for tier in tiers.TIERS:
         group = bpy.data.node_groups.get(group_name(tier, work.record["key"], work.method))
         if group is not None:
             measured = fits.measured_at(nodes.read_meta(group), work.coverage, work.absorption,

@@ -44,7 +44,7 @@ import json
 import bpy
 
 from . import storage
-from .core import fitting, tier_formulas, view_image
+from .core import tier_formulas, tiers, view_image
 from .keys import FIT_KEY, LEGACY_TABLES_REF, group_name, lut_image_name
 from .node_algebra import Builder, NodeAlgebra, NodeValue, socket
 
@@ -262,8 +262,8 @@ def build_group(tier: str, record: dict, fit, group=None, *, method=None, measur
     the SHA-256 of every image the group reads (:func:`storage.image_record`) and
     ``measured``, what the fit measured at the settings' coverage and absorption
     (:func:`.fits.measure`), if given."""
-    if tier not in fitting.TIERS:
-        raise ValueError(f"tier must be one of {fitting.TIERS}, got {tier!r}")
+    if tier not in tiers.TIERS:
+        raise ValueError(f"tier must be one of {tiers.TIERS}, got {tier!r}")
     key = record["key"]
     name = group_name(tier, key, method)
     if group is None:

@@ -15,8 +15,8 @@ from support import fit_audit
 from support.perturbation import LIMIT, PERTURBATION, movement, perturbed
 
 from lut_baker import auto_tier
-from lut_baker.closures import fitting
-from lut_baker.closures.view_grid import view_grid
+from lut_baker.closures import lobes, profiles
+from lut_baker.closures.view_grid import lobe_widths_deg, view_grid
 from lut_baker.model import presets, thick_layer
 
 MARGIN = 1e-4
@@ -57,13 +57,13 @@ def test_perturbed_tables_keep_their_grids(paper_tables):
 # --------------------------------------------------------------------------------------------
 def test_the_glossy_and_profile_fits_move_less_than_the_limit(paper_tables):
     theta = np.asarray(paper_tables.theta_deg)
-    grid = view_grid(fitting.lobe_widths_deg(paper_tables)["film_gloss"])
+    grid = view_grid(lobe_widths_deg(paper_tables)["film_gloss"])
 
     def fits(tables):
         target = tables.surface_gloss("film_gloss", *grid.directions)
-        return {"glossy": fitting.fit_glossy(grid, target, np.asarray(tables.film_gloss_albedo),
+        return {"glossy": lobes.fit_glossy(grid, target, np.asarray(tables.film_gloss_albedo),
                                              theta, companion=True),
-                "profile": fitting.fit_profile(tables, "BURLEY")}
+                "profile": profiles.fit_profile(tables, "BURLEY")}
 
     reference = fits(paper_tables)
     for seed in (0, 1):

@@ -9,7 +9,7 @@ Usage::
 The scene and the replica are tests/support/subsurface_edge.py's (shared with the tests): a
 thick slab with a Subsurface Scattering material of radius 10 mm lit up to a straight shadow
 edge, the rendered edge response against
-:func:`lut_baker.closures.fitting.edge_response` of the replica's profile.  Prints, per method
+:func:`lut_baker.closures.profiles.edge_response` of the replica's profile.  Prints, per method
 and albedo, the RMS difference from the replica and the Burley radius factor k that fits best
 (on a grid of ratio 1.08).
 """

@@ -26,7 +26,7 @@ COVERAGES = (1.0, 0.5, 0.0)
 
 def main(argv=None) -> int:
     from lut_baker import bake
-    from lut_baker.closures import fitting
+    from lut_baker.closures import fitting, tiers
     from lut_baker.model import presets
 
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
@@ -45,7 +45,7 @@ def main(argv=None) -> int:
             seconds.append(time.perf_counter() - start)
             fits[skin] = fit
             for coverage in COVERAGES:
-                errors = fitting.tier_errors(fit, tables, coverage, made_up.absorption)
+                errors = tiers.tier_errors(fit, tables, coverage, made_up.absorption)
                 p, lay = errors["PRINCIPLED"], errors["LAYERED"]
                 print(f"| {foundation} | {skin} | {coverage:g} | {100 * p.rms:.1f}% | "
                       f"{100 * p.albedo:.1f}% | {100 * lay.rms:.1f}% | {100 * lay.albedo:.1f}% |")

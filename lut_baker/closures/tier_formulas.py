@@ -2,7 +2,7 @@
 
 A tier is a set of closures whose colours and weights are arithmetic on the node group's inputs
 (Coverage ``w``, Foundation Absorption ``A``, Skin Color ``S``, Gloss ``g``), on constants of
-the :class:`~lut_baker.closures.fitting.ClosureFit` and on the view-angle image's rows.  The
+the :class:`~lut_baker.closures.closure_fit.ClosureFit` and on the view-angle image's rows.  The
 functions here compute them from those values with Python's operators and the few functions of
 an *algebra* (:class:`Algebra`), so the same code runs on two kinds of value:
 

@@ -17,6 +17,8 @@ Functions and types
 - :class:`ViewGrid` -- the pairs, their cosines and weights; relative RMS, view albedos and
   Glossy lobes on them.
 - :func:`view_grid` -- the grid for a lobe width (cached).
+- :func:`lobe_widths_deg` -- the widths of the tables' two surface glosses, which size the
+  grids.
 """
 
 from __future__ import annotations
@@ -120,3 +122,11 @@ def view_grid(width_deg: float, views: int = FIT_VIEWS,
     for value in vars(grid).values():
         value.setflags(write=False)
     return grid
+
+
+def lobe_widths_deg(tables) -> dict[str, float]:
+    """The 1/e half-widths (degrees, 1/n of eq. 2's D) of the film's and the skin's gloss, by
+    surface-gloss name; path 3 is at least as wide as the skin's (it is the skin's gloss seen
+    through the film's broad transmission)."""
+    return {name: 1.0 / float(np.max(tables.surface_layer(name).n))
+            for name in ("film_gloss", "skin_gloss")}

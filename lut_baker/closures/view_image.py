@@ -17,7 +17,7 @@ LUT_ROWS = ("film_gloss", "path3_gloss", "skin_gloss", "film_transmittance",
             "film_gloss_diffuse")
 """Rows of the LAYERED tier's view-angle image: three Glossy weights, the film's
 transmittance ``T(theta_o)`` and the film gloss's Lambertian companion
-(:func:`lut_baker.closures.fitting.fit_glossy`)."""
+(:func:`lut_baker.closures.lobes.fit_glossy`)."""
 DEFAULT_LUT_SIZE = 64
 """Texels per row of the view-angle image (linear filtering between texel centres)."""
 

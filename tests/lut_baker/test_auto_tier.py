@@ -201,7 +201,7 @@ def test_gloss_omission_is_the_tiers_gloss(paper_tables, paper_fit, matte):
     """What Gloss 0 changes in a sphere's image, from the tiers' replicas: for the paper's
     film within 15% of the tables' gloss share (the fits reproduce the gloss lobes) and the
     stored constants; for a film of index 1.01 under 1.5% at every light angle."""
-    from lut_baker.closures import fitting
+    from lut_baker.closures import tiers
 
     omissions = auto_tier.gloss_omissions(paper_tables, paper_fit, lights_deg=(0.0, 45.0))
     for tier, by_light in omissions.items():
@@ -212,7 +212,7 @@ def test_gloss_omission_is_the_tiers_gloss(paper_tables, paper_fit, matte):
                                           rel=0.05), (tier, light)  # default against preview
     _, tables, fit = matte
     traits = auto_tier.traits_from_tables(tables, fit)
-    for tier in fitting.TIERS:
+    for tier in tiers.TIERS:
         assert max(traits.gloss_omission[tier].values()) < 0.015, tier
         assert traits.gloss_error(tier, 45.0) == traits.gloss_omission[tier][45.0]
 

@@ -32,7 +32,7 @@ import pytest
 
 from lut_baker.bake import bake
 from lut_baker.closures import fitting as cf
-from lut_baker.closures import tier_formulas, view_image
+from lut_baker.closures import tier_formulas, tiers, view_image
 from lut_baker.model import presets
 
 CELL = 3
@@ -275,7 +275,7 @@ def _layered_expected(fit, case):
     return out
 
 
-@pytest.mark.parametrize("tier", cf.TIERS)
+@pytest.mark.parametrize("tier", tiers.TIERS)
 def test_node_group_follows_the_tier_formulas(blank_scene, baked, tmp_path, tier):
     """Every probe of ``tier`` in every case equals numpy's value to a relative 1e-5."""
     fit = baked[2]

@@ -30,7 +30,7 @@ from functools import lru_cache
 import numpy as np
 
 from lut_baker import auto_tier, bake
-from lut_baker.closures import fitting
+from lut_baker.closures import fitting, lobes, profiles
 from lut_baker.model import presets
 
 from .perturbation import movement, perturbed
@@ -130,8 +130,8 @@ def _separated_gap(samples) -> float:
 
 
 class SearchRecorder:
-    """Wraps the fits' two searches (``fitting.brent_minimum``'s coarse samples and
-    ``fitting.scanned_least_squares``' grid of starts) to keep each call's scan, and the
+    """Wraps the fits' two searches (``lobes.brent_minimum``'s coarse samples and
+    ``lobes.scanned_least_squares``' grid of starts) to keep each call's scan, and the
     final errors of the two-parameter fits (``errors``: the relative RMS the lobe-or-no-lobe
     rule compares)."""
 
@@ -160,7 +160,7 @@ class SearchRecorder:
         return x, cost, scan
 
 
-BRENT, SCANNED = fitting.brent_minimum, fitting.scanned_least_squares
+BRENT, SCANNED = lobes.brent_minimum, lobes.scanned_least_squares
 
 
 @contextmanager
@@ -168,11 +168,11 @@ def recorded_searches():
     """``with recorded_searches() as recorder:`` every search of
     :mod:`lut_baker.closures.fitting` inside is kept by ``recorder``."""
     recorder = SearchRecorder()
-    fitting.brent_minimum, fitting.scanned_least_squares = recorder.brent, recorder.scanned
+    lobes.brent_minimum, lobes.scanned_least_squares = recorder.brent, recorder.scanned
     try:
         yield recorder
     finally:
-        fitting.brent_minimum, fitting.scanned_least_squares = BRENT, SCANNED
+        lobes.brent_minimum, lobes.scanned_least_squares = BRENT, SCANNED
 
 
 def _relative_gap(values) -> float:
@@ -203,7 +203,7 @@ def distribution_margin(lobe) -> float:
     ggx = lobe.searched["GGX"]
     if ggx <= 0.0:
         return math.inf
-    return abs(min(others) / ggx - (1.0 - fitting.DISTRIBUTION_MARGIN))
+    return abs(min(others) / ggx - (1.0 - lobes.DISTRIBUTION_MARGIN))
 
 
 def decision_margins(tables, skin=None) -> dict:
@@ -229,9 +229,9 @@ def decision_margins(tables, skin=None) -> dict:
     names = (["coat"] if len(recorder.errors) == 3 else []) + ["specular_bare",
                                                                "specular_film"]
     for name, error in zip(names, recorder.errors, strict=True):
-        margins[f"no_lobe/{name}"] = abs(error - fitting.NO_LOBE_ERROR)
+        margins[f"no_lobe/{name}"] = abs(error - lobes.NO_LOBE_ERROR)
     margins["subsurface_method"] = _relative_gap(
-        np.hypot(p.worst_error, fitting.REPLICA_EDGE_ERROR[m]) for m, p in fit.profiles.items())
+        np.hypot(p.worst_error, profiles.REPLICA_EDGE_ERROR[m]) for m, p in fit.profiles.items())
     margins["coarse_valley"] = min(_separated_gap(scan) for scan in recorder.scans)
     if skin is not None:
         margins["node_counts"] = min(count_margin(bake.path3_width_deg(skin), r)

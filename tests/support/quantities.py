@@ -1,7 +1,7 @@
 """Results as named quantities, and how far one moved from another.
 
 :func:`flatten` turns what the model produces (baked :class:`lut_baker.tables.table_set.Tables`,
-a :class:`lut_baker.closures.fitting.ClosureFit`, a measurement fit's result; any nesting of
+a :class:`lut_baker.closures.closure_fit.ClosureFit`, a measurement fit's result; any nesting of
 dataclasses, dicts, lists and arrays) into ``{name: value}``: numbers become float64 arrays,
 and what is discrete (a chosen distribution or subsurface method, a count, a flag, None) stays
 as it is, to be compared exactly.  :func:`change` measures one numeric quantity against its

@@ -6,7 +6,7 @@ Scene: a thick slab (20 radii deep) with a Subsurface Scattering material of col
 radius R = 10 mm, lit from straight above by a sun (angle 0, irradiance pi) whose light a black
 plane, invisible to the camera, stops over x < 0; an orthographic camera looks down on a strip
 8 radii long across the edge (256 x 8 px, rows averaged).  The rendered profile, divided by its
-lit plateau, is the edge response :func:`lut_baker.closures.fitting.edge_response` of the
+lit plateau, is the edge response :func:`lut_baker.closures.profiles.edge_response` of the
 method's radial profile.
 
 Functions: :func:`edge_scene`, :func:`render_edge` (rendered response), :func:`replica_edge`.
@@ -106,12 +106,12 @@ def render_edge(method: str, albedo: float, samples: int = 256, folder=None):
 
 def replica_edge(x_mm, method: str, albedo: float, scale: float = 1.0) -> np.ndarray:
     """The replica's edge response at ``x_mm`` (lit for x > 0), radius x ``scale``."""
-    from lut_baker.closures import cycles, fitting
+    from lut_baker.closures import cycles, profiles
 
     radius_mm = RADIUS_M * 1e3 * scale
     if method != "BURLEY":
         radius_mm *= float(cycles.random_walk_scale(albedo, method))
     r = np.concatenate([[0.0], np.geomspace(1e-4, 40.0 * radius_mm, 3000)])
     profile = cycles.burley_profile(r, radius_mm)
-    tail = fitting.edge_response(r, profile, np.abs(x_mm))
+    tail = profiles.edge_response(r, profile, np.abs(x_mm))
     return np.where(x_mm < 0, tail, 1.0 - tail)

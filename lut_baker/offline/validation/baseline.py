@@ -12,7 +12,7 @@ the subsurface radius is fitted separately, to the profile, as for the tiers).
 Free sockets: Base Color (RGB), Roughness, Specular IOR Level, Coat Weight, Coat Roughness and
 Coat IOR, within the ranges Blender's sockets allow; IOR stays at the tiers' 1.5 (Specular IOR
 Level scales its F0).  The start is the PRINCIPLED tier's own table-space fit
-(:func:`lut_baker.closures.fitting.principled_inputs`), so the baseline is never worse than that
+(:func:`lut_baker.closures.tiers.principled_inputs`), so the baseline is never worse than that
 tier on this measure; Subsurface Weight, Radius, IOR and method are the tier's (its radius is
 fitted to the dipole's profile, the method chosen by that fit).  The baseline differs from the
 PRINCIPLED tier in what it is: constants typed into one node for one coverage and absorption,
@@ -31,7 +31,8 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from ...closures import cycles as cc
-from ...closures import fitting
+from ...closures import fitting, tiers
+from ...closures.closure_fit import ClosureFit
 from ...model.made_up_skin import MadeUpSkin
 from ...numerics.geometry import sphere_directions
 from ...tables.table_set import Tables
@@ -109,16 +110,16 @@ def _inputs(x: np.ndarray, start: cc.PrincipledInputs) -> cc.PrincipledInputs:
                    coat_weight=x[5], coat_roughness=x[6], coat_ior=x[7])
 
 
-def fit_baseline(skin: MadeUpSkin, tables: Tables, fit: fitting.ClosureFit | None = None, *,
+def fit_baseline(skin: MadeUpSkin, tables: Tables, fit: ClosureFit | None = None, *,
                  lights_deg=LIGHTS_DEG, resolution: int = FIT_RESOLUTION,
                  max_evaluations: int = MAX_EVALUATIONS) -> Baseline:
     """Fit a stock Principled BSDF to ``tables`` (baked from ``skin``) at the skin's coverage
     and absorption: least squares over the lit pixels of every light's image, each image's
     residual relative to its own RMS (so each light counts alike).  ``fit``: the tables'
-    :class:`~lut_baker.closures.fitting.ClosureFit` (fitted here if not given).  A light whose
+    :class:`~lut_baker.closures.closure_fit.ClosureFit` (fitted here if not given).  A light whose
     image is black (e.g. from behind the sphere) raises ValueError naming it."""
     fit = fit or fitting.fit_closures(tables)
-    start, weight = fitting.principled_inputs(fit, skin.coverage, skin.absorption)
+    start, weight = tiers.principled_inputs(fit, skin.coverage, skin.absorption)
     views = [sphere_directions(resolution, light) for light in lights_deg]
     wi = np.concatenate([v[1] for v in views])
     wo = np.concatenate([v[2] for v in views])

@@ -15,7 +15,7 @@ skin without Blender and measures what must always hold and how far each is from
   samples stay affordable, spread): finite, non-negative, and the spread image's total at most
   the local one's (spreading moves light, it does not make it);
 - ``tiers`` (``fit=True``): the closure fits' angular and albedo errors against the tables
-  (:func:`lut_baker.closures.fitting.tier_errors`) at the regime's coverage and absorption;
+  (:func:`lut_baker.closures.tiers.tier_errors`) at the regime's coverage and absorption;
 - ``auto``: the Auto tier's choice for the regime's scene (:func:`lut_baker.auto_tier.choose`).
 
 Functions and types
@@ -39,7 +39,8 @@ import numpy as np
 
 from ...auto_tier import SceneDescription, choose
 from ...bake import bake
-from ...closures.fitting import fit_closures, tier_errors
+from ...closures.fitting import fit_closures
+from ...closures.tiers import tier_errors
 from ...evaluate.made_up import directional_albedo, made_up_reflection
 from ...model.made_up_skin import MadeUpSkin
 from ...model.presets import made_up_skin

@@ -14,7 +14,7 @@ import pytest
 
 from lut_baker import bake
 from lut_baker.closures import cycles as cc
-from lut_baker.closures import fitting
+from lut_baker.closures import fitting, tiers
 from lut_baker.model import presets
 from lut_baker.offline.validation import baseline
 
@@ -39,7 +39,7 @@ class _PrincipledTables:
 @pytest.mark.slow  # a fit of ~1.5 s
 def test_fit_recovers_a_principled_bsdf(paper):
     skin, _, fit = paper
-    start, _ = fitting.principled_inputs(fit, skin.coverage, skin.absorption)
+    start, _ = tiers.principled_inputs(fit, skin.coverage, skin.absorption)
     truth = dataclasses.replace(start, base_color=(0.55, 0.45, 0.35), roughness=0.5,
                                 specular_ior_level=0.4, coat_weight=0.7, coat_roughness=0.3,
                                 coat_ior=1.7)

@@ -1,0 +1,265 @@
+"""Lobes fitted to an angular part of the tables: the Principled coat and specular, and the
+Glossy closures of the view-weighted tiers with their view-angle rows.
+
+Fits run on a :class:`lut_baker.closures.view_grid.ViewGrid` sized by the lobe (a 1-degree
+gloss costs what a 30-degree one does); the error is the relative RMS of the radiance
+``L = f cos(theta_i)`` (docs/baking.md, "Errors").  Every search is Brent's, converged far
+enough (:data:`FIT_XTOL`) that a fitted number follows its data continuously.
+
+- :class:`LobeFit` -- a fitted lobe.
+- :func:`fit_coat`, :func:`fit_specular` -- the Principled BSDF's coat (the film's gloss) and
+  specular (the skin's gloss, bare or through the film).
+- :func:`fit_glossy` -- a Glossy BSDF, its distribution, roughness and view-angle row (and, for
+  a broad lobe, its Lambertian companion's row).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..numerics.optimise import brent_minimum, scanned_least_squares
+from . import cycles as cc
+from .tier_formulas import SPECULAR_IOR
+from .view_grid import ViewGrid
+from .view_image import DEFAULT_LUT_SIZE, lut_nodes, sample_lut
+
+__all__ = ["LobeFit", "fit_coat", "fit_specular", "fit_glossy", "ROUGHNESS_RANGE",
+           "FIT_XTOL", "DISTRIBUTION_MARGIN", "COAT_IOR_RANGE", "SPECULAR_LEVEL_RANGE",
+           "SEARCH_QUADRATURE", "FINAL_QUADRATURE", "NO_LOBE_ERROR"]
+
+ROUGHNESS_RANGE = (0.02, 1.0)
+"""Roughness (Blender's socket, alpha = roughness^2) searched by the fits: from a lobe about
+0.03 degrees wide to the broadest; searched in ``log(roughness)``."""
+ROUGHNESS_SCAN = 7
+"""Evenly spaced ``log(roughness)`` samples that bracket the minimum before Brent's search."""
+SECOND_SCAN = 5
+"""Samples that bracket the second parameter (Coat IOR, Specular IOR Level)."""
+FIT_XTOL = 1e-7
+"""Absolute tolerance of the searches (``log(roughness)``, IOR, level): far below what a render
+shows and far above rounding, so that a fit moves continuously with its data (a 1e-9 change of
+the tables moves it by about 1e-9, never by a search's tolerance)."""
+DISTRIBUTION_MARGIN = 0.02
+"""A Glossy distribution other than GGX is chosen only when its error is this much (relative)
+lower than GGX's: a near tie keeps GGX, so the choice does not flip with rounding."""
+COAT_IOR_RANGE = (1.01, 4.0)
+"""Coat IOR searched (the socket's range in Blender)."""
+NO_LOBE_ERROR = 0.9
+"""A specular fit erring more than this (relative RMS; leaving the lobe out errs 1.0) is
+dropped and its albedo moved to the base colour."""
+SPECULAR_LEVEL_RANGE = (0.0, 8.0)
+"""Specular IOR Level searched (0.5 leaves IOR 1.5 as it is; F0 = 0.04 * 2 level)."""
+
+
+@dataclass(frozen=True)
+class LobeFit:
+    """A GGX lobe fitted to an angular part of the tables.
+
+    ``roughness``: Blender's Roughness; ``ior``: Coat IOR (coat) or the IOR whose F0 the
+    Specular IOR Level sets (specular), None for a Glossy BSDF; ``level``: Specular IOR Level
+    (specular only; 0 when no lobe beats leaving the gloss out); ``lut``: the Glossy weight per
+    view-angle texel, ``(size, 3)`` (Glossy only); ``distribution``: ``GGX``, ``BECKMANN`` or
+    ``ASHIKHMIN_SHIRLEY`` (Glossy only; the Principled BSDF is GGX); ``diffuse_lut``: the
+    weight of its Lambertian companion per texel, ``(size, 3)``, or None (:func:`fit_glossy`);
+    ``error``: relative RMS of this lobe against its target (module docstring);
+    ``searched``: each Glossy distribution's error in the search, by name (Glossy only: what
+    the choice of distribution compares).
+    """
+
+    roughness: float
+    error: float
+    ior: float | None = None
+    level: float | None = None
+    lut: np.ndarray | None = None
+    distribution: str = "GGX"
+    diffuse_lut: np.ndarray | None = None
+    searched: dict | None = None
+
+
+def _grey(values) -> np.ndarray:
+    """Per-pair values ``(V, A, P[, C])`` with their channels averaged, ``(V, A, P)``."""
+    values = np.asarray(values, float)
+    return np.mean(values, axis=-1) if values.ndim == 4 else values
+
+
+def _minimise_roughness(error_of) -> tuple[float, float]:
+    """``(roughness, error)``: ``error_of(roughness)`` minimised over :data:`ROUGHNESS_RANGE`,
+    in ``log(roughness)`` (a lobe's width goes as roughness squared)."""
+    log_r, error = brent_minimum(lambda x: error_of(float(np.exp(x))),
+                                 *np.log(ROUGHNESS_RANGE), coarse=ROUGHNESS_SCAN, xtol=FIT_XTOL)
+    return float(np.exp(log_r)), error
+
+
+def _fit_roughness_and(grid: ViewGrid, target, lobe_times, second_range):
+    """``(roughness, second, error)``: a GGX lobe times ``lobe_times(roughness)(second)`` (a
+    factor per pair) fitted to ``target`` (channels averaged).  A scan of
+    :data:`ROUGHNESS_SCAN` roughnesses by :data:`SECOND_SCAN` values of the second parameter
+    finds the start; bounded Levenberg-Marquardt on ``(log(roughness), second)`` converges
+    from it (:func:`lut_baker.numerics.optimise.least_squares`, to :data:`FIT_XTOL`)."""
+    target = _grey(target)
+    root_weight = np.sqrt(grid.weight) * grid.cos_i
+    scale = 1.0 / max(float(np.sqrt(np.sum(np.square(root_weight * target)))), 1e-300)
+
+    per_roughness = {}  # the lobe and its factor's set-up, once per roughness tried
+
+    def model(x):
+        roughness = float(np.exp(x[0]))
+        if roughness not in per_roughness:
+            per_roughness[roughness] = (grid.lobe(roughness), lobe_times(roughness))
+        lobe, factor = per_roughness[roughness]
+        return lobe * factor(float(x[1]))
+
+    def residuals(x):
+        return (scale * root_weight * (model(x) - target)).ravel()
+
+    low, high = np.log(ROUGHNESS_RANGE)
+    x, cost, _ = scanned_least_squares(
+        residuals, (np.linspace(low, high, ROUGHNESS_SCAN),
+                    np.linspace(second_range[0], second_range[1], SECOND_SCAN)), xtol=FIT_XTOL)
+    return float(np.exp(x[0])), float(x[1]), float(np.sqrt(cost))
+
+
+def fit_coat(grid: ViewGrid, target) -> LobeFit:
+    """Coat Roughness and Coat IOR of a GGX coat (weight 1, dielectric Fresnel, Cycles'
+    energy compensation) fitted to ``target`` (the film's gloss on ``grid``, ``(V, A, P[, 3])``,
+    channels averaged).  ``level`` is the coat's weight per unit coverage: 1, or 0 when the
+    film has no gloss (a matte product) or no coat does much better than none
+    (:data:`NO_LOBE_ERROR`)."""
+    if not np.any(np.asarray(target, float)):
+        return LobeFit(roughness=ROUGHNESS_RANGE[1], ior=COAT_IOR_RANGE[0], level=0.0,
+                       error=0.0)
+    def lobe_times(roughness):
+        albedo = cc.microfacet_albedo(grid.cos_view, roughness, **SEARCH_QUADRATURE)
+        average = cc.ggx_average_albedo(roughness)
+
+        def factor(ior):
+            scale = cc.ggx_energy_scale(albedo, average, float(cc.dielectric_fss(ior)))[0]
+            return cc.dielectric_fresnel(grid.cos_hi, ior) * scale[:, None, None]
+        return factor
+
+    roughness, ior, error = _fit_roughness_and(grid, target, lobe_times, COAT_IOR_RANGE)
+    if error >= NO_LOBE_ERROR:
+        return LobeFit(roughness=roughness, ior=ior, level=0.0, error=1.0)
+    return LobeFit(roughness=roughness, ior=ior, level=1.0, error=error)
+
+
+def _specular_fresnel(cos_hi, level):
+    """The Principled specular's Fresnel at IOR :data:`SPECULAR_IOR` and a Specular IOR
+    Level."""
+    f0 = float(cc.f0_from_ior(SPECULAR_IOR)) * 2.0 * level
+    eta = float(cc.ior_from_f0(f0)) if level != 0.5 else SPECULAR_IOR
+    return cc.schlick_ior_fresnel(cos_hi, eta, f0)
+
+
+def fit_specular(grid: ViewGrid, target, attenuation=None) -> LobeFit:
+    """Roughness and Specular IOR Level (at IOR :data:`SPECULAR_IOR`) of the Principled
+    specular fitted to ``target`` ``(V, A, P[, 3])`` (channels averaged).  ``attenuation``:
+    the factor the layers above apply to it per view ``(V,)`` (the coat's ``1 - E_coat``), or
+    None."""
+    scale = 1.0 if attenuation is None else np.asarray(attenuation, float)[:, None, None]
+
+    def lobe_times(roughness):
+        return lambda level: scale * _specular_fresnel(grid.cos_hi, level)
+
+    roughness, level, error = _fit_roughness_and(grid, target, lobe_times,
+                                                 SPECULAR_LEVEL_RANGE)
+    if error >= NO_LOBE_ERROR:  # no lobe does much better than none: leave it to the diffuse
+        return LobeFit(roughness=roughness, ior=SPECULAR_IOR, level=0.0, error=1.0)
+    return LobeFit(roughness=roughness, ior=SPECULAR_IOR, level=level, error=error)
+
+
+SEARCH_QUADRATURE = {"n_u": 24, "n_phi": 12}
+"""Closure-albedo quadrature while searching, at the grid's views (within 2%); the final
+weights use :data:`FINAL_QUADRATURE` (within 0.1%) at every texel."""
+FINAL_QUADRATURE = {"n_u": 96, "n_phi": 64}
+
+
+def _texel_albedo(albedo_table: np.ndarray, theta_deg: np.ndarray, cos_view) -> np.ndarray:
+    """A directional albedo table ``(n_theta, 3)`` on ``theta_deg`` at view cosines
+    ``cos_view`` ``(K,)``: ``(K, 3)``."""
+    theta = np.degrees(np.arccos(np.clip(cos_view, 0.0, 1.0)))
+    return np.stack([np.interp(theta, theta_deg, albedo_table[:, c]) for c in range(3)], -1)
+
+
+def _companion_share(grid: ViewGrid, lobe: np.ndarray, closure_albedo: np.ndarray,
+                     table_albedo: np.ndarray, target: np.ndarray) -> np.ndarray:
+    """The share ``s`` (per view of ``grid``, in [0, 1]) of a table's albedo ``A`` that the
+    Glossy lobe carries when a Lambertian companion carries the rest: weights ``a = s A / E``
+    (Glossy, ``E`` its albedo) and ``b = (1 - s) A`` (Diffuse), so ``a E + b = A`` at every
+    view.  ``s`` minimises ``|a lobe cos_i + b cos_i / pi - target cos_i|`` over the lights
+    of each view (closed form).  ``lobe`` and ``target`` grey ``(V, A, P)``, the albedos at
+    the views ``(V,)``."""
+    e = closure_albedo[:, None, None]
+    a = table_albedo[:, None, None]
+    lam = grid.cos_i / np.pi
+    u = a / np.maximum(e, 1e-6) * (lobe * grid.cos_i - e * lam)
+    v = target * grid.cos_i - a * lam
+    w = grid.weight
+    num = np.sum(w * u * v, axis=(1, 2))
+    den = np.sum(w * u * u, axis=(1, 2))
+    return np.clip(np.where(den > 0.0, num / np.where(den > 0.0, den, 1.0), 1.0), 0.0, 1.0)
+
+
+def fit_glossy(grid: ViewGrid, target, albedo_table: np.ndarray, theta_deg: np.ndarray,
+               size: int = DEFAULT_LUT_SIZE, *, companion: bool = False) -> LobeFit:
+    """Distribution (:data:`lut_baker.closures.cycles.GLOSSY_DISTRIBUTIONS`) and roughness of a
+    Glossy BSDF whose view-dependent weight (table albedo / closure albedo, read from a
+    ``size``-texel image by ``cos(theta_o)``) best reproduces ``target`` ``(V, A, P[, 3])``;
+    ``albedo_table`` ``(n_theta, 3)`` on ``theta_deg``.
+
+    ``companion``: the albedo is shared with a Lambertian companion, in the proportion that
+    fits each view best (:func:`_companion_share`); the weights are then ``lut`` (Glossy) and
+    ``diffuse_lut`` (Diffuse), whose albedos still add up to the table's at every view.  A
+    broad lobe whose radiance keeps a ``cos(theta_i)`` factor (the paper's film gloss) is
+    part Lambertian, which no Glossy closure alone reproduces.
+
+    The distribution is GGX unless another one's error is lower by more than
+    :data:`DISTRIBUTION_MARGIN` (relative): a near tie never flips the choice."""
+    target = np.asarray(target, float)
+    target = target if target.ndim == 4 else target[..., None]
+    target = target * np.ones(3)
+    grey = _grey(target)
+    if not np.any(albedo_table):  # no gloss (a matte film): weights 0, nothing to fit
+        zeros = np.zeros((size, 3))
+        return LobeFit(roughness=ROUGHNESS_RANGE[1], error=0.0, lut=zeros,
+                       diffuse_lut=zeros.copy() if companion else None)
+    texels = lut_nodes(size)
+    tables = {False: _texel_albedo(albedo_table, theta_deg, grid.cos_view),
+              True: _texel_albedo(albedo_table, theta_deg, texels)}
+
+    def weights(roughness, distribution, final: bool):
+        """``(lut, diffuse_lut or None, value on the grid)`` for one lobe: while searching
+        (``final`` False) the weights sit at the grid's views, with a coarser closure albedo;
+        the final ones at the image's texels, sampled as Blender samples them."""
+        shape = grid.lobe(roughness, distribution)
+        nodes = texels if final else grid.cos_view
+        closure = cc.microfacet_albedo(nodes, roughness, distribution=distribution,
+                                       **(FINAL_QUADRATURE if final else SEARCH_QUADRATURE))
+        table = tables[final]
+        lut = table / np.maximum(closure, 1e-6)[:, None]
+        diffuse = None
+        if companion:
+            e_views = np.interp(grid.cos_view, texels, closure) if final else closure
+            share = _companion_share(grid, shape, e_views, np.mean(tables[False], axis=-1),
+                                     grey)
+            share = np.interp(texels, grid.cos_view, share) if final else share
+            diffuse = (1.0 - share)[:, None] * table
+            lut = share[:, None] * lut
+        rows = ((lambda row: sample_lut(row, grid.cos_o)) if final
+                else (lambda row: row[:, None, None, :]))
+        value = shape[..., None] * rows(lut)
+        if diffuse is not None:
+            value = value + rows(diffuse) / np.pi
+        return lut, diffuse, value
+
+    searched = {distribution: _minimise_roughness(lambda r, d=distribution: grid.error(
+        weights(r, d, False)[2], target)) for distribution in cc.GLOSSY_DISTRIBUTIONS}
+    distribution = min(searched, key=lambda d: searched[d][1])
+    if searched[distribution][1] >= (1.0 - DISTRIBUTION_MARGIN) * searched["GGX"][1]:
+        distribution = "GGX"
+    roughness = searched[distribution][0]
+    lut, diffuse, value = weights(roughness, distribution, True)
+    return LobeFit(roughness=roughness, error=grid.error(value, target), lut=lut,
+                   distribution=distribution, diffuse_lut=diffuse,
+                   searched={name: float(found[1]) for name, found in searched.items()})

@@ -1,0 +1,151 @@
+"""The tiers' replicas and their errors against the tables.
+
+Each tier's formulas are :mod:`lut_baker.closures.tier_formulas`; here they are evaluated by the
+numpy algebra at a coverage, absorption and Gloss (Skin Color the fitted skin's albedo) and
+turned into BRDFs by the replicas of Blender's closures (:mod:`lut_baker.closures.cycles`), as
+Cycles renders the node group, then compared with the tables on a view grid.
+
+- :data:`TIERS`, :class:`TierError`.
+- :func:`principled_inputs`, :func:`principled_tier_reflection` -- the PRINCIPLED tier;
+  :func:`layered_tier_reflection` -- the LAYERED tier; :func:`view_weighted_reflection` -- a
+  view-weighted tier's closures as a BRDF; :data:`TIER_REPLICAS` -- each by name.
+- :func:`tier_errors` -- every tier against the tables at one coverage and absorption.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..model.made_up_skin import combine, coverage_weights
+from ..tables.table_set import Tables
+from . import cycles as cc
+from .closure_fit import ClosureFit
+from .tier_formulas import (
+    NumpyAlgebra,
+    TierInputs,
+    ViewWeightedClosures,
+    principled_sockets,
+    view_weighted_closures,
+)
+from .view_grid import ERROR_VIEWS, lobe_widths_deg, view_grid
+from .view_image import LUT_ROWS
+
+__all__ = ["TIERS", "TierError", "principled_inputs", "principled_tier_reflection",
+           "view_weighted_reflection", "layered_tier_reflection", "TIER_REPLICAS",
+           "tier_errors"]
+
+TIERS = ("PRINCIPLED", "LAYERED")
+"""The node group's tiers, cheapest first."""
+
+
+@dataclass(frozen=True)
+class TierError:
+    """A tier's error against the tables at one coverage and absorption: ``rms`` (relative RMS
+    of ``f cos(theta_i)``) and ``albedo`` (largest relative view-albedo error)."""
+
+    tier: str
+    coverage: float
+    absorption: tuple
+    rms: float
+    albedo: float
+
+
+def _absorption(absorption) -> np.ndarray:
+    return np.broadcast_to(np.asarray(absorption, float), (3,)).copy()
+
+
+def _inputs(fit: ClosureFit, coverage: float, absorption, gloss: float) -> TierInputs:
+    """The group's inputs a replica takes: the fitted skin's albedo as Skin Color."""
+    return TierInputs.numpy(coverage, _absorption(absorption), fit.skin_albedo, gloss)
+
+
+def principled_inputs(fit: ClosureFit, coverage: float, absorption, gloss: float = 1.0):
+    """``(PrincipledInputs, subsurface_weight)`` of the PRINCIPLED tier at a coverage,
+    absorption and Gloss, Skin Color the fitted skin's albedo:
+    :func:`lut_baker.closures.tier_formulas.principled_sockets`, which the node group
+    emits as nodes."""
+    sockets = principled_sockets(fit, _inputs(fit, coverage, absorption, gloss), NumpyAlgebra())
+
+    def scalar(name):
+        return float(np.ravel(sockets[name])[0])
+
+    inputs = cc.PrincipledInputs(
+        base_color=tuple(np.ravel(sockets["Base Color"]).tolist()),
+        roughness=scalar("Roughness"), ior=scalar("IOR"),
+        specular_ior_level=scalar("Specular IOR Level"), coat_weight=scalar("Coat Weight"),
+        coat_roughness=scalar("Coat Roughness"), coat_ior=scalar("Coat IOR"))
+    return inputs, scalar("Subsurface Weight")
+
+
+def principled_tier_reflection(fit: ClosureFit, tables: Tables, coverage: float, absorption,
+                               gloss: float = 1.0, directions=None):
+    """The PRINCIPLED tier's BRDF, ``(..., 3)``: at the angular nodes, or at ``directions``
+    ``(wi, wo)`` (local unit vectors); ``gloss``: the group's Gloss input."""
+    wi, wo = tables.node_directions() if directions is None else directions
+    inputs, _ = principled_inputs(fit, coverage, absorption, gloss)
+    return cc.principled_reflection(wi, wo, inputs)
+
+
+def view_weighted_reflection(closures: ViewWeightedClosures, lobe_of, wi, wo) -> np.ndarray:
+    """A view-weighted tier's BRDF, ``(..., 3)``, at ``(wi, wo)`` from its closures
+    (:func:`lut_baker.closures.tier_formulas.view_weighted_closures`, evaluated by the numpy
+    algebra at ``wo``'s view angles): each Glossy closure's white lobe ``lobe_of(name, wi,
+    wo)`` ``(...)`` times its colour, Diffuse and Subsurface closures Lambertian, each side
+    summed and the sides mixed by coverage."""
+    def side(closures_of_side):
+        value = 0.0
+        for closure in closures_of_side:
+            colour = closure.colour if closure.weight is None else closure.colour * closure.weight
+            if not np.any(colour):
+                continue  # a closure of weight 0 is never allocated
+            if closure.kind == "glossy":
+                value = value + lobe_of(closure.name, wi, wo)[..., None] * colour
+            else:
+                value = value + cc.lambert_reflection(colour)
+        return value
+
+    weights = coverage_weights(closures.coverage, 0.0)
+    return combine(weights, top=side(closures.covered), bare=side(closures.bare))
+
+
+def layered_tier_reflection(fit: ClosureFit, tables: Tables, coverage: float, absorption,
+                            gloss: float = 1.0, directions=None):
+    """The LAYERED tier's BRDF, ``(..., 3)``, at the angular nodes or at ``directions``
+    ``(wi, wo)``: its closures (:func:`lut_baker.closures.tier_formulas.view_weighted_closures`)
+    with the image rows read as Blender reads them (linear between texel centres) and Cycles'
+    Glossy lobes; ``gloss``: the group's Gloss input."""
+    wi, wo = tables.node_directions() if directions is None else directions
+    algebra = NumpyAlgebra(dict(zip(LUT_ROWS, fit.lut, strict=True)), wo[..., 2])
+    closures = view_weighted_closures(fit, _inputs(fit, coverage, absorption, gloss), algebra)
+
+    def lobe(name, wi, wo):
+        glossy = fit.glossy[name]
+        return cc.microfacet_reflection(wi, wo, glossy.roughness,
+                                        distribution=glossy.distribution)
+
+    return view_weighted_reflection(closures, lobe, wi, wo)
+
+
+TIER_REPLICAS = {"PRINCIPLED": principled_tier_reflection, "LAYERED": layered_tier_reflection}
+"""Each tier's replica, ``(fit, tables, coverage, absorption, gloss=1, directions=None)``."""
+
+
+def tier_errors(fit: ClosureFit, tables: Tables, coverage: float, absorption,
+                gloss: float = 1.0) -> dict:
+    """:class:`TierError` of every tier against the tables at one coverage and absorption
+    (``gloss``: the group's Gloss input; at 0 the error includes all of the gloss left out),
+    on a :class:`lut_baker.closures.view_grid.ViewGrid` of :data:`ERROR_VIEWS` views that
+    resolves the narrower of the two surfaces' gloss lobes."""
+    grid = view_grid(min(lobe_widths_deg(tables).values()), ERROR_VIEWS)
+    directions = grid.directions
+    reference = tables.made_up_reflection(*directions, coverage, absorption)
+    out = {}
+    for tier, replica in TIER_REPLICAS.items():
+        f = replica(fit, tables, coverage, absorption, gloss, directions)
+        out[tier] = TierError(tier=tier, coverage=float(coverage),
+                              absorption=tuple(_absorption(absorption).tolist()),
+                              rms=grid.error(f, reference),
+                              albedo=grid.albedo_error(f, reference))
+    return out

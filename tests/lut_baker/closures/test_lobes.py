@@ -1,0 +1,75 @@
+"""The lobe fits (lut_baker.closures.lobes), by round trips: tables synthesised from a known
+closure must give that closure's parameters back."""
+
+
+import numpy as np
+import pytest
+
+from lut_baker.closures import cycles as cc
+from lut_baker.closures import lobes, view_image
+from lut_baker.closures.view_grid import view_grid
+
+
+@pytest.mark.slow  # a fit of ~0.5 s
+def test_fit_glossy_companion_recovers_a_lobe_plus_lambert(paper_tables):
+    """A target that is 0.7 of a Beckmann lobe plus a Lambertian 0.2: the companion fit finds
+    the lobe and splits the albedo between the two, and the weights' albedos add up to the
+    table's at every texel (so the white furnace is kept)."""
+    grid = view_grid(20.0)
+    lobe = grid.lobe(0.5, "BECKMANN")
+    theta = np.asarray(paper_tables.theta_deg)
+    e = cc.microfacet_albedo(np.cos(np.radians(theta)), 0.5, distribution="BECKMANN")
+    albedo = (0.7 * e + 0.2)[:, None] * np.ones(3)
+    target = (0.7 * lobe + 0.2 / np.pi)[..., None] * np.ones(3)
+    plain = lobes.fit_glossy(grid, target, albedo, theta)
+    fit = lobes.fit_glossy(grid, target, albedo, theta, companion=True)
+    assert plain.diffuse_lut is None and fit.error < 0.25 * plain.error
+    assert fit.distribution == "BECKMANN" and fit.roughness == pytest.approx(0.5, abs=0.02)
+    inner = slice(4, -4)  # texels away from the ends, where interpolation holds them
+    np.testing.assert_allclose(fit.lut[inner], 0.7, atol=0.03)
+    np.testing.assert_allclose(fit.diffuse_lut[inner], 0.2, atol=0.02)
+    mu = view_image.lut_nodes(view_image.DEFAULT_LUT_SIZE)
+    texel_e = cc.microfacet_albedo(mu, fit.roughness, distribution=fit.distribution)
+    texel_table = np.interp(np.degrees(np.arccos(mu)), theta, albedo[:, 0])
+    np.testing.assert_allclose(fit.lut[:, 0] * texel_e + fit.diffuse_lut[:, 0], texel_table,
+                               rtol=2e-3)
+
+@pytest.mark.parametrize("roughness, ior", [(0.45, 1.8), (0.12, 1.4)])
+def test_fit_coat_recovers_a_known_coat(roughness, ior):
+    """A coat of any width comes back: the grid resolves the lobe it is given (0.12 is a lobe
+    about 0.6 degrees wide)."""
+    width = float(np.degrees(np.arctan(0.8 * roughness**2)))
+    grid = view_grid(width)
+    synthetic = cc.microfacet_reflection(*grid.directions, roughness,
+                                         lambda c: cc.dielectric_fresnel(c, ior))
+    # The coat's energy compensation (a view factor the fit models) is part of the target.
+    scale = cc.ggx_energy_compensation(grid.cos_view, roughness,
+                                       float(cc.dielectric_fss(ior)))[0]
+    fit = lobes.fit_coat(grid, (synthetic * scale[:, None, None])[..., None] * np.ones(3))
+    assert fit.roughness == pytest.approx(roughness, rel=0.02)
+    assert fit.ior == pytest.approx(ior, abs=0.02)
+    assert fit.error < 0.02
+
+def test_fit_glossy_recovers_distribution_and_roughness(paper_tables):
+    grid = view_grid(20.0)
+    lobe = grid.lobe(0.5, "BECKMANN")
+    mu = np.cos(np.radians(paper_tables.theta_deg))
+    albedo = cc.microfacet_albedo(mu, 0.5, distribution="BECKMANN")[:, None] * np.ones(3)
+    fit = lobes.fit_glossy(grid, lobe[..., None] * np.ones(3), albedo,
+                             np.asarray(paper_tables.theta_deg))
+    assert fit.distribution == "BECKMANN"
+    assert fit.roughness == pytest.approx(0.5, abs=0.01)
+    assert fit.error < 0.02
+    # The weight row is table albedo / closure albedo: 1 for the lobe itself.
+    np.testing.assert_allclose(fit.lut, 1.0, atol=0.02)
+
+def test_fit_glossy_keeps_ggx_in_a_near_tie(paper_tables, monkeypatch):
+    """Another distribution replaces GGX only when it errs DISTRIBUTION_MARGIN less: with a
+    margin no gain can reach, even a Beckmann target fits as GGX."""
+    grid = view_grid(20.0)
+    mu = np.cos(np.radians(paper_tables.theta_deg))
+    albedo = cc.microfacet_albedo(mu, 0.5, distribution="BECKMANN")[:, None] * np.ones(3)
+    target = grid.lobe(0.5, "BECKMANN")[..., None] * np.ones(3)
+    monkeypatch.setattr(lobes, "DISTRIBUTION_MARGIN", 1.0)
+    fit = lobes.fit_glossy(grid, target, albedo, np.asarray(paper_tables.theta_deg))
+    assert fit.distribution == "GGX"
