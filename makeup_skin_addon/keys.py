@@ -38,7 +38,7 @@ group"; Apply finds groups and images by name and reuses them):
 - :data:`GROUP_NODE` -- name and label of the group node in a made-up material's tree.
 - :data:`FRAME_NAME`, :data:`FRAME_LABEL` -- the frame around the previous surface shader.
 - :func:`group_name` -- ``Made-up Skin <Tier> [<method>] <key>`` (:data:`GROUP_PREFIX`,
-  :data:`METHOD_LABELS`).
+  :data:`TIER_LABELS`, :data:`METHOD_LABELS`).
 - :func:`lut_image_name` -- ``MakeupSkin LUT <Tier> <key>`` (:data:`LUT_PREFIX`).
 """
 
@@ -62,6 +62,7 @@ __all__ = [
     "FRAME_NAME",
     "FRAME_LABEL",
     "GROUP_PREFIX",
+    "TIER_LABELS",
     "METHOD_LABELS",
     "LUT_PREFIX",
     "group_name",
@@ -117,6 +118,8 @@ FRAME_LABEL = "Before Made-up Skin (Revert restores it)"
 """Label of that frame."""
 GROUP_PREFIX = "Made-up Skin"
 """Start of every node group name (:func:`group_name`)."""
+TIER_LABELS = {"PRINCIPLED": "Principled", "LAYERED": "Layered", "EEVEE": "EEVEE"}
+"""A tier's part of group and image names."""
 METHOD_LABELS = {"BURLEY": "Burley", "RANDOM_WALK": "RW", "RANDOM_WALK_SKIN": "RW Skin"}
 """A forced subsurface method's part of a group name."""
 LUT_PREFIX = "MakeupSkin LUT "
@@ -126,9 +129,10 @@ LUT_PREFIX = "MakeupSkin LUT "
 def group_name(tier: str, key: str, method: str | None = None) -> str:
     """``Made-up Skin <Tier> [<method>] <key>``; no method: the fit's own choice."""
     label = f" {METHOD_LABELS[method]}" if method else ""
-    return f"{GROUP_PREFIX} {tier.title()}{label} {key[:8]}"
+    return f"{GROUP_PREFIX} {TIER_LABELS[tier]}{label} {key[:8]}"
 
 
 def lut_image_name(key: str, tier: str = "LAYERED") -> str:
-    """``MakeupSkin LUT <Tier> <key>``: the name of the Layered tier's view-angle image."""
-    return f"{LUT_PREFIX}{tier.title()} {key[:16]}"
+    """``MakeupSkin LUT <Tier> <key>``: the name of a tier's view-angle image (Layered,
+    EEVEE)."""
+    return f"{LUT_PREFIX}{TIER_LABELS[tier]} {key[:16]}"

@@ -1,6 +1,6 @@
 """The "Made-up Skin" node groups: closures fitted to baked tables (lut_baker.closures.fitting).
 
-Both tiers share one interface, so a material keeps its links when the tier changes:
+Every tier shares one interface, so a material keeps its links when the tier changes:
 
 - inputs: ``Coverage`` (0..1, paintable with a texture), ``Foundation Absorption`` (colour:
   the fraction of light the film's pigment absorbs per channel), ``Skin Color`` (the skin's
@@ -27,6 +27,15 @@ of weight 0 is never allocated, ``bsdf_alloc``), view-dependent factors read fro
 (rows :data:`lut_baker.closures.fitting.LUT_ROWS`) at ``u = cos(theta_o)``, and a Mix Shader by
 Coverage between bare skin and made-up skin: an areal mix of closures, so a painted coverage
 fades out without fringe or halo.
+EEVEE: the LAYERED tier's closures and mix with their weights from
+:func:`lut_baker.closures.fitting.eevee_weights`, every Glossy BSDF GGX (fitted as EEVEE renders
+it), its own view-angle image (``fit.eevee_lut``), subsurface Christensen-Burley.
+
+The view-angle rows are read by :func:`_lut_rows`: two Closest lookups at neighbouring texel
+centres mixed linearly, which is what a Linear lookup gives in Cycles
+(:func:`lut_baker.closures.fitting.sample_lut`); EEVEE samples a Linear image through mipmaps
+and anisotropic filtering, which mixes the image's five rows wherever ``cos(theta_o)`` changes
+quickly across the screen (docs/addon.md, "Why the Layered tier breaks in EEVEE").
 
 - :func:`build_group` -- create or rebuild (in place) a group from a fit and its bake record,
   named by :func:`.keys.group_name` (tier, tables key, a forced subsurface method).
@@ -207,6 +216,50 @@ def _normal_or_shading(build: _Builder, normal, geometry):
     return build.mix_vector(linked, geometry.outputs["Normal"], normal, label="normal or shading")
 
 
+def _texel_pair(build: _Builder, u, size: int, label: str):
+    """``(u0, u1, t)`` for reading a row of ``size`` texels at ``u`` linearly: the texel
+    centres ``(i + 0.5) / size`` around ``u`` (the edge texel twice beyond the centres) and
+    the weight of the second, ``x = clamp(u size - 0.5, 0, size - 1)``, ``i = floor(x)``,
+    ``t = x - i``."""
+    x = build.math("MINIMUM", build.math("MAXIMUM", build.math(
+        "MULTIPLY", u, float(size), label=f"{label}: u size"), 0.5), size - 0.5)
+    x = build.math("SUBTRACT", x, 0.5, label=f"{label}: texel coordinate")
+    index = build.math("FLOOR", x, label=f"{label}: texel")
+    weight = build.math("SUBTRACT", x, index, label=f"{label}: t")
+    u0 = build.math("DIVIDE", build.math("ADD", index, 0.5), float(size))
+    u1 = build.math("DIVIDE", build.math("MINIMUM", build.math("ADD", index, 1.5),
+                                         size - 0.5), float(size))
+    return u0, u1, weight
+
+
+def _lut_rows(build: _Builder, lut, coordinates: dict) -> dict:
+    """Every row of the view-angle image ``lut`` (rows :data:`fitting.LUT_ROWS`), read at
+    ``u = coordinates[name]`` (a socket per row name) linearly between texel centres and held
+    beyond them, as :func:`lut_baker.closures.fitting.sample_lut` reads it: two Closest
+    lookups mixed, so that EEVEE reads what Cycles does (its Linear filter goes through
+    mipmaps, which mix rows).  The texel pair is built once per coordinate socket."""
+    size = lut.size[0]
+    pairs = {}
+    rows = {}
+    for j, name in enumerate(fitting.LUT_ROWS):
+        u = coordinates[name]
+        key = u.as_pointer()
+        if key not in pairs:
+            pairs[key] = _texel_pair(build, u, size, name)
+        u0, u1, weight = pairs[key]
+        samples = []
+        for k, at in enumerate((u0, u1)):
+            coordinate = build.node("ShaderNodeCombineXYZ", f"row {name}, texel {k}")
+            build.feed(coordinate.inputs["X"], at)
+            build.feed(coordinate.inputs["Y"], (j + 0.5) / len(fitting.LUT_ROWS))
+            texture = build.node("ShaderNodeTexImage", name, image=lut,
+                                 interpolation="Closest", extension="EXTEND")
+            build.tree.links.new(coordinate.outputs[0], texture.inputs["Vector"])
+            samples.append(texture.outputs["Color"])
+        rows[name] = build.mix_vector(weight, *samples, label=f"row {name}")
+    return rows
+
+
 def _cos_view(build: _Builder, normal, geometry, label: str):
     """``max(0, I . N)``: the cosine of the view angle against ``normal``."""
     return build.math("MAXIMUM", build.vector("DOT_PRODUCT", geometry.outputs["Incoming"],
@@ -272,7 +325,16 @@ def _build_principled(build: _Builder, fit, method: str, radius_mm, ior: float):
     build.tree.links.new(bsdf.outputs[0], output.inputs["Shader"])
 
 
-def _build_layered(build: _Builder, fit, lut, method: str, radius_mm, ior: float):
+def _build_view_weighted(build: _Builder, glossy_fits: dict, lut, method: str, radius_mm,
+                         ior: float, *, film_albedo, transmittance_mean,
+                         tinted_subsurface: bool):
+    """The LAYERED and EEVEE tiers' closures (their weights:
+    :func:`lut_baker.closures.fitting.layered_weights`, :func:`~lut_baker.closures.fitting.
+    eevee_weights`): Glossy lobes ``glossy_fits`` weighted by the rows of ``lut``, one Diffuse
+    for the film, Subsurface for the skin, a Mix Shader by Coverage.  ``tinted_subsurface``:
+    the skin through the film keeps the skin's own colour, tinted relative to its strongest
+    channel, which weights the closure (Cycles' random walk: see below); else its colour is
+    the product itself (EEVEE's screen-space Burley and Cycles' Burley take it as it is)."""
     inputs, output, w, through, through2, skin, scale, gloss = _common(build)
     geometry = build.node("ShaderNodeNewGeometry")
     film_normal, skin_normal = inputs.outputs["Film Normal"], inputs.outputs["Normal"]
@@ -280,18 +342,11 @@ def _build_layered(build: _Builder, fit, lut, method: str, radius_mm, ior: float
     # skin's own gloss against the skin's, the film and the light through it against the film's.
     cos_film = _cos_view(build, film_normal, geometry, "cos theta_o (film)")
     cos_skin = _cos_view(build, skin_normal, geometry, "cos theta_o (skin)")
-    rows = {}
-    for j, name in enumerate(fitting.LUT_ROWS):
-        coordinate = build.node("ShaderNodeCombineXYZ", f"u = cos, row {name}")
-        build.feed(coordinate.inputs["X"], cos_skin if name == "skin_gloss" else cos_film)
-        build.feed(coordinate.inputs["Y"], (j + 0.5) / len(fitting.LUT_ROWS))
-        texture = build.node("ShaderNodeTexImage", name, image=lut, interpolation="Linear",
-                             extension="EXTEND")
-        build.tree.links.new(coordinate.outputs[0], texture.inputs["Vector"])
-        rows[name] = texture.outputs["Color"]
+    rows = _lut_rows(build, lut, {name: cos_skin if name == "skin_gloss" else cos_film
+                                  for name in fitting.LUT_ROWS})
 
     def glossy(name, colour, normal):
-        lobe = fit.glossy[name]
+        lobe = glossy_fits[name]
         node = build.node("ShaderNodeBsdfGlossy", name.replace("_", " "),
                           distribution=lobe.distribution)
         # Gloss 0: colour 0, a closure Cycles does not allocate (bsdf_alloc's weight cutoff).
@@ -320,35 +375,39 @@ def _build_layered(build: _Builder, fit, lut, method: str, radius_mm, ior: float
     film_diffuse = build.node("ShaderNodeBsdfDiffuse", "film diffuse")
     companion = build.scale(rows["film_gloss_diffuse"], gloss, label="gloss companion x Gloss")
     build.feed(film_diffuse.inputs["Color"],
-               build.vector("ADD", build.vector("MULTIPLY", through, tuple(fit.film_albedo)),
+               build.vector("ADD", build.vector("MULTIPLY", through, tuple(film_albedo)),
                             companion, label="film diffuse + gloss companion"))
     build.feed(film_diffuse.inputs["Normal"], film_normal)
-    # The skin seen through the film, per channel (1 - A)^2 T(theta_o) T_mean times the skin:
-    # the closure's colour keeps the skin's own (bright) colour, tinted by that product
-    # relative to its strongest channel, and the strongest channel weights the closure.  A dark
-    # colour instead would make the random walk both noisy (14% against 1% at 32 samples) and
-    # wrongly short.
     transmitted = build.vector("MULTIPLY", build.vector("MULTIPLY", through2,
                                                         rows["film_transmittance"]),
-                               tuple(fit.transmittance_mean), label="(1 - A)^2 T(theta_o) T_mean")
-    separate = build.node("ShaderNodeSeparateXYZ", "transmitted channels")
-    build.feed(separate.inputs[0], transmitted)
-    strongest = build.math("MAXIMUM", separate.outputs[0],
-                           build.math("MAXIMUM", separate.outputs[1], separate.outputs[2]))
-    through_colour = build.scale(build.vector("MULTIPLY", transmitted, skin),
-                                 build.math("DIVIDE", 1.0, build.math("MAXIMUM", strongest,
-                                                                      1e-6)),
-                                 label="skin through film colour")
-    through_weight = strongest
-    weighted = build.node("ShaderNodeMixShader", "skin through film (weight)")
-    build.feed(socket(weighted.inputs, "Fac"), through_weight)
-    build.tree.links.new(subsurface(through_colour, "skin through film"),
-                         socket(weighted.inputs, "Shader_001"))
+                               tuple(transmittance_mean), label="(1 - A)^2 T(theta_o) T_mean")
+    if tinted_subsurface:
+        # The skin seen through the film, per channel (1 - A)^2 T(theta_o) T_mean times the
+        # skin: the closure's colour keeps the skin's own (bright) colour, tinted by that
+        # product relative to its strongest channel, and the strongest channel weights the
+        # closure.  A dark colour instead would make the random walk both noisy (14% against
+        # 1% at 32 samples) and wrongly short.
+        separate = build.node("ShaderNodeSeparateXYZ", "transmitted channels")
+        build.feed(separate.inputs[0], transmitted)
+        strongest = build.math("MAXIMUM", separate.outputs[0],
+                               build.math("MAXIMUM", separate.outputs[1], separate.outputs[2]))
+        through_colour = build.scale(build.vector("MULTIPLY", transmitted, skin),
+                                     build.math("DIVIDE", 1.0, build.math("MAXIMUM", strongest,
+                                                                          1e-6)),
+                                     label="skin through film colour")
+        weighted = build.node("ShaderNodeMixShader", "skin through film (weight)")
+        build.feed(socket(weighted.inputs, "Fac"), strongest)
+        build.tree.links.new(subsurface(through_colour, "skin through film"),
+                             socket(weighted.inputs, "Shader_001"))
+        skin_through = weighted.outputs[0]
+    else:
+        skin_through = subsurface(build.vector("MULTIPLY", transmitted, skin),
+                                  "skin through film")
     made_up = add(add(glossy("film_gloss", rows["film_gloss"], film_normal),
                       film_diffuse.outputs[0]),
                   add(glossy("path3_gloss", build.vector("MULTIPLY", rows["path3_gloss"],
                                                          through2), skin_normal),
-                      weighted.outputs[0]))
+                      skin_through))
     bare = add(glossy("skin_gloss", rows["skin_gloss"], skin_normal),
                subsurface(skin, "bare skin"))
     mix = build.node("ShaderNodeMixShader", "coverage (areal mix)")
@@ -356,6 +415,18 @@ def _build_layered(build: _Builder, fit, lut, method: str, radius_mm, ior: float
     build.tree.links.new(bare, socket(mix.inputs, "Shader"))
     build.tree.links.new(made_up, socket(mix.inputs, "Shader_001"))
     build.tree.links.new(mix.outputs[0], output.inputs["Shader"])
+
+
+def _build_layered(build: _Builder, fit, lut, method: str, radius_mm, ior: float):
+    _build_view_weighted(build, fit.glossy, lut, method, radius_mm, ior,
+                         film_albedo=fit.film_albedo,
+                         transmittance_mean=fit.transmittance_mean, tinted_subsurface=True)
+
+
+def _build_eevee(build: _Builder, fit, lut, method: str, radius_mm, ior: float):
+    _build_view_weighted(build, fit.eevee_glossy, lut, method, radius_mm, ior,
+                         film_albedo=fit.film_albedo,
+                         transmittance_mean=fit.transmittance_mean, tinted_subsurface=False)
 
 
 def build_group(tier: str, bake: dict, fit, group=None, *, method=None, measured=None):
@@ -379,16 +450,19 @@ def build_group(tier: str, bake: dict, fit, group=None, *, method=None, measured
     group.nodes.clear()
     build = _Builder(group)
     forced = method
-    method = method or fit.subsurface_method
+    method = method or (fitting.EEVEE_SUBSURFACE_METHOD if tier == "EEVEE"
+                        else fit.subsurface_method)
     radius = fit.profiles[method].radius_mm
     ior = fit.subsurface_ior
     images = []
     if tier == "PRINCIPLED":
         _build_principled(build, fit, method, radius, ior)
     else:
-        lut = storage.lut_image(lut_image_name(key), fit.lut)
+        rows = fit.eevee_lut if tier == "EEVEE" else fit.lut
+        lut = storage.lut_image(lut_image_name(key, tier), rows)
         images.append(storage.image_record(lut))
-        _build_layered(build, fit, lut, method, radius, ior)
+        (_build_eevee if tier == "EEVEE" else _build_layered)(build, fit, lut, method, radius,
+                                                              ior)
     group[FIT_KEY] = json.dumps({**bake, "tier": tier, "forced_method": forced,
                                  "images": images, **fit.summary(),
                                  "subsurface_method": method, "measured": measured},

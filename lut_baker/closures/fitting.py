@@ -19,6 +19,10 @@ attenuation of the layers above it; Subsurface Weight = the skin's share of it.
 row), film diffuse plus that companion (one Diffuse), the skin through the film and bare
 (Subsurface, colour ``(1 - A)^2 skin_diffuse pi T_mean T(theta_o)`` and ``skin_diffuse pi``),
 mixed by coverage.
+``EEVEE``: the LAYERED tier's closures and mix (:func:`eevee_weights`), made for EEVEE: every
+Glossy lobe is GGX (EEVEE renders no other distribution) fitted to the tables as EEVEE renders
+it under a lamp, a linearly transformed cosine (:mod:`lut_baker.closures.eevee`), with its own
+view-angle rows; subsurface Christensen-Burley (EEVEE's screen-space method).
 Both take the group's Gloss input ``g`` (0..1): it scales the gloss lobes (coat weight and
 specular level; the Glossy colours), and at 0 Cycles allocates none of them.  The replicas
 below take it as ``gloss``, so the Auto tier predicts a gloss-free candidate from the same
@@ -49,8 +53,8 @@ Functions and types
 - :func:`fit_closures` -- every fit of one set of tables.
 - :func:`principled_inputs`, :func:`principled_tier_reflection` -- the PRINCIPLED tier at a
   coverage, absorption and Gloss; :func:`layered_weights`, :func:`layered_tier_reflection` --
-  the LAYERED tier; :data:`TIER_REPLICAS` -- both by name; :func:`tier_errors` -- both
-  against the tables.
+  the LAYERED tier; :func:`eevee_weights`, :func:`eevee_tier_reflection` -- the EEVEE tier;
+  :data:`TIER_REPLICAS` -- all by name; :func:`tier_errors` -- all against the tables.
 """
 
 from __future__ import annotations
@@ -65,6 +69,7 @@ from ..numerics.optimise import brent_minimum, scanned_least_squares
 from ..numerics.quadrature import trapezoid_weights
 from ..tables.table_set import Tables
 from . import cycles as cc
+from . import eevee
 from .view_grid import ERROR_VIEWS, FIT_VIEWS, ViewGrid, view_grid
 
 __all__ = [
@@ -91,17 +96,29 @@ __all__ = [
     "principled_tier_reflection",
     "layered_weights",
     "layered_tier_reflection",
+    "eevee_weights",
+    "eevee_tier_reflection",
+    "EEVEE_GLOSSY",
+    "EEVEE_SUBSURFACE_METHOD",
     "TIER_REPLICAS",
     "tier_errors",
     "lobe_widths_deg",
 ]
 
-TIERS = ("PRINCIPLED", "LAYERED")
-"""The node group's tiers, cheapest first."""
+TIERS = ("PRINCIPLED", "LAYERED", "EEVEE")
+"""The node group's tiers: the two made for Cycles, cheapest first, then the one made for
+EEVEE."""
 LUT_ROWS = ("film_gloss", "path3_gloss", "skin_gloss", "film_transmittance",
             "film_gloss_diffuse")
-"""Rows of the LAYERED tier's view-angle image: three Glossy weights, the film's
+"""Rows of the LAYERED and EEVEE tiers' view-angle images: three Glossy weights, the film's
 transmittance ``T(theta_o)`` and the film gloss's Lambertian companion (:func:`fit_glossy`)."""
+EEVEE_GLOSSY = "EEVEE_GGX"
+"""The closure name :func:`fit_glossy` gives EEVEE's Glossy BSDF under a lamp
+(:func:`lut_baker.closures.eevee.glossy_from_cosines`); the node is a GGX Glossy BSDF."""
+EEVEE_SUBSURFACE_METHOD = "BURLEY"
+"""The EEVEE tier's subsurface method: EEVEE's screen-space subsurface is Burley's profile
+whatever the node asks for, and Cycles renders the same method when the file is rendered
+there."""
 DEFAULT_LUT_SIZE = 64
 """Texels per row of the view-angle image (linear filtering between texel centres)."""
 ROUGHNESS_RANGE = (0.02, 1.0)
@@ -304,8 +321,28 @@ def _companion_share(grid: ViewGrid, lobe: np.ndarray, closure_albedo: np.ndarra
     return np.clip(np.where(den > 0.0, num / np.where(den > 0.0, den, 1.0), 1.0), 0.0, 1.0)
 
 
+def glossy_lobe(grid: ViewGrid, roughness: float, closure: str) -> np.ndarray:
+    """A white Glossy closure's BRDF at ``grid``'s pairs, ``(V, A, P)``: Cycles' distribution
+    ``closure`` (:data:`lut_baker.closures.cycles.GLOSSY_DISTRIBUTIONS`) or, for
+    :data:`EEVEE_GLOSSY`, EEVEE's GGX under a lamp."""
+    if closure == EEVEE_GLOSSY:
+        return eevee.glossy_from_cosines(grid.wi, grid.cos_o, roughness)
+    return grid.lobe(roughness, closure)
+
+
+def glossy_albedo(cos_view, roughness: float, closure: str, *, final: bool = True):
+    """The albedo of :func:`glossy_lobe`'s closure at view cosines: by quadrature over
+    normals for Cycles' (:data:`FINAL_QUADRATURE`, or :data:`SEARCH_QUADRATURE` while
+    searching), in closed form for EEVEE's."""
+    if closure == EEVEE_GLOSSY:
+        return eevee.glossy_albedo(cos_view, roughness)
+    return cc.microfacet_albedo(cos_view, roughness, distribution=closure,
+                                **(FINAL_QUADRATURE if final else SEARCH_QUADRATURE))
+
+
 def fit_glossy(grid: ViewGrid, target, albedo_table: np.ndarray, theta_deg: np.ndarray,
-               size: int = DEFAULT_LUT_SIZE, *, companion: bool = False) -> LobeFit:
+               size: int = DEFAULT_LUT_SIZE, *, companion: bool = False,
+               closures: tuple = cc.GLOSSY_DISTRIBUTIONS) -> LobeFit:
     """Distribution (:data:`lut_baker.closures.cycles.GLOSSY_DISTRIBUTIONS`) and roughness of a
     Glossy BSDF whose view-dependent weight (table albedo / closure albedo, read from a
     ``size``-texel image by ``cos(theta_o)``) best reproduces ``target`` ``(V, A, P[, 3])``;
@@ -317,8 +354,11 @@ def fit_glossy(grid: ViewGrid, target, albedo_table: np.ndarray, theta_deg: np.n
     broad lobe whose radiance keeps a ``cos(theta_i)`` factor (the paper's film gloss) is
     part Lambertian, which no Glossy closure alone reproduces.
 
-    The distribution is GGX unless another one's error is lower by more than
-    :data:`DISTRIBUTION_MARGIN` (relative): a near tie never flips the choice."""
+    ``closures``: the Glossy closures to choose from (:func:`glossy_lobe`): Cycles'
+    distributions (default), or ``(EEVEE_GLOSSY,)`` for the EEVEE tier.  The first of them
+    (GGX) is chosen unless another one's error is lower by more than
+    :data:`DISTRIBUTION_MARGIN` (relative): a near tie never flips the choice.  The fit's
+    ``distribution`` is the Glossy node's (``GGX`` for EEVEE's closure)."""
     target = np.asarray(target, float)
     target = target if target.ndim == 4 else target[..., None]
     target = target * np.ones(3)
@@ -335,10 +375,9 @@ def fit_glossy(grid: ViewGrid, target, albedo_table: np.ndarray, theta_deg: np.n
         """``(lut, diffuse_lut or None, value on the grid)`` for one lobe: while searching
         (``final`` False) the weights sit at the grid's views, with a coarser closure albedo;
         the final ones at the image's texels, sampled as Blender samples them."""
-        shape = grid.lobe(roughness, distribution)
+        shape = glossy_lobe(grid, roughness, distribution)
         nodes = texels if final else grid.cos_view
-        closure = cc.microfacet_albedo(nodes, roughness, distribution=distribution,
-                                       **(FINAL_QUADRATURE if final else SEARCH_QUADRATURE))
+        closure = glossy_albedo(nodes, roughness, distribution, final=final)
         table = tables[final]
         lut = table / np.maximum(closure, 1e-6)[:, None]
         diffuse = None
@@ -357,15 +396,17 @@ def fit_glossy(grid: ViewGrid, target, albedo_table: np.ndarray, theta_deg: np.n
         return lut, diffuse, value
 
     searched = {distribution: _minimise_roughness(lambda r, d=distribution: grid.error(
-        weights(r, d, False)[2], target)) for distribution in cc.GLOSSY_DISTRIBUTIONS}
+        weights(r, d, False)[2], target)) for distribution in closures}
     distribution = min(searched, key=lambda d: searched[d][1])
-    if searched[distribution][1] >= (1.0 - DISTRIBUTION_MARGIN) * searched["GGX"][1]:
-        distribution = "GGX"
+    if searched[distribution][1] >= (1.0 - DISTRIBUTION_MARGIN) * searched[closures[0]][1]:
+        distribution = closures[0]
     roughness = searched[distribution][0]
     lut, diffuse, value = weights(roughness, distribution, True)
+    node = "GGX" if distribution == EEVEE_GLOSSY else distribution
     return LobeFit(roughness=roughness, error=grid.error(value, target), lut=lut,
-                   distribution=distribution, diffuse_lut=diffuse,
-                   searched={name: float(found[1]) for name, found in searched.items()})
+                   distribution=node, diffuse_lut=diffuse,
+                   searched={("GGX" if name == EEVEE_GLOSSY else name): float(found[1])
+                             for name, found in searched.items()})
 
 
 # --------------------------------------------------------------------------------------------
@@ -497,7 +538,10 @@ class ClosureFit:
     ``skin_albedo`` (RGB, ``pi P_d``), ``profiles`` (by method) and ``subsurface_method``
     (the best-fitting one), ``subsurface_ior`` (the dipole's index, for the random walk and
     the profile fits), ``lut`` (``(len(LUT_ROWS), size, 3)``: the view-angle image),
-    ``errors`` at the coverage and absorption the tables were baked for.
+    ``errors`` at the coverage and absorption the tables were baked for.  EEVEE:
+    ``eevee_glossy`` (the same three lobes, GGX as EEVEE renders it) and ``eevee_lut`` (their
+    view-angle image, rows :data:`LUT_ROWS`); its subsurface is Burley's
+    (:data:`EEVEE_SUBSURFACE_METHOD`).
     """
 
     coat: LobeFit
@@ -514,6 +558,8 @@ class ClosureFit:
     subsurface_method: str
     subsurface_ior: float
     lut: np.ndarray
+    eevee_glossy: dict
+    eevee_lut: np.ndarray
     errors: dict = field(default_factory=dict)
 
     @property
@@ -535,6 +581,8 @@ class ClosureFit:
             "glossy": {name: {"roughness": lobe.roughness, "error": lobe.error,
                               "distribution": lobe.distribution}
                        for name, lobe in self.glossy.items()},
+            "eevee_glossy": {name: {"roughness": lobe.roughness, "error": lobe.error}
+                             for name, lobe in self.eevee_glossy.items()},
             "subsurface_method": self.subsurface_method,
             "subsurface_ior": self.subsurface_ior,
             "profiles": {name: {"radius_mm": p.radius_mm.tolist(), "error": p.error.tolist(),
@@ -623,19 +671,28 @@ def fit_closures(tables: Tables, *, lut_size: int = DEFAULT_LUT_SIZE,
     elif specular_bare.level == 0.0:
         specular_bare = replace(specular_bare, roughness=specular_film.roughness)
 
-    report(0.3, "fitting the Layered tier's gloss lobes")
     theta_deg = np.asarray(tables.theta_deg, float)
-    glossy = {name: fit_glossy(grid, table, np.asarray(getattr(tables, name + "_albedo")),
-                               theta_deg, lut_size, companion=name == "film_gloss")
-              for name, grid, table in (("film_gloss", film_grid, film_gloss),
-                                        ("path3_gloss", skin_grid, path3),
-                                        ("skin_gloss", skin_grid, skin_gloss))}
     transmittance = np.asarray(tables.film_transmittance, float)
     mu = lut_nodes(lut_size)
     t_rows = np.stack([np.interp(np.degrees(np.arccos(mu)), theta_deg, transmittance[:, c])
                        for c in range(3)], -1)
-    lut = np.stack([glossy[name].lut for name in LUT_ROWS[:3]]
-                   + [t_rows, glossy["film_gloss"].diffuse_lut])
+
+    def view_weighted(closures):
+        """The three Glossy lobes fitted with ``closures``, and their view-angle image."""
+        lobes = {name: fit_glossy(grid, table, np.asarray(getattr(tables, name + "_albedo")),
+                                  theta_deg, lut_size, companion=name == "film_gloss",
+                                  closures=closures)
+                 for name, grid, table in (("film_gloss", film_grid, film_gloss),
+                                           ("path3_gloss", skin_grid, path3),
+                                           ("skin_gloss", skin_grid, skin_gloss))}
+        image = np.stack([lobes[name].lut for name in LUT_ROWS[:3]]
+                         + [t_rows, lobes["film_gloss"].diffuse_lut])
+        return lobes, image
+
+    report(0.3, "fitting the Layered tier's gloss lobes")
+    glossy, lut = view_weighted(cc.GLOSSY_DISTRIBUTIONS)
+    report(0.45, "fitting the EEVEE tier's gloss lobes")
+    eevee_glossy, eevee_lut = view_weighted((EEVEE_GLOSSY,))
 
     report(0.6, "fitting the subsurface profile")
     ior = subsurface_ior(tables.parameters)
@@ -669,6 +726,8 @@ def fit_closures(tables: Tables, *, lut_size: int = DEFAULT_LUT_SIZE,
         subsurface_method=subsurface_method,
         subsurface_ior=ior,
         lut=lut,
+        eevee_glossy=eevee_glossy,
+        eevee_lut=eevee_lut,
     )
     if errors_at is None:
         errors_at = (float(tables.parameters.get("coverage", 1.0)),
@@ -775,22 +834,19 @@ def layered_weights(fit: ClosureFit, coverage: float, absorption, gloss: float =
     }
 
 
-def layered_tier_reflection(fit: ClosureFit, tables: Tables, coverage: float, absorption,
-                            gloss: float = 1.0, directions=None):
-    """The LAYERED tier's BRDF, ``(..., 3)``, at the angular nodes or at ``directions``
-    ``(wi, wo)``: every closure added with its weight and image row (linear texel
-    interpolation, as Blender samples it); ``gloss``: the group's Gloss input."""
-    wi, wo = tables.node_directions() if directions is None else directions
+def _view_weighted_reflection(weights: dict, lobes: dict, lut: np.ndarray, lobe_of,
+                              directions) -> np.ndarray:
+    """The BRDF ``(..., 3)`` of closures added with constant ``weights`` and view-angle
+    rows ``lut`` (:data:`LUT_ROWS`, linear between texel centres): the three Glossy ``lobes``
+    (``lobe_of(wi, wo, lobe)``, white), one Lambertian term for the rest."""
+    wi, wo = directions
     cos_o = wo[..., 2]
-    weights = layered_weights(fit, coverage, absorption, gloss)
-    rows = dict(zip(LUT_ROWS, fit.lut, strict=True))
+    rows = dict(zip(LUT_ROWS, lut, strict=True))
     value = 0.0
     for name in LUT_ROWS[:3]:
         if not np.any(weights[name]):
-            continue  # Cycles allocates no closure of weight 0
-        glossy = fit.glossy[name]
-        lobe = cc.microfacet_reflection(wi, wo, glossy.roughness,
-                                        distribution=glossy.distribution)[..., None]
+            continue  # no closure of weight 0 is allocated (Cycles) or picked (EEVEE)
+        lobe = lobe_of(wi, wo, lobes[name])[..., None]
         value = value + lobe * weights[name] * sample_lut(rows[name], cos_o)
     diffuse = (weights["film_diffuse"] + weights["skin_bare"]
                + weights["film_gloss_diffuse"] * sample_lut(rows["film_gloss_diffuse"], cos_o)
@@ -798,8 +854,45 @@ def layered_tier_reflection(fit: ClosureFit, tables: Tables, coverage: float, ab
     return value + cc.lambert_reflection(diffuse)
 
 
-TIER_REPLICAS = {"PRINCIPLED": principled_tier_reflection, "LAYERED": layered_tier_reflection}
-"""Each tier's replica, ``(fit, tables, coverage, absorption, gloss=1, directions=None)``."""
+def layered_tier_reflection(fit: ClosureFit, tables: Tables, coverage: float, absorption,
+                            gloss: float = 1.0, directions=None):
+    """The LAYERED tier's BRDF, ``(..., 3)``, at the angular nodes or at ``directions``
+    ``(wi, wo)``: every closure added with its weight and image row (linear texel
+    interpolation, as Blender samples it); ``gloss``: the group's Gloss input."""
+    return _view_weighted_reflection(
+        layered_weights(fit, coverage, absorption, gloss), fit.glossy, fit.lut,
+        lambda wi, wo, lobe: cc.microfacet_reflection(wi, wo, lobe.roughness,
+                                                      distribution=lobe.distribution),
+        tables.node_directions() if directions is None else directions)
+
+
+def eevee_weights(fit: ClosureFit, coverage: float, absorption, gloss: float = 1.0) -> dict:
+    """The EEVEE tier's constant weights (RGB) at coverage ``w`` and absorption ``A``, by the
+    names of :func:`layered_weights` and with its values: the EEVEE tier keeps the LAYERED
+    tier's closures and areal mix (its own lobes and view-angle rows, ``fit.eevee_glossy``
+    and ``fit.eevee_lut``), so the mix of the model (eq. 9, docs/model.md §3) is the same;
+    ``g`` (the group's Gloss input) scales the three Glossy colours, and EEVEE picks no
+    closure of weight 0."""
+    return layered_weights(fit, coverage, absorption, gloss)
+
+
+def eevee_tier_reflection(fit: ClosureFit, tables: Tables, coverage: float, absorption,
+                          gloss: float = 1.0, directions=None):
+    """The EEVEE tier's BRDF as EEVEE renders it under lamps, ``(..., 3)``, at the angular
+    nodes or at ``directions`` ``(wi, wo)``: its Glossy closures as EEVEE's GGX
+    (:func:`lut_baker.closures.eevee.glossy_reflection`), weighted by :func:`eevee_weights`
+    and the rows of ``fit.eevee_lut`` (the node group interpolates them exactly as
+    :func:`sample_lut` does), its Diffuse and Subsurface closures Lambertian."""
+    return _view_weighted_reflection(
+        eevee_weights(fit, coverage, absorption, gloss), fit.eevee_glossy, fit.eevee_lut,
+        lambda wi, wo, lobe: eevee.glossy_reflection(wi, wo, lobe.roughness),
+        tables.node_directions() if directions is None else directions)
+
+
+TIER_REPLICAS = {"PRINCIPLED": principled_tier_reflection, "LAYERED": layered_tier_reflection,
+                 "EEVEE": eevee_tier_reflection}
+"""Each tier's replica, ``(fit, tables, coverage, absorption, gloss=1, directions=None)``:
+the Cycles tiers as Cycles renders them, the EEVEE tier as EEVEE does."""
 
 
 def tier_errors(fit: ClosureFit, tables: Tables, coverage: float, absorption,

@@ -1,8 +1,9 @@
 """The node group's coverage/absorption mix, evaluated by Cycles, against the closure fits.
 
 :func:`lut_baker.model.made_up_skin.coverage_weights` is the one rule that mixes coverage and
-absorption; :func:`lut_baker.closures.fitting.principled_inputs` and
-:func:`~lut_baker.closures.fitting.layered_weights` apply it, and the add-on's node group
+absorption; :func:`lut_baker.closures.fitting.principled_inputs`,
+:func:`~lut_baker.closures.fitting.layered_weights` and
+:func:`~lut_baker.closures.fitting.eevee_weights` apply it, and the add-on's node group
 (makeup_skin_addon/nodes.py) rebuilds it from math nodes.  These tests read what the group
 computes and compare it with those functions at several coverages, absorptions (grey and RGB)
 and one Gloss below 1.
@@ -13,9 +14,10 @@ place of the shader tree (Add and Mix Shaders kept), and the copy's other closur
 
 - PRINCIPLED: the Emission's colour is the socket feeding one Principled input (Base Color,
   Subsurface Weight, Specular IOR Level, Coat Weight, Roughness), so the pixel is that input;
-- LAYERED: the Emission replaces one closure (film gloss, path-3 gloss, skin gloss, film
-  diffuse, skin through the film, bare skin), so the pixel is that closure's colour times every
-  Mix Shader factor above it: its weight in the tier, as ``layered_tier_reflection`` adds it.
+- LAYERED and EEVEE: the Emission replaces one closure (film gloss, path-3 gloss, skin gloss,
+  film diffuse, skin through the film, bare skin), so the pixel is that closure's colour times
+  every Mix Shader factor above it: its weight in the tier, as ``layered_tier_reflection`` and
+  ``eevee_tier_reflection`` add it (each with its own view-angle image).
 
 Every (probe, case) pair is one 3x3-pixel face of one plane, with its own material, seen
 head-on by an orthographic camera (1 pixel per unit): Cycles CPU, 1 sample, box filter, no
@@ -220,10 +222,11 @@ def _principled_expected(fit, coverage, absorption, gloss):
             values.items()}
 
 
-def _layered_expected(fit, coverage, absorption, gloss):
-    weights = cf.layered_weights(fit, coverage, absorption, gloss)
-    rows = {name: cf.sample_lut(row, 1.0) for name, row in zip(cf.LUT_ROWS, fit.lut,
-                                                                strict=True)}
+def _layered_expected(fit, coverage, absorption, gloss, *, weights_of=cf.layered_weights,
+                      lut=None):
+    weights = weights_of(fit, coverage, absorption, gloss)
+    lut = fit.lut if lut is None else lut
+    rows = {name: cf.sample_lut(row, 1.0) for name, row in zip(cf.LUT_ROWS, lut, strict=True)}
     return {
         "film gloss": weights["film_gloss"] * rows["film_gloss"],
         "path3 gloss": weights["path3_gloss"] * rows["path3_gloss"],
@@ -243,6 +246,8 @@ def test_node_group_mix_follows_coverage_weights(blank_scene, baked, tmp_path, t
     probes, make_probe, expected_of = {
         "PRINCIPLED": (PRINCIPLED_PROBES, _principled_probe, _principled_expected),
         "LAYERED": (LAYERED_PROBES, _layered_probe, _layered_expected),
+        "EEVEE": (LAYERED_PROBES, _layered_probe, lambda *case: _layered_expected(
+            *case, weights_of=cf.eevee_weights, lut=case[0].eevee_lut)),
     }[tier]
     copies = [make_probe(group, name) for name in probes]
     materials = [[_material(copy, *case, fit.skin_albedo) for case in CASES]
