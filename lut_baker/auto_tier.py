@@ -26,14 +26,16 @@ exact image)::
   modelled) and in EEVEE.
 
 So a gloss below the noise of the fullest tier costs little to leave out, a subsurface
-radius under half a pixel leaves ``e_subsurface`` near 0, and EEVEE admits only the tiers that
-run there (:data:`ENGINE_TIERS`).  :func:`choose` takes the cheapest candidate (costs:
-:data:`RELATIVE_COST`, measured at coverage 1 and 0 and interpolated by the material's share
-of skin light) whose ``E`` is at most ``min E + tolerance`` (default 2%).
+radius under half a pixel leaves ``e_subsurface`` near 0, and each engine admits the tiers
+made for it (:data:`ENGINE_TIERS`: Cycles the Principled and Layered tiers, EEVEE the EEVEE
+tier).  :func:`choose` takes the cheapest candidate (costs: :data:`RELATIVE_COST`, measured at
+coverage 1 and 0 and interpolated by the material's share of skin light; in EEVEE
+:data:`EEVEE_RELATIVE_COST`) whose ``E`` is at most ``min E + tolerance`` (default 2%).
 
 Functions and types
 -------------------
-- :class:`Candidate`, :data:`CANDIDATES`, :data:`FULLEST`, :data:`ENGINE_TIERS`.
+- :class:`Candidate`, :data:`CANDIDATES` (Cycles), :data:`EEVEE_CANDIDATES`, :data:`FULLEST`,
+  :data:`ENGINE_TIERS`.
 - :class:`SceneDescription` -- what the model needs to know of a scene.
 - :func:`pixel_footprint_mm` -- millimetres of the object per pixel (ortho or perspective).
 - :class:`MaterialTraits`, :func:`paper_traits`, :func:`traits_from_tables` -- what it needs
@@ -71,10 +73,12 @@ from .tables.table_set import radius_nodes
 __all__ = [
     "Candidate",
     "CANDIDATES",
+    "EEVEE_CANDIDATES",
     "FULLEST",
     "ENGINES",
     "ENGINE_TIERS",
     "RELATIVE_COST",
+    "EEVEE_RELATIVE_COST",
     "NOISE_K",
     "COST_SKIN_SHARE",
     "relative_cost",
@@ -113,11 +117,12 @@ __all__ = [
 # --------------------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class Candidate:
-    """One way to shade made-up skin: an add-on ``tier`` (``PRINCIPLED`` or ``LAYERED``) with
-    or without its subsurface closure and its gloss lobes.  The add-on realises
-    ``subsurface=False`` with Subsurface Scale 0 (Cycles then turns subsurface closures into
-    diffuse ones) and ``gloss=False`` with the group's Gloss input at 0 (Cycles then
-    allocates no Glossy closure, coat or specular: their weights are 0)."""
+    """One way to shade made-up skin: an add-on ``tier`` (``PRINCIPLED``, ``LAYERED`` or
+    ``EEVEE``) with or without its subsurface closure and its gloss lobes.  The add-on
+    realises ``subsurface=False`` with Subsurface Scale 0 (Cycles then turns subsurface
+    closures into diffuse ones) and ``gloss=False`` with the group's Gloss input at 0 (Cycles
+    then allocates no Glossy closure, coat or specular, and EEVEE picks none: their weights
+    are 0)."""
 
     tier: str
     subsurface: bool = True
@@ -125,7 +130,7 @@ class Candidate:
 
     @property
     def name(self) -> str:
-        parts = [self.tier.title()]
+        parts = ["EEVEE" if self.tier == "EEVEE" else self.tier.title()]
         if not self.subsurface:
             parts.append("no subsurface")
         if not self.gloss:
@@ -135,14 +140,18 @@ class Candidate:
 
 CANDIDATES = tuple(Candidate(tier, subsurface, gloss) for tier in ("LAYERED", "PRINCIPLED")
                    for gloss in (True, False) for subsurface in (True, False))
-"""Every candidate, the fullest first."""
+"""Every candidate of the Cycles tiers, the fullest first."""
+EEVEE_CANDIDATES = tuple(Candidate("EEVEE", subsurface, gloss) for gloss in (True, False)
+                         for subsurface in (True, False))
+"""Every candidate of the EEVEE tier, the fullest first."""
 FULLEST = CANDIDATES[0]
-"""The LAYERED tier with subsurface and gloss: the most accurate, the costliest."""
+"""The LAYERED tier with subsurface and gloss: the most accurate, the costliest (Cycles)."""
 ENGINES = ("CYCLES", "EEVEE")
-ENGINE_TIERS = {"CYCLES": ("LAYERED", "PRINCIPLED"), "EEVEE": ("PRINCIPLED",)}
-"""Tiers per engine.  EEVEE gets the PRINCIPLED tier only: its Glossy BSDF has no Beckmann or
-Ashikhmin-Shirley distribution (the LAYERED fits may choose them), its subsurface is a
-screen-space Burley with no random walk, and it is optimised for the Principled BSDF."""
+ENGINE_TIERS = {"CYCLES": ("LAYERED", "PRINCIPLED"), "EEVEE": ("EEVEE",)}
+"""Tiers per engine: each engine gets the tiers made for it.  The Layered tier's fits choose
+Ashikhmin-Shirley and Beckmann lobes that EEVEE renders as GGX, and EEVEE renders GGX itself
+through a linearly transformed cosine (:mod:`lut_baker.closures.eevee`); the EEVEE tier is
+fitted to that, and Cycles renders its GGX lobes exactly, which they were not fitted to."""
 DEFAULT_TOLERANCE = 0.02
 """Error a cheaper candidate may add to the best one's (relative RMS)."""
 
@@ -172,20 +181,30 @@ choice then leans towards the fullest tier (docs/stability.md)."""
 COST_SKIN_SHARE = {1.0: 0.1327, 0.0: 0.9591}
 """The paper preset's skin share (:func:`gloss_and_skin_shares`, light 45 degrees) at the
 coverages the costs were measured at: a material's costs are interpolated by its share."""
+EEVEE_COST_COMMAND = "python bench/eevee_tier.py --costs"
+EEVEE_RELATIVE_COST = {
+    1.0: dict(zip(EEVEE_CANDIDATES, (1.000, 0.684, 0.783, 0.757), strict=True)),
+    0.0: dict(zip(EEVEE_CANDIDATES, (1.000, 1.001, 0.990, 0.797), strict=True)),
+}
+"""Render time per frame of the EEVEE tier's candidates relative to its fullest, by coverage,
+in EEVEE (5.0.1 on software OpenGL, 64 px, 64 samples, light 45 degrees), as
+:data:`EEVEE_COST_COMMAND` measures it: medians of three interleaved runs whose frames took
+20-40 s, so differences under ~30% are not resolved (docs/stability.md, "The Auto tier")."""
 
 
 def _by_share(table: dict, candidate: Candidate, skin_share: float) -> float:
-    """Interpolate a per-coverage table of :data:`RELATIVE_COST` or :data:`NOISE_K` to a
-    skin share (held beyond the measured ones)."""
+    """Interpolate a per-coverage table of :data:`RELATIVE_COST`, :data:`EEVEE_RELATIVE_COST`
+    or :data:`NOISE_K` to a skin share (held beyond the measured ones)."""
     shares = [COST_SKIN_SHARE[c] for c in (1.0, 0.0)]
     values = [table[c][candidate] for c in (1.0, 0.0)]
     return float(np.interp(skin_share, shares, values))
 
 
 def relative_cost(candidate: Candidate, skin_share: float = COST_SKIN_SHARE[1.0]) -> float:
-    """:data:`RELATIVE_COST` of ``candidate`` for a material whose skin share is
-    ``skin_share`` (default: the paper's film)."""
-    return _by_share(RELATIVE_COST, candidate, skin_share)
+    """:data:`RELATIVE_COST` of ``candidate`` (:data:`EEVEE_RELATIVE_COST` for the EEVEE
+    tier's) for a material whose skin share is ``skin_share`` (default: the paper's film)."""
+    table = EEVEE_RELATIVE_COST if candidate.tier == "EEVEE" else RELATIVE_COST
+    return _by_share(table, candidate, skin_share)
 
 
 def noise(candidate: Candidate, samples: int, *, engine: str = "CYCLES",
@@ -455,12 +474,13 @@ def traits_from_tables(tables, fit, coverage=None, absorption=None, *,
 
 
 TRAITS_COMMAND = "python bench/stability_sweep.py --traits"
-PAPER_TIER_ERRORS = {"PRINCIPLED": 0.0758, "LAYERED": 0.0499}
-PAPER_MISMATCH = 0.0474
+PAPER_TIER_ERRORS = {"PRINCIPLED": 0.0769, "LAYERED": 0.0476, "EEVEE": 0.0888}
+PAPER_MISMATCH = 0.0475
 PAPER_SKIN_SHARE = {0.0: 0.1361, 45.0: 0.1327, 75.0: 0.1233, 89.0: 0.1141}
 PAPER_GLOSS_SHARE = {0.0: 0.1825, 45.0: 0.1904, 75.0: 0.2274, 89.0: 0.2758}
-PAPER_GLOSS_OMISSION = {"PRINCIPLED": {0.0: 0.1586, 45.0: 0.1858, 75.0: 0.2511, 89.0: 0.3051},
-                        "LAYERED": {0.0: 0.1790, 45.0: 0.1875, 75.0: 0.2429, 89.0: 0.3012}}
+PAPER_GLOSS_OMISSION = {"PRINCIPLED": {0.0: 0.1602, 45.0: 0.1877, 75.0: 0.2533, 89.0: 0.3074},
+                        "LAYERED": {0.0: 0.1743, 45.0: 0.1869, 75.0: 0.2435, 89.0: 0.3022},
+                        "EEVEE": {0.0: 0.1676, 45.0: 0.1795, 75.0: 0.2245, 89.0: 0.2789}}
 """The paper preset's traits (foundation paper_natural on paper_bioplate, coverage 1,
 absorption 0, default bake, closure fit with Burley) as :data:`TRAITS_COMMAND` prints them:
 what the Auto tier assumes of a material it has no tables for yet."""
@@ -675,7 +695,8 @@ def needs_subsurface(scene: SceneDescription, traits: MaterialTraits) -> bool:
 def choose(scene: SceneDescription, traits: MaterialTraits | None = None, *,
            tolerance: float = DEFAULT_TOLERANCE, candidates=None) -> Choice:
     """The cheapest candidate whose predicted error is within ``tolerance`` of the best one's,
-    among ``candidates`` (default: :data:`CANDIDATES`) that run in the scene's engine, keep
+    among ``candidates`` (default: :data:`CANDIDATES` and :data:`EEVEE_CANDIDATES`) made for
+    the scene's engine (:data:`ENGINE_TIERS`), keep
     the subsurface closure if :func:`needs_subsurface` (and drop it when the Subsurface
     Scale is 0: Cycles then shades no spread anyway; likewise the gloss lobes when the
     artist's Gloss is 0).  ``traits`` default to the paper preset's (:func:`paper_traits`)."""
@@ -683,7 +704,7 @@ def choose(scene: SceneDescription, traits: MaterialTraits | None = None, *,
         raise ValueError(f"tolerance must be >= 0, got {tolerance}")
     traits = paper_traits() if traits is None else traits
     needed = needs_subsurface(scene, traits)
-    pool = [c for c in (candidates or CANDIDATES)
+    pool = [c for c in (candidates or CANDIDATES + EEVEE_CANDIDATES)
             if c.tier in ENGINE_TIERS[scene.engine]
             and not (needed and not c.subsurface)
             and not (traits.subsurface_scale <= 0.0 and c.subsurface)
@@ -705,8 +726,8 @@ def choose(scene: SceneDescription, traits: MaterialTraits | None = None, *,
         f"subsurface mean radius {radius:.3g} mm = {radius / scene.footprint_mm:.2g} px: "
         + ("needed (half a pixel or more)" if needed else
            f"not needed (under half a pixel; leaving it out errs {100 * omission:.2f}%)"),
-        f"gloss lobes {100 * gloss:.1f}% of the image ({tier.title()}), noise of the fullest "
-        f"tier at {scene.samples} samples {100 * grain:.1f}%: "
+        f"gloss lobes {100 * gloss:.1f}% of the image ({Candidate(tier).name}), noise of the "
+        f"fullest tier at {scene.samples} samples {100 * grain:.1f}%: "
         + ("kept" if chosen.candidate.gloss else "left out (Gloss 0)"),
         f"{chosen.candidate.name}: predicted error {100 * chosen.error:.1f}% (best "
         f"{100 * best:.1f}% + tolerance {100 * tolerance:.0f}%), cost {chosen.cost:.2f} of "

@@ -97,9 +97,13 @@ def measure(tables, fit, coverage: float, absorption, method=None, *,
 def measured_at(meta: dict, coverage: float, absorption, *,
                 with_traits: bool = False) -> dict | None:
     """The measurement a group's record keeps (``meta["measured"]``) if it was taken at this
-    coverage and absorption (and holds the Auto tier's traits, ``with_traits``), else None."""
+    coverage and absorption (and holds the Auto tier's traits, ``with_traits``), else None.
+    A measurement without every tier's errors (an older add-on's, before the EEVEE tier) is
+    None too: it is measured again."""
     measured = meta.get("measured") if isinstance(meta, dict) else None
     if not isinstance(measured, dict) or (with_traits and not measured.get("traits")):
+        return None
+    if not set(tiers.TIERS) <= set(measured.get("errors") or ()):
         return None
     try:
         if _same([measured["coverage"]], [coverage]) and _same(measured["absorption"],

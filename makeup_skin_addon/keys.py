@@ -42,7 +42,7 @@ group"; Apply finds groups and images by name and reuses them):
 - :data:`FILM_NORMAL_NODE` -- the film's own Normal Map (or Bump) node, a weaker copy of the
   skin's, and :data:`BASE_STRENGTH_KEY`, the strength of the skin's it scales.
 - :func:`group_name` -- ``Made-up Skin <Tier> [<method>] <key>`` (:data:`GROUP_PREFIX`,
-  :data:`METHOD_LABELS`).
+  :data:`TIER_LABELS`, :data:`METHOD_LABELS`).
 - :func:`lut_image_name` -- ``MakeupSkin LUT <Tier> <key>`` (:data:`LUT_PREFIX`).
 """
 
@@ -69,6 +69,7 @@ __all__ = [
     "FILM_NORMAL_NODE",
     "BASE_STRENGTH_KEY",
     "GROUP_PREFIX",
+    "TIER_LABELS",
     "METHOD_LABELS",
     "LUT_PREFIX",
     "group_name",
@@ -135,6 +136,8 @@ BASE_STRENGTH_KEY = "makeup_skin_base_strength"
 strength multiplies."""
 GROUP_PREFIX = "Made-up Skin"
 """Start of every node group name (:func:`group_name`)."""
+TIER_LABELS = {"PRINCIPLED": "Principled", "LAYERED": "Layered", "EEVEE": "EEVEE"}
+"""A tier's part of group and image names."""
 METHOD_LABELS = {"BURLEY": "Burley", "RANDOM_WALK": "RW", "RANDOM_WALK_SKIN": "RW Skin"}
 """A forced subsurface method's part of a group name."""
 LUT_PREFIX = "MakeupSkin LUT "
@@ -144,9 +147,10 @@ LUT_PREFIX = "MakeupSkin LUT "
 def group_name(tier: str, key: str, method: str | None = None) -> str:
     """``Made-up Skin <Tier> [<method>] <key>``; no method: the fit's own choice."""
     label = f" {METHOD_LABELS[method]}" if method else ""
-    return f"{GROUP_PREFIX} {tier.title()}{label} {key[:8]}"
+    return f"{GROUP_PREFIX} {TIER_LABELS[tier]}{label} {key[:8]}"
 
 
 def lut_image_name(key: str, tier: str = "LAYERED") -> str:
-    """``MakeupSkin LUT <Tier> <key>``: the name of the Layered tier's view-angle image."""
-    return f"{LUT_PREFIX}{tier.title()} {key[:16]}"
+    """``MakeupSkin LUT <Tier> <key>``: the name of a tier's view-angle image (Layered,
+    EEVEE)."""
+    return f"{LUT_PREFIX}{TIER_LABELS[tier]} {key[:16]}"

@@ -11,6 +11,7 @@ group by name and bakes, fits and hashes nothing; otherwise it bakes and fits on
 - :func:`skin_from_settings` -- the panel's settings as a :class:`MadeUpSkin` (coverage 1,
   absorption 0: those two are socket values, applied after the bake; :mod:`.shade`).
 - :func:`resolve_tier` -- the tier for the settings and scene (Auto: from a measurement).
+- :func:`engine_note` -- the report's sentence when a tier is not made for the scene's engine.
 - :func:`socket_values` -- the settings' group-node socket values; :func:`update_sockets`
   sets them on a material's group node.
 - :func:`refuse_linked` -- :class:`LinkedDataError` for data linked from a library.
@@ -28,8 +29,8 @@ import json
 import bpy
 
 from . import convert, fits, nodes, scene_fit, shade, storage
-from .core import params_file, tiers
-from .keys import AUTO_KEY, ERRORS_KEY, MATERIAL_NAME, SETTINGS_VERSION, group_name
+from .core import auto_tier, params_file, tiers
+from .keys import AUTO_KEY, ERRORS_KEY, MATERIAL_NAME, SETTINGS_VERSION, TIER_LABELS, group_name
 from .scene_fit import units_per_mm
 from .shade import skin_from_settings
 
@@ -40,6 +41,7 @@ __all__ = [
     "rebuild_from_settings",
     "skin_from_settings",
     "resolve_tier",
+    "engine_note",
     "forced_method",
     "group_for_tables",
     "group_of",
@@ -56,7 +58,7 @@ def resolve_tier(settings, scene, measured=None) -> str:
     """The tier to build: the settings' own, or for Auto the one
     :func:`.scene_fit.choose_with` picks in ``scene`` for a material whose fit measured
     ``measured`` (:func:`.fits.measure`; default: what the material's group keeps, never a new
-    bake; EEVEE: Principled)."""
+    bake; in EEVEE the EEVEE tier)."""
     if settings.tier != "AUTO":
         return settings.tier
     return _auto_choice(settings.id_data, scene, measured)[0]
@@ -71,6 +73,30 @@ def _auto_choice(material, scene, measured) -> tuple[str, dict]:
     chosen = choice.chosen
     return chosen.candidate.tier, {"tier": chosen.candidate.tier, "error": chosen.error,
                                    "engine": scene.render.engine}
+
+
+def engine_note(material, tier: str, scene, measured: dict | None = None) -> str | None:
+    """The report's sentence when ``tier`` is not made for the engine ``scene`` renders with
+    (:data:`lut_baker.auto_tier.ENGINE_TIERS`), naming the tier that is and its angular error
+    at the material's coverage (``measured``: :func:`.fits.measure`); None when it is.  The
+    group renders in either engine: nothing is changed."""
+    engine = scene_fit.render_engine(scene)
+    if tier in auto_tier.ENGINE_TIERS[engine]:
+        return None
+    suited = auto_tier.ENGINE_TIERS[engine][0]
+    error = ((measured or {}).get("errors") or {}).get(suited, {}).get("rms")
+    at = f" ({100 * error:.1f}% angular error here)" if error is not None else ""
+    label, better = TIER_LABELS[tier], TIER_LABELS[suited]
+    if engine == "EEVEE":
+        why = ("EEVEE draws every Glossy lobe as GGX through its own approximation, which "
+               "the Cycles tiers are not fitted to")
+    else:
+        why = "Cycles renders its GGX lobes exactly, which they are not fitted to"
+    return (f"{material.name!r} uses the {label} tier, made for "
+            f"{'EEVEE' if tier == 'EEVEE' else 'Cycles'}, but the scene renders with "
+            f"{'EEVEE' if engine == 'EEVEE' else 'Cycles'}: {why}; the {better} tier is "
+            f"fitted to {'EEVEE' if engine == 'EEVEE' else 'Cycles'}{at}: choose it, or Tier "
+            f"Auto.")
 
 
 def forced_method(settings):
@@ -410,10 +436,13 @@ def apply_to_object(context, obj, *, resolution=None) -> tuple:
     with _Progress(context) as progress:
         work = _Bake(record, forced_method(settings), settings.coverage,
                      settings.effective_absorption(), progress)
-        group, measured, _, auto = _group_for(material, settings, scene, work, messages)
+        group, measured, tier, auto = _group_for(material, settings, scene, work, messages)
     _record_errors(material, measured, record["key"])
     _record_auto(material, auto)
     installed = setup_material(material, group, scene)
+    note = engine_note(material, tier, scene, measured)
+    if note is not None:
+        messages.append(note)
     settings.is_made_up = True
     settings.settings_version = SETTINGS_VERSION
     if installed.first or created:

@@ -30,6 +30,15 @@ colours: a closure of weight 0 is never allocated, ``bsdf_alloc``), view-depende
 from one float image (rows :data:`lut_baker.closures.view_image.LUT_ROWS`) at ``u =
 cos(theta_o)``, and a Mix Shader by Coverage between bare skin and made-up skin: an areal mix
 of closures, so a painted coverage fades out without fringe or halo.
+EEVEE: the LAYERED tier's closures and mix, every Glossy BSDF GGX (fitted as EEVEE renders it),
+its own view-angle image (``fit.eevee_lut``), the skin through the film its plain colour,
+subsurface Christensen-Burley.
+
+The view-angle rows are read by :func:`_lut_rows`: two Closest lookups at neighbouring texel
+centres mixed linearly, which is what a Linear lookup gives in Cycles
+(:func:`lut_baker.closures.view_image.sample_lut`); EEVEE samples a Linear image through mipmaps
+and anisotropic filtering, which mixes the image's five rows wherever ``cos(theta_o)`` changes
+quickly across the screen (docs/addon.md, "Why the Layered tier breaks in EEVEE").
 
 - :func:`build_group` -- create or rebuild (in place) a group from a fit and its bake record,
   named by :func:`.keys.group_name` (tier, tables key, a forced subsurface method).
@@ -179,20 +188,50 @@ def _build_principled(build: Builder, fit, method: str, radius_mm, ior: float):
     build.tree.links.new(bsdf.outputs[0], output.inputs["Shader"])
 
 
+def _texel_pair(build: Builder, u, size: int, label: str):
+    """``(u0, u1, t)`` for reading a row of ``size`` texels at ``u`` linearly: the texel
+    centres ``(i + 0.5) / size`` around ``u`` (the edge texel twice beyond the centres) and
+    the weight of the second, ``x = clamp(u size - 0.5, 0, size - 1)``, ``i = floor(x)``,
+    ``t = x - i``."""
+    x = build.math("MINIMUM", build.math("MAXIMUM", build.math(
+        "MULTIPLY", u, float(size), label=f"{label}: u size"), 0.5), size - 0.5)
+    x = build.math("SUBTRACT", x, 0.5, label=f"{label}: texel coordinate")
+    index = build.math("FLOOR", x, label=f"{label}: texel")
+    weight = build.math("SUBTRACT", x, index, label=f"{label}: t")
+    u0 = build.math("DIVIDE", build.math("ADD", index, 0.5), float(size))
+    u1 = build.math("DIVIDE", build.math("MINIMUM", build.math("ADD", index, 1.5),
+                                         size - 0.5), float(size))
+    return u0, u1, weight
+
+
 def _lut_rows(build: Builder, lut, coordinates: dict) -> dict:
     """Every row of the view-angle image ``lut`` (rows :data:`view_image.LUT_ROWS`), read at
-    ``u = coordinates[name]`` (a socket per row name): Linear, EXTEND, as
-    :func:`lut_baker.closures.view_image.sample_lut` reads it.  Colour :class:`NodeValue` by
-    row name."""
+    ``u = coordinates[name]`` (a socket per row name) linearly between texel centres and held
+    beyond them, as :func:`lut_baker.closures.view_image.sample_lut` reads it: two Closest
+    lookups mixed, so that EEVEE reads what Cycles does (its Linear filter goes through
+    mipmaps, which mix rows).  The texel pair is built once per coordinate socket.  Colour
+    :class:`NodeValue` by row name."""
+    size = lut.size[0]
+    pairs: dict = {}
     rows = {}
     for j, name in enumerate(view_image.LUT_ROWS):
-        coordinate = build.node("ShaderNodeCombineXYZ", f"u = cos, row {name}")
-        build.feed(coordinate.inputs["X"], coordinates[name])
-        build.feed(coordinate.inputs["Y"], (j + 0.5) / len(view_image.LUT_ROWS))
-        texture = build.node("ShaderNodeTexImage", name, image=lut, interpolation="Linear",
-                             extension="EXTEND")
-        build.tree.links.new(coordinate.outputs[0], texture.inputs["Vector"])
-        rows[name] = NodeValue(build, texture.outputs["Color"], True)
+        u = coordinates[name]
+        key = u.as_pointer()
+        if key not in pairs:
+            pairs[key] = _texel_pair(build, u, size, name)
+        u0, u1, weight = pairs[key]
+        samples = []
+        for k, at in enumerate((u0, u1)):
+            coordinate = build.node("ShaderNodeCombineXYZ", f"row {name}, texel {k}")
+            build.feed(coordinate.inputs["X"], at)
+            build.feed(coordinate.inputs["Y"], (j + 0.5) / len(view_image.LUT_ROWS))
+            texture = build.node("ShaderNodeTexImage", name, image=lut,
+                                 interpolation="Closest", extension="EXTEND")
+            build.tree.links.new(coordinate.outputs[0], texture.inputs["Vector"])
+            samples.append(texture.outputs["Color"])
+        rows[name] = NodeValue(build, build.mix_vector(weight, samples[0], samples[1],
+                                                       label=f"row {name}"),
+                               True)
     return rows
 
 
@@ -207,8 +246,10 @@ def _add(build: Builder, shaders: list):
     return total
 
 
-def _build_layered(build: Builder, fit, lut, method: str, radius_mm, ior: float):
-    """The closures of :func:`lut_baker.closures.tier_formulas.view_weighted_closures`: a
+def _build_view_weighted(build: Builder, fit, lobes: dict, lut, method: str, radius_mm,
+                         ior: float, *, tinted_subsurface: bool):
+    """The closures of :func:`lut_baker.closures.tier_formulas.view_weighted_closures` (the
+    LAYERED and EEVEE tiers, their Glossy lobes ``lobes``, their view-angle image ``lut``): a
     Glossy, Diffuse or Subsurface node per closure, its colour and weight emitted as nodes,
     each side's closures added, the two sides mixed by Coverage (a Mix Shader: an areal mix,
     so a painted coverage fades out without fringe or halo)."""
@@ -220,11 +261,12 @@ def _build_layered(build: Builder, fit, lut, method: str, radius_mm, ior: float)
                for surface, normal in normals.items()}
     rows = _lut_rows(build, lut, {
         name: cosines[tier_formulas.ROW_SURFACE.get(name, "film")] for name in view_image.LUT_ROWS})
-    closures = tier_formulas.view_weighted_closures(fit, x, NodeAlgebra(build, rows))
+    closures = tier_formulas.view_weighted_closures(fit, x, NodeAlgebra(build, rows),
+                                                    tinted_subsurface=tinted_subsurface)
 
     def emit(closure):
         if closure.kind == "glossy":
-            lobe = fit.glossy[closure.name]
+            lobe = lobes[closure.name]
             node = build.node("ShaderNodeBsdfGlossy", closure.name.replace("_", " "),
                               distribution=lobe.distribution)
             build.feed(node.inputs["Roughness"], lobe.roughness)
@@ -275,16 +317,19 @@ def build_group(tier: str, record: dict, fit, group=None, *, method=None, measur
     group.nodes.clear()
     build = Builder(group)
     forced = method
-    method = method or fit.subsurface_method
+    method = method or (tiers.EEVEE_SUBSURFACE_METHOD if tier == "EEVEE"
+                        else fit.subsurface_method)
     radius = fit.profiles[method].radius_mm
     ior = fit.subsurface_ior
     images = []
     if tier == "PRINCIPLED":
         _build_principled(build, fit, method, radius, ior)
     else:
-        lut = storage.lut_image(lut_image_name(key), fit.lut)
+        eevee = tier == "EEVEE"
+        lut = storage.lut_image(lut_image_name(key, tier), fit.eevee_lut if eevee else fit.lut)
         images.append(storage.image_record(lut))
-        _build_layered(build, fit, lut, method, radius, ior)
+        _build_view_weighted(build, fit, fit.eevee_glossy if eevee else fit.glossy, lut, method,
+                             radius, ior, tinted_subsurface=not eevee)
     group[FIT_KEY] = json.dumps({**record, "tier": tier, "forced_method": forced,
                                  "images": images, **fit.summary(),
                                  "subsurface_method": method, "measured": measured},

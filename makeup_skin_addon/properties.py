@@ -37,6 +37,8 @@ TIER_ITEMS = (
                                  "no images"),
     ("LAYERED", "Layered", "Glossy, Diffuse and Subsurface closures with view-angle weights "
                            "from a lookup image; closest to the tables in Cycles"),
+    ("EEVEE", "EEVEE", "The Layered closures fitted as EEVEE renders them (GGX lobes, its "
+                       "own lookup image, Burley subsurface); closest to the tables in EEVEE"),
 )
 SUBSURFACE_ITEMS = (
     ("AUTO", "Auto", "The method whose shadow-edge blur is closest to the skin's (Burley)"),

@@ -8,6 +8,7 @@ coverage and absorption (kept in its group's record, :mod:`.fits`).
 :func:`lut_baker.auto_tier.choose` then picks the cheapest candidate within the tolerance.
 
 - :func:`units_per_mm` -- scene units in one millimetre, from the scene's unit scale.
+- :func:`render_engine` -- ``CYCLES`` or ``EEVEE``, as the Auto tier names the scene's engine.
 - :func:`describe_scene` -- the scene as the model sees it (None without a camera or object).
 - :func:`material_traits` -- the material as the model sees it.
 - :func:`choose_with` -- the choice for a material of given traits in a scene (Apply's Auto
@@ -34,9 +35,9 @@ from . import convert, fits, nodes, storage
 from .core import auto_tier
 from .keys import CHOICE_KEY, SAVED_GLOSS_KEY, SAVED_SCALE_KEY
 
-__all__ = ["ENVIRONMENT_LIGHT_DEG", "units_per_mm", "describe_scene", "material_traits",
-           "choose_with", "choose_for", "set_choice", "record_choice", "last_choice",
-           "register", "unregister"]
+__all__ = ["ENVIRONMENT_LIGHT_DEG", "units_per_mm", "render_engine", "describe_scene",
+           "material_traits", "choose_with", "choose_for", "set_choice", "record_choice",
+           "last_choice", "register", "unregister"]
 
 ENVIRONMENT_LIGHT_DEG = 45.0
 """Light angle (degrees from the view) assumed when the scene has no lamp (world light)."""
@@ -51,7 +52,9 @@ def units_per_mm(scene) -> float:
     return 0.001 / scale
 
 
-def _engine(scene) -> str:
+def render_engine(scene) -> str:
+    """``CYCLES`` for Cycles, else ``EEVEE`` (``BLENDER_EEVEE`` in 5.0, ``BLENDER_EEVEE_NEXT``
+    in 4.2-4.5; Workbench counts as EEVEE)."""
     return "CYCLES" if scene.render.engine == "CYCLES" else "EEVEE"
 
 
@@ -137,7 +140,7 @@ def describe_scene(scene, material=None, obj=None):
     item, footprint, size, toward_camera = best
     return auto_tier.SceneDescription(object_size_mm=size, footprint_mm=footprint,
                                lights_deg=_light_angles(scene, item, toward_camera),
-                               engine=_engine(scene), samples=samples, denoise=denoise)
+                               engine=render_engine(scene), samples=samples, denoise=denoise)
 
 
 def _meta(material) -> dict:
@@ -186,7 +189,7 @@ def material_traits(material, *, refit: bool = False, may_fit: bool = True):
 
 def _unknown_scene(scene):
     samples, denoise = _samples(scene)
-    return auto_tier.SceneDescription(engine=_engine(scene), samples=samples,
+    return auto_tier.SceneDescription(engine=render_engine(scene), samples=samples,
                                                    denoise=denoise, **UNKNOWN_SCENE)
 
 

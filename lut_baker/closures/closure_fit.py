@@ -26,7 +26,10 @@ class ClosureFit:
     ``skin_albedo`` (RGB, ``pi P_d``), ``profiles`` (by method) and ``subsurface_method``
     (the best-fitting one), ``subsurface_ior`` (the dipole's index, for the random walk and
     the profile fits), ``lut`` (``(len(LUT_ROWS), size, 3)``: the view-angle image),
-    ``errors`` at the coverage and absorption the tables were baked for.
+    ``errors`` at the coverage and absorption the tables were baked for.  EEVEE:
+    ``eevee_glossy`` (the same three lobes, GGX as EEVEE renders it) and ``eevee_lut`` (their
+    view-angle image, rows :data:`lut_baker.closures.view_image.LUT_ROWS`); its subsurface is
+    Burley's (:data:`lut_baker.closures.tiers.EEVEE_SUBSURFACE_METHOD`).
     """
 
     coat: LobeFit
@@ -43,6 +46,8 @@ class ClosureFit:
     subsurface_method: str
     subsurface_ior: float
     lut: np.ndarray
+    eevee_glossy: dict
+    eevee_lut: np.ndarray
     errors: dict = field(default_factory=dict)
 
     @property
@@ -64,6 +69,8 @@ class ClosureFit:
             "glossy": {name: {"roughness": lobe.roughness, "error": lobe.error,
                               "distribution": lobe.distribution}
                        for name, lobe in self.glossy.items()},
+            "eevee_glossy": {name: {"roughness": lobe.roughness, "error": lobe.error}
+                             for name, lobe in self.eevee_glossy.items()},
             "subsurface_method": self.subsurface_method,
             "subsurface_ior": self.subsurface_ior,
             "profiles": {name: {"radius_mm": p.radius_mm.tolist(), "error": p.error.tolist(),

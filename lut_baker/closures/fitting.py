@@ -19,7 +19,12 @@ Subsurface Weight = the skin's share of it.
 (Glossy, roughness fitted, weight = table albedo / closure albedo read from a 1-D image by
 ``cos(theta_o)``; the film gloss shares its albedo with a Lambertian companion, its own row),
 film diffuse plus that companion (one Diffuse), the skin through the film and bare
-(Subsurface), mixed by coverage.  The formulas of both: :mod:`lut_baker.closures.tier_formulas`.
+(Subsurface), mixed by coverage.
+``EEVEE``: the LAYERED tier's closures and mix, made for EEVEE: every Glossy lobe is GGX (EEVEE
+renders no other distribution) fitted to the tables as EEVEE renders it under a lamp, a
+linearly transformed cosine (:mod:`lut_baker.closures.eevee`), with its own view-angle rows;
+subsurface Christensen-Burley (EEVEE's screen-space method).
+The formulas of all three: :mod:`lut_baker.closures.tier_formulas`.
 
 Where each part lives: the lobes :mod:`~lut_baker.closures.lobes`, the subsurface radii
 :mod:`~lut_baker.closures.profiles`, the tiers' replicas and errors
@@ -40,7 +45,7 @@ from ..numerics.quadrature import trapezoid_weights
 from ..tables.table_set import Tables
 from . import cycles as cc
 from .closure_fit import ClosureFit
-from .lobes import fit_coat, fit_glossy, fit_specular
+from .lobes import EEVEE_GLOSSY, fit_coat, fit_glossy, fit_specular
 from .profiles import REPLICA_EDGE_ERROR, fit_profiles
 from .tier_formulas import SPECULAR_IOR
 from .tiers import tier_errors
@@ -122,23 +127,33 @@ def fit_closures(tables: Tables, *, lut_size: int = DEFAULT_LUT_SIZE,
     elif specular_bare.level == 0.0:
         specular_bare = replace(specular_bare, roughness=specular_film.roughness)
 
-    report(0.3, "fitting the Layered tier's gloss lobes")
     theta_deg = np.asarray(tables.theta_deg, float)
-    glossy = {name: fit_glossy(grid, table, np.asarray(getattr(tables, name + "_albedo")),
-                               theta_deg, lut_size, companion=name == "film_gloss")
-              for name, grid, table in (("film_gloss", film_grid, film_gloss),
-                                        ("path3_gloss", skin_grid, path3),
-                                        ("skin_gloss", skin_grid, skin_gloss))}
     transmittance = np.asarray(tables.film_transmittance, float)
     mu = lut_nodes(lut_size)
     t_rows = np.stack([np.interp(np.degrees(np.arccos(mu)), theta_deg, transmittance[:, c])
                        for c in range(3)], -1)
-    rows = [glossy[name].lut for name in LUT_ROWS[:3]] + [t_rows,
-                                                          glossy["film_gloss"].diffuse_lut]
+
+    def view_weighted(closures):
+        """The three Glossy lobes fitted with ``closures``, and their view-angle image."""
+        lobes = {name: fit_glossy(grid, table, np.asarray(getattr(tables, name + "_albedo")),
+                                  theta_deg, lut_size, companion=name == "film_gloss",
+                                  closures=closures)
+                 for name, grid, table in (("film_gloss", film_grid, film_gloss),
+                                           ("path3_gloss", skin_grid, path3),
+                                           ("skin_gloss", skin_grid, skin_gloss))}
+        rows = [lobes[name].lut for name in LUT_ROWS[:3]] + [t_rows,
+                                                             lobes["film_gloss"].diffuse_lut]
+        if any(row is None for row in rows):
+            raise AssertionError("fit_glossy gives a view-angle row")
+        return lobes, np.stack(rows)
+
+    report(0.3, "fitting the Layered tier's gloss lobes")
+    glossy, lut = view_weighted(cc.GLOSSY_DISTRIBUTIONS)
+    report(0.45, "fitting the EEVEE tier's gloss lobes")
+    eevee_glossy, eevee_lut = view_weighted((EEVEE_GLOSSY,))
     coat_ior = coat.ior
-    if coat_ior is None or any(row is None for row in rows):
-        raise AssertionError("fit_coat gives an IOR and fit_glossy a view-angle row")
-    lut = np.stack(rows)
+    if coat_ior is None:
+        raise AssertionError("fit_coat gives an IOR")
 
     report(0.6, "fitting the subsurface profile")
     ior = subsurface_ior(tables.parameters)
@@ -172,6 +187,8 @@ def fit_closures(tables: Tables, *, lut_size: int = DEFAULT_LUT_SIZE,
         subsurface_method=subsurface_method,
         subsurface_ior=ior,
         lut=lut,
+        eevee_glossy=eevee_glossy,
+        eevee_lut=eevee_lut,
     )
     if errors_at is None:
         errors_at = (float(tables.parameters.get("coverage", 1.0)),

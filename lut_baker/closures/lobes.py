@@ -10,7 +10,8 @@ enough (:data:`FIT_XTOL`) that a fitted number follows its data continuously.
 - :func:`fit_coat`, :func:`fit_specular` -- the Principled BSDF's coat (the film's gloss) and
   specular (the skin's gloss, bare or through the film).
 - :func:`fit_glossy` -- a Glossy BSDF, its distribution, roughness and view-angle row (and, for
-  a broad lobe, its Lambertian companion's row).
+  a broad lobe, its Lambertian companion's row), as Cycles renders it or as EEVEE does
+  (:data:`EEVEE_GLOSSY`, :func:`glossy_lobe`, :func:`glossy_albedo`).
 """
 
 from __future__ import annotations
@@ -21,13 +22,15 @@ import numpy as np
 
 from ..numerics.optimise import brent_minimum, scanned_least_squares
 from . import cycles as cc
+from . import eevee
 from .tier_formulas import SPECULAR_IOR
 from .view_grid import ViewGrid
 from .view_image import DEFAULT_LUT_SIZE, lut_nodes, sample_lut
 
 __all__ = ["LobeFit", "fit_coat", "fit_specular", "fit_glossy", "ROUGHNESS_RANGE",
            "FIT_XTOL", "DISTRIBUTION_MARGIN", "COAT_IOR_RANGE", "SPECULAR_LEVEL_RANGE",
-           "SEARCH_QUADRATURE", "FINAL_QUADRATURE", "NO_LOBE_ERROR"]
+           "SEARCH_QUADRATURE", "FINAL_QUADRATURE", "NO_LOBE_ERROR", "EEVEE_GLOSSY",
+           "glossy_lobe", "glossy_albedo"]
 
 ROUGHNESS_RANGE = (0.02, 1.0)
 """Roughness (Blender's socket, alpha = roughness^2) searched by the fits: from a lobe about
@@ -48,6 +51,9 @@ COAT_IOR_RANGE = (1.01, 4.0)
 NO_LOBE_ERROR = 0.9
 """A specular fit erring more than this (relative RMS; leaving the lobe out errs 1.0) is
 dropped and its albedo moved to the base colour."""
+EEVEE_GLOSSY = "EEVEE_GGX"
+"""The closure name :func:`fit_glossy` gives EEVEE's Glossy BSDF under a lamp
+(:func:`lut_baker.closures.eevee.glossy_from_cosines`); the node is a GGX Glossy BSDF."""
 SPECULAR_LEVEL_RANGE = (0.0, 8.0)
 """Specular IOR Level searched (0.5 leaves IOR 1.5 as it is; F0 = 0.04 * 2 level)."""
 
@@ -201,8 +207,28 @@ def _companion_share(grid: ViewGrid, lobe: np.ndarray, closure_albedo: np.ndarra
     return np.clip(np.where(den > 0.0, num / np.where(den > 0.0, den, 1.0), 1.0), 0.0, 1.0)
 
 
+def glossy_lobe(grid: ViewGrid, roughness: float, closure: str) -> np.ndarray:
+    """A white Glossy closure's BRDF at ``grid``'s pairs, ``(V, A, P)``: Cycles' distribution
+    ``closure`` (:data:`lut_baker.closures.cycles.GLOSSY_DISTRIBUTIONS`) or, for
+    :data:`EEVEE_GLOSSY`, EEVEE's GGX under a lamp."""
+    if closure == EEVEE_GLOSSY:
+        return eevee.glossy_from_cosines(grid.wi, grid.cos_o, roughness)
+    return grid.lobe(roughness, closure)
+
+
+def glossy_albedo(cos_view, roughness: float, closure: str, *, final: bool = True):
+    """The albedo of :func:`glossy_lobe`'s closure at view cosines: by quadrature over
+    normals for Cycles' (:data:`FINAL_QUADRATURE`, or :data:`SEARCH_QUADRATURE` while
+    searching), in closed form for EEVEE's."""
+    if closure == EEVEE_GLOSSY:
+        return eevee.glossy_albedo(cos_view, roughness)
+    return cc.microfacet_albedo(cos_view, roughness, distribution=closure,
+                                **(FINAL_QUADRATURE if final else SEARCH_QUADRATURE))
+
+
 def fit_glossy(grid: ViewGrid, target, albedo_table: np.ndarray, theta_deg: np.ndarray,
-               size: int = DEFAULT_LUT_SIZE, *, companion: bool = False) -> LobeFit:
+               size: int = DEFAULT_LUT_SIZE, *, companion: bool = False,
+               closures: tuple = cc.GLOSSY_DISTRIBUTIONS) -> LobeFit:
     """Distribution (:data:`lut_baker.closures.cycles.GLOSSY_DISTRIBUTIONS`) and roughness of a
     Glossy BSDF whose view-dependent weight (table albedo / closure albedo, read from a
     ``size``-texel image by ``cos(theta_o)``) best reproduces ``target`` ``(V, A, P[, 3])``;
@@ -214,8 +240,11 @@ def fit_glossy(grid: ViewGrid, target, albedo_table: np.ndarray, theta_deg: np.n
     broad lobe whose radiance keeps a ``cos(theta_i)`` factor (the paper's film gloss) is
     part Lambertian, which no Glossy closure alone reproduces.
 
-    The distribution is GGX unless another one's error is lower by more than
-    :data:`DISTRIBUTION_MARGIN` (relative): a near tie never flips the choice."""
+    ``closures``: the Glossy closures to choose from (:func:`glossy_lobe`): Cycles'
+    distributions (default), or ``(EEVEE_GLOSSY,)`` for the EEVEE tier.  The first of them
+    (GGX) is chosen unless another one's error is lower by more than
+    :data:`DISTRIBUTION_MARGIN` (relative): a near tie never flips the choice.  The fit's
+    ``distribution`` is the Glossy node's (``GGX`` for EEVEE's closure)."""
     target = np.asarray(target, float)
     target = target if target.ndim == 4 else target[..., None]
     target = target * np.ones(3)
@@ -232,10 +261,9 @@ def fit_glossy(grid: ViewGrid, target, albedo_table: np.ndarray, theta_deg: np.n
         """``(lut, diffuse_lut or None, value on the grid)`` for one lobe: while searching
         (``final`` False) the weights sit at the grid's views, with a coarser closure albedo;
         the final ones at the image's texels, sampled as Blender samples them."""
-        shape = grid.lobe(roughness, distribution)
+        shape = glossy_lobe(grid, roughness, distribution)
         nodes = texels if final else grid.cos_view
-        closure = cc.microfacet_albedo(nodes, roughness, distribution=distribution,
-                                       **(FINAL_QUADRATURE if final else SEARCH_QUADRATURE))
+        closure = glossy_albedo(nodes, roughness, distribution, final=final)
         table = tables[final]
         lut = table / np.maximum(closure, 1e-6)[:, None]
         diffuse = None
@@ -254,12 +282,14 @@ def fit_glossy(grid: ViewGrid, target, albedo_table: np.ndarray, theta_deg: np.n
         return lut, diffuse, value
 
     searched = {distribution: _minimise_roughness(lambda r, d=distribution: grid.error(
-        weights(r, d, False)[2], target)) for distribution in cc.GLOSSY_DISTRIBUTIONS}
+        weights(r, d, False)[2], target)) for distribution in closures}
     distribution = min(searched, key=lambda d: searched[d][1])
-    if searched[distribution][1] >= (1.0 - DISTRIBUTION_MARGIN) * searched["GGX"][1]:
-        distribution = "GGX"
+    if searched[distribution][1] >= (1.0 - DISTRIBUTION_MARGIN) * searched[closures[0]][1]:
+        distribution = closures[0]
     roughness = searched[distribution][0]
     lut, diffuse, value = weights(roughness, distribution, True)
+    node = "GGX" if distribution == EEVEE_GLOSSY else distribution
     return LobeFit(roughness=roughness, error=grid.error(value, target), lut=lut,
-                   distribution=distribution, diffuse_lut=diffuse,
-                   searched={name: float(found[1]) for name, found in searched.items()})
+                   distribution=node, diffuse_lut=diffuse,
+                   searched={("GGX" if name == EEVEE_GLOSSY else name): float(found[1])
+                             for name, found in searched.items()})

@@ -7,8 +7,10 @@ Cycles renders the node group, then compared with the tables on a view grid.
 
 - :data:`TIERS`, :class:`TierError`.
 - :func:`principled_inputs`, :func:`principled_tier_reflection` -- the PRINCIPLED tier;
-  :func:`layered_tier_reflection` -- the LAYERED tier; :func:`view_weighted_reflection` -- a
-  view-weighted tier's closures as a BRDF; :data:`TIER_REPLICAS` -- each by name.
+  :func:`layered_tier_reflection` -- the LAYERED tier; :func:`eevee_tier_reflection` -- the
+  EEVEE tier as EEVEE renders it; :func:`view_weighted_reflection` -- a view-weighted tier's
+  closures as a BRDF, :func:`view_weighted_tier` -- with any lobes and image;
+  :data:`TIER_REPLICAS` -- each by name.
 - :func:`tier_errors` -- every tier against the tables at one coverage and absorption.
 """
 
@@ -21,6 +23,7 @@ import numpy as np
 from ..model.made_up_skin import combine, coverage_weights
 from ..tables.table_set import Tables
 from . import cycles as cc
+from . import eevee
 from .closure_fit import ClosureFit
 from .tier_formulas import (
     NumpyAlgebra,
@@ -33,11 +36,16 @@ from .view_grid import ERROR_VIEWS, lobe_widths_deg, view_grid
 from .view_image import LUT_ROWS
 
 __all__ = ["TIERS", "TierError", "principled_inputs", "principled_tier_reflection",
-           "view_weighted_reflection", "layered_tier_reflection", "TIER_REPLICAS",
-           "tier_errors"]
+           "view_weighted_reflection", "view_weighted_tier", "layered_tier_reflection",
+           "eevee_tier_reflection", "TIER_REPLICAS", "EEVEE_SUBSURFACE_METHOD", "tier_errors"]
 
-TIERS = ("PRINCIPLED", "LAYERED")
-"""The node group's tiers, cheapest first."""
+TIERS = ("PRINCIPLED", "LAYERED", "EEVEE")
+"""The node group's tiers: the two made for Cycles, cheapest first, then the one made for
+EEVEE."""
+EEVEE_SUBSURFACE_METHOD = "BURLEY"
+"""The EEVEE tier's subsurface method: EEVEE's screen-space subsurface is Burley's profile
+whatever the node asks for, and Cycles renders the same method when the file is rendered
+there."""
 
 
 @dataclass(frozen=True)
@@ -110,25 +118,51 @@ def view_weighted_reflection(closures: ViewWeightedClosures, lobe_of, wi, wo) ->
     return combine(weights, top=side(closures.covered), bare=side(closures.bare))
 
 
+def view_weighted_tier(fit: ClosureFit, tables: Tables, coverage: float, absorption, gloss,
+                       directions, *, lobes: dict, lut: np.ndarray, lobe_of,
+                       tinted_subsurface: bool):
+    """A view-weighted tier's BRDF ``(..., 3)`` at the angular nodes or at ``directions``:
+    the closures of :func:`lut_baker.closures.tier_formulas.view_weighted_closures` with the
+    rows of ``lut`` read at ``wo``'s view angles, its Glossy ``lobes`` (by name) drawn by
+    ``lobe_of(wi, wo, lobe)``."""
+    wi, wo = tables.node_directions() if directions is None else directions
+    algebra = NumpyAlgebra(dict(zip(LUT_ROWS, lut, strict=True)), wo[..., 2])
+    closures = view_weighted_closures(fit, _inputs(fit, coverage, absorption, gloss), algebra,
+                                      tinted_subsurface=tinted_subsurface)
+    return view_weighted_reflection(closures, lambda name, a, b: lobe_of(a, b, lobes[name]),
+                                    wi, wo)
+
+
 def layered_tier_reflection(fit: ClosureFit, tables: Tables, coverage: float, absorption,
                             gloss: float = 1.0, directions=None):
     """The LAYERED tier's BRDF, ``(..., 3)``, at the angular nodes or at ``directions``
     ``(wi, wo)``: its closures (:func:`lut_baker.closures.tier_formulas.view_weighted_closures`)
     with the image rows read as Blender reads them (linear between texel centres) and Cycles'
     Glossy lobes; ``gloss``: the group's Gloss input."""
-    wi, wo = tables.node_directions() if directions is None else directions
-    algebra = NumpyAlgebra(dict(zip(LUT_ROWS, fit.lut, strict=True)), wo[..., 2])
-    closures = view_weighted_closures(fit, _inputs(fit, coverage, absorption, gloss), algebra)
-
-    def lobe(name, wi, wo):
-        glossy = fit.glossy[name]
-        return cc.microfacet_reflection(wi, wo, glossy.roughness,
-                                        distribution=glossy.distribution)
-
-    return view_weighted_reflection(closures, lobe, wi, wo)
+    return view_weighted_tier(
+        fit, tables, coverage, absorption, gloss, directions, lobes=fit.glossy, lut=fit.lut,
+        lobe_of=lambda wi, wo, lobe: cc.microfacet_reflection(
+            wi, wo, lobe.roughness, distribution=lobe.distribution),
+        tinted_subsurface=True)
 
 
-TIER_REPLICAS = {"PRINCIPLED": principled_tier_reflection, "LAYERED": layered_tier_reflection}
+def eevee_tier_reflection(fit: ClosureFit, tables: Tables, coverage: float, absorption,
+                          gloss: float = 1.0, directions=None):
+    """The EEVEE tier's BRDF as EEVEE renders it under lamps, ``(..., 3)``, at the angular
+    nodes or at ``directions`` ``(wi, wo)``: the LAYERED tier's closures and areal mix with
+    its own lobes (``fit.eevee_glossy``, EEVEE's GGX:
+    :func:`lut_baker.closures.eevee.glossy_reflection`) and view-angle rows
+    (``fit.eevee_lut``), the skin through the film as its plain colour (EEVEE's screen-space
+    subsurface takes it as it is); Diffuse and Subsurface closures Lambertian."""
+    return view_weighted_tier(
+        fit, tables, coverage, absorption, gloss, directions, lobes=fit.eevee_glossy,
+        lut=fit.eevee_lut,
+        lobe_of=lambda wi, wo, lobe: eevee.glossy_reflection(wi, wo, lobe.roughness),
+        tinted_subsurface=False)
+
+
+TIER_REPLICAS = {"PRINCIPLED": principled_tier_reflection, "LAYERED": layered_tier_reflection,
+                 "EEVEE": eevee_tier_reflection}
 """Each tier's replica, ``(fit, tables, coverage, absorption, gloss=1, directions=None)``."""
 
 

@@ -155,13 +155,20 @@ def test_half_a_pixel_is_the_threshold():
     assert not auto_tier.choose(CLOSE_UP, traits.scaled(0.0)).candidate.subsurface
 
 
-def test_eevee_gets_a_tier_that_runs_there():
+def test_each_engine_gets_the_tier_made_for_it():
+    """EEVEE: the EEVEE tier only (whatever its predicted error against the others'); Cycles:
+    never the EEVEE tier."""
     for scene in (CLOSE_UP, DISTANT):
         eevee = SceneDescription(**{**scene.__dict__, "engine": "EEVEE"})
         choice = auto_tier.choose(eevee)
-        assert choice.candidate.tier in auto_tier.ENGINE_TIERS["EEVEE"]
-        assert all(p.candidate.tier == "PRINCIPLED" for p in choice.predictions)
+        assert auto_tier.ENGINE_TIERS["EEVEE"] == ("EEVEE",)
+        assert {p.candidate.tier for p in choice.predictions} == {"EEVEE"}
         assert choice.chosen.noise == 0.0
+        assert "EEVEE" in choice.reasons[-1]
+        cycles = auto_tier.choose(scene)
+        assert "EEVEE" not in {p.candidate.tier for p in cycles.predictions}
+    assert {c.tier for c in auto_tier.EEVEE_CANDIDATES} == {"EEVEE"}
+    assert len(set(auto_tier.EEVEE_CANDIDATES)) == 4
 
 
 def _traits(gloss_share):

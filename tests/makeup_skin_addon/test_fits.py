@@ -43,7 +43,11 @@ def test_a_measurement_is_found_at_its_own_coverage_and_absorption(record):
     assert fits.measured_at(meta, 0.7, (0.1, 0.2, 0.3)) is None
     assert fits.measured_at(meta, 0.6, (0.1, 0.2, 0.4)) is None
     assert fits.measured_at({}, 0.6, (0.1, 0.2, 0.3)) is None
-    assert set(measured["errors"]) == {"PRINCIPLED", "LAYERED"}
+    assert set(measured["errors"]) == {"PRINCIPLED", "LAYERED", "EEVEE"}
+    # An older add-on's measurement, without the EEVEE tier, is taken again.
+    older = {**measured, "errors": {tier: e for tier, e in measured["errors"].items()
+                                    if tier != "EEVEE"}}
+    assert fits.measured_at({"measured": older}, 0.6, (0.1, 0.2, 0.3)) is None
     # Without traits a measurement does not serve the Auto tier.
     bare = fits.measure(tables, fit, 0.6, (0.1, 0.2, 0.3), with_traits=False)
     assert bare["traits"] is None

@@ -1,7 +1,8 @@
-"""The apply pipeline (makeup_skin_addon.material), headless: Apply and render both tiers on
-a sphere, reuse without duplicates, the scene's unit scale; on the textured head, a
-shared material converted once, the active slot only, linked library data refused, and
-the progress through bake and fit.  Cycles CPU at 16 samples."""
+"""The apply pipeline (makeup_skin_addon.material), headless: Apply and render every tier on
+a sphere, the report when a tier is not made for the scene's engine, reuse without
+duplicates, the scene's unit scale; on the textured head, a shared material converted once,
+the active slot only, linked library data refused, and the progress through bake and fit.
+Cycles CPU at 16 samples."""
 
 import json
 
@@ -19,16 +20,22 @@ from support.addon_steps import (
 )
 
 
-@pytest.mark.parametrize("tier", ["PRINCIPLED", "LAYERED"])
+@pytest.mark.parametrize("tier", ["PRINCIPLED", "LAYERED", "EEVEE"])
 def test_apply_and_render(sphere, tmp_path, tier):
-    material, _ = apply_pipeline(sphere, tier)
+    from makeup_skin_addon.keys import TIER_LABELS
+
+    material, messages = apply_pipeline(sphere, tier)
     assert material.makeup_skin.is_made_up
     group = material.node_tree.nodes["Made-up Skin"].node_tree
-    assert group.name.startswith(f"Made-up Skin {tier.title()}")
+    assert group.name.startswith(f"Made-up Skin {TIER_LABELS[tier]} ")
     meta = json.loads(group["makeup_skin_fit"])
     assert meta["tier"] == tier and meta["subsurface_method"] in ("BURLEY", "RANDOM_WALK_SKIN")
+    if tier == "EEVEE":  # EEVEE's screen-space subsurface is Burley's
+        assert meta["subsurface_method"] == "BURLEY"
     errors = json.loads(material["makeup_skin_errors"])
-    assert set(errors) == {"PRINCIPLED", "LAYERED"}
+    assert set(errors) == {"PRINCIPLED", "LAYERED", "EEVEE"}
+    # The scene renders with Cycles: the EEVEE tier is reported as made for EEVEE.
+    assert any("made for EEVEE" in m for m in messages) == (tier == "EEVEE"), messages
     pixels = render(tmp_path)
     assert np.all(np.isfinite(pixels)) and pixels.min() >= 0.0
     disc = pixels.mean(axis=-1) > 1e-4
@@ -39,6 +46,30 @@ def test_apply_and_render(sphere, tmp_path, tier):
     half = SPHERE_PX // 2
     left, right = pixels[:, :half][disc[:, :half]], pixels[:, half:][disc[:, half:]]
     assert right.mean() > 1.5 * left.mean()
+
+
+def test_report_says_when_a_tier_is_not_made_for_the_engine(sphere):
+    """In EEVEE a Cycles tier is built as asked and the report names the EEVEE tier and its
+    error; Auto takes the EEVEE tier and says nothing; back in Cycles the EEVEE tier is
+    reported the other way round.  Nothing is rendered."""
+    import bpy
+
+    scene = bpy.context.scene
+    scene.render.engine = "BLENDER_EEVEE" if bpy.app.version >= (5, 0, 0) else \
+        "BLENDER_EEVEE_NEXT"
+    material, messages = apply_pipeline(sphere, "LAYERED")
+    assert group_node(material).node_tree["makeup_skin_fit"]  # built all the same
+    note = [m for m in messages if "made for Cycles" in m]
+    assert len(note) == 1 and "the EEVEE tier is fitted to EEVEE (" in note[0], messages
+    error = json.loads(material["makeup_skin_errors"])["EEVEE"]["rms"]
+    assert f"{100 * error:.1f}% angular error" in note[0]
+    material, messages = apply_pipeline(sphere, "AUTO")
+    assert json.loads(group_node(material).node_tree["makeup_skin_fit"])["tier"] == "EEVEE"
+    assert not any("made for" in m for m in messages), messages
+    scene.render.engine = "CYCLES"
+    _, messages = apply_pipeline(sphere, "EEVEE")
+    assert any("made for EEVEE" in m and "the Layered tier is fitted to Cycles" in m
+               for m in messages), messages
 
 
 def test_apply_operator_and_twice_creates_no_duplicates(sphere):

@@ -13,9 +13,11 @@ place of the shader tree (Add and Mix Shaders kept), and the copy's other closur
 
 - PRINCIPLED: the Emission's colour is the socket feeding one Principled input (Base Color,
   Subsurface Weight, Specular IOR Level, Coat Weight, Roughness), so the pixel is that input;
-- LAYERED: the Emission replaces one closure (film gloss, path-3 gloss, skin gloss, film
-  diffuse, skin through the film, bare skin), so the pixel is that closure's colour times every
-  Mix Shader factor above it: its weight in the tier, as the replica adds it.
+- LAYERED and EEVEE: the Emission replaces one closure (film gloss, path-3 gloss, skin gloss,
+  film diffuse, skin through the film, bare skin), so the pixel is that closure's colour times
+  every Mix Shader factor above it: its weight in the tier, as the replica adds it (each tier
+  with its own view-angle image; the LAYERED tier's skin through the film has a weight of its
+  own, probed too).
 
 Every (probe, case) pair is one face of one plane, with its own material, tilted by the case's
 view angle about the x axis so that it fills a 3x3-pixel cell of an orthographic camera looking
@@ -246,11 +248,11 @@ def _render_grid(scene, materials, views_deg, tmp_path):
     return pixels[CELL // 2::CELL, CELL // 2::CELL]
 
 
-def _numpy(fit, case):
+def _numpy(fit, case, lut=None):
     """The tier formulas' inputs and algebra for one case, as the replicas take them."""
     coverage, absorption, gloss, skin_colour, view_deg = case
     x = tier_formulas.TierInputs.numpy(coverage, absorption, skin_colour, gloss)
-    rows = dict(zip(view_image.LUT_ROWS, fit.lut, strict=True))
+    rows = dict(zip(view_image.LUT_ROWS, fit.lut if lut is None else lut, strict=True))
     return x, tier_formulas.NumpyAlgebra(rows, np.cos(np.radians(view_deg)))
 
 
@@ -260,10 +262,11 @@ def _principled_expected(fit, case):
     return {name: np.broadcast_to(np.ravel(sockets[name]), (3,)) for name in PRINCIPLED_PROBES}
 
 
-def _layered_expected(fit, case):
+def _layered_expected(fit, case, eevee=False):
     """Each closure's colour times its weight and its side's share of the coverage mix."""
-    x, algebra = _numpy(fit, case)
-    closures = tier_formulas.view_weighted_closures(fit, x, algebra)
+    x, algebra = _numpy(fit, case, fit.eevee_lut if eevee else None)
+    closures = tier_formulas.view_weighted_closures(fit, x, algebra,
+                                                    tinted_subsurface=not eevee)
     coverage = case[0]
     out = {}
     for share, side in ((coverage, closures.covered), (1.0 - coverage, closures.bare)):
@@ -283,6 +286,8 @@ def test_node_group_follows_the_tier_formulas(blank_scene, baked, tmp_path, tier
     probes, make_probe, expected_of = {
         "PRINCIPLED": (PRINCIPLED_PROBES, _principled_probe, _principled_expected),
         "LAYERED": (LAYERED_PROBES, _layered_or_weight_probe, _layered_expected),
+        "EEVEE": (LAYERED_PROBES[:-1], _layered_probe,
+                  lambda fit, case: _layered_expected(fit, case, eevee=True)),
     }[tier]
     copies = [make_probe(group, name) for name in probes]
     materials = [[_material(copy, *case) for case in CASES] for copy in copies]

@@ -1,6 +1,7 @@
 """The Made-up Skin node groups (makeup_skin_addon.nodes): Normal, Film Normal and Skin Color
 reach every closure (Cycles and EEVEE), an albedo texture in Skin Color renders as a bake
-at that albedo, and a forced subsurface method gets its own group."""
+at that albedo, a forced subsurface method gets its own group, and the view-angle rows read
+in EEVEE as in Cycles."""
 
 import dataclasses
 import json
@@ -33,15 +34,15 @@ def _unlinked_against_no_normal_links(head, tmp_path, tier):
 @pytest.mark.slow  # renders compared
 def test_unlinked_normals_render_as_the_shading_normal(head, tmp_path):
     """Leaving Normal and Film Normal unlinked renders exactly as a group whose closures have
-    no Normal link at all, in both tiers (Cycles)."""
-    for tier in ("LAYERED", "PRINCIPLED"):
+    no Normal link at all, in every tier (Cycles)."""
+    for tier in ("LAYERED", "PRINCIPLED", "EEVEE"):
         with_inputs, bare = _unlinked_against_no_normal_links(head, tmp_path, tier)
         np.testing.assert_array_equal(bare, with_inputs)
 
 
 @pytest.mark.slow
 def test_unlinked_normals_in_eevee(head, tmp_path):
-    """The same in EEVEE, Principled tier (the one Auto gives EEVEE): a hidden-value group input
+    """The same in EEVEE, EEVEE tier (the one Auto gives EEVEE): a hidden-value group input
     stays unlinked inside the group, where a visible one would hand the BSDF a zero normal
     (flat shading in EEVEE 5.0)."""
     import bpy
@@ -53,7 +54,7 @@ def test_unlinked_normals_in_eevee(head, tmp_path):
     for light in (obj.data for obj in scene.objects if obj.type == "LIGHT"):
         light.use_shadow = False  # software OpenGL: ~45 s a render with shadows
     render(tmp_path, "warm_up")  # a process's first EEVEE render differs (by up to 0.03)
-    with_inputs, bare = _unlinked_against_no_normal_links(head, tmp_path, "PRINCIPLED")
+    with_inputs, bare = _unlinked_against_no_normal_links(head, tmp_path, "EEVEE")
     assert with_inputs.mean() > 0.1
     np.testing.assert_allclose(bare, with_inputs, atol=1e-4)  # a zero normal: ~0.5
 
@@ -62,7 +63,7 @@ def test_unlinked_normals_in_eevee(head, tmp_path):
 def test_every_closure_reads_a_normal_input(head, tmp_path):
     from makeup_skin_addon import nodes
 
-    for tier in ("LAYERED", "PRINCIPLED"):
+    for tier in ("LAYERED", "PRINCIPLED", "EEVEE"):
         group = group_node(apply_operator(head, tier)).node_tree
         closures = [n for n in group.nodes if n.type.startswith(("BSDF", "SUBSURFACE"))]
         assert closures
@@ -80,7 +81,7 @@ def test_every_closure_reads_a_normal_input(head, tmp_path):
 
 
 @pytest.mark.slow  # renders compared
-@pytest.mark.parametrize("tier", ["LAYERED", "PRINCIPLED"])
+@pytest.mark.parametrize("tier", ["LAYERED", "PRINCIPLED", "EEVEE"])
 def test_skin_colour_texture_matches_a_bake_at_that_albedo(addon, blank_scene, tmp_path, tier):
     """An albedo texture in Skin Color renders as the tables baked with that albedo: the skin's
     diffuse term is linear, so the texture scales every skin closure exactly."""
@@ -126,3 +127,72 @@ def test_forced_subsurface_method_gets_its_own_group(sphere):
     radius = meta["profiles"]["RANDOM_WALK_SKIN"]["radius_mm"]
     assert tuple(next(s for s in principled.inputs if s.identifier == "Subsurface Radius")
                  .default_value) == pytest.approx(radius)
+
+
+def _row_probe(group, row: str, linear: bool):
+    """A copy of ``group`` whose output is an Emission of its view-angle row ``row``: read as
+    the group reads it (two Closest texels mixed) or, ``linear``, by one Linear lookup at
+    ``u = cos(theta_o)`` (what the Layered tier did before)."""
+    probe = group.copy()
+    emission = probe.nodes.new("ShaderNodeEmission")
+    if linear:
+        cos = next(n for n in probe.nodes if n.label == "cos theta_o (film)").outputs[0]
+        texture = next(n for n in probe.nodes if n.type == "TEX_IMAGE" and n.label == row)
+        coordinate = probe.nodes.new("ShaderNodeCombineXYZ")
+        probe.links.new(cos, coordinate.inputs["X"])
+        coordinate.inputs["Y"].default_value = texture.inputs["Vector"].links[0].from_node \
+            .inputs["Y"].default_value
+        lookup = probe.nodes.new("ShaderNodeTexImage")
+        lookup.image, lookup.interpolation, lookup.extension = texture.image, "Linear", "EXTEND"
+        probe.links.new(coordinate.outputs[0], lookup.inputs["Vector"])
+        probe.links.new(lookup.outputs["Color"], emission.inputs["Color"])
+    else:
+        mixed = next(n for n in probe.nodes if n.label == f"row {row}")
+        probe.links.new(next(s for s in mixed.outputs if s.enabled and s.is_linked),
+                        emission.inputs["Color"])
+    output = next(n for n in probe.nodes if n.type == "GROUP_OUTPUT")
+    probe.links.new(emission.outputs[0], output.inputs["Shader"])
+    return probe
+
+
+@pytest.mark.slow  # EEVEE renders
+def test_view_angle_rows_read_in_eevee_as_in_cycles(addon, paper_tables):
+    """EEVEE samples a Linear image through mipmaps and anisotropic filtering, which mixes the
+    view-angle image's rows wherever cos(theta_o) changes quickly across the screen (the
+    Layered tier's bright patches in EEVEE, docs/addon.md).  The groups read each row from two
+    Closest texels mixed: in EEVEE, a sphere of the film gloss row equals
+    :func:`lut_baker.closures.view_image.sample_lut` at every pixel's cos(theta_o) within the
+    image's half-float precision (and the mesh's normals), where one Linear lookup errs by tens
+    of per cent."""
+    import bpy
+    from support import bench_scene as scene_module
+
+    from lut_baker.closures import view_image
+    from lut_baker.numerics.geometry import sphere_normals
+    from lut_baker.offline.validation import compare
+    from makeup_skin_addon import material as made_up
+
+    size = 48
+    sphere = scene_module.sphere_scene(size=size, samples=1)
+    scene = bpy.context.scene
+    scene_module.use_eevee(scene, 1)
+    group, fit = made_up.group_for_tables(paper_tables, "EEVEE", resolution="preview")
+    normals, mask = sphere_normals(size)
+    expected = np.zeros((size, size, 3))
+    expected[mask] = view_image.sample_lut(fit.eevee_lut[0], np.clip(normals[mask][:, 2], 0, 1))
+    errors = {}
+    for linear in (False, True):
+        material = bpy.data.materials.new(f"row probe {linear}")
+        if material.node_tree is None:
+            material.use_nodes = True
+        tree = material.node_tree
+        tree.nodes.clear()
+        node = tree.nodes.new("ShaderNodeGroup")
+        node.node_tree = _row_probe(group, "film_gloss", linear)
+        tree.links.new(node.outputs["Shader"],
+                       tree.nodes.new("ShaderNodeOutputMaterial").inputs["Surface"])
+        scene_module.set_material(sphere, material)
+        errors[linear] = compare.relative_rms(scene_module.render_image()[1], expected)
+    print(f"film gloss row in EEVEE: exact lookup {errors[False]:.2e}, Linear {errors[True]:.3f}")
+    assert errors[False] < 5e-3  # measured 2.4e-3: half floats and the mesh normals
+    assert errors[True] > 0.05

@@ -3,7 +3,7 @@
 A distant scene renders with the chosen and the fullest candidate (Cycles CPU, 48 px, 256
 samples) against lut_baker's reference: bare skin (the subsurface left out), a film whose
 gloss is below the noise (Gloss 0 chosen) and the paper's (gloss kept).  The operator runs
-on a close-up and a distant scene, on a film of index 1.01 and in EEVEE.
+on a close-up and a distant scene, on a film of index 1.01 and in EEVEE (the EEVEE tier).
 tests/lut_baker/test_auto_tier.py tests the model without Blender.
 """
 
@@ -198,10 +198,10 @@ def test_fit_to_scene_operator(addon):
     assert json.loads(material[scene_fit.CHOICE_KEY])["gloss"] and settings.gloss == 1.0
     assert scene_fit.SAVED_GLOSS_KEY not in material
     assert made_up.group_of(material).inputs["Gloss"].default_value == 1.0
-    # EEVEE: the Principled tier, through Auto as well.
+    # EEVEE: the EEVEE tier, through Auto as well.
     scene.render.engine = "BLENDER_EEVEE" if bpy.app.version >= (5, 0, 0) else \
         "BLENDER_EEVEE_NEXT"
     material.makeup_skin.tier = "AUTO"
-    assert made_up.resolve_tier(material.makeup_skin, scene) == "PRINCIPLED"
+    assert made_up.resolve_tier(material.makeup_skin, scene) == "EEVEE"
     assert bpy.ops.makeup_skin.fit_to_scene(apply=False) == {"FINISHED"}
-    assert json.loads(material[scene_fit.CHOICE_KEY])["tier"] == "PRINCIPLED"
+    assert json.loads(material[scene_fit.CHOICE_KEY])["tier"] == "EEVEE"
