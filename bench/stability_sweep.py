@@ -1,8 +1,8 @@
 """Stability where the methods fail, and the costs the Auto tier uses (a benchmark).
 
     python bench/stability_sweep.py [--out docs/stability.md] [--no-render] [--regimes K ...]
-    python bench/stability_sweep.py --costs [--repeats 3]
-    python bench/stability_sweep.py --traits
+    python bench/stability_sweep.py --costs [--repeats 3] [--write]
+    python bench/stability_sweep.py --traits [--write]
 
 The first form runs :func:`lut_baker.offline.validation.stability.sweep` (the exact model, the bake,
 the closure fits and the reference images in every regime of stability.REGIMES) and, unless
@@ -14,7 +14,9 @@ between its ``<!-- sweep -->`` markers).
 ``--costs`` measures what :mod:`lut_baker.auto_tier` stores: per-sample render time of every
 candidate relative to the fullest (the slope between two sample counts, so that scene set-up
 does not count) and its Monte Carlo noise coefficient (relative RMS between two seeds);
-``--traits`` prints the paper preset's traits it assumes without tables.
+``--traits`` prints the paper preset's traits it assumes without tables.  With ``--write`` each
+rewrites its section of lut_baker/auto_tier/measured.json (:mod:`lut_baker.auto_tier.measured`),
+where the Auto tier reads them.
 
 The scene is tests/support/bench_scene.py's (the reference's scene, shared with the tests):
 its :class:`~support.bench_scene.Stage` (one scene built once, changed between renders),
@@ -201,6 +203,57 @@ def _print_costs(costs, args, coverage) -> None:
           tuple(round(v["noise_k"], 4) for v in costs.values()))
 
 
+def _costs_section(by_coverage: dict, args) -> dict:
+    """The ``cycles_costs`` section of lut_baker/auto_tier/measured.json from
+    :func:`measure_costs` at coverages 1 and 0."""
+    from lut_baker import auto_tier
+    from lut_baker.auto_tier import measured
+
+    old = measured.load()["cycles_costs"]
+
+    def table(key, digits):
+        return {f"{coverage:g}": {c.name: round(value[key], digits) for c, value in costs.items()}
+                for coverage, costs in by_coverage.items()}
+
+    shares = {f"{coverage:g}": round(auto_tier.gloss_and_skin_shares(
+        _paper_tables(coverage), 45.0)[1], 4) for coverage in by_coverage}
+    return {"command": (f"python bench/stability_sweep.py --costs --repeats {args.repeats} "
+                        f"--size {args.size} --samples {args.samples[0]} {args.samples[1]} "
+                        "--write"),
+            "about": old["about"], "relative_cost": table("relative_cost", 3),
+            "noise_k": table("noise_k", 4), "skin_share": shares}
+
+
+def _paper_tables(coverage=1.0):
+    from lut_baker import bake
+    from lut_baker.model import presets
+
+    return bake.bake(presets.made_up_skin("paper_natural", "paper_bioplate",
+                                          coverage=coverage), "default")
+
+
+def _traits_section() -> dict:
+    """The ``paper_traits`` section of lut_baker/auto_tier/measured.json."""
+    from lut_baker import auto_tier
+    from lut_baker.auto_tier import measured
+    from lut_baker.closures import fitting
+
+    tables = _paper_tables()
+    traits = auto_tier.traits_from_tables(tables, fitting.fit_closures(tables))
+
+    def by_angle(table):
+        return {f"{angle:g}": round(value, 4) for angle, value in table.items()}
+
+    return {"command": "python bench/stability_sweep.py --traits --write",
+            "about": measured.load()["paper_traits"]["about"],
+            "tier_errors": {k: round(v, 4) for k, v in traits.tier_errors.items()},
+            "profile_mismatch": round(traits.profile_mismatch, 4),
+            "skin_share": by_angle(traits.skin_share),
+            "gloss_share": by_angle(traits.gloss_share),
+            "gloss_omission": {tier: by_angle(by_light)
+                               for tier, by_light in traits.gloss_omission.items()}}
+
+
 def _print_traits() -> None:
     """The paper preset's traits as lut_baker.auto_tier stores them."""
     from lut_baker import auto_tier, bake
@@ -297,6 +350,9 @@ def main(argv=None) -> int:
                         help="measure the candidates' relative costs and noise")
     parser.add_argument("--traits", action="store_true",
                         help="print the paper preset's traits (lut_baker.auto_tier)")
+    parser.add_argument("--write", action="store_true",
+                        help="--costs, --traits: rewrite their section of "
+                             "lut_baker/auto_tier/measured.json")
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--size", type=int, default=None,
                         help="render size, px (default 96 for --costs, 32 for the sweep)")
@@ -309,13 +365,25 @@ def main(argv=None) -> int:
     os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="stability_"))
     if args.traits:
         _print_traits()
+        if args.write:
+            from lut_baker.auto_tier import measured
+
+            measured.write_section("paper_traits", _traits_section())
+            print(f"# wrote paper_traits to {measured.PATH}")
         return 0
     if args.costs:
         args.size = args.size or 96
         args.samples = args.samples or [16, 272]
+        by_coverage = {}
         for coverage in (1.0, 0.0):
-            _print_costs(measure_costs(size=args.size, samples=tuple(args.samples[:2]),
-                                       repeats=args.repeats, coverage=coverage), args, coverage)
+            by_coverage[coverage] = measure_costs(size=args.size, samples=tuple(args.samples[:2]),
+                                                  repeats=args.repeats, coverage=coverage)
+            _print_costs(by_coverage[coverage], args, coverage)
+        if args.write:
+            from lut_baker.auto_tier import measured
+
+            measured.write_section("cycles_costs", _costs_section(by_coverage, args))
+            print(f"# wrote cycles_costs to {measured.PATH}")
         return 0
     from lut_baker.offline.validation import stability
 

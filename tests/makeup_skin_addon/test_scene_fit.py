@@ -4,7 +4,7 @@ A distant scene renders with the chosen and the fullest candidate (Cycles CPU, 4
 samples) against lut_baker's reference: bare skin (the subsurface left out), a film whose
 gloss is below the noise (Gloss 0 chosen) and the paper's (gloss kept).  The operator runs
 on a close-up and a distant scene, on a film of index 1.01 and in EEVEE (the EEVEE tier).
-tests/lut_baker/test_auto_tier.py tests the model without Blender.
+tests/lut_baker/auto_tier/ tests the model without Blender.
 """
 
 import math

@@ -28,12 +28,12 @@ def test_drawing_the_panel_computes_nothing(head, monkeypatch):
     import bpy
 
     from lut_baker import auto_tier, bake
-    from lut_baker.closures import fitting
+    from lut_baker.closures import fitting, tiers
     from makeup_skin_addon import ui
 
     apply_operator(head, tier="AUTO", foundation="clarins_112")
     calls = []
-    for module, name in ((bake, "bake"), (fitting, "fit_closures"), (fitting, "tier_errors"),
+    for module, name in ((bake, "bake"), (fitting, "fit_closures"), (tiers, "tier_errors"),
                          (auto_tier, "choose"), (auto_tier, "traits_from_tables")):
         original = getattr(module, name)
         monkeypatch.setattr(module, name, lambda *a, _n=name, _f=original, **k: (

@@ -1,0 +1,268 @@
+"""What the Auto tier needs to know of a made-up material.
+
+- :class:`MaterialTraits` -- the tiers' angular errors, the skin's profile, the shares of gloss
+  and of spreading skin light, the gloss each tier leaves out at Gloss 0.
+- :func:`traits_from_tables` -- a material's traits from its tables and closure fit;
+  :func:`paper_traits` -- the paper preset's (measured, :mod:`.measured`), assumed before a
+  material has tables.
+- :func:`profile_mean_radius_mm`, :func:`gloss_and_skin_shares`, :func:`gloss_omission_error`,
+  :func:`gloss_omissions`, :func:`profile_mismatch` -- the traits' parts.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from functools import lru_cache
+
+import numpy as np
+
+from ..bake import RESOLUTIONS, profile_radius
+from ..closures.profiles import edge_response, profile_grid
+from ..closures.tiers import TIER_REPLICAS, TIERS, tier_errors
+from ..model.dipole import dipole_profile, dipole_total_reflectance
+from ..model.made_up_skin import combine, coverage_weights
+from ..model.presets import made_up_skin
+from ..numerics.geometry import polar_angle_deg, sphere_directions
+from ..numerics.quadrature import trapezoid_weights
+from ..tables.table_set import radius_nodes
+from .measured import by_number, load
+
+__all__ = ["MaterialTraits", "traits_from_tables", "paper_traits", "profile_mean_radius_mm",
+           "gloss_and_skin_shares", "gloss_omission_error", "gloss_omissions",
+           "profile_mismatch", "SHARE_LIGHTS_DEG", "TRAITS_COMMAND", "PAPER_TIER_ERRORS",
+           "PAPER_MISMATCH", "PAPER_SKIN_SHARE", "PAPER_GLOSS_SHARE", "PAPER_GLOSS_OMISSION"]
+
+
+@dataclass(frozen=True, eq=False)
+class MaterialTraits:
+    """What the Auto tier needs of a made-up material at its coverage and absorption.
+
+    ``tier_errors``: angular relative RMS per tier (:func:`lut_baker.closures.tiers.tier_errors`);
+    ``radius_mm``, ``profile``: the normalised radial profile ``R(d)/Rd`` (1/mm^2, ``(n, 3)``)
+    on distances (mm), the tables' ``radius_mm`` and ``profile``; ``profile_mismatch``: the
+    fitted closure's relative edge-response error (:func:`profile_mismatch`);
+    ``skin_share``, ``gloss_share``: per light angle (degrees), the share of the image that
+    spreads under the skin and that the gloss lobes make (:func:`gloss_and_skin_shares`);
+    ``subsurface_scale``, ``gloss_scale``: the artist's Subsurface Scale and Gloss (the
+    group's inputs); ``gloss_omission``: per tier, per light angle, what Gloss 0 changes in
+    a sphere's image (:func:`gloss_omissions`; None: ``gloss_share`` stands in for it).
+    """
+
+    tier_errors: dict
+    radius_mm: np.ndarray
+    profile: np.ndarray
+    profile_mismatch: float
+    skin_share: dict
+    gloss_share: dict
+    subsurface_scale: float = 1.0
+    gloss_omission: dict | None = None
+    gloss_scale: float = 1.0
+
+    def share(self, name: str, light_deg: float) -> float:
+        """``skin_share`` or ``gloss_share`` at a light angle (linear between the stored
+        angles, held beyond them)."""
+        return _at_angle(getattr(self, name), light_deg)
+
+    def gloss_error(self, tier: str, light_deg: float) -> float:
+        """What leaving out the gloss lobes changes in a sphere's image lit ``light_deg`` from
+        the view: ``gloss_omission`` of ``tier`` if known, else ``gloss_share``."""
+        if self.gloss_omission and tier in self.gloss_omission:
+            return _at_angle(self.gloss_omission[tier], light_deg)
+        return self.share("gloss_share", light_deg)
+
+    def scaled(self, subsurface_scale: float, gloss_scale: float | None = None
+               ) -> MaterialTraits:
+        """The same material with the artist's Subsurface Scale (distances multiplied) and
+        Gloss (default: unchanged)."""
+        return replace(self, subsurface_scale=float(subsurface_scale),
+                       gloss_scale=self.gloss_scale if gloss_scale is None
+                       else float(gloss_scale))
+
+    @property
+    def mean_radius_mm(self) -> float:
+        """:func:`profile_mean_radius_mm` with the Subsurface Scale applied."""
+        return self.subsurface_scale * profile_mean_radius_mm(self.radius_mm, self.profile)
+
+    def as_dict(self) -> dict:
+        """Plain data (floats, lists, string keys), for a file; :meth:`from_dict` reads it."""
+        def by_angle(table):
+            return {repr(float(angle)): float(value) for angle, value in table.items()}
+
+        return {
+            "tier_errors": {tier: float(e) for tier, e in self.tier_errors.items()},
+            "radius_mm": np.asarray(self.radius_mm, float).tolist(),
+            "profile": np.asarray(self.profile, float).tolist(),
+            "profile_mismatch": float(self.profile_mismatch),
+            "skin_share": by_angle(self.skin_share),
+            "gloss_share": by_angle(self.gloss_share),
+            "subsurface_scale": float(self.subsurface_scale),
+            "gloss_omission": None if self.gloss_omission is None else {
+                tier: by_angle(table) for tier, table in self.gloss_omission.items()},
+            "gloss_scale": float(self.gloss_scale),
+        }
+
+    @classmethod
+    def from_dict(cls, data: dict) -> MaterialTraits:
+        """The traits :meth:`as_dict` wrote (``KeyError``, ``TypeError`` or ``ValueError``
+        when an entry is missing or malformed)."""
+        def by_angle(table):
+            return {float(angle): float(value) for angle, value in table.items()}
+
+        omission = data["gloss_omission"]
+        return cls(
+            tier_errors={str(tier): float(e) for tier, e in data["tier_errors"].items()},
+            radius_mm=np.asarray(data["radius_mm"], float),
+            profile=np.asarray(data["profile"], float),
+            profile_mismatch=float(data["profile_mismatch"]),
+            skin_share=by_angle(data["skin_share"]),
+            gloss_share=by_angle(data["gloss_share"]),
+            subsurface_scale=float(data["subsurface_scale"]),
+            gloss_omission=None if omission is None else {
+                str(tier): by_angle(table) for tier, table in omission.items()},
+            gloss_scale=float(data["gloss_scale"]),
+        )
+
+
+def _at_angle(table: dict, light_deg: float) -> float:
+    """A per-light-angle table at ``light_deg`` (linear between its angles, held beyond)."""
+    angles = sorted(table)
+    return float(np.interp(light_deg, angles, [table[a] for a in angles]))
+
+
+def profile_mean_radius_mm(radius_mm, profile) -> float:
+    """Mean distance (mm) between where light enters and leaves: ``Int d P(d) 2 pi d dd`` of
+    the normalised profile ``P = R/Rd`` (largest over channels)."""
+    d = np.asarray(radius_mm, float)
+    p = np.reshape(np.asarray(profile, float), (d.size, -1))
+    w = trapezoid_weights(d)
+    mass = w @ (p * (2.0 * np.pi * d)[:, None])
+    mean = w @ (p * (2.0 * np.pi * d * d)[:, None])
+    return float(np.max(mean / np.maximum(mass, 1e-300)))
+
+
+def gloss_and_skin_shares(tables, light_deg: float, coverage=None, absorption=None, *,
+                          resolution: int = 48) -> tuple[float, float]:
+    """``(gloss share, skin share)`` of a sphere's image under one distant light
+    ``light_deg`` from the view (orthographic, the reference's framing): relative RMS over
+    the lit pixels of the gloss lobes' radiance (film, path-3 and skin gloss at the coverage
+    and absorption) and of the skin's diffuse part (what spreads), against the total radiance
+    ``f cos(theta_i)`` from the tables."""
+    _, wi, wo = sphere_directions(resolution, light_deg)
+    w, a = tables.coverage_and_absorption(coverage, absorption)
+    weights = coverage_weights(w, a)
+    cos_i = wi[:, 2:3]
+    total = tables.made_up_reflection(wi, wo, w, a) * cos_i
+    gloss = combine(weights, top=tables.angular("film_gloss", wi, wo),
+                    twice=tables.angular("path3_gloss", wi, wo),
+                    bare=tables.angular("skin_gloss", wi, wo)) * cos_i
+    t_i = tables.directional("film_transmittance", polar_angle_deg(wi))
+    t_o = tables.directional("film_transmittance", polar_angle_deg(wo))
+    skin = combine(weights, twice=tables.skin_diffuse * t_i * t_o,
+                   bare=tables.skin_diffuse) * cos_i
+    norm = np.sqrt(np.mean(total**2))
+    if not norm > 0:
+        return 0.0, 0.0
+    return float(np.sqrt(np.mean(gloss**2)) / norm), float(np.sqrt(np.mean(skin**2)) / norm)
+
+
+def gloss_omission_error(tables, fit, tier: str, light_deg: float, coverage=None,
+                         absorption=None, *, resolution: int = 48) -> float:
+    """Relative RMS change of a sphere's image (orthographic, one distant light ``light_deg``
+    from the view, the lit pixels) when ``tier``'s Gloss input goes from 1 to 0: the tier's
+    replica (:data:`lut_baker.closures.tiers.TIER_REPLICAS` with the closure fit ``fit``) with
+    and without its gloss lobes, over the RMS of the tables' radiance ``f cos(theta_i)``, at
+    the coverage and absorption (default: the tables')."""
+    _, wi, wo = sphere_directions(resolution, light_deg)
+    w, a = tables.coverage_and_absorption(coverage, absorption)
+    cos_i = wi[:, 2:3]
+    norm = np.sqrt(np.mean((tables.made_up_reflection(wi, wo, w, a) * cos_i) ** 2))
+    if not norm > 0:
+        return 0.0
+    replica = TIER_REPLICAS[tier]
+    kept, left_out = (replica(fit, tables, w, a, gloss, (wi, wo)) for gloss in (1.0, 0.0))
+    return float(np.sqrt(np.mean(((kept - left_out) * cos_i) ** 2)) / norm)
+
+
+def gloss_omissions(tables, fit, coverage=None, absorption=None, *,
+                    lights_deg=None) -> dict:
+    """:func:`gloss_omission_error` of every tier at ``lights_deg`` (default
+    :data:`SHARE_LIGHTS_DEG`): ``{tier: {light angle: error}}``."""
+    lights = SHARE_LIGHTS_DEG if lights_deg is None else lights_deg
+    return {tier: {float(light): gloss_omission_error(tables, fit, tier, light, coverage,
+                                                      absorption)
+                   for light in lights} for tier in TIERS}
+
+
+def profile_mismatch(tables, fit_error) -> float:
+    """Relative error of a fitted subsurface closure's blur: ``fit_error`` (per channel, the
+    RMS difference of its edge response and the tables', a fraction of the lit level:
+    :class:`lut_baker.closures.profiles.ProfileFit` ``error``) over the RMS of the tables' edge
+    response's departure from a sharp edge, largest over channels."""
+    r_max = float(tables.radius_mm[-1])
+    r = profile_grid(r_max)
+    s = np.linspace(0.0, r_max, 48)
+    reference = edge_response(r, tables.radial(r), s)
+    departure = np.sqrt(np.mean(reference**2, axis=0))  # the sharp edge is 0 inside
+    return float(np.max(np.asarray(fit_error, float) / np.maximum(departure, 1e-12)))
+
+
+SHARE_LIGHTS_DEG = (0.0, 45.0, 75.0, 89.0)
+"""Light angles (degrees from the view) at which :func:`traits_from_tables` measures the
+shares."""
+
+
+def traits_from_tables(tables, fit, coverage=None, absorption=None, *,
+                       lights_deg=SHARE_LIGHTS_DEG, method: str | None = None,
+                       errors: dict | None = None) -> MaterialTraits:
+    """:class:`MaterialTraits` of baked ``tables`` and their
+    :class:`lut_baker.closures.closure_fit.ClosureFit` ``fit`` at a coverage and absorption
+    (default:
+    the tables'); ``errors``: the fit's :func:`lut_baker.closures.tiers.tier_errors` there,
+    if already measured."""
+    w, a = tables.coverage_and_absorption(coverage, absorption)
+    errors = tier_errors(fit, tables, w, a) if errors is None else errors
+    shares = {float(angle): gloss_and_skin_shares(tables, angle, w, a) for angle in lights_deg}
+    return MaterialTraits(
+        tier_errors={tier: float(e.rms) for tier, e in errors.items()},
+        radius_mm=np.asarray(tables.radius_mm, float),
+        profile=np.asarray(tables.profile, float),
+        profile_mismatch=profile_mismatch(
+            tables, fit.profiles[method or fit.subsurface_method].error),
+        skin_share={angle: value[1] for angle, value in shares.items()},
+        gloss_share={angle: value[0] for angle, value in shares.items()},
+        gloss_omission=gloss_omissions(tables, fit, w, a, lights_deg=lights_deg),
+    )
+
+
+_PAPER = load()["paper_traits"]
+TRAITS_COMMAND = _PAPER["command"]
+PAPER_TIER_ERRORS = {tier: float(error) for tier, error in _PAPER["tier_errors"].items()}
+PAPER_MISMATCH = float(_PAPER["profile_mismatch"])
+PAPER_SKIN_SHARE = by_number(_PAPER["skin_share"])
+PAPER_GLOSS_SHARE = by_number(_PAPER["gloss_share"])
+PAPER_GLOSS_OMISSION = {tier: by_number(by_light)
+                        for tier, by_light in _PAPER["gloss_omission"].items()}
+"""The paper preset's traits (foundation paper_natural on paper_bioplate, coverage 1,
+absorption 0, default bake, closure fit with Burley) as :data:`TRAITS_COMMAND` measures them
+into ``measured.json``: what the Auto tier assumes of a material it has no tables for yet."""
+
+
+def _paper_traits() -> MaterialTraits:
+    """The constants above with the paper dipole's profile on the bake's
+    radial grid (exact and cheap to recompute)."""
+    dipole = made_up_skin("paper_natural", "paper_bioplate").dipole
+    res = RESOLUTIONS["default"]
+    radius = radius_nodes(res.n_radius, res.radius_spacing, profile_radius(dipole))
+    profile = np.reshape(dipole_profile(radius, dipole), (radius.size, -1))
+    profile = profile / np.atleast_1d(dipole_total_reflectance(dipole)) * np.ones(3)
+    return MaterialTraits(tier_errors=dict(PAPER_TIER_ERRORS), radius_mm=radius,
+                          profile=profile, profile_mismatch=PAPER_MISMATCH,
+                          skin_share=dict(PAPER_SKIN_SHARE), gloss_share=dict(PAPER_GLOSS_SHARE),
+                          gloss_omission={tier: dict(by_light) for tier, by_light
+                                          in PAPER_GLOSS_OMISSION.items()})
+
+
+@lru_cache(maxsize=1)
+def paper_traits() -> MaterialTraits:
+    """The paper preset's :class:`MaterialTraits` (the constants above; built once)."""
+    return _paper_traits()

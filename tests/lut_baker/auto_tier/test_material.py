@@ -1,0 +1,62 @@
+"""What the Auto tier needs of a material (lut_baker.auto_tier.material): the profile's mean
+radius, the shares of a sphere's image, the gloss each tier leaves out."""
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from lut_baker import auto_tier
+
+ROOT = Path(__file__).resolve().parents[3]
+
+
+def test_mean_radius_of_a_burley_profile():
+    """Cycles' Burley profile (shape length d, cut at a = 16 d, renormalised) has the mean
+    distance ``[I(d) + I(3d)] / (4 d cdf)`` with ``I(s) = s^2 (1 - e^(-a/s) (1 + a/s))``
+    (2.44 d; 2.5 d uncut)."""
+    from lut_baker.closures.cycles import BURLEY_MFP_SCALE, burley_profile
+
+    radius = 6.0
+    s = radius * BURLEY_MFP_SCALE
+    a = 16.0 * s
+
+    def moment(length):
+        return length**2 * (1.0 - math.exp(-a / length) * (1.0 + a / length))
+
+    cdf = 1.0 - 0.25 * math.exp(-16.0) - 0.75 * math.exp(-16.0 / 3.0)
+    expected = (moment(s) + moment(3.0 * s)) / (4.0 * s * cdf)
+    d = np.concatenate([[0.0], np.geomspace(1e-6, a * (1 - 1e-9), 20000)])
+    mean = auto_tier.profile_mean_radius_mm(d, burley_profile(d, radius))
+    assert mean == pytest.approx(expected, rel=1e-3)
+
+
+def test_shares_add_up(paper_tables):
+    """Gloss and skin light are parts of the image: each share is in (0, 1); bare skin is
+    nearly all skin light, full film mostly not (the film hides the skin)."""
+    gloss, skin = auto_tier.gloss_and_skin_shares(paper_tables, 45.0, 1.0, 0.0)
+    bare_gloss, bare_skin = auto_tier.gloss_and_skin_shares(paper_tables, 45.0, 0.0, 0.0)
+    assert 0.0 < gloss < 1.0 and 0.0 < skin < 0.5 and bare_skin > 0.9 > bare_gloss
+    _, absorbed = auto_tier.gloss_and_skin_shares(paper_tables, 45.0, 1.0, 1.0)
+    assert absorbed == 0.0
+
+
+def test_gloss_omission_is_the_tiers_gloss(paper_tables, paper_fit, matte):
+    """What Gloss 0 changes in a sphere's image, from the tiers' replicas: for the paper's
+    film within 15% of the tables' gloss share (the fits reproduce the gloss lobes) and the
+    stored constants; for a film of index 1.01 under 1.5% at every light angle."""
+    from lut_baker.closures import tiers
+
+    omissions = auto_tier.gloss_omissions(paper_tables, paper_fit, lights_deg=(0.0, 45.0))
+    for tier, by_light in omissions.items():
+        for light, value in by_light.items():
+            share, _ = auto_tier.gloss_and_skin_shares(paper_tables, light)
+            assert value == pytest.approx(share, rel=0.15), (tier, light)
+            assert value == pytest.approx(auto_tier.PAPER_GLOSS_OMISSION[tier][light],
+                                          rel=0.05), (tier, light)  # default against preview
+    _, tables, fit = matte
+    traits = auto_tier.traits_from_tables(tables, fit)
+    for tier in tiers.TIERS:
+        assert max(traits.gloss_omission[tier].values()) < 0.015, tier
+        assert traits.gloss_error(tier, 45.0) == traits.gloss_omission[tier][45.0]
