@@ -65,14 +65,6 @@ def test_each_engine_gets_the_tier_made_for_it():
     assert len(set(auto_tier.EEVEE_CANDIDATES)) == 4
 
 
-def _traits(gloss_share):
-    paper = auto_tier.paper_traits()
-    return auto_tier.MaterialTraits(
-        tier_errors=dict(paper.tier_errors), radius_mm=paper.radius_mm, profile=paper.profile,
-        profile_mismatch=paper.profile_mismatch, skin_share=dict(paper.skin_share),
-        gloss_share={angle: gloss_share for angle in paper.gloss_share})
-
-
 def test_gloss_below_the_noise_needs_no_gloss_lobe():
     """A gloss of 1% of the image, under the noise of the fullest tier (6% at 16 samples, 3%
     at 64), is left out far away and close up (subsurface kept); the paper's 19% never is.
