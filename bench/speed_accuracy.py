@@ -15,7 +15,10 @@ load of a shared machine falls on all alike.
 Against the reference (:func:`lut_baker.offline.validation.compare.reference_image`, paths 1 + 3
 from "high" tables, the skin's diffuse part spread by the dipole profile): relative RMS error over
 the sphere's pixels (mean of the two seeds), the noise floor ``rms(a - b) / sqrt(2)`` and the time
-per render (mean of the two). The bake axis: per bake resolution, the tables' size, bake time
+per render (mean of the two). EEVEE points: the EEVEE tier and the Principled tier in EEVEE
+(software OpenGL here) at :data:`EEVEE_SAMPLES` samples, shadows off, one render each (EEVEE's
+images do not depend on a seed), time per frame after a first render compiled the shaders.
+The bake axis: per bake resolution, the tables' size, bake time
 (median of 3), table error
 (:func:`lut_baker.offline.validation.table_accuracy.table_error`, 500 points) and the LAYERED
 tier's render error at 256 samples, light 45 degrees, seed 0. 48 px keeps the whole run near 8
@@ -52,9 +55,15 @@ from lut_baker.offline.validation.baseline import fit_baseline  # noqa: E402
 DOCS = ROOT / "docs"
 BEGIN, END = "<!-- results:begin -->", "<!-- results:end -->"
 CONFIGS = ("PRINCIPLED", "LAYERED", "BASELINE")
+EEVEE_CONFIGS = ("EEVEE", "PRINCIPLED_EEVEE")
+"""The tiers rendered in EEVEE: the EEVEE tier, the Principled tier."""
+EEVEE_TIERS = {"EEVEE": "EEVEE", "PRINCIPLED_EEVEE": "PRINCIPLED"}
+EEVEE_SAMPLES = (16, 64)
 LABELS = {"PRINCIPLED": "Principled tier", "LAYERED": "Layered tier",
-          "BASELINE": "baseline (stock Principled)"}
-COLOURS = {"PRINCIPLED": "tab:blue", "LAYERED": "tab:orange", "BASELINE": "tab:grey"}
+          "BASELINE": "baseline (stock Principled)", "EEVEE": "EEVEE tier in EEVEE",
+          "PRINCIPLED_EEVEE": "Principled tier in EEVEE"}
+COLOURS = {"PRINCIPLED": "tab:blue", "LAYERED": "tab:orange", "BASELINE": "tab:grey",
+           "EEVEE": "tab:green", "PRINCIPLED_EEVEE": "tab:purple"}
 RADIUS_MM = 10.0
 SEEDS = (0, 1)
 SPREAD_PER_MEAN_FREE_PATH = 1.5
@@ -128,6 +137,7 @@ def render_rows(skin, tables, baseline, refs: dict, size: int, sample_counts,
                     scene_module.set_samples(scene, GOAL_SAMPLES, 0)
                     _, image = scene_module.render_image()
                     bake_errors[resolution] = compare.relative_rms(image, ref)
+            rows += eevee_rows(sphere, tables, ref, light, size)
         for (name, samples), runs in results.items():
             (t0, a), (t1, b) = runs
             error = 0.5 * (compare.relative_rms(a, ref) + compare.relative_rms(b, ref))
@@ -142,6 +152,32 @@ def render_rows(skin, tables, baseline, refs: dict, size: int, sample_counts,
         for row, on in zip(mine, front, strict=True):
             row["pareto"] = bool(on)
     return rows, bake_errors
+
+
+def eevee_rows(sphere, tables, ref, light: float, size: int) -> list[dict]:
+    """The EEVEE points at one light (the add-on registered, the scene's sphere given): per
+    configuration of :data:`EEVEE_CONFIGS` and sample count, the error against ``ref`` and the
+    time per frame (a first render per material compiles its shaders)."""
+    import bpy
+    from support import bench_scene as scene_module
+
+    scene = bpy.context.scene
+    materials = {name: scene_module.tier_material(sphere, tables, tier)
+                 for name, tier in EEVEE_TIERS.items()}
+    scene_module.use_eevee(scene, EEVEE_SAMPLES[0])
+    rows = []
+    for name, material in materials.items():
+        scene_module.set_material(sphere, material)
+        scene_module.render_image()  # compile
+        for samples in EEVEE_SAMPLES:
+            scene_module.set_samples(scene, samples)
+            seconds, image = scene_module.render_image()
+            error = compare.relative_rms(image, ref)
+            print(f"  light {light:g}, {name} in EEVEE, {samples} samples: {seconds:.2f} s, "
+                  f"error {error:.4f}", flush=True)
+            rows.append(_row(axis="eevee", config=name, light_deg=light, samples=samples,
+                             size_px=size, seconds=seconds, error=error))
+    return rows
 
 
 def bake_rows(skin, runs: int = 3):
@@ -232,6 +268,14 @@ def chart(rows, path: Path) -> None:
             for r in points:
                 ax.annotate(str(r["samples"]), (r["seconds"], r["error"]), fontsize=7,
                             xytext=(3, 3), textcoords="offset points")
+        for name in EEVEE_CONFIGS:
+            points = sorted((r for r in rows if r["axis"] == "eevee" and r["config"] == name
+                             and r["light_deg"] == light), key=lambda r: r["samples"])
+            ax.plot([r["seconds"] for r in points], [r["error"] for r in points], "s--",
+                    color=COLOURS[name], label=LABELS[name])
+            for r in points:
+                ax.annotate(str(r["samples"]), (r["seconds"], r["error"]), fontsize=7,
+                            xytext=(3, 3), textcoords="offset points")
         front = sorted((r for r in mine if r["pareto"]), key=lambda r: r["seconds"])
         ax.plot([r["seconds"] for r in front], [r["error"] for r in front], "k--", lw=0.8)
         ax.scatter([r["seconds"] for r in front], [r["error"] for r in front], s=90,
@@ -243,8 +287,8 @@ def chart(rows, path: Path) -> None:
         ax.set_ylabel("relative RMS error vs reference")
         ax.set_title(f"light {light:g} deg from the view")
         ax.grid(True, which="both", alpha=0.3)
-    axes[0][0].legend(fontsize=7, title="dotted: noise floor; labels: samples",
-                      title_fontsize=7)
+    axes[0][0].legend(fontsize=7, title="dotted: noise floor; labels: samples; squares: EEVEE "
+                      "(software OpenGL), time per frame", title_fontsize=7)
     if baked:
         ax = axes[0][-1]
         size = [r["table_mb"] for r in baked]
@@ -264,7 +308,8 @@ def chart(rows, path: Path) -> None:
         ax.set_title("bake resolution")
         ax.legend(fontsize=7)
         ax.grid(True, which="both", alpha=0.3)
-    fig.suptitle("Made-up Skin, paper preset, 10 mm sphere, 48 px, Cycles CPU", fontsize=10)
+    fig.suptitle("Made-up Skin, paper preset, 10 mm sphere, 48 px, Cycles CPU and EEVEE",
+                 fontsize=10)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
@@ -286,6 +331,13 @@ def markdown(rows, goal_rows, seconds: float) -> str:
                      f"{r['seconds']:.2f} | {_percent(r['error'])} | "
                      f"{_percent(r['noise_floor'])} | {_percent(r['bias'])} | "
                      f"{'yes' if r['pareto'] else ''} |")
+    eevee = [r for r in rows if r["axis"] == "eevee"]
+    if eevee:
+        lines += ["", "In EEVEE (5.0.1, software OpenGL; one render each, time per frame "
+                  "after the shaders compiled):", "",
+                  "| light | config | samples | s per frame | error |", "|---|---|---|---|---|"]
+        lines += [f"| {r['light_deg']:g} | {LABELS[r['config']]} | {r['samples']} | "
+                  f"{r['seconds']:.2f} | {_percent(r['error'])} |" for r in eevee]
     baked = [r for r in rows if r["axis"] == "bake"]
     if baked:
         lines += ["", "| bake resolution | angular entries | MB | bake ms | table error | "

@@ -41,8 +41,6 @@ import time
 import traceback
 from pathlib import Path
 
-import numpy as np
-
 REPO_ROOT = Path(__file__).resolve().parent.parent
 for _path in (REPO_ROOT, REPO_ROOT / "tests"):
     if str(_path) not in sys.path:
@@ -50,7 +48,7 @@ for _path in (REPO_ROOT, REPO_ROOT / "tests"):
 
 from support import character, sphere_scene  # noqa: E402  (tests/support/)
 
-__all__ = ["main", "WorkflowError", "check", "apply_foundation", "save_png", "run_reporting"]
+__all__ = ["main", "WorkflowError", "check", "apply_foundation", "run_reporting"]
 
 FOUNDATIONS = ("light_ivory", "medium_beige", "deep_mocha")
 COVERAGE_OFFSET = (0.0, 0.35)
@@ -126,17 +124,9 @@ def apply_foundation(obj, foundation: str, args):
 
 def _strip(paths, out_path: Path, gap: int = GAP_PX) -> None:
     """The PNGs ``paths`` side by side, ``gap`` white pixels between them, as a PNG."""
-
-    panels = [sphere_scene.image_pixels(p) for p in paths]
-    height = panels[0].shape[0]
-    check(all(p.shape[0] == height for p in panels), "strip panels differ in height")
-    width = sum(p.shape[1] for p in panels) + gap * (len(panels) - 1)
-    strip = np.ones((height, width, 4), np.float32)
-    x = 0
-    for panel in panels:
-        strip[:, x:x + panel.shape[1], :3] = panel[..., :3]
-        x += panel.shape[1] + gap
-    save_png(strip, out_path)
+    strip = sphere_scene.tile([[sphere_scene.image_pixels(p) for p in paths]], gap)
+    height, width = strip.shape[:2]
+    sphere_scene.save_png(strip, out_path)
     print(f"render_character: {out_path.name:<26} {len(paths)} panels, {width}x{height} px",
           flush=True)
 
@@ -311,23 +301,6 @@ def main(argv=None) -> int:
     parser.add_argument("--seed", type=int, default=0, help="texture and Cycles seed")
     args = parser.parse_args(argv)
     return run_reporting("render_character", run, args)
-
-
-def save_png(rgba: np.ndarray, out_path) -> None:
-    """Write ``rgba`` ``(height, width, 4)`` (rows bottom-up, as Blender's) as a PNG through a
-    temporary bpy image, which is removed again."""
-    import bpy
-
-    height, width = rgba.shape[:2]
-    image = bpy.data.images.new(out_path.stem, width, height, alpha=True, float_buffer=False)
-    try:
-        image.pixels.foreach_set(np.ascontiguousarray(rgba, np.float32).ravel())
-        image.filepath_raw = str(out_path)
-        image.file_format = "PNG"
-        image.save()
-    finally:
-        bpy.data.images.remove(image)
-    check(out_path.is_file(), f"{out_path} was not written")
 
 
 def run_reporting(name: str, run, args) -> int:

@@ -45,7 +45,7 @@ for _path in (REPO_ROOT, REPO_ROOT / "tests", REPO_ROOT / "tools"):
         sys.path.insert(0, str(_path))
 
 import render_character  # noqa: E402  (tools/render_character.py: Apply and its checks)
-from render_character import apply_foundation, check, run_reporting, save_png  # noqa: E402
+from render_character import apply_foundation, check, run_reporting  # noqa: E402
 from support import character, sphere_scene  # noqa: E402  (tests/support/)
 
 __all__ = ["main", "PRODUCTS"]
@@ -89,22 +89,10 @@ def _shoot(tmp: Path, name: str, what: str) -> np.ndarray:
 def _grid(rows, out_path: Path, gap: int = GAP_PX) -> None:
     """Tiles ``rows`` (lists of equal-sized pixel arrays, top row first; None: a white cell)
     as a grid with ``gap`` white pixels between cells, written as a PNG through a bpy image."""
-
-    tile = next(t for row in rows for t in row if t is not None)
-    th, tw = tile.shape[:2]
+    grid = sphere_scene.tile(rows, gap)
+    height, width = grid.shape[:2]
     columns = max(len(row) for row in rows)
-    width = columns * tw + gap * (columns - 1)
-    height = len(rows) * th + gap * (len(rows) - 1)
-    grid = np.ones((height, width, 4), np.float32)
-    for r, row in enumerate(rows):
-        y = height - (r + 1) * th - r * gap  # Blender's rows run bottom-up
-        for c, panel in enumerate(row):
-            if panel is None:
-                continue
-            check(panel.shape[:2] == (th, tw), "grid tiles differ in size")
-            x = c * (tw + gap)
-            grid[y:y + th, x:x + tw, :3] = panel[..., :3]
-    save_png(grid, out_path)
+    sphere_scene.save_png(grid, out_path)
     print(f"render_foundations: {out_path.name:<36} {len(rows)} rows x {columns} columns, "
           f"{width}x{height} px", flush=True)
 

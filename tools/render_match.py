@@ -125,26 +125,9 @@ def _save_png(path: Path, scene) -> float:
 
 
 def _strip(rows, out_path: Path) -> None:
-    """PNG rows (lists of paths) as one image, ``GAP_PX`` white pixels between panels."""
-    import bpy
-
-    panels = [[sphere_scene.image_pixels(p) for p in row] for row in rows]
-    height = panels[0][0].shape[0]
-    width = max(sum(p.shape[1] for p in row) + GAP_PX * (len(row) - 1) for row in panels)
-    total = len(panels) * height + GAP_PX * (len(panels) - 1)
-    image = np.ones((total, width, 4), np.float32)
-    for r, row in enumerate(panels):
-        y = total - (r + 1) * height - r * GAP_PX  # rows are bottom-up
-        x = 0
-        for panel in row:
-            image[y:y + height, x:x + panel.shape[1], :3] = panel[..., :3]
-            x += panel.shape[1] + GAP_PX
-    picture = bpy.data.images.new("match strip", width, total, alpha=False)
-    picture.pixels.foreach_set(image.ravel())
-    picture.filepath_raw = str(out_path)
-    picture.file_format = "PNG"
-    picture.save()
-    bpy.data.images.remove(picture)
+    """The PNGs ``rows`` (lists of paths, top row first) as one picture, white gaps between."""
+    sphere_scene.save_png(sphere_scene.tile(
+        [[sphere_scene.image_pixels(p) for p in row] for row in rows], GAP_PX), out_path)
 
 
 def run_tone(tone: str, args, out: Path, work: Path) -> dict:

@@ -36,7 +36,7 @@ skin (EEVEE's screen-space subsurface at the terminator), 2.9-3.2% at coverage 0
 4.4-4.9% at full coverage (the paper film's gloss, which no GGX lobe EEVEE can render
 follows closer: docs/addon.md, "The EEVEE tier")."""
 REPLICA_BOUND = 0.01
-"""Full coverage against the tier's replica (:func:`lut_baker.closures.fitting.
+"""Full coverage against the tier's replica (:func:`lut_baker.closures.tiers.
 eevee_tier_reflection`, no spread; the film hides the skin's): measured 0.3-0.5%, against
 1.8-2.6% for the same lobes as Cycles renders them."""
 
@@ -72,20 +72,26 @@ def renders(bpy_factory, made_up):
     return out
 
 
-def _reference(skin, tables, coverage, light):
-    at = skin.replace(coverage=coverage)
-    return compare.reference_image(
-        at, tables=tables, resolution=SIZE, radius_mm=RADIUS_MM, light_angle_deg=light,
-        irradiance=scene_module.IRRADIANCE,
-        samples=reference.default_samples(at, RADIUS_MM, SPREAD_PER_MEAN_FREE_PATH))
+@pytest.fixture(scope="module")
+def references(made_up):
+    """``{(coverage, light): image}``: the exact model's images."""
+    skin, tables, _ = made_up
+    out = {}
+    for coverage in COVERAGES:
+        at = skin.replace(coverage=coverage)
+        samples = reference.default_samples(at, RADIUS_MM, SPREAD_PER_MEAN_FREE_PATH)
+        for light in LIGHTS_DEG:
+            out[coverage, light] = compare.reference_image(
+                at, tables=tables, resolution=SIZE, radius_mm=RADIUS_MM,
+                light_angle_deg=light, irradiance=scene_module.IRRADIANCE, samples=samples)
+    return out
 
 
 @pytest.mark.parametrize("light", LIGHTS_DEG)
 @pytest.mark.parametrize("coverage", COVERAGES)
-def test_eevee_tier_against_the_exact_image(renders, made_up, coverage, light):
-    skin, tables, _ = made_up
+def test_eevee_tier_against_the_exact_image(renders, references, coverage, light):
     image = renders[coverage, light]
-    ref = _reference(skin, tables, coverage, light)
+    ref = references[coverage, light]
     mask = compare.sphere_mask(SIZE)
     assert np.all(np.isfinite(image)) and np.all(image >= 0.0)
     assert np.sum(image[~mask]) < 1e-3 * np.sum(image[mask])
@@ -94,6 +100,24 @@ def test_eevee_tier_against_the_exact_image(renders, made_up, coverage, light):
           f"mean {image[mask].mean() / ref[mask].mean():.3f} of it")
     assert error < BIAS_BOUND[coverage]
     assert image[mask].mean() == pytest.approx(ref[mask].mean(), rel=0.02)
+
+
+TARGET = 0.02
+"""The goal set for the tier: at most 2% against the exact image on every image."""
+
+
+@pytest.mark.xfail(strict=True, reason="not reached: the paper film's gloss at full coverage "
+                   "(4.4-4.9%) and EEVEE's subsurface on bare skin (2-3%): docs/addon.md, "
+                   "'The EEVEE tier'")
+def test_eevee_tier_within_the_target_on_every_image(renders, references):
+    """Strict: passes (and so fails the suite) the day the tier reaches its goal, so that the
+    bounds above are tightened then."""
+    errors = {case: compare.relative_rms(image, references[case])
+              for case, image in renders.items()}
+    worst = max(errors, key=errors.get)
+    assert errors[worst] <= TARGET, (
+        f"coverage {worst[0]:g}, light {worst[1]:g}: {100 * errors[worst]:.2f}% against "
+        f"the exact image; target {100 * TARGET:g}%")
 
 
 @pytest.mark.parametrize("light", LIGHTS_DEG)

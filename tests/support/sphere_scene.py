@@ -17,6 +17,7 @@ Functions (for the tests, the benchmarks and the scripts):
 - :func:`render` -- render to PNG and EXR; returns seconds.
 - :func:`render_pixels` -- render to a float EXR and return its pixels; :func:`image_pixels`
   an image file's pixels.
+- :func:`tile` -- pictures as a grid with white gaps; :func:`save_png` -- pixels as a PNG.
 """
 
 from __future__ import annotations
@@ -28,7 +29,7 @@ from pathlib import Path
 
 __all__ = ["build_scene", "light_and_camera", "black_world", "cycles_settings",
            "addon_registered", "made_up_material", "coverage_ramp", "render", "render_pixels",
-           "image_pixels", "add_sphere", "IRRADIANCE"]
+           "image_pixels", "add_sphere", "tile", "save_png", "IRRADIANCE"]
 
 IRRADIANCE = math.pi
 """Sun strength (W/m^2): a white Lambertian surface facing the sun renders as 1.0."""
@@ -218,3 +219,52 @@ def render_pixels(exr_path):
     scene.render.filepath = str(exr_path)
     bpy.ops.render.render(write_still=True)
     return image_pixels(scene.render.filepath)[..., :3]
+
+
+def tile(rows, gap: int = 4):
+    """``rows`` of pixel arrays ``(height, width, >=3)`` (top row first; ``None``: a white
+    cell; cells of a row side by side, as wide as they are) as one RGBA array with ``gap``
+    white pixels between cells and rows, rows bottom-up (Blender's order).  Every cell is as
+    high as the first."""
+    import numpy as np
+
+    first = next(t for row in rows for t in row if t is not None)
+    cell_height = first.shape[0]
+    if any(t is not None and t.shape[0] != cell_height for row in rows for t in row):
+        raise ValueError("the cells differ in height")
+    cell_width = first.shape[1]
+
+    def width_of(t):
+        return cell_width if t is None else t.shape[1]
+
+    width = max(sum(width_of(t) for t in row) + gap * (len(row) - 1) for row in rows)
+    height = len(rows) * cell_height + gap * (len(rows) - 1)
+    out = np.ones((height, width, 4), np.float32)
+    for r, row in enumerate(rows):
+        y = height - (r + 1) * cell_height - r * gap
+        x = 0
+        for cell in row:
+            if cell is not None:
+                out[y:y + cell_height, x:x + cell.shape[1], :3] = cell[..., :3]
+            x += width_of(cell) + gap
+    return out
+
+
+def save_png(rgba, out_path) -> None:
+    """Write ``rgba`` ``(height, width, 4)`` (rows bottom-up, as Blender's) as a PNG through a
+    temporary bpy image, which is removed again."""
+    import bpy
+    import numpy as np
+
+    height, width = rgba.shape[:2]
+    image = bpy.data.images.new(Path(out_path).stem, width, height, alpha=True,
+                                float_buffer=False)
+    try:
+        image.pixels.foreach_set(np.ascontiguousarray(rgba, np.float32).ravel())
+        image.filepath_raw = str(out_path)
+        image.file_format = "PNG"
+        image.save()
+    finally:
+        bpy.data.images.remove(image)
+    if not Path(out_path).is_file():
+        raise OSError(f"{out_path} was not written")
