@@ -23,10 +23,13 @@ foundation: rendered once):
   Cycles with Cycles' noise removed, ``sqrt(e^2 - s^2)`` with ``e`` the mean relative RMS of
   EEVEE against the two Cycles images and ``s`` their noise floor
   (:func:`lut_baker.offline.validation.compare.noise_floor`);
-- **Principled tier in EEVEE**, the same samples: its error, and (paper preset only: EEVEE
-  frames take 20-40 s here, and the time hardly depends on the foundation) the time per
-  frame of the two tiers in EEVEE (shaders compiled first; renders interleaved; median of
-  :data:`TIME_REPEATS`).
+- **Principled tier in EEVEE**, the same samples: its error, and (paper preset only, light
+  :data:`TIME_LIGHT_DEG`, at :data:`TIME_SAMPLES` samples: EEVEE frames take 20-40 s here, and
+  the time hardly depends on the foundation) the time per frame of the two tiers in EEVEE
+  (shaders compiled first; renders interleaved; median of :data:`TIME_REPEATS`).
+
+Each case (foundation, coverage) runs in a process of its own and appends its rows to
+``bench/results/eevee_tier.jsonl``; a run that stopped resumes from there.
 
 ``--costs``: the EEVEE tier's four candidates (with or without subsurface and gloss, as Fit to
 Scene sets them) at coverage 1 and 0, light 45 degrees, time per frame relative to the fullest
@@ -38,9 +41,11 @@ from __future__ import annotations
 
 import argparse
 import csv
+import json
 import math
 import os
 import statistics
+import subprocess
 import sys
 import tempfile
 import time
@@ -68,7 +73,12 @@ COVERAGES = (0.0, 0.5, 1.0)
 LIGHTS_DEG = (0.0, 45.0, 75.0)
 SIZE = 64
 RADIUS_MM = 10.0
-EEVEE_SAMPLES = 64
+EEVEE_SAMPLES = 16
+"""EEVEE samples of the images compared: they move by 0.2% from 16 to 64."""
+TIME_SAMPLES = 64
+"""EEVEE samples of the timed frames (an artist's final frame)."""
+TIME_LIGHT_DEG = 45.0
+"""The light of the timed frames (time hardly depends on it)."""
 CYCLES_SAMPLES = 1024
 SEEDS = (0, 1)
 TIME_REPEATS = 3
@@ -105,9 +115,12 @@ def _median(values) -> float:
     return statistics.median(values) if values else float("nan")
 
 
-def measure(foundations, *, eevee_samples=EEVEE_SAMPLES, cycles_samples=CYCLES_SAMPLES,
-            repeats=TIME_REPEATS) -> list[dict]:
-    """Every row of the table (module docstring)."""
+def measure_case(foundation: str, coverage: float, *, timed: bool,
+                 eevee_samples=EEVEE_SAMPLES, cycles_samples=CYCLES_SAMPLES,
+                 repeats=TIME_REPEATS) -> list[dict]:
+    """The rows of one foundation and coverage, one per light (module docstring); with
+    ``timed``, the time per frame of both tiers at :data:`TIME_SAMPLES` samples and light
+    :data:`TIME_LIGHT_DEG` (the shaders compiled first, renders interleaved)."""
     import bpy
     from support import bench_scene as scene_module
     from support import sphere_scene
@@ -117,53 +130,96 @@ def measure(foundations, *, eevee_samples=EEVEE_SAMPLES, cycles_samples=CYCLES_S
     sun = scene.objects["Sun"]
     rows = []
     with sphere_scene.addon_registered():
-        for foundation, coverage in _cases(foundations):
-            skin = _skin(foundation, coverage)
-            tables = bake.bake(skin, "default")
-            high = bake.bake(skin, "high")
-            materials = {}
-            for tier in ("EEVEE", "PRINCIPLED"):
-                sphere.data.materials.clear()
-                materials[tier] = sphere_scene.made_up_material(sphere, tables, tier,
-                                                                coverage=coverage)
-            for light in LIGHTS_DEG:
-                sun.rotation_euler = (math.pi / 2, 0.0, math.radians(light))
-                ref = _reference(skin, high, light)
-                scene_module.use_eevee(scene, eevee_samples)
-                images, seconds = {}, {"EEVEE": [], "PRINCIPLED": []}
-                for tier in materials:  # compile both shaders first
-                    scene_module.set_material(sphere, materials[tier])
-                    images[tier] = scene_module.render_image()[1]
-                for _ in range(repeats if foundation == foundations[0] else 0):
-                    for tier in materials:
-                        scene_module.set_material(sphere, materials[tier])
+        skin = _skin(foundation, coverage)
+        tables = bake.bake(skin, "default")
+        high = bake.bake(skin, "high")
+        materials = {}
+        for tier in ("EEVEE", "PRINCIPLED"):
+            sphere.data.materials.clear()
+            materials[tier] = sphere_scene.made_up_material(sphere, tables, tier,
+                                                            coverage=coverage)
+        for light in LIGHTS_DEG:
+            sun.rotation_euler = (math.pi / 2, 0.0, math.radians(light))
+            ref = _reference(skin, high, light)
+            scene_module.use_eevee(scene, eevee_samples)
+            images = {}
+            for tier, material in materials.items():
+                scene_module.set_material(sphere, material)
+                images[tier] = scene_module.render_image()[1]
+            seconds = {tier: [] for tier in materials}
+            if timed and light == TIME_LIGHT_DEG:
+                scene_module.set_samples(scene, TIME_SAMPLES)
+                for _ in range(repeats):
+                    for tier, material in materials.items():
+                        scene_module.set_material(sphere, material)
                         seconds[tier].append(scene_module.render_image()[0])
-                scene_module.set_material(sphere, materials["EEVEE"])
-                scene_module.use_cycles(scene, cycles_samples)
-                cycles = []
-                for seed in SEEDS:
-                    scene_module.set_samples(scene, cycles_samples, seed)
-                    cycles.append(scene_module.render_image()[1])
-                eevee = images["EEVEE"]
-                mask = compare.sphere_mask(SIZE)
-                floor = compare.noise_floor(*cycles, cycles[0])
-                against = sum(compare.relative_rms(eevee, c) for c in cycles) / len(cycles)
-                row = {
-                    "foundation": foundation, "coverage": coverage, "light_deg": light,
-                    "eevee_error": compare.relative_rms(eevee, ref),
-                    "eevee_mean_ratio": float(eevee[mask].mean() / ref[mask].mean()),
-                    "principled_eevee_error": compare.relative_rms(images["PRINCIPLED"], ref),
-                    "cycles_error": sum(compare.relative_rms(c, ref) for c in cycles) / 2,
-                    "cycles_floor": floor,
-                    "eevee_vs_cycles": compare.bias(against, floor),
-                    "eevee_seconds": _median(seconds["EEVEE"]),
-                    "principled_seconds": _median(seconds["PRINCIPLED"]),
-                }
-                row["time_ratio"] = row["eevee_seconds"] / row["principled_seconds"]
-                rows.append(row)
-                print(" ".join(f"{k}={v:.4g}" if isinstance(v, float) else f"{k}={v}"
-                               for k, v in row.items()), flush=True)
+            scene_module.set_material(sphere, materials["EEVEE"])
+            scene_module.use_cycles(scene, cycles_samples)
+            cycles = []
+            for seed in SEEDS:
+                scene_module.set_samples(scene, cycles_samples, seed)
+                cycles.append(scene_module.render_image()[1])
+            eevee = images["EEVEE"]
+            mask = compare.sphere_mask(SIZE)
+            floor = compare.noise_floor(*cycles, cycles[0])
+            against = sum(compare.relative_rms(eevee, c) for c in cycles) / len(cycles)
+            row = {
+                "foundation": foundation, "coverage": coverage, "light_deg": light,
+                "eevee_error": compare.relative_rms(eevee, ref),
+                "eevee_mean_ratio": float(eevee[mask].mean() / ref[mask].mean()),
+                "principled_eevee_error": compare.relative_rms(images["PRINCIPLED"], ref),
+                "cycles_error": sum(compare.relative_rms(c, ref) for c in cycles) / 2,
+                "cycles_floor": floor,
+                "eevee_vs_cycles": compare.bias(against, floor),
+                "eevee_seconds": _median(seconds["EEVEE"]),
+                "principled_seconds": _median(seconds["PRINCIPLED"]),
+            }
+            row["time_ratio"] = row["eevee_seconds"] / row["principled_seconds"]
+            rows.append(row)
+            print(" ".join(f"{k}={v:.4g}" if isinstance(v, float) else f"{k}={v}"
+                           for k, v in row.items()), flush=True)
     return rows
+
+
+def measure(foundations, rows_path: Path, *, repeats=TIME_REPEATS) -> list[dict]:
+    """Every row of the table, each case (foundation, coverage) in a process of its own (a
+    long EEVEE session on software OpenGL has crashed in Blender's allocator here), its rows
+    appended to ``rows_path`` (JSON lines); cases already there are not measured again, so a
+    run that stopped resumes.  A case whose process fails twice is an error."""
+    done = _read_rows(rows_path)
+    for foundation, coverage in _cases(foundations):
+        if any(r["foundation"] == foundation and r["coverage"] == coverage for r in done):
+            print(f"{foundation}, coverage {coverage:g}: measured before, in {rows_path}")
+            continue
+        command = [sys.executable, __file__, "--case", foundation, str(coverage),
+                   "--rows", str(rows_path), "--repeats", str(repeats)]
+        if foundation == foundations[0]:
+            command.append("--timed")
+        for attempt in (1, 2):
+            rc = subprocess.run(command, check=False).returncode
+            if rc == 0:
+                break
+            print(f"{foundation}, coverage {coverage:g}: the process ended with {rc} "
+                  f"(attempt {attempt})", flush=True)
+        else:
+            raise RuntimeError(f"{foundation}, coverage {coverage:g} failed twice: see above")
+        done = _read_rows(rows_path)
+    order = {case: k for k, case in enumerate(_cases(foundations))}
+    rows = [r for r in done if (r["foundation"], r["coverage"]) in order]
+    return sorted(rows, key=lambda r: (order[r["foundation"], r["coverage"]], r["light_deg"]))
+
+
+def _read_rows(path: Path) -> list[dict]:
+    if not path.exists():
+        return []
+    with open(path, encoding="utf-8") as handle:
+        return [json.loads(line) for line in handle if line.strip()]
+
+
+def _append_rows(rows, path: Path) -> None:
+    with open(path, "a", encoding="utf-8") as handle:
+        for row in rows:
+            handle.write(json.dumps(row) + "\n")
 
 
 def measure_costs(repeats: int) -> dict:
@@ -219,10 +275,11 @@ def markdown(rows, minutes: float) -> str:
     met = {name: sum(1 for r in rows if r[key] <= TARGETS[name]) for name, key in
            (("exact", "eevee_error"), ("cycles", "eevee_vs_cycles"), ("time", "time_ratio"))}
     timed = sum(1 for r in rows if r["time_ratio"] == r["time_ratio"])
-    lines = [f"Measured by `python bench/eevee_tier.py` in {minutes:.0f} min (2 cores, shared; "
-             f"the load is in docs/eevee_tier.csv's header run). {SIZE} px, EEVEE "
-             f"{EEVEE_SAMPLES} samples, Cycles {CYCLES_SAMPLES} x 2 seeds, skin "
-             f"{SKIN}; coverage 0 is bare skin, the same for every foundation.", "",
+    lines = [f"Measured by `python bench/eevee_tier.py` (its last run {minutes:.0f} min, 2 "
+             f"shared cores; the load is in docs/eevee_tier.csv's header). {SIZE} px, EEVEE "
+             f"{EEVEE_SAMPLES} samples (timed frames {TIME_SAMPLES}, light "
+             f"{TIME_LIGHT_DEG:g} degrees, the first foundation), Cycles {CYCLES_SAMPLES} x 2 "
+             f"seeds, skin {SKIN}; coverage 0 is bare skin, the same for every foundation.", "",
              "| foundation | coverage | light | EEVEE tier vs exact | mean / exact | "
              "Principled in EEVEE vs exact | EEVEE vs Cycles (noise removed) | Cycles noise | "
              "time EEVEE tier / Principled (EEVEE) |",
@@ -263,8 +320,22 @@ def main(argv=None) -> int:
                         help="with --costs: rewrite lut_baker/auto_tier/measured.json's "
                         "eevee_costs section")
     parser.add_argument("--out", type=Path, default=DOCS)
+    parser.add_argument("--rows", type=Path, default=None,
+                        help="the measured rows, JSON lines (default: "
+                        "bench/results/eevee_tier[_quick].jsonl); cases already there are "
+                        "kept: delete it to measure everything again")
+    parser.add_argument("--case", nargs=2, metavar=("FOUNDATION", "COVERAGE"),
+                        help=argparse.SUPPRESS)
+    parser.add_argument("--timed", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="eevee_tier_"))
+    suffix = "_quick" if args.quick else ""
+    rows_path = args.rows or ROOT / "bench" / "results" / f"eevee_tier{suffix}.jsonl"
+    if args.case:
+        foundation, coverage = args.case[0], float(args.case[1])
+        _append_rows(measure_case(foundation, coverage, timed=args.timed,
+                                  repeats=args.repeats), rows_path)
+        return 0
     start = time.perf_counter()
     load = f"load average before: {os.getloadavg()[0]:.2f}, {os.cpu_count()} cores"
     if args.costs:
@@ -278,13 +349,13 @@ def main(argv=None) -> int:
             print(f"# wrote eevee_costs to {measured.PATH}")
         return 0
     foundations = FOUNDATIONS[:1] if args.quick else FOUNDATIONS
-    rows = measure(foundations, repeats=args.repeats)
+    rows_path.parent.mkdir(parents=True, exist_ok=True)
+    rows = measure(foundations, rows_path, repeats=args.repeats)
     minutes = (time.perf_counter() - start) / 60
     load += f", after: {os.getloadavg()[0]:.2f}"
     text = markdown(rows, minutes)
     print(text)
     args.out.mkdir(parents=True, exist_ok=True)
-    suffix = "_quick" if args.quick else ""
     write_csv(rows, args.out / f"eevee_tier{suffix}.csv", load)
     if not args.quick and args.out == DOCS:
         replace_block(DOCS / "speed_accuracy.md", text, BEGIN, END)

@@ -5,6 +5,7 @@ A benchmark, not a test::
     python bench/speed_accuracy.py            # docs/speed_accuracy.csv, .png, the table in .md
     python bench/speed_accuracy.py --quick    # 16 and 64 samples, no bake axis (smoke run)
     python bench/speed_accuracy.py --replot   # redraw the PNG from the CSV
+    python bench/speed_accuracy.py --eevee-only   # the EEVEE points alone, added to the CSV
 
 Scene (``tests/support/bench_scene.py``, shared with the tests): the paper preset on a sphere of
 10 mm radius, 48 x 48 px, Cycles CPU, light 0, 45 and 75 degrees from the view. Each of PRINCIPLED,
@@ -54,6 +55,7 @@ from lut_baker.offline.validation.baseline import fit_baseline  # noqa: E402
 
 DOCS = ROOT / "docs"
 BEGIN, END = "<!-- results:begin -->", "<!-- results:end -->"
+EEVEE_MARKERS = ("<!-- eevee-points:begin -->", "<!-- eevee-points:end -->")
 CONFIGS = ("PRINCIPLED", "LAYERED", "BASELINE")
 EEVEE_CONFIGS = ("EEVEE", "PRINCIPLED_EEVEE")
 """The tiers rendered in EEVEE: the EEVEE tier, the Principled tier."""
@@ -146,11 +148,7 @@ def render_rows(skin, tables, baseline, refs: dict, size: int, sample_counts,
                              size_px=size, seconds=0.5 * (t0 + t1), error=error,
                              noise_floor=floor, bias=compare.bias(error, floor),
                              excess=error - floor))
-    for light in refs:
-        mine = [row for row in rows if row["light_deg"] == light]
-        front = compare.pareto_front([r["seconds"] for r in mine], [r["error"] for r in mine])
-        for row, on in zip(mine, front, strict=True):
-            row["pareto"] = bool(on)
+    mark_pareto(rows)
     return rows, bake_errors
 
 
@@ -319,6 +317,28 @@ def _percent(x: float) -> str:
     return f"{100 * x:.2f}%"
 
 
+def eevee_markdown(rows) -> str:
+    """The EEVEE points of ``rows`` as a table."""
+    lines = ["In EEVEE (5.0.1, software OpenGL; one render each, time per frame after the "
+             "shaders compiled; `python bench/speed_accuracy.py`, or `--eevee-only` for these "
+             "points alone):", "",
+             "| light | config | samples | s per frame | error |", "|---|---|---|---|---|"]
+    lines += [f"| {r['light_deg']:g} | {LABELS[r['config']]} | {r['samples']} | "
+              f"{r['seconds']:.2f} | {_percent(r['error'])} |"
+              for r in rows if r["axis"] == "eevee"]
+    return "\n".join(lines)
+
+
+def mark_pareto(rows) -> None:
+    """Set each render and EEVEE row's ``pareto`` flag: on the front of time against error
+    at its light."""
+    for light in {r["light_deg"] for r in rows if r["axis"] in ("render", "eevee")}:
+        mine = [r for r in rows if r["axis"] in ("render", "eevee") and r["light_deg"] == light]
+        front = compare.pareto_front([r["seconds"] for r in mine], [r["error"] for r in mine])
+        for row, on in zip(mine, front, strict=True):
+            row["pareto"] = bool(on)
+
+
 def markdown(rows, goal_rows, seconds: float) -> str:
     lines = [f"Measured by `python bench/speed_accuracy.py` in {seconds / 60:.1f} min "
              "(2 cores, shared).", "",
@@ -331,13 +351,6 @@ def markdown(rows, goal_rows, seconds: float) -> str:
                      f"{r['seconds']:.2f} | {_percent(r['error'])} | "
                      f"{_percent(r['noise_floor'])} | {_percent(r['bias'])} | "
                      f"{'yes' if r['pareto'] else ''} |")
-    eevee = [r for r in rows if r["axis"] == "eevee"]
-    if eevee:
-        lines += ["", "In EEVEE (5.0.1, software OpenGL; one render each, time per frame "
-                  "after the shaders compiled):", "",
-                  "| light | config | samples | s per frame | error |", "|---|---|---|---|---|"]
-        lines += [f"| {r['light_deg']:g} | {LABELS[r['config']]} | {r['samples']} | "
-                  f"{r['seconds']:.2f} | {_percent(r['error'])} |" for r in eevee]
     baked = [r for r in rows if r["axis"] == "bake"]
     if baked:
         lines += ["", "| bake resolution | angular entries | MB | bake ms | table error | "
@@ -379,6 +392,34 @@ def baseline_text(baseline, seconds: float) -> str:
     return "\n".join(lines)
 
 
+def add_eevee_points(args) -> int:
+    """``--eevee-only``: the EEVEE rows rendered again, the CSV's other rows kept."""
+    import bpy  # noqa: F401  (Blender, before the scenes)
+    from support import bench_scene as scene_module
+    from support import sphere_scene
+
+    os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="speed_accuracy_"))
+    path = args.out / "speed_accuracy.csv"
+    rows = [r for r in read_csv(path) if r["axis"] != "eevee"]
+    sizes = {r["size_px"] for r in rows if r["axis"] == "render"}
+    if sizes != {args.size}:
+        raise SystemExit(f"{path} was rendered at {sorted(sizes)} px, not --size {args.size}")
+    skin = presets.paper()
+    tables = bake.bake(skin, "default")
+    for light, ref in references(skin, args.size, args.lights).items():
+        sphere = scene_module.sphere_scene(size=args.size, samples=16, radius_mm=RADIUS_MM,
+                                           light_deg=light)
+        with sphere_scene.addon_registered():
+            rows += eevee_rows(sphere, tables, ref, light, args.size)
+    mark_pareto(rows)
+    write_csv(rows, path)
+    chart(rows, args.out / "speed_accuracy.png")
+    if args.out == DOCS:
+        replace_block(DOCS / "speed_accuracy.md", eevee_markdown(rows), *EEVEE_MARKERS)
+    print(eevee_markdown(rows))
+    return 0
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--size", type=int, default=48, help="pixels (square), default 48")
@@ -390,10 +431,15 @@ def main(argv=None) -> int:
     parser.add_argument("--out", type=Path, default=DOCS, help="folder for the CSV and PNG")
     parser.add_argument("--replot", action="store_true",
                         help="only redraw the PNG from the CSV in --out (no rendering)")
+    parser.add_argument("--eevee-only", action="store_true",
+                        help="render the EEVEE points alone and add them to the CSV in --out "
+                        "(its other rows kept), the chart and the table")
     args = parser.parse_args(argv)
     if args.replot:
         chart(read_csv(args.out / "speed_accuracy.csv"), args.out / "speed_accuracy.png")
         return 0
+    if args.eevee_only:
+        return add_eevee_points(args)
     if args.quick:
         args.samples = [16, 64]
     os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="speed_accuracy_"))
@@ -422,6 +468,7 @@ def main(argv=None) -> int:
     chart(rows, args.out / f"speed_accuracy{suffix}.png")
     if not args.quick and args.out == DOCS:
         replace_block(DOCS / "speed_accuracy.md", text, BEGIN, END)
+        replace_block(DOCS / "speed_accuracy.md", eevee_markdown(rows), *EEVEE_MARKERS)
     print(f"speed_accuracy: {seconds / 60:.1f} min -> {args.out}/speed_accuracy{suffix}.csv, .png")
     return 0
 

@@ -121,7 +121,9 @@ def test_whole_walk_reopened_without_the_addon_renders_the_same(head, tmp_path):
 @pytest.mark.slow  # heads saved, reopened, rendered
 def test_apply_adds_little_to_the_file(head, tmp_path):
     """The .blend keeps the bake's record and the view-angle image (5.7 kB), not the tables:
-    Apply adds a few hundred kilobytes per skin, not the 21.6 MB of tables it used to pack."""
+    Apply adds a few hundred kilobytes per skin, not the 21.6 MB of tables it used to pack.
+    The groups' nodes are most of it: 91 in the Layered group, 54 before its view-angle rows
+    were each read from two Closest texels (EEVEE's Linear filter mixes the rows)."""
     import bpy
 
     def saved_size(name):
@@ -133,7 +135,7 @@ def test_apply_adds_little_to_the_file(head, tmp_path):
     before = saved_size("before")
     apply_operator(head)
     apply_operator(other, "LAYERED", skin="jensen_skin1")  # two skins: two groups, two images
-    assert saved_size("after") - before < 600e3  # measured 2 x 237 kB: the groups' nodes
+    assert saved_size("after") - before < 1e6  # measured 773 kB on 5.0.1 (2 x 237 kB before)
     assert len([image for image in bpy.data.images if image.name.startswith("MakeupSkin")]) == 2
 
 
