@@ -172,6 +172,16 @@ _PNG_BYTES: dict = {}
 repacks the same bytes instead of encoding the pixels again (~0.05 s a megapixel)."""
 
 
+def _png_image(name: str, width: int, height: int, colorspace: str):
+    """A new byte image ``name`` (no alpha) in colour space ``colorspace``, saved as PNG."""
+    import bpy
+
+    image = bpy.data.images.new(name, width, height, alpha=False, float_buffer=False)
+    image.colorspace_settings.name = colorspace
+    image.file_format = "PNG"
+    return image
+
+
 def _packed_image(name: str, pixels, colorspace: str, source=None):
     """The image ``name`` if present (reused as is), else a new byte image from ``pixels``
     (rows bottom-up; or a function that returns them), colour space ``colorspace``, packed
@@ -186,18 +196,13 @@ def _packed_image(name: str, pixels, colorspace: str, source=None):
     key = None if source is None else (name, colorspace, source)
     data = _PNG_BYTES.get(key) if key is not None else None
     if data is not None:
-        width, height = data[1]
-        image = bpy.data.images.new(name, width, height, alpha=False, float_buffer=False)
-        image.colorspace_settings.name = colorspace
-        image.file_format = "PNG"
+        image = _png_image(name, *data[1], colorspace)
         image.pack(data=data[0], data_len=len(data[0]))
         image.source = "FILE"  # read from the packed PNG, as an image packed from pixels is
         return image
     pixels = pixels() if callable(pixels) else pixels
     height, width = pixels.shape[:2]
-    image = bpy.data.images.new(name, width, height, alpha=False, float_buffer=False)
-    image.colorspace_settings.name = colorspace
-    image.file_format = "PNG"
+    image = _png_image(name, width, height, colorspace)
     image.pixels.foreach_set(np.ascontiguousarray(pixels, np.float32).ravel())
     image.pack()
     if key is not None:
