@@ -7,18 +7,23 @@ bpy is imported only by the fixtures below, on first use: tests of ``lut_baker``
   ``read_factory_settings(use_empty=True)``. Skips the test if bpy cannot be imported.
 - ``blank_scene`` (function): ``read_homefile(use_empty=True, use_factory_startup=True)``, which
   keeps enabled add-ons; returns the (empty) ``bpy.context.scene``.
-- ``paper_tables``, ``paper_fit`` (module): the paper preset's preview tables and their closure
-  fit; ``matte`` (module): ``(skin, tables, fit)`` of :func:`matte_film`, the paper's film at
-  index 1.01 (the Auto tier's tests, with and without Blender).
+- ``paper_tables``, ``paper_fit`` (session): the paper preset's preview tables and their
+  closure fit; ``matte`` (session): ``(skin, tables, fit)`` of :func:`matte_film`, the paper's
+  film at index 1.01 (the Auto tier's tests, with and without Blender).  Baked and fitted once
+  per process (a bake and fit take ~0.5 s, and some twenty test files read them); their arrays
+  are made read-only (:func:`read_only`), so a test that changed them would fail, not pass a
+  changed fixture on to the next file.
 
 Tests that use either fixture get the ``bpy`` marker automatically (select them with
 ``pytest -m bpy``, leave them out with ``-m "not bpy"``).
 """
 
+import dataclasses
 import os
 import sys
 import warnings
 
+import numpy as np
 import pytest
 
 from lut_baker import bake
@@ -63,14 +68,33 @@ def pytest_collection_modifyitems(config, items):
             item.add_marker(pytest.mark.bpy)
 
 
-@pytest.fixture(scope="module")
+def read_only(value):
+    """``value`` with every array it holds (in dataclass fields, dicts, lists and tuples, at
+    any depth) made read-only, so that fixtures shared by many tests cannot be changed by
+    one."""
+    if isinstance(value, np.ndarray):
+        value.flags.writeable = False
+    elif dataclasses.is_dataclass(value) and not isinstance(value, type):
+        for field in dataclasses.fields(value):
+            read_only(getattr(value, field.name))
+    elif isinstance(value, dict):
+        for item in value.values():
+            read_only(item)
+    elif isinstance(value, (list, tuple)):
+        for item in value:
+            read_only(item)
+    return value
+
+
+@pytest.fixture(scope="session")
 def paper_tables():
-    return bake.bake(presets.made_up_skin("paper_natural", "paper_bioplate"), "preview")
+    return read_only(bake.bake(presets.made_up_skin("paper_natural", "paper_bioplate"),
+                               "preview"))
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def paper_fit(paper_tables):
-    return fitting.fit_closures(paper_tables)
+    return read_only(fitting.fit_closures(paper_tables))
 
 
 def matte_film(ior=1.01, coverage=1.0):
@@ -83,9 +107,9 @@ def matte_film(ior=1.01, coverage=1.0):
             eta=ior / float(skin.film_transmission.eta)))
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def matte():
-    """``(skin, tables, fit)`` of :func:`matte_film` (preview bake)."""
+    """``(skin, tables, fit)`` of :func:`matte_film` (preview bake), read-only."""
     skin = matte_film()
     tables = bake.bake(skin, "preview")
-    return skin, tables, fitting.fit_closures(tables)
+    return read_only((skin, tables, fitting.fit_closures(tables)))

@@ -98,6 +98,7 @@ def test_apply_from_the_installed_extension(installed, tmp_path):
     assert centre.sum() > 0.3 and centre[0] > centre[2]
 
 
+@pytest.mark.slow  # the install's own check (test_extension_package.py, fast) asserts the same
 def test_uninstall_leaves_nothing(installed):
     import bpy
 

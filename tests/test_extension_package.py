@@ -163,6 +163,8 @@ def test_install_enable_uninstall(bpy_factory, extension_zip, tmp_path):
         assert ADDON_MODULE not in prefs.addons
         assert not [a.module for a in prefs.addons if a.module.startswith(ADDON_MODULE)]
         assert _registered_classes(bpy, ADDON_MODULE) == []
+        assert not hasattr(bpy.types.Material, "makeup_skin")  # its property went too
+        assert [n for n in dir(bpy.types) if n.startswith(("MAKEUPSKIN", "MAKEUP_SKIN"))] == []
         assert not [m for m in sys.modules if m == ADDON_MODULE or m.startswith(ADDON_MODULE + ".")]
         assert not (repo_dir / PKG_ID).exists()
     finally:

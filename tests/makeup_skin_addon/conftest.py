@@ -2,7 +2,12 @@
 
 - ``addon`` -- the add-on from this checkout (``makeup_skin_addon`` as a top-level package),
   registered for the test and unregistered after it (bpy 4.5 hangs at exit while an add-on's
-  classes stay registered); a fresh registration starts with empty caches.  Yields the package.
+  classes stay registered).  Yields the package.  Its session caches (re-baked tables and
+  closure fits, by bake key: :mod:`makeup_skin_addon.storage`, :mod:`makeup_skin_addon.fits`)
+  carry over from the test before, as they do in Blender from one file to the next: the
+  same settings are baked and fitted once per process, not once per test (a preview fit
+  takes ~0.25 s).  A test about what a cold session bakes or fits clears them first
+  (:func:`support.addon_steps.cold_caches`).
 - ``sphere`` -- a smooth sphere (radius 3 cm), the camera and sun of
   tests/support/sphere_scene.py (60 degrees off the view towards +x), black world, Cycles CPU
   at 16 samples, :data:`support.addon_steps.SPHERE_PX` px.
@@ -13,7 +18,10 @@
 
 import pytest
 from support import character, sphere_scene
-from support.addon_steps import HEAD_PX, SPHERE_PX
+from support.addon_steps import HEAD_PX, SPHERE_PX, session_caches
+
+_SESSION: dict = {}
+"""The add-on's session caches (re-baked tables, closure fits) as the last test left them."""
 
 
 @pytest.fixture
@@ -21,7 +29,11 @@ def addon(bpy_factory):
     import makeup_skin_addon
 
     with sphere_scene.addon_registered():
+        for name, cache in session_caches().items():
+            for key, value in _SESSION.get(name, {}).items():  # oldest first, as they were
+                cache.put(key, value)
         yield makeup_skin_addon
+        _SESSION.update({name: dict(cache._values) for name, cache in session_caches().items()})
 
 
 @pytest.fixture

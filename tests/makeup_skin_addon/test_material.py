@@ -13,6 +13,7 @@ from support.addon_steps import (
     SPHERE_PX,
     apply_operator,
     apply_pipeline,
+    cold_caches,
     counts,
     group_node,
     render,
@@ -180,6 +181,7 @@ def test_apply_progress_covers_bake_and_fit(head):
         scene = bpy.context.scene
         window_manager = WindowManager()
 
+    cold_caches()  # so that the bake and the fit run
     head.active_material.makeup_skin.resolution = "preview"
     made_up.apply_to_object(Context, head)
     values = Context.window_manager.values

@@ -116,12 +116,6 @@ def test_gloss_below_the_noise_is_left_out_measured(stage, paper_tables, paper_f
     assert measured[dropped] == pytest.approx(predicted.error, rel=0.2), report
 
 
-@pytest.fixture
-def addon(bpy_factory):
-    with sphere_scene.addon_registered():  # this module's stage may hold it registered
-        yield
-
-
 def _scene_with_sphere(radius_mm, size, camera_distance_mm=None):
     """A low-poly sphere (the operator needs no render), a perspective camera
     ``camera_distance_mm`` away on -y (50 mm lens, 36 mm sensor), a sun, Cycles."""

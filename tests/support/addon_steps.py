@@ -11,6 +11,8 @@ does, or through the pipeline), render, and read node trees and images back.
 - :func:`group_node` -- a material's Made-up Skin group node.
 - :func:`lut_images` -- the add-on's view-angle images.
 - :func:`counts` -- how many node groups, images and materials the file holds.
+- :func:`session_caches` -- the add-on's session caches (re-baked tables, closure fits).
+- :func:`cold_caches` -- empty them: the next Apply bakes and fits.
 """
 
 from __future__ import annotations
@@ -18,7 +20,7 @@ from __future__ import annotations
 from support import sphere_scene
 
 __all__ = ["SPHERE_PX", "HEAD_PX", "apply_operator", "apply_pipeline", "render", "tree_state",
-           "group_node", "lut_images", "counts"]
+           "group_node", "lut_images", "counts", "session_caches", "cold_caches"]
 
 SPHERE_PX = 64
 """The sphere scene's size (px): Cycles CPU at 16 samples, about 0.3 s a render."""
@@ -90,3 +92,18 @@ def counts():
     import bpy
 
     return (len(bpy.data.node_groups), len(bpy.data.images), len(bpy.data.materials))
+
+
+def session_caches() -> dict:
+    """The add-on's session caches by name: ``tables`` (re-baked, :mod:`makeup_skin_addon.storage`)
+    and ``fits`` (closure fits, :mod:`makeup_skin_addon.fits`), both keyed by bake key."""
+    from makeup_skin_addon import fits, storage
+
+    return {"tables": storage._TABLES, "fits": fits._FITS}
+
+
+def cold_caches():
+    """Empty the add-on's session caches: the next Apply bakes and fits (the fixture ``addon``
+    carries them over from one test to the next)."""
+    for cache in session_caches().values():
+        cache.clear()

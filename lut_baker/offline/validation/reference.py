@@ -24,8 +24,9 @@ Functions
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
-from scipy.spatial import cKDTree
 
 from ...evaluate.made_up import made_up_reflection
 from ...model.albedo import film_transmittance
@@ -39,6 +40,9 @@ from ...model.made_up_skin import (
 from ...numerics.cache import LRUCache
 from ...numerics.geometry import VIEW, direction, light_direction, local_directions, sphere_normals
 from ...numerics.quadrature import cumulative_trapezoid
+
+if TYPE_CHECKING:
+    from scipy.spatial import cKDTree
 
 __all__ = [
     "sphere_points",
@@ -162,6 +166,8 @@ def spread_diffuse(exit_normals: np.ndarray, light: np.ndarray, skin: MadeUpSkin
     exit_local = local_directions(np.broadcast_to(VIEW, exit_normals.shape), exit_normals)
     exit_film = _film_transmittance_rgb(exit_local, skin)
     rd = np.atleast_1d(dipole_total_reflectance(skin.dipole)) * np.ones(3)
+    from scipy.spatial import cKDTree  # here: importing scipy.spatial takes ~0.3 s
+
     tree = cKDTree(entry_pos)
     exit_pos = exit_normals * radius_mm
     cutoff = profile_cutoff_mm(skin)

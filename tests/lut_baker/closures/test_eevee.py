@@ -36,10 +36,13 @@ def test_magnitude_is_the_ggx_albedo(roughness):
 
 @pytest.mark.parametrize("roughness", [0.35, 0.65, 0.95])
 def test_albedo_closed_form_matches_quadrature(roughness):
+    """A grid for 10-degree lobes is converged far below the tolerance: within 3.4e-5 of the
+    closed form at every roughness (a grid for 5-degree lobes at level 1, four times the
+    nodes in each angle and 40 times the cost: within 2.2e-6)."""
     mu = np.array([0.95, 0.6, 0.3])
     closed = eevee.glossy_albedo(mu, roughness)
     brute = cc.directional_albedo(lambda w, v: eevee.glossy_reflection(w, v, roughness), mu,
-                                  lobe_width_deg=5.0, level=1)
+                                  lobe_width_deg=10.0)
     np.testing.assert_allclose(closed, brute, rtol=4e-3)
     _, magnitude = eevee.ltc_coefficients(roughness, mu)
     assert np.all(closed <= magnitude + 1e-12)  # the LTC's share above the horizon

@@ -6,7 +6,6 @@ import math
 
 import numpy as np
 import pytest
-from scipy.integrate import quad
 from support import reference_impl as ref
 from support.samples import DIPOLES, layer_args
 
@@ -29,6 +28,8 @@ def test_dipole_profile_matches_reference(name):
 # --- dipole --------------------------------------------------------------------------------
 @pytest.mark.parametrize("name", sorted(DIPOLES))
 def test_dipole_integral_equals_closed_form(name):
+    from scipy.integrate import quad  # here: importing scipy.integrate slows collection ~0.3 s
+
     dipole = DIPOLES[name]
     closed = np.atleast_1d(dipole_total_reflectance(dipole))
     for c in range(closed.size):

@@ -42,6 +42,7 @@ def test_any_films_exchange_is_its_gloss_diffuse_and_transmission():
     and transmission) against the albedos integrated directly; a matte film has no gloss; a
     roughened lobe keeps its gloss albedo (lut_baker.model.roughness)."""
     base = presets.paper()
+    t_0 = float(bihemispherical(lambda t: transmission_albedo(t, base.film_transmission)))
     for name in ("clarins_105", "clarins_112", "clarins_103"):
         film = presets.foundation_film(name)
         exchange = TL.film_exchange(film, base.film_transmission)
@@ -49,8 +50,7 @@ def test_any_films_exchange_is_its_gloss_diffuse_and_transmission():
         expected = (float(bihemispherical(lambda t, g=gloss: reflection_albedo(t, g)))
                     if float(film.P_s) > 0 else 0.0)
         assert exchange.r_gloss == pytest.approx(expected, rel=1e-12, abs=1e-15), name
-        assert exchange.t_0 == pytest.approx(float(bihemispherical(
-            lambda t: transmission_albedo(t, base.film_transmission))), rel=1e-12)
+        assert exchange.t_0 == pytest.approx(t_0, rel=1e-12), name
     assert TL.film_exchange(presets.foundation_film("clarins_103"),
                             base.film_transmission).r_gloss == 0.0
     rough = roughness.with_roughness(base.film, 0.4)

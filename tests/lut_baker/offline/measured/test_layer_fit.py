@@ -278,8 +278,16 @@ def _channels(tilt_deg, noise, seed, layers=CHANNEL_LAYERS):
             for layer in layers]
 
 
-def test_a_shared_tilt_is_fitted_with_its_standard_error():
-    joint = F.fit_reflection_sets(_channels(1.2, NOISE, 3), tilt=True)
+@pytest.fixture(scope="module")
+def tilted():
+    """``(data, joint fit)``: three channels of a sample tilted by 1.2 degrees, fitted with
+    a shared tilt (two tests read the one fit)."""
+    data = _channels(1.2, NOISE, 3)
+    return data, F.fit_reflection_sets(data, tilt=True)
+
+
+def test_a_shared_tilt_is_fitted_with_its_standard_error(tilted):
+    joint = tilted[1]
     tilt, stderr = joint.nuisance[F.TILT]
     assert 0.0 < stderr < 0.1 and abs(tilt - 1.2) < 4 * stderr
     assert joint.labels == ("R", "G", "B") and joint.names[-1] == F.TILT
@@ -352,9 +360,8 @@ def test_the_fits_are_determined_by_their_data(name, fit):
         assert abs(moved[key] / value - 1.0) < 1e-6, (key, value, moved[key])
 
 
-def test_a_joint_tilted_fit_is_determined_by_its_data():
-    data = _channels(1.2, NOISE, 4)
-    reference = F.fit_reflection_sets(data, tilt=True)
+def test_a_joint_tilted_fit_is_determined_by_its_data(tilted):
+    data, reference = tilted
     moved = F.fit_reflection_sets([_perturbed(d, seed=s) for s, d in enumerate(data)], tilt=True)
     assert abs(moved.nuisance[F.TILT][0] - reference.nuisance[F.TILT][0]) < 1e-6
     for a, b in zip(reference.fits, moved.fits, strict=True):

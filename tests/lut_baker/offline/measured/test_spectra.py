@@ -4,7 +4,6 @@ computed directly (CIE 1931 2-degree observer, D65, sRGB primaries)."""
 
 from pathlib import Path
 
-import colour
 import numpy as np
 import pytest
 
@@ -35,6 +34,8 @@ def test_the_wrong_number_of_samples_is_one_clear_error():
 
 
 def _direct(spectrum: np.ndarray) -> np.ndarray:
+    import colour  # here, not at the top: its import (~0.8 s) would slow every collection
+
     shape = colour.SpectralShape(380.0, 780.0, 5.0)  # the data's grid: no interpolation
     cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"].copy().align(shape)
     illuminant = colour.SDS_ILLUMINANTS["D65"].copy().align(shape)

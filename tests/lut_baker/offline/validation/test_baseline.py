@@ -12,18 +12,15 @@ import dataclasses
 import numpy as np
 import pytest
 
-from lut_baker import bake
 from lut_baker.closures import cycles as cc
-from lut_baker.closures import fitting, tiers
+from lut_baker.closures import tiers
 from lut_baker.model import presets
 from lut_baker.offline.validation import baseline
 
 
 @pytest.fixture(scope="module")
-def paper():
-    skin = presets.paper()
-    tables = bake.bake(skin, "preview")
-    return skin, tables, fitting.fit_closures(tables)
+def paper(paper_tables, paper_fit):
+    return presets.paper(), paper_tables, paper_fit  # the preset's tables (conftest.py)
 
 
 class _PrincipledTables:
@@ -54,7 +51,8 @@ def test_fit_recovers_a_principled_bsdf(paper):
 
 def test_paper_baseline_improves_on_its_start_within_socket_ranges(paper):
     skin, tables, fit = paper
-    result = baseline.fit_baseline(skin, tables, fit, resolution=16, max_evaluations=12)
+    # Six evaluations take the error (sum of squares) to 0.68 of the start's, twelve to 0.66.
+    result = baseline.fit_baseline(skin, tables, fit, resolution=16, max_evaluations=6)
     print(result.start_error, result.error)
     assert sum(e * e for e in result.error.values()) < 0.9 * sum(
         e * e for e in result.start_error.values())
