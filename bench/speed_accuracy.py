@@ -254,7 +254,7 @@ def chart(rows, path: Path) -> None:
     lights = sorted({r["light_deg"] for r in rows if r["axis"] == "render"})
     baked = [r for r in rows if r["axis"] == "bake"]
     panels = len(lights) + (1 if baked else 0)
-    fig, axes = plt.subplots(1, panels, figsize=(4.2 * panels, 4.2), squeeze=False)
+    fig, axes = plt.subplots(1, panels, figsize=(4.2 * panels, 4.9), squeeze=False)
     for ax, light in zip(axes[0], lights, strict=False):
         mine = [r for r in rows if r["axis"] == "render" and r["light_deg"] == light]
         for name in CONFIGS:
@@ -285,8 +285,10 @@ def chart(rows, path: Path) -> None:
         ax.set_ylabel("relative RMS error vs reference")
         ax.set_title(f"light {light:g} deg from the view")
         ax.grid(True, which="both", alpha=0.3)
-    axes[0][0].legend(fontsize=7, title="dotted: noise floor; labels: samples; squares: EEVEE "
-                      "(software OpenGL), time per frame", title_fontsize=7)
+    handles, labels = axes[0][0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=len(labels), fontsize=8,
+               title="dotted: noise floor; numbers: samples; squares: EEVEE (software OpenGL), "
+               "time per frame", title_fontsize=8, frameon=False)
     if baked:
         ax = axes[0][-1]
         size = [r["table_mb"] for r in baked]
@@ -308,7 +310,7 @@ def chart(rows, path: Path) -> None:
         ax.grid(True, which="both", alpha=0.3)
     fig.suptitle("Made-up Skin, paper preset, 10 mm sphere, 48 px, Cycles CPU and EEVEE",
                  fontsize=10)
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0.14, 1, 1))
     fig.savefig(path, dpi=110)
     plt.close(fig)
 

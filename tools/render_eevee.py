@@ -4,18 +4,19 @@ EEVEE as it was (one Linear lookup per view-angle row) and as it is now.
 Usage::
 
     "$(tools/venv.sh)/bin/python" tools/render_eevee.py [--out docs/renders/eevee]
-        [--size 256 --samples 64 --eevee-samples 16 --foundation medium_beige
+        [--size 128 --samples 64 --eevee-samples 16 --foundation medium_beige
          --skin jensen_skin2]
 
 The head of tests/support/character.py with its portrait camera and lights (an area key light
 45 degrees to the side and 35 above, a fill, a dim world) and a sphere sharing its material
 beside it; Apply with Tier Auto (default tables, coverage 1).  The lights cast no shadows, in
-both engines: EEVEE's shadow maps on software OpenGL took over 20 minutes for one 256 px frame
-here, and the pictures compare shading, not shadows.  Writes to ``--out``:
+both engines (the pictures compare shading, not shadows), and the pictures are 128 px: on
+software OpenGL here a 128 px EEVEE frame takes ~30 s, a 256 px one did not finish in 10
+minutes with or without shadows.  Writes to ``--out``:
 
 - ``cycles_auto.png`` -- Cycles: Auto gives the Layered tier;
-- ``eevee_auto.png`` -- EEVEE (16 samples: its images move by 0.2% from 16 to 64, and a
-  256 px frame with shadows takes minutes on software OpenGL): Auto gives the EEVEE tier;
+- ``eevee_auto.png`` -- EEVEE (16 samples: its images move by 0.2% from 16 to 64): Auto
+  gives the EEVEE tier;
 - ``eevee_layered_linear_lookup.png`` -- EEVEE, the Layered tier reading its view-angle rows
   by one Linear lookup, as before: EEVEE samples that image through mipmaps, which mix its
   rows where cos(theta_o) changes fast across the screen (the pores' normal map): bright,
@@ -113,7 +114,9 @@ def strip(panels, path: Path) -> None:
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--out", type=Path, default=REPO_ROOT / "docs" / "renders" / "eevee")
-    parser.add_argument("--size", type=int, default=256)
+    parser.add_argument("--size", type=int, default=128,
+                        help="pixels (square); EEVEE frames of 128 px take ~30 s here, 256 px "
+                        "ones did not finish in 10 minutes on software OpenGL")
     parser.add_argument("--samples", type=int, default=64, help="Cycles samples")
     parser.add_argument("--eevee-samples", type=int, default=16,
                         help="EEVEE samples (its images move by 0.2%% from 16 to 64)")

@@ -19,7 +19,8 @@ builds the textured head with its portrait camera and lights and:
   the skin's normal map; then renders ``<tone>_<coverage>_pores.png`` at coverage 0.3, 0.6
   and 1, and ``<tone>_<coverage>_smooth.png`` with Film Follows Pores off (Film Normal
   unlinked: the film fills the pores);
-- composes ``match_strip.png`` (one row per tone and film normal: before, 0.3, 0.6, 1);
+- composes ``match_strip.png`` (one row per tone and film normal: before, 0.3, 0.6, 1) and
+  ``first_apply_strip.png`` (each tone before and after the first Apply);
 - measures, under uniform white light (a white world, lamps off: the light the match is
   exact for) and under the portrait lights, the mean colour over the head's pixels of the
   model's bare skin (coverage 0) and of the made-up skin at each coverage, and the blotches'
@@ -203,6 +204,12 @@ def _table(results) -> str:
     return "\n".join(lines)
 
 
+def first_apply_row(out: Path, tones) -> list[Path]:
+    """Each tone before Apply and after the first Apply (every setting at its default:
+    coverage 0.6, the film following the pores), side by side: the README's picture."""
+    return [out / f"{tone}_{kind}.png" for tone in tones for kind in ("before", "0.6_pores")]
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--out", type=Path, default=REPO_ROOT / "docs" / "renders" / "match")
@@ -236,6 +243,7 @@ def main(argv=None) -> int:
                     rows.append([Path(pictures["before"])] + [Path(pictures[f"{c:g}_{label}"])
                                                               for c in COVERAGES])
             _strip(rows, args.out / "match_strip.png")
+            _strip([first_apply_row(args.out, args.tones)], args.out / "first_apply_strip.png")
     except Exception:  # noqa: BLE001  (a tool: say what failed and exit non-zero)
         traceback.print_exc()
         return 1
