@@ -34,7 +34,8 @@ BIAS_BOUND = {0.0: 0.035, 0.5: 0.04, 1.0: 0.06}
 """Relative RMS against the exact image per coverage, any light: measured 2.1-2.8% on bare
 skin (EEVEE's screen-space subsurface at the terminator), 2.9-3.2% at coverage 0.5 and
 4.4-4.9% at full coverage (the paper film's gloss, which no GGX lobe EEVEE can render
-follows closer: docs/addon.md, "The EEVEE tier")."""
+follows closer: docs/addon.md, "The EEVEE tier").  The goal was 2% on every image; where it is
+missed is measured by bench/eevee_tier.py and listed in docs/addon.md, "Not done"."""
 REPLICA_BOUND = 0.01
 """Full coverage against the tier's replica (:func:`lut_baker.closures.tiers.
 eevee_tier_reflection`, no spread; the film hides the skin's): measured 0.3-0.5%, against
@@ -100,24 +101,6 @@ def test_eevee_tier_against_the_exact_image(renders, references, coverage, light
           f"mean {image[mask].mean() / ref[mask].mean():.3f} of it")
     assert error < BIAS_BOUND[coverage]
     assert image[mask].mean() == pytest.approx(ref[mask].mean(), rel=0.02)
-
-
-TARGET = 0.02
-"""The goal set for the tier: at most 2% against the exact image on every image."""
-
-
-@pytest.mark.xfail(strict=True, reason="not reached: the paper film's gloss at full coverage "
-                   "(4.4-4.9%) and EEVEE's subsurface on bare skin (2-3%): docs/addon.md, "
-                   "'The EEVEE tier'")
-def test_eevee_tier_within_the_target_on_every_image(renders, references):
-    """Strict: passes (and so fails the suite) the day the tier reaches its goal, so that the
-    bounds above are tightened then."""
-    errors = {case: compare.relative_rms(image, references[case])
-              for case, image in renders.items()}
-    worst = max(errors, key=errors.get)
-    assert errors[worst] <= TARGET, (
-        f"coverage {worst[0]:g}, light {worst[1]:g}: {100 * errors[worst]:.2f}% against "
-        f"the exact image; target {100 * TARGET:g}%")
 
 
 @pytest.mark.parametrize("light", LIGHTS_DEG)
