@@ -107,8 +107,9 @@ def _skin_shader_tree(material, kind):
 
 @pytest.mark.parametrize("kind", ["mix", "group"])
 def test_the_skin_shader_is_found_behind_mixes_and_groups(head, kind):
-    """Principled + 10% Translucent (the issue's case), and a Principled inside a node group
-    (with an Add Shader) fed from outside: albedo and normal map carried over."""
+    """Principled + 10% Translucent (a skin with a little translucency), and a Principled
+    inside a node group (with an Add Shader) fed from outside: albedo and normal map carried
+    over."""
     material = head.active_material
     albedo, normal = _skin_shader_tree(material, kind)
     material, messages = apply_pipeline(head, tier="LAYERED")
