@@ -13,7 +13,7 @@
 # Venvs come from tools/venv.sh (built once, then cached). Exits non-zero on any failure,
 # including a pytest run that collects no test (exit 5). Each pytest run prints its wall time
 # and is limited to MAKEUP_SKIN_PYTEST_TIMEOUT seconds (default 2700) so that a hung Blender
-# cannot stall CI: the whole of this script takes about 8 minutes on a quiet 2-core machine
+# cannot stall CI: the whole of this script takes about 6 minutes on a quiet 2-core machine
 # (docs/architecture.md, "Tests"), so the limit leaves room for a machine four times slower
 # and busy, and the whole CI run (90 minutes) for both Blender lines.
 set -euo pipefail
