@@ -61,7 +61,7 @@ from doc_block import replace_block  # noqa: E402  (bench/doc_block.py)
 from lut_baker import auto_tier, bake  # noqa: E402
 from lut_baker.auto_tier import measured  # noqa: E402
 from lut_baker.model import presets  # noqa: E402
-from lut_baker.offline.validation import compare, reference  # noqa: E402
+from lut_baker.offline.validation import compare  # noqa: E402
 
 DOCS = ROOT / "docs"
 BEGIN, END = "<!-- eevee:begin -->", "<!-- eevee:end -->"
@@ -93,15 +93,6 @@ FIELDS = ("foundation", "coverage", "light_deg", "eevee_error", "eevee_mean_rati
 
 def _skin(foundation: str, coverage: float):
     return presets.made_up_skin(foundation, SKIN, coverage=coverage)
-
-
-def _reference(skin, tables, light: float):
-    from support import bench_scene
-
-    samples = reference.default_samples(skin, RADIUS_MM, SPREAD_PER_MEAN_FREE_PATH)
-    return compare.reference_image(skin, tables=tables, resolution=SIZE, radius_mm=RADIUS_MM,
-                                   light_angle_deg=light, irradiance=bench_scene.IRRADIANCE,
-                                   samples=samples)
 
 
 def _cases(foundations):
@@ -140,7 +131,9 @@ def measure_case(foundation: str, coverage: float, *, timed: bool,
                                                             coverage=coverage)
         for light in LIGHTS_DEG:
             sun.rotation_euler = (math.pi / 2, 0.0, math.radians(light))
-            ref = _reference(skin, high, light)
+            ref = scene_module.exact_image(
+                skin, high, size=SIZE, light_deg=light, radius_mm=RADIUS_MM,
+                spread_per_mean_free_path=SPREAD_PER_MEAN_FREE_PATH)
             scene_module.use_eevee(scene, eevee_samples)
             images = {}
             for tier, material in materials.items():

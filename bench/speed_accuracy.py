@@ -48,7 +48,6 @@ from lut_baker import bake  # noqa: E402
 from lut_baker.model import presets  # noqa: E402
 from lut_baker.offline.validation import (  # noqa: E402
     compare,
-    reference,
     table_accuracy,  # noqa: E402
 )
 from lut_baker.offline.validation.baseline import fit_baseline  # noqa: E402
@@ -90,11 +89,9 @@ def references(skin, size: int, lights) -> dict:
     from support import bench_scene
 
     tables = bake.bake(skin, "high")
-    samples = reference.default_samples(skin, RADIUS_MM, SPREAD_PER_MEAN_FREE_PATH)
-    return {light: compare.reference_image(skin, tables=tables, resolution=size,
-                                           radius_mm=RADIUS_MM, light_angle_deg=light,
-                                           irradiance=bench_scene.IRRADIANCE, samples=samples)
-            for light in lights}
+    return {light: bench_scene.exact_image(
+        skin, tables, size=size, light_deg=light, radius_mm=RADIUS_MM,
+        spread_per_mean_free_path=SPREAD_PER_MEAN_FREE_PATH) for light in lights}
 
 
 def _row(**values) -> dict:
@@ -396,11 +393,10 @@ def baseline_text(baseline, seconds: float) -> str:
 
 def add_eevee_points(args) -> int:
     """``--eevee-only``: the EEVEE rows rendered again, the CSV's other rows kept."""
-    import bpy  # noqa: F401  (Blender, before the scenes)
+    os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="speed_accuracy_"))
     from support import bench_scene as scene_module
     from support import sphere_scene
 
-    os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="speed_accuracy_"))
     path = args.out / "speed_accuracy.csv"
     rows = [r for r in read_csv(path) if r["axis"] != "eevee"]
     sizes = {r["size_px"] for r in rows if r["axis"] == "render"}

@@ -20,7 +20,7 @@ from lut_baker import bake
 from lut_baker.closures import cycles as cc
 from lut_baker.closures import fitting, tiers
 from lut_baker.model import presets
-from lut_baker.offline.validation import compare, reference
+from lut_baker.offline.validation import compare
 
 pytestmark = pytest.mark.slow  # EEVEE renders on software OpenGL
 
@@ -80,11 +80,10 @@ def references(made_up):
     out = {}
     for coverage in COVERAGES:
         at = skin.replace(coverage=coverage)
-        samples = reference.default_samples(at, RADIUS_MM, SPREAD_PER_MEAN_FREE_PATH)
         for light in LIGHTS_DEG:
-            out[coverage, light] = compare.reference_image(
-                at, tables=tables, resolution=SIZE, radius_mm=RADIUS_MM,
-                light_angle_deg=light, irradiance=scene_module.IRRADIANCE, samples=samples)
+            out[coverage, light] = scene_module.exact_image(
+                at, tables, size=SIZE, light_deg=light, radius_mm=RADIUS_MM,
+                spread_per_mean_free_path=SPREAD_PER_MEAN_FREE_PATH)
     return out
 
 
@@ -121,9 +120,10 @@ def test_eevee_renders_the_tier_as_its_replica(renders, made_up, light):
     assert error < REPLICA_BOUND
 
     def as_cycles(fit_, tables_, coverage, absorption, gloss, directions):
+        parts = tiers.view_weighted_parts(fit_, "EEVEE")
         return tiers.view_weighted_tier(
-            fit_, tables_, coverage, absorption, gloss, directions, lobes=fit_.eevee_glossy,
-            lut=fit_.eevee_lut, lobe_of=lambda wi, wo, lobe: cc.microfacet_reflection(
-                wi, wo, lobe.roughness), tinted_subsurface=False)
+            fit_, tables_, coverage, absorption, gloss, directions, lobes=parts.lobes,
+            lut=parts.lut, lobe_of=lambda wi, wo, lobe: cc.microfacet_reflection(
+                wi, wo, lobe.roughness), tinted_subsurface=parts.tinted_subsurface)
 
     assert error < 0.4 * compare.relative_rms(image, replica(as_cycles))

@@ -21,7 +21,7 @@ from support import sphere_scene
 
 from lut_baker import bake
 from lut_baker.model import presets
-from lut_baker.offline.validation import baseline, compare, reference
+from lut_baker.offline.validation import baseline, compare
 
 pytestmark = pytest.mark.slow  # renders: ~15 s, and the EEVEE check 10-100 s more
 
@@ -58,10 +58,9 @@ def made_up():
     """The paper preset, its tables and reference image (spread on)."""
     skin = presets.paper()
     tables = bake.bake(skin, "default")
-    ref = compare.reference_image(
-        skin, tables=tables, resolution=SIZE, radius_mm=RADIUS_MM, light_angle_deg=LIGHT_DEG,
-        irradiance=scene_module.IRRADIANCE, spread=True,
-        samples=reference.default_samples(skin, RADIUS_MM, SPREAD_PER_MEAN_FREE_PATH))
+    ref = scene_module.exact_image(skin, tables, size=SIZE, light_deg=LIGHT_DEG,
+                                   radius_mm=RADIUS_MM,
+                                   spread_per_mean_free_path=SPREAD_PER_MEAN_FREE_PATH)
     return skin, tables, ref
 
 

@@ -40,6 +40,7 @@ Functions
   add-on's render tests.
 - :func:`candidate_material` -- the made-up material of an Auto-tier candidate.
 - :func:`furnace_rings` -- a furnace image averaged over rings of the view angle.
+- :func:`exact_image` -- the exact model's image of this scene (the reference, spread on).
 """
 
 from __future__ import annotations
@@ -50,7 +51,7 @@ from pathlib import Path
 
 import numpy as np
 
-from lut_baker.offline.validation import compare
+from lut_baker.offline.validation import compare, reference
 from support import sphere_scene as base_scene
 
 __all__ = [
@@ -304,3 +305,14 @@ def furnace_rings(image, rings: int = FURNACE_RINGS):
     errors = np.stack([values[ring == k].std(axis=0) / np.sqrt(max((ring == k).sum(), 1))
                        for k in range(rings)])
     return (np.arange(rings) + 0.5) / rings, means, errors
+
+
+def exact_image(skin, tables, *, size: int, light_deg: float, radius_mm: float,
+                spread_per_mean_free_path: float):
+    """The exact model's image of this scene (:func:`lut_baker.offline.validation.compare.
+    reference_image` from ``tables``, the skin's spread on), its spread drawn with
+    ``spread_per_mean_free_path`` entry samples per mean free path."""
+    samples = reference.default_samples(skin, radius_mm, spread_per_mean_free_path)
+    return compare.reference_image(skin, tables=tables, resolution=size, radius_mm=radius_mm,
+                                   light_angle_deg=light_deg, irradiance=IRRADIANCE,
+                                   samples=samples)
