@@ -120,6 +120,11 @@ class NodeValue:
         self.colour = colour
 
     # --- one node per operation, or none when the result is known ---------------------------
+    def _neutral(self, other, number: float) -> bool:
+        """Whether ``self (op) other`` is ``self`` itself: ``other`` is the constant
+        ``number`` and does not turn a scalar into a colour."""
+        return _equals(other, number) and (self.colour or not _is_colour(other))
+
     def _op(self, operation: str, a, b, label: str = ""):
         build = self.build
         if _is_colour(a) or _is_colour(b):
@@ -128,15 +133,13 @@ class NodeValue:
         return NodeValue(build, build.math(operation, _operand(a), _operand(b), label), False)
 
     def __add__(self, other):
-        return self if _equals(other, 0.0) and not (_is_colour(other) and not self.colour) \
-            else self._op("ADD", self, other)
+        return self if self._neutral(other, 0.0) else self._op("ADD", self, other)
 
     def __radd__(self, other):
         return self.__add__(other)
 
     def __sub__(self, other):
-        return self if _equals(other, 0.0) and not (_is_colour(other) and not self.colour) \
-            else self._op("SUBTRACT", self, other)
+        return self if self._neutral(other, 0.0) else self._op("SUBTRACT", self, other)
 
     def __rsub__(self, other):
         return self._op("SUBTRACT", other, self)
@@ -144,7 +147,7 @@ class NodeValue:
     def __mul__(self, other):
         if _equals(other, 0.0):
             return np.zeros(3) if self.colour or _is_colour(other) else 0.0
-        if _equals(other, 1.0) and not (_is_colour(other) and not self.colour):
+        if self._neutral(other, 1.0):
             return self
         return self._op("MULTIPLY", self, other)
 
@@ -152,7 +155,7 @@ class NodeValue:
         return self.__mul__(other)
 
     def __truediv__(self, other):
-        if _equals(other, 1.0) and not (_is_colour(other) and not self.colour):
+        if self._neutral(other, 1.0):
             return self
         return self._op("DIVIDE", self, other)
 

@@ -1,6 +1,6 @@
 """The "Made-up Skin" node groups: closures fitted to baked tables (lut_baker.closures.fitting).
 
-Both tiers share one interface, so a material keeps its links when the tier changes:
+Every tier shares one interface, so a material keeps its links when the tier changes:
 
 - inputs: ``Coverage`` (0..1, paintable with a texture), ``Foundation Absorption`` (colour:
   the fraction of light the film's pigment absorbs per channel), ``Skin Color`` (the skin's
@@ -325,11 +325,11 @@ def build_group(tier: str, record: dict, fit, group=None, *, method=None, measur
     if tier == "PRINCIPLED":
         _build_principled(build, fit, method, radius, ior)
     else:
-        eevee = tier == "EEVEE"
-        lut = storage.lut_image(lut_image_name(key, tier), fit.eevee_lut if eevee else fit.lut)
+        parts = tiers.view_weighted_parts(fit, tier)
+        lut = storage.lut_image(lut_image_name(key, tier), parts.lut)
         images.append(storage.image_record(lut))
-        _build_view_weighted(build, fit, fit.eevee_glossy if eevee else fit.glossy, lut, method,
-                             radius, ior, tinted_subsurface=not eevee)
+        _build_view_weighted(build, fit, parts.lobes, lut, method, radius, ior,
+                             tinted_subsurface=parts.tinted_subsurface)
     group[FIT_KEY] = json.dumps({**record, "tier": tier, "forced_method": forced,
                                  "images": images, **fit.summary(),
                                  "subsurface_method": method, "measured": measured},

@@ -11,6 +11,8 @@ Cycles renders the node group, then compared with the tables on a view grid.
   EEVEE tier as EEVEE renders it; :func:`view_weighted_reflection` -- a view-weighted tier's
   closures as a BRDF, :func:`view_weighted_tier` -- with any lobes and image;
   :data:`TIER_REPLICAS` -- each by name.
+- :func:`view_weighted_parts` -- what the LAYERED and EEVEE tiers take from a fit (the replicas
+  here and the node group alike).
 - :func:`tier_errors` -- every tier against the tables at one coverage and absorption.
 """
 
@@ -37,7 +39,8 @@ from .view_image import LUT_ROWS
 
 __all__ = ["TIERS", "TierError", "principled_inputs", "principled_tier_reflection",
            "view_weighted_reflection", "view_weighted_tier", "layered_tier_reflection",
-           "eevee_tier_reflection", "TIER_REPLICAS", "EEVEE_SUBSURFACE_METHOD", "tier_errors"]
+           "eevee_tier_reflection", "TIER_REPLICAS", "EEVEE_SUBSURFACE_METHOD", "tier_errors",
+           "ViewWeightedParts", "view_weighted_parts"]
 
 TIERS = ("PRINCIPLED", "LAYERED", "EEVEE")
 """The node group's tiers: the two made for Cycles, cheapest first, then the one made for
@@ -96,6 +99,29 @@ def principled_tier_reflection(fit: ClosureFit, tables: Tables, coverage: float,
     return cc.principled_reflection(wi, wo, inputs)
 
 
+@dataclass(frozen=True)
+class ViewWeightedParts:
+    """What a view-weighted tier takes from a :class:`ClosureFit`: its Glossy ``lobes`` (by
+    name), its view-angle image ``lut`` (rows :data:`LUT_ROWS`) and whether the skin through
+    the film is a tinted, weighted Subsurface closure (``tinted_subsurface``, see
+    :func:`lut_baker.closures.tier_formulas.view_weighted_closures`)."""
+
+    lobes: dict
+    lut: np.ndarray
+    tinted_subsurface: bool
+
+
+def view_weighted_parts(fit: ClosureFit, tier: str) -> ViewWeightedParts:
+    """The LAYERED tier's parts (Cycles' lobes, the tinted subsurface its random walk needs)
+    or the EEVEE tier's (lobes fitted as EEVEE renders GGX, its own image, the plain colour
+    EEVEE's subsurface takes)."""
+    if tier == "LAYERED":
+        return ViewWeightedParts(fit.glossy, fit.lut, tinted_subsurface=True)
+    if tier == "EEVEE":
+        return ViewWeightedParts(fit.eevee_glossy, fit.eevee_lut, tinted_subsurface=False)
+    raise ValueError(f"{tier!r} is not a view-weighted tier (LAYERED, EEVEE)")
+
+
 def view_weighted_reflection(closures: ViewWeightedClosures, lobe_of, wi, wo) -> np.ndarray:
     """A view-weighted tier's BRDF, ``(..., 3)``, at ``(wi, wo)`` from its closures
     (:func:`lut_baker.closures.tier_formulas.view_weighted_closures`, evaluated by the numpy
@@ -139,11 +165,12 @@ def layered_tier_reflection(fit: ClosureFit, tables: Tables, coverage: float, ab
     ``(wi, wo)``: its closures (:func:`lut_baker.closures.tier_formulas.view_weighted_closures`)
     with the image rows read as Blender reads them (linear between texel centres) and Cycles'
     Glossy lobes; ``gloss``: the group's Gloss input."""
+    parts = view_weighted_parts(fit, "LAYERED")
     return view_weighted_tier(
-        fit, tables, coverage, absorption, gloss, directions, lobes=fit.glossy, lut=fit.lut,
+        fit, tables, coverage, absorption, gloss, directions, lobes=parts.lobes, lut=parts.lut,
         lobe_of=lambda wi, wo, lobe: cc.microfacet_reflection(
             wi, wo, lobe.roughness, distribution=lobe.distribution),
-        tinted_subsurface=True)
+        tinted_subsurface=parts.tinted_subsurface)
 
 
 def eevee_tier_reflection(fit: ClosureFit, tables: Tables, coverage: float, absorption,
@@ -154,11 +181,11 @@ def eevee_tier_reflection(fit: ClosureFit, tables: Tables, coverage: float, abso
     :func:`lut_baker.closures.eevee.glossy_reflection`) and view-angle rows
     (``fit.eevee_lut``), the skin through the film as its plain colour (EEVEE's screen-space
     subsurface takes it as it is); Diffuse and Subsurface closures Lambertian."""
+    parts = view_weighted_parts(fit, "EEVEE")
     return view_weighted_tier(
-        fit, tables, coverage, absorption, gloss, directions, lobes=fit.eevee_glossy,
-        lut=fit.eevee_lut,
+        fit, tables, coverage, absorption, gloss, directions, lobes=parts.lobes, lut=parts.lut,
         lobe_of=lambda wi, wo, lobe: eevee.glossy_reflection(wi, wo, lobe.roughness),
-        tinted_subsurface=False)
+        tinted_subsurface=parts.tinted_subsurface)
 
 
 TIER_REPLICAS = {"PRINCIPLED": principled_tier_reflection, "LAYERED": layered_tier_reflection,
