@@ -31,13 +31,14 @@ from one float image (rows :data:`lut_baker.closures.view_image.LUT_ROWS`) at ``
 cos(theta_o)``, and a Mix Shader by Coverage between bare skin and made-up skin: an areal mix
 of closures, so a painted coverage fades out without fringe or halo.
 EEVEE: the LAYERED tier's closures and mix, every Glossy BSDF GGX (fitted as EEVEE renders it),
-its own view-angle image (``fit.eevee_lut``), the skin through the film its plain colour,
-subsurface Christensen-Burley.
+the film's gloss in two Glossy BSDFs, its own view-angle image (``fit.eevee_lut``, rows
+:data:`lut_baker.closures.view_image.EEVEE_LUT_ROWS`), the skin through the film its plain
+colour, subsurface Christensen-Burley.
 
 The view-angle rows are read by :func:`_lut_rows`: two Closest lookups at neighbouring texel
 centres mixed linearly, which is what a Linear lookup gives in Cycles
 (:func:`lut_baker.closures.view_image.sample_lut`); EEVEE samples a Linear image through mipmaps
-and anisotropic filtering, which mixes the image's five rows wherever ``cos(theta_o)`` changes
+and anisotropic filtering, which mixes the image's rows wherever ``cos(theta_o)`` changes
 quickly across the screen (docs/addon.md, "Why the Layered tier breaks in EEVEE").
 
 - :func:`build_group` -- create or rebuild (in place) a group from a fit and its bake record,
@@ -53,7 +54,7 @@ import json
 import bpy
 
 from . import storage
-from .core import tier_formulas, tiers, view_image
+from .core import tier_formulas, tiers
 from .keys import FIT_KEY, LEGACY_TABLES_REF, group_name, lut_image_name
 from .node_algebra import Builder, NodeAlgebra, NodeValue, socket
 
@@ -204,8 +205,8 @@ def _texel_pair(build: Builder, u, size: int, label: str):
     return u0, u1, weight
 
 
-def _lut_rows(build: Builder, lut, coordinates: dict) -> dict:
-    """Every row of the view-angle image ``lut`` (rows :data:`view_image.LUT_ROWS`), read at
+def _lut_rows(build: Builder, lut, names: tuple, coordinates: dict) -> dict:
+    """Every row of the view-angle image ``lut`` (rows named ``names``), read at
     ``u = coordinates[name]`` (a socket per row name) linearly between texel centres and held
     beyond them, as :func:`lut_baker.closures.view_image.sample_lut` reads it: two Closest
     lookups mixed, so that EEVEE reads what Cycles does (its Linear filter goes through
@@ -214,7 +215,7 @@ def _lut_rows(build: Builder, lut, coordinates: dict) -> dict:
     size = lut.size[0]
     pairs: dict = {}
     rows = {}
-    for j, name in enumerate(view_image.LUT_ROWS):
+    for j, name in enumerate(names):
         u = coordinates[name]
         key = u.as_pointer()
         if key not in pairs:
@@ -224,7 +225,7 @@ def _lut_rows(build: Builder, lut, coordinates: dict) -> dict:
         for k, at in enumerate((u0, u1)):
             coordinate = build.node("ShaderNodeCombineXYZ", f"row {name}, texel {k}")
             build.feed(coordinate.inputs["X"], at)
-            build.feed(coordinate.inputs["Y"], (j + 0.5) / len(view_image.LUT_ROWS))
+            build.feed(coordinate.inputs["Y"], (j + 0.5) / len(names))
             texture = build.node("ShaderNodeTexImage", name, image=lut,
                                  interpolation="Closest", extension="EXTEND")
             build.tree.links.new(coordinate.outputs[0], texture.inputs["Vector"])
@@ -246,10 +247,11 @@ def _add(build: Builder, shaders: list):
     return total
 
 
-def _build_view_weighted(build: Builder, fit, lobes: dict, lut, method: str, radius_mm,
-                         ior: float, *, tinted_subsurface: bool):
+def _build_view_weighted(build: Builder, fit, parts, lut, method: str, radius_mm,
+                         ior: float):
     """The closures of :func:`lut_baker.closures.tier_formulas.view_weighted_closures` (the
-    LAYERED and EEVEE tiers, their Glossy lobes ``lobes``, their view-angle image ``lut``): a
+    LAYERED and EEVEE tiers: their :class:`lut_baker.closures.tiers.ViewWeightedParts`
+    ``parts``, their view-angle image ``lut``): a
     Glossy, Diffuse or Subsurface node per closure, its colour and weight emitted as nodes,
     each side's closures added, the two sides mixed by Coverage (a Mix Shader: an areal mix,
     so a painted coverage fades out without fringe or halo)."""
@@ -259,10 +261,10 @@ def _build_view_weighted(build: Builder, fit, lobes: dict, lut, method: str, rad
     # Each row is read at the view angle against the normal of the surface it describes.
     cosines = {surface: _cos_view(build, normal, geometry, f"cos theta_o ({surface})")
                for surface, normal in normals.items()}
-    rows = _lut_rows(build, lut, {
-        name: cosines[tier_formulas.ROW_SURFACE.get(name, "film")] for name in view_image.LUT_ROWS})
-    closures = tier_formulas.view_weighted_closures(fit, x, NodeAlgebra(build, rows),
-                                                    tinted_subsurface=tinted_subsurface)
+    rows = _lut_rows(build, lut, parts.rows, {
+        name: cosines[tier_formulas.ROW_SURFACE.get(name, "film")] for name in parts.rows})
+    closures = parts.closures(fit, x, NodeAlgebra(build, rows))
+    lobes = parts.lobes
 
     def emit(closure):
         if closure.kind == "glossy":
@@ -328,8 +330,7 @@ def build_group(tier: str, record: dict, fit, group=None, *, method=None, measur
         parts = tiers.view_weighted_parts(fit, tier)
         lut = storage.lut_image(lut_image_name(key, tier), parts.lut)
         images.append(storage.image_record(lut))
-        _build_view_weighted(build, fit, parts.lobes, lut, method, radius, ior,
-                             tinted_subsurface=parts.tinted_subsurface)
+        _build_view_weighted(build, fit, parts, lut, method, radius, ior)
     group[FIT_KEY] = json.dumps({**record, "tier": tier, "forced_method": forced,
                                  "images": images, **fit.summary(),
                                  "subsurface_method": method, "measured": measured},

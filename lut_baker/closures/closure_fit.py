@@ -27,8 +27,9 @@ class ClosureFit:
     (the best-fitting one), ``subsurface_ior`` (the dipole's index, for the random walk and
     the profile fits), ``lut`` (``(len(LUT_ROWS), size, 3)``: the view-angle image),
     ``errors`` at the coverage and absorption the tables were baked for.  EEVEE:
-    ``eevee_glossy`` (the same three lobes, GGX as EEVEE renders it) and ``eevee_lut`` (their
-    view-angle image, rows :data:`lut_baker.closures.view_image.LUT_ROWS`); its subsurface is
+    ``eevee_glossy`` (the same lobes, GGX as EEVEE renders it, the film gloss in two:
+    ``film_gloss`` and ``film_gloss_2``) and ``eevee_lut`` (their view-angle image, rows
+    :data:`lut_baker.closures.view_image.EEVEE_LUT_ROWS`); its subsurface is
     Burley's (:data:`lut_baker.closures.tiers.EEVEE_SUBSURFACE_METHOD`).
     """
 

@@ -22,8 +22,9 @@ film diffuse plus that companion (one Diffuse), the skin through the film and ba
 (Subsurface), mixed by coverage.
 ``EEVEE``: the LAYERED tier's closures and mix, made for EEVEE: every Glossy lobe is GGX (EEVEE
 renders no other distribution) fitted to the tables as EEVEE renders it under a lamp, a
-linearly transformed cosine (:mod:`lut_baker.closures.eevee`), with its own view-angle rows;
-subsurface Christensen-Burley (EEVEE's screen-space method).
+linearly transformed cosine (:mod:`lut_baker.closures.eevee`), the film's gloss as two such
+lobes and the companion (:func:`~lut_baker.closures.lobes.fit_glossy_pair`), with its own
+view-angle rows; subsurface Christensen-Burley (EEVEE's screen-space method).
 The formulas of all three: :mod:`lut_baker.closures.tier_formulas`.
 
 Where each part lives: the lobes :mod:`~lut_baker.closures.lobes`, the subsurface radii
@@ -45,12 +46,12 @@ from ..numerics.quadrature import trapezoid_weights
 from ..tables.table_set import Tables
 from . import cycles as cc
 from .closure_fit import ClosureFit
-from .lobes import EEVEE_GLOSSY, fit_coat, fit_glossy, fit_specular
+from .lobes import EEVEE_GLOSSY, fit_coat, fit_glossy, fit_glossy_pair, fit_specular
 from .profiles import REPLICA_EDGE_ERROR, fit_profiles
 from .tier_formulas import SPECULAR_IOR
 from .tiers import tier_errors
 from .view_grid import FIT_VIEWS, lobe_widths_deg, view_grid
-from .view_image import DEFAULT_LUT_SIZE, LUT_ROWS, lut_nodes
+from .view_image import DEFAULT_LUT_SIZE, EEVEE_LUT_ROWS, LUT_ROWS, lut_nodes
 
 __all__ = ["fit_closures", "subsurface_ior"]
 
@@ -133,24 +134,34 @@ def fit_closures(tables: Tables, *, lut_size: int = DEFAULT_LUT_SIZE,
     t_rows = np.stack([np.interp(np.degrees(np.arccos(mu)), theta_deg, transmittance[:, c])
                        for c in range(3)], -1)
 
-    def view_weighted(closures):
-        """The three Glossy lobes fitted with ``closures``, and their view-angle image."""
-        lobes = {name: fit_glossy(grid, table, np.asarray(getattr(tables, name + "_albedo")),
-                                  theta_deg, lut_size, companion=name == "film_gloss",
-                                  closures=closures)
-                 for name, grid, table in (("film_gloss", film_grid, film_gloss),
-                                           ("path3_gloss", skin_grid, path3),
-                                           ("skin_gloss", skin_grid, skin_gloss))}
-        rows = [lobes[name].lut for name in LUT_ROWS[:3]] + [t_rows,
-                                                             lobes["film_gloss"].diffuse_lut]
-        if any(row is None for row in rows):
-            raise AssertionError("fit_glossy gives a view-angle row")
-        return lobes, np.stack(rows)
+    targets = {"film_gloss": (film_grid, film_gloss), "path3_gloss": (skin_grid, path3),
+               "skin_gloss": (skin_grid, skin_gloss)}
+
+    def lobe(name, closures):
+        grid, table = targets[name]
+        return fit_glossy(grid, table, np.asarray(getattr(tables, name + "_albedo")),
+                          theta_deg, lut_size, companion=name == "film_gloss",
+                          closures=closures)
+
+    def image(lobes, rows):
+        """The view-angle image of ``lobes``, rows named ``rows``."""
+        found = {**{name: lobes[name].lut for name in lobes}, "film_transmittance": t_rows,
+                 "film_gloss_diffuse": lobes["film_gloss"].diffuse_lut}
+        if any(found.get(name) is None for name in rows):
+            raise AssertionError("the lobes give every view-angle row")
+        return np.stack([found[name] for name in rows])
 
     report(0.3, "fitting the Layered tier's gloss lobes")
-    glossy, lut = view_weighted(cc.GLOSSY_DISTRIBUTIONS)
+    glossy = {name: lobe(name, cc.GLOSSY_DISTRIBUTIONS) for name in targets}
+    lut = image(glossy, LUT_ROWS)
     report(0.45, "fitting the EEVEE tier's gloss lobes")
-    eevee_glossy, eevee_lut = view_weighted((EEVEE_GLOSSY,))
+    # EEVEE draws GGX alone: the film's gloss takes two lobes and the companion.
+    first, second = fit_glossy_pair(film_grid, film_gloss,
+                                    np.asarray(tables.film_gloss_albedo), theta_deg, lut_size)
+    eevee_glossy = {"film_gloss": first, "film_gloss_2": second,
+                    **{name: lobe(name, (EEVEE_GLOSSY,)) for name in ("path3_gloss",
+                                                                       "skin_gloss")}}
+    eevee_lut = image(eevee_glossy, EEVEE_LUT_ROWS)
     coat_ior = coat.ior
     if coat_ior is None:
         raise AssertionError("fit_coat gives an IOR")

@@ -12,11 +12,13 @@ enough (:data:`FIT_XTOL`) that a fitted number follows its data continuously.
 - :func:`fit_glossy` -- a Glossy BSDF, its distribution, roughness and view-angle row (and, for
   a broad lobe, its Lambertian companion's row), as Cycles renders it or as EEVEE does
   (:data:`EEVEE_GLOSSY`, :func:`glossy_lobe`, :func:`glossy_albedo`).
+- :func:`fit_glossy_pair` -- two of EEVEE's Glossy lobes and a Lambertian companion sharing a
+  table's albedo (the EEVEE tier's film gloss).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -30,7 +32,8 @@ from .view_image import DEFAULT_LUT_SIZE, lut_nodes, sample_lut
 __all__ = ["LobeFit", "fit_coat", "fit_specular", "fit_glossy", "ROUGHNESS_RANGE",
            "FIT_XTOL", "DISTRIBUTION_MARGIN", "COAT_IOR_RANGE", "SPECULAR_LEVEL_RANGE",
            "SEARCH_QUADRATURE", "FINAL_QUADRATURE", "NO_LOBE_ERROR", "EEVEE_GLOSSY",
-           "glossy_lobe", "glossy_albedo"]
+           "glossy_lobe", "glossy_albedo", "fit_glossy_pair", "PAIR_RATIO", "PAIR_ALBEDO_SLACK",
+           "PAIR", "SHARE_RIDGE"]
 
 ROUGHNESS_RANGE = (0.02, 1.0)
 """Roughness (Blender's socket, alpha = roughness^2) searched by the fits: from a lobe about
@@ -293,3 +296,152 @@ def fit_glossy(grid: ViewGrid, target, albedo_table: np.ndarray, theta_deg: np.n
                    distribution=node, diffuse_lut=diffuse,
                    searched={("GGX" if name == EEVEE_GLOSSY else name): float(found[1])
                              for name, found in searched.items()})
+
+
+PAIR_RATIO = 1.26
+"""The ratio of :func:`fit_glossy_pair`'s two roughnesses: where a fit of both roughnesses
+lands on the paper film (0.516 and 0.651).  Fitted freely, the pair moves by 2e-6 when the
+tables move by 1e-9 (a valley the data hardly determine), so the ratio is held."""
+PAIR_ALBEDO_SLACK = 0.05
+"""How far (relative) :func:`fit_glossy_pair`'s closures may move the film gloss's albedo
+from the table's at a view, to follow its shape closer."""
+PAIR = "GGX x2"
+"""The name :func:`fit_glossy_pair` gives two lobes in a fit's ``searched`` errors (beside
+``GGX``, one lobe): the choice between them is kept as a distribution choice is."""
+SHARE_RIDGE = 1e-3
+"""Ridge (relative to the mean diagonal of the normal equations) on :func:`_albedo_shares`:
+two lobes of similar width are nearly collinear, and without it their split would amplify a
+change of the data a thousandfold."""
+
+
+def _face_minimum(gram: np.ndarray, right: np.ndarray, total=None) -> np.ndarray:
+    """Per view, the non-negative ``f`` ``(V, K)`` that minimises ``f G f - 2 r f`` (``gram``
+    ``(V, K, K)``, positive definite; ``right`` ``(V, K)``), with ``sum(f) = total`` ``(V,)``
+    if given: a convex quadratic, minimised exactly (the optimum on every face of the orthant,
+    the best feasible one), so that ``f`` follows the data continuously."""
+    views, count = right.shape
+    if total is None:
+        best_cost, shares = np.zeros(views), np.zeros((views, count))  # f = 0 is feasible
+    else:
+        best_cost, shares = np.full(views, np.inf), np.zeros((views, count))
+    for mask in range(1, 2 ** count):
+        face = np.flatnonzero([(mask >> k) & 1 for k in range(count)])
+        n = face.size
+        size = n if total is None else n + 1
+        system = np.zeros((views, size, size))
+        system[:, :n, :n] = gram[:, face][:, :, face]
+        rhs = right[:, face]
+        if total is not None:
+            system[:, :n, n] = system[:, n, :n] = 1.0
+            rhs = np.concatenate([rhs, np.asarray(total, float)[:, None]], axis=1)
+        solution = np.linalg.solve(system, rhs[..., None])[..., :n, 0]
+        f = np.zeros((views, count))
+        f[:, face] = solution
+        cost = np.einsum("vk,vkj,vj->v", f, gram, f) - 2.0 * np.einsum("vk,vk->v", right, f)
+        better = np.all(solution >= 0.0, axis=1) & (cost < best_cost)
+        best_cost = np.where(better, cost, best_cost)
+        shares = np.where(better[:, None], f, shares)
+    return shares
+
+
+def _albedo_shares(grid: ViewGrid, models: list, target: np.ndarray,
+                   slack: float) -> np.ndarray:
+    """Per view of ``grid``, the shares ``f`` ``(V, K)`` (non-negative) that minimise
+    ``|sum_k f_k m_k cos_i - target cos_i|`` over the lights (the grid's measure, with a
+    :data:`SHARE_RIDGE`), ``models`` the closures' BRDFs ``(V, A, P)`` when each carries the
+    whole table albedo, with ``|sum(f) - 1| <= slack``: the closures' albedo within ``slack``
+    (relative) of the table's at every view.  Convex: the optimum without the albedo bound
+    where it keeps the bound, else on the bound's nearer side (:func:`_face_minimum`)."""
+    weight = grid.weight * np.square(grid.cos_i)
+    stacked = np.stack(models, axis=1)  # (V, K, A, P)
+    gram = np.einsum("vkap,vjap,vap->vkj", stacked, stacked, weight)
+    diagonal = np.einsum("vkk->vk", gram).mean(axis=1)
+    gram = gram + SHARE_RIDGE * diagonal[:, None, None] * np.eye(len(models))
+    right = np.einsum("vkap,vap,vap->vk", stacked, target, weight)
+    free = _face_minimum(gram, right)
+    total = np.clip(free.sum(axis=1), 1.0 - slack, 1.0 + slack)
+    bounded = _face_minimum(gram, right, total)
+    return np.where((np.abs(free.sum(axis=1) - 1.0) <= slack)[:, None], free, bounded)
+
+
+def fit_glossy_pair(grid: ViewGrid, target, albedo_table: np.ndarray, theta_deg: np.ndarray,
+                    size: int = DEFAULT_LUT_SIZE, *,
+                    slack: float = PAIR_ALBEDO_SLACK,
+                    ratio: float = PAIR_RATIO) -> tuple[LobeFit, LobeFit]:
+    """One or two of EEVEE's Glossy lobes (:data:`EEVEE_GLOSSY`) and a Lambertian companion
+    sharing the table's albedo ``A`` view by view (the EEVEE tier's film gloss): weights
+    ``a_k = f_k A / E_k`` (``E_k`` the lobes' albedos) and ``b = f_c A``, the shares ``f``
+    non-negative and adding up to within ``slack`` of 1 (:func:`_albedo_shares`), so that the
+    closures' albedo stays that close to the table's at every view.  Two lobes have
+    roughnesses ``r / sqrt(ratio)`` and ``r sqrt(ratio)`` (:data:`PAIR_RATIO`); one lobe's
+    roughness or two lobes' ``r`` is found by Brent's search.  The pair is kept when it errs
+    less than the one lobe by more than :data:`DISTRIBUTION_MARGIN` (relative); else the
+    second lobe has weight 0 and the first's roughness.
+
+    Returns ``(first, second)``: the first holds its row and the companion's (``lut``,
+    ``diffuse_lut``) and, in ``searched``, both errors (``GGX`` and :data:`PAIR`); the second
+    its row.  EEVEE draws only GGX and drops a closure of negative colour, so no lobe can cut
+    another's tail: a broad gloss whose radiance keeps ``cos(theta_i)`` (the paper film's) is
+    followed closer by two lobes of different widths than by one, and a short-tailed narrow
+    one (Clarins 112's) by a lobe whose albedo may give a little (docs/addon.md, "The EEVEE
+    tier")."""
+    if not np.any(albedo_table):  # no gloss (a matte film): weights 0, nothing to fit
+        zeros = np.zeros((size, 3))
+        empty = LobeFit(roughness=ROUGHNESS_RANGE[1], error=0.0, lut=zeros)
+        return replace(empty, diffuse_lut=zeros.copy()), replace(empty, lut=zeros.copy())
+    target = np.asarray(target, float)
+    target = (target if target.ndim == 4 else target[..., None]) * np.ones(3)
+    grey = _grey(target)
+    texels = lut_nodes(size)
+    at_views = np.mean(_texel_albedo(albedo_table, theta_deg, grid.cos_view), axis=-1)
+    lambert = np.broadcast_to(1.0 / np.pi, grid.cos_i.shape) * at_views[:, None, None]
+    root_weight = np.sqrt(grid.weight) * grid.cos_i
+    scale = 1.0 / max(float(np.sqrt(np.sum(np.square(root_weight * grey)))), 1e-300)
+
+    carrying = {}  # a lobe carrying the table's albedo, once per roughness tried
+
+    def models(roughnesses) -> list:
+        for r in roughnesses:
+            if r not in carrying:
+                albedo = glossy_albedo(grid.cos_view, r, EEVEE_GLOSSY)
+                carrying[r] = (glossy_lobe(grid, r, EEVEE_GLOSSY)
+                               * (at_views / np.maximum(albedo, 1e-6))[:, None, None])
+        return [carrying[r] for r in roughnesses] + [lambert]
+
+    def residuals_of(roughnesses):
+        found = models(roughnesses)
+        shares = _albedo_shares(grid, found, grey, slack)
+        value = sum(shares[:, k, None, None] * m for k, m in enumerate(found))
+        return (scale * root_weight * (value - grey)).ravel()
+
+    def pair(r: float) -> list:
+        return [float(r / np.sqrt(ratio)), float(r * np.sqrt(ratio))]
+
+    def result(roughnesses) -> tuple[float, list, np.ndarray]:
+        """The error on the grid, the Glossy rows and the companion's row."""
+        shares = _albedo_shares(grid, models(roughnesses), grey, slack)
+        table = _texel_albedo(albedo_table, theta_deg, texels)
+        at_texels = np.stack([np.interp(texels, grid.cos_view, shares[:, k])
+                              for k in range(len(roughnesses) + 1)], -1)
+        rows = [at_texels[:, k, None] * table
+                / np.maximum(glossy_albedo(texels, r, EEVEE_GLOSSY), 1e-6)[:, None]
+                for k, r in enumerate(roughnesses)]
+        companion = at_texels[:, -1, None] * table
+        fitted = (sum(glossy_lobe(grid, r, EEVEE_GLOSSY)[..., None]
+                      * sample_lut(row, grid.cos_o)
+                      for r, row in zip(roughnesses, rows, strict=True))
+                  + sample_lut(companion, grid.cos_o) / np.pi)
+        return grid.error(fitted, target), rows, companion
+
+    one = [_minimise_roughness(lambda r: float(np.linalg.norm(residuals_of([r]))))[0]]
+    two = pair(_minimise_roughness(lambda r: float(np.linalg.norm(residuals_of(pair(r)))))[0])
+    (one_error, one_rows, one_companion), (two_error, two_rows, two_companion) = (
+        result(one), result(two))
+    searched = {"GGX": one_error, PAIR: two_error}
+    if two_error >= (1.0 - DISTRIBUTION_MARGIN) * one_error:
+        first = LobeFit(roughness=one[0], error=one_error, lut=one_rows[0],
+                        diffuse_lut=one_companion, searched=searched)
+        return first, LobeFit(roughness=one[0], error=one_error, lut=np.zeros((size, 3)))
+    first = LobeFit(roughness=two[0], error=two_error, lut=two_rows[0],
+                    diffuse_lut=two_companion, searched=searched)
+    return first, LobeFit(roughness=two[1], error=two_error, lut=two_rows[1])

@@ -171,11 +171,13 @@ class ViewWeightedClosures:
 
 
 def view_weighted_closures(fit, x: TierInputs, ops: Algebra, *,
-                           tinted_subsurface: bool = True) -> ViewWeightedClosures:
+                           tinted_subsurface: bool = True,
+                           film_lobes: tuple = ("film_gloss",)) -> ViewWeightedClosures:
     """The LAYERED tier's closures at inputs ``x``, their view-dependent factors read from the
     image rows (``ops.row``, :data:`lut_baker.closures.view_image.LUT_ROWS`):
 
-    - where the film is: its gloss (Glossy, ``g`` times row ``film_gloss``), its diffuse and
+    - where the film is: its gloss (a Glossy per lobe of ``film_lobes``, ``g`` times the row
+      of its name: ``film_gloss``, and ``film_gloss_2`` in the EEVEE tier), its diffuse and
       the gloss's Lambertian companion (one Diffuse, ``(1 - A) pi P_d,f + g`` row
       ``film_gloss_diffuse``), the skin's gloss through it (Glossy, ``g (1 - A)^2`` row
       ``path3_gloss``), the skin through it (Subsurface, ``(1 - A)^2 T(theta_o) T_mean S``);
@@ -200,7 +202,7 @@ def view_weighted_closures(fit, x: TierInputs, ops: Algebra, *,
     else:
         through = Closure("subsurface", "skin through film", transmitted * x.skin_color, "skin")
     covered = (
-        Closure("glossy", "film_gloss", g * ops.row("film_gloss"), "film"),
+        *(Closure("glossy", name, g * ops.row(name), "film") for name in film_lobes),
         Closure("diffuse", "film diffuse",
                 weights.once * fit.film_albedo + g * ops.row("film_gloss_diffuse"), "film"),
         Closure("glossy", "path3_gloss", g * ops.row("path3_gloss") * weights.twice, "skin"),

@@ -35,7 +35,7 @@ from .tier_formulas import (
     view_weighted_closures,
 )
 from .view_grid import ERROR_VIEWS, lobe_widths_deg, view_grid
-from .view_image import LUT_ROWS
+from .view_image import EEVEE_LUT_ROWS, LUT_ROWS
 
 __all__ = ["TIERS", "TierError", "principled_inputs", "principled_tier_reflection",
            "view_weighted_reflection", "view_weighted_tier", "layered_tier_reflection",
@@ -102,23 +102,36 @@ def principled_tier_reflection(fit: ClosureFit, tables: Tables, coverage: float,
 @dataclass(frozen=True)
 class ViewWeightedParts:
     """What a view-weighted tier takes from a :class:`ClosureFit`: its Glossy ``lobes`` (by
-    name), its view-angle image ``lut`` (rows :data:`LUT_ROWS`) and whether the skin through
-    the film is a tinted, weighted Subsurface closure (``tinted_subsurface``, see
-    :func:`lut_baker.closures.tier_formulas.view_weighted_closures`)."""
+    name), its view-angle image ``lut`` (rows named ``rows``), the lobes of the film's gloss
+    (``film_lobes``) and whether the skin through the film is a tinted, weighted Subsurface
+    closure (``tinted_subsurface``); see
+    :func:`lut_baker.closures.tier_formulas.view_weighted_closures`."""
 
     lobes: dict
     lut: np.ndarray
+    rows: tuple
+    film_lobes: tuple
     tinted_subsurface: bool
+
+    def closures(self, fit: ClosureFit, x: TierInputs, ops) -> ViewWeightedClosures:
+        """The tier's closures at inputs ``x`` in the algebra ``ops``."""
+        return view_weighted_closures(fit, x, ops, tinted_subsurface=self.tinted_subsurface,
+                                      film_lobes=self.film_lobes)
 
 
 def view_weighted_parts(fit: ClosureFit, tier: str) -> ViewWeightedParts:
     """The LAYERED tier's parts (Cycles' lobes, the tinted subsurface its random walk needs)
-    or the EEVEE tier's (lobes fitted as EEVEE renders GGX, its own image, the plain colour
-    EEVEE's subsurface takes)."""
+    or the EEVEE tier's (lobes fitted as EEVEE renders GGX, the film's gloss in two, its own
+    image, the plain colour EEVEE's subsurface takes)."""
     if tier == "LAYERED":
-        return ViewWeightedParts(fit.glossy, fit.lut, tinted_subsurface=True)
+        return ViewWeightedParts(fit.glossy, fit.lut, LUT_ROWS, ("film_gloss",),
+                                 tinted_subsurface=True)
     if tier == "EEVEE":
-        return ViewWeightedParts(fit.eevee_glossy, fit.eevee_lut, tinted_subsurface=False)
+        # The film gloss's second lobe is a closure only where its fit kept two.
+        second = np.any(fit.eevee_glossy["film_gloss_2"].lut)
+        return ViewWeightedParts(fit.eevee_glossy, fit.eevee_lut, EEVEE_LUT_ROWS,
+                                 ("film_gloss", "film_gloss_2") if second else ("film_gloss",),
+                                 tinted_subsurface=False)
     raise ValueError(f"{tier!r} is not a view-weighted tier (LAYERED, EEVEE)")
 
 
@@ -145,18 +158,15 @@ def view_weighted_reflection(closures: ViewWeightedClosures, lobe_of, wi, wo) ->
 
 
 def view_weighted_tier(fit: ClosureFit, tables: Tables, coverage: float, absorption, gloss,
-                       directions, *, lobes: dict, lut: np.ndarray, lobe_of,
-                       tinted_subsurface: bool):
+                       directions, parts: ViewWeightedParts, lobe_of):
     """A view-weighted tier's BRDF ``(..., 3)`` at the angular nodes or at ``directions``:
-    the closures of :func:`lut_baker.closures.tier_formulas.view_weighted_closures` with the
-    rows of ``lut`` read at ``wo``'s view angles, its Glossy ``lobes`` (by name) drawn by
-    ``lobe_of(wi, wo, lobe)``."""
+    the closures of its ``parts`` (:class:`ViewWeightedParts`) with the rows of their image
+    read at ``wo``'s view angles, its Glossy lobes drawn by ``lobe_of(wi, wo, lobe)``."""
     wi, wo = tables.node_directions() if directions is None else directions
-    algebra = NumpyAlgebra(dict(zip(LUT_ROWS, lut, strict=True)), wo[..., 2])
-    closures = view_weighted_closures(fit, _inputs(fit, coverage, absorption, gloss), algebra,
-                                      tinted_subsurface=tinted_subsurface)
-    return view_weighted_reflection(closures, lambda name, a, b: lobe_of(a, b, lobes[name]),
-                                    wi, wo)
+    algebra = NumpyAlgebra(dict(zip(parts.rows, parts.lut, strict=True)), wo[..., 2])
+    closures = parts.closures(fit, _inputs(fit, coverage, absorption, gloss), algebra)
+    return view_weighted_reflection(
+        closures, lambda name, a, b: lobe_of(a, b, parts.lobes[name]), wi, wo)
 
 
 def layered_tier_reflection(fit: ClosureFit, tables: Tables, coverage: float, absorption,
@@ -165,27 +175,23 @@ def layered_tier_reflection(fit: ClosureFit, tables: Tables, coverage: float, ab
     ``(wi, wo)``: its closures (:func:`lut_baker.closures.tier_formulas.view_weighted_closures`)
     with the image rows read as Blender reads them (linear between texel centres) and Cycles'
     Glossy lobes; ``gloss``: the group's Gloss input."""
-    parts = view_weighted_parts(fit, "LAYERED")
     return view_weighted_tier(
-        fit, tables, coverage, absorption, gloss, directions, lobes=parts.lobes, lut=parts.lut,
-        lobe_of=lambda wi, wo, lobe: cc.microfacet_reflection(
-            wi, wo, lobe.roughness, distribution=lobe.distribution),
-        tinted_subsurface=parts.tinted_subsurface)
+        fit, tables, coverage, absorption, gloss, directions, view_weighted_parts(fit, "LAYERED"),
+        lambda wi, wo, lobe: cc.microfacet_reflection(wi, wo, lobe.roughness,
+                                                      distribution=lobe.distribution))
 
 
 def eevee_tier_reflection(fit: ClosureFit, tables: Tables, coverage: float, absorption,
                           gloss: float = 1.0, directions=None):
     """The EEVEE tier's BRDF as EEVEE renders it under lamps, ``(..., 3)``, at the angular
     nodes or at ``directions`` ``(wi, wo)``: the LAYERED tier's closures and areal mix with
-    its own lobes (``fit.eevee_glossy``, EEVEE's GGX:
+    its own lobes (``fit.eevee_glossy``, the film's gloss in two; EEVEE's GGX:
     :func:`lut_baker.closures.eevee.glossy_reflection`) and view-angle rows
     (``fit.eevee_lut``), the skin through the film as its plain colour (EEVEE's screen-space
     subsurface takes it as it is); Diffuse and Subsurface closures Lambertian."""
-    parts = view_weighted_parts(fit, "EEVEE")
     return view_weighted_tier(
-        fit, tables, coverage, absorption, gloss, directions, lobes=parts.lobes, lut=parts.lut,
-        lobe_of=lambda wi, wo, lobe: eevee.glossy_reflection(wi, wo, lobe.roughness),
-        tinted_subsurface=parts.tinted_subsurface)
+        fit, tables, coverage, absorption, gloss, directions, view_weighted_parts(fit, "EEVEE"),
+        lambda wi, wo, lobe: eevee.glossy_reflection(wi, wo, lobe.roughness))
 
 
 TIER_REPLICAS = {"PRINCIPLED": principled_tier_reflection, "LAYERED": layered_tier_reflection,

@@ -2,7 +2,8 @@
 Blender's Image Texture samples it.
 
 A tier's view-dependent weights are 1-D functions of ``cos(theta_o)``, one per row of a small
-float image that the node group reads at ``u = cos(theta_o)``: :data:`LUT_ROWS` names the rows,
+float image that the node group reads at ``u = cos(theta_o)``: :data:`LUT_ROWS` names the rows
+(:data:`EEVEE_LUT_ROWS` the EEVEE tier's),
 :func:`lut_nodes` gives the texel centres, :func:`sample_lut` reads a row as Blender does
 (Linear, EXTEND).
 """
@@ -11,13 +12,16 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["LUT_ROWS", "DEFAULT_LUT_SIZE", "lut_nodes", "sample_lut"]
+__all__ = ["LUT_ROWS", "EEVEE_LUT_ROWS", "DEFAULT_LUT_SIZE", "lut_nodes", "sample_lut"]
 
 LUT_ROWS = ("film_gloss", "path3_gloss", "skin_gloss", "film_transmittance",
             "film_gloss_diffuse")
 """Rows of the LAYERED tier's view-angle image: three Glossy weights, the film's
 transmittance ``T(theta_o)`` and the film gloss's Lambertian companion
 (:func:`lut_baker.closures.lobes.fit_glossy`)."""
+EEVEE_LUT_ROWS = LUT_ROWS + ("film_gloss_2",)
+"""Rows of the EEVEE tier's view-angle image: :data:`LUT_ROWS` and the weight of the film
+gloss's second lobe (:func:`lut_baker.closures.lobes.fit_glossy_pair`)."""
 DEFAULT_LUT_SIZE = 64
 """Texels per row of the view-angle image (linear filtering between texel centres)."""
 

@@ -120,10 +120,9 @@ def test_eevee_renders_the_tier_as_its_replica(renders, made_up, light):
     assert error < REPLICA_BOUND
 
     def as_cycles(fit_, tables_, coverage, absorption, gloss, directions):
-        parts = tiers.view_weighted_parts(fit_, "EEVEE")
         return tiers.view_weighted_tier(
-            fit_, tables_, coverage, absorption, gloss, directions, lobes=parts.lobes,
-            lut=parts.lut, lobe_of=lambda wi, wo, lobe: cc.microfacet_reflection(
-                wi, wo, lobe.roughness), tinted_subsurface=parts.tinted_subsurface)
+            fit_, tables_, coverage, absorption, gloss, directions,
+            tiers.view_weighted_parts(fit_, "EEVEE"),
+            lambda wi, wo, lobe: cc.microfacet_reflection(wi, wo, lobe.roughness))
 
     assert error < 0.4 * compare.relative_rms(image, replica(as_cycles))

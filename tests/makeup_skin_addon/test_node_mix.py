@@ -34,7 +34,7 @@ import pytest
 
 from lut_baker.bake import bake
 from lut_baker.closures import fitting as cf
-from lut_baker.closures import tier_formulas, tiers, view_image
+from lut_baker.closures import tier_formulas, tiers
 from lut_baker.model import presets
 
 CELL = 3
@@ -248,11 +248,13 @@ def _render_grid(scene, materials, views_deg, tmp_path):
     return pixels[CELL // 2::CELL, CELL // 2::CELL]
 
 
-def _numpy(fit, case, lut=None):
-    """The tier formulas' inputs and algebra for one case, as the replicas take them."""
+def _numpy(fit, case, parts=None):
+    """The tier formulas' inputs and algebra for one case, as the replicas take them (the
+    image of ``parts``, a view-weighted tier's, or the LAYERED tier's)."""
     coverage, absorption, gloss, skin_colour, view_deg = case
     x = tier_formulas.TierInputs.numpy(coverage, absorption, skin_colour, gloss)
-    rows = dict(zip(view_image.LUT_ROWS, fit.lut if lut is None else lut, strict=True))
+    parts = parts or tiers.view_weighted_parts(fit, "LAYERED")
+    rows = dict(zip(parts.rows, parts.lut, strict=True))
     return x, tier_formulas.NumpyAlgebra(rows, np.cos(np.radians(view_deg)))
 
 
@@ -264,9 +266,9 @@ def _principled_expected(fit, case):
 
 def _layered_expected(fit, case, eevee=False):
     """Each closure's colour times its weight and its side's share of the coverage mix."""
-    x, algebra = _numpy(fit, case, fit.eevee_lut if eevee else None)
-    closures = tier_formulas.view_weighted_closures(fit, x, algebra,
-                                                    tinted_subsurface=not eevee)
+    parts = tiers.view_weighted_parts(fit, "EEVEE" if eevee else "LAYERED")
+    x, algebra = _numpy(fit, case, parts)
+    closures = parts.closures(fit, x, algebra)
     coverage = case[0]
     out = {}
     for share, side in ((coverage, closures.covered), (1.0 - coverage, closures.bare)):
@@ -286,7 +288,7 @@ def test_node_group_follows_the_tier_formulas(blank_scene, baked, tmp_path, tier
     probes, make_probe, expected_of = {
         "PRINCIPLED": (PRINCIPLED_PROBES, _principled_probe, _principled_expected),
         "LAYERED": (LAYERED_PROBES, _layered_or_weight_probe, _layered_expected),
-        "EEVEE": (LAYERED_PROBES[:-1], _layered_probe,
+        "EEVEE": (("film gloss", "film gloss 2", *LAYERED_PROBES[1:-1]), _layered_probe,
                   lambda fit, case: _layered_expected(fit, case, eevee=True)),
     }[tier]
     copies = [make_probe(group, name) for name in probes]

@@ -225,6 +225,8 @@ def decision_margins(tables, skin=None) -> dict:
         fit = fitting.fit_closures(tables)
     for lobe, found in fit.glossy.items():
         margins[f"distribution/{lobe}"] = distribution_margin(found)
+    # One EEVEE lobe or two for the film gloss: GGX against lobes.PAIR in its searched errors.
+    margins["pair/film_gloss"] = distribution_margin(fit.eevee_glossy["film_gloss"])
     # The scanned fits in order: the coat (when the film has gloss), then the two speculars.
     names = (["coat"] if len(recorder.errors) == 3 else []) + ["specular_bare",
                                                                "specular_film"]

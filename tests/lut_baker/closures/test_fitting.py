@@ -21,6 +21,13 @@ def test_paper_fit_parameters_are_in_blender_ranges(paper_fit):
         assert lobe.distribution in cc.GLOSSY_DISTRIBUTIONS
         assert np.all(np.isfinite(lobe.lut)) and np.all(lobe.lut >= 0.0)
     assert paper_fit.lut.shape == (len(view_image.LUT_ROWS), view_image.DEFAULT_LUT_SIZE, 3)
+    assert paper_fit.eevee_lut.shape == (len(view_image.EEVEE_LUT_ROWS),
+                                         view_image.DEFAULT_LUT_SIZE, 3)
+    assert np.all(paper_fit.eevee_lut >= 0.0)
+    # The paper film's broad gloss takes two EEVEE lobes.
+    film = paper_fit.eevee_glossy["film_gloss"]
+    assert np.any(paper_fit.eevee_glossy["film_gloss_2"].lut)
+    assert film.searched[lobes.PAIR] < (1.0 - lobes.DISTRIBUTION_MARGIN) * film.searched["GGX"]
     assert np.all(paper_fit.subsurface_radius_mm > 0.0)
     assert paper_fit.subsurface_method in cc.SUBSURFACE_METHODS
     # Burley's edge response follows the dipole's within 1% RMS of the lit level.

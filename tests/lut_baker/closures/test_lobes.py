@@ -73,3 +73,70 @@ def test_fit_glossy_keeps_ggx_in_a_near_tie(paper_tables, monkeypatch):
     monkeypatch.setattr(lobes, "DISTRIBUTION_MARGIN", 1.0)
     fit = lobes.fit_glossy(grid, target, albedo, np.asarray(paper_tables.theta_deg))
     assert fit.distribution == "GGX"
+
+
+def _eevee_target(grid, theta, parts):
+    """A target made of EEVEE lobes ``(weight, roughness)`` (roughness None: Lambert) on the
+    grid, and its albedo table on ``theta``."""
+    cos_theta = np.cos(np.radians(theta))
+    target, albedo = 0.0, 0.0
+    for weight, roughness in parts:
+        if roughness is None:
+            target, albedo = target + weight / np.pi, albedo + weight
+        else:
+            target = target + weight * lobes.glossy_lobe(grid, roughness, lobes.EEVEE_GLOSSY)
+            albedo = albedo + weight * lobes.glossy_albedo(cos_theta, roughness,
+                                                           lobes.EEVEE_GLOSSY)
+    return target[..., None] * np.ones(3), np.asarray(albedo)[:, None] * np.ones(3)
+
+
+def _closure_albedo(first, second):
+    """The closures' albedo per texel: both lobes' rows times their albedos, and the
+    companion's row."""
+    mu = view_image.lut_nodes(view_image.DEFAULT_LUT_SIZE)
+    return (first.lut[:, 0] * lobes.glossy_albedo(mu, first.roughness, lobes.EEVEE_GLOSSY)
+            + second.lut[:, 0] * lobes.glossy_albedo(mu, second.roughness, lobes.EEVEE_GLOSSY)
+            + first.diffuse_lut[:, 0])
+
+
+def test_fit_glossy_pair_recovers_two_lobes(paper_tables):
+    """Two EEVEE lobes at the pair's ratio and a Lambertian term: the pair comes back, both
+    rows carry their weights, and the closures' albedo stays within the slack of the
+    table's."""
+    grid = view_grid(10.0)
+    theta = np.asarray(paper_tables.theta_deg)
+    r = 0.45
+    low, high = r / np.sqrt(lobes.PAIR_RATIO), r * np.sqrt(lobes.PAIR_RATIO)
+    target, albedo = _eevee_target(grid, theta, [(0.5, low), (0.4, high), (0.05, None)])
+    first, second = lobes.fit_glossy_pair(grid, target, albedo, theta)
+    assert first.searched[lobes.PAIR] < 0.25 * first.searched["GGX"]
+    assert first.roughness == pytest.approx(low, rel=0.02)
+    assert second.roughness == pytest.approx(high, rel=0.02)
+    assert first.error < 0.02
+    inner = slice(4, -4)
+    np.testing.assert_allclose(first.lut[inner, 0], 0.5, atol=0.05)
+    np.testing.assert_allclose(second.lut[inner, 0], 0.4, atol=0.05)
+    mu = view_image.lut_nodes(view_image.DEFAULT_LUT_SIZE)
+    table = np.interp(np.degrees(np.arccos(mu)), theta, albedo[:, 0])
+    ratio = _closure_albedo(first, second) / table
+    assert np.all(np.abs(ratio - 1.0) <= lobes.PAIR_ALBEDO_SLACK + 1e-3)
+
+
+def test_fit_glossy_pair_keeps_one_lobe_where_one_fits(paper_tables):
+    """One EEVEE lobe: the pair gains nothing, so the second lobe has weight 0 and the
+    first's roughness, and the one lobe comes back."""
+    grid = view_grid(10.0)
+    theta = np.asarray(paper_tables.theta_deg)
+    target, albedo = _eevee_target(grid, theta, [(0.6, 0.3)])
+    first, second = lobes.fit_glossy_pair(grid, target, albedo, theta)
+    assert not np.any(second.lut) and second.roughness == first.roughness
+    assert first.roughness == pytest.approx(0.3, rel=0.01) and first.error < 0.01
+    assert first.searched[lobes.PAIR] >= (1.0 - lobes.DISTRIBUTION_MARGIN) * first.searched["GGX"]
+
+
+def test_fit_glossy_pair_of_no_gloss_is_empty():
+    grid = view_grid(10.0)
+    theta = np.linspace(0.0, 90.0, 10)
+    first, second = lobes.fit_glossy_pair(grid, np.zeros(grid.cos_i.shape), np.zeros((10, 3)),
+                                          theta)
+    assert not np.any(first.lut) and not np.any(first.diffuse_lut) and not np.any(second.lut)
