@@ -30,12 +30,17 @@ RADIUS_MM = 10.0
 LIGHTS_DEG = (0.0, 45.0, 75.0)
 COVERAGES = (0.0, 0.5, 1.0)
 SPREAD_PER_MEAN_FREE_PATH = 0.75
-BIAS_BOUND = {0.0: 0.035, 0.5: 0.04, 1.0: 0.06}
+BIAS_BOUND = {0.0: 0.035, 0.5: 0.03, 1.0: 0.04}
 """Relative RMS against the exact image per coverage, any light: measured 2.1-2.8% on bare
-skin (EEVEE's screen-space subsurface at the terminator), 2.9-3.2% at coverage 0.5 and
-4.4-4.9% at full coverage (the paper film's gloss, which no GGX lobe EEVEE can render
-follows closer: docs/addon.md, "The EEVEE tier").  The goal was 2% on every image; where it is
-missed is measured by bench/eevee_tier.py and listed in docs/addon.md, "Not done"."""
+skin (EEVEE's screen-space subsurface at the terminator), 2.1-2.4% at coverage 0.5 and
+2.6-3.2% at full coverage (the paper film's gloss, which no sum of lobes EEVEE can render
+follows closer than 2.1-3.0%: docs/speed_accuracy.md, "How close EEVEE's closures can come").
+The goal was 2% on every image; where it is missed is measured by bench/eevee_tier.py and
+listed in docs/addon.md, "Not done"."""
+MEAN_BOUND = 0.03
+"""The image's mean against the exact image's: measured 0.988-1.021 (the film gloss's
+albedo may give 5% where that follows its shape closer, lobes.PAIR_ALBEDO_SLACK; most at
+grazing light)."""
 REPLICA_BOUND = 0.01
 """Full coverage against the tier's replica (:func:`lut_baker.closures.tiers.
 eevee_tier_reflection`, no spread; the film hides the skin's): measured 0.3-0.5%, against
@@ -99,7 +104,7 @@ def test_eevee_tier_against_the_exact_image(renders, references, coverage, light
     print(f"coverage {coverage:g}, light {light:g}: {100 * error:.2f}% against the exact image, "
           f"mean {image[mask].mean() / ref[mask].mean():.3f} of it")
     assert error < BIAS_BOUND[coverage]
-    assert image[mask].mean() == pytest.approx(ref[mask].mean(), rel=0.02)
+    assert image[mask].mean() == pytest.approx(ref[mask].mean(), rel=MEAN_BOUND)
 
 
 @pytest.mark.parametrize("light", LIGHTS_DEG)
