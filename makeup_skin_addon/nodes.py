@@ -254,7 +254,8 @@ def _build_view_weighted(build: Builder, fit, parts, lut, method: str, radius_mm
     ``parts``, their view-angle image ``lut``): a
     Glossy, Diffuse or Subsurface node per closure, its colour and weight emitted as nodes,
     each side's closures added, the two sides mixed by Coverage (a Mix Shader: an areal mix,
-    so a painted coverage fades out without fringe or halo)."""
+    so a painted coverage fades out without fringe or halo), the shared closures added to
+    the mix."""
     inputs, output, x, scale = _group_io(build)
     geometry = build.node("ShaderNodeNewGeometry")
     normals = {"film": inputs.outputs["Film Normal"], "skin": inputs.outputs["Normal"]}
@@ -295,7 +296,8 @@ def _build_view_weighted(build: Builder, fit, parts, lut, method: str, radius_mm
                          socket(mix.inputs, "Shader"))
     build.tree.links.new(_add(build, [emit(c) for c in closures.covered]),
                          socket(mix.inputs, "Shader_001"))
-    build.tree.links.new(mix.outputs[0], output.inputs["Shader"])
+    shaded = _add(build, [mix.outputs[0], *(emit(c) for c in closures.shared)])
+    build.tree.links.new(shaded, output.inputs["Shader"])
 
 
 def build_group(tier: str, record: dict, fit, group=None, *, method=None, measured=None):

@@ -103,8 +103,9 @@ def principled_tier_reflection(fit: ClosureFit, tables: Tables, coverage: float,
 class ViewWeightedParts:
     """What a view-weighted tier takes from a :class:`ClosureFit`: its Glossy ``lobes`` (by
     name), its view-angle image ``lut`` (rows named ``rows``), the lobes of the film's gloss
-    (``film_lobes``) and whether the skin through the film is a tinted, weighted Subsurface
-    closure (``tinted_subsurface``); see
+    (``film_lobes``), whether the skin through the film is a tinted, weighted Subsurface
+    closure (``tinted_subsurface``) and whether both sides share one Subsurface closure
+    (``one_subsurface``); see
     :func:`lut_baker.closures.tier_formulas.view_weighted_closures`."""
 
     lobes: dict
@@ -112,17 +113,20 @@ class ViewWeightedParts:
     rows: tuple
     film_lobes: tuple
     tinted_subsurface: bool
+    one_subsurface: bool = False
 
     def closures(self, fit: ClosureFit, x: TierInputs, ops) -> ViewWeightedClosures:
         """The tier's closures at inputs ``x`` in the algebra ``ops``."""
         return view_weighted_closures(fit, x, ops, tinted_subsurface=self.tinted_subsurface,
-                                      film_lobes=self.film_lobes)
+                                      film_lobes=self.film_lobes,
+                                      one_subsurface=self.one_subsurface)
 
 
 def view_weighted_parts(fit: ClosureFit, tier: str) -> ViewWeightedParts:
     """The LAYERED tier's parts (Cycles' lobes, the tinted subsurface its random walk needs)
     or the EEVEE tier's (lobes fitted as EEVEE renders GGX, the film's gloss in two, its own
-    image, the plain colour EEVEE's subsurface takes)."""
+    image, the plain colour EEVEE's subsurface takes, one Subsurface closure for both sides:
+    EEVEE picks one Diffuse or Subsurface closure per sample, and fewer are less noise)."""
     if tier == "LAYERED":
         return ViewWeightedParts(fit.glossy, fit.lut, LUT_ROWS, ("film_gloss",),
                                  tinted_subsurface=True)
@@ -131,7 +135,7 @@ def view_weighted_parts(fit: ClosureFit, tier: str) -> ViewWeightedParts:
         second = np.any(fit.eevee_glossy["film_gloss_2"].lut)
         return ViewWeightedParts(fit.eevee_glossy, fit.eevee_lut, EEVEE_LUT_ROWS,
                                  ("film_gloss", "film_gloss_2") if second else ("film_gloss",),
-                                 tinted_subsurface=False)
+                                 tinted_subsurface=False, one_subsurface=True)
     raise ValueError(f"{tier!r} is not a view-weighted tier (LAYERED, EEVEE)")
 
 
@@ -154,7 +158,8 @@ def view_weighted_reflection(closures: ViewWeightedClosures, lobe_of, wi, wo) ->
         return value
 
     weights = coverage_weights(closures.coverage, 0.0)
-    return combine(weights, top=side(closures.covered), bare=side(closures.bare))
+    mixed = combine(weights, top=side(closures.covered), bare=side(closures.bare))
+    return mixed + side(closures.shared) if closures.shared else mixed
 
 
 def view_weighted_tier(fit: ClosureFit, tables: Tables, coverage: float, absorption, gloss,

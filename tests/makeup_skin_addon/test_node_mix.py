@@ -271,7 +271,8 @@ def _layered_expected(fit, case, eevee=False):
     closures = parts.closures(fit, x, algebra)
     coverage = case[0]
     out = {}
-    for share, side in ((coverage, closures.covered), (1.0 - coverage, closures.bare)):
+    for share, side in ((coverage, closures.covered), (1.0 - coverage, closures.bare),
+                        (1.0, closures.shared)):
         for closure in side:
             weight = 1.0 if closure.weight is None else closure.weight
             out[closure.name.replace("_", " ")] = np.ravel(share * closure.colour * weight)
@@ -288,7 +289,8 @@ def test_node_group_follows_the_tier_formulas(blank_scene, baked, tmp_path, tier
     probes, make_probe, expected_of = {
         "PRINCIPLED": (PRINCIPLED_PROBES, _principled_probe, _principled_expected),
         "LAYERED": (LAYERED_PROBES, _layered_or_weight_probe, _layered_expected),
-        "EEVEE": (("film gloss", "film gloss 2", *LAYERED_PROBES[1:-1]), _layered_probe,
+        "EEVEE": (("film gloss", "film gloss 2", "path3 gloss", "skin gloss", "film diffuse",
+                   "skin"), _layered_probe,
                   lambda fit, case: _layered_expected(fit, case, eevee=True)),
     }[tier]
     copies = [make_probe(group, name) for name in probes]
