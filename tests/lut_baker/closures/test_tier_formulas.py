@@ -75,6 +75,25 @@ def test_tinted_and_plain_subsurface_carry_the_same_light(paper_fit):
                   == pytest.approx(1.0))  # the strongest channel keeps the skin's colour
 
 
+def test_one_shared_subsurface_carries_what_two_did(paper_fit):
+    """The EEVEE tier's one Subsurface closure outside the coverage mix: its colour is the
+    areal mix of the two it replaces, and nothing else moves."""
+    x = tf.TierInputs.numpy(0.6, (0.2, 0.5, 0.7), (0.7, 0.45, 0.35), 1.0)
+    algebra = _algebra(paper_fit, np.linspace(0.02, 1.0, 12))
+    two = tf.view_weighted_closures(paper_fit, x, algebra, tinted_subsurface=False)
+    one = tf.view_weighted_closures(paper_fit, x, algebra, tinted_subsurface=False,
+                                    one_subsurface=True)
+    kinds = [c.kind for c in one.covered + one.bare + one.shared]
+    assert kinds.count("subsurface") == 1 and [c.kind for c in one.shared] == ["subsurface"]
+    for mine, theirs in zip(one.covered + one.bare, two.covered[:-1] + two.bare[:-1],
+                            strict=True):
+        assert mine.name == theirs.name
+        np.testing.assert_array_equal(mine.colour, theirs.colour)
+    np.testing.assert_allclose(one.shared[0].colour,
+                               0.6 * two.covered[-1].colour + 0.4 * two.bare[-1].colour,
+                               rtol=1e-12)
+
+
 def test_plain_numbers_are_inputs_too(paper_fit):
     """Python floats need no algebra of their own: the formulas are plain arithmetic."""
     x = tf.TierInputs(coverage=0.5, absorption=np.array([0.1, 0.2, 0.3]),
