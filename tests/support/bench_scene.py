@@ -45,6 +45,7 @@ Functions
 
 from __future__ import annotations
 
+import importlib
 import math
 import tempfile
 from pathlib import Path
@@ -87,8 +88,9 @@ def sphere_scene(*, size: int = 64, samples: int = 64, radius_mm: float = 10.0,
     """The reference's scene in a fresh file (module docstring); returns the sphere object.
     ``light_deg``: angle (degrees) between the light and the view direction, towards image
     +x, as :func:`lut_baker.numerics.geometry.light_direction`."""
-    import bmesh
     import bpy
+
+    bmesh = importlib.import_module("bmesh")  # Blender's own: importable once bpy is
 
     sphere = base_scene.build_scene(size=size, samples=samples, radius_mm=radius_mm,
                                        light_deg=light_deg, seed=seed)
