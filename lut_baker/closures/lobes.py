@@ -355,7 +355,8 @@ def _albedo_shares(grid: ViewGrid, models: list, target: np.ndarray,
     weight = grid.weight * np.square(grid.cos_i)
     stacked = np.stack(models, axis=1)  # (V, K, A, P)
     gram = np.einsum("vkap,vjap,vap->vkj", stacked, stacked, weight)
-    diagonal = np.einsum("vkk->vk", gram).mean(axis=1)
+    # The ridge keeps every view solvable, one where the table's albedo is 0 as well.
+    diagonal = np.maximum(np.einsum("vkk->vk", gram).mean(axis=1), 1e-300)
     gram = gram + SHARE_RIDGE * diagonal[:, None, None] * np.eye(len(models))
     right = np.einsum("vkap,vap,vap->vk", stacked, target, weight)
     free = _face_minimum(gram, right)
@@ -373,8 +374,9 @@ def fit_glossy_pair(grid: ViewGrid, target, albedo_table: np.ndarray, theta_deg:
     ``a_k = f_k A / E_k`` (``E_k`` the lobes' albedos) and ``b = f_c A``, the shares ``f``
     non-negative and adding up to within ``slack`` of 1 (:func:`_albedo_shares`), so that the
     closures' albedo stays that close to the table's at every view.  Two lobes have
-    roughnesses ``r / sqrt(ratio)`` and ``r sqrt(ratio)`` (:data:`PAIR_RATIO`); one lobe's
-    roughness or two lobes' ``r`` is found by Brent's search.  The pair is kept when it errs
+    roughnesses ``r / sqrt(ratio)`` and ``r sqrt(ratio)`` (:data:`PAIR_RATIO`), both within
+    :data:`ROUGHNESS_RANGE`; one lobe's roughness or two lobes' ``r`` is found by Brent's
+    search.  The pair is kept when it errs
     less than the one lobe by more than :data:`DISTRIBUTION_MARGIN` (relative); else the
     second lobe has weight 0 and the first's roughness.
 
@@ -434,7 +436,11 @@ def fit_glossy_pair(grid: ViewGrid, target, albedo_table: np.ndarray, theta_deg:
         return grid.error(fitted, target), rows, companion
 
     one = [_minimise_roughness(lambda r: float(np.linalg.norm(residuals_of([r]))))[0]]
-    two = pair(_minimise_roughness(lambda r: float(np.linalg.norm(residuals_of(pair(r)))))[0])
+    # r within the range that keeps both lobes' roughness in ROUGHNESS_RANGE.
+    low, high = np.log(ROUGHNESS_RANGE) + np.array([0.5, -0.5]) * np.log(ratio)
+    log_r, _ = brent_minimum(lambda x: float(np.linalg.norm(residuals_of(pair(np.exp(x))))),
+                             low, high, coarse=ROUGHNESS_SCAN, xtol=FIT_XTOL)
+    two = pair(float(np.exp(log_r)))
     (one_error, one_rows, one_companion), (two_error, two_rows, two_companion) = (
         result(one), result(two))
     searched = {"GGX": one_error, PAIR: two_error}

@@ -27,6 +27,8 @@ def test_paper_fit_parameters_are_in_blender_ranges(paper_fit):
     # The paper film's broad gloss takes two EEVEE lobes.
     film = paper_fit.eevee_glossy["film_gloss"]
     assert np.any(paper_fit.eevee_glossy["film_gloss_2"].lut)
+    for lobe in paper_fit.eevee_glossy.values():
+        assert lobes.ROUGHNESS_RANGE[0] <= lobe.roughness <= lobes.ROUGHNESS_RANGE[1]
     assert film.searched[lobes.PAIR] < (1.0 - lobes.DISTRIBUTION_MARGIN) * film.searched["GGX"]
     assert np.all(paper_fit.subsurface_radius_mm > 0.0)
     assert paper_fit.subsurface_method in cc.SUBSURFACE_METHODS

@@ -134,6 +134,19 @@ def test_fit_glossy_pair_keeps_one_lobe_where_one_fits(paper_tables):
     assert first.searched[lobes.PAIR] >= (1.0 - lobes.DISTRIBUTION_MARGIN) * first.searched["GGX"]
 
 
+def test_fit_glossy_pair_stays_in_blenders_range(paper_tables):
+    """Two lobes of the narrowest: the pair's roughnesses stay within ROUGHNESS_RANGE (the
+    Glossy BSDF's socket), the narrower one at its floor."""
+    grid = view_grid(2.0)
+    theta = np.asarray(paper_tables.theta_deg)
+    low, high = lobes.ROUGHNESS_RANGE[0], lobes.ROUGHNESS_RANGE[0] * lobes.PAIR_RATIO
+    target, albedo = _eevee_target(grid, theta, [(0.3, low), (0.3, high), (0.1, None)])
+    first, second = lobes.fit_glossy_pair(grid, target, albedo, theta)
+    for lobe in (first, second):
+        assert lobes.ROUGHNESS_RANGE[0] <= lobe.roughness <= lobes.ROUGHNESS_RANGE[1]
+    assert first.roughness == pytest.approx(low, rel=0.02)
+
+
 def test_fit_glossy_pair_of_no_gloss_is_empty():
     grid = view_grid(10.0)
     theta = np.linspace(0.0, 90.0, 10)
