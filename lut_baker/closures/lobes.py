@@ -376,9 +376,9 @@ def fit_glossy_pair(grid: ViewGrid, target, albedo_table: np.ndarray, theta_deg:
     closures' albedo stays that close to the table's at every view.  Two lobes have
     roughnesses ``r / sqrt(ratio)`` and ``r sqrt(ratio)`` (:data:`PAIR_RATIO`), both within
     :data:`ROUGHNESS_RANGE`; one lobe's roughness or two lobes' ``r`` is found by Brent's
-    search.  The pair is kept when it errs
-    less than the one lobe by more than :data:`DISTRIBUTION_MARGIN` (relative); else the
-    second lobe has weight 0 and the first's roughness.
+    search.  The pair is kept when it errs less than the one lobe by more than
+    :data:`DISTRIBUTION_MARGIN` (relative); else the second lobe has weight 0 and the first's
+    roughness.
 
     Returns ``(first, second)``: the first holds its row and the companion's (``lut``,
     ``diffuse_lut``) and, in ``searched``, both errors (``GGX`` and :data:`PAIR`); the second
