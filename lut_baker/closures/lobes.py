@@ -314,11 +314,30 @@ two lobes of similar width are nearly collinear, and without it their split woul
 change of the data a thousandfold."""
 
 
+def _spd_solve(matrix: np.ndarray, right: np.ndarray) -> np.ndarray:
+    """``x`` with ``matrix x = right`` per view (``(V, n, n)`` symmetric positive definite,
+    ``(V, n, m)``): Gaussian elimination without pivoting, in element-wise arithmetic only, so
+    that the result does not depend on the BLAS library or its threads."""
+    a, b = matrix.astype(float).copy(), right.astype(float).copy()
+    n = a.shape[-1]
+    for k in range(n):
+        for i in range(k + 1, n):
+            factor = a[:, i, k] / a[:, k, k]
+            a[:, i, k:] -= factor[:, None] * a[:, k, k:]
+            b[:, i] -= factor[:, None] * b[:, k]
+    x = np.zeros_like(b)
+    for k in range(n - 1, -1, -1):
+        x[:, k] = (b[:, k] - np.einsum("vj,vjm->vm", a[:, k, k + 1:], x[:, k + 1:])) \
+            / a[:, k, k, None]
+    return x
+
+
 def _face_minimum(gram: np.ndarray, right: np.ndarray, total=None) -> np.ndarray:
     """Per view, the non-negative ``f`` ``(V, K)`` that minimises ``f G f - 2 r f`` (``gram``
     ``(V, K, K)``, positive definite; ``right`` ``(V, K)``), with ``sum(f) = total`` ``(V,)``
     if given: a convex quadratic, minimised exactly (the optimum on every face of the orthant,
-    the best feasible one), so that ``f`` follows the data continuously."""
+    the best feasible one), so that ``f`` follows the data continuously.  On a face the
+    optimum is ``G^-1 r`` plus, with the sum held, the multiple of ``G^-1 1`` that meets it."""
     views, count = right.shape
     if total is None:
         best_cost, shares = np.zeros(views), np.zeros((views, count))  # f = 0 is feasible
@@ -326,15 +345,13 @@ def _face_minimum(gram: np.ndarray, right: np.ndarray, total=None) -> np.ndarray
         best_cost, shares = np.full(views, np.inf), np.zeros((views, count))
     for mask in range(1, 2 ** count):
         face = np.flatnonzero([(mask >> k) & 1 for k in range(count)])
-        n = face.size
-        size = n if total is None else n + 1
-        system = np.zeros((views, size, size))
-        system[:, :n, :n] = gram[:, face][:, :, face]
-        rhs = right[:, face]
+        both = np.stack([right[:, face], np.ones((views, face.size))], axis=-1)
+        solved = _spd_solve(gram[:, face][:, :, face], both)
+        solution = solved[..., 0]
         if total is not None:
-            system[:, :n, n] = system[:, n, :n] = 1.0
-            rhs = np.concatenate([rhs, np.asarray(total, float)[:, None]], axis=1)
-        solution = np.linalg.solve(system, rhs[..., None])[..., :n, 0]
+            ones = solved[..., 1]
+            solution = solution + ((np.asarray(total, float) - solution.sum(axis=1))
+                                   / ones.sum(axis=1))[:, None] * ones
         f = np.zeros((views, count))
         f[:, face] = solution
         cost = np.einsum("vk,vkj,vj->v", f, gram, f) - 2.0 * np.einsum("vk,vk->v", right, f)
@@ -435,11 +452,14 @@ def fit_glossy_pair(grid: ViewGrid, target, albedo_table: np.ndarray, theta_deg:
                   + sample_lut(companion, grid.cos_o) / np.pi)
         return grid.error(fitted, target), rows, companion
 
-    one = [_minimise_roughness(lambda r: float(np.linalg.norm(residuals_of([r]))))[0]]
+    def cost(roughnesses) -> float:  # np.sum, not BLAS: the same on every processor
+        return float(np.sqrt(np.sum(np.square(residuals_of(roughnesses)))))
+
+    one = [_minimise_roughness(lambda r: cost([r]))[0]]
     # r within the range that keeps both lobes' roughness in ROUGHNESS_RANGE.
     low, high = np.log(ROUGHNESS_RANGE) + np.array([0.5, -0.5]) * np.log(ratio)
-    log_r, _ = brent_minimum(lambda x: float(np.linalg.norm(residuals_of(pair(np.exp(x))))),
-                             low, high, coarse=ROUGHNESS_SCAN, xtol=FIT_XTOL)
+    log_r, _ = brent_minimum(lambda x: cost(pair(np.exp(x))), low, high,
+                             coarse=ROUGHNESS_SCAN, xtol=FIT_XTOL)
     two = pair(float(np.exp(log_r)))
     (one_error, one_rows, one_companion), (two_error, two_rows, two_companion) = (
         result(one), result(two))
