@@ -22,7 +22,6 @@ Where EEVEE's bound exceeds a goal, no tier of EEVEE's closures meets it.
 from __future__ import annotations
 
 import argparse
-import csv
 import sys
 import time
 from pathlib import Path
@@ -33,7 +32,7 @@ for _path in (ROOT, ROOT / "bench"):
         sys.path.insert(0, str(_path))
 
 from doc_block import replace_block  # noqa: E402  (bench/doc_block.py)
-from eevee_tier import FOUNDATIONS, LIGHTS_DEG, SKIN  # noqa: E402
+from eevee_tier import FOUNDATIONS, LIGHTS_DEG, SKIN, write_csv  # noqa: E402
 
 from lut_baker import bake  # noqa: E402
 from lut_baker.closures import fitting, tiers  # noqa: E402
@@ -108,12 +107,7 @@ def main(argv=None) -> int:
     text = markdown(rows, (time.perf_counter() - start) / 60)
     print(text)
     if not args.quick:
-        with open(DOCS / "eevee_bound.csv", "w", newline="") as handle:
-            writer = csv.DictWriter(handle, fieldnames=FIELDS)
-            writer.writeheader()
-            for row in rows:
-                writer.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v)
-                                 for k, v in row.items()})
+        write_csv(rows, DOCS / "eevee_bound.csv", fields=FIELDS)
         replace_block(DOCS / "speed_accuracy.md", text, BEGIN, END)
     return 0
 

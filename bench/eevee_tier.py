@@ -296,10 +296,13 @@ def markdown(rows, minutes: float) -> str:
     return "\n".join(lines)
 
 
-def write_csv(rows, path: Path, load: str) -> None:
+def write_csv(rows, path: Path, load: str | None = None, fields=FIELDS) -> None:
+    """``rows`` (dicts) as CSV with columns ``fields``, floats to 6 digits, after a ``# load``
+    comment line if given."""
     with open(path, "w", newline="") as handle:
-        handle.write(f"# {load}\n")
-        writer = csv.DictWriter(handle, fieldnames=FIELDS)
+        if load is not None:
+            handle.write(f"# {load}\n")
+        writer = csv.DictWriter(handle, fieldnames=fields)
         writer.writeheader()
         for row in rows:
             writer.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v)

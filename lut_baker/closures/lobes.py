@@ -436,10 +436,11 @@ def fit_glossy_pair(grid: ViewGrid, target, albedo_table: np.ndarray, theta_deg:
     def pair(r: float) -> list:
         return [float(r / np.sqrt(ratio)), float(r * np.sqrt(ratio))]
 
+    table = _texel_albedo(albedo_table, theta_deg, texels)
+
     def result(roughnesses) -> tuple[float, list, np.ndarray]:
         """The error on the grid, the Glossy rows and the companion's row."""
         shares = _albedo_shares(grid, models(roughnesses), grey, slack)
-        table = _texel_albedo(albedo_table, theta_deg, texels)
         at_texels = np.stack([np.interp(texels, grid.cos_view, shares[:, k])
                               for k in range(len(roughnesses) + 1)], -1)
         rows = [at_texels[:, k, None] * table

@@ -159,6 +159,11 @@ class Closure:
     surface: str
     weight: Any = None
 
+    @property
+    def product(self):
+        """What the closure carries: its colour times its weight (if it has one)."""
+        return self.colour if self.weight is None else self.colour * self.weight
+
 
 @dataclass(frozen=True)
 class ViewWeightedClosures:
@@ -225,8 +230,7 @@ def view_weighted_closures(fit, x: TierInputs, ops: Algebra, *,
     )
     if not one_subsurface:
         return ViewWeightedClosures(covered=covered, bare=bare, coverage=x.coverage)
-    through_colour = through.colour if through.weight is None else through.colour * through.weight
     skin = Closure("subsurface", "skin", combine(coverage_weights(x.coverage, 0.0),
-                                                 top=through_colour, bare=x.skin_color), "skin")
+                                                 top=through.product, bare=x.skin_color), "skin")
     return ViewWeightedClosures(covered=covered[:-1], bare=bare[:-1], coverage=x.coverage,
                                 shared=(skin,))

@@ -148,7 +148,7 @@ def view_weighted_reflection(closures: ViewWeightedClosures, lobe_of, wi, wo) ->
     def side(closures_of_side):
         value = 0.0
         for closure in closures_of_side:
-            colour = closure.colour if closure.weight is None else closure.colour * closure.weight
+            colour = closure.product
             if not np.any(colour):
                 continue  # a closure of weight 0 is never allocated
             if closure.kind == "glossy":
