@@ -32,7 +32,17 @@ its own, and only at module level (no import inside a function, no cycle):
 This package (the top) registers the modules with classes or session state in that order
 (:data:`modules`) and unregisters them in reverse.  A new operator goes into ``operators``, a
 new panel or section into ``ui``; a new module takes its own place in the list above.
+
+:func:`register` also registers :func:`unregister` with :mod:`atexit` (and :func:`unregister`
+drops it): pip ``bpy`` 4.5 hangs at interpreter exit while any class, app handler or timer is
+still registered, so a pipeline script that imports bpy and registers the add-on without ever
+unregistering it would never end.  In Blender itself add-ons are disabled before Python
+finalizes, and the hook goes with them.  :func:`unregister` does nothing when the add-on is not
+registered: enabled as an extension in pip ``bpy``, the hook unregisters it and then Blender's
+own exit disables it again.
 """
+
+import atexit
 
 from . import live, on_load, operators, properties, scene_fit, ui
 
@@ -40,8 +50,14 @@ __all__ = ["modules", "register", "unregister"]
 
 modules = (scene_fit, live, on_load, properties, operators, ui)
 
+_registered = False
+"""Whether :func:`register` ran and :func:`unregister` has not since."""
+
 
 def register():
+    global _registered
+    if _registered:
+        return
     done = []
     try:
         for module in modules:
@@ -52,8 +68,24 @@ def register():
         for module in reversed(done):
             module.unregister()
         raise
+    _registered = True
+    atexit.register(unregister)
 
 
 def unregister():
+    """Unregister every module, in reverse; each is tried even if one before it fails (what is
+    left registered hangs bpy 4.5 at exit), then the first error is raised.  Not registered:
+    nothing to do."""
+    global _registered
+    atexit.unregister(unregister)
+    if not _registered:
+        return
+    _registered = False
+    first_error = None
     for module in reversed(modules):
-        module.unregister()
+        try:
+            module.unregister()
+        except Exception as error:  # noqa: BLE001 - raised below, after the others
+            first_error = first_error or error
+    if first_error is not None:
+        raise first_error

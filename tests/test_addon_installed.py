@@ -2,7 +2,8 @@
 add-on renders made-up skin, and uninstalling leaves nothing registered.
 
 Builds the zip with tools/build_extension.py and installs it into a temporary USER repository
-(``BLENDER_USER_RESOURCES`` is a temporary folder, see conftest.py).
+(``BLENDER_USER_RESOURCES`` is a temporary folder, see conftest.py).  A script that installs and
+enables it and never disables it ends cleanly (its own process).
 """
 
 import contextlib
@@ -13,6 +14,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from support import sphere_scene
+from support.process_exit import bpy_importable, run_to_exit
 
 REPO_ROOT = Path(__file__).resolve().parent.parent
 pytestmark = pytest.mark.bpy
@@ -112,3 +114,37 @@ def test_uninstall_leaves_nothing(installed):
     assert [n for n in dir(bpy.types) if n.startswith(("MAKEUPSKIN", "MAKEUP_SKIN"))] == []
     assert not [m for m in sys.modules if m.startswith(installed["module"])]
     assert not (installed["repo_dir"] / installed["pkg_id"]).exists()
+
+
+INSTALL_AND_EXIT = """
+    import sys
+
+    import bpy
+
+    zip_path, repo_dir = sys.argv[1:]
+    bpy.context.preferences.extensions.repos.new(
+        name="Made-up Skin exit test", module="makeup_skin_exit_repo",
+        custom_directory=repo_dir, source="USER")
+    assert bpy.ops.extensions.package_install_files(
+        filepath=zip_path, repo="makeup_skin_exit_repo", enable_on_install=True) == {"FINISHED"}
+    assert hasattr(bpy.types.Material, "makeup_skin")
+    print("installed, never disabled")
+"""
+
+
+def test_a_script_that_installs_and_never_disables_ends(tmp_path):
+    """Enabled as an extension, the add-on is unregistered at exit by its own hook, and then
+    Blender's exit disables it again: the process ends, exit code 0, with no error from the
+    second unregister."""
+    if not bpy_importable():  # pragma: no cover - CI has bpy
+        pytest.skip("bpy is not importable; run with the venv from tools/venv.sh")
+    build = _build_extension()
+    try:
+        build.find_extension_tool()
+    except build.BuildError as error:  # pragma: no cover - the venvs ship the tool
+        pytest.skip(str(error))
+    zip_path = build.build(REPO_ROOT, tmp_path / "dist")
+    done = run_to_exit(INSTALL_AND_EXIT, tmp_path / "user", str(zip_path), str(tmp_path / "repo"))
+    assert done.returncode == 0, done.stderr
+    assert "installed, never disabled" in done.stdout
+    assert "Traceback" not in done.stderr, done.stderr

@@ -1,5 +1,10 @@
 """Registering the add-on (makeup_skin_addon.register, unregister): unregistering leaves
-no class, property, timer or handler behind."""
+no class, property, timer or handler behind; a script that registers it and never unregisters
+still ends."""
+
+import pytest
+from support.process_exit import bpy_importable, run_to_exit
+
 
 def test_unregister_leaves_nothing(addon, bpy_factory):
     import bpy
@@ -29,3 +34,49 @@ def test_unregister_leaves_nothing(addon, bpy_factory):
         assert live.pending() == set()
     finally:
         addon.register()
+
+
+PIPELINE = """
+    import bpy
+    import makeup_skin_addon
+    from makeup_skin_addon import on_load
+
+    makeup_skin_addon.register()
+    bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)  # load_post runs
+    assert on_load.check_on_load in bpy.app.handlers.load_post
+    print("registered, never unregistered")
+"""
+
+
+@pytest.mark.bpy
+def test_a_script_that_registers_and_never_unregisters_ends(tmp_path):
+    """A pipeline script imports bpy, registers the add-on and ends without unregistering it:
+    the process ends, exit code 0, nothing raised on the way out (bpy 4.5 hangs at exit while
+    the add-on's handler or classes stay registered, unless the add-on's exit hook removes
+    them)."""
+    if not bpy_importable():  # pragma: no cover - CI has bpy
+        pytest.skip("bpy is not importable; run with the venv from tools/venv.sh")
+    done = run_to_exit(PIPELINE, tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert "registered, never unregistered" in done.stdout
+    assert "Traceback" not in done.stderr, done.stderr
+
+
+def test_unregister_twice_and_register_twice_change_nothing(addon, bpy_factory):
+    """What the exit hook relies on: enabled as an extension, the add-on is unregistered by
+    the hook and then disabled by Blender's own exit, which must do nothing (no error); a
+    second register neither raises nor adds a second handler."""
+    import bpy
+
+    from makeup_skin_addon import on_load
+
+    addon.register()
+    assert bpy.app.handlers.load_post.count(on_load.check_on_load) == 1
+    addon.unregister()
+    try:
+        addon.unregister()
+        assert not hasattr(bpy.types.Material, "makeup_skin")
+        assert on_load.check_on_load not in bpy.app.handlers.load_post
+    finally:
+        addon.register()
+    assert hasattr(bpy.types.Material, "makeup_skin")

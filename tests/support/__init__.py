@@ -21,4 +21,6 @@ functions that need it, after the caller has set ``BLENDER_USER_RESOURCES``.
 - :mod:`support.character` -- an artist's textured head (albedo texture, pore normal map).
 - :mod:`support.panel_layout` -- a stand-in ``UILayout`` that records what a panel draws.
 - :mod:`support.subsurface_edge` -- Cycles' subsurface blur of a shadow edge, and its replica.
+- :mod:`support.process_exit` -- a script that imports bpy run in its own process, which must
+  end.
 """
