@@ -2,7 +2,11 @@
 (Lighter / Darker), and the preset menu with its add/remove operator.  Each operator's work is
 a function of a lower module (:mod:`.material`, :mod:`.scene_fit`, :mod:`.live`,
 :mod:`.shade`); here it is run and reported.  Idnames are
-``makeup_skin.<name>`` (:data:`.keys.OPERATOR_PREFIX`)."""
+``makeup_skin.<name>`` (:data:`.keys.OPERATOR_PREFIX`).
+
+A button Blender greys out says why in its tooltip: every ``poll`` that can refuse gives its
+reason with ``poll_message_set`` (:func:`_allowed`; the reasons: :func:`_object_reason`,
+:func:`_material_reason`, :func:`_linked_reason`, :func:`_revert_reason`)."""
 
 from __future__ import annotations
 
@@ -19,14 +23,71 @@ __all__ = ["MAKEUPSKIN_OT_apply", "MAKEUPSKIN_OT_revert", "MAKEUPSKIN_OT_check_t
            "unregister"]
 
 
-class _ObjectPoll:
-    @classmethod
-    def poll(cls, context):
-        obj = context.active_object
-        return obj is not None and obj.type in {"MESH", "CURVE", "SURFACE", "META", "FONT"}
+SURFACE_TYPES = frozenset({"MESH", "CURVE", "SURFACE", "META", "FONT"})
+"""Object types with a surface and material slots: what Apply makes up."""
 
 
-class MAKEUPSKIN_OT_apply(_ObjectPoll, bpy.types.Operator):
+def _allowed(cls, reason: str | None) -> bool:
+    """Whether the operator can run (``reason`` is None); if not, the greyed-out button's
+    tooltip says ``reason`` (``poll_message_set``, capitalised as Blender's own)."""
+    if reason is not None:
+        cls.poll_message_set(reason[0].upper() + reason[1:])
+    return reason is None
+
+
+def _a(noun: str) -> str:
+    return f"{'an' if noun[0] in 'aeiou' else 'a'} {noun}"
+
+
+def _object_reason(obj, types=SURFACE_TYPES, wanted: str = "a mesh") -> str | None:
+    """Why ``obj`` (the active object) cannot be used: none, or of a type outside ``types``."""
+    if obj is None:
+        return f"no active object: select {wanted}"
+    if obj.type not in types:
+        kind = obj.bl_rna.properties["type"].enum_items[obj.type].name  # Blender's: "Text"
+        return f"the active object is {_a(kind.lower())}: select {wanted}"
+    return None
+
+
+def _material_reason(obj, then: str) -> str | None:
+    """Why ``obj``'s active material cannot be used: no object or no material (``then``:
+    what to do about the missing material)."""
+    if obj is None:
+        return "no active object: select an object with a material"
+    if obj.active_material is None:
+        return f"the active object {obj.name!r} has no material: {then}"
+    return None
+
+
+def _linked_reason(obj, material) -> str | None:
+    """Why the data Apply, Fit to Scene or a shade would change cannot be changed here: the
+    material, its group, or (no material) ``obj``'s mesh linked from a library."""
+    try:
+        made_up.refuse_linked(obj, material)
+    except made_up.LinkedDataError as error:
+        return str(error)
+    return None
+
+
+def _made_up_reason(material) -> str | None:
+    """Why a shade cannot be set on ``material``: it is not made up yet (before Apply, the
+    skin's colour is not read from the artist's shader, and the first Apply matches it)."""
+    if not material.makeup_skin.is_made_up:
+        return f"material {material.name!r} is not made up: Apply first (it matches the skin)"
+    return None
+
+
+def _revert_reason(material) -> str | None:
+    """Why ``material`` cannot be reverted: nothing to revert to, or linked."""
+    if not convert.can_revert(material):
+        if convert.group_node(material) is None:
+            return f"material {material.name!r} is not made up: nothing to revert"
+        return (f"material {material.name!r} has no record of its surface before Apply: "
+                f"nothing to revert to")
+    return convert.linked_library(material, "material")
+
+
+class MAKEUPSKIN_OT_apply(bpy.types.Operator):
     """Bake and fit the made-up skin and make it the surface of the active object's material,
     converted in place: the previous surface shader is kept, framed and disconnected, and its
     albedo and normal links are carried over"""
@@ -40,6 +101,11 @@ class MAKEUPSKIN_OT_apply(_ObjectPoll, bpy.types.Operator):
                                   ("preview", "Preview", ""), ("default", "Default", ""),
                                   ("high", "High", "")),
         default="SETTINGS", options={"SKIP_SAVE"})
+
+    @classmethod
+    def poll(cls, context):
+        obj = context.active_object
+        return _allowed(cls, _object_reason(obj) or _linked_reason(obj, obj.active_material))
 
     def execute(self, context):
         obj = context.active_object
@@ -66,7 +132,8 @@ class MAKEUPSKIN_OT_revert(bpy.types.Operator):
     @classmethod
     def poll(cls, context):
         obj = context.active_object
-        return obj is not None and convert.can_revert(obj.active_material)
+        reason = _material_reason(obj, "nothing to revert")
+        return _allowed(cls, reason or _revert_reason(obj.active_material))
 
     def execute(self, context):
         try:
@@ -122,7 +189,8 @@ class MAKEUPSKIN_OT_fit_to_scene(bpy.types.Operator):
     @classmethod
     def poll(cls, context):
         obj = context.active_object
-        return obj is not None and obj.type == "MESH"
+        return _allowed(cls, _object_reason(obj, {"MESH"})
+                        or _linked_reason(obj, obj.active_material))
 
     def execute(self, context):
         obj = context.active_object
@@ -158,11 +226,17 @@ class MAKEUPSKIN_OT_fit_to_scene(bpy.types.Operator):
         return {"FINISHED"}
 
 
-class _MaterialPoll:
+class _ShadePoll:
+    """Match Skin and the shade steps: the active object's material, made up and local."""
+
     @classmethod
     def poll(cls, context):
         obj = context.active_object
-        return obj is not None and obj.active_material is not None
+        reason = _material_reason(obj, "Apply first")
+        if reason is None:
+            reason = (_linked_reason(None, obj.active_material)
+                      or _made_up_reason(obj.active_material))
+        return _allowed(cls, reason)
 
 
 def _set_shade(operator, context, solve) -> set:
@@ -183,7 +257,7 @@ def _set_shade(operator, context, solve) -> set:
     return {"FINISHED"}
 
 
-class MAKEUPSKIN_OT_match_skin(_MaterialPoll, bpy.types.Operator):
+class MAKEUPSKIN_OT_match_skin(_ShadePoll, bpy.types.Operator):
     """Set the shade so that the made-up skin has the skin's own colour at any coverage: Skin
     Color's value, or the mean of the image feeding it over the faces that use the material"""
 
@@ -195,7 +269,7 @@ class MAKEUPSKIN_OT_match_skin(_MaterialPoll, bpy.types.Operator):
         return _set_shade(self, context, shade.matched)
 
 
-class MAKEUPSKIN_OT_shade_step(_MaterialPoll, bpy.types.Operator):
+class MAKEUPSKIN_OT_shade_step(_ShadePoll, bpy.types.Operator):
     """One shade lighter or darker: the covered skin's colour 10% up or down in luminance"""
 
     bl_idname = f"{OPERATOR_PREFIX}.shade_step"
@@ -237,8 +311,8 @@ class MAKEUPSKIN_OT_add_preset(AddPresetBase, bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        obj = context.object
-        return obj is not None and obj.active_material is not None
+        return _allowed(cls, _material_reason(
+            context.object, "a preset holds a material's settings"))
 
     bl_idname = f"{OPERATOR_PREFIX}.add_preset"
     bl_label = "Add Made-up Skin Preset"
