@@ -70,8 +70,9 @@ def _linked_reason(obj, material) -> str | None:
 
 
 def _made_up_reason(material) -> str | None:
-    """Why a shade cannot be set on ``material``: it is not made up yet (before Apply, the
-    skin's colour is not read from the artist's shader, and the first Apply matches it)."""
+    """Why a shade cannot be set on ``material``: it is not made up yet.  The first Apply
+    matches the skin itself (choosing a matte film when the skin is darker than the default
+    film's gloss); a shade set before it would be kept as chosen, and skip that."""
     if not material.makeup_skin.is_made_up:
         return f"material {material.name!r} is not made up: Apply first (it matches the skin)"
     return None
