@@ -13,7 +13,7 @@ changes.  Each repair is printed as one line on the console and kept for the pan
 one pass over its node groups.
 
 The same handler first upgrades the settings of files saved by an earlier add-on
-(:func:`upgrade_settings`, :data:`.keys.SETTINGS_VERSION`): their Shade By Colour meant the
+(:func:`upgrade_settings`, :data:`.keys.SETTINGS_VERSION`): their Shade By Color meant the
 colour the pigment passes (now the colour seen), their film width was in degrees under Override
 Film (now Film Roughness, always on), and their Coverage and Shade By defaulted to 1 and
 Absorption; every value they meant is kept.

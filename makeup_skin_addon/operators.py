@@ -16,6 +16,7 @@ from bl_operators.presets import AddPresetBase
 from . import convert, live, scene_fit, shade
 from . import material as made_up
 from .keys import OPERATOR_PREFIX, PRESET_SUBDIR, SETTINGS_ATTRIBUTE
+from .properties import RESOLUTION_ITEMS
 
 __all__ = ["MAKEUPSKIN_OT_apply", "MAKEUPSKIN_OT_revert", "MAKEUPSKIN_OT_check_tables",
            "MAKEUPSKIN_OT_fit_to_scene", "MAKEUPSKIN_OT_match_skin", "MAKEUPSKIN_OT_shade_step",
@@ -98,10 +99,11 @@ class MAKEUPSKIN_OT_apply(bpy.types.Operator):
     bl_options = {"REGISTER", "UNDO"}
 
     resolution: bpy.props.EnumProperty(
-        name="Resolution", items=(("SETTINGS", "From Settings", "The material's bake resolution"),
-                                  ("preview", "Preview", ""), ("default", "Default", ""),
-                                  ("high", "High", "")),
-        default="SETTINGS", options={"SKIP_SAVE"})
+        name="Resolution",
+        items=(("SETTINGS", "From Settings", "The material's Bake Resolution"),
+               *RESOLUTION_ITEMS),
+        default="SETTINGS", options={"SKIP_SAVE"},
+        description="Resolution of the tables this Apply bakes")
 
     @classmethod
     def poll(cls, context):
@@ -259,7 +261,7 @@ def _set_shade(operator, context, solve) -> set:
 
 
 class MAKEUPSKIN_OT_match_skin(_ShadePoll, bpy.types.Operator):
-    """Set the shade so that the made-up skin has the skin's own colour at any coverage: Skin
+    """Set the shade so that the made-up skin has the skin's own color at any coverage: Skin
     Color's value, or the mean of the image feeding it over the faces that use the material"""
 
     bl_idname = f"{OPERATOR_PREFIX}.match_skin"
@@ -271,7 +273,7 @@ class MAKEUPSKIN_OT_match_skin(_ShadePoll, bpy.types.Operator):
 
 
 class MAKEUPSKIN_OT_shade_step(_ShadePoll, bpy.types.Operator):
-    """One shade lighter or darker: the covered skin's colour 10% up or down in luminance"""
+    """One shade lighter or darker: the covered skin's color 10% up or down in luminance"""
 
     bl_idname = f"{OPERATOR_PREFIX}.shade_step"
     bl_label = "Shade Step"
@@ -280,11 +282,11 @@ class MAKEUPSKIN_OT_shade_step(_ShadePoll, bpy.types.Operator):
     direction: bpy.props.EnumProperty(
         name="Direction", items=(("LIGHTER", "Lighter", "One shade lighter"),
                                  ("DARKER", "Darker", "One shade darker")),
-        default="LIGHTER")
+        default="LIGHTER", description="Which way the shade steps")
 
     @classmethod
     def description(cls, context, properties):
-        return (f"One shade {properties.direction.lower()}: the covered skin's colour "
+        return (f"One shade {properties.direction.lower()}: the covered skin's color "
                 f"{'times' if properties.direction == 'LIGHTER' else 'divided by'} "
                 f"{shade.SHADE_STEP:g}")
 
@@ -302,6 +304,7 @@ def _sentence(error) -> str:
 
 class MAKEUPSKIN_MT_presets(bpy.types.Menu):
     bl_label = "Made-up Skin Presets"
+    bl_description = "Saved Made-up Skin parameter sets: pick one to load it into the material"
     preset_subdir = PRESET_SUBDIR
     preset_operator = "script.execute_preset"
     draw = bpy.types.Menu.draw_preset

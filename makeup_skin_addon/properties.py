@@ -7,7 +7,7 @@ Roughness, the film's index, tier and resolution change the tables: with live up
 them schedules a preview re-bake (:mod:`.live`); Apply bakes at full resolution.  The settings
 are registered as ``Material.makeup_skin`` (:data:`.keys.SETTINGS_ATTRIBUTE`).
 
-The shade is kept as its absorption; the Foundation Colour is its colour seen (the thick
+The shade is kept as its absorption; the Foundation Color is its colour seen (the thick
 layer, :func:`.shade.colour_seen`) and picking a colour solves the absorption
 (:func:`.shade.absorption_for_colour`), both at once in the update callbacks, never while the
 panel draws.  Choosing a foundation sets its shade, colour and film roughness; choosing a skin
@@ -26,8 +26,9 @@ from . import live, shade
 from .core import presets, roughness
 from .keys import SETTINGS_ATTRIBUTE, SETTINGS_VERSION
 
-__all__ = ["MakeupSkinSettings", "register", "unregister", "TIER_ITEMS", "SETTINGS_VERSION",
-           "ROUGHNESS_MAX", "FILM_ROUGHNESS_MIN", "SKIN_ROUGHNESS_MIN"]
+__all__ = ["MakeupSkinSettings", "register", "unregister", "TIER_ITEMS", "SUBSURFACE_ITEMS",
+           "RESOLUTION_ITEMS", "SETTINGS_VERSION", "ROUGHNESS_MAX", "FILM_ROUGHNESS_MIN",
+           "SKIN_ROUGHNESS_MIN"]
 
 TIER_ITEMS = (
     ("AUTO", "Auto", "The cheapest tier within 2% of the best one's error in this scene (camera, "
@@ -45,7 +46,7 @@ SUBSURFACE_ITEMS = (
     ("BURLEY", "Christensen-Burley", "Burley's profile: Cycles and EEVEE, fitted exactly"),
     ("RANDOM_WALK", "Random Walk", "Cycles' volume random walk (radius = mean free path)"),
     ("RANDOM_WALK_SKIN", "Random Walk (Skin)", "Cycles' random walk with radius adjusted by "
-                                               "colour, as Principled skin presets use"),
+                                               "color, as Principled skin presets use"),
 )
 RESOLUTION_ITEMS = (
     ("preview", "Preview", "Coarse tables (fast bake, under 1% error)"),
@@ -187,27 +188,30 @@ class MakeupSkinSettings(bpy.types.PropertyGroup):
     absorption_mode: bpy.props.EnumProperty(
         name="Shade By", items=(
             ("ABSORPTION", "Absorption", "Pigment absorption per channel"),
-            ("COLOUR", "Colour", "The colour the foundation has in the bottle or as a swatch "
-                                 "(linear; sample a product photo with the picker)")),
-        default="COLOUR", update=_update_sockets)
+            ("COLOUR", "Color", "The color the foundation has in the bottle or as a swatch "
+                                "(linear; sample a product photo with the picker)")),
+        default="COLOUR",
+        description="How the foundation's shade is given: by its color in the bottle (the "
+                    "absorption is solved from it) or by the pigment's absorption",
+        update=_update_sockets)
     absorption: bpy.props.FloatVectorProperty(
         name="Absorption", size=3, default=(0.0, 0.0, 0.0), min=0.0, max=1.0, subtype="NONE",
         description="Fraction of the light crossing the film's pigment absorbed, per R, G, B "
                     "(the foundation's shade)", update=_update_absorption)
     shade_colour: bpy.props.FloatVectorProperty(
-        name="Foundation Colour", size=3, min=0.0, max=1.0, subtype="COLOR",
+        name="Foundation Color", size=3, min=0.0, max=1.0, subtype="COLOR",
         default=tuple(float(c) for c in shade.colour_seen((0.0, 0.0, 0.0))),
-        description="The colour of a thick layer of the foundation (in the bottle, a swatch on "
+        description="The color of a thick layer of the foundation (in the bottle, a swatch on "
                     "a card), linear: the absorption is solved so that the film stacked on "
-                    "itself has it; colours the film cannot reach are clamped (the panel says "
+                    "itself has it; colors the film cannot reach are clamped (the panel says "
                     "so)", update=_update_shade_colour)
     foundation_colour: bpy.props.FloatVectorProperty(
-        name="Colour Passed (old)", size=3, default=(1.0, 1.0, 1.0), min=0.0, max=1.0,
-        subtype="COLOR", description="Files of older versions: the colour the pigment let "
+        name="Color Passed (old)", size=3, default=(1.0, 1.0, 1.0), min=0.0, max=1.0,
+        subtype="COLOR", description="Files of older versions: the color the pigment let "
                                      "through (1 - absorption); upgraded when opened")
     shade_note: bpy.props.StringProperty(
         name="Shade Note", default="",
-        description="What the last colour pick or match could not reach (internal, shown)")
+        description="What the last color pick or match could not reach (internal, shown)")
     shade_source: bpy.props.EnumProperty(
         name="Shade Source", items=(
             ("DEFAULT", "Default", "Never chosen: the first Apply matches the skin"),
@@ -296,8 +300,10 @@ _register_classes, _unregister_classes = bpy.utils.register_classes_factory(clas
 
 def register():
     _register_classes()
-    setattr(bpy.types.Material, SETTINGS_ATTRIBUTE,
-            bpy.props.PointerProperty(type=MakeupSkinSettings))
+    setattr(bpy.types.Material, SETTINGS_ATTRIBUTE, bpy.props.PointerProperty(
+        type=MakeupSkinSettings, name="Made-up Skin",
+        description="This material's Made-up Skin settings: foundation, coverage, shade, skin, "
+                    "film, tier"))
 
 
 def unregister():

@@ -179,6 +179,8 @@ class _SettingsPanel:
     """Shared body: :func:`draw_settings`, then :func:`draw_fit`."""
 
     bl_label = "Made-up Skin"
+    bl_description = ("Foundation on skin: the active object's material made up (Apply, "
+                      "Revert), its settings, and Fit to Scene")
 
     def draw(self, context):
         draw_settings(self.layout, context)

@@ -14,6 +14,7 @@ import zipfile
 from pathlib import Path
 
 import pytest
+from support.addon_steps import registered_classes
 
 pytestmark = pytest.mark.bpy
 
@@ -66,20 +67,6 @@ def test_zip_contents(extension_zip):
     assert not [n for n in names if n.startswith("data/")]  # published measurements stay out
     # the runtime only: no scipy-backed validation, no command line
     assert not [n for n in names if n.startswith(("lut_baker/offline/", "lut_baker/__main__"))]
-
-
-def _registered_classes(bpy, module_prefix):
-    """Registered bpy classes (operators, panels, preferences, ...) defined under a module."""
-    found, stack, seen = [], [bpy.types.bpy_struct], set()
-    while stack:
-        for sub in stack.pop().__subclasses__():
-            if sub in seen:
-                continue
-            seen.add(sub)
-            stack.append(sub)
-            if sub.__module__.startswith(module_prefix) and getattr(sub, "is_registered", False):
-                found.append(sub)
-    return found
 
 
 def _repo_index(bpy, module):
@@ -147,7 +134,7 @@ def test_install_enable_uninstall(bpy_factory, extension_zip, tmp_path):
         # Enabled under the root package name, its operators registered; no preferences.
         assert ADDON_MODULE in prefs.addons
         assert addon_utils.check(ADDON_MODULE) == (True, True)
-        registered = _registered_classes(bpy, ADDON_MODULE)
+        registered = registered_classes(ADDON_MODULE)
         assert "MAKEUPSKIN_OT_apply" in [c.__name__ for c in registered]
         assert not [c for c in registered if issubclass(c, bpy.types.AddonPreferences)]
 
@@ -162,7 +149,7 @@ def test_install_enable_uninstall(bpy_factory, extension_zip, tmp_path):
 
         assert ADDON_MODULE not in prefs.addons
         assert not [a.module for a in prefs.addons if a.module.startswith(ADDON_MODULE)]
-        assert _registered_classes(bpy, ADDON_MODULE) == []
+        assert registered_classes(ADDON_MODULE) == []
         assert not hasattr(bpy.types.Material, "makeup_skin")  # its property went too
         assert [n for n in dir(bpy.types) if n.startswith(("MAKEUPSKIN", "MAKEUP_SKIN"))] == []
         assert not [m for m in sys.modules if m == ADDON_MODULE or m.startswith(ADDON_MODULE + ".")]

@@ -106,7 +106,7 @@ def test_a_file_without_a_made_up_material_is_left_alone(addon, blank_scene, tmp
 
 def test_settings_of_an_older_file_are_upgraded(sphere, tmp_path):
     """A file of the previous version (its settings as that version stored them: no settings
-    version, Shade By Colour meaning the colour the pigment passes, the film's width in degrees
+    version, Shade By Color meaning the colour the pigment passes, the film's width in degrees
     under Override Film, Coverage and Shade By left at their old defaults 1 and Absorption):
     opened, the settings mean what they meant, and Apply's sockets are those it had."""
     import math

@@ -1,8 +1,10 @@
 """Registering the add-on (makeup_skin_addon.register, unregister): unregistering leaves
 no class, property, timer or handler behind; a script that registers it and never unregisters
-still ends."""
+still ends; what the registered classes show (labels, names, tooltips) is complete and spells
+"Color" as Blender does."""
 
 import pytest
+from support.addon_steps import ui_texts
 from support.process_exit import bpy_importable, run_to_exit
 
 
@@ -80,3 +82,24 @@ def test_unregister_twice_and_register_twice_change_nothing(addon, bpy_factory):
     finally:
         addon.register()
     assert hasattr(bpy.types.Material, "makeup_skin")
+
+
+def test_every_property_operator_panel_and_menu_has_a_tooltip(addon):
+    """Every registered class of the add-on, walked from Blender's types (property groups and
+    their pointers, operators and their properties, panels, menus): a label or name, and a
+    tooltip, for the class, each property and each enum item (hidden properties show none)."""
+    texts = ui_texts()
+    where = {at.split(".")[0].split("[")[0] for at, _, _ in texts}
+    assert {"makeup_skin", "MakeupSkinSettings", "Material", "MAKEUPSKIN_PT_material",
+            "MAKEUPSKIN_PT_node_editor", "MAKEUPSKIN_MT_presets"} <= where, where
+    empty = [(at, kind) for at, kind, text in texts if not text.strip()]
+    assert empty == []
+    assert ("Material.makeup_skin", "name", "Made-up Skin") in texts
+
+
+def test_the_interface_spells_color_as_blender_does(addon):
+    """Blender's interface says "Color": no label, name or tooltip of the add-on says
+    "colour" (identifiers in code are not shown)."""
+    texts = ui_texts()
+    assert len(texts) > 100
+    assert [(at, kind, text) for at, kind, text in texts if "colour" in text.lower()] == []

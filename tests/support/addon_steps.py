@@ -13,6 +13,9 @@ does, or through the pipeline), render, and read node trees and images back.
 - :func:`counts` -- how many node groups, images and materials the file holds.
 - :func:`session_caches` -- the add-on's session caches (re-baked tables, closure fits).
 - :func:`cold_caches` -- empty them: the next Apply bakes and fits.
+- :func:`registered_classes` -- the classes of a package registered with Blender.
+- :func:`ui_texts` -- every text the add-on's registered classes show (labels, names,
+  tooltips), by where it shows.
 """
 
 from __future__ import annotations
@@ -20,7 +23,8 @@ from __future__ import annotations
 from support import sphere_scene
 
 __all__ = ["SPHERE_PX", "HEAD_PX", "apply_operator", "apply_pipeline", "render", "tree_state",
-           "group_node", "lut_images", "counts", "session_caches", "cold_caches"]
+           "group_node", "lut_images", "counts", "session_caches", "cold_caches",
+           "registered_classes", "ui_texts"]
 
 SPHERE_PX = 64
 """The sphere scene's size (px): Cycles CPU at 16 samples, about 0.3 s a render."""
@@ -107,3 +111,99 @@ def cold_caches():
     carries them over from one test to the next)."""
     for cache in session_caches().values():
         cache.clear()
+
+
+def registered_classes(module_prefix: str) -> list:
+    """The classes defined under ``module_prefix`` that are registered with Blender
+    (operators, panels, menus, property groups, preferences...), walked from ``bpy_struct``'s
+    subclasses: a class missing from its module's list is found all the same."""
+    import bpy
+
+    found, stack, seen = [], [bpy.types.bpy_struct], set()
+    while stack:
+        for sub in stack.pop().__subclasses__():
+            if sub in seen:
+                continue
+            seen.add(sub)
+            stack.append(sub)
+            if sub.__module__.startswith(module_prefix) and getattr(sub, "is_registered", False):
+                found.append(sub)
+    return found
+
+
+def _deferred(cls, identifier: str):
+    """The ``bpy.props`` definition of ``identifier`` in ``cls`` or a base: its annotation,
+    evaluated in its module as Blender does when the annotation is a string (a module with
+    ``from __future__ import annotations``)."""
+    import sys
+
+    for base in cls.__mro__:
+        annotation = vars(base).get("__annotations__", {}).get(identifier)
+        if isinstance(annotation, str):
+            return eval(annotation, vars(sys.modules[base.__module__]))  # noqa: S307
+        if annotation is not None:
+            return annotation
+    raise LookupError(f"{cls.__name__} defines no property {identifier!r}")
+
+
+def _property_texts(where: str, cls, rna, inherited) -> list[tuple[str, str, str]]:
+    """``(where, kind, text)`` of each property of ``rna`` not in ``inherited`` (Blender's own)
+    and not hidden: its name and tooltip, each enum item's name and tooltip (a dynamic enum's
+    items from its ``items`` function)."""
+    import bpy
+
+    texts = []
+    for prop in rna.properties:
+        if prop.identifier in inherited or prop.is_hidden:
+            continue
+        at = f"{where}.{prop.identifier}"
+        texts += [(at, "name", prop.name), (at, "description", prop.description)]
+        if prop.type != "ENUM":
+            continue
+        items = [(item.identifier, item.name, item.description) for item in prop.enum_items]
+        if not items:  # dynamic: Blender lists its items only for a context
+            items = [item[:3] for item in
+                     _deferred(cls, prop.identifier).keywords["items"](None, bpy.context)]
+        for identifier, name, description in items:
+            texts += [(f"{at}[{identifier}]", "name", name),
+                      (f"{at}[{identifier}]", "description", description)]
+    return texts
+
+
+def ui_texts(module_prefix: str = "makeup_skin_addon") -> list[tuple[str, str, str]]:
+    """``(where, kind, text)`` for every text the classes registered from ``module_prefix``
+    show: each operator's label and tooltip (a dynamic one for each value of its enum
+    properties) and its properties, each panel's and menu's label and tooltip, each property
+    group's properties, and the pointers they are registered under on Blender's types.
+    ``kind`` is ``label``, ``description`` or ``name``."""
+    import bpy
+
+    texts = []
+    for cls in registered_classes(module_prefix):
+        if issubclass(cls, bpy.types.Operator):
+            module, _, name = cls.bl_idname.partition(".")
+            rna = getattr(getattr(bpy.ops, module), name).get_rna_type()
+            texts += [(cls.bl_idname, "label", rna.name),
+                      (cls.bl_idname, "description", rna.description)]
+            texts += _property_texts(cls.bl_idname, cls, rna, {"rna_type"})
+            if "description" in vars(cls):  # a tooltip that depends on the properties
+                for prop in rna.properties:
+                    for item in prop.enum_items if prop.type == "ENUM" else ():
+                        values = type("Properties", (), {prop.identifier: item.identifier})
+                        texts.append((f"{cls.bl_idname}({item.identifier})", "description",
+                                      cls.description(bpy.context, values)))
+        elif issubclass(cls, (bpy.types.Panel, bpy.types.Menu)):
+            texts += [(cls.__name__, "label", cls.bl_label),
+                      (cls.__name__, "description", getattr(cls, "bl_description", ""))]
+        elif issubclass(cls, bpy.types.PropertyGroup):
+            inherited = {p.identifier for p in bpy.types.PropertyGroup.bl_rna.properties}
+            texts += _property_texts(cls.__name__, cls, cls.bl_rna, inherited)
+            for owner in (bpy.types.ID, bpy.types.Material, bpy.types.Object, bpy.types.Scene,
+                          bpy.types.WindowManager):
+                texts += [(f"{owner.__name__}.{p.identifier}", kind, getattr(p, kind))
+                          for p in owner.bl_rna.properties if p.type == "POINTER"
+                          and p.fixed_type.identifier == cls.bl_rna.identifier
+                          for kind in ("name", "description")]
+        else:  # a kind of class this walk does not know: say so rather than skip it
+            texts.append((cls.__name__, "unknown kind of class", ""))
+    return texts
