@@ -1,29 +1,36 @@
 """Made-up Skin in the artist's own material, and back: nothing of theirs is lost.
 
 :func:`install` puts the Made-up Skin group node into a material's node tree and makes it the
-Material Output's Surface.  The shader that was the surface stays in the tree, disconnected,
-inside a frame labelled :data:`.keys.FRAME_LABEL`, with every link and value it had.
+Material Output's Surface.  How depends on what the surface was (docs/addon.md, "Over the
+artist's skin"):
 
-What the artist's skin shader takes is carried over (:func:`surface_sources`): the surface is
-followed through Mix Shaders (the input with the larger share), Add Shaders, reroutes and node
-groups (into the group, and back out through its Group Input) down to a Principled BSDF (or a
-Diffuse BSDF).  What is linked into its Base Color (Diffuse: Color), Normal and (Principled)
-Coat Normal is linked into the group's Skin Color, Normal and Film Normal; an unlinked Base
-Color's value becomes the Skin Color; what cannot be carried (a texture inside a node group,
-no such shader at all) is named in the report.  When the skin's Normal comes from a Normal
-Map (or Bump) node and no Coat Normal is linked, the film gets its own copy of that node at a
-fraction of its strength (:data:`.keys.FILM_NORMAL_NODE`; the panel's Film Normal settings,
-:func:`set_film_normal`): a film that softens the pores without filling them.
+- **The artist's shader** (anything but Blender's untouched default Principled BSDF,
+  :func:`.artist_shader.read`): it stays linked, into the group's Skin Shader input, and
+  renders as it is wherever the film does not cover (Coverage 0 renders as before Apply).  The
+  group is one built over a shader (:func:`.nodes.over_shader`).  Under the film the group
+  takes the skin that shader describes (:mod:`.artist_skin`): its Skin Color is fed by nodes
+  the add-on adds (in a frame, :data:`.keys.SKIN_FRAME_NAME`) that follow the shader's own
+  structure: each skin BSDF's Base Color source scaled by the share of it that BSDF renders as
+  body colour, mixed as its Mix Shaders mix (the same factors) and added as its Add Shaders
+  add; its Normal, Subsurface Radius (times Subsurface Scale) and Subsurface Weight are the
+  dominant skin BSDF's.  What is computed inside the artist's node groups is brought out by
+  copying the nodes that compute it (:mod:`.node_copy`); the groups are never edited.  When
+  the skin's Normal comes from a Normal Map (or Bump) node and no Coat Normal is linked, the
+  film gets its own copy of that node at a fraction of its strength
+  (:data:`.keys.FILM_NORMAL_NODE`; :func:`set_film_normal`).
+- **No shader of the artist's** (no surface, or Blender's own untouched default): the group is
+  the skin preset's made-up skin, bare skin included; a default shader that was there stays
+  in the tree, disconnected, inside a frame (:data:`.keys.FRAME_LABEL`).
 
-The material records the previous surface (:data:`.keys.RECORD_KEY`), and :func:`revert`
-reconnects it and removes the group node, the film's normal node and the frame (the add-on's
-own nodes), leaving the tree as it was.  The Material Output's other inputs (Volume,
-Displacement) are never touched.
+Every node the add-on adds carries :data:`.keys.OWNED_KEY`.  The material records the previous
+surface (:data:`.keys.RECORD_KEY`), and :func:`revert` reconnects it, removes the add-on's own
+nodes (and nothing else), and removes the node group and images the material's made-up skin
+leaves unused.  The Material Output's other inputs (Volume, Displacement) are never touched.
 
 - :func:`group_node` -- the material's Made-up Skin group node, or None.
 - :func:`linked_library` -- why a datablock cannot be changed here (linked data), or None.
 - :func:`material_output` -- the output node Apply uses.
-- :func:`surface_sources` -- what the artist's surface gives the group's inputs.
+- :func:`artist_tree` -- the artist's shader tree of a material, converted or not.
 - :func:`install` -- the group node in place of the surface; returns what was carried over.
 - :func:`set_film_normal` -- the film's normal node's strength, linked or not.
 - :func:`revert` -- the previous surface back.
@@ -35,61 +42,49 @@ import json
 from dataclasses import dataclass, field
 
 import bpy
+import numpy as np
 
+from . import artist_shader, node_copy
+from .artist_shader import Add, Leaf, Source, source
 from .keys import (
     BASE_STRENGTH_KEY,
     FILM_NORMAL_NODE,
+    FIT_KEY,
     FRAME_LABEL,
     FRAME_NAME,
     GROUP_NODE,
+    LUT_PREFIX,
+    OWNED_KEY,
     RECORD_KEY,
+    SKIN_FRAME_LABEL,
+    SKIN_FRAME_NAME,
 )
 
-__all__ = ["CARRIED_INPUTS", "SKIN_SHADERS", "Sources", "Installed", "group_node",
-           "linked_library", "material_output", "surface_sources", "install",
-           "set_film_normal", "film_normal_node", "revert", "can_revert"]
+__all__ = ["Installed", "group_node", "linked_library", "material_output", "artist_tree",
+           "install", "set_film_normal", "film_normal_node", "revert", "can_revert",
+           "owned_nodes", "RECORD_VERSION"]
 
-CARRIED_INPUTS = (
-    # (the skin shader's inputs, by name in order of preference) -> the group's input
-    (("Base Color", "Color"), "Skin Color"),
-    (("Normal",), "Normal"),
-    (("Coat Normal",), "Film Normal"),
-)
-"""Inputs of the artist's skin shader carried over to the group's."""
-SKIN_SHADERS = ("BSDF_PRINCIPLED", "BSDF_DIFFUSE")
-"""Node types whose Base Color (or Color) is the skin's albedo."""
 GAP = 60.0
-"""Space (node-editor units) between the group node and the framed previous shader."""
-
-
-@dataclass
-class Sources:
-    """What the artist's surface gives the group's inputs (:func:`surface_sources`).
-
-    ``shader``: the skin shader found (None if none), ``route``: the nodes passed on the way
-    from the output (Mix Shader, node groups...), ``links``: group input -> the socket of the
-    material's own tree to link from, with the shader's input name, ``values``: group input ->
-    value (an unlinked Base Color), ``missing``: group input -> why it is not carried."""
-
-    shader: object = None
-    route: list = field(default_factory=list)
-    links: dict = field(default_factory=dict)
-    values: dict = field(default_factory=dict)
-    missing: dict = field(default_factory=dict)
+"""Space (node-editor units) between the nodes Apply places."""
+RECORD_VERSION = 2
+"""What the record of the previous surface means: 2, the group goes over the artist's shader
+(its Skin Shader input); absent (1), an earlier add-on framed and disconnected the shader."""
 
 
 @dataclass
 class Installed:
     """What :func:`install` did, for the report: ``carried`` (sentences' parts, e.g. "Base
-    Color -> Skin Color"), ``values`` (group input -> value taken from the shader),
-    ``missing`` (sentences: what was not carried over and why), ``film_normal`` (a sentence
-    about the film's normal, or ""), ``first`` (the material was converted now)."""
+    Color -> Skin Color"), ``values`` (group input -> value taken from the shader, the skin
+    preset's groups only), ``missing`` (what was not carried over and what is used instead),
+    ``film_normal`` (a sentence about the film's normal, or ""), ``first`` (the material was
+    converted now), ``over_shader`` (the artist's shader is the bare skin)."""
 
     carried: list = field(default_factory=list)
     values: dict = field(default_factory=dict)
     missing: list = field(default_factory=list)
     film_normal: str = ""
     first: bool = False
+    over_shader: bool = False
 
 
 def group_node(material):
@@ -103,7 +98,8 @@ def group_node(material):
 
 def linked_library(datablock, kind: str) -> str | None:
     """A sentence saying why ``datablock`` (a material, node group or mesh, named ``kind``)
-    cannot be changed here, or None if it is local and editable."""
+    cannot be changed here, or None if it is local and editable.  The library is named by its
+    file name: Blender cuts a greyed-out button's reason at 200 characters."""
     if datablock is None:
         return None
     library = datablock.library
@@ -112,14 +108,13 @@ def linked_library(datablock, kind: str) -> str | None:
         library = reference.library if reference is not None else None
         if library is not None:
             return (f"{kind} {datablock.name!r} is a library override of data in "
-                    f"{library.filepath!r}: changes to its nodes are not saved; make it local "
-                    f"first (Object > Library Override > Make Local, or Object > Relations > "
-                    f"Make Local) and try again")
+                    f"{bpy.path.basename(library.filepath)!r}: its nodes are not saved; make "
+                    f"it local (Object > Library Override > Make Local)")
     if library is None:
         return None
-    return (f"{kind} {datablock.name!r} is linked from the library {library.filepath!r}: "
-            f"changes to it are not saved in this file; make it local first (Object > Relations "
-            f"> Make Local > Selected Objects, Data and Materials) and try again")
+    return (f"{kind} {datablock.name!r} is linked from the library "
+            f"{bpy.path.basename(library.filepath)!r}: changes are not saved; make it local "
+            f"(Object > Relations > Make Local)")
 
 
 def material_output(tree):
@@ -133,116 +128,23 @@ def material_output(tree):
     return output
 
 
-def _first_input(node, names):
-    for name in names:
-        socket = node.inputs.get(name)
-        if socket is not None and socket.enabled:
-            return socket
-    return None
-
-
-def _active_group_output(tree):
-    """The active Group Output node of a node group's tree, or None."""
-    outputs = [node for node in tree.nodes if node.type == "GROUP_OUTPUT"]
-    return next((node for node in outputs if node.is_active_output), outputs[0] if outputs
-                else None)
-
-
-def _shaders(socket, groups: tuple, weight: float, route: tuple, seen: set):
-    """``[(shader node, groups, weight, route)]``: the skin shaders behind the output socket
-    ``socket`` (a node's output): through reroutes, Mix Shaders (weights ``1 - Fac`` and
-    ``Fac``, 1/2 each when Fac is linked), Add Shaders and node groups (``groups``: the group
-    nodes entered, outermost first)."""
-    node = socket.node
-    if node.as_pointer() in seen:
-        return []
-    seen = seen | {node.as_pointer()}
-    if node.type in SKIN_SHADERS:
-        return [(node, groups, weight, route)]
-    if node.type == "REROUTE":
-        return _linked_shaders(node.inputs[0], groups, weight, route, seen)
-    if node.type == "MIX_SHADER":
-        fac = node.inputs[0]
-        share = 0.5 if fac.is_linked else min(max(float(fac.default_value), 0.0), 1.0)
-        route = route + (f"Mix Shader {node.name!r}",)
-        return (_linked_shaders(node.inputs[1], groups, weight * (1.0 - share), route, seen)
-                + _linked_shaders(node.inputs[2], groups, weight * share, route, seen))
-    if node.type == "ADD_SHADER":
-        route = route + (f"Add Shader {node.name!r}",)
-        return (_linked_shaders(node.inputs[0], groups, weight, route, seen)
-                + _linked_shaders(node.inputs[1], groups, weight, route, seen))
-    if node.type == "GROUP" and node.node_tree is not None:
-        inner = _active_group_output(node.node_tree)
-        target = (next((s for s in inner.inputs if s.identifier == socket.identifier), None)
-                  if inner is not None else None)
-        if target is None:
-            return []
-        return _linked_shaders(target, groups + (node,), weight,
-                               route + (f"node group {node.node_tree.name!r}",), seen)
-    return []
-
-
-def _linked_shaders(input_socket, groups, weight, route, seen):
-    if not input_socket.is_linked or weight <= 0.0:
-        return []
-    return _shaders(input_socket.links[0].from_socket, groups, weight, route, seen)
-
-
-def _source(socket, groups: tuple):
-    """``("link", socket)`` of the material's own tree feeding ``socket`` (an input inside the
-    ``groups`` entered), ``("value", value)`` when it is unlinked all the way out, or
-    ``("missing", why)``."""
-    if not socket.is_linked:
-        value = getattr(socket, "default_value", None)
-        return ("value", tuple(value)[:3]) if value is not None else ("missing", "no value")
-    origin = socket.links[0].from_socket
-    node = origin.node
-    if node.type == "REROUTE":
-        return _source(node.inputs[0], groups)
-    if node.type == "GROUP_INPUT" and groups:
-        outer = groups[-1]
-        outer_input = next((s for s in outer.inputs if s.identifier == origin.identifier), None)
-        if outer_input is None:
-            return "missing", f"node group {outer.node_tree.name!r} has no such input"
-        return _source(outer_input, groups[:-1])
-    if groups:
-        return "missing", (f"it is fed by {node.name!r} inside node group "
-                           f"{groups[-1].node_tree.name!r}, which cannot be linked from outside")
-    return "link", origin
-
-
-def surface_sources(material) -> Sources:
-    """What the surface of ``material`` gives the group's inputs: the skin shader found behind
-    the active Material Output's Surface (the one with the largest share, a Principled BSDF
-    first among equals) and, per :data:`CARRIED_INPUTS`, the socket to link from, the value
-    (Base Color only), or why neither can be carried."""
-    sources = Sources()
+def owned_nodes(material) -> list:
+    """The nodes of ``material``'s tree the add-on added (:data:`.keys.OWNED_KEY`)."""
     tree = material.node_tree if material is not None else None
-    output = (tree.get_output_node("ALL") or tree.get_output_node("CYCLES")) if tree else None
-    if output is None or not output.inputs["Surface"].is_linked:
-        return sources
-    candidates = _linked_shaders(output.inputs["Surface"], (), 1.0, (), set())
-    if not candidates:
-        shader = output.inputs["Surface"].links[0].from_node
-        for _, target in CARRIED_INPUTS[:2]:
-            sources.missing[target] = (f"no Principled or Diffuse BSDF behind the surface "
-                                       f"({shader.name!r})")
-        return sources
-    best = max(candidates, key=lambda c: (c[2], c[0].type == "BSDF_PRINCIPLED"))
-    sources.shader, groups, _, route = best
-    sources.route = list(route)
-    for names, target in CARRIED_INPUTS:
-        socket = _first_input(sources.shader, names)
-        if socket is None:
-            continue
-        kind, what = _source(socket, groups)
-        if kind == "link":
-            sources.links[target] = (socket.name, what)
-        elif kind == "value" and target == "Skin Color":
-            sources.values[target] = what
-        elif kind == "missing" and (socket.is_linked or target == "Skin Color"):
-            sources.missing[target] = f"{socket.name}: {what}"
-    return sources
+    return [node for node in tree.nodes if node.get(OWNED_KEY)] if tree is not None else []
+
+
+def artist_tree(material):
+    """The artist's shader tree of ``material`` (:func:`.artist_shader.read`): behind its
+    surface before Apply, behind the group's Skin Shader input after; None when there is
+    none."""
+    node = group_node(material)
+    if node is None:
+        return artist_shader.read(material)
+    shader = node.inputs.get("Skin Shader")
+    if shader is None or not shader.is_linked:
+        return None
+    return artist_shader._linked(shader, (), (), frozenset())
 
 
 def film_normal_node(material):
@@ -251,43 +153,197 @@ def film_normal_node(material):
     return tree.nodes.get(FILM_NORMAL_NODE) if tree is not None else None
 
 
-def _copy_input(tree, source, target) -> None:
-    """Give ``target`` (an input) what ``source`` (the same input of another node) has: its
-    link, else its value."""
-    if source.is_linked:
-        tree.links.new(source.links[0].from_socket, target)
-    elif hasattr(source, "default_value"):
-        target.default_value = source.default_value
+# -- the skin under the film -------------------------------------------------------------------
+
+class _SkinNodes:
+    """Adds the nodes that give the group the skin under the film, inside their frame."""
+
+    def __init__(self, tree, location):
+        self.tree = tree
+        frame = tree.nodes.new("NodeFrame")
+        frame.name, frame.label = SKIN_FRAME_NAME, SKIN_FRAME_LABEL
+        node_copy.mark(frame)
+        self.frame = frame
+        self.location = location
+        self.count = 0
+        self.copier = node_copy.copier(tree, (location[0] - 600.0, location[1]))
+
+    def node(self, kind: str, label: str, **props):
+        node = self.tree.nodes.new(kind)
+        node_copy.mark(node)
+        node.label = label
+        node.location = (self.location[0] - 220.0 * (self.count % 3),
+                         self.location[1] - 200.0 * (self.count // 3))
+        self.count += 1
+        for name, value in props.items():
+            setattr(node, name, value)
+        return node
+
+    def out(self, where: Source):
+        """A socket of the material's tree (or a value) giving ``where``."""
+        value = node_copy.bring_out(where, self.tree, copier=self.copier)
+        return value
+
+    def finish(self) -> None:
+        for node in list(self.copier.copies.values()):
+            node.parent = self.frame
+        if not any(n.parent == self.frame for n in self.tree.nodes):
+            self.tree.nodes.remove(self.frame)
+
+
+def _is_socket(value) -> bool:
+    return isinstance(value, bpy.types.NodeSocket)
+
+
+def _rgb(value) -> np.ndarray:
+    array = np.asarray(value if value is not None else 0.0, float).ravel()
+    return np.repeat(array[:1], 3) if array.size == 1 else array[:3]
+
+
+def _mix_colour(nodes: _SkinNodes, blend: str, factor, a, b, label: str):
+    """``a`` and ``b`` (sockets or RGB values) blended by a Mix node (``blend``: ``"MIX"`` by
+    ``factor``, ``"ADD"``, ``"MULTIPLY"`` at factor 1); constants fold."""
+    if not any(_is_socket(v) for v in (factor, a, b)):
+        f = float(np.clip(float(factor), 0.0, 1.0))
+        a, b = _rgb(a), _rgb(b)
+        return {"MIX": a + f * (b - a), "ADD": a + b, "MULTIPLY": a * b}[blend]
+    node = nodes.node("ShaderNodeMix", label, data_type="RGBA", blend_type=blend)
+    node.clamp_factor = True
+    for identifier, value in (("Factor_Float", factor), ("A_Color", a), ("B_Color", b)):
+        target = next(s for s in node.inputs if s.identifier == identifier)
+        if _is_socket(value):
+            nodes.tree.links.new(value, target)
+        elif identifier == "Factor_Float":
+            target.default_value = float(value)
+        else:
+            target.default_value = (*map(float, _rgb(value)), 1.0)
+    return next(s for s in node.outputs if s.identifier == "Result_Color")
+
+
+def _body_colour(nodes: _SkinNodes, shader, reading):
+    """The body colour of ``shader`` (a shader tree) as nodes: each skin leaf's Base Color
+    source times its factor (:class:`.artist_skin.LeafReading`), the Mix Shaders' mixes and
+    the Add Shaders' sums of them; a leaf without a body is black."""
+    if shader is None:
+        return np.zeros(3)
+    if isinstance(shader, Leaf):
+        factor = reading.factor_of(shader)
+        name = "Base Color" if shader.node.type == "BSDF_PRINCIPLED" else "Color"
+        if factor is None or not np.any(factor) or name not in shader.node.inputs:
+            return np.zeros(3)
+        base = nodes.out(source(shader.node.inputs[name], shader.groups))
+        return _mix_colour(nodes, "MULTIPLY", 1.0, base, factor,
+                           f"{shader.node.name}: body color")
+    first = _body_colour(nodes, shader.first, reading)
+    second = _body_colour(nodes, shader.second, reading)
+    if isinstance(shader, Add):
+        return _mix_colour(nodes, "ADD", 1.0, first, second, f"{shader.node.name}: sum")
+    return _mix_colour(nodes, "MIX", nodes.out(shader.factor), first, second,
+                       f"{shader.node.name}: mix")
+
+
+def _link_or_set(tree, value, target) -> None:
+    if _is_socket(value):
+        tree.links.new(value, target)
+    elif value is not None and hasattr(target, "default_value"):
+        current = target.default_value
+        if isinstance(current, (int, float)):
+            target.default_value = float(np.ravel(value)[0])
+        else:
+            target.default_value = (*map(float, _rgb(value)), 1.0)[:len(current)]
+
+
+def _radius(nodes: _SkinNodes, node, groups):
+    """The dominant skin BSDF's Subsurface Radius times Subsurface Scale (scene units), a
+    socket or a value."""
+    radius_name = "Subsurface Radius" if node.type == "BSDF_PRINCIPLED" else "Radius"
+    scale_name = "Subsurface Scale" if node.type == "BSDF_PRINCIPLED" else "Scale"
+    radius = nodes.out(source(node.inputs[radius_name], groups))
+    scale = nodes.out(source(node.inputs[scale_name], groups))
+    if not _is_socket(radius) and not _is_socket(scale):
+        return _rgb(radius) * float(scale)
+    product = nodes.node("ShaderNodeVectorMath", f"{node.name}: radius x scale",
+                         operation="SCALE")
+    _link_or_set(nodes.tree, radius, product.inputs[0])
+    scale_input = next(s for s in product.inputs if s.identifier == "Scale")
+    _link_or_set(nodes.tree, scale, scale_input)
+    return product.outputs["Vector"]
+
+
+def _carry_skin(tree, node, shader, reading, installed: Installed, film_strength: float,
+                film_follows: bool) -> None:
+    """Feed the group node ``node`` (over the artist's shader) the skin under the film read
+    from ``shader`` (:class:`.artist_skin.SkinReading` ``reading``)."""
+    nodes = _SkinNodes(tree, (node.location.x - 300.0, node.location.y - 500.0))
+    colour = _body_colour(nodes, shader, reading)
+    _link_or_set(tree, colour, node.inputs["Skin Color"])
+    installed.carried.append("the shader's body color -> Skin Color")
+    dominant = reading.dominant
+    if dominant is not None:
+        groups = dominant.groups
+        normal = nodes.out(source(dominant.node.inputs["Normal"], groups))
+        if _is_socket(normal):
+            tree.links.new(normal, node.inputs["Normal"])
+            installed.carried.append("Normal -> Normal")
+        if dominant.node.type != "BSDF_DIFFUSE":
+            _link_or_set(tree, _radius(nodes, dominant.node, groups),
+                         node.inputs["Subsurface Radius"])
+            installed.carried.append("Subsurface Radius x Scale -> Subsurface Radius")
+        weight = (nodes.out(source(dominant.node.inputs["Subsurface Weight"], groups))
+                  if dominant.node.type == "BSDF_PRINCIPLED" else reading.subsurface_weight)
+        _link_or_set(tree, weight, node.inputs["Subsurface Weight"])
+        coat = dominant.node.inputs.get("Coat Normal")
+        coat = nodes.out(source(coat, groups)) if coat is not None else None
+        if _is_socket(coat):
+            tree.links.new(coat, node.inputs["Film Normal"])
+            installed.carried.append("Coat Normal -> Film Normal")
+        elif _is_socket(normal):
+            installed.film_normal = _film_normal(tree, normal, node, film_strength,
+                                                 film_follows)
+    nodes.finish()
+    installed.missing = list(reading.warnings)
+
+
+# -- the film's normal ----------------------------------------------------------------------
+
+def _copy_input(tree, source_socket, target) -> None:
+    """Give ``target`` (an input) what ``source_socket`` (the same input of another node)
+    has: its link, else its value."""
+    if source_socket.is_linked:
+        tree.links.new(source_socket.links[0].from_socket, target)
+    elif hasattr(source_socket, "default_value"):
+        target.default_value = source_socket.default_value
 
 
 def _film_normal(tree, skin_normal, node, strength: float, follows: bool) -> str:
     """Give the film a normal from the skin's (``skin_normal``, the output feeding the
     group's Normal): a copy of its Normal Map or Bump node at ``strength`` times its own, or
     the same output when it has no strength to lower.  Returns the report's sentence."""
-    source = skin_normal.node
-    if source.type not in {"NORMAL_MAP", "BUMP"}:
+    skin_map = skin_normal.node
+    if skin_map.type not in {"NORMAL_MAP", "BUMP"}:
         if follows:
             tree.links.new(skin_normal, node.inputs["Film Normal"])
-        return (f"Film Normal follows the skin's normal from {source.name!r} at its full "
+        return (f"Film Normal follows the skin's normal from {skin_map.name!r} at its full "
                 f"strength (a Normal Map or Bump node could be weakened)")
-    copy = tree.nodes.new("ShaderNodeNormalMap" if source.type == "NORMAL_MAP"
+    copy = tree.nodes.new("ShaderNodeNormalMap" if skin_map.type == "NORMAL_MAP"
                           else "ShaderNodeBump")
+    node_copy.mark(copy)
     copy.name = copy.label = FILM_NORMAL_NODE
-    copy.location = (source.location.x, source.location.y - 200.0)
-    if source.type == "NORMAL_MAP":
-        copy.space, copy.uv_map = source.space, source.uv_map
+    copy.location = (skin_map.location.x, skin_map.location.y - 200.0)
+    if skin_map.type == "NORMAL_MAP":
+        copy.space, copy.uv_map = skin_map.space, skin_map.uv_map
     else:
-        copy.invert = source.invert
-    for socket in source.inputs:
+        copy.invert = skin_map.invert
+    for socket in skin_map.inputs:
         if socket.name != "Strength" and socket.name in copy.inputs:
             _copy_input(tree, socket, copy.inputs[socket.name])
-    base = source.inputs["Strength"]
+    base = skin_map.inputs["Strength"]
     copy[BASE_STRENGTH_KEY] = float(base.default_value)
     copy.inputs["Strength"].default_value = float(base.default_value) * strength
     if follows:
         tree.links.new(copy.outputs["Normal"], node.inputs["Film Normal"])
-    return (f"Film Normal from a copy of {source.name!r} at {strength:g} of its strength (the "
-            f"film softens the pores; Film Follows Pores off makes it fill them)")
+    return (f"Film Normal from a copy of {skin_map.name!r} at {strength:g} of its strength "
+            f"(the film softens the pores; Film Follows Pores off makes it fill them)")
 
 
 def set_film_normal(material, follows: bool, strength: float) -> None:
@@ -308,71 +364,74 @@ def set_film_normal(material, follows: bool, strength: float) -> None:
         material.node_tree.links.remove(target.links[0])
 
 
-def _carry(tree, sources: Sources, node, installed: Installed, film_strength: float,
-           film_follows: bool) -> None:
-    """Link and take over what ``sources`` found into the group node ``node``."""
-    for target, (name, origin) in sources.links.items():
-        if not node.inputs[target].is_linked:
-            tree.links.new(origin, node.inputs[target])
-            installed.carried.append(f"{name} -> {target}")
-    installed.values = dict(sources.values)
-    for target, why in sources.missing.items():
-        installed.missing.append(f"{target} ({why})")
-    normal = sources.links.get("Normal")
-    if normal is not None and "Film Normal" not in sources.links:
-        installed.film_normal = _film_normal(tree, normal[1], node, film_strength,
-                                             film_follows)
-
+# -- install and revert -------------------------------------------------------------------------
 
 def _frame(tree, node) -> None:
     frame = tree.nodes.new("NodeFrame")
     frame.name = FRAME_NAME
     frame.label = FRAME_LABEL
+    node_copy.mark(frame)
     location = node.location.copy()
     node.parent = frame
     node.location = location  # parenting keeps the location relative to the frame: restore
 
 
-def install(material, group, *, film_strength: float = 0.5,
+def _remove_skin_nodes(material) -> None:
+    """The add-on's nodes that feed the group the skin (everything it owns but the group
+    node and the frame of an untouched default shader), removed before they are built again."""
+    tree = material.node_tree
+    for node in owned_nodes(material):
+        if node.name != FRAME_NAME:
+            tree.nodes.remove(node)
+
+
+def install(material, group, *, over_shader: bool, reading=None, film_strength: float = 0.5,
             film_follows: bool = True) -> Installed:
     """Make the group ``group`` (a node group) the surface of ``material``, converting the
-    artist's tree in place (see the module docstring); a material already converted only gets
-    its group node pointed at ``group``.  ``film_strength``, ``film_follows``: the film's
-    normal node (:func:`set_film_normal`).  Returns what was carried over
-    (:class:`Installed`)."""
+    artist's tree in place (see the module docstring); a material already converted gets its
+    group node pointed at ``group`` and, over the artist's shader, the skin under the film
+    read again (``reading``: :class:`.artist_skin.SkinReading` of :func:`artist_tree`).
+    ``over_shader``: ``group`` is one built over the artist's shader
+    (:func:`.nodes.over_shader`); ``film_strength``, ``film_follows``: the film's normal node
+    (:func:`set_film_normal`).  Returns what was carried over (:class:`Installed`)."""
     if material.node_tree is None and bpy.app.version < (5, 0, 0):
         material.use_nodes = True
     tree = material.node_tree
     node = group_node(material)
+    if node is not None and material.get(RECORD_KEY) and \
+            json.loads(material[RECORD_KEY]).get("version") != RECORD_VERSION and over_shader:
+        revert(material, remove_unused=False)  # an earlier add-on's conversion: again, over
+        node = None
     output = material_output(tree)
     surface = output.inputs["Surface"]
-    installed = Installed()
+    installed = Installed(over_shader=over_shader)
     if node is None:
         installed.first = True
-        sources = surface_sources(material)
         node = tree.nodes.new("ShaderNodeGroup")
         node.name = node.label = GROUP_NODE
         node.width = 240
         node.node_tree = group
         previous = surface.links[0] if surface.is_linked else None
-        record = {"output": output.name}
+        record = {"output": output.name, "version": RECORD_VERSION}
+        node.location = (output.location.x - node.width - 2 * GAP, output.location.y)
         if previous is not None:
-            shader = previous.from_node
-            record.update(node=shader.name, socket=previous.from_socket.identifier,
+            shader, socket = previous.from_node, previous.from_socket
+            record.update(node=shader.name, socket=socket.identifier,
                           parent=shader.parent.name if shader.parent else None,
                           location=list(shader.location))
-            node.location = (shader.location.x, shader.location.y + shader.dimensions.y
-                             + node.dimensions.y + 4 * GAP)
             tree.links.remove(previous)
-            _carry(tree, sources, node, installed, film_strength, film_follows)
-            if shader.parent is None:
+            if over_shader:
+                tree.links.new(socket, node.inputs["Skin Shader"])
+            elif shader.parent is None:
                 _frame(tree, shader)
-        else:
-            node.location = (output.location.x - node.width - 2 * GAP, output.location.y)
         material[RECORD_KEY] = json.dumps(record)
     node.node_tree = group
     if not (surface.is_linked and surface.links[0].from_node == node):
         tree.links.new(node.outputs["Shader"], surface)
+    if over_shader and reading is not None:
+        _remove_skin_nodes(material)
+        _carry_skin(tree, node, artist_tree(material), reading, installed, film_strength,
+                    film_follows)
     return installed
 
 
@@ -381,9 +440,30 @@ def can_revert(material) -> bool:
     return material is not None and RECORD_KEY in material and group_node(material) is not None
 
 
-def revert(material) -> str:
-    """Reconnect the surface ``material`` had before :func:`install` and remove the group node,
-    the film's normal node and the frame.  Returns what was restored, for the report.
+def _remove_unused(group) -> list[str]:
+    """Remove the add-on's node group ``group`` if nothing uses it any more, and the
+    view-angle images it read if nothing else does; the names removed."""
+    if group is None or group.users > 0 or FIT_KEY not in group:
+        return []
+    try:
+        images = [entry.get("name") for entry in json.loads(group[FIT_KEY]).get("images", [])]
+    except (TypeError, ValueError, AttributeError):
+        images = []
+    removed = [group.name]
+    bpy.data.node_groups.remove(group)
+    for name in images:
+        image = bpy.data.images.get(name or "")
+        if image is not None and image.name.startswith(LUT_PREFIX) and image.users == 0:
+            removed.append(image.name)
+            bpy.data.images.remove(image)
+    return removed
+
+
+def revert(material, *, remove_unused: bool = True) -> str:
+    """Reconnect the surface ``material`` had before :func:`install`, remove the add-on's own
+    nodes (the group node, the skin under the film's, the film's normal, frames) and, with
+    ``remove_unused``, the node group and view-angle images no other material uses.  Returns
+    what was restored, for the report.
 
     Raises
     ------
@@ -405,19 +485,24 @@ def revert(material) -> str:
                          f"{record['node']!r} was deleted; nothing was changed")
     output = tree.nodes.get(record.get("output") or "") or material_output(tree)
     node = group_node(material)
-    tree.nodes.remove(node)
-    copy = film_normal_node(material)
-    if copy is not None:
-        tree.nodes.remove(copy)
+    group = node.node_tree
     frame = tree.nodes.get(FRAME_NAME)
+    if shader is not None and frame is not None and shader.parent == frame:
+        shader.parent = tree.nodes.get(record.get("parent") or "")
+        shader.location = record.get("location", list(shader.location))
+    tree.nodes.remove(node)
+    for owned in owned_nodes(material):
+        tree.nodes.remove(owned)
+    frame = tree.nodes.get(FRAME_NAME)  # an earlier add-on's frame is not marked as owned
+    if frame is not None and not any(n.parent == frame for n in tree.nodes):
+        tree.nodes.remove(frame)
     if shader is not None:
         socket = next((s for s in shader.outputs if s.identifier == record.get("socket")),
                       shader.outputs[0])
-        if frame is not None and shader.parent == frame:
-            shader.parent = tree.nodes.get(record.get("parent") or "")
-            shader.location = record.get("location", list(shader.location))
         tree.links.new(socket, output.inputs["Surface"])
-    if frame is not None and not any(n.parent == frame for n in tree.nodes):
-        tree.nodes.remove(frame)
     del material[RECORD_KEY]
-    return f"{shader.name!r} is the surface again" if shader is not None else "no surface"
+    removed = _remove_unused(group) if remove_unused else []
+    restored = f"{shader.name!r} is the surface again" if shader is not None else "no surface"
+    if removed:
+        restored += f"; removed {', '.join(repr(n) for n in removed)}, which nothing else uses"
+    return restored

@@ -16,6 +16,7 @@ if INSTALLED:
     from ..lut_baker.closures import (
         closure_fit,
         fitting,
+        principled_albedo,
         profiles,
         tier_formulas,
         tiers,
@@ -26,11 +27,19 @@ if INSTALLED:
     from ..lut_baker.tables import codec, table_set, uniform_light
 else:
     from lut_baker import auto_tier, bake
-    from lut_baker.closures import closure_fit, fitting, profiles, tier_formulas, tiers, view_image
+    from lut_baker.closures import (
+        closure_fit,
+        fitting,
+        principled_albedo,
+        profiles,
+        tier_formulas,
+        tiers,
+        view_image,
+    )
     from lut_baker.model import params_file, presets, roughness, thick_layer
     from lut_baker.numerics import cache
     from lut_baker.tables import codec, table_set, uniform_light
 
 __all__ = ["auto_tier", "bake", "cache", "closure_fit", "codec", "fitting", "params_file",
-           "presets", "profiles", "roughness", "table_set", "thick_layer", "tier_formulas",
-           "tiers", "uniform_light", "view_image"]
+           "presets", "principled_albedo", "profiles", "roughness", "table_set", "thick_layer",
+           "tier_formulas", "tiers", "uniform_light", "view_image"]

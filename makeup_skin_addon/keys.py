@@ -41,6 +41,9 @@ group"; Apply finds groups and images by name and reuses them):
 - :data:`FRAME_NAME`, :data:`FRAME_LABEL` -- the frame around the previous surface shader.
 - :data:`FILM_NORMAL_NODE` -- the film's own Normal Map (or Bump) node, a weaker copy of the
   skin's, and :data:`BASE_STRENGTH_KEY`, the strength of the skin's it scales.
+- :data:`OWNED_KEY` -- marks a node of the material's tree as the add-on's own (the skin under
+  the film's nodes, copies of nodes from the artist's groups, the film's normal): Revert
+  removes exactly these; :data:`SKIN_FRAME_NAME`, :data:`SKIN_FRAME_LABEL` -- their frame.
 - :func:`group_name` -- ``Made-up Skin <Tier> [<method>] <key>`` (:data:`GROUP_PREFIX`,
   :data:`TIER_LABELS`, :data:`METHOD_LABELS`).
 - :func:`lut_image_name` -- ``MakeupSkin LUT <Tier> <key>`` (:data:`LUT_PREFIX`).
@@ -68,6 +71,10 @@ __all__ = [
     "FRAME_LABEL",
     "FILM_NORMAL_NODE",
     "BASE_STRENGTH_KEY",
+    "OWNED_KEY",
+    "SKIN_FRAME_NAME",
+    "SKIN_FRAME_LABEL",
+    "OVER_LABEL",
     "GROUP_PREFIX",
     "TIER_LABELS",
     "METHOD_LABELS",
@@ -134,6 +141,13 @@ feeding the skin's Normal, at a fraction of its strength (Revert removes it)."""
 BASE_STRENGTH_KEY = "makeup_skin_base_strength"
 """Float custom property of that node: the skin's own strength, which the panel's Film Normal
 strength multiplies."""
+OWNED_KEY = "makeup_skin_owned"
+"""Int custom property (1) of a node the add-on added to a material's tree (Revert removes the
+nodes that have it, and only those)."""
+SKIN_FRAME_NAME = "Made-up Skin: skin under the film"
+"""Name of the frame around the nodes that give the group the skin under the film."""
+SKIN_FRAME_LABEL = "Made-up Skin: the skin under the film (from the shader)"
+"""Label of that frame."""
 GROUP_PREFIX = "Made-up Skin"
 """Start of every node group name (:func:`group_name`)."""
 TIER_LABELS = {"PRINCIPLED": "Principled", "LAYERED": "Layered", "EEVEE": "EEVEE"}
@@ -144,10 +158,17 @@ LUT_PREFIX = "MakeupSkin LUT "
 """Start of every view-angle image name (:func:`lut_image_name`)."""
 
 
-def group_name(tier: str, key: str, method: str | None = None) -> str:
-    """``Made-up Skin <Tier> [<method>] <key>``; no method: the fit's own choice."""
+OVER_LABEL = "over Shader"
+"""The part of a group's name that says it goes over the artist's shader (the bare skin is
+its Skin Shader input), not over the skin preset's closures."""
+
+
+def group_name(tier: str, key: str, method: str | None = None, over_shader: bool = False) -> str:
+    """``Made-up Skin <Tier> [<method>] [over Shader] <key>``; no method: the fit's own
+    choice; ``over_shader``: a group whose bare skin is the artist's shader."""
     label = f" {METHOD_LABELS[method]}" if method else ""
-    return f"{GROUP_PREFIX} {TIER_LABELS[tier]}{label} {key[:8]}"
+    over = f" {OVER_LABEL}" if over_shader else ""
+    return f"{GROUP_PREFIX} {TIER_LABELS[tier]}{label}{over} {key[:8]}"
 
 
 def lut_image_name(key: str, tier: str = "LAYERED") -> str:

@@ -28,11 +28,11 @@ import json
 
 import bpy
 
-from . import convert, fits, nodes, scene_fit, shade, storage
+from . import artist_skin, convert, fits, matching, nodes, scene_fit, shade, storage
 from .core import auto_tier, params_file, tiers
 from .keys import AUTO_KEY, ERRORS_KEY, MATERIAL_NAME, SETTINGS_VERSION, TIER_LABELS, group_name
 from .scene_fit import units_per_mm
-from .shade import skin_from_settings
+from .shade import ROUGHNESS_MAX, SKIN_ROUGHNESS_MIN, skin_from_settings
 
 __all__ = [
     "LinkedDataError",
@@ -209,19 +209,22 @@ class _Bake:
         return self._measured
 
 
-def _existing(record: dict, tier: str, method, messages: list):
-    """The group of this bake, tier and method if the file has it intact, else None."""
-    group = bpy.data.node_groups.get(group_name(tier, record["key"], method))
-    if group is not None and _reusable(group, record["key"], tier, method, messages):
+def _existing(record: dict, tier: str, method, messages: list, over: bool):
+    """The group of this bake, tier, method and kind (``over`` the artist's shader or not) if
+    the file has it intact, else None."""
+    group = bpy.data.node_groups.get(group_name(tier, record["key"], method, over))
+    if group is not None and nodes.over_shader(group) == over and \
+            _reusable(group, record["key"], tier, method, messages):
         return group
     return None
 
 
-def _stored_measurement(work: _Bake):
+def _stored_measurement(work: _Bake, over: bool):
     """What any group of this bake (either tier) keeps measured at the coverage and
     absorption, with the Auto tier's traits, or None."""
     for tier in tiers.TIERS:
-        group = bpy.data.node_groups.get(group_name(tier, work.record["key"], work.method))
+        group = bpy.data.node_groups.get(group_name(tier, work.record["key"], work.method,
+                                                    over))
         if group is not None:
             measured = fits.measured_at(nodes.read_meta(group), work.coverage, work.absorption,
                                         with_traits=True)
@@ -230,33 +233,35 @@ def _stored_measurement(work: _Bake):
     return None
 
 
-def _build(work: _Bake, tier: str, group=None):
+def _build(work: _Bake, tier: str, group=None, over: bool = False):
     """The group of ``tier`` built from the bake (rebuilt in place when ``group`` is given),
-    its record keeping the measurement."""
+    its record keeping the measurement; ``over``: over the artist's shader."""
     _, fit = work.fitted()
     return nodes.build_group(tier, work.record, fit, group, method=work.method,
-                             measured=work.measured())
+                             measured=work.measured(), over=over)
 
 
-def _group_for(material, settings, scene, work: _Bake, messages: list, group=None):
+def _group_for(material, settings, scene, work: _Bake, messages: list, group=None,
+               over: bool = False):
     """``(group, measured, tier, auto record or None)`` for the settings: the existing group
     of the tier reused when intact (nothing baked or fitted), else built (``group`` given:
-    rebuilt in place, always)."""
+    rebuilt in place, always); ``over``: a group over the artist's shader."""
     auto = None
     tier = settings.tier
     if tier == "AUTO":
-        work.adopt(_stored_measurement(work))
+        work.adopt(_stored_measurement(work, over))
         tier, auto = _auto_choice(material, scene, work.measured(with_traits=True))
     existing = None if group is not None else _existing(work.record, tier, work.method,
-                                                        messages)
+                                                        messages, over)
     if existing is not None:
         stored = fits.measured_at(nodes.read_meta(existing), work.coverage, work.absorption)
         if stored is None:  # the group was built at another coverage or absorption
             nodes.write_measured(existing, work.measured())
         return existing, stored or work.measured(), tier, auto
     if group is None:
-        group = bpy.data.node_groups.get(group_name(tier, work.record["key"], work.method))
-    return _build(work, tier, group), work.measured(), tier, auto
+        group = bpy.data.node_groups.get(group_name(tier, work.record["key"], work.method,
+                                                    over))
+    return _build(work, tier, group, over), work.measured(), tier, auto
 
 
 def group_for_tables(tables, tier: str, *, resolution: str = "default", group=None,
@@ -276,7 +281,8 @@ def group_for_tables(tables, tier: str, *, resolution: str = "default", group=No
     coverage, absorption = errors_at if errors_at is not None else \
         tables.coverage_and_absorption()
     work = _Bake(record, method, coverage, absorption)
-    existing = None if group is not None else _existing(record, tier, method, messages)
+    existing = None if group is not None else _existing(record, tier, method, messages,
+                                                        False)
     if existing is not None:
         return existing, None
     if group is None:
@@ -289,6 +295,7 @@ def clear_cache() -> None:
     fits.clear()
     storage.clear_cache()
     shade.clear_cache()
+    matching.clear_cache()
 
 
 def group_of(material):
@@ -296,35 +303,34 @@ def group_of(material):
     return convert.group_node(material)
 
 
-def setup_material(material, group, scene):
+def setup_material(material, group, scene, reading=None):
     """Make ``group`` the surface of ``material`` (:func:`convert.install`: the artist's tree is
-    converted in place, their shader kept and framed, what it takes carried over; an unlinked
-    Base Color's value becomes Skin Color unless it is Blender's default grey or Skin Color
-    was set in the panel, :func:`.shade.base_colour_value`) and set the group node's inputs
-    from the settings.
-    Returns what was carried over (:class:`.convert.Installed`)."""
+    converted in place; over the artist's shader, ``reading``
+    (:class:`.artist_skin.SkinReading`) gives the skin under the film) and set the group
+    node's inputs from the settings.  Returns what was carried over
+    (:class:`.convert.Installed`)."""
     settings = material.makeup_skin
-    installed = convert.install(material, group, film_strength=settings.film_normal_strength,
+    installed = convert.install(material, group, over_shader=nodes.over_shader(group),
+                                reading=reading, film_strength=settings.film_normal_strength,
                                 film_follows=settings.film_follows_pores)
-    value = shade.base_colour_value(settings, installed)
-    installed.values = {} if value is None else {"Skin Color": value}
-    if value is not None:
-        with shade.assigning():
-            settings.skin_colour = value
     nodes.set_inputs(group_of(material), {"Units per mm": units_per_mm(scene)})
     update_sockets(material)
     return installed
 
 
 def socket_values(settings) -> dict:
-    """Group-node socket values of the settings (by socket name)."""
-    return {
+    """Group-node socket values of the settings (by socket name; over the artist's shader the
+    skin's colour comes from the shader, not from Skin Color)."""
+    values = {
         "Coverage": settings.coverage,
         "Foundation Absorption": tuple(settings.effective_absorption()),
         "Skin Color": tuple(settings.skin_colour),
         "Subsurface Scale": settings.subsurface_scale,
         "Gloss": settings.gloss,
     }
+    if settings.over_shader:
+        del values["Skin Color"]
+    return values
 
 
 def update_sockets(material) -> None:
@@ -358,27 +364,58 @@ def _material_for(obj) -> tuple:
     return material, True
 
 
-def _conversion_sentences(material, installed, created: bool, obj) -> list[str]:
-    """The report's sentences about a first conversion: what was kept, carried over, taken as
-    a value, not carried over, and the film's normal."""
+class Report(list):
+    """The sentences of an Apply, in order; ``warnings``: those that say what could not be
+    carried over (the operator reports them as warnings)."""
+
+    def __init__(self):
+        super().__init__()
+        self.warnings: list[str] = []
+
+    def warn(self, sentence: str) -> None:
+        self.append(sentence)
+        self.warnings.append(sentence)
+
+
+def _conversion_sentences(material, installed, created: bool, obj, report: Report) -> None:
+    """The report's sentences about a first conversion: what was kept, carried over, not
+    carried over (warnings), and the film's normal."""
     if created:
-        return [f"{obj.name!r} had no material: created {material.name!r} with the skin "
-                f"preset's Skin Color."]
-    if convert.can_revert(material):
-        kept = "its previous surface is kept, framed and disconnected (Revert restores it)"
+        report.append(f"{obj.name!r} had no material: created {material.name!r} with the skin "
+                      f"preset's Skin Color.")
+        return
+    if installed.over_shader:
+        kept = ("its own shader stays the bare skin (Coverage 0 renders as before Apply) and "
+                "gives the skin under the film")
+    elif convert.can_revert(material):
+        kept = ("it had no shader of the artist's (Blender's default Principled BSDF, kept "
+                "framed and disconnected): the skin is the skin preset's")
     else:
-        kept = "it had no surface before"
+        kept = "it had no surface before: the skin is the skin preset's"
     linked = f"; linked {', '.join(installed.carried)}" if installed.carried else ""
-    sentences = [f"Converted {material.name!r} in place: {kept}{linked}."]
-    if "Skin Color" in installed.values:
-        value = ", ".join(f"{float(c):.3f}" for c in installed.values["Skin Color"])
-        sentences.append(f"Skin Color is the value of its Base Color ({value}).")
-    if installed.missing:
-        sentences.append(f"Not carried over: {'; '.join(installed.missing)}: Skin Color stays "
-                         f"the panel's value and Normal the surface's.")
+    report.append(f"Converted {material.name!r} in place: {kept}{linked}.")
     if installed.film_normal:
-        sentences.append(installed.film_normal + ".")
-    return sentences
+        report.append(installed.film_normal + ".")
+
+
+def _follow_shader(settings, reading, report: Report) -> None:
+    """Take from the artist's shader (``reading``) what the bake needs of the skin under the
+    film: its roughness (within the panel's range), index and subsurface method."""
+    with shade.assigning():
+        settings.over_shader = True
+        if reading.roughness is not None:
+            value = min(max(reading.roughness, SKIN_ROUGHNESS_MIN), ROUGHNESS_MAX)
+            if abs(value - reading.roughness) > 1e-6:
+                report.append(
+                    f"The skin under the film has Skin Roughness {value:.3f}, the shader's "
+                    f"{reading.roughness:.3f} clamped to the panel's range (its gloss is seen "
+                    f"through the film's transmission, which spreads it over about 29 degrees;"
+                    f" the bare skin keeps the shader's).")
+            settings.skin_roughness = value
+        if reading.ior is not None:
+            settings.skin_ior = min(max(reading.ior, 1.01), 2.5)
+        if reading.method in {"BURLEY", "RANDOM_WALK", "RANDOM_WALK_SKIN"}:
+            settings.subsurface_method = reading.method
 
 
 def _record_errors(material, measured: dict, key: str) -> None:
@@ -403,11 +440,14 @@ def _record_auto(material, auto) -> None:
 def apply_to_object(context, obj, *, resolution=None) -> tuple:
     """Find or build the group for the settings of ``obj``'s active material and make it the
     material's surface, converted in place (:func:`setup_material`); an object without a
-    material gets a new one.  Returns ``(material, messages)``: the report's sentences (what
-    was carried over, how many objects share the material).
+    material gets a new one.  Returns ``(material, report)``: the report's sentences
+    (:class:`Report`: what was carried over, what was not as warnings, how many objects
+    share the material).
 
-    Settings Apply has seen before (the same bake, tier and method, in this file) reuse their
-    group: nothing is baked, fitted or hashed.
+    Over the artist's shader (:func:`.convert.artist_tree`) the skin under the film is read
+    from it again at every Apply (:func:`.artist_skin.read_material`).  Settings Apply has
+    seen before (the same bake, tier and method, in this file) reuse their group: nothing is
+    baked, fitted or hashed.
 
     Raises
     ------
@@ -420,38 +460,49 @@ def apply_to_object(context, obj, *, resolution=None) -> tuple:
     settings = material.makeup_skin
     first = not settings.is_made_up or group_of(material) is None
     scene = context.scene
-    messages = []
+    report = Report()
+    reading = None if created else artist_skin.read_material(material, scene)
+    if reading is not None:
+        _follow_shader(settings, reading, report)
+    else:
+        with shade.assigning():
+            settings.over_shader = False
     if first and settings.shade_source == "DEFAULT":
         # A shade never chosen: match the skin (the artist's first step), before the fit
         # measures the tiers at the absorption.
-        film, matched = shade.first_shade(material)
+        film, result = matching.first_shade(material, reading)
         if film is not None:
             with shade.assigning():
                 settings.foundation = film
                 settings.film_roughness = shade.foundation_roughness(film)
-        shade.assign(settings, matched, "MATCH")
-        messages += matched.sentences
+        matching.assign(settings, result, "MATCH")
+        report += result.sentences
     record = storage.bake_record(skin_from_settings(settings),
                                  resolution or settings.resolution)
     with _Progress(context) as progress:
         work = _Bake(record, forced_method(settings), settings.coverage,
                      settings.effective_absorption(), progress)
-        group, measured, tier, auto = _group_for(material, settings, scene, work, messages)
+        group, measured, tier, auto = _group_for(material, settings, scene, work, report,
+                                                 over=reading is not None)
     _record_errors(material, measured, record["key"])
     _record_auto(material, auto)
-    installed = setup_material(material, group, scene)
+    installed = setup_material(material, group, scene, reading)
     note = engine_note(material, tier, scene, measured)
     if note is not None:
-        messages.append(note)
+        report.append(note)
     settings.is_made_up = True
     settings.settings_version = SETTINGS_VERSION
     if installed.first or created:
-        messages[:0] = _conversion_sentences(material, installed, created, obj)
+        head = Report()
+        _conversion_sentences(material, installed, created, obj, head)
+        report[:0] = head
+    for sentence in installed.missing:
+        report.warn(f"Not carried over: {sentence}.")
     users = len(_users(material))
     if users > 1:
-        messages.append(f"{material.name!r} is shared by {users} objects: all of them show "
-                        f"the made-up skin.")
-    return material, messages
+        report.append(f"{material.name!r} is shared by {users} objects: all of them show "
+                      f"the made-up skin.")
+    return material, report
 
 
 def revert_material(material) -> str:
@@ -462,6 +513,8 @@ def revert_material(material) -> str:
         raise LinkedDataError(reason)
     restored = convert.revert(material)
     material.makeup_skin.is_made_up = False
+    with shade.assigning():
+        material.makeup_skin.over_shader = False
     return f"Reverted {material.name!r}: {restored}."
 
 
@@ -471,11 +524,12 @@ def rebuild_from_settings(context, material, group, resolution: str) -> None:
     Tables' repair when the group's record cannot be used."""
     settings = material.makeup_skin
     record = storage.bake_record(skin_from_settings(settings), resolution)
+    over = settings.over_shader and convert.artist_tree(material) is not None
     with _Progress(context) as progress:
         work = _Bake(record, forced_method(settings), settings.coverage,
                      settings.effective_absorption(), progress)
         group, measured, _, auto = _group_for(material, settings, context.scene, work, [],
-                                              group=group)
+                                              group=group, over=over)
     _record_errors(material, measured, record["key"])
     _record_auto(material, auto)
     setup_material(material, group, context.scene)
@@ -515,6 +569,6 @@ def check_material(context, material) -> tuple[bool, str]:
     settings = material.makeup_skin
     work = _Bake({k: meta[k] for k in ("key", "parameters", "resolution")},
                  meta.get("forced_method"), settings.coverage, settings.effective_absorption())
-    _build(work, meta.get("tier", "LAYERED"), group)
+    _build(work, meta.get("tier", "LAYERED"), group, nodes.over_shader(group))
     what = "; ".join(problems) if problems else "its inputs were of an older version"
     return False, f"{name!r}: {what}; rebuilt it from a re-bake."

@@ -58,8 +58,9 @@ from .core import tier_formulas, tiers
 from .keys import FIT_KEY, LEGACY_TABLES_REF, group_name, lut_image_name
 from .node_algebra import Builder, NodeAlgebra, NodeValue, socket
 
-__all__ = ["INPUTS", "NORMAL_INPUTS", "build_group", "read_meta", "write_measured",
-           "set_inputs", "socket", "has_interface"]
+__all__ = ["INPUTS", "OVER_SHADER_INPUTS", "NORMAL_INPUTS", "build_group", "read_meta",
+           "write_measured", "set_inputs", "socket", "has_interface", "over_shader",
+           "inputs_of"]
 
 INPUTS = (
     # name, socket type, default, min, max, subtype, description
@@ -85,6 +86,27 @@ INPUTS = (
     ("Units per mm", "NodeSocketFloat", 0.001, 0.0, 1e6, "NONE",
      "Scene units in one millimetre (set from the scene's unit scale on Apply)"),
 )
+OVER_SHADER_INPUTS = (
+    ("Skin Shader", "NodeSocketShader", None, None, None, None,
+     "The artist's own skin shader: rendered as it is where the film does not cover "
+     "(Coverage 0 renders exactly as before Apply)"),
+    INPUTS[0], INPUTS[1],
+    ("Skin Color", "NodeSocketColor", (0.8, 0.8, 0.8, 1.0), None, None, None,
+     "The body colour of the skin under the film: what the artist's shader renders of its "
+     "Base Color (Apply links it); every closure of the skin under the film scales with it"),
+    INPUTS[3], INPUTS[4],
+    ("Subsurface Radius", "NodeSocketVector", (0.005, 0.001, 0.0005), None, None, None,
+     "The subsurface radius of the skin under the film per channel, in scene units (Apply "
+     "links the artist's Subsurface Radius times Subsurface Scale)"),
+    ("Subsurface Weight", "NodeSocketFloat", 1.0, 0.0, 1.0, "FACTOR",
+     "Share of the skin under the film that scatters below its surface (the artist's "
+     "Subsurface Weight); the rest is diffuse"),
+    ("Subsurface Scale", "NodeSocketFloat", 1.0, 0.0, 100.0, "NONE",
+     "Multiplies the subsurface radius of the skin under the film"),
+    INPUTS[6],
+)
+"""The inputs of a group built over the artist's shader (:func:`over_shader`): the bare skin
+is the Skin Shader input, the skin under the film's radius and weight are the artist's."""
 NORMAL_INPUTS = ("Normal", "Film Normal")
 """Vector inputs whose value is hidden: unlinked, a closure's Normal is the shading normal
 (Blender leaves a hidden-value group input unlinked inside the group), and the view-angle
@@ -97,22 +119,36 @@ def _input_names(group) -> list[str]:
             and getattr(item, "in_out", "INPUT") == "INPUT"]
 
 
-def _interface(group, skin_albedo) -> None:
+def inputs_of(over: bool) -> tuple:
+    """The inputs of a group over the artist's shader (:data:`OVER_SHADER_INPUTS`) or of the
+    skin preset's (:data:`INPUTS`)."""
+    return OVER_SHADER_INPUTS if over else INPUTS
+
+
+def over_shader(group) -> bool:
+    """Whether ``group`` goes over the artist's shader (its bare skin is its Skin Shader
+    input)."""
+    return group is not None and "Skin Shader" in _input_names(group)
+
+
+def _interface(group, skin_albedo, over: bool) -> None:
     """Create the group's sockets if missing (existing ones keep their links and values); a
-    socket added to a group built before it existed is moved to its place in :data:`INPUTS`,
-    and inputs no longer in :data:`INPUTS` are removed.  ``skin_albedo`` (RGB) becomes Skin
-    Color's default."""
-    known = {name for name, *_ in INPUTS}
+    socket added to a group built before it existed is moved to its place in
+    :func:`inputs_of` ``over``, and inputs no longer there are removed.  ``skin_albedo`` (RGB)
+    becomes Skin Color's default."""
+    specs = inputs_of(over)
+    known = {name for name, *_ in specs}
     for item in list(group.interface.items_tree):
         if (getattr(item, "item_type", "SOCKET") == "SOCKET" and item.in_out == "INPUT"
                 and item.name not in known):
             group.interface.remove(item)
     existing = set(_input_names(group))
-    for position, (name, kind, default, low, high, subtype, description) in enumerate(INPUTS):
+    for position, (name, kind, default, low, high, subtype, description) in enumerate(specs):
         if name in existing:
             continue
         item = group.interface.new_socket(name=name, in_out="INPUT", socket_type=kind)
-        item.default_value = default
+        if default is not None:
+            item.default_value = default
         item.description = description
         if low is not None:
             item.min_value, item.max_value = low, high
@@ -123,7 +159,7 @@ def _interface(group, skin_albedo) -> None:
         if existing and position:  # after its predecessor (outputs may come first)
             items = list(group.interface.items_tree)
             before = next(i for i, other in enumerate(items)
-                          if other.name == INPUTS[position - 1][0])
+                          if other.name == specs[position - 1][0])
             group.interface.move(item, before + 1)
     if not any(getattr(item, "in_out", "") == "OUTPUT" and item.name == "Shader"
                for item in group.interface.items_tree):
@@ -134,9 +170,10 @@ def _interface(group, skin_albedo) -> None:
 
 
 def has_interface(group) -> bool:
-    """Whether ``group``'s inputs are exactly :data:`INPUTS` (a group built by an older version
-    of the add-on may lack one, e.g. Film Normal, and is then rebuilt)."""
-    return _input_names(group) == [name for name, *_ in INPUTS]
+    """Whether ``group``'s inputs are exactly those of its kind (:func:`inputs_of`: a group
+    built by an older version of the add-on may lack one, e.g. Film Normal, and is then
+    rebuilt)."""
+    return _input_names(group) == [name for name, *_ in inputs_of(over_shader(group))]
 
 
 def _normal_or_shading(build: Builder, normal, geometry):
@@ -154,39 +191,62 @@ def _cos_view(build: Builder, normal, geometry, label: str):
                       0.0, label=label)
 
 
-def _group_io(build: Builder):
+def _group_io(build: Builder, over: bool):
     """The group's input and output nodes, the tier formulas' inputs as node values
-    (:class:`lut_baker.closures.tier_formulas.TierInputs`) and the subsurface scale in scene
-    units (Subsurface Scale x Units per mm)."""
+    (:class:`lut_baker.closures.tier_formulas.TierInputs`; over the artist's shader, at
+    coverage 1: the film covers all of what the group computes, Coverage mixes it with the
+    Skin Shader) and the subsurface ``(radius, scale)``: the fitted radius (mm) and Subsurface
+    Scale x Units per mm, or over the artist's shader its Subsurface Radius (scene units) and
+    Subsurface Scale."""
     inputs = build.node("NodeGroupInput")
     output = build.node("NodeGroupOutput")
     out = inputs.outputs
     x = tier_formulas.TierInputs(
-        coverage=NodeValue(build, out["Coverage"], False),
+        coverage=1.0 if over else NodeValue(build, out["Coverage"], False),
         absorption=NodeValue(build, out["Foundation Absorption"], True),
         skin_color=NodeValue(build, out["Skin Color"], True),
         gloss=NodeValue(build, out["Gloss"], False))
+    if over:
+        return inputs, output, x, (out["Subsurface Radius"], out["Subsurface Scale"])
     scale = build.math("MULTIPLY", out["Subsurface Scale"], out["Units per mm"],
                        label="subsurface scale")
-    return inputs, output, x, scale
+    return inputs, output, x, (None, scale)
 
 
-def _build_principled(build: Builder, fit, method: str, radius_mm, ior: float):
+def _finish(build: Builder, inputs, output, shader, over: bool) -> None:
+    """Link the group's shader to its output: over the artist's shader, mixed with the Skin
+    Shader by Coverage (an areal mix; at Coverage 0 exactly the Skin Shader)."""
+    if over:
+        mix = build.node("ShaderNodeMixShader", "coverage (areal mix over the artist's shader)")
+        build.feed(socket(mix.inputs, "Fac"), inputs.outputs["Coverage"])
+        build.tree.links.new(inputs.outputs["Skin Shader"], socket(mix.inputs, "Shader"))
+        build.tree.links.new(shader, socket(mix.inputs, "Shader_001"))
+        shader = mix.outputs[0]
+    build.tree.links.new(shader, output.inputs["Shader"])
+
+
+def _build_principled(build: Builder, fit, method: str, radius_mm, ior: float, over: bool):
     """One Principled BSDF whose formula sockets are
-    :func:`lut_baker.closures.tier_formulas.principled_sockets` emitted as nodes."""
-    inputs, output, x, scale = _group_io(build)
+    :func:`lut_baker.closures.tier_formulas.principled_sockets` emitted as nodes (over the
+    artist's shader: the film at full coverage, its subsurface the artist's radius and weight,
+    mixed with the Skin Shader by Coverage)."""
+    inputs, output, x, (radius, scale) = _group_io(build, over)
     bsdf = build.node("ShaderNodeBsdfPrincipled", "Made-up skin", distribution="GGX",
                       subsurface_method=method)
+    sockets = tier_formulas.principled_sockets(fit, x, NodeAlgebra(build))
+    if over:
+        sockets["Subsurface Weight"] = sockets["Subsurface Weight"] * NodeValue(
+            build, inputs.outputs["Subsurface Weight"], False)
     values = {
-        **tier_formulas.principled_sockets(fit, x, NodeAlgebra(build)),
-        "Subsurface Radius": tuple(map(float, radius_mm)), "Subsurface Scale": scale,
-        "Subsurface IOR": ior, "Normal": inputs.outputs["Normal"],
+        **sockets,
+        "Subsurface Radius": radius if over else tuple(map(float, radius_mm)),
+        "Subsurface Scale": scale, "Subsurface IOR": ior, "Normal": inputs.outputs["Normal"],
         "Coat Normal": inputs.outputs["Film Normal"],
     }
     for name, value in values.items():
         # By identifier: a socket the method leaves unavailable is not found by name in 5.0.
         build.feed(socket(bsdf.inputs, name), value)
-    build.tree.links.new(bsdf.outputs[0], output.inputs["Shader"])
+    _finish(build, inputs, output, bsdf.outputs[0], over)
 
 
 def _texel_pair(build: Builder, u, size: int, label: str):
@@ -248,7 +308,7 @@ def _add(build: Builder, shaders: list):
 
 
 def _build_view_weighted(build: Builder, fit, parts, lut, method: str, radius_mm,
-                         ior: float):
+                         ior: float, over: bool):
     """The closures of :func:`lut_baker.closures.tier_formulas.view_weighted_closures` (the
     LAYERED and EEVEE tiers: their :class:`lut_baker.closures.tiers.ViewWeightedParts`
     ``parts``, their view-angle image ``lut``): a
@@ -256,7 +316,7 @@ def _build_view_weighted(build: Builder, fit, parts, lut, method: str, radius_mm
     each side's closures added, the two sides mixed by Coverage (a Mix Shader: an areal mix,
     so a painted coverage fades out without fringe or halo), the shared closures added to
     the mix."""
-    inputs, output, x, scale = _group_io(build)
+    inputs, output, x, (radius, scale) = _group_io(build, over)
     geometry = build.node("ShaderNodeNewGeometry")
     normals = {"film": inputs.outputs["Film Normal"], "skin": inputs.outputs["Normal"]}
     # Each row is read at the view angle against the normal of the surface it describes.
@@ -264,7 +324,8 @@ def _build_view_weighted(build: Builder, fit, parts, lut, method: str, radius_mm
                for surface, normal in normals.items()}
     rows = _lut_rows(build, lut, parts.rows, {
         name: cosines[tier_formulas.ROW_SURFACE.get(name, "film")] for name in parts.rows})
-    closures = parts.closures(fit, x, NodeAlgebra(build, rows))
+    weight = NodeValue(build, inputs.outputs["Subsurface Weight"], False) if over else None
+    closures = parts.closures(fit, x, NodeAlgebra(build, rows), subsurface_weight=weight)
     lobes = parts.lobes
 
     def emit(closure):
@@ -277,7 +338,8 @@ def _build_view_weighted(build: Builder, fit, parts, lut, method: str, radius_mm
             node = build.node("ShaderNodeBsdfDiffuse", closure.name)
         else:
             node = build.node("ShaderNodeSubsurfaceScattering", closure.name, falloff=method)
-            build.feed(socket(node.inputs, "Radius"), tuple(map(float, radius_mm)))
+            build.feed(socket(node.inputs, "Radius"),
+                       radius if over else tuple(map(float, radius_mm)))
             build.feed(socket(node.inputs, "Scale"), scale)
             build.feed(socket(node.inputs, "IOR"), ior)
         # A colour of 0 (Gloss 0) is a closure Cycles does not allocate (bsdf_alloc's cutoff).
@@ -290,34 +352,40 @@ def _build_view_weighted(build: Builder, fit, parts, lut, method: str, radius_mm
         build.tree.links.new(node.outputs[0], socket(weighted.inputs, "Shader_001"))
         return weighted.outputs[0]
 
+    covered = _add(build, [emit(c) for c in closures.covered])
+    if over:
+        _finish(build, inputs, output, covered, over)
+        return
     mix = build.node("ShaderNodeMixShader", "coverage (areal mix)")
     build.feed(socket(mix.inputs, "Fac"), closures.coverage)
     build.tree.links.new(_add(build, [emit(c) for c in closures.bare]),
                          socket(mix.inputs, "Shader"))
-    build.tree.links.new(_add(build, [emit(c) for c in closures.covered]),
-                         socket(mix.inputs, "Shader_001"))
+    build.tree.links.new(covered, socket(mix.inputs, "Shader_001"))
     shaded = _add(build, [mix.outputs[0], *(emit(c) for c in closures.shared)])
-    build.tree.links.new(shaded, output.inputs["Shader"])
+    _finish(build, inputs, output, shaded, over)
 
 
-def build_group(tier: str, record: dict, fit, group=None, *, method=None, measured=None):
+def build_group(tier: str, record: dict, fit, group=None, *, method=None, measured=None,
+                over: bool = False):
     """Create (or, given ``group``, rebuild in place) the node group of ``tier`` from a
     :class:`ClosureFit` ``fit`` of the tables that the bake record ``record`` describes
     (:func:`storage.bake_record`).  ``method``: a subsurface method forced by the user, else the
     fit's choice.  The group's :data:`.keys.FIT_KEY` holds the bake record, the fit's summary,
     the SHA-256 of every image the group reads (:func:`storage.image_record`) and
     ``measured``, what the fit measured at the settings' coverage and absorption
-    (:func:`.fits.measure`), if given."""
+    (:func:`.fits.measure`), if given.  ``over``: a group over the artist's shader (its
+    Skin Shader input is the bare skin, :data:`OVER_SHADER_INPUTS`), else the skin preset's
+    made-up skin, bare skin included (:data:`INPUTS`)."""
     if tier not in tiers.TIERS:
         raise ValueError(f"tier must be one of {tiers.TIERS}, got {tier!r}")
     key = record["key"]
-    name = group_name(tier, key, method)
+    name = group_name(tier, key, method, over)
     if group is None:
         group = bpy.data.node_groups.get(name) or bpy.data.node_groups.new(name,
                                                                            "ShaderNodeTree")
     elif group.name != name and bpy.data.node_groups.get(name) is None:
         group.name = name
-    _interface(group, fit.skin_albedo)
+    _interface(group, fit.skin_albedo, over)
     group.nodes.clear()
     build = Builder(group)
     forced = method
@@ -327,13 +395,14 @@ def build_group(tier: str, record: dict, fit, group=None, *, method=None, measur
     ior = fit.subsurface_ior
     images = []
     if tier == "PRINCIPLED":
-        _build_principled(build, fit, method, radius, ior)
+        _build_principled(build, fit, method, radius, ior, over)
     else:
         parts = tiers.view_weighted_parts(fit, tier)
         lut = storage.lut_image(lut_image_name(key, tier), parts.lut)
         images.append(storage.image_record(lut))
-        _build_view_weighted(build, fit, parts, lut, method, radius, ior)
+        _build_view_weighted(build, fit, parts, lut, method, radius, ior, over)
     group[FIT_KEY] = json.dumps({**record, "tier": tier, "forced_method": forced,
+                                 "over_shader": over,
                                  "images": images, **fit.summary(),
                                  "subsurface_method": method, "measured": measured},
                                 default=float)

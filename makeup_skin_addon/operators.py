@@ -13,7 +13,7 @@ from __future__ import annotations
 import bpy
 from bl_operators.presets import AddPresetBase
 
-from . import convert, live, scene_fit, shade
+from . import convert, live, matching, scene_fit
 from . import material as made_up
 from .keys import OPERATOR_PREFIX, PRESET_SUBDIR, SETTINGS_ATTRIBUTE
 from .properties import RESOLUTION_ITEMS
@@ -118,9 +118,14 @@ class MAKEUPSKIN_OT_apply(bpy.types.Operator):
         except (ValueError, RuntimeError) as error:
             self.report({"ERROR"}, f"Made-up Skin: {_sentence(error)}")
             return {"CANCELLED"}
+        warnings = getattr(messages, "warnings", [])
         for message in messages:
-            self.report({"INFO"}, f"Made-up Skin: {message}")
-        self.report({"INFO"}, f"Made-up Skin: {material.name!r} on {obj.name!r} is made up.")
+            self.report({"WARNING"} if message in warnings else {"INFO"},
+                        f"Made-up Skin: {message}")
+        left = (f" ({len(warnings)} thing{'s' if len(warnings) != 1 else ''} of its shader "
+                f"not carried over: see the warnings)" if warnings else "")
+        self.report({"INFO"}, f"Made-up Skin: {material.name!r} on {obj.name!r} is made "
+                              f"up{left}.")
         return {"FINISHED"}
 
 
@@ -252,7 +257,7 @@ def _set_shade(operator, context, solve) -> set:
     except (ValueError, RuntimeError) as error:
         operator.report({"ERROR"}, f"Made-up Skin: {_sentence(error)}")
         return {"CANCELLED"}
-    shade.assign(material.makeup_skin, result, "MATCH")
+    matching.assign(material.makeup_skin, result, "MATCH")
     made_up.update_sockets(material)
     for sentence in result.sentences:
         operator.report({"WARNING"} if "out of reach" in sentence else {"INFO"},
@@ -269,7 +274,7 @@ class MAKEUPSKIN_OT_match_skin(_ShadePoll, bpy.types.Operator):
     bl_options = {"REGISTER", "UNDO"}
 
     def execute(self, context):
-        return _set_shade(self, context, shade.matched)
+        return _set_shade(self, context, matching.matched)
 
 
 class MAKEUPSKIN_OT_shade_step(_ShadePoll, bpy.types.Operator):
@@ -288,11 +293,11 @@ class MAKEUPSKIN_OT_shade_step(_ShadePoll, bpy.types.Operator):
     def description(cls, context, properties):
         return (f"One shade {properties.direction.lower()}: the covered skin's color "
                 f"{'times' if properties.direction == 'LIGHTER' else 'divided by'} "
-                f"{shade.SHADE_STEP:g}")
+                f"{matching.SHADE_STEP:g}")
 
     def execute(self, context):
         steps = 1 if self.direction == "LIGHTER" else -1
-        return _set_shade(self, context, lambda material: shade.stepped(material, steps))
+        return _set_shade(self, context, lambda material: matching.stepped(material, steps))
 
 
 def _sentence(error) -> str:

@@ -23,8 +23,9 @@ import math
 import bpy
 
 from . import live, shade
-from .core import presets, roughness
+from .core import presets
 from .keys import SETTINGS_ATTRIBUTE, SETTINGS_VERSION
+from .shade import FILM_ROUGHNESS_MIN, ROUGHNESS_MAX, SKIN_ROUGHNESS_MIN
 
 __all__ = ["MakeupSkinSettings", "register", "unregister", "TIER_ITEMS", "SUBSURFACE_ITEMS",
            "RESOLUTION_ITEMS", "SETTINGS_VERSION", "ROUGHNESS_MAX", "FILM_ROUGHNESS_MIN",
@@ -74,17 +75,6 @@ FIRST_FOUNDATION = next(iter(presets.FOUNDATIONS))
 """The default foundation (the first preset: the paper's film, matched to the skin at the first
 Apply, docs/addon.md "A first Apply")."""
 FIRST_SKIN = next(iter(presets.SKINS))
-ROUGHNESS_MAX = float(roughness.roughness_for_width(60.0))
-"""The roughest lobe the panel offers (0.856: 60 degrees wide); beyond it the Layered tier's
-film lobe breaks the white furnace (docs/stability.md, the "rougher" regime)."""
-FILM_ROUGHNESS_MIN = float(roughness.roughness_for_width(1.0))
-"""The smoothest film gloss (0.147: a lobe 1 degree wide)."""
-SKIN_ROUGHNESS_MIN = 0.5
-"""The smoothest skin gloss (a lobe 12 degrees wide): path 3 goes through the skin's gloss, so
-a narrower lobe scales the bake's grids (``bake.path3_width_deg``); at 0.5 a first Apply still
-takes under a second (docs/addon.md, "Skin Roughness")."""
-
-
 # Enum items must stay referenced while Blender shows them.
 _ITEMS_CACHE: dict[str, list] = {}
 
@@ -219,6 +209,21 @@ class MakeupSkinSettings(bpy.types.PropertyGroup):
             ("MATCH", "Match Skin", "Matched to the skin, or stepped from there"),
             ("USER", "User", "Set by hand")),
         default="DEFAULT", description="Where the shade came from (internal)")
+    shade_base: bpy.props.FloatVectorProperty(
+        name="Shade Base", size=3, default=(0.0, 0.0, 0.0), min=0.0,
+        description="The covered colour the last Match Skin aimed at, from which Lighter and "
+                    "Darker count their steps (internal)")
+    shade_steps: bpy.props.IntProperty(
+        name="Shade Steps", default=0,
+        description="Lighter (+1) and Darker (-1) steps since the last Match Skin (internal)")
+    over_shader: bpy.props.BoolProperty(
+        name="Over the Artist's Shader", default=False,
+        description="The film goes over the material's own shader, which stays the bare skin "
+                    "and gives the skin under the film (set by Apply; internal)")
+    skin_ior: bpy.props.FloatProperty(
+        name="Skin IOR", default=1.4, min=1.01, max=2.5,
+        description="Index of refraction of the skin under the film (Apply takes the "
+                    "artist's shader's IOR)", update=_update_tables)
     skin_colour: bpy.props.FloatVectorProperty(
         name="Skin Color", size=3, min=0.0, max=1.0,
         default=_first_skin_albedo(),

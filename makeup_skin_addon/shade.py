@@ -1,38 +1,36 @@
-"""What the panel's shade, film and skin settings mean in the model, and the shade that matches
-the skin (Match Skin, Lighter / Darker).
+"""What the panel's shade, film and skin settings mean in the model.
 
 - The settings as a made-up skin (:func:`skin_from_settings`): the foundation and skin presets,
   Film Roughness and Skin Roughness (Blender roughness, :mod:`lut_baker.model.roughness`: the
-  preset's own unless moved), Film IOR with its override.
+  preset's own unless moved), Film IOR with its override, and over the artist's shader its
+  skin's index.
 - The colour seen (:func:`colour_seen`, :func:`absorption_for_colour`): a shade picked by the
   colour the product has in the bottle, the thick layer of :mod:`lut_baker.model.thick_layer`
   against the exchange the measured presets were derived with (nothing is integrated).
-- The skin's own colour (:func:`skin_colour`): Skin Color's value or, when an image texture
-  feeds it, the mean of the image over the faces that use the material (area-weighted, read at
-  the faces' UVs, linearised from sRGB).
-- The shade that matches (:func:`matched`, :func:`stepped`): the absorption whose made-up skin
-  has the skin's own colour under uniform light (:mod:`lut_baker.tables.uniform_light`, from
-  the settings' tables), or one step (10% in luminance) lighter or darker than the current
-  shade; :func:`assign` stores a shade on the settings without marking it the user's
-  (:func:`assigning`).
+- The skin preset's own colour (:func:`skin_colour`): Skin Color's value or, when an image
+  texture feeds it, the mean of the image over the faces that use the material (area-weighted,
+  read at the faces' UVs, linearised from sRGB).
+- :func:`assigning`: settings the add-on assigns, not the user (the update callbacks leave the
+  shade's origin alone).
 """
 
 from __future__ import annotations
 
 import contextlib
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import bpy
 import numpy as np
 
-from . import convert, storage
-from .core import cache, presets, roughness, thick_layer, uniform_light
+from . import convert
+from .core import cache, presets, roughness, thick_layer
 
 __all__ = [
-    "SHADE_STEP",
     "ROUGHNESS_TOLERANCE",
+    "ROUGHNESS_MAX",
+    "FILM_ROUGHNESS_MIN",
+    "SKIN_ROUGHNESS_MIN",
     "SkinColour",
-    "Shade",
     "foundation_roughness",
     "skin_roughness",
     "has_film_gloss",
@@ -42,29 +40,28 @@ __all__ = [
     "preset_colour",
     "colour_note",
     "skin_colour",
-    "base_colour_value",
-    "BLENDER_DEFAULT_BASE",
     "image_mean",
-    "light_for",
-    "matched",
-    "first_shade",
-    "stepped",
-    "assign",
     "assigning",
     "is_assigning",
     "clear_cache",
 ]
 
-SHADE_STEP = 1.1
-"""One shade step of Lighter / Darker: the covered skin's colour times this (10% in
-luminance)."""
+ROUGHNESS_MAX = float(roughness.roughness_for_width(60.0))
+"""The roughest lobe the panel offers (0.856: 60 degrees wide); beyond it the Layered tier's
+film lobe breaks the white furnace (docs/stability.md, the "rougher" regime)."""
+FILM_ROUGHNESS_MIN = float(roughness.roughness_for_width(1.0))
+"""The smoothest film gloss (0.147: a lobe 1 degree wide)."""
+SKIN_ROUGHNESS_MIN = 0.5
+"""The smoothest skin gloss (a lobe 12 degrees wide): path 3 goes through the skin's gloss, so
+a narrower lobe scales the bake's grids (``bake.path3_width_deg``); at 0.5 a first Apply still
+takes under a second (docs/addon.md, "Skin Roughness")."""
+
 ROUGHNESS_TOLERANCE = 1e-5
 """A roughness this close to the preset's is the preset's (the panel stores float32)."""
 CHANNELS = ("Red", "Green", "Blue")
 SAMPLES = ((1 / 3, 1 / 3, 1 / 3), (2 / 3, 1 / 6, 1 / 6), (1 / 6, 2 / 3, 1 / 6),
            (1 / 6, 1 / 6, 2 / 3))
 """Barycentric points at which :func:`image_mean` reads each face's triangles."""
-_LIGHT = cache.LRUCache(8)
 _ROUGHENED = cache.LRUCache(32)
 _assigning = [0]
 
@@ -112,6 +109,14 @@ def skin_from_settings(settings, foundation: str | None = None):
     surface = _roughened(skin.skin_reflection, settings.skin_roughness,
                          skin_roughness(settings.skin))
     skin = skin.replace(film=film, skin_reflection=surface)
+    if settings.over_shader:
+        # The skin under the film has the artist's index (docs/addon.md, "Over the artist's
+        # skin"): its surface's Fresnel term, and the dipole's boundary.
+        eta = max(float(settings.skin_ior), 1.0)
+        skin = skin.replace(
+            skin_reflection=skin.skin_reflection.scaled(
+                eta=eta / float(skin.skin_reflection.eta)),
+            dipole=skin.dipole.scaled(eta=eta / float(skin.dipole.eta)))
     if settings.override_film:
         skin = skin.replace(
             film=skin.film.scaled(eta=settings.film_ior / float(skin.film.eta)),
@@ -296,37 +301,15 @@ def _uv_map(texture) -> tuple[str, str]:
     return "", f"; its coordinates come from {node.name!r}: read at the mesh's UVs"
 
 
-BLENDER_DEFAULT_BASE = (0.8, 0.8, 0.8)
-"""The Base Color of a new Principled BSDF: a material never coloured, not a skin colour."""
-
-
-def base_colour_value(settings, sources) -> tuple | None:
-    """The unlinked Base Color value the artist's shader gives Skin Color
-    (:func:`.convert.surface_sources`), or None: none, Blender's default grey
-    (:data:`BLENDER_DEFAULT_BASE`), or Skin Color (or the skin) already set in the panel."""
-    value = sources.values.get("Skin Color")
-    if value is None or settings.is_property_set("skin_colour"):
-        return None
-    if np.allclose(value, BLENDER_DEFAULT_BASE, atol=1e-6):
-        return None
-    return tuple(min(max(float(c), 0.0), 1.0) for c in value)
-
-
 def skin_colour(material) -> SkinColour:
-    """The skin's own diffuse albedo: what feeds the group's Skin Color (or, before Apply, the
-    artist's Base Color, :func:`.convert.surface_sources`): an image texture's mean over the
-    faces that use the material (:func:`image_mean`), else Skin Color's value."""
+    """The diffuse albedo of the skin preset's made-up skin (a material without a shader of
+    the artist's; over one, :mod:`.artist_skin` reads the skin): what feeds the group's Skin
+    Color, an image texture's mean over the faces that use the material (:func:`image_mean`),
+    else Skin Color's value."""
     settings = material.makeup_skin
     value = SkinColour(np.asarray(settings.skin_colour, float), "Skin Color's value")
     node = convert.group_node(material)
     socket = node.inputs["Skin Color"] if node is not None else None
-    if socket is None:
-        sources = convert.surface_sources(material)
-        base = base_colour_value(settings, sources)
-        if base is not None:
-            return SkinColour(np.asarray(base, float), "the value of the shader's Base Color")
-        link = sources.links.get("Skin Color")
-        socket = link[1].links[0].to_socket if link is not None and link[1].links else None
     if socket is None or not socket.is_linked:
         return value
     texture, route = _image_feeding(socket)
@@ -346,142 +329,6 @@ def skin_colour(material) -> SkinColour:
                            f"that use {material.name!r}{through}{note}{uv_note}")
 
 
-# -- matching -------------------------------------------------------------------------------
-
-def light_for(settings, foundation: str | None = None):
-    """The settings' made-up skin (with ``foundation``'s film instead, if given) under uniform
-    light (:func:`lut_baker.tables.uniform_light.uniform_light` of their tables, re-baked once
-    per session)."""
-    record = storage.bake_record(skin_from_settings(settings, foundation), settings.resolution)
-    return _LIGHT.get_or_compute(record["key"],
-                                 lambda: uniform_light.uniform_light(storage.rebake(record)))
-
-
-@dataclass
-class Shade:
-    """A shade solved for the covered skin to have ``target``: ``absorption`` and
-    ``clamped`` per channel, the covered colour ``reached``, the skin's colour ``skin``, the
-    bare skin's colour ``bare`` and the report's ``sentences``."""
-
-    absorption: np.ndarray
-    clamped: np.ndarray
-    target: np.ndarray
-    reached: np.ndarray
-    skin: SkinColour
-    bare: np.ndarray
-    sentences: list = field(default_factory=list)
-
-    def note(self) -> str:
-        """The panel's short line about channels out of reach, or ""."""
-        out = [name for name, c in zip(CHANNELS, self.clamped, strict=True) if c]
-        if not out:
-            return ""
-        return (f"{' and '.join(out)} out of the film's reach: "
-                + ", ".join(f"{name[0]} {r:.3f} for {t:.3f}" for name, r, t, c in
-                            zip(CHANNELS, self.reached, self.target, self.clamped, strict=True)
-                            if c))
-
-
-def _solve(settings, light, target, skin: SkinColour) -> Shade:
-    gloss = float(settings.gloss)
-    absorption, clamped = uniform_light.matching_absorption(light, target, skin.rgb, gloss)
-    reached = uniform_light.covered_colour(light, absorption, skin.rgb, gloss)
-    bare = uniform_light.bare_colour(light, skin.rgb, gloss)
-    return Shade(absorption, clamped, np.asarray(target, float), reached, skin, bare)
-
-
-def _reach_sentences(shade: Shade, light, gloss: float) -> list[str]:
-    sentences = []
-    for c, name in enumerate(CHANNELS):
-        if not shade.clamped[c]:
-            continue
-        if shade.absorption[c] == 0.0:
-            sentences.append(
-                f"{name} is out of reach: the film over this skin reflects at most "
-                f"{shade.reached[c]:.3f} (no absorption) against {shade.target[c]:.3f}: the "
-                f"made-up skin is that much darker where the film covers it.")
-        else:
-            floor = gloss * float(light.film_gloss[c])
-            sentences.append(
-                f"{name} is out of reach: the film's own gloss reflects {floor:.3f} and the "
-                f"covered skin at least {shade.reached[c]:.3f} (full absorption) against "
-                f"{shade.target[c]:.3f}; a matte product (no gloss: Clarins 103, 108) comes "
-                f"closer.")
-    return sentences
-
-
-def matched(material, foundation: str | None = None, skin: SkinColour | None = None) -> Shade:
-    """The shade whose made-up skin has the skin's own colour under uniform light at any
-    coverage (:func:`lut_baker.tables.uniform_light.matching_absorption` with the bare skin's
-    colour as the target: the made-up colour is the areal mix of the bare and the covered
-    skin), with the report's sentences; ``foundation``: on that preset's film instead of the
-    settings'; ``skin``: the skin's colour if known (:func:`skin_colour`)."""
-    settings = material.makeup_skin
-    light = light_for(settings, foundation)
-    skin = skin_colour(material) if skin is None else skin
-    bare = uniform_light.bare_colour(light, skin.rgb, float(settings.gloss))
-    shade = _solve(settings, light, bare, skin)
-    shade.sentences.append(
-        f"Matched the shade to the skin's own colour ({_rgb(bare)} with its gloss; its diffuse "
-        f"albedo {_rgb(skin.rgb)} is {skin.source}): absorption {_rgb(shade.absorption)}, "
-        f"in the bottle {_rgb(colour_seen(shade.absorption))}.")
-    shade.sentences += _reach_sentences(shade, light, float(settings.gloss))
-    return shade
-
-
-MATTE_FILM = "clarins_103"
-"""The matte film a first Apply turns to when the skin is darker than the default film's own
-gloss (any matte product's film is the same: no surface gloss; this is the first)."""
-
-
-def _shortfall(shade: Shade) -> float:
-    """How far a shade's covered colour misses its target, relative, summed over channels."""
-    return float(np.sum(np.abs(shade.reached - shade.target) / np.maximum(shade.target, 1e-6)))
-
-
-def first_shade(material) -> tuple[str | None, Shade]:
-    """The first Apply's shade (docs/addon.md, "A first Apply"): :func:`matched` on the
-    settings' film; when the skin is darker than that film's own gloss in some channel (clamped
-    at full absorption) and the matte film (:data:`MATTE_FILM`) reaches it better, matched on
-    that instead, and its name returned (else None)."""
-    skin = skin_colour(material)
-    shade = matched(material, skin=skin)
-    too_dark = np.any(shade.clamped & (shade.absorption == 1.0))
-    if not too_dark or material.makeup_skin.foundation == MATTE_FILM:
-        return None, shade
-    matte = matched(material, MATTE_FILM, skin)
-    if _shortfall(matte) >= _shortfall(shade):
-        return None, shade
-    label = presets.FOUNDATIONS[MATTE_FILM]["label"]
-    matte.sentences.insert(0, f"Chose {label}'s matte film: this skin is darker than the "
-                              f"{presets.FOUNDATIONS[material.makeup_skin.foundation]['label']} "
-                              f"film's own gloss reaches.")
-    return MATTE_FILM, matte
-
-
-def stepped(material, steps: int) -> Shade:
-    """The shade ``steps`` shade steps lighter (positive) or darker than the current one: the
-    covered skin's colour times :data:`SHADE_STEP` per step."""
-    settings = material.makeup_skin
-    light = light_for(settings)
-    skin = skin_colour(material)
-    gloss = float(settings.gloss)
-    current = uniform_light.covered_colour(light, settings.effective_absorption(), skin.rgb,
-                                           gloss)
-    shade = _solve(settings, light, current * SHADE_STEP ** int(steps), skin)
-    word = "lighter" if steps > 0 else "darker"
-    shade.sentences.append(
-        f"One shade {word}: the covered skin {_rgb(current)} -> {_rgb(shade.reached)}, "
-        f"absorption {_rgb(shade.absorption)}, in the bottle "
-        f"{_rgb(colour_seen(shade.absorption))}.")
-    shade.sentences += _reach_sentences(shade, light, gloss)
-    return shade
-
-
-def _rgb(values) -> str:
-    return "(" + ", ".join(f"{float(v):.3f}" for v in values) + ")"
-
-
 @contextlib.contextmanager
 def assigning():
     """Settings assigned inside are the add-on's, not the user's: the properties' update
@@ -498,19 +345,7 @@ def is_assigning() -> bool:
     return _assigning[0] > 0
 
 
-def assign(settings, shade: Shade, source: str) -> None:
-    """Store ``shade`` on the settings: the absorption, its colour seen, the panel's note and
-    where the shade came from (``source``: ``"MATCH"``)."""
-    with assigning():
-        settings.absorption = [float(a) for a in shade.absorption]
-        settings.shade_colour = [float(c) for c in colour_seen(shade.absorption)]
-        settings.shade_note = shade.note()
-        settings.shade_source = source
-
-
 def clear_cache() -> None:
-    """Forget the session's uniform-light parts and roughened layers (the add-on's unregister
-    calls it)."""
-    _LIGHT.clear()
+    """Forget the session's roughened layers (the add-on's unregister calls it)."""
     _ROUGHENED.clear()
 

@@ -180,7 +180,8 @@ class ViewWeightedClosures:
 def view_weighted_closures(fit, x: TierInputs, ops: Algebra, *,
                            tinted_subsurface: bool = True,
                            film_lobes: tuple = ("film_gloss",),
-                           one_subsurface: bool = False) -> ViewWeightedClosures:
+                           one_subsurface: bool = False,
+                           subsurface_weight=None) -> ViewWeightedClosures:
     """The LAYERED tier's closures at inputs ``x``, their view-dependent factors read from the
     image rows (``ops.row``, :data:`lut_baker.closures.view_image.LUT_ROWS`):
 
@@ -205,7 +206,12 @@ def view_weighted_closures(fit, x: TierInputs, ops: Algebra, *,
     proportion to weight times luminance, ``closure_select`` in eevee_nodetree_lib.glsl), so
     closures of different hues in one pixel are noise that samples average away slowly: a
     matte film at coverage 0.5 errs 3.4% at 16 samples against 0.6% at 256 with three such
-    closures; with two, as at full coverage, 1.4%."""
+    closures; with two, as at full coverage, 1.4%.
+
+    ``subsurface_weight`` (a scalar, or None): the share of the skin through the film that
+    scatters below its surface, the rest a Diffuse closure of the same product (a skin whose
+    shader has a Subsurface Weight, docs/addon.md "Over the artist's skin"); None: all of
+    it."""
     weights = coverage_weights(x.coverage, x.absorption)
     g = x.gloss
     transmitted = weights.twice * ops.row("film_transmittance") * fit.transmittance_mean
@@ -217,12 +223,21 @@ def view_weighted_closures(fit, x: TierInputs, ops: Algebra, *,
                           "skin", weight=strongest)
     else:
         through = Closure("subsurface", "skin through film", transmitted * x.skin_color, "skin")
+    diffuse_through: tuple = ()
+    if subsurface_weight is not None:
+        diffuse_through = (Closure("diffuse", "skin through film (diffuse)",
+                                   transmitted * x.skin_color, "skin",
+                                   weight=1.0 - subsurface_weight),)
+        through = Closure(through.kind, through.name, through.colour, through.surface,
+                          weight=subsurface_weight if through.weight is None
+                          else through.weight * subsurface_weight)
     covered = (
         *(Closure("glossy", name, g * ops.row(name), "film") for name in film_lobes),
         Closure("diffuse", "film diffuse",
                 weights.once * fit.film_albedo + g * ops.row("film_gloss_diffuse"), "film"),
         Closure("glossy", "path3_gloss", g * ops.row("path3_gloss") * weights.twice, "skin"),
         through,
+        *diffuse_through,
     )
     bare = (
         Closure("glossy", "skin_gloss", g * ops.row("skin_gloss"), "skin"),

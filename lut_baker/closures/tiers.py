@@ -115,11 +115,16 @@ class ViewWeightedParts:
     tinted_subsurface: bool
     one_subsurface: bool = False
 
-    def closures(self, fit: ClosureFit, x: TierInputs, ops) -> ViewWeightedClosures:
-        """The tier's closures at inputs ``x`` in the algebra ``ops``."""
+    def closures(self, fit: ClosureFit, x: TierInputs, ops,
+                 subsurface_weight=None) -> ViewWeightedClosures:
+        """The tier's closures at inputs ``x`` in the algebra ``ops``; ``subsurface_weight``:
+        the share of the skin under the film that is subsurface (a group over the artist's
+        shader: theirs; its bare side is their shader, so nothing is shared with it)."""
         return view_weighted_closures(fit, x, ops, tinted_subsurface=self.tinted_subsurface,
                                       film_lobes=self.film_lobes,
-                                      one_subsurface=self.one_subsurface)
+                                      one_subsurface=self.one_subsurface
+                                      and subsurface_weight is None,
+                                      subsurface_weight=subsurface_weight)
 
 
 def view_weighted_parts(fit: ClosureFit, tier: str) -> ViewWeightedParts:

@@ -1,0 +1,238 @@
+"""The shade that matches the skin: Match Skin, Lighter / Darker and the first Apply's match.
+
+Matching means the artist's render: the shade is solved so that the skin under the film, the
+film over it included, has under uniform white light the colour the artist's own shader has
+there (:class:`SkinTarget`, from :mod:`.artist_skin`: a Principled BSDF's layering and its
+random walk included), so that at any coverage the face keeps the tone it had before Apply.
+A material without a shader of the artist's (the skin preset's made-up skin) matches its own
+bare skin instead.  The covered colour is the model's
+(:func:`lut_baker.tables.uniform_light.covered_colour`), solved per channel in closed form
+(:func:`lut_baker.tables.uniform_light.matching_absorption`); a colour beyond the film's reach
+is matched as far as it goes and the report says so.
+
+Lighter and Darker step the covered colour's target by :data:`SHADE_STEP` from where the last
+match (or the current shade) put it, counting steps (``shade_steps``), so that Lighter then
+Darker returns to exactly the same shade, clamped or not.
+
+- :class:`SkinTarget` -- the colour to match and the skin under the film's body colour.
+- :func:`skin_target` -- both for a material, with where they came from.
+- :class:`Shade` -- a solved shade.
+- :func:`matched` -- Match Skin; :func:`first_shade` -- the first Apply's;
+  :func:`stepped` -- Lighter / Darker; :func:`assign` -- store a shade on the settings.
+- :func:`light_for` -- the settings' made-up skin under uniform light (cached per bake).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import artist_skin, shade, storage
+from .core import cache, presets, uniform_light
+
+__all__ = ["SHADE_STEP", "MATTE_FILM", "SkinTarget", "Shade", "skin_target", "light_for",
+           "matched", "first_shade", "stepped", "assign", "clear_cache"]
+
+SHADE_STEP = 1.1
+"""One shade step of Lighter / Darker: the covered skin's colour times this (10% in
+luminance)."""
+MATTE_FILM = "clarins_103"
+"""The matte film a first Apply turns to when the skin is darker than the default film's own
+gloss (any matte product's film is the same: no surface gloss; this is the first)."""
+CHANNELS = ("Red", "Green", "Blue")
+_LIGHT = cache.LRUCache(8)
+
+
+@dataclass
+class SkinTarget:
+    """What a shade is matched to: ``target``, the colour the skin has before Apply under
+    uniform light (RGB, its gloss included), ``body``, the body colour of the skin under the
+    film (RGB, the model's skin diffuse albedo ``a``), and ``source``, the end of a sentence
+    saying where they came from."""
+
+    target: np.ndarray
+    body: np.ndarray
+    source: str
+
+
+def light_for(settings, foundation: str | None = None):
+    """The settings' made-up skin (with ``foundation``'s film instead, if given) under uniform
+    light (:func:`lut_baker.tables.uniform_light.uniform_light` of their tables, re-baked once
+    per session)."""
+    record = storage.bake_record(shade.skin_from_settings(settings, foundation),
+                                 settings.resolution)
+    return _LIGHT.get_or_compute(record["key"],
+                                 lambda: uniform_light.uniform_light(storage.rebake(record)))
+
+
+def skin_target(material, reading=None, light=None) -> SkinTarget:
+    """What the material's shade matches: over the artist's shader its colour under uniform
+    light and its body colour (``reading``: :class:`.artist_skin.SkinReading`, read now if not
+    given); the skin preset's made-up skin matches its own bare skin (Skin Color, or the mean
+    of the image feeding it, with the preset's gloss, ``light``)."""
+    settings = material.makeup_skin
+    if reading is None and settings.over_shader:
+        reading = artist_skin.read_material(material)
+    if reading is not None and reading.dominant is not None:
+        return SkinTarget(np.asarray(reading.target, float), np.asarray(reading.body, float),
+                          "the artist's shader under uniform light")
+    skin = shade.skin_colour(material)
+    light = light_for(settings) if light is None else light
+    bare = uniform_light.bare_colour(light, skin.rgb, float(settings.gloss))
+    return SkinTarget(np.asarray(bare, float), np.asarray(skin.rgb, float),
+                      f"its diffuse albedo {_rgb(skin.rgb)} with the skin preset's gloss; the "
+                      f"albedo is {skin.source}")
+
+
+@dataclass
+class Shade:
+    """A shade solved for the covered skin to have ``target``: ``absorption`` and
+    ``clamped`` per channel, the covered colour ``reached``, the skin ``skin``
+    (:class:`SkinTarget`), the report's ``sentences``, and the step count and its base that
+    Lighter / Darker keep (``steps``, ``base``)."""
+
+    absorption: np.ndarray
+    clamped: np.ndarray
+    target: np.ndarray
+    reached: np.ndarray
+    skin: SkinTarget
+    sentences: list = field(default_factory=list)
+    steps: int = 0
+    base: np.ndarray | None = None
+
+    def note(self) -> str:
+        """The panel's short line about channels out of reach, or ""."""
+        out = [name for name, c in zip(CHANNELS, self.clamped, strict=True) if c]
+        if not out:
+            return ""
+        return (f"{' and '.join(out)} out of the film's reach: "
+                + ", ".join(f"{name[0]} {r:.3f} for {t:.3f}" for name, r, t, c in
+                            zip(CHANNELS, self.reached, self.target, self.clamped, strict=True)
+                            if c))
+
+
+def _solve(settings, light, target, skin: SkinTarget) -> Shade:
+    gloss = float(settings.gloss)
+    absorption, clamped = uniform_light.matching_absorption(light, target, skin.body, gloss)
+    reached = uniform_light.covered_colour(light, absorption, skin.body, gloss)
+    return Shade(absorption, clamped, np.asarray(target, float), reached, skin)
+
+
+def _reach_sentences(shade_: Shade, light, gloss: float) -> list[str]:
+    sentences = []
+    for c, name in enumerate(CHANNELS):
+        if not shade_.clamped[c]:
+            continue
+        if shade_.absorption[c] == 0.0:
+            sentences.append(
+                f"{name} is out of reach: the film over this skin reflects at most "
+                f"{shade_.reached[c]:.3f} (no absorption) against {shade_.target[c]:.3f}: the "
+                f"made-up skin is that much darker where the film covers it.")
+        else:
+            floor = gloss * float(light.film_gloss[c])
+            sentences.append(
+                f"{name} is out of reach: the film's own gloss reflects {floor:.3f} and the "
+                f"covered skin at least {shade_.reached[c]:.3f} (full absorption) against "
+                f"{shade_.target[c]:.3f}; a matte product (no gloss: Clarins 103, 108) comes "
+                f"closer.")
+    return sentences
+
+
+def matched(material, foundation: str | None = None, skin: SkinTarget | None = None) -> Shade:
+    """The shade whose covered skin has the skin's colour before Apply under uniform light
+    (:func:`skin_target`), so that the made-up skin has it at any coverage, with the report's
+    sentences; ``foundation``: on that preset's film instead of the settings'; ``skin``: the
+    target if known."""
+    settings = material.makeup_skin
+    light = light_for(settings, foundation)
+    skin = skin_target(material, light=light) if skin is None else skin
+    result = _solve(settings, light, skin.target, skin)
+    result.base = result.target
+    result.sentences.append(
+        f"Matched the shade to the skin's color before Apply ({_rgb(skin.target)}: "
+        f"{skin.source}; under the film the skin's body color is {_rgb(skin.body)}): "
+        f"absorption {_rgb(result.absorption)}, in the bottle "
+        f"{_rgb(shade.colour_seen(result.absorption))}.")
+    result.sentences += _reach_sentences(result, light, float(settings.gloss))
+    return result
+
+
+def _shortfall(result: Shade) -> float:
+    """How far a shade's covered colour misses its target, relative, summed over channels."""
+    return float(np.sum(np.abs(result.reached - result.target)
+                        / np.maximum(result.target, 1e-6)))
+
+
+def first_shade(material, reading=None) -> tuple[str | None, Shade]:
+    """The first Apply's shade (docs/addon.md, "A first Apply"): :func:`matched` on the
+    settings' film; when the skin is darker than that film's own gloss in some channel
+    (clamped at full absorption) and the matte film (:data:`MATTE_FILM`) reaches it better,
+    matched on that instead, and its name returned (else None).  ``reading``: the artist's
+    skin (:class:`.artist_skin.SkinReading`), if read."""
+    settings = material.makeup_skin
+    skin = skin_target(material, reading)
+    result = matched(material, skin=skin)
+    too_dark = np.any(result.clamped & (result.absorption == 1.0))
+    if not too_dark or settings.foundation == MATTE_FILM:
+        return None, result
+    matte = matched(material, MATTE_FILM, skin)
+    if _shortfall(matte) >= _shortfall(result):
+        return None, result
+    label = presets.FOUNDATIONS[MATTE_FILM]["label"]
+    matte.sentences.insert(0, f"Chose {label}'s matte film: this skin is darker than the "
+                              f"{presets.FOUNDATIONS[settings.foundation]['label']} film's own "
+                              f"gloss reaches.")
+    return MATTE_FILM, matte
+
+
+def stepped(material, steps: int) -> Shade:
+    """The shade ``steps`` shade steps lighter (positive) or darker than the current one: the
+    covered skin's target times :data:`SHADE_STEP` per step, counted from the last match (or
+    from the current shade's covered colour when it was set otherwise), so that steps undone
+    give back exactly the shade they started from."""
+    settings = material.makeup_skin
+    light = light_for(settings)
+    skin = skin_target(material, light=light)
+    gloss = float(settings.gloss)
+    if settings.shade_source == "MATCH" and settings.is_property_set("shade_base"):
+        base, count = np.asarray(settings.shade_base, float), int(settings.shade_steps)
+    else:
+        base = uniform_light.covered_colour(light, settings.effective_absorption(), skin.body,
+                                            gloss)
+        count = 0
+    current = uniform_light.covered_colour(light, settings.effective_absorption(), skin.body,
+                                           gloss)
+    count += int(steps)
+    result = _solve(settings, light, base * SHADE_STEP ** count, skin)
+    result.steps, result.base = count, base
+    word = "lighter" if steps > 0 else "darker"
+    result.sentences.append(
+        f"One shade {word}: the covered skin {_rgb(current)} -> {_rgb(result.reached)}, "
+        f"absorption {_rgb(result.absorption)}, in the bottle "
+        f"{_rgb(shade.colour_seen(result.absorption))}.")
+    result.sentences += _reach_sentences(result, light, gloss)
+    return result
+
+
+def _rgb(values) -> str:
+    return "(" + ", ".join(f"{float(v):.3f}" for v in values) + ")"
+
+
+def assign(settings, result: Shade, source: str) -> None:
+    """Store ``result`` on the settings: the absorption, its colour seen, the panel's note,
+    where the shade came from (``source``: ``"MATCH"``) and the steps' count and base."""
+    with shade.assigning():
+        settings.absorption = [float(a) for a in result.absorption]
+        settings.shade_colour = [float(c) for c in shade.colour_seen(result.absorption)]
+        settings.shade_note = result.note()
+        settings.shade_source = source
+        if result.base is not None:
+            settings.shade_base = [float(b) for b in result.base]
+        settings.shade_steps = int(result.steps)
+
+
+def clear_cache() -> None:
+    """Forget the session's uniform-light parts (the add-on's unregister calls it)."""
+    _LIGHT.clear()
+
