@@ -28,7 +28,7 @@ import json
 
 import bpy
 
-from . import convert, fits, nodes, scene_fit, shade, storage
+from . import convert, fits, nodes, scene_fit, shade, skin_sampling, storage
 from .core import auto_tier, params_file, tiers
 from .keys import AUTO_KEY, ERRORS_KEY, MATERIAL_NAME, SETTINGS_VERSION, TIER_LABELS, group_name
 from .scene_fit import units_per_mm
@@ -289,6 +289,7 @@ def clear_cache() -> None:
     fits.clear()
     storage.clear_cache()
     shade.clear_cache()
+    skin_sampling.clear_cache()
 
 
 def group_of(material):
@@ -424,7 +425,8 @@ def apply_to_object(context, obj, *, resolution=None) -> tuple:
     if first and settings.shade_source == "DEFAULT":
         # A shade never chosen: match the skin (the artist's first step), before the fit
         # measures the tiers at the absorption.
-        film, matched = shade.first_shade(material)
+        with skin_sampling.progress_bar(getattr(context, "window_manager", None)):
+            film, matched = shade.first_shade(material)
         if film is not None:
             with shade.assigning():
                 settings.foundation = film
