@@ -469,18 +469,30 @@ def reduced_image(image, size: int = IMAGE_SIZE) -> ReducedImage:
     """``image`` as its texture node reads it (linear), box-filtered down to at most ``size``
     texels across; kept until the image changes (an image with unsaved changes is read again
     each time: nothing cheap tells a second paint stroke from the first)."""
-    key = (image.session_uid, size)
-    fingerprint = _image_fingerprint(image)
-    entry = _IMAGES.get(key)
-    if entry is not None and entry[0] == fingerprint and not image.is_dirty:
-        return entry[1]
-    _report(0.4, f"Reading image {image.name!r}")
-    reduced = _read(image, size)
-    _IMAGES.put(key, (fingerprint, reduced))
+    reduced = _cached_image(image, size)
+    if reduced is None:
+        _report(0.0, f"Reading image {image.name!r}")
+        reduced = _read(image, size)
+        _IMAGES.put((image.session_uid, size), (_image_fingerprint(image), reduced))
     return reduced
 
 
+def _cached_image(image, size: int) -> ReducedImage | None:
+    entry = _IMAGES.get((image.session_uid, size))
+    if entry is None or image.is_dirty or entry[0] != _image_fingerprint(image):
+        return None
+    return entry[1]
+
+
 def _read(image, size: int) -> ReducedImage:
+    reduced = _read_pixels(image, size)
+    if image.source == "TILED" and reduced.pixels is not None:
+        tiled = f"image {image.name!r} is tiled: its first tile was read for every UV"
+        return ReducedImage(reduced.pixels, "; ".join(n for n in (reduced.note, tiled) if n))
+    return reduced
+
+
+def _read_pixels(image, size: int) -> ReducedImage:
     if image.source == "VIEWER":
         return ReducedImage(None, problem=f"image {image.name!r} is a render result")
     if image.is_dirty or image.source == "GENERATED":
@@ -553,10 +565,14 @@ def surface_mean(image, material, *, uv_map: str = "", extension: str = "REPEAT"
     if not readable:
         return SurfaceMean(None, None, 0, problem="; ".join(missing))
     notes += [f"{text}: left out" for text in missing]
+    slow = _cached_image(image, size) is None
+    reduced = reduced_image(image, size)  # first: its decoder's peak is the call's
+    if reduced.pixels is None:
+        return SurfaceMean(None, None, 0, notes=notes, problem=reduced.problem)
     surfaces = [_Surface(obj, material, layer) for obj, layer in readable]
     cold = [surface for surface in surfaces if surface.cached is None]
     for step, surface in enumerate(cold):
-        _report(0.4 * step / len(cold), f"Reading the faces of {surface.obj.name!r}")
+        _report(0.6 + 0.4 * step / len(cold), f"Reading the faces of {surface.obj.name!r}")
         surface.areas()
     counts = _shares([surface.area() for surface in surfaces], budget)
     every = [(surface.obj, surface.points(n)) for surface, n in zip(surfaces, counts,
@@ -567,9 +583,6 @@ def surface_mean(image, material, *, uv_map: str = "", extension: str = "REPEAT"
         why = (f"the {faces} faces that use {material.name!r} have no area" if faces else
                f"no face uses {material.name!r}")
         return SurfaceMean(None, None, faces, notes=notes, problem=why)
-    reduced = reduced_image(image, size)
-    if reduced.pixels is None:
-        return SurfaceMean(None, None, faces, notes=notes, problem=reduced.problem)
     total = sum(points.area for _, points in picked)
     rgb, variance = np.zeros(3), np.zeros(3)
     for _, points in picked:
@@ -577,7 +590,8 @@ def surface_mean(image, material, *, uv_map: str = "", extension: str = "REPEAT"
         share = points.area / total
         rgb += share * values.mean(axis=0)
         variance += share ** 2 * values.var(axis=0) / len(values)
-    _report(1.0, "")
+    if slow or cold:
+        _report(1.0, "")
     if reduced.note:
         notes.insert(0, reduced.note)
     return SurfaceMean(rgb, np.sqrt(variance), faces, tuple(obj.name for obj, _ in picked),

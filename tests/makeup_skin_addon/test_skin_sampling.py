@@ -339,18 +339,21 @@ def test_messages(two_faces):
                             "'//gone.png' is missing))"
 
 
-def test_progress_is_reported_only_when_something_is_read(two_faces):
-    """A cold call reports progress (the faces, then the image), a warm one nothing; a window
+def test_progress_is_reported_only_when_something_is_read(two_faces, tmp_path):
+    """A cold call reports progress (the image, then the faces), a warm one nothing; a window
     manager's progress is begun on the first report and ended after."""
     from makeup_skin_addon import skin_sampling
 
     obj, skin, texture = two_faces
+    texture.image.filepath_raw = str(tmp_path / "bands.png")
+    texture.image.file_format = "PNG"
+    texture.image.save()  # a file image, not dirty: cached once read
     reports = []
     with skin_sampling.reporting(lambda fraction, message="": reports.append(fraction)):
         skin_sampling.surface_mean(texture.image, skin)
-        assert reports and reports[0] == 0.0 and reports[-1] == 1.0
+        assert len(reports) == 3 and reports[0] == 0.0 and reports[-1] == 1.0
         reports.clear()
-        skin_sampling.object_points(obj, skin, obj.data.uv_layers[0])
+        skin_sampling.surface_mean(texture.image, skin)
         assert reports == []
 
     class Manager:
@@ -368,9 +371,13 @@ def test_progress_is_reported_only_when_something_is_read(two_faces):
 
     manager = Manager()
     with skin_sampling.progress_bar(manager):
-        skin_sampling.surface_mean(texture.image, skin)  # the image is dirty: read again
-    assert manager.calls[0] == ("begin", 0, 100) and manager.calls[-1] == ("end",)
-    assert ("update", 100) in manager.calls
+        skin_sampling.surface_mean(texture.image, skin)
+    assert manager.calls == []
+    skin_sampling.clear_cache()
+    with skin_sampling.progress_bar(manager):
+        skin_sampling.surface_mean(texture.image, skin)
+    assert manager.calls == [("begin", 0, 100), ("update", 0), ("update", 60), ("update", 100),
+                             ("end",)]
 
 
 def test_texels_wrap_as_the_texture_extension_does(addon):
