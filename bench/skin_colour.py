@@ -21,11 +21,12 @@ Parts, each in fresh Blender processes (so the first call is truly cold), this c
   is read whole).  Per step: wall seconds, CPU seconds (the process's, every thread), the memory
   added (the resident set's high-water mark, VmHWM reset before the step through
   /proc/self/clear_refs, minus the resident set before it: tracemalloc misses C allocations).
-- ``accuracy`` -- the mean against the exact full-resolution one: every loop triangle at the
-  16 centroids of its 4 x 4 subdivision, weighted by its area, read in the whole image
-  linearised; ours at 2^16 points in the image reduced to 512 px, and each error apart: 2^16
-  points in the whole image (the points' error), 2^20 points in reduced images of 256-2048 px
-  (the box filter's bias, sRGB bytes averaged before they are linearised).
+- ``accuracy`` -- the mean against the exact full-resolution one
+  (:func:`support.exact_mean.exact_mean`: every loop triangle at the 16 centroids of its 4 x 4
+  subdivision, weighted by its area, read in the whole image linearised); ours at 2^16 points
+  in the image reduced to 512 px, and each error apart: 2^16 points in the whole image (the
+  points' error), 2^20 points in reduced images of 256-2048 px (the box filter's bias, sRGB
+  bytes averaged before they are linearised).
 - ``operators`` -- end to end on the head with the add-on registered: ``bpy.ops.makeup_skin.
   match_skin()`` (the first: the colour cold, the session's uniform-light tables baked),
   ``shade_step(direction="LIGHTER")``, ``shade_step(direction="DARKER")``, Match Skin again;
@@ -192,53 +193,6 @@ def sampling_worker(cache: Path, repo: Path) -> dict:
     return out
 
 
-def _exact_mean(bpy, head, image, grid: int = 4):
-    """The exact area-weighted mean: every loop triangle at the centroids of its ``grid`` x
-    ``grid`` subdivision, read in the whole image linearised (and that image)."""
-    import numpy as np
-
-    from makeup_skin_addon import skin_sampling
-
-    width, height = image.size
-    values = np.empty(width * height * image.channels, np.float32)
-    image.pixels.foreach_get(values)
-    full = skin_sampling.srgb_to_linear(values.reshape(height, width, -1)[..., :3])
-    del values
-    mesh = head.data
-    mesh.calc_loop_triangles()
-    count = len(mesh.loop_triangles)
-    loops = np.empty(3 * count, np.int32)
-    mesh.loop_triangles.foreach_get("loops", loops)
-    loops = loops.reshape(-1, 3)
-    vertex = np.empty(len(mesh.loops), np.int32)
-    mesh.loops.foreach_get("vertex_index", vertex)
-    position = np.empty(3 * len(mesh.vertices), np.float32)
-    mesh.vertices.foreach_get("co", position)
-    position = position.reshape(-1, 3).astype(float)
-    uv = np.empty(2 * len(mesh.loops), np.float32)
-    next(layer for layer in mesh.uv_layers if layer.active_render).data.foreach_get("uv", uv)
-    uv = uv.reshape(-1, 2).astype(float)
-    centres = []
-    for i in range(grid):
-        for j in range(grid - i):
-            centres.append(((i + 1 / 3) / grid, (j + 1 / 3) / grid))
-            if i + j < grid - 1:
-                centres.append(((i + 2 / 3) / grid, (j + 2 / 3) / grid))
-    centres = np.array(centres)
-    weights = np.column_stack([1 - centres.sum(axis=1), centres])
-    total, area_sum = np.zeros(3), 0.0
-    for start in range(0, count, 100_000):
-        chunk = loops[start:start + 100_000]
-        corners = position[vertex[chunk]]
-        area = 0.5 * np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0],
-                                             corners[:, 2] - corners[:, 0]), axis=-1)
-        texel = skin_sampling.read_texels(
-            full, np.einsum("sk,tkc->tsc", weights, uv[chunk]).reshape(-1, 2))
-        total += area @ texel.reshape(len(chunk), -1, 3).mean(axis=1)
-        area_sum += area.sum()
-    return total / area_sum, full
-
-
 def accuracy_worker(cache: Path, repo: Path) -> dict:
     bpy, head = _open(cache, repo)
     from makeup_skin_addon import skin_sampling
@@ -246,7 +200,9 @@ def accuracy_worker(cache: Path, repo: Path) -> dict:
     material = head.active_material
     image = material.node_tree.nodes["Albedo"].image
     layer = next(layer for layer in head.data.uv_layers if layer.active_render)
-    exact, full = _exact_mean(bpy, head, image)
+    from support import exact_mean
+
+    exact, full = exact_mean.exact_mean(head, image, layer.name, grid=4)
 
     def relative(values):
         return [float(v) for v in values / exact - 1.0]

@@ -7,6 +7,7 @@ bpy.data; progress reported only when something is read."""
 
 import numpy as np
 import pytest
+from support import exact_mean
 
 # Two faces of a hand-made mesh: colours as sRGB bytes (exact in an 8-bit image).
 LEFT_BYTES = (200, 120, 90)
@@ -14,9 +15,7 @@ RIGHT_BYTES = (60, 90, 220)
 OTHER_BYTES = (10, 250, 10)
 
 
-def _linear(srgb):
-    srgb = np.asarray(srgb, float)
-    return np.where(srgb <= 0.04045, srgb / 12.92, ((srgb + 0.055) / 1.055) ** 2.4)
+_linear = exact_mean.srgb_to_linear
 
 
 def _image(name, columns, height=8, colorspace="sRGB"):
@@ -116,53 +115,10 @@ def test_two_faces_of_known_areas_and_colours(two_faces):
     np.testing.assert_allclose(mean.rgb, _exact_two_faces(3.0, 3.0), atol=2e-5)
 
 
-def _exact_head_mean(obj, image, uv_name):
-    """The exact area-weighted mean of the head's albedo: every loop triangle at the 576
-    centroids of its 24 x 24 subdivision, weighted by its world area, read in the whole image
-    linearised (an independent reckoning: the triangles, not the faces; a grid, not random
-    points; 6 x 6 would miss by about one standard error of 2^16 points, 48 x 48 moves it by
-    0.1 of one)."""
-    mesh = obj.data
-    mesh.calc_loop_triangles()
-    count = len(mesh.loop_triangles)
-    loops = np.empty(3 * count, np.int64)
-    mesh.loop_triangles.foreach_get("loops", loops)
-    loops = loops.reshape(-1, 3)
-    vertex = np.empty(len(mesh.loops), np.int64)
-    mesh.loops.foreach_get("vertex_index", vertex)
-    position = np.empty(3 * len(mesh.vertices))
-    mesh.vertices.foreach_get("co", position)
-    matrix = np.array(obj.matrix_world)
-    position = position.reshape(-1, 3) @ matrix[:3, :3].T
-    uv = np.empty(2 * len(mesh.loops))
-    mesh.uv_layers[uv_name].data.foreach_get("uv", uv)
-    uv = uv.reshape(-1, 2)
-    corners = position[vertex[loops]]
-    area = 0.5 * np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0],
-                                         corners[:, 2] - corners[:, 0]), axis=-1)
-    n = 24
-    points = []
-    for i in range(n):
-        for j in range(n - i):
-            points.append(((i + 1 / 3) / n, (j + 1 / 3) / n))
-            if i + j < n - 1:
-                points.append(((i + 2 / 3) / n, (j + 2 / 3) / n))
-    points = np.array(points)
-    weights = np.column_stack([1 - points.sum(axis=1), points])
-    width, height = image.size
-    pixels = np.empty(width * height * image.channels, np.float32)
-    image.pixels.foreach_get(pixels)
-    pixels = _linear(pixels.reshape(height, width, -1)[..., :3])
-    at = np.einsum("sk,tkc->tsc", weights, uv[loops])
-    at -= np.floor(at)
-    column = np.clip((at[..., 0] * width).astype(int), 0, width - 1)
-    row = np.clip((at[..., 1] * height).astype(int), 0, height - 1)
-    return area @ pixels[row, column].mean(axis=1) / area.sum()
-
-
 def test_the_heads_mean_is_within_its_sampling_error(head):
     """The textured head (its 500 faces, 512 px albedo): the mean of 2^16 points is within four
-    of its standard errors of the exact mean, channel by channel (measured: 0.3-0.6 of one);
+    of its standard errors of the exact mean (:func:`support.exact_mean.exact_mean`), channel
+    by channel (measured: 0.3-0.6 of one);
     read through a copy reduced to 128 px (a box filter in sRGB bytes, then linearised),
     within 0.2% (measured: 0.03-0.06%); the mean found by :func:`.shade.skin_colour` is this
     one."""
@@ -171,7 +127,9 @@ def test_the_heads_mean_is_within_its_sampling_error(head):
     material = head.active_material
     texture = material.node_tree.nodes["Albedo"]
     layer = next(layer for layer in head.data.uv_layers if layer.active_render)
-    exact = _exact_head_mean(head, texture.image, layer.name)
+    # 6 x 6 points a triangle would miss by about one standard error of 2^16 points; 48 x 48
+    # moves 24 x 24's by a tenth of one.
+    exact, _ = exact_mean.exact_mean(head, texture.image, layer.name, grid=24)
     mean = skin_sampling.surface_mean(texture.image, material, reader=texture.name)
     assert mean.faces == len(head.data.polygons)
     assert np.all(mean.error < 2e-3 * exact)  # 2^16 points: a tight estimate
