@@ -99,7 +99,8 @@ def _exact_two_faces(left_area, right_area):
 def test_two_faces_of_known_areas_and_colours(two_faces):
     """Every point reads its face's colour, so the mean misses the exact one only by how the
     points split between the faces (at most one point in 2^16 of the colours' difference):
-    1:3 by area, then 3:3 once the object is scaled 3 times along Z (the standing face grows);
+    1:3 by area, then 3:3 once the object is scaled 3 times along Z (the standing face grows),
+    0:3 flattened along Z;
     the third face, of another slot, does not count, nor in the faces reported."""
     import bpy
 
@@ -113,6 +114,10 @@ def test_two_faces_of_known_areas_and_colours(two_faces):
     bpy.context.view_layer.update()
     mean = skin_sampling.surface_mean(texture.image, skin)
     np.testing.assert_allclose(mean.rgb, _exact_two_faces(3.0, 3.0), atol=2e-5)
+    obj.scale = (1.0, 1.0, 0.0)  # flattened: the standing face has no area left
+    bpy.context.view_layer.update()
+    mean = skin_sampling.surface_mean(texture.image, skin)
+    np.testing.assert_allclose(mean.rgb, _exact_two_faces(0.0, 3.0), atol=1e-6)
 
 
 def test_the_heads_mean_is_within_its_sampling_error(head):
