@@ -50,7 +50,6 @@ Run with the venv's python of the Blender line to measure (``$(tools/venv.sh)/bi
 from __future__ import annotations
 
 import argparse
-import gc
 import json
 import os
 import platform
@@ -62,6 +61,8 @@ import time
 from pathlib import Path
 
 from checkout import (  # bench/checkout.py
+    MB,
+    Memory,
     commit,
     machine_load,
     packages_commit,
@@ -92,60 +93,6 @@ TARGETS = {
     "cli mb written": 16.0,
 }
 """The goals these figures are judged by (wall time on a quiet machine)."""
-MB = 1e6
-
-
-# -- memory of this process -----------------------------------------------------------------
-
-def _status_kb(field: str) -> int | None:
-    """A ``kB`` field of /proc/self/status (``VmRSS``, ``VmHWM``), or None off Linux."""
-    try:
-        for line in Path("/proc/self/status").read_text().splitlines():
-            if line.startswith(field + ":"):
-                return int(line.split()[1])
-    except OSError:
-        return None
-    return None
-
-
-def _reset_peak() -> bool:
-    """Reset VmHWM to the current resident set (``5`` to /proc/self/clear_refs); whether it
-    worked."""
-    try:
-        Path("/proc/self/clear_refs").write_text("5")
-    except OSError:
-        return False
-    return True
-
-
-def _maxrss_kb() -> int:
-    import resource
-
-    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss  # kB on Linux
-
-
-class _Memory:
-    """Resident set before a step, and the peak and the resident set after it (bytes)."""
-
-    def __enter__(self):
-        gc.collect()
-        self.reset = _reset_peak()
-        self.before = (_status_kb("VmRSS") or 0) * 1024
-        return self
-
-    def __exit__(self, *exc):
-        peak_kb = _status_kb("VmHWM") if self.reset else None
-        self.peak = (peak_kb if peak_kb is not None else _maxrss_kb()) * 1024
-        self.after = (_status_kb("VmRSS") or 0) * 1024
-        return False
-
-    @property
-    def added_mb(self) -> float:
-        return max(self.peak - self.before, 0) / MB
-
-    @property
-    def kept_mb(self) -> float:
-        return (self.after - self.before) / MB
 
 
 # -- the worker: one case in a fresh process ------------------------------------------------
@@ -232,7 +179,7 @@ def worker(bpy, support, case: str, tier: str) -> dict:
                                    if settings.override_film and not has_roughness else None),
            "film_roughness": float(settings.film_roughness) if has_roughness else None,
            "skin_roughness": float(settings.skin_roughness) if has_roughness else None}
-    with _Memory() as memory:
+    with Memory() as memory:
         out["cold_s"] = _apply_once(bpy)
     out["cold_cpu_s"] = CPU_SECONDS[-1]
     out.update(cold_mb=memory.added_mb, kept_mb=memory.kept_mb, peak_reset=memory.reset,
@@ -242,7 +189,7 @@ def worker(bpy, support, case: str, tier: str) -> dict:
                                                     material, DRAWS)
     repeats, peaks = [], []
     while len(repeats) < REPEATS_IN_PROCESS and (not repeats or repeats[0] <= 1.0):
-        with _Memory() as memory:
+        with Memory() as memory:
             repeats.append(_apply_once(bpy))
         peaks.append(memory.added_mb)
     out.update(repeat_s=statistics.median(repeats), repeat_runs=repeats,

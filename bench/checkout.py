@@ -7,10 +7,13 @@ bench/apply.py, bench/tier_accuracy.py).
   :func:`packages_commit` -- the last commit that changed its packages.
 - :func:`machine_load` -- the load averages, recorded beside the figures.
 - :func:`write_figures` -- a benchmark's results as JSON (``--json FILE``).
+- :class:`Memory` -- the memory a step adds: its peak resident set (VmHWM, reset before it)
+  and what it keeps, in :data:`MB`.
 """
 
 from __future__ import annotations
 
+import gc
 import importlib
 import json
 import os
@@ -21,8 +24,10 @@ from pathlib import Path
 OWN_ROOT = Path(__file__).resolve().parents[1]
 OWN_TESTS = OWN_ROOT / "tests"
 
-__all__ = ["OWN_ROOT", "OWN_TESTS", "use_checkout", "commit", "packages_commit", "machine_load",
-           "write_figures"]
+__all__ = ["OWN_ROOT", "OWN_TESTS", "MB", "use_checkout", "commit", "packages_commit",
+           "machine_load", "write_figures", "Memory"]
+
+MB = 1e6
 
 
 def use_checkout(repo: Path, packages=("lut_baker",), *, who: str = "bench") -> list:
@@ -80,3 +85,54 @@ def write_figures(path: Path | None, results: dict) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(json.dumps(results, indent=1) + "\n")
     print(f"\n-> {path}")
+
+
+def _status_kb(field: str) -> int | None:
+    """A ``kB`` field of /proc/self/status (``VmRSS``, ``VmHWM``), or None off Linux."""
+    try:
+        for line in Path("/proc/self/status").read_text().splitlines():
+            if line.startswith(field + ":"):
+                return int(line.split()[1])
+    except OSError:
+        return None
+    return None
+
+
+def _reset_peak() -> bool:
+    """Reset VmHWM to the current resident set (``5`` to /proc/self/clear_refs); whether it
+    worked."""
+    try:
+        Path("/proc/self/clear_refs").write_text("5")
+    except OSError:
+        return False
+    return True
+
+
+def _maxrss_kb() -> int:
+    import resource
+
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss  # kB on Linux
+
+
+class Memory:
+    """Resident set before a step, and the peak and the resident set after it (bytes)."""
+
+    def __enter__(self):
+        gc.collect()
+        self.reset = _reset_peak()
+        self.before = (_status_kb("VmRSS") or 0) * 1024
+        return self
+
+    def __exit__(self, *exc):
+        peak_kb = _status_kb("VmHWM") if self.reset else None
+        self.peak = (peak_kb if peak_kb is not None else _maxrss_kb()) * 1024
+        self.after = (_status_kb("VmRSS") or 0) * 1024
+        return False
+
+    @property
+    def added_mb(self) -> float:
+        return max(self.peak - self.before, 0) / MB
+
+    @property
+    def kept_mb(self) -> float:
+        return (self.after - self.before) / MB

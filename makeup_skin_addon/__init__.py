@@ -12,6 +12,8 @@ its own, and only at module level (no import inside a function, no cycle):
    skin shader followed through mixes and groups, its albedo, normal and film normal carried.
 4. ``storage`` -- what the .blend keeps: bake records, re-bakes, packed images and their hashes.
    ``fits`` -- the session's tables and closure fits by bake key.
+   ``skin_sampling`` -- the mean of an image over a material's surface (points on its faces,
+   the image reduced), cached per mesh and per image.
    ``shade`` -- the settings as the model (roughness, IOR), the colour seen, the skin's own
    colour, Match Skin and the shade steps.
 5. ``nodes`` -- the node groups built from closure fits, and their records.

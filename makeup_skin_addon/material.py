@@ -28,7 +28,7 @@ import json
 
 import bpy
 
-from . import artist_skin, convert, fits, matching, nodes, scene_fit, shade, storage
+from . import artist_skin, convert, fits, matching, nodes, scene_fit, shade, skin_sampling, storage
 from .core import auto_tier, params_file, tiers
 from .keys import AUTO_KEY, ERRORS_KEY, MATERIAL_NAME, SETTINGS_VERSION, TIER_LABELS, group_name
 from .scene_fit import units_per_mm
@@ -296,6 +296,7 @@ def clear_cache() -> None:
     storage.clear_cache()
     shade.clear_cache()
     matching.clear_cache()
+    skin_sampling.clear_cache()
 
 
 def group_of(material):
@@ -461,7 +462,8 @@ def apply_to_object(context, obj, *, resolution=None) -> tuple:
     first = not settings.is_made_up or group_of(material) is None
     scene = context.scene
     report = Report()
-    reading = None if created else artist_skin.read_material(material, scene)
+    with skin_sampling.progress_bar(getattr(context, "window_manager", None)):
+        reading = None if created else artist_skin.read_material(material, scene)
     if reading is not None:
         _follow_shader(settings, reading, report)
     else:
@@ -470,7 +472,8 @@ def apply_to_object(context, obj, *, resolution=None) -> tuple:
     if first and settings.shade_source == "DEFAULT":
         # A shade never chosen: match the skin (the artist's first step), before the fit
         # measures the tiers at the absorption.
-        film, result = matching.first_shade(material, reading)
+        with skin_sampling.progress_bar(getattr(context, "window_manager", None)):
+            film, result = matching.first_shade(material, reading)
         if film is not None:
             with shade.assigning():
                 settings.foundation = film

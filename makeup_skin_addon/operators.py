@@ -13,7 +13,7 @@ from __future__ import annotations
 import bpy
 from bl_operators.presets import AddPresetBase
 
-from . import convert, live, matching, scene_fit
+from . import convert, live, matching, scene_fit, skin_sampling
 from . import material as made_up
 from .keys import OPERATOR_PREFIX, PRESET_SUBDIR, SETTINGS_ATTRIBUTE
 from .properties import RESOLUTION_ITEMS
@@ -253,7 +253,8 @@ def _set_shade(operator, context, solve) -> set:
     material = context.active_object.active_material
     try:
         made_up.refuse_linked(None, material)
-        result = solve(material)
+        with skin_sampling.progress_bar(context.window_manager):
+            result = solve(material)
     except (ValueError, RuntimeError) as error:
         operator.report({"ERROR"}, f"Made-up Skin: {_sentence(error)}")
         return {"CANCELLED"}

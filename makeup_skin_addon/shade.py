@@ -8,8 +8,8 @@
   colour the product has in the bottle, the thick layer of :mod:`lut_baker.model.thick_layer`
   against the exchange the measured presets were derived with (nothing is integrated).
 - The skin preset's own colour (:func:`skin_colour`): Skin Color's value or, when an image
-  texture feeds it, the mean of the image over the faces that use the material (area-weighted,
-  read at the faces' UVs, linearised from sRGB).
+  texture feeds it, the mean of the image over the faces that use the material
+  (:func:`.skin_sampling.surface_mean`: area-weighted, read at the faces' UVs, linear).
 - :func:`assigning`: settings the add-on assigns, not the user (the update callbacks leave the
   shade's origin alone).
 """
@@ -19,10 +19,9 @@ from __future__ import annotations
 import contextlib
 from dataclasses import dataclass
 
-import bpy
 import numpy as np
 
-from . import convert
+from . import convert, skin_sampling
 from .core import cache, presets, roughness, thick_layer
 
 __all__ = [
@@ -40,7 +39,6 @@ __all__ = [
     "preset_colour",
     "colour_note",
     "skin_colour",
-    "image_mean",
     "assigning",
     "is_assigning",
     "clear_cache",
@@ -59,9 +57,6 @@ takes under a second (docs/addon.md, "Skin Roughness")."""
 ROUGHNESS_TOLERANCE = 1e-5
 """A roughness this close to the preset's is the preset's (the panel stores float32)."""
 CHANNELS = ("Red", "Green", "Blue")
-SAMPLES = ((1 / 3, 1 / 3, 1 / 3), (2 / 3, 1 / 6, 1 / 6), (1 / 6, 2 / 3, 1 / 6),
-           (1 / 6, 1 / 6, 2 / 3))
-"""Barycentric points at which :func:`image_mean` reads each face's triangles."""
 _ROUGHENED = cache.LRUCache(32)
 _assigning = [0]
 
@@ -177,94 +172,6 @@ class SkinColour:
     source: str
 
 
-def _srgb_to_linear(values: np.ndarray) -> np.ndarray:
-    return np.where(values <= 0.04045, values / 12.92, ((values + 0.055) / 1.055) ** 2.4)
-
-
-def _image_pixels(image) -> tuple[np.ndarray, str]:
-    """``(pixels (height, width, 3) linear, note)`` of an image as its texture node reads it."""
-    width, height = image.size
-    channels = image.channels
-    pixels = np.empty(width * height * channels, np.float32)
-    image.pixels.foreach_get(pixels)
-    rgb = pixels.reshape(height, width, channels)[..., :3].astype(float)
-    if channels < 3:
-        rgb = np.repeat(pixels.reshape(height, width, channels)[..., :1], 3, axis=-1)
-    space = image.colorspace_settings.name
-    if image.is_float or space in {"Non-Color", "Linear Rec.709", "Linear", "Raw",
-                                   "Linear CIE-XYZ E", "Linear FilmLight E-Gamut"}:
-        return rgb, ""
-    note = "" if space == "sRGB" else f"; its colour space {space!r} was read as sRGB"
-    return _srgb_to_linear(rgb), note
-
-
-def _users(material) -> list:
-    return [obj for obj in bpy.data.objects if obj.type == "MESH"
-            and any(slot.material == material for slot in obj.material_slots)]
-
-
-def _face_samples(obj, material, uv_map: str):
-    """``(uv (T, S, 2), area (T,))`` at :data:`SAMPLES` of the triangles of ``obj``'s faces
-    that use ``material`` (world-space areas), or None."""
-    mesh = obj.data
-    slots = [i for i, slot in enumerate(obj.material_slots) if slot.material == material]
-    layer = mesh.uv_layers.get(uv_map) if uv_map else None
-    if layer is None:
-        layer = next((uv for uv in mesh.uv_layers if uv.active_render), None)
-    if layer is None or not slots:
-        return None
-    mesh.calc_loop_triangles()
-    count = len(mesh.loop_triangles)
-    loops = np.empty(count * 3, np.int64)
-    mesh.loop_triangles.foreach_get("loops", loops)
-    index = np.empty(count, np.int64)
-    mesh.loop_triangles.foreach_get("material_index", index)
-    keep = np.isin(index, slots)
-    loops = loops.reshape(count, 3)[keep]
-    uv = np.empty(len(mesh.loops) * 2, np.float32)
-    layer.data.foreach_get("uv", uv)
-    uv = uv.reshape(-1, 2)[loops]  # (T, 3, 2)
-    vertex = np.empty(len(mesh.loops), np.int64)
-    mesh.loops.foreach_get("vertex_index", vertex)
-    position = np.empty(len(mesh.vertices) * 3, np.float32)
-    mesh.vertices.foreach_get("co", position)
-    matrix = np.array(obj.matrix_world)
-    position = position.reshape(-1, 3) @ matrix[:3, :3].T
-    corners = position[vertex[loops]]  # (T, 3, 3)
-    area = 0.5 * np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0],
-                                         corners[:, 2] - corners[:, 0]), axis=-1)
-    weights = np.asarray(SAMPLES)  # (S, 3)
-    return np.einsum("sk,tkc->tsc", weights, uv), area
-
-
-def image_mean(image, material, *, uv_map: str = "", extension: str = "REPEAT"):
-    """``(rgb, faces, note)``: the mean of ``image`` (linear) over the faces that use
-    ``material`` on every mesh object, weighted by their area, read at :data:`SAMPLES` of each
-    triangle at the UV map ``uv_map`` (the active render map when empty) with the texture's
-    ``extension``; None for ``rgb`` when no face uses it."""
-    if not image.has_data and (image.size[0] == 0 or image.size[1] == 0):
-        return None, 0, f"; image {image.name!r} has no pixels (its file is missing)"
-    pixels, note = _image_pixels(image)
-    height, width = pixels.shape[:2]
-    total, weight, faces = np.zeros(3), 0.0, 0
-    for obj in _users(material):
-        samples = _face_samples(obj, material, uv_map)
-        if samples is None:
-            continue
-        uv, area = samples
-        if extension == "REPEAT":
-            uv = uv - np.floor(uv)
-        column = np.clip((uv[..., 0] * width).astype(np.int64), 0, width - 1)
-        row = np.clip((uv[..., 1] * height).astype(np.int64), 0, height - 1)
-        values = pixels[row, column].mean(axis=1)  # (T, 3)
-        total += area @ values
-        weight += float(area.sum())
-        faces += len(obj.data.polygons)
-    if weight <= 0.0:
-        return None, 0, note
-    return total / weight, faces, note
-
-
 def _image_feeding(socket):
     """``(image texture node, route)`` feeding ``socket`` through reroutes, or, further up,
     the first image texture behind colour nodes (route: their names), or ``(None, ...)``."""
@@ -304,8 +211,8 @@ def _uv_map(texture) -> tuple[str, str]:
 def skin_colour(material) -> SkinColour:
     """The diffuse albedo of the skin preset's made-up skin (a material without a shader of
     the artist's; over one, :mod:`.artist_skin` reads the skin): what feeds the group's Skin
-    Color, an image texture's mean over the faces that use the material (:func:`image_mean`),
-    else Skin Color's value."""
+    Color, an image texture's mean over the faces that use the material
+    (:func:`.skin_sampling.surface_mean`), else Skin Color's value."""
     settings = material.makeup_skin
     value = SkinColour(np.asarray(settings.skin_colour, float), "Skin Color's value")
     node = convert.group_node(material)
@@ -318,15 +225,16 @@ def skin_colour(material) -> SkinColour:
                         f"this does not read)" if route else value.source)
         return value
     uv_map, uv_note = _uv_map(texture)
-    rgb, faces, note = image_mean(texture.image, material, uv_map=uv_map,
-                                  extension=texture.extension)
-    if rgb is None:
-        why = note.lstrip("; ") or f"no face uses {material.name!r}"
-        value.source = f"Skin Color's value ({why})"
+    mean = skin_sampling.surface_mean(texture.image, material, uv_map=uv_map,
+                                      extension=texture.extension, reader=texture.name)
+    if mean.rgb is None:
+        value.source = f"Skin Color's value ({mean.problem})"
         return value
     through = f" through {', '.join(repr(n) for n in route)}" if route else ""
-    return SkinColour(rgb, f"the mean of image {texture.image.name!r} over the {faces} faces "
-                           f"that use {material.name!r}{through}{note}{uv_note}")
+    note = "".join(f"; {n}" for n in mean.notes)
+    return SkinColour(mean.rgb, f"the mean of image {texture.image.name!r} over the "
+                                f"{mean.faces} faces that use {material.name!r}{through}{note}"
+                                f"{uv_note}")
 
 
 @contextlib.contextmanager

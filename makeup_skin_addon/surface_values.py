@@ -122,8 +122,10 @@ class _Evaluator:
     def uv(self, node, name: str) -> np.ndarray:
         uv = self.samples.uv(name)
         if uv is None:
-            sentence = (f"the meshes have no UV map {name!r} (read by {node.name!r})" if name
-                        else f"the meshes have no UV map (read by {node.name!r})")
+            owner = getattr(self.samples, "missing", {}).get(name)
+            owner = repr(owner) if owner else "the mesh"
+            sentence = (f"{owner} has no UV map {name!r} (read by {node.name!r})" if name
+                        else f"{owner} has no UV map (read by {node.name!r})")
             if sentence not in self.notes:
                 self.notes.append(sentence)
             return np.zeros((1, 3))

@@ -55,6 +55,7 @@ LAYERS: dict[str, list[tuple[str, ...]]] = {
         ("makeup_skin_addon.convert",),
         ("makeup_skin_addon.storage",),
         ("makeup_skin_addon.fits",),
+        ("makeup_skin_addon.skin_sampling",),
         ("makeup_skin_addon.shade",),
         ("makeup_skin_addon.node_algebra",),
         ("makeup_skin_addon.nodes",),
