@@ -90,11 +90,17 @@ class SkinReading:
     notes: list = field(default_factory=list)
 
     def factor_of(self, leaf: Leaf) -> np.ndarray | None:
-        """The body factor of ``leaf`` (RGB), or None if it has no body."""
+        """The body factor of ``leaf`` (RGB; the same node reached through the same groups,
+        read again or not), or None if it has no body."""
+        key = _leaf_key(leaf)
         for reading in self.leaves:
-            if reading.leaf is leaf:
+            if _leaf_key(reading.leaf) == key:
                 return reading.factor
         return None
+
+
+def _leaf_key(leaf: Leaf) -> tuple:
+    return leaf.node.as_pointer(), tuple(group.as_pointer() for group in leaf.groups)
 
 
 def _input(node, identifier: str):
@@ -150,9 +156,12 @@ def _leaf_reading(leaf: Leaf, share: float, samples, notes, warnings, engine) ->
         base, body, total = colour, np.zeros(3), colour
         values = None
     else:
-        warnings.append(f"{node.name!r} ({node.bl_label}) is rendered as it is where the film "
-                        f"does not cover, but not followed under it: the skin under the film "
-                        f"leaves its {100 * share:.0f}% out")
+        if node.type == "EMISSION" and _mean(node, "Strength", leaf.groups, samples,
+                                             notes) == 0.0:
+            return None, None  # adds nothing
+        warnings.append(f"{node.name!r} ({node.bl_label}, weight {share:.2g} in the shader) is "
+                        f"rendered as it is where the film does not cover, but not followed "
+                        f"under it")
         return None, None
     factor = np.where(base > 1e-4, body / np.maximum(base, 1e-4), 0.0)
     return LeafReading(leaf, share, base, body, total, factor), values
@@ -181,6 +190,10 @@ def read_skin(tree, samples, engine: str = "CYCLES") -> SkinReading:
     skins = [r for r in readings if r.leaf.role == "skin"]
     dominant = max(skins, key=lambda r: (r.share, r.leaf.node.type == "BSDF_PRINCIPLED"),
                    default=None)
+    notes += [n for n in getattr(samples, "notes", []) if n not in notes]
+    problem = getattr(samples, "problem", "")
+    if problem:
+        notes.insert(0, f"{problem}: the shader's inputs are read at UV (0, 0)")
     reading = SkinReading(readings, dominant.leaf if dominant else None, target, body,
                           warnings=warnings, notes=notes)
     if dominant is None:

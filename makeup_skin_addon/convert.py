@@ -207,6 +207,16 @@ def _mix_colour(nodes: _SkinNodes, blend: str, factor, a, b, label: str):
         f = float(np.clip(float(factor), 0.0, 1.0))
         a, b = _rgb(a), _rgb(b)
         return {"MIX": a + f * (b - a), "ADD": a + b, "MULTIPLY": a * b}[blend]
+
+    def constant(value, number: float) -> bool:
+        return not _is_socket(value) and bool(np.all(_rgb(value) == number))
+
+    if blend == "ADD" and constant(b, 0.0) or blend == "MULTIPLY" and constant(b, 1.0):
+        return a
+    if blend == "ADD" and constant(a, 0.0):
+        return b
+    if blend == "MIX" and not _is_socket(factor) and float(factor) in (0.0, 1.0):
+        return a if float(factor) <= 0.0 else b
     node = nodes.node("ShaderNodeMix", label, data_type="RGBA", blend_type=blend)
     node.clamp_factor = True
     for identifier, value in (("Factor_Float", factor), ("A_Color", a), ("B_Color", b)):

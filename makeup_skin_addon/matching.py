@@ -72,11 +72,12 @@ def skin_target(material, reading=None, light=None) -> SkinTarget:
     given); the skin preset's made-up skin matches its own bare skin (Skin Color, or the mean
     of the image feeding it, with the preset's gloss, ``light``)."""
     settings = material.makeup_skin
-    if reading is None and settings.over_shader:
+    if reading is None:
         reading = artist_skin.read_material(material)
     if reading is not None and reading.dominant is not None:
+        notes = "".join(f"; {note}" for note in reading.notes)
         return SkinTarget(np.asarray(reading.target, float), np.asarray(reading.body, float),
-                          "the artist's shader under uniform light")
+                          f"the artist's shader under uniform light{notes}")
     skin = shade.skin_colour(material)
     light = light_for(settings) if light is None else light
     bare = uniform_light.bare_colour(light, skin.rgb, float(settings.gloss))

@@ -211,7 +211,7 @@ class MakeupSkinSettings(bpy.types.PropertyGroup):
         default="DEFAULT", description="Where the shade came from (internal)")
     shade_base: bpy.props.FloatVectorProperty(
         name="Shade Base", size=3, default=(0.0, 0.0, 0.0), min=0.0,
-        description="The covered colour the last Match Skin aimed at, from which Lighter and "
+        description="The covered color the last Match Skin aimed at, from which Lighter and "
                     "Darker count their steps (internal)")
     shade_steps: bpy.props.IntProperty(
         name="Shade Steps", default=0,

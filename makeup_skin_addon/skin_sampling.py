@@ -614,11 +614,15 @@ class SurfaceSamples:
     """The points of a material's surface as :mod:`.surface_values` evaluates the artist's
     shader at them (:class:`.surface_values.Samples`): the same points (faces and places in
     them: the seed and the areas fix them) at every UV map, ``weights`` (each point's share of
-    the area), image values read from the reduced image (:func:`reduced_image`)."""
+    the area), image values read from the reduced image (:func:`reduced_image`).
+
+    An object without a UV map a texture reads is left out for that map (said in ``notes``);
+    with no face to read (``problem`` says why: no object, no face of the material, no UV
+    map), one point at UV (0, 0) stands for the surface."""
 
     def __init__(self, material, budget: int = BUDGET):
         self.material = material
-        self.objects = [obj for obj in users(material)]
+        self.objects = users(material)
         for obj in self.objects:
             if obj.mode == "EDIT":
                 obj.update_from_editmode()
@@ -627,37 +631,49 @@ class SurfaceSamples:
         self.count = 0
         self.weights: np.ndarray | None = None
         self.notes: list[str] = []
-        self.missing: dict = {}
         self.problem = "" if self.objects else f"no mesh object uses {material.name!r}"
 
-    def uv(self, name: str) -> np.ndarray | None:
-        """``(count, 2)`` UVs of the map ``name`` (``""``: each mesh's active render map), or
-        None when a mesh using the material lacks it (``missing[name]``: that object's
-        name)."""
+    def _note(self, sentence: str) -> None:
+        if sentence and sentence not in self.notes:
+            self.notes.append(sentence)
+
+    def uv(self, name: str, reader: str = "") -> np.ndarray:
+        """``(count, 2)`` UVs of the map ``name`` (``""``: each mesh's active render map);
+        the objects without it are left out (noted)."""
         if name in self._uv:
             return self._uv[name]
-        surfaces = []
+        surfaces, missing = [], []
         for obj in self.objects:
             layer = _uv_layer(obj.data, name)
             if layer is None:
-                self.missing[name] = obj.name
-                return self._remember(name, None)
-            surfaces.append(_Surface(obj, self.material, layer))
+                missing.append(_missing_uv(obj, name, reader))
+            else:
+                surfaces.append(_Surface(obj, self.material, layer))
         counts = _shares([surface.area() for surface in surfaces], self.budget)
         picked = [(surface.points(n), n) for surface, n in zip(surfaces, counts, strict=True)
                   if n > 0]
         if not picked:
-            return self._remember(name, None)
+            faces = sum(surface.areas()[1] for surface in surfaces)
+            if missing and not surfaces:
+                self._note(f"{'; '.join(missing)}: read at UV (0, 0)")
+            elif self.objects:
+                self.problem = (f"no face uses {self.material.name!r}" if not faces else
+                                f"the {faces} faces that use {self.material.name!r} have no "
+                                f"area")
+            return self._remember(name, np.zeros((1, 2)), np.ones(1))
+        for sentence in missing:
+            self._note(f"{sentence}: left out")
         uv = np.concatenate([points.uv for points, _ in picked]).astype(float)
-        if self.weights is None:
-            self.weights = np.concatenate([np.full(len(points.uv), points.area / max(n, 1))
-                                           for points, n in picked])
-            self.count = len(uv)
-        elif len(uv) != self.count:
-            return self._remember(name, None)
-        return self._remember(name, uv)
+        weights = np.concatenate([np.full(len(points.uv), points.area / n)
+                                  for points, n in picked])
+        return self._remember(name, uv, weights)
 
-    def _remember(self, name: str, uv):
+    def _remember(self, name: str, uv, weights):
+        if self.weights is None:
+            self.weights, self.count = weights, len(uv)
+        elif len(uv) != self.count:  # the objects left out differ between maps
+            uv = np.broadcast_to(uv.mean(axis=0), (self.count, 2))
+            self._note(f"UV map {name!r} read at its mean (not every object has it)")
         self._uv[name] = uv
         return uv
 
@@ -665,12 +681,9 @@ class SurfaceSamples:
         """``(count, 4)`` linear RGBA of ``image`` at ``uv`` (alpha 1)."""
         reduced = reduced_image(image)
         if reduced.pixels is None:
-            sentence = reduced.problem
-            if sentence not in self.notes:
-                self.notes.append(sentence)
+            self._note(reduced.problem)
             return np.zeros((len(uv), 4))
-        if reduced.note and reduced.note not in self.notes:
-            self.notes.append(reduced.note)
+        self._note(reduced.note)
         rgb = read_texels(reduced.pixels, uv, extension)
         return np.concatenate([rgb, np.ones((len(rgb), 1))], axis=1)
 

@@ -40,26 +40,34 @@ class Samples(Protocol):
 
     count: int
 
-    def uv(self, name: str) -> np.ndarray | None:
-        """``(count, 2)`` UVs of the map ``name`` (``""``: the active render map), or None
-        when the meshes lack it."""
+    def uv(self, name: str, reader: str = "") -> np.ndarray:
+        """``(count, 2)`` UVs of the map ``name`` (``""``: the active render map) read by the
+        node named ``reader`` (for the notes)."""
 
     def image(self, image, uv: np.ndarray, extension: str) -> np.ndarray:
         """``(count, 4)`` linear RGBA of ``image`` at ``uv``, as an Image Texture reads it."""
 
 
 def _colour(value) -> np.ndarray:
-    array = np.asarray(value, float).reshape(1, -1)
+    """A value as colours ``(n, 3)``: an array of values per sample as it is (a float per
+    sample grey), a constant (a number, a tuple) as one row."""
+    array = np.asarray(value, float)
+    if array.ndim < 2:
+        array = array.reshape(1, -1)
     if array.shape[1] == 1:
         return np.repeat(array, 3, axis=1)
     return array[:, :3]
 
 
 def _float(value) -> np.ndarray:
+    """A value as floats ``(n, 1)``: a colour's luminance (Blender's conversion), a vector's
+    mean, a constant as one row."""
     array = np.asarray(value, float)
-    if array.ndim == 2 and array.shape[1] == 3:  # a colour read as a float: its luminance
-        return (array @ np.array([0.2126, 0.7152, 0.0722]))[:, None]
-    return array.reshape(-1, 1) if array.ndim < 2 else array[:, :1]
+    if array.ndim < 2:
+        array = array.reshape(1, -1)
+    if array.shape[1] >= 3:
+        return (array[:, :3] @ np.array([0.2126, 0.7152, 0.0722]))[:, None]
+    return array[:, :1]
 
 
 def _as(kind: str, value) -> np.ndarray:
@@ -70,6 +78,7 @@ class _Evaluator:
     def __init__(self, samples: Samples, notes: list):
         self.samples, self.notes = samples, notes
         self.memo: dict = {}
+        self.readers: list[str] = []  # the image textures whose coordinates are evaluated
 
     def note(self, node, what: str) -> np.ndarray:
         sentence = f"{node.name!r} ({what}) is not evaluated: taken as {NEUTRAL:g}"
@@ -120,15 +129,7 @@ class _Evaluator:
         return self.uv(node, "")
 
     def uv(self, node, name: str) -> np.ndarray:
-        uv = self.samples.uv(name)
-        if uv is None:
-            owner = getattr(self.samples, "missing", {}).get(name)
-            owner = repr(owner) if owner else "the mesh"
-            sentence = (f"{owner} has no UV map {name!r} (read by {node.name!r})" if name
-                        else f"{owner} has no UV map (read by {node.name!r})")
-            if sentence not in self.notes:
-                self.notes.append(sentence)
-            return np.zeros((1, 3))
+        uv = self.samples.uv(name, self.readers[-1] if self.readers else node.name)
         return np.concatenate([uv, np.zeros((len(uv), 1))], axis=1)
 
     def node_group(self, node, socket, groups):
@@ -146,8 +147,12 @@ class _Evaluator:
         if node.image is None:
             return np.zeros((1, 3)) if socket.name == "Color" else np.zeros((1, 1))
         vector = node.inputs["Vector"]
-        uv = (self.input(node, "Vector", groups, "VECTOR")[:, :2] if vector.is_linked
-              else self.uv(node, "")[:, :2])
+        self.readers.append(node.name)
+        try:
+            uv = (self.input(node, "Vector", groups, "VECTOR")[:, :2] if vector.is_linked
+                  else self.uv(node, "")[:, :2])
+        finally:
+            self.readers.pop()
         if uv.shape[0] != self.samples.count:
             uv = np.broadcast_to(uv, (self.samples.count, 2))
         rgba = self.samples.image(node.image, uv, node.extension)

@@ -1,14 +1,30 @@
-"""Made-up Skin in the artist's own material (makeup_skin_addon.convert), on the textured head
-of tests/support/character.py: Apply converts the material in place and carries the albedo and
-the normal map over, through Mix and Add Shaders and node groups, takes an unlinked Base
-Color's value, says what it could not carry, gives the film a weaker copy of the skin's normal
-map; Revert restores it."""
+"""Made-up Skin over the artist's own material (makeup_skin_addon.convert), on the textured head
+of tests/support/character.py: Apply keeps the artist's shader as the bare skin (linked into
+the group's Skin Shader), feeds the skin under the film from it (its Base Color's source scaled
+by what the shader renders of it, mixed as its Mix Shaders mix, brought out of node groups by
+copies, the artist's groups untouched), its normal map and a weaker copy for the film, says
+what it could not follow; a material without a shader of the artist's gets the skin preset;
+Revert restores the tree."""
 
+import numpy as np
 import pytest
 from support.addon_steps import apply_operator, apply_pipeline, group_node, tree_state
 
 
-def test_apply_converts_the_artists_material_in_place(head):
+def _owned(material):
+    return [n for n in material.node_tree.nodes if n.get("makeup_skin_owned")]
+
+
+def _body_colour_node(group):
+    """The node feeding the group's Skin Color (the skin under the film's body color)."""
+    return group.inputs["Skin Color"].links[0].from_node
+
+
+def _input(node, identifier):
+    return next(s for s in node.inputs if s.identifier == identifier)
+
+
+def test_apply_goes_over_the_artists_shader(head):
     import bpy
 
     material = head.active_material
@@ -20,13 +36,24 @@ def test_apply_converts_the_artists_material_in_place(head):
     group = group_node(material)
     output = material.node_tree.get_output_node("ALL")
     assert output.inputs["Surface"].links[0].from_node == group
-    # The artist's shader stays, framed and disconnected, its own links intact.
-    assert principled.parent is not None and principled.parent.label.startswith("Before Made-up")
-    assert not principled.outputs[0].is_linked
+    # The artist's shader is the bare skin: linked, unframed, its own links intact.
+    assert group.inputs["Skin Shader"].links[0].from_node == principled
+    assert principled.parent is None
     assert principled.inputs["Base Color"].links[0].from_socket == albedo
-    # Albedo and normal map carried over to the group.
-    assert group.inputs["Skin Color"].links[0].from_socket == albedo
+    # Under the film: the albedo texture times what the shader renders of it (a Mix node,
+    # multiply, its factor the body color over the Base Color: below 1, about 0.9-1).
+    body = _body_colour_node(group)
+    assert body.get("makeup_skin_owned") and body.blend_type == "MULTIPLY"
+    assert _input(body, "A_Color").links[0].from_socket == albedo
+    factor = np.array(_input(body, "B_Color").default_value[:3])
+    assert np.all((factor > 0.7) & (factor < 1.0)), factor
     assert group.inputs["Normal"].links[0].from_socket == normal
+    radius = np.array(principled.inputs["Subsurface Radius"].default_value)
+    scale = principled.inputs["Subsurface Scale"].default_value
+    np.testing.assert_allclose(group.inputs["Subsurface Radius"].default_value, radius * scale,
+                               rtol=1e-6)
+    assert group.inputs["Subsurface Weight"].default_value == pytest.approx(
+        principled.inputs["Subsurface Weight"].default_value)
     # The film gets a copy of the skin's Normal Map at half its strength (pores softened).
     film = group.inputs["Film Normal"].links[0].from_node
     assert film.name == "Made-up Skin Film Normal" and film.type == "NORMAL_MAP"
@@ -105,46 +132,78 @@ def _skin_shader_tree(material, kind):
     return albedo, normal
 
 
-@pytest.mark.parametrize("kind", ["mix", "group"])
-def test_the_skin_shader_is_found_behind_mixes_and_groups(head, kind):
-    """Principled + 10% Translucent (a skin with a little translucency), and a Principled
-    inside a node group (with an Add Shader) fed from outside: albedo and normal map carried
-    over."""
+def test_behind_a_mix_shader_the_skin_under_the_film_mixes_as_the_shader_does(head):
+    """Principled + 10% Translucent: the skin under the film is the Principled's body color
+    at 90% (the translucency is rendered bare, not followed under the film: a warning)."""
     material = head.active_material
-    albedo, normal = _skin_shader_tree(material, kind)
-    material, messages = apply_pipeline(head, tier="LAYERED")
+    albedo, normal = _skin_shader_tree(material, "mix")
+    material, report = apply_pipeline(head, tier="LAYERED")
     group = group_node(material)
-    assert group.inputs["Skin Color"].links[0].from_socket == albedo
+    assert group.inputs["Skin Shader"].links[0].from_node.type == "MIX_SHADER"
+    mix = _body_colour_node(group)
+    assert mix.blend_type == "MIX"
+    assert _input(mix, "Factor_Float").default_value == pytest.approx(0.1)
+    body = _input(mix, "A_Color").links[0].from_node
+    assert _input(body, "A_Color").links[0].from_socket == albedo
+    assert tuple(_input(mix, "B_Color").default_value)[:3] == (0.0, 0.0, 0.0)
     assert group.inputs["Normal"].links[0].from_socket == normal
-    assert any("linked Base Color -> Skin Color, Normal -> Normal" in m for m in messages)
-    assert not any("Not carried over" in m for m in messages)
+    assert [w for w in report.warnings if "Translucent" in w and "weight 0.1 " in w]
 
 
-def test_an_unlinked_base_colour_becomes_the_skin_colour(head):
+def test_inside_a_node_group_what_feeds_the_skin_is_followed(head):
+    """The Principled inside the artist's node group, its Base Color and Normal from the
+    group's inputs linked outside: followed out to the albedo and the normal map."""
+    material = head.active_material
+    albedo, normal = _skin_shader_tree(material, "group")
+    material, report = apply_pipeline(head, tier="LAYERED")
+    group = group_node(material)
+    assert _input(_body_colour_node(group), "A_Color").links[0].from_socket == albedo
+    assert group.inputs["Normal"].links[0].from_socket == normal
+    assert not report.warnings
+
+
+def test_a_texture_inside_the_artists_group_is_copied_out_and_the_group_untouched(head):
+    import bpy
+
+    material = head.active_material
+    _skin_shader_tree(material, "inside")
+    artist_group = bpy.data.node_groups["Skin Shader"]
+    inside = sorted((n.name, n.bl_idname) for n in artist_group.nodes), len(artist_group.links)
+    material, report = apply_pipeline(head, tier="LAYERED")
+    assert (sorted((n.name, n.bl_idname) for n in artist_group.nodes),
+            len(artist_group.links)) == inside
+    copy = _input(_body_colour_node(group_node(material)), "A_Color").links[0].from_node
+    assert copy.type == "TEX_IMAGE" and copy.get("makeup_skin_owned")
+    assert copy.image == material.node_tree.nodes["Albedo"].image
+    assert copy.parent is not None and copy.parent.name == "Made-up Skin: skin under the film"
+    assert not report.warnings
+
+
+def test_an_unlinked_base_colour_gives_a_value(head):
+    """Base Color (0.6, 0.4, 0.3) unlinked: the skin under the film is a value, that color
+    times what the shader renders of it."""
+    from makeup_skin_addon import artist_skin
+
     material = head.active_material
     _skin_shader_tree(material, "value")
-    material, messages = apply_pipeline(head, tier="LAYERED")
-    assert tuple(material.makeup_skin.skin_colour) == pytest.approx((0.6, 0.4, 0.3), abs=1e-6)
-    assert tuple(group_node(material).inputs["Skin Color"].default_value)[:3] == pytest.approx(
-        (0.6, 0.4, 0.3), abs=1e-6)
-    assert any("Skin Color is the value of its Base Color (0.600, 0.400, 0.300)" in m
-               for m in messages)
-
-
-@pytest.mark.parametrize("kind", ["inside", "emission"])
-def test_what_cannot_be_carried_is_named(head, kind):
-    material = head.active_material
-    _skin_shader_tree(material, kind)
-    material, messages = apply_pipeline(head, tier="LAYERED")
+    reading = artist_skin.read_material(material)
+    material, _ = apply_pipeline(head, tier="LAYERED")
     group = group_node(material)
     assert not group.inputs["Skin Color"].is_linked
-    sentence = next(m for m in messages if m.startswith("Not carried over"))
-    assert "Skin Color" in sentence
-    if kind == "inside":
-        assert "inside node group 'Skin Shader'" in sentence
-        assert group.inputs["Normal"].is_linked  # the normal comes from outside: carried
-    else:
-        assert "no Principled or Diffuse BSDF" in sentence and "Normal" in sentence
+    np.testing.assert_allclose(group.inputs["Skin Color"].default_value[:3], reading.body,
+                               rtol=1e-6)
+    np.testing.assert_allclose(reading.leaves[0].base, (0.6, 0.4, 0.3), rtol=1e-6)
+
+
+def test_a_shader_without_skin_is_kept_and_named(head):
+    """An Emission alone: it stays the bare skin; the skin under the film is the skin preset's,
+    and the report warns and says so."""
+    material = head.active_material
+    _skin_shader_tree(material, "emission")
+    material, report = apply_pipeline(head, tier="LAYERED")
+    group = group_node(material)
+    assert group.inputs["Skin Shader"].links[0].from_node.type == "EMISSION"
+    assert any("no skin BSDF" in w and "skin preset" in w for w in report.warnings)
 
 
 def test_an_object_without_material_gets_one_and_is_told(addon, blank_scene):
@@ -156,6 +215,21 @@ def test_an_object_without_material_gets_one_and_is_told(addon, blank_scene):
     assert obj.active_material == material and material.name == "Made-up Skin"
     assert messages[0] == ("'Sphere' had no material: created 'Made-up Skin' with the skin "
                            "preset's Skin Color.")
+    assert "Skin Shader" not in group_node(material).inputs  # the preset's bare skin
+
+
+def test_blenders_untouched_default_shader_is_no_skin_of_the_artists(addon, blank_scene):
+    """A new material's own Principled BSDF, untouched: the skin preset's made-up skin, the
+    default shader kept framed and disconnected."""
+    import bpy
+
+    bpy.ops.mesh.primitive_uv_sphere_add(radius=0.03)
+    obj = bpy.context.active_object
+    material, _ = apply_pipeline(obj, tier="LAYERED")
+    group = group_node(material)
+    assert "Skin Shader" not in group.inputs
+    principled = next(n for n in material.node_tree.nodes if n.type == "BSDF_PRINCIPLED")
+    assert not principled.outputs[0].is_linked and principled.parent is not None
 
 
 def _apply_without_material(obj):
@@ -173,9 +247,10 @@ def test_revert_restores_the_previous_surface(head):
     material = head.active_material
     before = tree_state(material)
     apply_operator(head)
+    assert _owned(material)
     assert bpy.ops.makeup_skin.revert() == {"FINISHED"}
     assert tree_state(material) == before
-    assert not material.makeup_skin.is_made_up
+    assert not material.makeup_skin.is_made_up and not _owned(material)
     assert bpy.ops.makeup_skin.revert.poll() is False  # nothing left to revert
     apply_operator(head)  # and again: converts once more
     assert group_node(material).inputs["Skin Color"].is_linked

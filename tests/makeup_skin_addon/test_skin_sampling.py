@@ -125,9 +125,9 @@ def test_the_heads_mean_is_within_its_sampling_error(head):
     of its standard errors of the exact mean (:func:`support.exact_mean.exact_mean`), channel
     by channel (measured: 0.3-0.6 of one);
     read through a copy reduced to 128 px (a box filter in sRGB bytes, then linearised),
-    within 0.2% (measured: 0.03-0.06%); the mean found by :func:`.shade.skin_colour` is this
-    one."""
-    from makeup_skin_addon import shade, skin_sampling
+    within 0.2% (measured: 0.03-0.06%); the Base Color the artist's shader is read with
+    (:func:`.artist_skin.read_material`) is this mean."""
+    from makeup_skin_addon import artist_skin, skin_sampling
 
     material = head.active_material
     texture = material.node_tree.nodes["Albedo"]
@@ -141,10 +141,9 @@ def test_the_heads_mean_is_within_its_sampling_error(head):
     assert np.all(np.abs(mean.rgb - exact) < 4 * mean.error), (mean.rgb, exact, mean.error)
     reduced = skin_sampling.surface_mean(texture.image, material, size=128)
     np.testing.assert_allclose(reduced.rgb, exact, rtol=2e-3)
-    found = shade.skin_colour(material)
-    np.testing.assert_allclose(found.rgb, mean.rgb, rtol=1e-12)
-    assert found.source.startswith(f"the mean of image {texture.image.name!r} over the 500 "
-                                   f"faces that use {material.name!r}")
+    reading = artist_skin.read_material(material)
+    np.testing.assert_allclose(reading.leaves[0].base, mean.rgb, rtol=1e-9)
+    assert reading.notes == []
 
 
 def test_the_same_mesh_gives_the_same_points(head):
@@ -257,10 +256,13 @@ def test_nothing_is_left_in_the_file(head):
     assert tuple(image.size) == size and not image.is_dirty
 
 
-def _source(material):
-    from makeup_skin_addon import shade
+SOURCE = "the artist's shader under uniform light"
 
-    return shade.skin_colour(material).source
+
+def _source(material):
+    from makeup_skin_addon import matching
+
+    return matching.skin_target(material).source
 
 
 def test_messages(two_faces):
@@ -274,8 +276,8 @@ def test_messages(two_faces):
     uv_node = skin.node_tree.nodes.new("ShaderNodeUVMap")
     uv_node.uv_map = "UVMap.001"
     skin.node_tree.links.new(uv_node.outputs["UV"], texture.inputs["Vector"])
-    assert _source(skin) == (f"Skin Color's value ('Two Faces' has no UV map 'UVMap.001' "
-                             f"(read by {texture.name!r}))")
+    assert _source(skin) == (f"{SOURCE}; 'Two Faces' has no UV map 'UVMap.001' (read by "
+                             f"{texture.name!r}): read at UV (0, 0)")
     skin.node_tree.links.remove(texture.inputs["Vector"].links[0])
     bare = _two_faces(skin)
     bare.name = "Bare"
@@ -284,22 +286,24 @@ def test_messages(two_faces):
     bpy.data.objects.remove(bare)
     for polygon in obj.data.polygons:
         polygon.material_index = 1
-    assert _source(skin) == "Skin Color's value (no face uses 'Skin')"
+    assert _source(skin) == (f"{SOURCE}; no face uses 'Skin': the shader's inputs are read at "
+                             f"UV (0, 0)")
     for polygon in obj.data.polygons:
         polygon.material_index = 0
     obj.data.uv_layers.remove(obj.data.uv_layers[0])
-    assert _source(skin) == f"Skin Color's value ('Two Faces' has no UV map (read by " \
-                            f"{texture.name!r}))"
+    assert _source(skin) == (f"{SOURCE}; 'Two Faces' has no UV map (read by {texture.name!r}):"
+                             f" read at UV (0, 0)")
     obj.data.materials.clear()
-    assert _source(skin) == "Skin Color's value (no mesh object uses 'Skin')"
+    assert _source(skin) == (f"{SOURCE}; no mesh object uses 'Skin': the shader's inputs are "
+                             f"read at UV (0, 0)")
     obj.data.materials.append(skin)
     obj.data.uv_layers.new(name="UVMap")
     missing = bpy.data.images.new("Gone", 4, 4)
     missing.source = "FILE"  # no file behind it: no pixels
     missing.filepath = "//gone.png"
     texture.image = missing
-    assert _source(skin) == "Skin Color's value (image 'Gone' has no pixels (its file " \
-                            "'//gone.png' is missing))"
+    assert _source(skin) == f"{SOURCE}; image 'Gone' has no pixels (its file '//gone.png' is " \
+                            f"missing)"
 
 
 def test_progress_is_reported_only_when_something_is_read(two_faces, tmp_path):

@@ -70,13 +70,16 @@ def test_panel_says_when_the_file_was_repaired_on_opening(head, tmp_path):
 
 
 def test_panel_shows_the_shade_buttons_and_what_is_out_of_reach(head):
-    """Match Skin, Lighter and Darker beside the shade; after the first Apply matched the head
-    (whose red the film cannot reach) the panel says so in words, read from what Apply
+    """Match Skin, Lighter and Darker beside the shade; after the first Apply matched a fair
+    head (whose red the film cannot reach) the panel says so in words, read from what Apply
     stored; a matte product's Film Roughness says it has no gloss to roughen."""
     import bpy
+    from support import character
 
     from makeup_skin_addon import ui
 
+    fair = character.skin_albedo_image(0, tone="lighter")
+    head.active_material.node_tree.nodes["Albedo"].image = fair
     material = apply_operator(head)
     layout = RecordingLayout()
     ui.draw_settings(layout, bpy.context)

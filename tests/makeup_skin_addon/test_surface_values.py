@@ -1,0 +1,133 @@
+"""What feeds an input evaluated at points of the surface (makeup_skin_addon.surface_values):
+the common colour nodes as Blender computes them, an image at its UVs, node groups, and a node
+it cannot evaluate taken as 0.5 with a note."""
+
+import numpy as np
+import pytest
+
+
+class Points:
+    """Three points whose UVs fall in three columns of a 3 x 1 image."""
+
+    count = 3
+    weights = None
+
+    def __init__(self):
+        self.uv_read = []
+
+    def uv(self, name, reader=""):
+        self.uv_read.append(name)
+        return np.array([[0.1, 0.5], [0.5, 0.5], [0.9, 0.5]])
+
+    def image(self, image, uv, extension):
+        columns = (uv[:, 0] * 3).astype(int)
+        palette = np.array([[0.2, 0.4, 0.6, 1.0], [0.4, 0.4, 0.4, 1.0], [0.9, 0.1, 0.3, 1.0]])
+        return palette[columns]
+
+
+def _source_of(socket):
+    from makeup_skin_addon import artist_shader
+
+    return artist_shader.source(socket, ())
+
+
+@pytest.fixture
+def tree(addon, blank_scene):
+    import bpy
+
+    group = bpy.data.node_groups.new("Evaluated", "ShaderNodeTree")
+    target = group.nodes.new("ShaderNodeBsdfDiffuse")
+    return group, target.inputs["Color"]
+
+
+def test_an_image_tinted_by_a_multiply_mix(tree):
+    import bpy
+
+    from makeup_skin_addon import surface_values
+
+    group, colour = tree
+    texture = group.nodes.new("ShaderNodeTexImage")
+    texture.image = bpy.data.images.new("Any", 3, 1)
+    mix = group.nodes.new("ShaderNodeMix")
+    mix.data_type, mix.blend_type = "RGBA", "MULTIPLY"
+    mix.inputs["Factor"].default_value = 0.5
+    next(s for s in mix.inputs if s.identifier == "B_Color").default_value = (0.5, 1.0, 0.0, 1)
+    group.links.new(texture.outputs["Color"], next(s for s in mix.inputs
+                                                   if s.identifier == "A_Color"))
+    group.links.new(next(s for s in mix.outputs if s.identifier == "Result_Color"), colour)
+    notes = []
+    points = Points()
+    values = surface_values.values(_source_of(colour), points, notes)
+    image = Points().image(None, points.uv(""), "REPEAT")[:, :3]
+    expected = image * (0.5 + 0.5 * np.array([0.5, 1.0, 0.0]))
+    np.testing.assert_allclose(values, expected, atol=1e-6)
+    np.testing.assert_allclose(surface_values.mean(_source_of(colour), points, notes),
+                               expected.mean(axis=0), atol=1e-6)
+    assert notes == [] and "" in points.uv_read  # an unlinked Vector: the render UV map
+
+
+@pytest.mark.parametrize("operation, expected", [("MULTIPLY", 0.8), ("ADD", 2.4),
+                                                 ("POWER", 4.0), ("MAXIMUM", 2.0)])
+def test_math(tree, operation, expected):
+    from makeup_skin_addon import surface_values
+
+    group, colour = tree
+    math = group.nodes.new("ShaderNodeMath")
+    math.operation = operation
+    math.inputs[0].default_value, math.inputs[1].default_value = 2.0, 0.4 if operation != \
+        "POWER" else 2.0
+    group.links.new(math.outputs[0], colour)
+    assert surface_values.mean(_source_of(colour), Points(), [], "VALUE") == pytest.approx(
+        expected)
+
+
+def test_a_ramp_inverted_and_a_hue_shift(tree):
+    """A Color Ramp (black to red, linear) at 0.25, inverted at factor 1: (0.75, 1, 1); a
+    Hue/Saturation/Value at neutral settings gives its colour back."""
+    from makeup_skin_addon import surface_values
+
+    group, colour = tree
+    ramp = group.nodes.new("ShaderNodeValToRGB")
+    ramp.color_ramp.elements[1].color = (1.0, 0.0, 0.0, 1.0)
+    ramp.inputs["Fac"].default_value = 0.25
+    invert = group.nodes.new("ShaderNodeInvert")
+    hue = group.nodes.new("ShaderNodeHueSaturation")
+    group.links.new(ramp.outputs["Color"], invert.inputs["Color"])
+    group.links.new(invert.outputs["Color"], hue.inputs["Color"])
+    group.links.new(hue.outputs["Color"], colour)
+    np.testing.assert_allclose(surface_values.mean(_source_of(colour), Points(), []),
+                               (0.75, 1.0, 1.0), atol=1e-6)
+
+
+def test_a_node_group_is_evaluated_inside(tree):
+    import bpy
+
+    from makeup_skin_addon import surface_values
+
+    group, colour = tree
+    inner = bpy.data.node_groups.new("Tint", "ShaderNodeTree")
+    inner.interface.new_socket("In", in_out="INPUT", socket_type="NodeSocketColor")
+    inner.interface.new_socket("Out", in_out="OUTPUT", socket_type="NodeSocketColor")
+    inputs, outputs = inner.nodes.new("NodeGroupInput"), inner.nodes.new("NodeGroupOutput")
+    gamma = inner.nodes.new("ShaderNodeGamma")
+    gamma.inputs["Gamma"].default_value = 2.0
+    inner.links.new(inputs.outputs["In"], gamma.inputs["Color"])
+    inner.links.new(gamma.outputs["Color"], outputs.inputs["Out"])
+    node = group.nodes.new("ShaderNodeGroup")
+    node.node_tree = inner
+    node.inputs["In"].default_value = (0.5, 0.2, 1.0, 1.0)
+    group.links.new(node.outputs["Out"], colour)
+    np.testing.assert_allclose(surface_values.mean(_source_of(colour), Points(), []),
+                               (0.25, 0.04, 1.0), atol=1e-6)
+
+
+def test_what_cannot_be_evaluated_is_half_and_said(tree):
+    from makeup_skin_addon import surface_values
+
+    group, colour = tree
+    noise = group.nodes.new("ShaderNodeTexNoise")
+    group.links.new(noise.outputs["Color"], colour)
+    notes = []
+    np.testing.assert_allclose(surface_values.mean(_source_of(colour), Points(), notes),
+                               (0.5, 0.5, 0.5))
+    assert notes == [f"{noise.name!r} (Noise Texture) is not evaluated: taken as 0.5"]
