@@ -12,7 +12,7 @@ Roughness 0.45.
 - :func:`head_with` -- the textured head with a material of one kind.
 - :func:`uniform_white` -- the scene lit by a uniform white world and nothing else, framed by
   the portrait camera: the light under which a surface shows its albedo.
-- :func:`face_mean` -- the mean colour of the object's pixels (alpha 1) in a render.
+- :func:`face_mean` -- the object's mean colour in a render (its pixels weighted by alpha).
 - :func:`blurred` -- the object's pixels blurred (noise averaged, detail kept at a few pixels).
 """
 
@@ -187,10 +187,11 @@ def uniform_white(scene, obj, *, size: int = 128, samples: int = 64, seed: int =
 
 
 def face_mean(pixels: np.ndarray) -> np.ndarray:
-    """The mean RGB of the pixels the object covers whole (alpha above 0.999) of an RGBA
-    render."""
-    mask = pixels[..., 3] > 0.999
-    return pixels[mask][:, :3].mean(axis=0)
+    """The object's mean RGB in an RGBA render with a transparent film (Blender's alpha is
+    premultiplied): the sum of its colour over the sum of its alpha, so a pixel the object
+    covers in part counts by its share.  Its edges, seen at grazing angles, count as much as
+    their area: leaving them out would weigh a shader by how bright it is face on."""
+    return pixels[..., :3].reshape(-1, 3).sum(axis=0) / pixels[..., 3].sum()
 
 
 def blurred(pixels: np.ndarray, sigma_px: float = 1.5) -> tuple[np.ndarray, np.ndarray]:
