@@ -61,8 +61,10 @@ def test_zip_contents(extension_zip):
     assert "makeup_skin_addon/convert.py" in names
     assert "lut_baker/__init__.py" in names
     assert "lut_baker/closures/fitting.py" in names
-    # the runtime's data files: the Auto tier's measurements, the table of EEVEE's GGX
-    assert {"lut_baker/auto_tier/measured.json", "lut_baker/closures/eevee_ltc.json"} <= set(names)
+    # the runtime's data files: the Auto tier's measurements, the table of EEVEE's GGX, the
+    # Principled BSDF's measured albedo
+    assert {"lut_baker/auto_tier/measured.json", "lut_baker/closures/eevee_ltc.json",
+            "lut_baker/closures/principled_albedo.json"} <= set(names)
     assert not [n for n in names if n.startswith("tests/") or "/tests/" in n]
     assert not [n for n in names if n.startswith("data/")]  # published measurements stay out
     # the runtime only: no scipy-backed validation, no command line
