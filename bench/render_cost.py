@@ -3,8 +3,8 @@ the tiers over the skin preset.
 
 A benchmark, not a test::
 
-    python bench/render_cost.py            # docs/render_cost.png, the table in docs/speed_accuracy.md
-    python bench/render_cost.py --quick    # fewer repeats (a smoke run)
+    python bench/render_cost.py          # docs/render_cost.png, a table in speed_accuracy.md
+    python bench/render_cost.py --quick  # fewer repeats (a smoke run)
 
 Scene: the bench sphere (``tests/support/bench_scene.py``: 10 mm, orthographic, a sun 45 degrees
 from the view, Cycles CPU, adaptive sampling off), 64 x 64 px.  The artist's shader is a
@@ -64,7 +64,6 @@ def measure(repeats: int) -> list[dict]:
     """Median seconds per frame of every config (module docstring)."""
     import bpy
     import numpy as np
-
     from support import artist_skins, bench_scene, sphere_scene
 
     sphere = bench_scene.sphere_scene(size=SIZE, samples=SAMPLES)

@@ -28,6 +28,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import bpy
 
@@ -46,8 +47,8 @@ class Source:
     the groups), or ``socket`` (an output socket of a node of the tree inside ``groups``, the
     group nodes entered, outermost first: ``()`` is the material's own tree)."""
 
-    value: object = None
-    socket: object = None
+    value: Any = None
+    socket: Any = None
     groups: tuple = ()
 
     @property
@@ -65,7 +66,7 @@ class Leaf:
     ``role`` (``"skin"``, ``"gloss"`` or ``"other"``) and ``route`` (the nodes passed, for
     sentences)."""
 
-    node: object
+    node: Any
     groups: tuple
     role: str
     route: tuple = ()
@@ -76,21 +77,21 @@ class Mix:
     """A Mix Shader: ``first`` where ``factor`` is 0, ``second`` where it is 1 (either None
     when unlinked: no closure)."""
 
-    node: object
+    node: Any
     groups: tuple
     factor: Source
-    first: object
-    second: object
+    first: Any
+    second: Any
 
 
 @dataclass(frozen=True)
 class Add:
     """An Add Shader: ``first`` plus ``second`` (either None when unlinked)."""
 
-    node: object
+    node: Any
     groups: tuple
-    first: object
-    second: object
+    first: Any
+    second: Any
 
 
 Shader = Leaf | Mix | Add
