@@ -117,7 +117,9 @@ def _mean(node, identifier: str, groups, samples, notes, kind="VALUE"):
 def _principled(leaf: Leaf, samples, notes, warnings, engine: str) -> tuple:
     """``(base, body, total, roughness, ior, weight)`` of a Principled BSDF leaf."""
     node, groups = leaf.node, leaf.groups
-    base = np.clip(_mean(node, "Base Color", groups, samples, notes, "RGBA"), 0.0, 1.0)
+    bases = np.clip(surface_values.values(source(node.inputs["Base Color"], groups), samples,
+                                          notes), 0.0, 1.0)
+    base = _weighted_mean(bases, samples)
     roughness = float(np.clip(_mean(node, "Roughness", groups, samples, notes), 0.0, 1.0))
     ior = float(max(_mean(node, "IOR", groups, samples, notes), 1.0))
     weight = float(np.clip(_mean(node, "Subsurface Weight", groups, samples, notes), 0.0,
@@ -134,10 +136,20 @@ def _principled(leaf: Leaf, samples, notes, warnings, engine: str) -> tuple:
         warnings.append(f"{node.name!r}: its {', '.join(left_out)} is not followed under the "
                         f"film (the bare skin keeps it; the skin under the film is its "
                         f"dielectric layers)")
-    albedo = principled_albedo.principled_albedo(base, roughness, ior, weight,
+    # Each point's Base Color: the body is not linear in it (random walk's inversion), and a
+    # texture's dark freckles weigh more than its mean says.
+    albedo = principled_albedo.principled_albedo(bases, roughness, ior, weight,
                                                  node.subsurface_method, engine=engine)
-    return base, np.asarray(albedo.body, float), np.asarray(albedo.total, float), \
-        roughness, ior, weight
+    return base, _weighted_mean(np.asarray(albedo.body, float), samples), \
+        _weighted_mean(np.asarray(albedo.total, float), samples), roughness, ior, weight
+
+
+def _weighted_mean(values: np.ndarray, samples) -> np.ndarray:
+    """The mean of per-point ``values`` ``(n, 3)`` (or one row) by the points' weights."""
+    weights = getattr(samples, "weights", None)
+    if weights is not None and len(values) == len(weights) and len(values) > 1:
+        return (weights @ values) / weights.sum()
+    return values.mean(axis=0)
 
 
 def _leaf_reading(leaf: Leaf, share: float, samples, notes, warnings, engine) -> tuple:
@@ -226,5 +238,5 @@ def read_material(material, scene=None, progress=None) -> SkinReading | None:
     if tree is None:
         return None
     scene = scene if scene is not None else bpy.context.scene
-    samples = skin_sampling.surface_samples(material, progress=progress)
+    samples = skin_sampling.surface_samples(material, progress=progress, scene=scene)
     return read_skin(tree, samples, engine_of(scene))

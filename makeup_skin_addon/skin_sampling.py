@@ -93,11 +93,15 @@ _REPORTS: list[Report] = []
 @dataclass(frozen=True)
 class Points:
     """Points on one object's faces of a material: their UVs ``uv`` ((n, 2) float32, in the UV
-    map read), the faces' world area ``area`` (square metres) and how many faces ``faces``."""
+    map read), the faces' world area ``area`` (square metres) and how many faces ``faces``;
+    ``position`` and ``normal`` ((n, 3) float32, the object's own space: the point and its
+    face's normal), or None."""
 
     uv: np.ndarray
     area: float
     faces: int
+    position: np.ndarray | None = None
+    normal: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -183,14 +187,15 @@ def users(material) -> list:
 
 
 def face_points(face_area, loop_start, loop_total, corner_vert, positions, corner_uv,
-                count: int, seed: int = SEED) -> np.ndarray:
+                count: int, seed: int = SEED, *, with_positions: bool = False):
     """UVs ((count, 2) float32) of ``count`` points spread over the faces in proportion to
     ``face_area`` (zero: a face not counted), uniform within each face: stratified along the
     cumulative area (point i falls in the i-th of ``count`` equal shares, at a random place in
     it), then a triangle of the face's fan from its first corner by its area (``positions`` of
     the corners ``corner_vert``), then a uniform point in it, its UV interpolated from the
     corners' ``corner_uv``.  Faces are given by ``loop_start`` and ``loop_total`` (corners);
-    fans assume convex faces."""
+    fans assume convex faces.  ``with_positions``: ``(uv, position (count, 3), face index
+    (count,))``."""
     rng = np.random.default_rng(seed)
     draws = rng.random((4, count))
     face_area = np.asarray(face_area, float)
@@ -201,6 +206,7 @@ def face_points(face_area, loop_start, loop_total, corner_vert, positions, corne
     start = np.asarray(loop_start)[face].astype(np.int64)
     corners = np.asarray(loop_total)[face]
     uv = np.empty((count, 2), np.float32)
+    xyz = np.empty((count, 3), np.float32) if with_positions else None
     for k in np.unique(corners):
         pick = np.flatnonzero(corners == k)
         loops = start[pick, None] + np.arange(k)
@@ -217,7 +223,9 @@ def face_points(face_area, loop_start, loop_total, corner_vert, positions, corne
         weights = np.stack([1.0 - root, root * (1.0 - draws[3, pick]), root * draws[3, pick]])
         triangle = np.stack([loops[:, 0], loops[rows, second], loops[rows, second + 1]])
         uv[pick] = np.einsum("tn,tnc->nc", weights, corner_uv[triangle])
-    return uv
+        if xyz is not None:
+            xyz[pick] = np.einsum("tn,tnc->nc", weights, positions[corner_vert[triangle]])
+    return (uv, xyz, face) if with_positions else uv
 
 
 def _array(collection, name: str, count: int, dtype) -> np.ndarray:
@@ -310,9 +318,11 @@ def _points(obj, layer, area: np.ndarray, faces: int, count: int) -> Points:
         loop_total = np.diff(loop_start, append=len(mesh.loops))
     else:
         loop_total = _array(mesh.polygons, "loop_total", len(mesh.polygons), np.int32)
-    uv = face_points(area, loop_start, loop_total, _corner_verts(mesh), _positions(mesh),
-                     _corner_uvs(layer), count)
-    return Points(uv, float(area.sum()), faces)
+    uv, position, face = face_points(area, loop_start, loop_total, _corner_verts(mesh),
+                                     _positions(mesh), _corner_uvs(layer), count,
+                                     with_positions=True)
+    normal = _array(mesh.polygons, "normal", 3 * len(mesh.polygons), np.float32).reshape(-1, 3)
+    return Points(uv, float(area.sum()), faces, position, normal[face])
 
 
 class _Surface:
@@ -620,8 +630,10 @@ class SurfaceSamples:
     with no face to read (``problem`` says why: no object, no face of the material, no UV
     map), one point at UV (0, 0) stands for the surface."""
 
-    def __init__(self, material, budget: int = BUDGET):
+    def __init__(self, material, budget: int = BUDGET, scene=None):
         self.material = material
+        self.scene = scene
+        self.camera = scene.camera if scene is not None else None
         self.objects = users(material)
         for obj in self.objects:
             if obj.mode == "EDIT":
@@ -666,6 +678,16 @@ class SurfaceSamples:
         uv = np.concatenate([points.uv for points, _ in picked]).astype(float)
         weights = np.concatenate([np.full(len(points.uv), points.area / n)
                                   for points, n in picked])
+        if self.camera is not None and self.weights is None:
+            seen = np.concatenate([_seen(surface.obj, points, self.camera, self.scene)
+                                   for surface, (points, _) in zip(
+                                       [s for s, n in zip(surfaces, counts, strict=True)
+                                        if n > 0], picked, strict=True)])
+            if np.any(seen > 0.0):
+                weights = weights * seen
+            else:
+                self._note(f"the camera {self.camera.name!r} sees none of it: the whole "
+                           f"surface counts")
         return self._remember(name, uv, weights)
 
     def _remember(self, name: str, uv, weights):
@@ -688,10 +710,42 @@ class SurfaceSamples:
         return np.concatenate([rgb, np.ones((len(rgb), 1))], axis=1)
 
 
-def surface_samples(material, progress: Report | None = None) -> SurfaceSamples:
+def _seen(obj, points: Points, camera, scene) -> np.ndarray:
+    """How much of each point the camera sees: its area's projection towards the camera (the
+    cosine between its face's normal and the direction to the camera, 0 facing away) where it
+    falls inside the camera's frame and in front of it, else 0 (hidden surfaces are not
+    looked for)."""
+    matrix = np.array(obj.matrix_world, float)
+    position = points.position @ matrix[:3, :3].T + matrix[:3, 3]
+    normal = points.normal @ np.linalg.inv(matrix[:3, :3])  # the inverse transpose, by rows
+    normal /= np.maximum(np.linalg.norm(normal, axis=1, keepdims=True), 1e-30)
+    view = np.array(camera.matrix_world, float)
+    local = (position - view[:3, 3]) @ view[:3, :3]  # in the camera's frame (looks down -z)
+    frame = np.array([tuple(corner) for corner in camera.data.view_frame(scene=scene)])
+    if camera.data.type == "ORTHO":
+        towards = np.broadcast_to(view[:3, 2], position.shape)
+        x, y = local[:, 0], local[:, 1]
+        inside = np.ones(len(local), bool)
+    else:
+        towards = view[:3, 3] - position
+        towards = towards / np.maximum(np.linalg.norm(towards, axis=1, keepdims=True), 1e-30)
+        depth = -local[:, 2]
+        inside = depth > 0.0
+        scale = -frame[0, 2] / np.where(inside, depth, 1.0)
+        x, y = local[:, 0] * scale, local[:, 1] * scale
+    inside &= ((x >= frame[:, 0].min()) & (x <= frame[:, 0].max())
+               & (y >= frame[:, 1].min()) & (y <= frame[:, 1].max()))
+    return np.where(inside, np.maximum(np.sum(normal * towards, axis=1), 0.0), 0.0)
+
+
+def surface_samples(material, progress: Report | None = None, scene=None) -> SurfaceSamples:
     """The points of ``material``'s surface for evaluating its shader
-    (:class:`SurfaceSamples`; their UVs are read, and cached, when first asked for)."""
-    samples = SurfaceSamples(material)
+    (:class:`SurfaceSamples`; their UVs are read, and cached, when first asked for); with a
+    ``scene`` that has a camera, each point counts by how much of it the camera sees
+    (:func:`_seen`: the skin as the camera shows it), else by its area."""
+    if scene is not None and scene.camera is not None and scene == bpy.context.scene:
+        bpy.context.view_layer.update()  # matrices follow moves only after an update
+    samples = SurfaceSamples(material, scene=scene)
     if progress is not None:
         with reporting(progress):
             samples.uv("")

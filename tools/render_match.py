@@ -22,11 +22,12 @@ builds the textured head with its portrait camera and lights and:
 - composes ``match_strip.png`` (one row per tone and film normal: before, 0.3, 0.6, 1) and
   ``first_apply_strip.png`` (each tone before and after the first Apply);
 - measures, under uniform white light (a white world, lamps off: the light the match is
-  exact for) and under the portrait lights, the mean colour over the head's pixels of the
-  model's bare skin (coverage 0) and of the made-up skin at each coverage, and the blotches'
+  defined for) and under the portrait lights, the head's mean colour
+  (:func:`support.artist_skins.face_mean`) at coverage 0 (the artist's own render: the film
+  goes over their shader) and of the made-up skin at each coverage, and the blotches'
   contrast: the standard deviation of the luminance of the render divided by the render of
-  the same head with Skin Color at the texture's mean (the albedo texture as the render shows
-  it; same seed, so the noise mostly divides out), at coverage 0, 0.3, 0.6 and 1.
+  the same head with its albedo at the mean (the artist's Base Color and the skin under the
+  film; same seed, so the noise mostly divides out), at coverage 0, 0.3, 0.6 and 1.
 
 Prints a Markdown table of the figures and writes them to ``--json`` (default
 ``<out>/match.json``).  Exits non-zero with a message if a step fails.
@@ -48,7 +49,7 @@ for _path in (REPO_ROOT, REPO_ROOT / "tests"):
     if str(_path) not in sys.path:
         sys.path.insert(0, str(_path))
 
-from support import character, sphere_scene  # noqa: E402  (tests/support/)
+from support import artist_skins, character, sphere_scene  # noqa: E402  (tests/support/)
 
 __all__ = ["main", "measure_means", "blotch_contrast", "uniform_light", "COVERAGES"]
 
@@ -85,33 +86,38 @@ def uniform_light(scene, on: bool) -> None:
 
 
 def measure_means(scene, settings, work: Path, tag: str) -> dict:
-    """Mean colour over the head's pixels at coverage 0 (the model's bare skin) and at
-    :data:`COVERAGES`: ``{coverage: [r, g, b]}``."""
+    """The head's mean colour (:func:`support.artist_skins.face_mean`) at coverage 0 (the
+    artist's own render: the film goes over their shader) and at :data:`COVERAGES`:
+    ``{coverage: [r, g, b]}``."""
     means = {}
     for coverage in (0.0,) + COVERAGES:
         settings.coverage = coverage
         rgba = _render_rgba(scene, work / f"{tag}_{coverage}.exr")
-        means[coverage] = rgba[_mask(rgba)][:, :3].mean(axis=0).tolist()
+        means[coverage] = artist_skins.face_mean(rgba).tolist()
     return means
 
 
 def blotch_contrast(scene, material, settings, work: Path, tag: str) -> dict:
     """``{coverage: contrast}``: the standard deviation over the head's pixels of the
-    luminance of the render divided by the render with Skin Color at the texture's mean."""
-    from makeup_skin_addon import shade
+    luminance of the render divided by the render with the albedo at its mean (the artist's
+    Base Color and the group's Skin Color, the skin under the film, both set to their means)."""
+    from makeup_skin_addon import artist_skin
 
-    node = material.node_tree.nodes[GROUP_NODE]
-    socket = node.inputs["Skin Color"]
-    source = socket.links[0].from_socket
-    mean = shade.skin_colour(material).rgb
+    tree = material.node_tree
+    reading = artist_skin.read_material(material, scene)
+    sockets = [(tree.nodes[GROUP_NODE].inputs["Skin Color"], reading.body),
+               (reading.dominant.node.inputs["Base Color"], reading.leaves[0].base)]
+    sources = [socket.links[0].from_socket for socket, _ in sockets]
     contrast = {}
     for coverage in (0.0,) + COVERAGES:
         settings.coverage = coverage
         textured = _render_rgba(scene, work / f"{tag}_tex_{coverage}.exr")
-        material.node_tree.links.remove(socket.links[0])
-        socket.default_value = (*mean, 1.0)
+        for socket, mean in sockets:
+            tree.links.remove(socket.links[0])
+            socket.default_value = (*mean, 1.0)
         flat = _render_rgba(scene, work / f"{tag}_flat_{coverage}.exr")
-        material.node_tree.links.new(source, socket)
+        for (socket, _), source in zip(sockets, sources, strict=True):
+            tree.links.new(source, socket)
         mask = _mask(textured) & _mask(flat)
         ratio = (textured[mask][:, :3] @ LUMINANCE) / np.maximum(flat[mask][:, :3] @ LUMINANCE,
                                                                  1e-6)
@@ -182,7 +188,7 @@ def run_tone(tone: str, args, out: Path, work: Path) -> dict:
 
 
 def _table(results) -> str:
-    lines = ["| skin | foundation | light | bare (coverage 0) | coverage 0.3 | 0.6 | 1 | "
+    lines = ["| skin | foundation | light | before Apply (coverage 0) | coverage 0.3 | 0.6 | 1 | "
              "blotch contrast 0 / 0.3 / 0.6 / 1 |",
              "|---|---|---|---|---|---|---|---|"]
     for figures in results:

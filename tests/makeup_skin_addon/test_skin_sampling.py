@@ -127,6 +127,8 @@ def test_the_heads_mean_is_within_its_sampling_error(head):
     read through a copy reduced to 128 px (a box filter in sRGB bytes, then linearised),
     within 0.2% (measured: 0.03-0.06%); the Base Color the artist's shader is read with
     (:func:`.artist_skin.read_material`) is this mean."""
+    import bpy
+
     from makeup_skin_addon import artist_skin, skin_sampling
 
     material = head.active_material
@@ -141,7 +143,9 @@ def test_the_heads_mean_is_within_its_sampling_error(head):
     assert np.all(np.abs(mean.rgb - exact) < 4 * mean.error), (mean.rgb, exact, mean.error)
     reduced = skin_sampling.surface_mean(texture.image, material, size=128)
     np.testing.assert_allclose(reduced.rgb, exact, rtol=2e-3)
-    reading = artist_skin.read_material(material)
+    scene = bpy.context.scene
+    scene.camera = None  # with a camera, the points count by how much of them it sees
+    reading = artist_skin.read_material(material, scene)
     np.testing.assert_allclose(reading.leaves[0].base, mean.rgb, rtol=1e-9)
     assert reading.notes == []
 
@@ -359,3 +363,32 @@ def test_texels_wrap_as_the_texture_extension_does(addon):
         read = skin_sampling.read_texels(pixels, uv, extension)
         np.testing.assert_allclose(read, np.repeat(np.array(values, float)[:, None], 3, 1),
                                    atol=1e-12, err_msg=extension)
+
+
+def test_with_a_camera_the_points_count_by_what_it_sees(two_faces):
+    """A camera looking straight down at the lying face (the standing one is seen edge on):
+    the shader is read as the camera sees it, the lying face's colour; turned away, over the
+    whole surface (and said)."""
+    import bpy
+
+    from makeup_skin_addon import artist_skin
+
+    obj, skin, texture = two_faces
+    scene = bpy.context.scene
+    camera = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
+    scene.collection.objects.link(camera)
+    camera.data.type = "ORTHO"
+    camera.data.ortho_scale = 2.0
+    camera.location = (3.5, 0.5, 5.0)
+    scene.camera = camera
+    scene.render.resolution_x = scene.render.resolution_y = 64
+    seen = artist_skin.read_material(skin, scene).leaves[0].base
+    np.testing.assert_allclose(seen, _linear(np.asarray(RIGHT_BYTES) / 255), atol=2e-5)
+    scene.camera = None
+    everywhere = artist_skin.read_material(skin, scene).leaves[0].base
+    np.testing.assert_allclose(everywhere, _exact_two_faces(1.0, 3.0), atol=1e-4)
+    scene.camera = camera
+    camera.rotation_euler = (3.14159, 0.0, 0.0)  # looking up, away from the faces
+    away = artist_skin.read_material(skin, scene)
+    np.testing.assert_allclose(away.leaves[0].base, everywhere, atol=1e-6)
+    assert any("sees none of it" in note for note in away.notes)
