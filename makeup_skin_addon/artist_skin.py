@@ -75,13 +75,15 @@ class SkinReading:
     the shader has none); ``target``: the shader's colour under uniform light (RGB, gloss
     included); ``body``: the body colour of the skin under the film (RGB, the leaves' bodies
     by share); ``roughness``, ``ior``, ``method``, ``subsurface_weight``: the dominant leaf's
-    (for the bake and the group); ``warnings``: sentences saying what could not be followed
-    and what is used instead; ``notes``: what evaluating the inputs assumed."""
+    (for the bake and the group); ``where``: the surface it was read over (the end of a
+    sentence); ``warnings``: sentences saying what could not be followed and what is used
+    instead; ``notes``: what evaluating the inputs assumed."""
 
     leaves: list
     dominant: Leaf | None
     target: np.ndarray
     body: np.ndarray
+    where: str = ""
     roughness: float | None = None
     ior: float | None = None
     method: str | None = None
@@ -206,7 +208,11 @@ def read_skin(tree, samples, engine: str = "CYCLES") -> SkinReading:
     problem = getattr(samples, "problem", "")
     if problem:
         notes.insert(0, f"{problem}: the shader's inputs are read at UV (0, 0)")
-    reading = SkinReading(readings, dominant.leaf if dominant else None, target, body,
+    faces = getattr(samples, "faces", 0)
+    seen_by = getattr(samples, "seen_by", "")
+    where = (f"over the {faces} faces that use it" if faces else "") + (
+        f", as the camera {seen_by!r} sees them" if faces and seen_by else "")
+    reading = SkinReading(readings, dominant.leaf if dominant else None, target, body, where,
                           warnings=warnings, notes=notes)
     if dominant is None:
         warnings.append("no skin BSDF (Principled, Diffuse or Subsurface Scattering) behind "

@@ -76,8 +76,9 @@ def skin_target(material, reading=None, light=None) -> SkinTarget:
         reading = artist_skin.read_material(material)
     if reading is not None and reading.dominant is not None:
         notes = "".join(f"; {note}" for note in reading.notes)
+        where = f" {reading.where}" if reading.where else ""
         return SkinTarget(np.asarray(reading.target, float), np.asarray(reading.body, float),
-                          f"the artist's shader under uniform light{notes}")
+                          f"the artist's shader under uniform light{where}{notes}")
     skin = shade.skin_colour(material)
     light = light_for(settings) if light is None else light
     bare = uniform_light.bare_colour(light, skin.rgb, float(settings.gloss))

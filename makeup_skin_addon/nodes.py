@@ -52,6 +52,7 @@ from __future__ import annotations
 import json
 
 import bpy
+import numpy as np
 
 from . import storage
 from .core import tier_formulas, tiers
@@ -265,7 +266,7 @@ def _texel_pair(build: Builder, u, size: int, label: str):
     return u0, u1, weight
 
 
-def _lut_rows(build: Builder, lut, names: tuple, coordinates: dict) -> dict:
+def _lut_rows(build: Builder, lut, names: tuple, coordinates: dict, bounds=None) -> dict:
     """Every row of the view-angle image ``lut`` (rows named ``names``), read at
     ``u = coordinates[name]`` (a socket per row name) linearly between texel centres and held
     beyond them, as :func:`lut_baker.closures.view_image.sample_lut` reads it: two Closest
@@ -290,9 +291,13 @@ def _lut_rows(build: Builder, lut, names: tuple, coordinates: dict) -> dict:
                                  interpolation="Closest", extension="EXTEND")
             build.tree.links.new(coordinate.outputs[0], texture.inputs["Vector"])
             samples.append(texture.outputs["Color"])
-        rows[name] = NodeValue(build, build.mix_vector(weight, samples[0], samples[1],
-                                                       label=f"row {name}"),
-                               True)
+        value = build.mix_vector(weight, samples[0], samples[1], label=f"row {name}")
+        if bounds is not None:
+            # Within the row's own range as baked: an image damaged in a file read where the
+            # add-on cannot repair it (a render farm) renders wrong, not blown out.
+            value = build.vector("MINIMUM", build.vector("MAXIMUM", value, (0.0, 0.0, 0.0)),
+                                 tuple(map(float, bounds[j])), label=f"row {name} (bounded)")
+        rows[name] = NodeValue(build, value, True)
     return rows
 
 
@@ -323,7 +328,8 @@ def _build_view_weighted(build: Builder, fit, parts, lut, method: str, radius_mm
     cosines = {surface: _cos_view(build, normal, geometry, f"cos theta_o ({surface})")
                for surface, normal in normals.items()}
     rows = _lut_rows(build, lut, parts.rows, {
-        name: cosines[tier_formulas.ROW_SURFACE.get(name, "film")] for name in parts.rows})
+        name: cosines[tier_formulas.ROW_SURFACE.get(name, "film")] for name in parts.rows},
+        bounds=np.max(np.asarray(parts.lut, float), axis=1))
     weight = NodeValue(build, inputs.outputs["Subsurface Weight"], False) if over else None
     closures = parts.closures(fit, x, NodeAlgebra(build, rows), subsurface_weight=weight)
     lobes = parts.lobes

@@ -643,6 +643,8 @@ class SurfaceSamples:
         self.count = 0
         self.weights: np.ndarray | None = None
         self.notes: list[str] = []
+        self.faces = 0
+        self.seen_by = ""
         self.problem = "" if self.objects else f"no mesh object uses {material.name!r}"
 
     def _note(self, sentence: str) -> None:
@@ -678,6 +680,8 @@ class SurfaceSamples:
         uv = np.concatenate([points.uv for points, _ in picked]).astype(float)
         weights = np.concatenate([np.full(len(points.uv), points.area / n)
                                   for points, n in picked])
+        if self.weights is None:
+            self.faces = sum(points.faces for points, _ in picked)
         if self.camera is not None and self.weights is None:
             seen = np.concatenate([_seen(surface.obj, points, self.camera, self.scene)
                                    for surface, (points, _) in zip(
@@ -685,6 +689,7 @@ class SurfaceSamples:
                                         if n > 0], picked, strict=True)])
             if np.any(seen > 0.0):
                 weights = weights * seen
+                self.seen_by = self.camera.name
             else:
                 self._note(f"the camera {self.camera.name!r} sees none of it: the whole "
                            f"surface counts")

@@ -198,3 +198,23 @@ def test_view_angle_rows_read_in_eevee_as_in_cycles(addon, paper_tables):
     print(f"{row} row in EEVEE: exact lookup {errors[False]:.2e}, Linear {errors[True]:.3f}")
     assert errors[False] < 5e-3  # measured 4.3e-4: half floats and the mesh normals
     assert errors[True] > 0.05
+
+
+@pytest.mark.parametrize("tier", ["LAYERED", "EEVEE"])
+def test_a_damaged_lookup_image_renders_wrong_but_bounded(sphere, tmp_path, tier):
+    """The view-angle image overwritten with 1e20 (a file damaged where the add-on cannot
+    repair it, on a render farm): every row is held within its own range as baked, so the
+    sphere renders no brighter than the brightest the rows allow, and finite (unbounded, it
+    rendered values up to 6e23)."""
+    import bpy
+
+    from support.addon_steps import lut_images
+
+    material, _ = apply_pipeline(sphere, tier)
+    intact = render(tmp_path, "intact")
+    image = lut_images()[0]
+    image.pixels.foreach_set(np.full(len(image.pixels), 1e20, np.float32))
+    bpy.context.scene.cycles.samples = 4
+    damaged = render(tmp_path, "damaged")
+    assert np.all(np.isfinite(damaged))
+    assert damaged.max() < 3.0 * intact.max() + 0.5, (damaged.max(), intact.max())

@@ -57,7 +57,11 @@ def test_a_damaged_image_is_repaired_on_opening_and_renders_no_magenta(damaged_f
     makeup_skin_addon.unregister()  # as where the add-on is not installed: the damage shows
     try:
         bpy.ops.wm.open_mainfile(filepath=str(path), load_ui=False)
-        assert magenta(render(tmp_path, "without")) > 0.5
+        without = render(tmp_path, "without")
+        # Wrong (Blender's magenta for an unreadable image, each row held within its range as
+        # baked), but not blown out.
+        assert np.abs(without - before).max() > 0.1 * before.max()
+        assert np.all(np.isfinite(without)) and without.max() < 3.0 * before.max() + 0.5
     finally:
         makeup_skin_addon.register()
     capsys.readouterr()

@@ -306,8 +306,8 @@ def test_messages(two_faces):
     missing.source = "FILE"  # no file behind it: no pixels
     missing.filepath = "//gone.png"
     texture.image = missing
-    assert _source(skin) == f"{SOURCE}; image 'Gone' has no pixels (its file '//gone.png' is " \
-                            f"missing)"
+    assert _source(skin) == (f"{SOURCE} over the 3 faces that use it; image 'Gone' has no "
+                             f"pixels (its file '//gone.png' is missing)")
 
 
 def test_progress_is_reported_only_when_something_is_read(two_faces, tmp_path):
