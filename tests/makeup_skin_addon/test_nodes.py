@@ -207,7 +207,6 @@ def test_a_damaged_lookup_image_renders_wrong_but_bounded(sphere, tmp_path, tier
     sphere renders no brighter than the brightest the rows allow, and finite (unbounded, it
     rendered values up to 6e23)."""
     import bpy
-
     from support.addon_steps import lut_images
 
     material, _ = apply_pipeline(sphere, tier)
