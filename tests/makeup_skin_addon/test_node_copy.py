@@ -43,6 +43,19 @@ def _group_with_texture():
     return group, principled
 
 
+def _material_with(group):
+    """A new material whose tree holds a node of ``group``: ``(tree, group node)``."""
+    import bpy
+
+    material = bpy.data.materials.new("Skin")
+    if material.node_tree is None:
+        material.use_nodes = True
+    tree = material.node_tree
+    node = tree.nodes.new("ShaderNodeGroup")
+    node.node_tree = group
+    return tree, node
+
+
 def _state(group):
     return (sorted((n.name, n.bl_idname) for n in group.nodes),
             sorted((link.from_node.name, link.to_node.name) for link in group.links))
@@ -54,12 +67,7 @@ def test_bring_out_copies_the_nodes_and_resolves_the_group_input(addon, blank_sc
     from makeup_skin_addon import artist_shader, node_copy
 
     group, principled = _group_with_texture()
-    material = bpy.data.materials.new("Skin")
-    if material.node_tree is None:
-        material.use_nodes = True
-    tree = material.node_tree
-    node = tree.nodes.new("ShaderNodeGroup")
-    node.node_tree = group
+    tree, node = _material_with(group)
     rgb = tree.nodes.new("ShaderNodeRGB")
     tree.links.new(rgb.outputs[0], node.inputs["Tint"])
     before = _state(group), _state(group.nodes["Group"].node_tree)
@@ -80,19 +88,13 @@ def test_bring_out_copies_the_nodes_and_resolves_the_group_input(addon, blank_sc
 
 
 def test_a_copier_copies_each_node_once(addon, blank_scene):
-    import bpy
 
     from makeup_skin_addon import artist_shader, node_copy
 
     group, principled = _group_with_texture()
     group.links.new(group.nodes["Image Texture"].outputs["Alpha"],
                     principled.inputs["Roughness"])
-    material = bpy.data.materials.new("Skin")
-    if material.node_tree is None:
-        material.use_nodes = True
-    tree = material.node_tree
-    node = tree.nodes.new("ShaderNodeGroup")
-    node.node_tree = group
+    tree, node = _material_with(group)
     copier = node_copy.copier(tree)
     base = node_copy.bring_out(artist_shader.source(principled.inputs["Base Color"], (node,)),
                                tree, copier=copier)
