@@ -18,6 +18,7 @@ the film does not cover, not followed under it).
 - :class:`Leaf`, :class:`Mix`, :class:`Add` -- the shader tree.
 - :func:`read` -- the tree behind a material's surface, or None (no surface, or Blender's own
   untouched default Principled BSDF: no skin of the artist's, :func:`is_untouched_default`).
+- :func:`behind` -- the tree linked into an input of the material's tree.
 - :func:`source` -- where an input (inside the groups entered) gets its value.
 - :func:`leaves` -- the leaves of a tree with their shares (the Mix Shaders' factors along the
   way, a linked factor counted by a caller-given mean).
@@ -33,7 +34,7 @@ from typing import Any
 import bpy
 
 __all__ = ["Source", "Leaf", "Mix", "Add", "Shader", "SKIN_TYPES", "GLOSS_TYPES", "read",
-           "source", "leaves", "is_untouched_default", "surface_output"]
+           "behind", "source", "leaves", "is_untouched_default", "surface_output"]
 
 SKIN_TYPES = ("BSDF_PRINCIPLED", "BSDF_DIFFUSE", "SUBSURFACE_SCATTERING")
 """Node types with a body colour: a skin under the film."""
@@ -226,6 +227,12 @@ def is_untouched_default(node) -> bool:
         elif expected is None or abs(value - expected) > 1e-6:
             return False
     return True
+
+
+def behind(input_socket):
+    """The shader tree linked into ``input_socket`` (an input of the material's own tree, such
+    as the group's Skin Shader), or None."""
+    return _linked(input_socket, (), (), frozenset())
 
 
 def read(material):

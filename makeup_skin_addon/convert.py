@@ -144,7 +144,7 @@ def artist_tree(material):
     shader = node.inputs.get("Skin Shader")
     if shader is None or not shader.is_linked:
         return None
-    return artist_shader._linked(shader, (), (), frozenset())
+    return artist_shader.behind(shader)
 
 
 def film_normal_node(material):

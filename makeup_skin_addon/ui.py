@@ -99,6 +99,19 @@ def _draw_film(col, settings) -> None:
     ior.prop(settings, "film_ior")
 
 
+def _draw_skin_from_shader(col, settings) -> None:
+    """The skin under the film as Apply read it from the artist's shader (greyed: the next
+    Apply reads it again; edit the shader)."""
+    col.label(text="Skin: the material's own shader (bare, and under the film)",
+              icon="SHADING_RENDERED")
+    taken = col.column()
+    taken.enabled = False
+    taken.prop(settings, "skin_roughness", text="Skin Roughness (from the shader)",
+               slider=True)
+    taken.prop(settings, "skin_ior", text="Skin IOR (from the shader)")
+    taken.prop(settings, "subsurface_method", text="Subsurface (from the shader)")
+
+
 def draw_settings(layout, context) -> None:
     """The panel body, shared by both panels (the active object's material)."""
     obj = context.active_object
@@ -119,15 +132,19 @@ def draw_settings(layout, context) -> None:
     col.prop(settings, "coverage", slider=True)
     _draw_shade(col, settings)
     col.separator()
-    col.prop(settings, "skin")
-    colour = col.row()
-    linked = node_input_linked(made_up.group_of(material), "Skin Color")
-    colour.enabled = not linked
-    colour.prop(settings, "skin_colour", **({"text": "Skin Color (linked)"} if linked else {}))
-    col.prop(settings, "skin_roughness", slider=True)
+    if settings.over_shader:
+        _draw_skin_from_shader(col, settings)
+    else:
+        col.prop(settings, "skin")
+        colour = col.row()
+        linked = node_input_linked(made_up.group_of(material), "Skin Color")
+        colour.enabled = not linked
+        colour.prop(settings, "skin_colour", **({"text": "Skin Color (linked)"} if linked
+                                                 else {}))
+        col.prop(settings, "skin_roughness", slider=True)
+        col.prop(settings, "subsurface_method")
     col.prop(settings, "subsurface_scale")
     col.prop(settings, "gloss", slider=True)
-    col.prop(settings, "subsurface_method")
     col.separator()
     _draw_film(col, settings)
     col.separator()

@@ -7,7 +7,9 @@ from support.addon_steps import apply_operator, lut_images
 from support.panel_layout import RecordingLayout
 
 
-def test_panel_shows_revert_and_a_linked_skin_colour(head):
+def test_panel_shows_revert_and_the_skin_from_the_shader(head):
+    """Before Apply the skin preset's settings; over the artist's shader, the skin read from it
+    (greyed: the next Apply reads it again) and no skin preset."""
     import bpy
 
     from makeup_skin_addon import ui
@@ -19,7 +21,10 @@ def test_panel_shows_revert_and_a_linked_skin_colour(head):
     layout = RecordingLayout()
     ui.draw_settings(layout, bpy.context)
     assert ("operator", "makeup_skin.revert") in layout.drawn
-    assert ("prop", "skin_colour", "Skin Color (linked)", False) in layout.drawn
+    labels = [item[1] for item in layout.drawn if item[0] == "label"]
+    assert "Skin: the material's own shader (bare, and under the film)" in labels
+    assert ("prop", "skin_roughness", "Skin Roughness (from the shader)", False) in layout.drawn
+    assert not any(item[:2] == ("prop", "skin") for item in layout.drawn)
 
 
 def test_drawing_the_panel_computes_nothing(head, monkeypatch):
