@@ -1,0 +1,467 @@
+"""The foundation film as a slab with a thickness: a surface on top, a body beneath
+(docs/model.md, "The film as a slab"; paper 4.1 for the film measured, eqs. 2 and 4).
+
+The film is made of
+
+- its **surface**: eq. 2's specular lobe of the film (its gloss, path 1) reflects the fraction
+  ``a_g(theta)`` of the light falling on it (:func:`face_albedo`); the rest, ``1 - a_g``,
+  crosses it straight (the film does not refract, docs/model.md §2.2); light reaching it from
+  inside is reflected back by the same fraction, specularly, and crosses it by ``1 - a_g``.
+  It is lossless and reciprocal;
+- its **body**: a homogeneous symmetric slab (the pigment), whose reflection and transmission
+  per Fourier order come from :mod:`lut_baker.numerics.adding_doubling`.
+
+The free film the paper measured (foundation filling a hole in a 0.15 mm cover glass, paper
+4.1) is surface, body, surface (air on both sides): its diffuse reflection is eq. 2's ``P_d``
+and its transmission eq. 4.  The body at that thickness is what remains when the two faces are
+taken off those measurements (:func:`remove_faces`, exact), and the body at any other thickness
+follows from the doubling relation inverted (:func:`body_generator`).  On skin the film is its
+surface and its body (no air under it), over the skin with every inter-reflection summed
+(:func:`made_up_matrices`).
+
+Absorption ``A`` (per channel, docs/model.md §4) keeps its meaning at the paper's thickness: the
+measured film's diffuse reflection and transmission are scaled by ``1 - A`` before the body is
+derived, so the free film of the paper's thickness reflects and transmits exactly what it did
+(up to :func:`passive` below); the thickness then decides how much a film absorbs.
+
+Functions and types
+-------------------
+- :data:`PAPER_FILM_THICKNESS_UM`, :data:`APPLIED_MASS_MG_PER_CM2`,
+  :data:`FOUNDATION_DENSITY_G_PER_CM3`, :data:`DEFAULT_THICKNESS_UM`,
+  :data:`PAPER_FILM_OPTICAL_THICKNESS` -- the thicknesses and their sources.
+- :func:`thickness_from_mass` -- micrometres of film from mass per area and density.
+- :func:`relative_thickness` -- a thickness in units of the paper's film.
+- :func:`face_albedo` -- ``a_g`` of a film's surface at the grid's nodes.
+- :func:`face_layer` -- the surface as a layer (star form, its gloss left out).
+- :func:`measured_body_matrices` -- the free film's diffuse reflection and transmission (eq. 2's
+  ``P_d``, eq. 4) in the star form.
+- :func:`remove_faces` -- the body inside a symmetric free film, its two faces taken off.
+- :class:`FilmSlab`, :func:`film_slab` -- the body at every thickness, with absorption.
+- :func:`body` -- the body's ``(R, T)`` at a thickness.
+- :func:`free_film_matrices` -- the free film (face, body, face) at a thickness.
+- :func:`made_up_matrices`, :func:`made_up_albedo` -- the film on skin (surface, body, skin,
+  every inter-reflection), its directional albedo with the surface's gloss.
+- :func:`thick_limit_albedo` -- the film at infinite thickness (what a product looks like in
+  the bottle), directional.
+- :func:`bihemispherical_on_grid` -- a directional albedo at the nodes averaged over uniform
+  light.
+- :func:`solve_thick_absorption` -- the absorption whose thick film has a target colour.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..numerics.adding_doubling import (
+    Layer,
+    SlabGenerator,
+    add_layers,
+    mirror,
+    passive_generator,
+    slab,
+    slab_generator,
+    star_albedo,
+    star_scale,
+    thick_slab,
+    to_star,
+)
+from ..numerics.cache import LRUCache
+from ..numerics.quadrature import HemisphereGrid
+from .albedo import layer_fourier_kernel, reflection_albedo, with_channel_axis
+from .layers import ReflectionLayer, TransmissionLayer
+
+__all__ = [
+    "PAPER_FILM_THICKNESS_UM",
+    "APPLIED_MASS_MG_PER_CM2",
+    "FOUNDATION_DENSITY_G_PER_CM3",
+    "DEFAULT_THICKNESS_UM",
+    "ON_SKIN_OPTICAL_THICKNESS",
+    "PAPER_FILM_OPTICAL_THICKNESS",
+    "thickness_from_mass",
+    "relative_thickness",
+    "face_albedo",
+    "face_layer",
+    "measured_body_matrices",
+    "remove_faces",
+    "FilmSlab",
+    "film_slab",
+    "body",
+    "free_film_matrices",
+    "made_up_matrices",
+    "made_up_albedo",
+    "thick_limit_albedo",
+    "bihemispherical_on_grid",
+    "solve_thick_absorption",
+    "ROOT_STEPS",
+]
+
+PAPER_FILM_THICKNESS_UM = 150.0
+"""The film the paper measured: foundation filling a hole in a cover glass about 0.15 mm thick
+(paper 4.1, fig. 4), micrometres."""
+
+APPLIED_MASS_MG_PER_CM2 = 540.0 / 565.0
+"""Liquid foundation applied to a face, mg/cm^2: 0.54 g per application (geometric mean over
+about 300 US women weighing their own product for two weeks, Loretz et al. 2006, Food Chem.
+Toxicol. 44(12):2008-2018; median 0.36 g) over a face of 565 cm^2 (the face area of the SCCS
+Notes of Guidance for cosmetic exposure)."""
+
+FOUNDATION_DENSITY_G_PER_CM3 = 1.0
+"""Density of a liquid foundation, g/cm^3: an emulsion of water, oils and silicones (about 1)
+with some 10-20% pigment; taken as 1 (the pigment would raise it by some 10%)."""
+
+
+def thickness_from_mass(mass_mg_per_cm2, density_g_per_cm3=FOUNDATION_DENSITY_G_PER_CM3):
+    """Film thickness in micrometres of a mass per area (mg/cm^2) at a density (g/cm^3):
+    ``10 m / rho`` (1 mg/cm^2 at 1 g/cm^3 is 10 micrometres)."""
+    return 10.0 * np.asarray(mass_mg_per_cm2, float) / np.asarray(density_g_per_cm3, float)
+
+
+DEFAULT_THICKNESS_UM = float(thickness_from_mass(APPLIED_MASS_MG_PER_CM2))
+"""A typical application on a face, micrometres (about 9.6): :data:`APPLIED_MASS_MG_PER_CM2`
+at :data:`FOUNDATION_DENSITY_G_PER_CM3`, as applied (before anything evaporates; the paper's
+film is measured as filled in, likewise)."""
+
+ON_SKIN_OPTICAL_THICKNESS = 0.5
+"""Optical thickness of foundation on skin in Lanza et al. 2024's renderings (their fig. 10
+scripts, about 0.51), taken as that of :data:`DEFAULT_THICKNESS_UM`."""
+
+PAPER_FILM_OPTICAL_THICKNESS = (ON_SKIN_OPTICAL_THICKNESS * PAPER_FILM_THICKNESS_UM
+                                / DEFAULT_THICKNESS_UM)
+"""Optical thickness of the paper's film (about 7.8): how fast light the measured film
+extinguishes entirely (below what eq. 4 resolves) fades with thickness, the unscattered light's
+``exp(-tau x)`` (:func:`lut_baker.numerics.adding_doubling.slab_generator`'s ``max_rate``)."""
+
+ROOT_STEPS = 30
+"""Steps of the root finder (false position, Illinois) of :func:`solve_thick_absorption` and
+of the passive slab's relief: it reaches rounding within some 10-15 steps."""
+RELIEF_STEPS = ROOT_STEPS
+ROOT_TOLERANCE = 1e-13
+"""The root finder stops when every entry is within this of its target, or its bracket is
+this narrow."""
+MEASURED_CACHE_SIZE = 8
+"""Films and grids whose measured matrices are kept in this process."""
+
+
+def relative_thickness(thickness_um) -> float:
+    """A thickness in micrometres in units of the paper's film (:data:`PAPER_FILM_THICKNESS_UM`)."""
+    value = float(thickness_um)
+    if not value >= 0.0:
+        raise ValueError(f"thickness must be >= 0 micrometres, got {thickness_um!r}")
+    return value / PAPER_FILM_THICKNESS_UM
+
+
+def _channels_first(values: np.ndarray) -> np.ndarray:
+    """``(..., C)`` to ``(C, ...)``."""
+    return np.moveaxis(values, -1, 0)
+
+
+def face_albedo(film: ReflectionLayer, grid: HemisphereGrid) -> np.ndarray:
+    """``a_g``: the directional albedo of the film's surface gloss (eq. 2's specular term, its
+    ``P_d`` left out) at the grid's polar nodes, ``(C, N)`` (C = 1 for a scalar film), computed
+    through the half vector for narrow lobes (:func:`~lut_baker.model.albedo.reflection_albedo`);
+    zeros for a film without gloss (``P_s = 0``)."""
+    gloss = film.scaled(P_d=0.0)
+    channels = 3 if film.channels else 1
+    if not np.any(gloss.P_s > 0.0):
+        return np.zeros((channels, grid.theta.size))
+    values = with_channel_axis(reflection_albedo(np.degrees(grid.theta), gloss), film)
+    return _channels_first(values)
+
+
+def face_layer(albedo: np.ndarray, orders: int) -> Layer:
+    """The surface in the star form, ``(C, orders, N, N)``: from above it reflects nothing here
+    (its gloss, eq. 2's specular term, is the closed form added outside the grid), transmits
+    ``1 - a_g`` straight; from below it reflects ``a_g`` specularly."""
+    albedo = np.asarray(albedo, float)
+    eye = np.eye(albedo.shape[-1])
+    down = np.broadcast_to((1.0 - albedo)[:, None, None, :] * eye,
+                           albedo.shape[:1] + (orders,) + eye.shape)
+    return Layer(top=np.zeros(down.shape), bottom=mirror(albedo, orders), down=down)
+
+
+def measured_body_matrices(film: ReflectionLayer, transmission: TransmissionLayer,
+                           grid: HemisphereGrid):
+    """The measured free film's diffuse reflection (eq. 2's ``P_d``, Lambertian) and
+    transmission (eq. 4) in the star form, each ``(C, orders, N, N)``."""
+    scale = star_scale(grid)
+    t = _channels_first(layer_fourier_kernel(transmission, grid.theta, grid.theta, grid.n_phi))
+    p_d = np.asarray(film.P_d, float).reshape(-1)
+    channels = max(t.shape[0], p_d.size)
+    t = np.broadcast_to(t, (channels,) + t.shape[1:])
+    r = np.zeros(t.shape)
+    r[:, 0] = np.broadcast_to(p_d, (channels,))[:, None, None]
+    return to_star(r, scale), to_star(t, scale)
+
+
+def remove_faces(reflection: np.ndarray, transmission: np.ndarray, albedo: np.ndarray):
+    """The body inside a symmetric free film (surface, body, surface) whose reflection without
+    its gloss is ``reflection`` and whose transmission is ``transmission`` (star form,
+    ``(C, orders, N, N)``), the surfaces reflecting ``a_g = albedo`` ``(C, N)``.
+
+    The film lit alike from both sides (``S = R + T``), and in antiphase (``D = R - T``), is
+    half the film over a mirror, and over an anti-mirror; for either, with ``F = diag(1 -
+    a_g)`` and ``rho`` the surface's reflection from below,
+    ``S_film - gloss = F (I - S_body rho)^-1 S_body F``, hence ``X = F^-1 (S_film - gloss)
+    F^-1`` and ``S_body = X (I + rho X)^-1`` (likewise ``D``); ``R = (S + D) / 2``,
+    ``T = (S - D) / 2``.  Exact; symmetric matrices in, symmetric out."""
+    albedo = np.asarray(albedo, float)
+    orders = reflection.shape[-3]
+    inv = 1.0 / (1.0 - albedo)
+    rho = mirror(albedo, orders)
+    eye = np.eye(albedo.shape[-1])
+
+    def inner(film):
+        x = inv[:, None, :, None] * film * inv[:, None, None, :]
+        # X (I + rho X)^-1, solved from the right.
+        return np.swapaxes(np.linalg.solve(np.swapaxes(eye + rho @ x, -1, -2),
+                                           np.swapaxes(x, -1, -2)), -1, -2)
+
+    even = inner(reflection + transmission)
+    odd = inner(reflection - transmission)
+    return 0.5 * (even + odd), 0.5 * (even - odd)
+
+
+@dataclass(frozen=True, eq=False)
+class FilmSlab:
+    """The film's body at every thickness, per channel (``(C, orders, N, N)``): ``generator``
+    (:class:`~lut_baker.numerics.adding_doubling.SlabGenerator`, thickness in units of the
+    paper's film), on ``grid``, with ``absorption`` ``(C,)`` and ``measured_face`` ``(C, N)``,
+    the surface the body was derived under (the measured film's)."""
+
+    grid: HemisphereGrid
+    generator: SlabGenerator
+    absorption: np.ndarray
+    measured_face: np.ndarray
+
+    @property
+    def orders(self) -> int:
+        """Fourier orders held."""
+        return self.generator.rates.shape[-2]
+
+    @property
+    def scale(self) -> np.ndarray:
+        """:func:`~lut_baker.numerics.adding_doubling.star_scale` of the grid."""
+        return star_scale(self.grid)
+
+
+_MEASURED = LRUCache(MEASURED_CACHE_SIZE)
+
+
+def _measured(film: ReflectionLayer, transmission: TransmissionLayer, grid: HemisphereGrid):
+    """:func:`measured_body_matrices` and :func:`face_albedo`, computed once per film and grid."""
+    key = (repr(film.as_dict()), repr(transmission.as_dict()), grid.theta.tobytes(),
+           grid.weight.tobytes(), grid.n_phi)
+
+    def compute():
+        arrays = (*measured_body_matrices(film, transmission, grid), face_albedo(film, grid))
+        for array in arrays:
+            array.setflags(write=False)
+        return arrays
+
+    return _MEASURED.get_or_compute(key, compute)
+
+
+def _free_film_albedo(generator: SlabGenerator, face: np.ndarray, scale0: np.ndarray,
+                      grid: HemisphereGrid) -> np.ndarray:
+    """Bihemispherical ``R + T`` (gloss left out) of the free film of unit thickness, order 0."""
+    order0 = SlabGenerator(basis=generator.basis[..., :1, :, :], rates=generator.rates[..., :1, :])
+    stand_in = FilmSlab(grid=grid, generator=order0, absorption=np.zeros(face.shape[0]),
+                        measured_face=face)
+    r, t = free_film_matrices(stand_in, 1.0)
+    return bihemispherical_on_grid(star_albedo(r[:, 0], scale0) + star_albedo(t[:, 0], scale0),
+                                   grid)
+
+
+def _passive(generator: SlabGenerator, target: float | np.ndarray, face: np.ndarray,
+             grid: HemisphereGrid) -> SlabGenerator:
+    """:func:`~lut_baker.numerics.adding_doubling.passive_generator` with the ``relief`` per
+    channel (false position on [0, 1]) at which the free film of unit thickness keeps, under uniform
+    light, the measured film's ``R + T`` (``target``): passive, and absorbing what the measured
+    film absorbs."""
+    scale0 = star_scale(grid)[0]
+    order0 = SlabGenerator(basis=generator.basis[..., :1, :, :], rates=generator.rates[..., :1, :])
+    relief = _increasing_root(
+        lambda r: _free_film_albedo(passive_generator(order0, scale0, r), face, scale0, grid),
+        np.broadcast_to(np.asarray(target, float), (face.shape[0],)), RELIEF_STEPS)
+    return passive_generator(generator, scale0, relief)
+
+
+def _increasing_root(function, target: np.ndarray, steps: int) -> np.ndarray:
+    """Per entry, ``x`` in [0, 1] with ``function(x) = target`` for an increasing ``function``
+    (vectorised over the entries), by the Illinois variant of false position (the bracket
+    always holds the root; it shrinks superlinearly) until :data:`ROOT_TOLERANCE`; 0 or 1
+    when the target lies outside ``[function(0), function(1)]``."""
+    low = np.zeros(target.shape)
+    high = np.ones(target.shape)
+    f_low = function(low) - target
+    f_high = function(high) - target
+    below = f_low >= 0.0
+    above = f_high <= 0.0
+    side = np.zeros(target.shape, int)
+    for _ in range(steps):
+        span = f_high - f_low
+        x = np.where(span > 0.0, low - f_low * (high - low) / np.where(span > 0.0, span, 1.0),
+                     0.5 * (low + high))
+        x = np.clip(x, low, high)
+        f_x = function(x) - target
+        left = f_x < 0.0  # the root is above x
+        low = np.where(left, x, low)
+        f_low = np.where(left, f_x, f_low)
+        high = np.where(left, high, x)
+        f_high = np.where(left, f_high, f_x)
+        # Illinois: an end kept twice in a row has its value halved.
+        f_high = np.where(left & (side == 1), 0.5 * f_high, f_high)
+        f_low = np.where(~left & (side == -1), 0.5 * f_low, f_low)
+        side = np.where(left, 1, -1)
+        if np.all((np.abs(f_x) <= ROOT_TOLERANCE) | (high - low <= ROOT_TOLERANCE)):
+            return np.where(below, 0.0, np.where(above, 1.0, x))
+    span = f_high - f_low
+    x = np.where(span > 0.0, low - f_low * (high - low) / np.where(span > 0.0, span, 1.0),
+                 0.5 * (low + high))
+    return np.where(below, 0.0, np.where(above, 1.0, np.clip(x, low, high)))
+
+
+def film_slab(film: ReflectionLayer, transmission: TransmissionLayer, grid: HemisphereGrid, *,
+              absorption=0.0, optical_thickness: float = PAPER_FILM_OPTICAL_THICKNESS,
+              passive: bool = True, orders: int | None = None) -> FilmSlab:
+    """The body of a measured film (``film``: eq. 2, gloss and ``P_d``; ``transmission``:
+    eq. 4; in albedo units) at every thickness, with absorption ``A`` (scalar or RGB in
+    [0, 1]).
+
+    At the measured thickness the free film's diffuse reflection and transmission times
+    ``1 - A`` are the target; its faces (``film``'s gloss) are taken off
+    (:func:`remove_faces`) and the doubling relation inverted
+    (:func:`~lut_baker.numerics.adding_doubling.slab_generator`, light the film extinguishes
+    fading as ``exp(-optical_thickness x)``).  ``passive``: no direction may gain light
+    (:func:`~lut_baker.numerics.adding_doubling.passive_generator`, with the relief that keeps
+    the free film's absorption under uniform light; docs/model.md, "The film as a slab": the
+    measured film, normalised to be lossless at normal incidence, is not quite a passive slab
+    under a lossless surface).  ``orders``: keep the first orders only (1 for albedos under
+    uniform light)."""
+    a = np.atleast_1d(np.asarray(absorption, float))
+    if a.shape not in ((1,), (3,)) or np.any(a < 0.0) or np.any(a > 1.0):
+        raise ValueError(f"absorption must be a float or RGB in [0, 1], got {absorption!r}")
+    if not optical_thickness > 0.0:
+        raise ValueError(f"optical_thickness must be > 0, got {optical_thickness!r}")
+    r, t, face = _measured(film, transmission, grid)
+    if orders is not None:
+        r, t = r[:, :orders], t[:, :orders]
+    channels = max(r.shape[0], face.shape[0], a.size)
+    once = (1.0 - a)[:, None, None, None]
+    r = np.broadcast_to(r, (channels,) + r.shape[1:]) * once
+    t = np.broadcast_to(t, (channels,) + t.shape[1:]) * once
+    face = np.broadcast_to(face, (channels, face.shape[-1]))
+    body_r, body_t = remove_faces(r, t, face)
+    generator = slab_generator(body_r, body_t, max_rate=0.5 * float(optical_thickness))
+    if passive:
+        scale0 = star_scale(grid)[0]
+        target = bihemispherical_on_grid(star_albedo(r[:, 0], scale0)
+                                         + star_albedo(t[:, 0], scale0), grid)
+        generator = _passive(generator, target, face, grid)
+    return FilmSlab(grid=grid, generator=generator,
+                    absorption=np.broadcast_to(a, (channels,)).copy(), measured_face=face)
+
+
+def body(film: FilmSlab, thickness: float):
+    """The body's ``(R, T)`` (star form, ``(C, orders, N, N)``) at ``thickness`` in units of
+    the paper's film (:func:`relative_thickness`)."""
+    return slab(film.generator, thickness)
+
+
+def _body_layer(film: FilmSlab, thickness: float) -> Layer:
+    r, t = body(film, thickness)
+    return Layer(top=r, bottom=r, down=t)
+
+
+def free_film_matrices(film: FilmSlab, thickness: float, face=None):
+    """The free film (surface, body, surface; air on both sides) at ``thickness``: its
+    reflection without the top surface's gloss and its transmission, star form.  ``face``: the
+    surfaces' ``a_g`` ``(C, N)`` (default: the measured film's)."""
+    face = film.measured_face if face is None else np.asarray(face, float)
+    upper = face_layer(face, film.orders)
+    lower = Layer(top=upper.bottom, bottom=upper.top, down=upper.down)
+    stack = add_layers(add_layers(upper, _body_layer(film, thickness)), lower)
+    return stack.top, stack.down
+
+
+_SKINS = LRUCache(MEASURED_CACHE_SIZE)
+
+
+def _skin_star(skin: ReflectionLayer, grid: HemisphereGrid) -> np.ndarray:
+    """The skin's eq. 2 kernel in the star form, ``(C, orders, N, N)``, once per skin and grid."""
+    key = (repr(skin.as_dict()), grid.theta.tobytes(), grid.weight.tobytes(), grid.n_phi)
+
+    def compute():
+        kernel = layer_fourier_kernel(skin, grid.theta, grid.theta, grid.n_phi)
+        star = to_star(_channels_first(kernel), star_scale(grid))
+        star.setflags(write=False)
+        return star
+
+    return _SKINS.get_or_compute(key, compute)
+
+
+def _skin_layer(skin_star: np.ndarray) -> Layer:
+    zeros = np.zeros_like(skin_star)
+    return Layer(top=skin_star, bottom=zeros, down=zeros)
+
+
+def made_up_matrices(film: FilmSlab, thickness: float, skin: ReflectionLayer, face=None):
+    """Made-up skin without its top gloss (star form, ``(C, orders, N, N)``): the film's
+    surface (``face``, default the measured film's) over its body at ``thickness`` over the
+    skin's surface reflection (eq. 2, gloss and diffuse part), every inter-reflection summed
+    (the adding equations).  Add the surface's gloss (eq. 2's specular term, closed form) for
+    the whole BRDF."""
+    face = film.measured_face if face is None else np.asarray(face, float)
+    skin_star = _skin_star(skin, film.grid)[:, :film.orders]
+    stack = add_layers(add_layers(face_layer(face, film.orders), _body_layer(film, thickness)),
+                       _skin_layer(skin_star))
+    return stack.top
+
+
+def made_up_albedo(film: FilmSlab, thickness: float, skin: ReflectionLayer, face=None):
+    """Directional albedo of made-up skin at the grid's nodes, ``(C, N)``: the surface's gloss
+    ``a_g`` plus :func:`made_up_matrices`' order 0."""
+    face = film.measured_face if face is None else np.asarray(face, float)
+    top = made_up_matrices(film, thickness, skin, face)
+    return face + star_albedo(top[:, 0], film.scale[0])
+
+
+def thick_limit_albedo(film: FilmSlab, face=None) -> np.ndarray:
+    """Directional albedo at the nodes ``(C, N)`` of the film at infinite thickness under its
+    surface (``face``, default the measured film's): the gloss ``a_g`` plus
+    ``F (I - R_inf rho)^-1 R_inf F``'s order 0."""
+    face = film.measured_face if face is None else np.asarray(face, float)
+    r_inf = thick_slab(film.generator)
+    zeros = np.zeros_like(r_inf)
+    stack = add_layers(face_layer(face, film.orders), Layer(top=r_inf, bottom=r_inf, down=zeros))
+    return face + star_albedo(stack.top[:, 0], film.scale[0])
+
+
+def bihemispherical_on_grid(albedo: np.ndarray, grid: HemisphereGrid) -> np.ndarray:
+    """``2 Int a(mu) mu dmu`` from a directional albedo at the grid's polar nodes (``(..., N)``):
+    ``sum 2 w_j a_j`` (the weights are ``cos sin dtheta``)."""
+    return np.asarray(albedo, float) @ (2.0 * grid.weight)
+
+
+def solve_thick_absorption(target, film: ReflectionLayer, transmission: TransmissionLayer,
+                           grid: HemisphereGrid, *, face=None,
+                           optical_thickness: float = PAPER_FILM_OPTICAL_THICKNESS,
+                           passive: bool = True):
+    """``(A, clamped)`` per channel of ``target`` (a colour under uniform light, RGB): the
+    absorption whose film, infinitely thick under its surface (``face``: ``a_g`` ``(C, N)``,
+    default the measured film's), has that bihemispherical albedo, by false position on [0, 1]
+    (order 0 only; the thick film darkens as ``A`` grows).  Out of reach: ``A = 0`` or 1 and
+    ``clamped``."""
+    target = np.atleast_1d(np.asarray(target, float))
+
+    def limit(a):
+        slab_a = film_slab(film, transmission, grid, absorption=a,
+                           optical_thickness=optical_thickness, passive=passive, orders=1)
+        return bihemispherical_on_grid(thick_limit_albedo(slab_a, face), grid)
+
+    absorption = _increasing_root(lambda a: -limit(a), -target, ROOT_STEPS)
+    too_light = target > limit(np.zeros_like(target))
+    too_dark = target < limit(np.ones_like(target))
+    return absorption, too_light | too_dark
