@@ -32,8 +32,11 @@ Parts, each in fresh Blender processes (so the first call is truly cold), this c
   ``shade_step(direction="LIGHTER")``, ``shade_step(direction="DARKER")``, Match Skin again;
   and, in another process, a first Apply at the defaults
   (:func:`makeup_skin_addon.material.apply_to_object`: the match, then the bake and fit).  Each
-  with the part spent in the colour sampling (``skin_sampling.surface_mean``, or an older
-  checkout's ``shade.image_mean``) and, for Apply, in the match (``shade.first_shade``).
+  with the part spent in reading the skin's colour (over the artist's shader
+  ``artist_skin.read_material``; an older checkout's ``skin_sampling.surface_mean`` or
+  ``shade.image_mean``) and, for Apply, in the match (``matching.first_shade``, or
+  ``shade.first_shade``).  Match Skin waits for Apply: the head is applied first and the
+  colour's caches emptied, as in a made-up file opened anew.
 
 Every time is also printed times 3 (a machine three times slower), against the target: Match
 Skin, Lighter, Darker and the first Apply's match at most 0.2 s and 100 MB on this head.  The
@@ -46,6 +49,7 @@ Run with the venv's python of the Blender line to measure (``$(tools/venv.sh)/bi
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import json
 import os
 import shutil
@@ -262,20 +266,32 @@ def operators_worker(cache: Path, repo: Path, which: str) -> dict:
     from makeup_skin_addon import shade
 
     spent: dict = {}
-    sampler = "image_mean" if hasattr(shade, "image_mean") else None
-    if sampler is None:
-        from makeup_skin_addon import skin_sampling
+    over_shader = importlib.util.find_spec("makeup_skin_addon.artist_skin") is not None
+    if over_shader:  # the film over the artist's shader: the skin read from it
+        from makeup_skin_addon import artist_skin, matching, skin_sampling
 
-        _timed(skin_sampling, "surface_mean", spent)
-        sampling = "surface_mean"
+        _timed(artist_skin, "read_material", spent)
+        sampling, match = "read_material", "first_shade"
+        _timed(matching, match, spent)
     else:
-        _timed(shade, sampler, spent)
-        sampling = sampler
-    _timed(shade, "first_shade", spent)
+        sampling = "image_mean" if hasattr(shade, "image_mean") else "surface_mean"
+        if sampling == "surface_mean":
+            from makeup_skin_addon import skin_sampling
+
+            _timed(skin_sampling, sampling, spent)
+        else:
+            _timed(shade, sampling, spent)
+        match = "first_shade"
+        _timed(shade, match, spent)
     makeup_skin_addon.register()
     try:
         material = head.active_material
         material.makeup_skin.live_update = False
+        if which == "match" and over_shader:
+            # Match Skin waits for Apply (greyed out before): Apply, then forget the colour
+            # read (a made-up file opened anew: the first Match Skin reads it cold).
+            made_up.apply_to_object(bpy.context, head)
+            skin_sampling.clear_cache()
         steps = ([("match_skin", lambda: bpy.ops.makeup_skin.match_skin()),
                   ("lighter", lambda: bpy.ops.makeup_skin.shade_step(direction="LIGHTER")),
                   ("darker", lambda: bpy.ops.makeup_skin.shade_step(direction="DARKER")),
@@ -290,8 +306,9 @@ def operators_worker(cache: Path, repo: Path, which: str) -> dict:
             if isinstance(result, set) and result != {"FINISHED"}:
                 raise SystemExit(f"skin_colour: {name} returned {result}")
             out[name] = step.figures(sampling_s=spent.get(sampling, 0.0),
-                                     match_s=spent.get("first_shade"))
-        out["source"] = shade.skin_colour(material).source
+                                     match_s=spent.get(match))
+        out["source"] = (matching.skin_target(material).source if over_shader
+                         else shade.skin_colour(material).source)
     finally:
         makeup_skin_addon.unregister()
     return out
