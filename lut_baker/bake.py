@@ -52,7 +52,7 @@ from .model.dipole import dipole_profile, dipole_total_reflectance
 from .model.layers import Dipole, ReflectionLayer
 from .model.made_up_skin import MadeUpSkin, film_reflection_layer, film_transmission_layer
 from .model.microfacet import (
-    fresnel_term,
+    fresnel_reflectance,
     fresnel_transmittance,
     half_vector_cosines,
     ts_specular_from_cosines,
@@ -198,19 +198,19 @@ def fresnel_tabulation(eta: float) -> np.ndarray | None:
     """``F_r`` (eq. 2) at ``FRESNEL_NODES + 1`` uniform cosines, or None when linear
     interpolation of it errs by more than ``FRESNEL_TOLERANCE`` (eta near 1, or below 1 where
     total internal reflection puts a kink in F)."""
-    nodes = fresnel_term(np.linspace(0.0, 1.0, FRESNEL_NODES + 1), eta)
-    mid = fresnel_term((np.arange(FRESNEL_NODES) + 0.5) / FRESNEL_NODES, eta)
+    nodes = fresnel_reflectance(np.linspace(0.0, 1.0, FRESNEL_NODES + 1), eta)
+    mid = fresnel_reflectance((np.arange(FRESNEL_NODES) + 0.5) / FRESNEL_NODES, eta)
     error = np.abs(0.5 * (nodes[1:] + nodes[:-1]) - mid) / np.maximum(mid, 1e-300)
     return nodes if error.max() <= FRESNEL_TOLERANCE else None
 
 
 def fresnel_interpolated(cosine: np.ndarray, eta) -> np.ndarray:
-    """:func:`lut_baker.model.microfacet.fresnel_term` of cosines in [0, 1] with a trailing
-    channel axis of 1, interpolated from :func:`fresnel_tabulation` (5x faster, within 1e-8
-    relative) when eta is one number; the formula itself otherwise."""
+    """:func:`lut_baker.model.microfacet.fresnel_reflectance` of cosines in [0, 1] with a
+    trailing channel axis of 1, interpolated from :func:`fresnel_tabulation` (5x faster,
+    within 1e-8 relative) when eta is one number; the formula itself otherwise."""
     table = fresnel_tabulation(float(eta)) if np.ndim(eta) == 0 else None
     if table is None:
-        return fresnel_term(cosine, eta)
+        return fresnel_reflectance(cosine, eta)
     x = cosine * FRESNEL_NODES
     low = np.minimum(x.astype(np.intp), FRESNEL_NODES - 1)
     below = table[low]

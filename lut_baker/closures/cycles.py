@@ -48,7 +48,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from ..model.microfacet import fresnel_term
+from ..model.microfacet import fresnel_reflectance
 from ..numerics.geometry import direction, half_vector
 from ..numerics.quadrature import gauss_legendre, hemisphere_grid, midpoint_nodes
 
@@ -192,9 +192,11 @@ def microfacet_shadowing(cos_i, cos_o, alpha, distribution: str = "GGX"):
 
 
 def dielectric_fresnel(cos_theta, eta):
-    """Cycles' ``fresnel_dielectric_cos``: the model's ``F_r`` (eq. 2, :func:`fresnel_term`) at
-    cosines clipped to [0, 1] (Cycles alone gives 1 at eta = 1 and grazing, the model 0)."""
-    return fresnel_term(np.clip(np.asarray(cos_theta, float), 0.0, 1.0), np.asarray(eta, float))
+    """Cycles' ``fresnel_dielectric_cos``: the model's ``F_r`` (eq. 2,
+    :func:`~lut_baker.model.microfacet.fresnel_reflectance`) at cosines clipped to [0, 1]
+    (Cycles alone gives 1 at eta = 1 and grazing, the model 0)."""
+    return fresnel_reflectance(np.clip(np.asarray(cos_theta, float), 0.0, 1.0),
+                               np.asarray(eta, float))
 
 
 def f0_from_ior(eta):

@@ -38,7 +38,7 @@ from ..numerics.quadrature import (
 from .layers import ReflectionLayer, TransmissionLayer
 from .microfacet import (
     check_directions,
-    fresnel_term,
+    fresnel_reflectance,
     ts_reflection,
     ts_specular_from_cosines,
     ts_transmission,
@@ -144,12 +144,13 @@ degrees (:data:`lut_baker.numerics.quadrature.NARROWEST_LOBE_DEG`)."""
 
 
 def specular_albedo(theta_i_deg, layer: ReflectionLayer, *, level: int = 0,
-                    fresnel=fresnel_term):
+                    fresnel=fresnel_reflectance):
     """Directional albedo of eq. 2's specular term alone, ``Int P_s D G F_r cos(theta_o)
     dwo``, at incidence ``theta_i_deg`` (degrees, any shape), through the half vector
     (:func:`lut_baker.numerics.quadrature.mirror_quadrature`, panels sized by the lobe): the
-    same cost for a lobe of any width.  ``fresnel``: :func:`fresnel_term` or an accelerator of
-    it.  Shape ``theta.shape + (C,)`` (C the layer's channels, 1 for a scalar layer)."""
+    same cost for a lobe of any width.  ``fresnel``: :func:`fresnel_reflectance` or an
+    accelerator of it.  Shape ``theta.shape + (C,)`` (C the layer's channels, 1 for a scalar
+    layer)."""
     theta = np.radians(np.asarray(theta_i_deg, float))
     scale = 2**int(level)
     quad = mirror_quadrature(theta.ravel(), 1.0 / float(np.max(layer.n)),

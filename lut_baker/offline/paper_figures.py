@@ -230,7 +230,7 @@ def made_up_profile_curves(skin: MadeUpSkin | None = None, angle_deg: float = 30
     d = profile_distances(max_mm, step_mm)
     profile = _red(dipole_profile(d, skin.dipole)) / np.pi
     cosines = np.array([[wi[2]], [wo[2]]])  # (2, 1): broadcasts against a scalar or RGB eta
-    fresnel_t = 1.0 - _red(fresnel_reflectance(cosines, skin.dipole.eta))
+    fresnel_t = 1.0 - _red(fresnel_reflectance(cosines, skin.dipole.eta, check=True))
     t = _red(transmission_factor(np.stack([wi, wo]), film_transmission_layer(skin), skin.dipole))
     bare = profile * fresnel_t[0] * fresnel_t[1]
     made_up = profile * t[0] * t[1]
