@@ -61,9 +61,9 @@ __all__ = [
 UNIT_TOLERANCE = 1e-6
 """How far ``|w|`` may stray from 1 (and a cosine from [0, 1]) before it is rejected."""
 
-Fresnel = Callable[[Real, Real], NDArray[np.float64]]
-"""``F_r(c, eta)``: :func:`fresnel_reflectance` or an accelerator of it (the bake's
-tabulation)."""
+Fresnel = Callable[[NDArray[np.float64], Real], NDArray[np.float64]]
+"""``F_r(c, eta)`` at an array of cosines: :func:`fresnel_reflectance` or an accelerator of it
+(the bake's tabulation)."""
 
 
 # --------------------------------------------------------------------------------------------
@@ -221,8 +221,12 @@ def _checked_cosines(cosines: tuple[Real, ...]) -> tuple[NDArray[np.float64], ..
 # --------------------------------------------------------------------------------------------
 # Eqs. 2 and 4 over cosines
 # --------------------------------------------------------------------------------------------
-def ts_specular_from_cosines(n_dot_h: Real, v_dot_h: Real, n_dot_v: Real, n_dot_l: Real,
-                             P_s: Real, n: Real, eta: Real,
+Cosines = NDArray[np.float64]
+"""Cosines ``n.h``, ``v.h``, ``n.v``, ``n.l`` in [0, 1] (any shapes that broadcast)."""
+
+
+def ts_specular_from_cosines(n_dot_h: Cosines, v_dot_h: Cosines, n_dot_v: Cosines,
+                             n_dot_l: Cosines, P_s: Real, n: Real, eta: Real,
                              fresnel: Fresnel = fresnel_reflectance) -> NDArray[np.float64]:
     """Eq. 2's specular term ``P_s D(alpha) G F_r(v.h)`` in the unit of ``P_s`` (1/sr once
     normalised), ``alpha = acos(n.h)`` in degrees, ``n`` in 1/degree.  ``fresnel(c, eta)``:
@@ -232,8 +236,8 @@ def ts_specular_from_cosines(n_dot_h: Real, v_dot_h: Real, n_dot_v: Real, n_dot_
     return P_s * distribution_term(alpha, n) * geometry * fresnel(v_dot_h, eta)
 
 
-def ts_reflection_from_cosines(n_dot_h: Real, v_dot_h: Real, n_dot_v: Real, n_dot_l: Real,
-                               layer: ReflectionLayer,
+def ts_reflection_from_cosines(n_dot_h: Cosines, v_dot_h: Cosines, n_dot_v: Cosines,
+                               n_dot_l: Cosines, layer: ReflectionLayer,
                                fresnel: Fresnel = fresnel_reflectance) -> NDArray[np.float64]:
     """Torrance-Sparrow BRDF ``f_r = P_d + P_s D(alpha) G F_r(v.h)`` (paper eq. 2), without
     the cosine, in the unit of ``P_d``/``P_s`` (1/sr once normalised).  The cosines must
@@ -242,7 +246,7 @@ def ts_reflection_from_cosines(n_dot_h: Real, v_dot_h: Real, n_dot_v: Real, n_do
                                                 layer.n, layer.eta, fresnel)
 
 
-def ts_transmission_from_cosines(n_dot_h: Real, v_dot_h: Real, layer: TransmissionLayer,
+def ts_transmission_from_cosines(n_dot_h: Cosines, v_dot_h: Cosines, layer: TransmissionLayer,
                                  fresnel: Fresnel = fresnel_reflectance) -> NDArray[np.float64]:
     """Thin-film BTDF ``f_t = P_d + P_t D(beta) (1 - F_r(v'.h'))`` (paper eq. 4), without the
     cosine, in the unit of ``P_d``/``P_t``: ``n_dot_h`` is ``n.h'`` (``beta = acos(n.h')`` in

@@ -17,6 +17,15 @@ RUNTIME = sorted(
 FORMULAS_WITH_EXAMPLES = {
     "lut_baker.model.microfacet": ["fresnel_reflectance", "fresnel_transmittance",
                                    "distribution_term", "attenuation_term"],
+    "lut_baker.model.dipole": ["fresnel_diffuse_reflectance", "dipole_profile",
+                               "dipole_total_reflectance"],
+    "lut_baker.model.albedo": ["reflection_albedo", "transmission_albedo", "bihemispherical"],
+    "lut_baker.model.thick_layer": ["stack_reflectance", "solve_absorption"],
+    "lut_baker.model.roughness": ["lobe_width_deg", "roughness_for_width"],
+    "lut_baker.model.made_up_skin": ["coverage_weights", "combine"],
+    "lut_baker.tables.uniform_light": ["made_up_colour", "matching_absorption"],
+    "lut_baker.closures.view_image": ["sample_lut"],
+    "lut_baker.closures.principled_albedo": ["base_color_for_body"],
 }
 """The formulas whose docstrings must show an example (docs/model.md's equations)."""
 
