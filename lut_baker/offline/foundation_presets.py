@@ -42,6 +42,7 @@ Functions and types
 from __future__ import annotations
 
 import json
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -133,7 +134,7 @@ def derive_preset(name: str, finish: str, layers, exchange: FilmExchange | None 
     absorption) and ``clamped``."""
     _check_layers(layers)
     exchange = exchange or paper_film_exchange()
-    target = np.array([float(bihemispherical(lambda t, layer=layer: reflection_albedo(t, layer)))
+    target = np.array([float(bihemispherical(partial(reflection_albedo, layer=layer)))
                        for layer in layers])
     absorption, clamped = solve_absorption(target, exchange)
     if label is None:

@@ -6,6 +6,7 @@ import doctest
 import importlib
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -29,12 +30,19 @@ FORMULAS_WITH_EXAMPLES = {
 }
 """The formulas whose docstrings must show an example (docs/model.md's equations)."""
 
+NUMPY_PRINTING = {"legacy": False, "sign": "-", "precision": 8, "floatmode": "maxprec",
+                  "suppress": False, "linewidth": 75, "threshold": 1000, "edgeitems": 3}
+"""numpy's default printing, which the examples are written in: colour-science switches the
+process to numpy 1.13's when it is imported (the offline part imports it), so the examples
+run under these whatever ran before them."""
+
 
 @pytest.mark.parametrize("name", RUNTIME)
 def test_docstring_examples_hold(name):
     module = importlib.import_module(name)
-    result = doctest.testmod(module, optionflags=doctest.NORMALIZE_WHITESPACE
-                             | doctest.ELLIPSIS, report=True, verbose=False)
+    with np.printoptions(**NUMPY_PRINTING):
+        result = doctest.testmod(module, optionflags=doctest.NORMALIZE_WHITESPACE
+                                 | doctest.ELLIPSIS, report=True, verbose=False)
     assert result.failed == 0, f"{result.failed} of {result.attempted} examples fail in {name}"
 
 
