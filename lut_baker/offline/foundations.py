@@ -123,11 +123,11 @@ def analyse(name: str, data_dir) -> ProductAnalysis:
     split = alternate_incidences(data.incidences_deg)
     held_out = tuple(fit_channels(data.theta_i_deg, data.theta_o_deg, rgb, split[0],
                                   fits.fit_model) for fits, _ in choice.steps)
-    untilted = None
+    untilted: tuple[ChannelFits, ChannelFits] | None = None
     if choice.model.tilt:
         model = replace(choice.model, tilt=False)
-        untilted = tuple(fit_channels(data.theta_i_deg, data.theta_o_deg, rgb, rows, model)
-                         for rows in (None, split[0]))
+        untilted = (fit_channels(data.theta_i_deg, data.theta_o_deg, rgb, None, model),
+                    fit_channels(data.theta_i_deg, data.theta_o_deg, rgb, split[0], model))
     return ProductAnalysis(name, finish, data, choice, held_out, split, misses(choice.fit),
                            untilted)
 
