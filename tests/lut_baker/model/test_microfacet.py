@@ -102,7 +102,7 @@ def test_distribution_half_width(n):
     (0.8, 0.0, 0.9, 0.5, 0.0),  # grazing view
     (1.0, 0.0, 0.0, 0.0, 0.0),  # opposite horizontal pair: VH = 0
 ])
-def test_geometric_attenuation_cases(nh, nv, nl, vh, expected):
+def test_attenuation_term_cases(nh, nv, nl, vh, expected):
     assert microfacet.attenuation_term(nh, nv, nl, vh, check=True) == pytest.approx(expected,
                                                                                  rel=1e-12)
 
