@@ -41,24 +41,27 @@ How close the tables come to the exact evaluator is measured offline, by
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from functools import lru_cache
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from .evaluate.two_layer import inter_reflection_fourier_matrices, layered_fourier_matrices
 from .model.albedo import specular_albedo
 from .model.dipole import dipole_profile, dipole_total_reflectance
-from .model.layers import Dipole, ReflectionLayer
+from .model.layers import Dipole, ReflectionLayer, TransmissionLayer
 from .model.made_up_skin import MadeUpSkin, film_reflection_layer, film_transmission_layer
 from .model.microfacet import (
-    fresnel_term,
+    fresnel_reflectance,
     fresnel_transmittance,
     half_vector_cosines,
     ts_specular_from_cosines,
     ts_transmission_from_cosines,
 )
 from .model.params_file import skin_to_dict
+from .numerics import Real
 from .numerics.cache import LRUCache
 from .numerics.quadrature import (
     hemisphere_panels,
@@ -174,7 +177,7 @@ RESOLUTIONS = {
 """Named resolutions, chosen by the convergence study in docs/baking.md."""
 
 
-def resolution(name_or_resolution) -> Resolution:
+def resolution(name_or_resolution: str | Resolution) -> Resolution:
     """A :class:`Resolution` from its name (``preview``, ``default``, ``high``) or itself."""
     if isinstance(name_or_resolution, Resolution):
         return name_or_resolution
@@ -198,26 +201,28 @@ def fresnel_tabulation(eta: float) -> np.ndarray | None:
     """``F_r`` (eq. 2) at ``FRESNEL_NODES + 1`` uniform cosines, or None when linear
     interpolation of it errs by more than ``FRESNEL_TOLERANCE`` (eta near 1, or below 1 where
     total internal reflection puts a kink in F)."""
-    nodes = fresnel_term(np.linspace(0.0, 1.0, FRESNEL_NODES + 1), eta)
-    mid = fresnel_term((np.arange(FRESNEL_NODES) + 0.5) / FRESNEL_NODES, eta)
+    nodes = fresnel_reflectance(np.linspace(0.0, 1.0, FRESNEL_NODES + 1), eta)
+    mid = fresnel_reflectance((np.arange(FRESNEL_NODES) + 0.5) / FRESNEL_NODES, eta)
     error = np.abs(0.5 * (nodes[1:] + nodes[:-1]) - mid) / np.maximum(mid, 1e-300)
     return nodes if error.max() <= FRESNEL_TOLERANCE else None
 
 
-def fresnel_interpolated(cosine: np.ndarray, eta) -> np.ndarray:
-    """:func:`lut_baker.model.microfacet.fresnel_term` of cosines in [0, 1] with a trailing
-    channel axis of 1, interpolated from :func:`fresnel_tabulation` (5x faster, within 1e-8
-    relative) when eta is one number; the formula itself otherwise."""
+def fresnel_interpolated(cosine: NDArray[np.float64], eta: Real) -> NDArray[np.float64]:
+    """:func:`lut_baker.model.microfacet.fresnel_reflectance` of cosines in [0, 1] with a
+    trailing channel axis of 1, interpolated from :func:`fresnel_tabulation` (5x faster,
+    within 1e-8 relative) when eta is one number; the formula itself otherwise."""
     table = fresnel_tabulation(float(eta)) if np.ndim(eta) == 0 else None
     if table is None:
-        return fresnel_term(cosine, eta)
+        return fresnel_reflectance(cosine, eta)
     x = cosine * FRESNEL_NODES
     low = np.minimum(x.astype(np.intp), FRESNEL_NODES - 1)
     below = table[low]
     return below + (x - low) * (table[low + 1] - below)
 
 
-def _reflection_values(layer: ReflectionLayer, cos_a, cos_b, n_dot_h, v_dot_h):
+def _reflection_values(layer: ReflectionLayer, cos_a: NDArray[np.float64],
+                       cos_b: NDArray[np.float64], n_dot_h: NDArray[np.float64],
+                       v_dot_h: NDArray[np.float64]) -> NDArray[np.float64]:
     """``P_d + P_s (D G F_r)`` (eq. 2) of ``wa``, ``wb`` with polar cosines ``cos_a``,
     ``cos_b`` and half-vector cosines ``n_dot_h``, ``v_dot_h``, with a trailing channel axis
     (1 or 3): :func:`~lut_baker.model.microfacet.ts_specular_from_cosines` of the unit lobe,
@@ -229,7 +234,9 @@ def _reflection_values(layer: ReflectionLayer, cos_a, cos_b, n_dot_h, v_dot_h):
     return layer.P_d + layer.P_s * lobe
 
 
-def _kernel_values(layer, theta_a, theta_b, cos_phi):
+def _kernel_values(layer: ReflectionLayer | TransmissionLayer, theta_a: NDArray[np.float64],
+                   theta_b: NDArray[np.float64],
+                   cos_phi: NDArray[np.float64]) -> NDArray[np.float64]:
     """The layer's kernel at polar angles ``theta_a``, ``theta_b`` (radians, broadcasting)
     and relative azimuths with cosine ``cos_phi``: ``f_r(wa, wb)`` for a reflecting layer,
     ``f_t(wa, -wb)`` for the film (whose lobe is the mirror image: azimuth ``phi + pi``)."""
@@ -254,24 +261,26 @@ def _cosine_matrix(n_phi: int) -> np.ndarray:
     return matrix
 
 
-def fourier_coefficients(layer, theta_a, theta_b, n_phi: int) -> np.ndarray:
+def fourier_coefficients(layer: ReflectionLayer | TransmissionLayer, theta_a: ArrayLike,
+                         theta_b: ArrayLike, n_phi: int) -> NDArray[np.float64]:
     """Cosine coefficients ``(orders, A, B, C)`` of a layer's kernel (the signature and result
     of :func:`lut_baker.model.albedo.layer_fourier_kernel`, within 1e-8 relative: the
     tabulated Fresnel term), evaluated at the distinct azimuths only, and once per unordered pair
     when ``theta_a`` equals ``theta_b``."""
-    theta_a = np.atleast_1d(np.asarray(theta_a, float))
-    theta_b = np.atleast_1d(np.asarray(theta_b, float))
+    angles_a = np.atleast_1d(np.asarray(theta_a, float))
+    angles_b = np.atleast_1d(np.asarray(theta_b, float))
     matrix = _cosine_matrix(n_phi)
     cos_phi = np.cos(uniform_azimuths(n_phi)[:matrix.shape[1]])
-    if theta_a.shape == theta_b.shape and np.array_equal(theta_a, theta_b):
-        upper = np.triu_indices(theta_a.size)
-        values = _kernel_values(layer, theta_a[upper[0], None], theta_b[upper[1], None], cos_phi)
+    if angles_a.shape == angles_b.shape and np.array_equal(angles_a, angles_b):
+        upper = np.triu_indices(angles_a.size)
+        values = _kernel_values(layer, angles_a[upper[0], None], angles_b[upper[1], None],
+                                cos_phi)
         pairs = np.tensordot(matrix, values, axes=([1], [1]))  # (M, pairs, C)
-        out = np.empty((matrix.shape[0], theta_a.size, theta_a.size, pairs.shape[-1]))
+        out = np.empty((matrix.shape[0], angles_a.size, angles_a.size, pairs.shape[-1]))
         out[:, upper[0], upper[1]] = pairs
         out[:, upper[1], upper[0]] = pairs
         return out
-    values = _kernel_values(layer, theta_a[:, None, None], theta_b[None, :, None], cos_phi)
+    values = _kernel_values(layer, angles_a[:, None, None], angles_b[None, :, None], cos_phi)
     return np.tensordot(matrix, values, axes=([1], [2]))
 
 
@@ -280,16 +289,17 @@ class KernelCache:
     matrix functions of :mod:`lut_baker.evaluate.two_layer` so that one bake evaluates each
     kernel once."""
 
-    def __init__(self):
+    def __init__(self) -> None:
         self._store = LRUCache(None)
 
-    def __call__(self, layer, theta_a, theta_b, n_phi: int) -> np.ndarray:
-        theta_a = np.atleast_1d(np.asarray(theta_a, float))
-        theta_b = np.atleast_1d(np.asarray(theta_b, float))
-        key = (id(layer), theta_a.tobytes(), theta_b.tobytes(), n_phi)
+    def __call__(self, layer: ReflectionLayer | TransmissionLayer, theta_a: ArrayLike,
+                 theta_b: ArrayLike, n_phi: int) -> NDArray[np.float64]:
+        angles_a = np.atleast_1d(np.asarray(theta_a, float))
+        angles_b = np.atleast_1d(np.asarray(theta_b, float))
+        key = (id(layer), angles_a.tobytes(), angles_b.tobytes(), n_phi)
         # The layer is stored too, so that it stays alive and its id unique.
         return self._store.get_or_compute(key, lambda: (layer, fourier_coefficients(
-            layer, theta_a, theta_b, n_phi)))[1]
+            layer, angles_a, angles_b, n_phi)))[1]
 
 
 # --------------------------------------------------------------------------------------------
@@ -317,7 +327,8 @@ class _NodePairs:
     relative azimuth ``cos_phi`` ``(P, n_phi)``; :meth:`tables` evaluates functions on them in
     cache-sized chunks and fills the symmetric tables."""
 
-    def __init__(self, theta_deg, phi_deg, phi_spacing: str):
+    def __init__(self, theta_deg: NDArray[np.float64], phi_deg: NDArray[np.float64],
+                 phi_spacing: str) -> None:
         theta_deg = np.asarray(theta_deg, float)
         self.n, self.n_phi = theta_deg.size, np.size(phi_deg)
         self.upper = np.triu_indices(self.n)
@@ -332,7 +343,8 @@ class _NodePairs:
                                                     theta_deg[self.upper[1][chunk]],
                                                     phi_deg, phi_spacing)
 
-    def tables(self, function, channels) -> list[np.ndarray]:
+    def tables(self, function: Callable[[slice], list[NDArray[np.float64]]],
+               channels: Sequence[int]) -> list[np.ndarray]:
         """``function(chunk)`` -> a list of ``(len(chunk), n_phi, C_k)`` arrays for slices of
         the pairs; returns the full ``(n_theta, n_theta, n_phi, 3)`` tables (read-only
         broadcasts where ``C_k`` = 1).  ``channels``: the ``C_k``."""
@@ -345,7 +357,7 @@ class _NodePairs:
         return [rgb_view(table) for table in out]
 
 
-def gloss_albedos(layers, theta_deg) -> list[np.ndarray]:
+def gloss_albedos(layers: Sequence[ReflectionLayer], theta_deg: ArrayLike) -> list[np.ndarray]:
     """Directional albedos ``Int P_s D G F_r cos(theta_o) dwo`` (eq. 2's specular part
     integrated) of each reflecting layer at incidences ``theta_deg``: ``(n_theta, 3)`` each.
 
@@ -369,7 +381,7 @@ def _cosine_series(matrices: np.ndarray, pairs: _NodePairs) -> np.ndarray:
     ``(I, I, P, 3)``, clipped at 0 (cos(m phi) by Chebyshev's recurrence)."""
     f = matrices[:, pairs.upper[0], pairs.upper[1], None, :]  # (M, P, 1, C)
 
-    def values(chunk):
+    def values(chunk: slice) -> list[NDArray[np.float64]]:
         x = pairs.cos_phi[chunk][..., None]  # (p, n_phi, 1)
         previous, current = np.ones_like(x), x
         series = f[0, chunk] + f[1, chunk] * x
@@ -387,7 +399,7 @@ def profile_radius(dipole: Dipole, floor: float = PROFILE_FLOOR) -> float:
     bisected in ``log d`` to :data:`RADIUS_PRECISION` (the value returned is the last bracket's
     far end).  A continuous function of the dipole: a grid's far end would jump a grid step
     (2e-4) when the crossing moves past a node."""
-    def above(d):  # d (K,) -> (K,): R(d) > floor R(0) in some channel
+    def above(d: NDArray[np.float64]) -> NDArray[np.bool_]:  # (K,): R(d) > floor R(0) anywhere
         values = np.reshape(dipole_profile(d, dipole), (np.size(d), -1))
         return np.any(values > limit, axis=1)
 
@@ -409,13 +421,17 @@ def profile_radius(dipole: Dipole, floor: float = PROFILE_FLOOR) -> float:
     return float(high)
 
 
-def _stage(progress, fraction: float, message: str) -> None:
+Progress = Callable[[float, str], object]
+"""``progress(fraction, message)``: told as a bake advances (fraction 0..1)."""
+
+
+def _stage(progress: Progress | None, fraction: float, message: str) -> None:
     if progress is not None:
         progress(fraction, message)
 
 
-def bake(skin: MadeUpSkin, resolution_name="default", *, inter_reflection: bool = False,
-         progress=None) -> Tables:
+def bake(skin: MadeUpSkin, resolution_name: str | Resolution = "default", *,
+         inter_reflection: bool = False, progress: Progress | None = None) -> Tables:
     """Bake the tables of one made-up skin (see :mod:`lut_baker.tables.table_set` for their
     meaning).
 
@@ -496,7 +512,8 @@ def bake(skin: MadeUpSkin, resolution_name="default", *, inter_reflection: bool 
     return tables
 
 
-def inter_reflection_albedo(skin: MadeUpSkin, theta_deg, resolution_name="default"):
+def inter_reflection_albedo(skin: MadeUpSkin, theta_deg: ArrayLike,
+                            resolution_name: str | Resolution = "default") -> NDArray[np.float64]:
     """Directional albedo ``Int f_extra(wi, wo) cos(theta_o) dwo`` of the inter-reflections
     beyond path 3 (the adding equation's further terms, as in :func:`bake`'s
     ``inter_reflection`` table), at the skin's absorption, before coverage: ``(n, 3)``."""

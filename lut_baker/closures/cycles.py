@@ -43,12 +43,15 @@ Walter et al. 2007 (GGX); Heitz 2014 (height-correlated Smith); Christensen, Bur
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import lru_cache
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
-from ..model.microfacet import fresnel_term
+from ..model.microfacet import fresnel_reflectance
+from ..numerics import Real
 from ..numerics.geometry import direction, half_vector
 from ..numerics.quadrature import gauss_legendre, hemisphere_grid, midpoint_nodes
 
@@ -96,18 +99,21 @@ SUBSURFACE_METHODS = ("BURLEY", "RANDOM_WALK", "RANDOM_WALK_SKIN")
 ROUGHNESS_EPS = 1e-3
 """Roughness below this is a mirror Cycles cannot evaluate; the replicas clamp to it."""
 
+OfCosine = Callable[[NDArray[np.float64]], ArrayLike]
+"""A factor of a cosine array (a Fresnel term of ``h.wi``, a function of the view cosine)."""
+
 
 # --------------------------------------------------------------------------------------------
 # GGX microfacet model (bsdf_microfacet.h)
 # --------------------------------------------------------------------------------------------
-def ggx_distribution(cos_h, alpha):
+def ggx_distribution(cos_h: ArrayLike, alpha: Real) -> NDArray[np.float64]:
     """GGX ``D = alpha^2 / (pi ((1 - c^2) + alpha^2 c^2)^2)`` at ``c = N.H`` (Walter 2007)."""
     c2 = np.minimum(np.square(np.asarray(cos_h, float)), 1.0)
     a2 = np.square(alpha)
     return a2 / (np.pi * np.square((1.0 - c2) + a2 * c2))
 
 
-def beckmann_distribution(cos_h, alpha):
+def beckmann_distribution(cos_h: ArrayLike, alpha: Real) -> NDArray[np.float64]:
     """Beckmann ``D = exp(-tan^2 / alpha^2) / (pi alpha^2 c^4)`` at ``c = N.H``."""
     c2 = np.clip(np.square(np.asarray(cos_h, float)), 1e-300, 1.0)
     a2 = np.square(alpha)
@@ -115,17 +121,17 @@ def beckmann_distribution(cos_h, alpha):
         return np.exp(-(1.0 - c2) / (c2 * a2)) / (np.pi * a2 * c2 * c2)
 
 
-def _alpha_tan2(cos_theta, alpha):
+def _alpha_tan2(cos_theta: ArrayLike, alpha: Real) -> NDArray[np.float64]:
     c2 = np.square(np.asarray(cos_theta, float))
     return np.square(alpha) * np.maximum(1.0 / np.maximum(c2, 1e-300) - 1.0, 0.0)
 
 
-def ggx_lambda(cos_theta, alpha):
+def ggx_lambda(cos_theta: ArrayLike, alpha: Real) -> NDArray[np.float64]:
     """Smith ``Lambda = (sqrt(1 + alpha^2 tan^2) - 1) / 2`` of GGX (Heitz 2014, eq. 72)."""
     return 0.5 * (np.sqrt(1.0 + _alpha_tan2(cos_theta, alpha)) - 1.0)
 
 
-def beckmann_lambda(cos_theta, alpha):
+def beckmann_lambda(cos_theta: ArrayLike, alpha: Real) -> NDArray[np.float64]:
     """Smith ``Lambda`` of Beckmann, the rational approximation Cycles uses (0 where
     ``alpha^2 tan^2 < 0.39``)."""
     t2 = _alpha_tan2(cos_theta, alpha)
@@ -141,21 +147,23 @@ GLOSSY_DISTRIBUTIONS = ("GGX", "BECKMANN", "ASHIKHMIN_SHIRLEY")
 """The Glossy BSDF's distributions the replicas cover (Multiscatter GGX is left out)."""
 
 
-def ashikhmin_shirley_exponent(roughness):
+def ashikhmin_shirley_exponent(roughness: Real) -> NDArray[np.float64]:
     """Phong exponent ``2 / alpha^2 - 2`` of Cycles' Ashikhmin-Shirley lobe, ``alpha =
     roughness^2`` clamped to [1e-4, 1] (``bsdf_ashikhmin_shirley_roughness_to_exponent``)."""
     alpha = np.clip(np.square(roughness), 1e-4, 1.0)
     return 2.0 / (alpha * alpha) - 2.0
 
 
-def ashikhmin_shirley_reflection(wi, wo, roughness):
+def ashikhmin_shirley_reflection(wi: ArrayLike, wo: ArrayLike,
+                                 roughness: float) -> NDArray[np.float64]:
     """Isotropic Ashikhmin-Shirley lobe without Fresnel (Cycles ``bsdf_ashikhmin_shirley_eval``)
     at unit vectors: :func:`microfacet_from_cosines` with ``ASHIKHMIN_SHIRLEY``."""
     return microfacet_reflection(wi, wo, roughness, distribution="ASHIKHMIN_SHIRLEY")
 
 
-def microfacet_from_cosines(cos_h, cos_hi, cos_i, cos_o, roughness,
-                            distribution: str = "GGX"):
+def microfacet_from_cosines(cos_h: NDArray[np.float64], cos_hi: NDArray[np.float64],
+                            cos_i: ArrayLike, cos_o: ArrayLike, roughness: float,
+                            distribution: str = "GGX") -> NDArray[np.float64]:
     """A Glossy lobe without Fresnel (no cosine, 1/sr) from the cosines ``n.h``, ``h.wi``,
     ``n.wi``, ``n.wo`` (broadcasting; ``roughness`` Blender's socket, clamped to
     :data:`ROUGHNESS_EPS`); 0 where either direction is below the surface.
@@ -184,43 +192,49 @@ def microfacet_from_cosines(cos_h, cos_hi, cos_i, cos_o, roughness,
     return np.where(upper, value, 0.0)
 
 
-def microfacet_shadowing(cos_i, cos_o, alpha, distribution: str = "GGX"):
+def microfacet_shadowing(cos_i: ArrayLike, cos_o: ArrayLike, alpha: Real,
+                         distribution: str = "GGX") -> NDArray[np.float64]:
     """Height-correlated masking-shadowing ``G2 = 1 / (1 + Lambda_i + Lambda_o)``
     (Cycles ``bsdf_G``)."""
     lam = DISTRIBUTIONS[distribution][1]
     return 1.0 / (1.0 + lam(cos_i, alpha) + lam(cos_o, alpha))
 
 
-def dielectric_fresnel(cos_theta, eta):
-    """Cycles' ``fresnel_dielectric_cos``: the model's ``F_r`` (eq. 2, :func:`fresnel_term`) at
-    cosines clipped to [0, 1] (Cycles alone gives 1 at eta = 1 and grazing, the model 0)."""
-    return fresnel_term(np.clip(np.asarray(cos_theta, float), 0.0, 1.0), np.asarray(eta, float))
+def dielectric_fresnel(cos_theta: ArrayLike, eta: ArrayLike) -> NDArray[np.float64]:
+    """Cycles' ``fresnel_dielectric_cos``: the model's ``F_r`` (eq. 2,
+    :func:`~lut_baker.model.microfacet.fresnel_reflectance`) at cosines clipped to [0, 1]
+    (Cycles alone gives 1 at eta = 1 and grazing, the model 0)."""
+    return fresnel_reflectance(np.clip(np.asarray(cos_theta, float), 0.0, 1.0),
+                               np.asarray(eta, float))
 
 
-def f0_from_ior(eta):
+def f0_from_ior(eta: ArrayLike) -> NDArray[np.float64]:
     """Normal-incidence reflectance ``((eta - 1) / (eta + 1))^2``."""
     return np.square((np.asarray(eta, float) - 1.0) / (np.asarray(eta, float) + 1.0))
 
 
-def ior_from_f0(f0):
+def ior_from_f0(f0: ArrayLike) -> NDArray[np.float64]:
     """Inverse of :func:`f0_from_ior` (Cycles ``ior_from_F0``), for ``f0`` in [0, 1)."""
     root = np.sqrt(np.clip(f0, 0.0, 0.999999))
     return (1.0 + root) / (1.0 - root)
 
 
-def schlick_ior_fresnel(cos_theta, eta, f0):
+def schlick_ior_fresnel(cos_theta: ArrayLike, eta: ArrayLike,
+                        f0: ArrayLike) -> NDArray[np.float64]:
     """The Principled specular's Fresnel: generalised Schlick with a negative exponent, i.e.
     ``mix(f0, 1, s)`` with ``s = (F(c, eta) - F0(eta)) / (1 - F0(eta))`` from the real curve.
     ``f0`` may be RGB (Specular Tint); the result then has a trailing channel axis."""
     real0 = f0_from_ior(eta)
     s = np.clip((dielectric_fresnel(cos_theta, eta) - real0) / (1.0 - real0), 0.0, 1.0)
-    f0 = np.asarray(f0, float)
-    if f0.ndim:
+    start = np.asarray(f0, float)
+    if start.ndim:
         s = s[..., None]
-    return f0 + (1.0 - f0) * s
+    return start + (1.0 - start) * s
 
 
-def microfacet_reflection(wi, wo, roughness, fresnel=None, distribution: str = "GGX"):
+def microfacet_reflection(wi: ArrayLike, wo: ArrayLike, roughness: float,
+                          fresnel: OfCosine | None = None,
+                          distribution: str = "GGX") -> NDArray[np.float64]:
     """Microfacet reflection ``F(H.wi) D G2 / (4 cos_i cos_o)`` (Cycles
     ``bsdf_microfacet_eval``).
 
@@ -232,43 +246,46 @@ def microfacet_reflection(wi, wo, roughness, fresnel=None, distribution: str = "
     """
     if distribution == "ASHIKHMIN_SHIRLEY" and fresnel is not None:
         raise ValueError("the Ashikhmin-Shirley lobe takes no Fresnel in Cycles")
-    wi, wo = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
-    h = half_vector(wi, wo)
-    cos_hi = np.sum(h * wi, axis=-1)
-    value = microfacet_from_cosines(h[..., 2], cos_hi, wi[..., 2], wo[..., 2], roughness,
-                                    distribution)
+    to_light, to_view = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
+    h = half_vector(to_light, to_view)
+    cos_hi = np.sum(h * to_light, axis=-1)
+    value = microfacet_from_cosines(h[..., 2], cos_hi, to_light[..., 2], to_view[..., 2],
+                                    roughness, distribution)
     if fresnel is None:
         return value
     f = np.asarray(fresnel(np.clip(cos_hi, 0.0, 1.0)))
     return (value[..., None] if f.ndim > value.ndim else value) * f
 
 
-def lambert_reflection(albedo):
+def lambert_reflection(albedo: ArrayLike) -> NDArray[np.float64]:
     """Lambertian BRDF ``albedo / pi`` (Diffuse BSDF at roughness 0)."""
     return np.asarray(albedo, float) / np.pi
 
 
-def directional_albedo(brdf, cos_theta, *, lobe_width_deg: float = 20.0, level: int = 0):
+def directional_albedo(brdf: Callable[[NDArray[np.float64], NDArray[np.float64]], ArrayLike],
+                       cos_theta: ArrayLike, *, lobe_width_deg: float = 20.0,
+                       level: int = 0) -> NDArray[np.float64]:
     """``Int brdf(w, v) cos(theta_w) dw`` for view directions ``v`` at ``cos_theta`` (any
     shape), by the hemisphere quadrature of :mod:`lut_baker.numerics.quadrature`.
 
     ``brdf(w, v)`` takes direction arrays ``(..., 3)`` and returns ``(...)`` or ``(..., C)``.
     """
-    cos_theta = np.asarray(cos_theta, float)
+    cosines = np.asarray(cos_theta, float)
     grid = hemisphere_grid(lobe_width_deg, level)
     w = direction(grid.theta[:, None], grid.phi[None, :])  # (N, P, 3)
-    theta_v = np.arccos(np.clip(cos_theta.ravel(), 0.0, 1.0))
+    theta_v = np.arccos(np.clip(cosines.ravel(), 0.0, 1.0))
     v = direction(theta_v, 0.0)[:, None, None, :]  # (V, 1, 1, 3)
     values = np.asarray(brdf(w[None], v))
     weights = grid.weight[None, :, None] * grid.phi_weight
     if values.ndim == 4:
         total = np.einsum("vnpc,vnp->vc", values, np.broadcast_to(weights, values.shape[:3]))
-        return total.reshape(cos_theta.shape + (values.shape[-1],))
-    return np.sum(values * weights, axis=(1, 2)).reshape(cos_theta.shape)
+        return total.reshape(cosines.shape + (values.shape[-1],))
+    return np.sum(values * weights, axis=(1, 2)).reshape(cosines.shape)
 
 
-def microfacet_albedo(cos_view, roughness, fresnel=None, distribution: str = "GGX", *,
-                      n_u: int = 48, n_phi: int = 32):
+def microfacet_albedo(cos_view: ArrayLike, roughness: float, fresnel: OfCosine | None = None,
+                      distribution: str = "GGX", *, n_u: int = 48,
+                      n_phi: int = 32) -> NDArray[np.float64]:
     """Albedo ``Int f cos(theta_i) dwi`` of :func:`microfacet_reflection` at view cosines
     ``cos_view`` (any shape; a ``fresnel`` returning RGB adds a channel axis).
 
@@ -280,7 +297,7 @@ def microfacet_albedo(cos_view, roughness, fresnel=None, distribution: str = "GG
     Ashikhmin-Shirley: ``h`` has density ``(e + 1) / (2 pi) cos^e`` (``cos = u^(1/(e+1))``) and
     the albedo is the mean of ``cos_i / max(cos_i, cos_o)``.
     """
-    cos_view = np.asarray(cos_view, float)
+    views = np.asarray(cos_view, float)
     alpha = np.square(max(float(roughness), ROUGHNESS_EPS))
     u, w_u = gauss_legendre(n_u)
     if distribution == "GGX":
@@ -296,7 +313,7 @@ def microfacet_albedo(cos_view, roughness, fresnel=None, distribution: str = "GG
     cos_h = 1.0 / np.sqrt(1.0 + tan2)
     sin_h = np.sqrt(tan2) * cos_h
     phi = midpoint_nodes(n_phi, 0.0, np.pi)
-    mu_o = np.clip(cos_view.ravel(), 1e-6, 1.0)[:, None, None]
+    mu_o = np.clip(views.ravel(), 1e-6, 1.0)[:, None, None]
     sin_o = np.sqrt(1.0 - mu_o * mu_o)
     hx = sin_h[None, :, None] * np.cos(phi)[None, None, :]
     hz = cos_h[None, :, None]
@@ -311,15 +328,16 @@ def microfacet_albedo(cos_view, roughness, fresnel=None, distribution: str = "GG
     weights = w_u[None, :, None] / n_phi
     if fresnel is None:
         total = np.sum(value * weights, axis=(1, 2))
-        return total.reshape(cos_view.shape)
+        return total.reshape(views.shape)
     f = np.asarray(fresnel(np.clip(h_dot_o, 0.0, 1.0)))
     if f.ndim > value.ndim:
         total = np.einsum("vup,vupc->vc", value * weights, f)
-        return total.reshape(cos_view.shape + (f.shape[-1],))
-    return np.sum(value * weights * f, axis=(1, 2)).reshape(cos_view.shape)
+        return total.reshape(views.shape + (f.shape[-1],))
+    return np.sum(value * weights * f, axis=(1, 2)).reshape(views.shape)
 
 
-def layering_albedo(cos_view, roughness, eta, f0=None):
+def layering_albedo(cos_view: ArrayLike, roughness: float, eta: float,
+                    f0: ArrayLike | None = None) -> NDArray[np.float64]:
     """The albedo Cycles attributes to a dielectric GGX layer seen at ``cos_view`` when it
     attenuates the layers below (``bsdf_microfacet_estimate_albedo``): ``mix(f0, 1, s)``.
 
@@ -329,26 +347,27 @@ def layering_albedo(cos_view, roughness, eta, f0=None):
     real Fresnel at ``eta``.  ``f0`` (default ``F0(eta)``, RGB allowed) rescales the start as
     Specular IOR Level and Specular Tint do.
     """
-    cos_view = np.asarray(cos_view, float)
-    e_f = microfacet_albedo(cos_view, roughness, lambda c: dielectric_fresnel(c, eta))
-    e_1 = microfacet_albedo(cos_view, roughness)
+    views = np.asarray(cos_view, float)
+    e_f = microfacet_albedo(views, roughness, lambda c: dielectric_fresnel(c, eta))
+    e_1 = microfacet_albedo(views, roughness)
     real0 = f0_from_ior(eta)
     s = np.clip((e_f / np.maximum(e_1, 1e-12) - real0) / (1.0 - real0), 0.0, 1.0)
-    f0 = real0 if f0 is None else np.asarray(f0, float)
-    if np.ndim(f0):
+    start = real0 if f0 is None else np.asarray(f0, float)
+    if np.ndim(start):
         s = s[..., None]
-    return f0 + (1.0 - f0) * s
+    return start + (1.0 - start) * s
 
 
-def dielectric_fss(eta):
+def dielectric_fss(eta: ArrayLike) -> NDArray[np.float64]:
     """Cycles' average single-scattering dielectric Fresnel ``Int 2 mu F(mu) dmu`` at ``eta``
     (``fresnel_dielectric_Fss``: Kulla and Conty's fit; exact to ~1e-3)."""
-    eta = np.asarray(eta, float)
-    below = 0.997118 + eta * (0.1014 - eta * (0.965241 + eta * 0.130607))
-    return np.where(eta < 1.0, below, (eta - 1.0) / (4.08567 + 1.00071 * eta))
+    index = np.asarray(eta, float)
+    below = 0.997118 + index * (0.1014 - index * (0.965241 + index * 0.130607))
+    return np.where(index < 1.0, below, (index - 1.0) / (4.08567 + 1.00071 * index))
 
 
-def ggx_energy_compensation(cos_view, roughness, fss):
+def ggx_energy_compensation(cos_view: ArrayLike, roughness: float, fss: Real
+                            ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """``(scale, darkening)`` Cycles applies to a GGX lobe with Fresnel (the Principled coat:
     ``microfacet_ggx_preserve_energy``), at view cosines ``cos_view``.
 
@@ -358,12 +377,12 @@ def ggx_energy_compensation(cos_view, roughness, fss):
     E_avg))``, of which ``darkening = scale E`` sits in the closure's weight (so in the albedo
     that attenuates the layers below) and ``1 / E`` in its evaluation.
     """
-    cos_view = np.asarray(cos_view, float)
-    return ggx_energy_scale(microfacet_albedo(cos_view, roughness),
+    return ggx_energy_scale(microfacet_albedo(np.asarray(cos_view, float), roughness),
                             ggx_average_albedo(float(roughness)), fss)
 
 
-def ggx_energy_scale(albedo, average_albedo: float, fss):
+def ggx_energy_scale(albedo: ArrayLike, average_albedo: float, fss: Real
+                     ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """:func:`ggx_energy_compensation` from the Fresnel-free albedo ``E`` at the views and its
     cosine-weighted mean ``E_avg`` (so that a fit varying only the Fresnel reuses them)."""
     e = np.asarray(albedo, float)
@@ -373,7 +392,8 @@ def ggx_energy_scale(albedo, average_albedo: float, fss):
     return scale, scale / (1.0 + missing)
 
 
-def coat_view_terms(cos_view, roughness, ior):
+def coat_view_terms(cos_view: ArrayLike, roughness: float, ior: float
+                    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """``(scale, layering albedo)`` of the Principled coat at view cosines ``cos_view``: the
     factor :func:`ggx_energy_compensation` puts on its lobe, and the albedo by which it
     attenuates the layers below, ``darkening * layering_albedo`` (Cycles' ``bsdf_albedo``
@@ -412,7 +432,7 @@ class PrincipledInputs:
     coat_ior: float = 1.5
     extra: dict = field(default_factory=dict)
 
-    def specular_eta_f0(self):
+    def specular_eta_f0(self) -> tuple[float, NDArray[np.float64]]:
         """``(eta', f0 per channel)`` after Specular IOR Level and Tint (Cycles' "IOR
         adjustment"): ``f0 = F0(ior) 2 level``, ``eta' = ior_from_F0(f0)``."""
         f0 = float(f0_from_ior(self.ior))
@@ -423,7 +443,8 @@ class PrincipledInputs:
         return eta, f0 * np.asarray(self.specular_tint, float)
 
 
-def principled_reflection(wi, wo, inputs: PrincipledInputs):
+def principled_reflection(wi: ArrayLike, wo: ArrayLike,
+                          inputs: PrincipledInputs) -> NDArray[np.float64]:
     """The Principled BSDF's reflection (no cosine), RGB ``(..., 3)``, as Cycles layers it:
 
     ``w_c k(wo) coat(wi, wo) + a_c(wo) [spec(wi, wo) + a_s(wo) base / pi]``
@@ -435,21 +456,21 @@ def principled_reflection(wi, wo, inputs: PrincipledInputs):
     only, so the model is not reciprocal, like Cycles.  Subsurface counts as its albedo in
     ``base_color`` leaving Lambertian-like (its spread is separate, see the profiles).
     """
-    wi, wo = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
-    cos_o = np.clip(wo[..., 2], 0.0, 1.0)
+    to_light, to_view = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
+    cos_o = np.clip(to_view[..., 2], 0.0, 1.0)
     eta, f0 = inputs.specular_eta_f0()
     base = lambert_reflection(np.minimum(np.maximum(inputs.base_color, 0.0), 1.0))
     if eta == 1.0:  # Specular IOR Level 0: Cycles allocates no specular closure
         lower = base * np.ones(cos_o.shape + (1,))
     else:
-        spec = microfacet_reflection(wi, wo, inputs.roughness,
+        spec = microfacet_reflection(to_light, to_view, inputs.roughness,
                                      lambda c: schlick_ior_fresnel(c, eta, f0))
         a_s = 1.0 - np.max(view_table(cos_o, _layering_nodes(
             float(inputs.roughness), float(eta), tuple(np.atleast_1d(f0).tolist()))), axis=-1)
         lower = spec + a_s[..., None] * base
     if inputs.coat_weight <= 0.0:
         return lower
-    coat = microfacet_reflection(wi, wo, inputs.coat_roughness,
+    coat = microfacet_reflection(to_light, to_view, inputs.coat_roughness,
                                  lambda c: dielectric_fresnel(c, inputs.coat_ior))
     terms = view_table(cos_o, _coat_nodes(float(inputs.coat_roughness),
                                           float(inputs.coat_ior)))
@@ -477,7 +498,8 @@ def _coat_nodes(roughness: float, ior: float) -> np.ndarray:
                     axis=-1)
 
 
-def view_table(cos_view: np.ndarray, function, size: int = VIEW_TABLE_SIZE) -> np.ndarray:
+def view_table(cos_view: NDArray[np.float64], function: OfCosine | ArrayLike,
+               size: int = VIEW_TABLE_SIZE) -> NDArray[np.float64]:
     """``function`` of the view cosine, tabulated on ``size`` nodes and interpolated linearly
     (the layering albedos are smooth; tabulating keeps a replica of a large grid cheap);
     ``function`` may also be the table itself, at those nodes."""
@@ -492,7 +514,7 @@ def view_table(cos_view: np.ndarray, function, size: int = VIEW_TABLE_SIZE) -> n
 # --------------------------------------------------------------------------------------------
 # Subsurface radial profiles (bssrdf.h, subsurface_random_walk.h)
 # --------------------------------------------------------------------------------------------
-def burley_profile(r_mm, radius_mm):
+def burley_profile(r_mm: ArrayLike, radius_mm: ArrayLike) -> NDArray[np.float64]:
     """Christensen-Burley profile as Cycles evaluates it, normalised to ``Int P 2 pi r dr = 1``
     (1/mm^2): ``P = (exp(-r/d) + exp(-r/(3d))) / (8 pi d r)`` with ``d = radius / (4 pi)``
     (``bssrdf_setup_radius``; ``radius`` = Subsurface Radius x Scale), cut at ``16 d`` and
@@ -520,7 +542,8 @@ itself within 0.3-0.4%, the Monte Carlo noise); ``k`` is interpolated linearly i
 held beyond the measured range."""
 
 
-def random_walk_scale(surface_albedo, method: str = "RANDOM_WALK_SKIN"):
+def random_walk_scale(surface_albedo: ArrayLike,
+                      method: str = "RANDOM_WALK_SKIN") -> NDArray[np.float64]:
     """The measured ``k`` of :data:`RANDOM_WALK_BURLEY_SCALE` at a surface albedo (colour)."""
     if method not in RANDOM_WALK_BURLEY_SCALE:
         raise ValueError(f"method must be one of {list(RANDOM_WALK_BURLEY_SCALE)}, "
@@ -529,7 +552,8 @@ def random_walk_scale(surface_albedo, method: str = "RANDOM_WALK_SKIN"):
     return np.interp(np.asarray(surface_albedo, float), albedo, scale)
 
 
-def subsurface_profile(r_mm, radius_mm, surface_albedo=0.8, method: str = "BURLEY"):
+def subsurface_profile(r_mm: ArrayLike, radius_mm: ArrayLike, surface_albedo: ArrayLike = 0.8,
+                       method: str = "BURLEY") -> NDArray[np.float64]:
     """Radial profile (1/mm^2, unit area) of a Blender subsurface method at Subsurface Radius x
     Scale ``radius_mm`` (scalar or RGB) and colour ``surface_albedo``: :func:`burley_profile`,
     for the random walks with the measured scale :func:`random_walk_scale`."""

@@ -35,6 +35,7 @@ from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 __all__ = ["LTC_TABLE_FILE", "LTC_TABLE_SIZE", "ltc_table", "ltc_coefficients",
            "glossy_from_cosines", "glossy_reflection", "glossy_albedo"]
@@ -58,7 +59,8 @@ def ltc_table() -> tuple[np.ndarray, np.ndarray]:
     return inverse, magnitude
 
 
-def ltc_coefficients(roughness: float, cos_view) -> tuple[np.ndarray, np.ndarray]:
+def ltc_coefficients(roughness: float,
+                     cos_view: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """``(inverse (..., 4), magnitude (...))`` at Blender ``roughness`` (clamped to [0, 1])
     and view cosines ``cos_view``: bilinear between the table's nodes, as EEVEE's linear
     texture filter reads them at ``(roughness, sqrt(1 - cos(theta_o)))``."""
@@ -71,7 +73,7 @@ def ltc_coefficients(roughness: float, cos_view) -> tuple[np.ndarray, np.ndarray
     j0 = np.minimum(np.floor(y).astype(int), size - 2)
     ty = y - j0
 
-    def at(table):
+    def at(table: NDArray[np.float64]) -> NDArray[np.float64]:
         rows = (1.0 - tx) * table[i0] + tx * table[i0 + 1]  # (N[, 4]) along s
         low, high = rows[j0], rows[j0 + 1]
         weight = ty[..., None] if table.ndim == 3 else ty
@@ -80,47 +82,49 @@ def ltc_coefficients(roughness: float, cos_view) -> tuple[np.ndarray, np.ndarray
     return at(inverse), at(magnitude)
 
 
-def glossy_from_cosines(wi, cos_o, roughness: float):
+def glossy_from_cosines(wi: ArrayLike, cos_o: ArrayLike,
+                        roughness: float) -> NDArray[np.float64]:
     """EEVEE's white Glossy BSDF (1/sr, without the cosine) at light directions ``wi``
     ``(..., 3)`` expressed in the frame of a view of cosine ``cos_o`` (broadcasting) that lies
     in the x-z plane towards +x; 0 where either direction is below the surface."""
-    wi = np.asarray(wi, float)
-    cos_o = np.asarray(cos_o, float)
-    inverse, magnitude = ltc_coefficients(roughness, cos_o)
+    to_light = np.asarray(wi, float)
+    view = np.asarray(cos_o, float)
+    inverse, magnitude = ltc_coefficients(roughness, view)
     a, b, c, d = np.moveaxis(inverse, -1, 0)
-    x, y, z = wi[..., 0], wi[..., 1], wi[..., 2]
+    x, y, z = to_light[..., 0], to_light[..., 1], to_light[..., 2]
     lx, lz = a * x + b * z, c * x + d * z
     length2 = lx * lx + y * y + lz * lz
     value = (magnitude * np.maximum(lz, 0.0) * np.abs(a * d - b * c)
              / (np.pi * np.maximum(length2, 1e-300) ** 2))
-    upper = (z > 0.0) & (cos_o > 0.0)
+    upper = (z > 0.0) & (view > 0.0)
     return np.where(upper, value / np.where(upper, z, 1.0), 0.0)
 
 
-def glossy_reflection(wi, wo, roughness: float):
+def glossy_reflection(wi: ArrayLike, wo: ArrayLike, roughness: float) -> NDArray[np.float64]:
     """:func:`glossy_from_cosines` at unit vectors ``wi``, ``wo`` ``(..., 3)`` in any local
     frame (normal +z): ``wi`` is turned about the normal so that ``wo`` lies towards +x."""
-    wi, wo = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
-    tangent = np.hypot(wo[..., 0], wo[..., 1])
+    to_light, to_view = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
+    tangent = np.hypot(to_view[..., 0], to_view[..., 1])
     safe = tangent > 1e-12
-    cos_phi = np.where(safe, wo[..., 0] / np.where(safe, tangent, 1.0), 1.0)
-    sin_phi = np.where(safe, wo[..., 1] / np.where(safe, tangent, 1.0), 0.0)
-    turned = np.stack([cos_phi * wi[..., 0] + sin_phi * wi[..., 1],
-                       -sin_phi * wi[..., 0] + cos_phi * wi[..., 1], wi[..., 2]], -1)
-    return glossy_from_cosines(turned, wo[..., 2], roughness)
+    cos_phi = np.where(safe, to_view[..., 0] / np.where(safe, tangent, 1.0), 1.0)
+    sin_phi = np.where(safe, to_view[..., 1] / np.where(safe, tangent, 1.0), 0.0)
+    turned = np.stack([cos_phi * to_light[..., 0] + sin_phi * to_light[..., 1],
+                       -sin_phi * to_light[..., 0] + cos_phi * to_light[..., 1],
+                       to_light[..., 2]], -1)
+    return glossy_from_cosines(turned, to_view[..., 2], roughness)
 
 
-def glossy_albedo(cos_view, roughness: float):
+def glossy_albedo(cos_view: ArrayLike, roughness: float) -> NDArray[np.float64]:
     """``Int f cos(theta_i) dw_i`` of :func:`glossy_from_cosines` over the upper hemisphere at
     view cosines ``cos_view``: ``magnitude (1 + cos(beta)) / 2``, the clamped cosine's share
     that ``M`` maps above the horizon (its directions ``w_o`` with ``(M w_o)_z > 0``, a
     half-space at angle ``beta`` from its axis, whose intersection with the upper hemisphere
     holds ``(1 + cos(beta)) / 2`` of its projected solid angle)."""
-    cos_view = np.asarray(cos_view, float)
-    inverse, magnitude = ltc_coefficients(roughness, cos_view)
+    views = np.asarray(cos_view, float)
+    inverse, magnitude = ltc_coefficients(roughness, views)
     a, b, c, d = np.moveaxis(inverse, -1, 0)
     det = a * d - b * c
     # Third row of M = (M^-1)^-1 (the middle entry 1 leaves it in the x-z block): (-c, 0, a)/det.
     row_x, row_z = -c / det, a / det
     cos_beta = row_z / np.hypot(row_x, row_z)
-    return np.where(cos_view > 0.0, magnitude * 0.5 * (1.0 + cos_beta), 0.0)
+    return np.where(views > 0.0, magnitude * 0.5 * (1.0 + cos_beta), 0.0)

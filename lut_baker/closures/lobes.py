@@ -18,9 +18,12 @@ enough (:data:`FIT_XTOL`) that a fitted number follows its data continuously.
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
+from typing import TypedDict
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..numerics.optimise import brent_minimum, scanned_least_squares
 from . import cycles as cc
@@ -86,13 +89,13 @@ class LobeFit:
     searched: dict | None = None
 
 
-def _grey(values) -> np.ndarray:
+def _grey(values: ArrayLike) -> NDArray[np.float64]:
     """Per-pair values ``(V, A, P[, C])`` with their channels averaged, ``(V, A, P)``."""
-    values = np.asarray(values, float)
-    return np.mean(values, axis=-1) if values.ndim == 4 else values
+    array = np.asarray(values, float)
+    return np.mean(array, axis=-1) if array.ndim == 4 else array
 
 
-def _minimise_roughness(error_of) -> tuple[float, float]:
+def _minimise_roughness(error_of: Callable[[float], float]) -> tuple[float, float]:
     """``(roughness, error)``: ``error_of(roughness)`` minimised over :data:`ROUGHNESS_RANGE`,
     in ``log(roughness)`` (a lobe's width goes as roughness squared)."""
     log_r, error = brent_minimum(lambda x: error_of(float(np.exp(x))),
@@ -100,27 +103,34 @@ def _minimise_roughness(error_of) -> tuple[float, float]:
     return float(np.exp(log_r)), error
 
 
-def _fit_roughness_and(grid: ViewGrid, target, lobe_times, second_range):
+LobeTimes = Callable[[float], Callable[[float], NDArray[np.float64]]]
+"""``lobe_times(roughness)(second)``: the factor per pair a GGX lobe is multiplied by."""
+
+
+def _fit_roughness_and(grid: ViewGrid, target: ArrayLike, lobe_times: LobeTimes,
+                       second_range: tuple[float, float]) -> tuple[float, float, float]:
     """``(roughness, second, error)``: a GGX lobe times ``lobe_times(roughness)(second)`` (a
     factor per pair) fitted to ``target`` (channels averaged).  A scan of
     :data:`ROUGHNESS_SCAN` roughnesses by :data:`SECOND_SCAN` values of the second parameter
     finds the start; bounded Levenberg-Marquardt on ``(log(roughness), second)`` converges
     from it (:func:`lut_baker.numerics.optimise.least_squares`, to :data:`FIT_XTOL`)."""
-    target = _grey(target)
+    grey = _grey(target)
     root_weight = np.sqrt(grid.weight) * grid.cos_i
-    scale = 1.0 / max(float(np.sqrt(np.sum(np.square(root_weight * target)))), 1e-300)
+    scale = 1.0 / max(float(np.sqrt(np.sum(np.square(root_weight * grey)))), 1e-300)
 
-    per_roughness = {}  # the lobe and its factor's set-up, once per roughness tried
+    # the lobe and its factor's set-up, once per roughness tried
+    per_roughness: dict[float, tuple[NDArray[np.float64],
+                                     Callable[[float], NDArray[np.float64]]]] = {}
 
-    def model(x):
+    def model(x: NDArray[np.float64]) -> NDArray[np.float64]:
         roughness = float(np.exp(x[0]))
         if roughness not in per_roughness:
             per_roughness[roughness] = (grid.lobe(roughness), lobe_times(roughness))
         lobe, factor = per_roughness[roughness]
         return lobe * factor(float(x[1]))
 
-    def residuals(x):
-        return (scale * root_weight * (model(x) - target)).ravel()
+    def residuals(x: NDArray[np.float64]) -> NDArray[np.float64]:
+        return (scale * root_weight * (model(x) - grey)).ravel()
 
     low, high = np.log(ROUGHNESS_RANGE)
     x, cost, _ = scanned_least_squares(
@@ -129,7 +139,7 @@ def _fit_roughness_and(grid: ViewGrid, target, lobe_times, second_range):
     return float(np.exp(x[0])), float(x[1]), float(np.sqrt(cost))
 
 
-def fit_coat(grid: ViewGrid, target) -> LobeFit:
+def fit_coat(grid: ViewGrid, target: ArrayLike) -> LobeFit:
     """Coat Roughness and Coat IOR of a GGX coat (weight 1, dielectric Fresnel, Cycles'
     energy compensation) fitted to ``target`` (the film's gloss on ``grid``, ``(V, A, P[, 3])``,
     channels averaged).  ``level`` is the coat's weight per unit coverage: 1, or 0 when the
@@ -138,11 +148,11 @@ def fit_coat(grid: ViewGrid, target) -> LobeFit:
     if not np.any(np.asarray(target, float)):
         return LobeFit(roughness=ROUGHNESS_RANGE[1], ior=COAT_IOR_RANGE[0], level=0.0,
                        error=0.0)
-    def lobe_times(roughness):
+    def lobe_times(roughness: float) -> Callable[[float], NDArray[np.float64]]:
         albedo = cc.microfacet_albedo(grid.cos_view, roughness, **SEARCH_QUADRATURE)
         average = cc.ggx_average_albedo(roughness)
 
-        def factor(ior):
+        def factor(ior: float) -> NDArray[np.float64]:
             scale = cc.ggx_energy_scale(albedo, average, float(cc.dielectric_fss(ior)))[0]
             return cc.dielectric_fresnel(grid.cos_hi, ior) * scale[:, None, None]
         return factor
@@ -153,7 +163,7 @@ def fit_coat(grid: ViewGrid, target) -> LobeFit:
     return LobeFit(roughness=roughness, ior=ior, level=1.0, error=error)
 
 
-def _specular_fresnel(cos_hi, level):
+def _specular_fresnel(cos_hi: NDArray[np.float64], level: float) -> NDArray[np.float64]:
     """The Principled specular's Fresnel at IOR :data:`SPECULAR_IOR` and a Specular IOR
     Level."""
     f0 = float(cc.f0_from_ior(SPECULAR_IOR)) * 2.0 * level
@@ -161,14 +171,16 @@ def _specular_fresnel(cos_hi, level):
     return cc.schlick_ior_fresnel(cos_hi, eta, f0)
 
 
-def fit_specular(grid: ViewGrid, target, attenuation=None) -> LobeFit:
+def fit_specular(grid: ViewGrid, target: ArrayLike,
+                 attenuation: ArrayLike | None = None) -> LobeFit:
     """Roughness and Specular IOR Level (at IOR :data:`SPECULAR_IOR`) of the Principled
     specular fitted to ``target`` ``(V, A, P[, 3])`` (channels averaged).  ``attenuation``:
     the factor the layers above apply to it per view ``(V,)`` (the coat's ``1 - E_coat``), or
     None."""
-    scale = 1.0 if attenuation is None else np.asarray(attenuation, float)[:, None, None]
+    scale: float | NDArray[np.float64] = (1.0 if attenuation is None
+                                          else np.asarray(attenuation, float)[:, None, None])
 
-    def lobe_times(roughness):
+    def lobe_times(roughness: float) -> Callable[[float], NDArray[np.float64]]:
         return lambda level: scale * _specular_fresnel(grid.cos_hi, level)
 
     roughness, level, error = _fit_roughness_and(grid, target, lobe_times,
@@ -178,13 +190,22 @@ def fit_specular(grid: ViewGrid, target, attenuation=None) -> LobeFit:
     return LobeFit(roughness=roughness, ior=SPECULAR_IOR, level=level, error=error)
 
 
-SEARCH_QUADRATURE = {"n_u": 24, "n_phi": 12}
+class AlbedoQuadrature(TypedDict):
+    """Nodes of :func:`lut_baker.closures.cycles.microfacet_albedo`: ``n_u`` over the facet
+    distribution, ``n_phi`` in azimuth."""
+
+    n_u: int
+    n_phi: int
+
+
+SEARCH_QUADRATURE: AlbedoQuadrature = {"n_u": 24, "n_phi": 12}
 """Closure-albedo quadrature while searching, at the grid's views (within 2%); the final
 weights use :data:`FINAL_QUADRATURE` (within 0.1%) at every texel."""
-FINAL_QUADRATURE = {"n_u": 96, "n_phi": 64}
+FINAL_QUADRATURE: AlbedoQuadrature = {"n_u": 96, "n_phi": 64}
 
 
-def _texel_albedo(albedo_table: np.ndarray, theta_deg: np.ndarray, cos_view) -> np.ndarray:
+def _texel_albedo(albedo_table: np.ndarray, theta_deg: np.ndarray,
+                  cos_view: NDArray[np.float64]) -> NDArray[np.float64]:
     """A directional albedo table ``(n_theta, 3)`` on ``theta_deg`` at view cosines
     ``cos_view`` ``(K,)``: ``(K, 3)``."""
     theta = np.degrees(np.arccos(np.clip(cos_view, 0.0, 1.0)))
@@ -219,7 +240,8 @@ def glossy_lobe(grid: ViewGrid, roughness: float, closure: str) -> np.ndarray:
     return grid.lobe(roughness, closure)
 
 
-def glossy_albedo(cos_view, roughness: float, closure: str, *, final: bool = True):
+def glossy_albedo(cos_view: ArrayLike, roughness: float, closure: str, *,
+                  final: bool = True) -> NDArray[np.float64]:
     """The albedo of :func:`glossy_lobe`'s closure at view cosines: by quadrature over
     normals for Cycles' (:data:`FINAL_QUADRATURE`, or :data:`SEARCH_QUADRATURE` while
     searching), in closed form for EEVEE's."""
@@ -229,9 +251,9 @@ def glossy_albedo(cos_view, roughness: float, closure: str, *, final: bool = Tru
                                 **(FINAL_QUADRATURE if final else SEARCH_QUADRATURE))
 
 
-def fit_glossy(grid: ViewGrid, target, albedo_table: np.ndarray, theta_deg: np.ndarray,
-               size: int = DEFAULT_LUT_SIZE, *, companion: bool = False,
-               closures: tuple = cc.GLOSSY_DISTRIBUTIONS) -> LobeFit:
+def fit_glossy(grid: ViewGrid, target: ArrayLike, albedo_table: np.ndarray,
+               theta_deg: np.ndarray, size: int = DEFAULT_LUT_SIZE, *, companion: bool = False,
+               closures: tuple[str, ...] = cc.GLOSSY_DISTRIBUTIONS) -> LobeFit:
     """Distribution (:data:`lut_baker.closures.cycles.GLOSSY_DISTRIBUTIONS`) and roughness of a
     Glossy BSDF whose view-dependent weight (table albedo / closure albedo, read from a
     ``size``-texel image by ``cos(theta_o)``) best reproduces ``target`` ``(V, A, P[, 3])``;
@@ -248,10 +270,10 @@ def fit_glossy(grid: ViewGrid, target, albedo_table: np.ndarray, theta_deg: np.n
     (GGX) is chosen unless another one's error is lower by more than
     :data:`DISTRIBUTION_MARGIN` (relative): a near tie never flips the choice.  The fit's
     ``distribution`` is the Glossy node's (``GGX`` for EEVEE's closure)."""
-    target = np.asarray(target, float)
-    target = target if target.ndim == 4 else target[..., None]
-    target = target * np.ones(3)
-    grey = _grey(target)
+    values = np.asarray(target, float)
+    values = values if values.ndim == 4 else values[..., None]
+    values = values * np.ones(3)
+    grey = _grey(values)
     if not np.any(albedo_table):  # no gloss (a matte film): weights 0, nothing to fit
         zeros = np.zeros((size, 3))
         return LobeFit(roughness=ROUGHNESS_RANGE[1], error=0.0, lut=zeros,
@@ -260,7 +282,9 @@ def fit_glossy(grid: ViewGrid, target, albedo_table: np.ndarray, theta_deg: np.n
     tables = {False: _texel_albedo(albedo_table, theta_deg, grid.cos_view),
               True: _texel_albedo(albedo_table, theta_deg, texels)}
 
-    def weights(roughness, distribution, final: bool):
+    def weights(roughness: float, distribution: str, final: bool
+                ) -> tuple[NDArray[np.float64], NDArray[np.float64] | None,
+                           NDArray[np.float64]]:
         """``(lut, diffuse_lut or None, value on the grid)`` for one lobe: while searching
         (``final`` False) the weights sit at the grid's views, with a coarser closure albedo;
         the final ones at the image's texels, sampled as Blender samples them."""
@@ -284,15 +308,18 @@ def fit_glossy(grid: ViewGrid, target, albedo_table: np.ndarray, theta_deg: np.n
             value = value + rows(diffuse) / np.pi
         return lut, diffuse, value
 
-    searched = {distribution: _minimise_roughness(lambda r, d=distribution: grid.error(
-        weights(r, d, False)[2], target)) for distribution in closures}
+    def search(distribution: str) -> tuple[float, float]:
+        return _minimise_roughness(
+            lambda r: grid.error(weights(r, distribution, False)[2], values))
+
+    searched = {distribution: search(distribution) for distribution in closures}
     distribution = min(searched, key=lambda d: searched[d][1])
     if searched[distribution][1] >= (1.0 - DISTRIBUTION_MARGIN) * searched[closures[0]][1]:
         distribution = closures[0]
     roughness = searched[distribution][0]
     lut, diffuse, value = weights(roughness, distribution, True)
     node = "GGX" if distribution == EEVEE_GLOSSY else distribution
-    return LobeFit(roughness=roughness, error=grid.error(value, target), lut=lut,
+    return LobeFit(roughness=roughness, error=grid.error(value, values), lut=lut,
                    distribution=node, diffuse_lut=diffuse,
                    searched={("GGX" if name == EEVEE_GLOSSY else name): float(found[1])
                              for name, found in searched.items()})
@@ -332,7 +359,8 @@ def _spd_solve(matrix: np.ndarray, right: np.ndarray) -> np.ndarray:
     return x
 
 
-def _face_minimum(gram: np.ndarray, right: np.ndarray, total=None) -> np.ndarray:
+def _face_minimum(gram: np.ndarray, right: np.ndarray,
+                  total: NDArray[np.float64] | None = None) -> NDArray[np.float64]:
     """Per view, the non-negative ``f`` ``(V, K)`` that minimises ``f G f - 2 r f`` (``gram``
     ``(V, K, K)``, positive definite; ``right`` ``(V, K)``), with ``sum(f) = total`` ``(V,)``
     if given: a convex quadratic, minimised exactly (the optimum on every face of the orthant,
@@ -382,7 +410,8 @@ def _albedo_shares(grid: ViewGrid, models: list, target: np.ndarray,
     return np.where((np.abs(free.sum(axis=1) - 1.0) <= slack)[:, None], free, bounded)
 
 
-def fit_glossy_pair(grid: ViewGrid, target, albedo_table: np.ndarray, theta_deg: np.ndarray,
+def fit_glossy_pair(grid: ViewGrid, target: ArrayLike, albedo_table: np.ndarray,
+                    theta_deg: np.ndarray,
                     size: int = DEFAULT_LUT_SIZE, *,
                     slack: float = PAIR_ALBEDO_SLACK,
                     ratio: float = PAIR_RATIO) -> tuple[LobeFit, LobeFit]:
@@ -408,18 +437,19 @@ def fit_glossy_pair(grid: ViewGrid, target, albedo_table: np.ndarray, theta_deg:
         zeros = np.zeros((size, 3))
         empty = LobeFit(roughness=ROUGHNESS_RANGE[1], error=0.0, lut=zeros)
         return replace(empty, diffuse_lut=zeros.copy()), replace(empty, lut=zeros.copy())
-    target = np.asarray(target, float)
-    target = (target if target.ndim == 4 else target[..., None]) * np.ones(3)
-    grey = _grey(target)
+    values = np.asarray(target, float)
+    values = (values if values.ndim == 4 else values[..., None]) * np.ones(3)
+    grey = _grey(values)
     texels = lut_nodes(size)
     at_views = np.mean(_texel_albedo(albedo_table, theta_deg, grid.cos_view), axis=-1)
     lambert = np.broadcast_to(1.0 / np.pi, grid.cos_i.shape) * at_views[:, None, None]
     root_weight = np.sqrt(grid.weight) * grid.cos_i
     scale = 1.0 / max(float(np.sqrt(np.sum(np.square(root_weight * grey)))), 1e-300)
 
-    carrying = {}  # a lobe carrying the table's albedo, once per roughness tried
+    # a lobe carrying the table's albedo, once per roughness tried
+    carrying: dict[float, NDArray[np.float64]] = {}
 
-    def models(roughnesses) -> list:
+    def models(roughnesses: Sequence[float]) -> list[NDArray[np.float64]]:
         for r in roughnesses:
             if r not in carrying:
                 albedo = glossy_albedo(grid.cos_view, r, EEVEE_GLOSSY)
@@ -427,7 +457,7 @@ def fit_glossy_pair(grid: ViewGrid, target, albedo_table: np.ndarray, theta_deg:
                                * (at_views / np.maximum(albedo, 1e-6))[:, None, None])
         return [carrying[r] for r in roughnesses] + [lambert]
 
-    def residuals_of(roughnesses):
+    def residuals_of(roughnesses: Sequence[float]) -> NDArray[np.float64]:
         found = models(roughnesses)
         shares = _albedo_shares(grid, found, grey, slack)
         value = sum(shares[:, k, None, None] * m for k, m in enumerate(found))
@@ -438,7 +468,7 @@ def fit_glossy_pair(grid: ViewGrid, target, albedo_table: np.ndarray, theta_deg:
 
     table = _texel_albedo(albedo_table, theta_deg, texels)
 
-    def result(roughnesses) -> tuple[float, list, np.ndarray]:
+    def result(roughnesses: Sequence[float]) -> tuple[float, list, np.ndarray]:
         """The error on the grid, the Glossy rows and the companion's row."""
         shares = _albedo_shares(grid, models(roughnesses), grey, slack)
         at_texels = np.stack([np.interp(texels, grid.cos_view, shares[:, k])
@@ -451,9 +481,9 @@ def fit_glossy_pair(grid: ViewGrid, target, albedo_table: np.ndarray, theta_deg:
                       * sample_lut(row, grid.cos_o)
                       for r, row in zip(roughnesses, rows, strict=True))
                   + sample_lut(companion, grid.cos_o) / np.pi)
-        return grid.error(fitted, target), rows, companion
+        return grid.error(fitted, values), rows, companion
 
-    def cost(roughnesses) -> float:  # np.sum, not BLAS: the same on every processor
+    def cost(roughnesses: Sequence[float]) -> float:  # np.sum, not BLAS: same everywhere
         return float(np.sqrt(np.sum(np.square(residuals_of(roughnesses)))))
 
     one = [_minimise_roughness(lambda r: cost([r]))[0]]

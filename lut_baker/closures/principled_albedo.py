@@ -59,6 +59,7 @@ from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..numerics.quadrature import gauss_legendre
 from . import cycles as cc
@@ -132,29 +133,30 @@ def albedo_table() -> dict:
     return json.loads(TABLE_FILE.read_text())
 
 
-def _bracket(nodes, x: float) -> tuple[int, int, float]:
+def _bracket(nodes: ArrayLike, x: float) -> tuple[int, int, float]:
     """Neighbouring node indices and the weight of the second, ``x`` held at the ends (a
     single node: that node)."""
-    nodes = np.asarray(nodes, float)
-    if nodes.size == 1:
+    grid = np.asarray(nodes, float)
+    if grid.size == 1:
         return 0, 0, 0.0
-    x = float(np.clip(x, nodes[0], nodes[-1]))
-    i = int(np.clip(np.searchsorted(nodes, x, side="right") - 1, 0, nodes.size - 2))
-    return i, i + 1, (x - nodes[i]) / (nodes[i + 1] - nodes[i])
+    x = float(np.clip(x, grid[0], grid[-1]))
+    i = int(np.clip(np.searchsorted(grid, x, side="right") - 1, 0, grid.size - 2))
+    return i, i + 1, (x - grid[i]) / (grid[i + 1] - grid[i])
 
 
-def _on_plane(values, roughness_nodes, ior_nodes, roughness: float, ior: float) -> np.ndarray:
+def _on_plane(values: ArrayLike, roughness_nodes: ArrayLike, ior_nodes: ArrayLike,
+              roughness: float, ior: float) -> NDArray[np.float64]:
     """``values`` (roughness, IOR, ...) bilinear at ``(roughness, ior)``, held beyond the
     nodes."""
-    values = np.asarray(values, float)
+    table = np.asarray(values, float)
     i0, i1, s = _bracket(roughness_nodes, roughness)
     j0, j1, t = _bracket(ior_nodes, ior)
-    return ((1.0 - s) * ((1.0 - t) * values[i0, j0] + t * values[i0, j1])
-            + s * ((1.0 - t) * values[i1, j0] + t * values[i1, j1]))
+    return ((1.0 - s) * ((1.0 - t) * table[i0, j0] + t * table[i0, j1])
+            + s * ((1.0 - t) * table[i1, j0] + t * table[i1, j1]))
 
 
-def subsurface_ratio(base_color, roughness: float, ior: float, method: str = "RANDOM_WALK",
-                     engine: str = "CYCLES"):
+def subsurface_ratio(base_color: ArrayLike, roughness: float, ior: float,
+                     method: str = "RANDOM_WALK", engine: str = "CYCLES") -> NDArray[np.float64]:
     """``rho``: the subsurface closure's albedo over a Diffuse closure's of the same Base
     Color under the same specular layer (module docstring), at ``base_color`` (any shape,
     clamped to [0, 1] as Cycles clamps it), as measured: linear in Base Color and bilinear in
@@ -197,19 +199,20 @@ def rendered_layer(roughness: float, ior: float, distribution: str = "MULTI_GGX"
     return gloss, 1.0 - gloss
 
 
-def _body_per_layer(base, subsurface_weight: float, roughness: float, ior: float, method: str,
-                    engine: str):
+def _body_per_layer(base: ArrayLike, subsurface_weight: float, roughness: float, ior: float,
+                    method: str, engine: str) -> NDArray[np.float64]:
     """``(1 - w) base + w base rho``: the body over ``W`` (Cycles' clamps of Base Color)."""
-    base = np.maximum(np.asarray(base, float), 0.0)
+    colour = np.maximum(np.asarray(base, float), 0.0)
     w = float(np.clip(subsurface_weight, 0.0, 1.0))
     if w == 0.0:
-        return base
-    clamped = np.minimum(base, 1.0)
-    return ((1.0 - w) * base
+        return colour
+    clamped = np.minimum(colour, 1.0)
+    return ((1.0 - w) * colour
             + w * clamped * subsurface_ratio(clamped, roughness, ior, method, engine))
 
 
-def principled_albedo(base_color, roughness: float, ior: float, subsurface_weight: float = 0.0,
+def principled_albedo(base_color: ArrayLike, roughness: float, ior: float,
+                      subsurface_weight: float = 0.0,
                       method: str = "RANDOM_WALK", engine: str = "CYCLES",
                       distribution: str = "MULTI_GGX") -> PrincipledAlbedo:
     """The bihemispherical albedo of a dielectric Principled BSDF (module docstring) per
@@ -226,15 +229,22 @@ def principled_albedo(base_color, roughness: float, ior: float, subsurface_weigh
     return PrincipledAlbedo(total=gloss_rgb + body, gloss=gloss_rgb, body=body)
 
 
-def base_color_for_body(body, roughness: float, ior: float, subsurface_weight: float = 0.0,
-                        method: str = "RANDOM_WALK", engine: str = "CYCLES",
-                        distribution: str = "MULTI_GGX"):
+def base_color_for_body(body: ArrayLike, roughness: float, ior: float,
+                        subsurface_weight: float = 0.0, method: str = "RANDOM_WALK",
+                        engine: str = "CYCLES",
+                        distribution: str = "MULTI_GGX") -> NDArray[np.float64]:
     """The Base Color (same shape as ``body``) whose :func:`principled_albedo` body is
     ``body``: exact for diffuse (``body / W``), otherwise by inverting the body's curve on
     :data:`INVERSE_NODES` Base Colors in [0, 1], made increasing (where a random walk's body
     levels off, above Base Color 0.92, a colour of that level gives a Base Color on the level;
     beyond 1 only the diffuse share grows, so with a Subsurface Weight of 1 a body above the
-    curve's top gives 1).  Negative colours give 0."""
+    curve's top gives 1).  Negative colours give 0.
+
+    >>> skin = np.array([0.6, 0.35, 0.25])  # a Base Color, half of it subsurface
+    >>> body = principled_albedo(skin, 0.5, 1.4, 0.5, "RANDOM_WALK_SKIN").body
+    >>> print(np.round(base_color_for_body(body, 0.5, 1.4, 0.5, "RANDOM_WALK_SKIN"), 4))
+    [0.6  0.35 0.25]
+    """
     target = np.maximum(np.asarray(body, float), 0.0)
     _, passed = rendered_layer(roughness, ior, distribution, engine)
     w = float(np.clip(subsurface_weight, 0.0, 1.0))

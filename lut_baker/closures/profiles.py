@@ -16,6 +16,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..numerics.cache import LRUCache
 from ..numerics.optimise import brent_minimum
@@ -53,7 +54,7 @@ class ProfileFit:
         return float(np.max(self.error))
 
 
-def edge_response(r_mm, profile, s_mm) -> np.ndarray:
+def edge_response(r_mm: ArrayLike, profile: ArrayLike, s_mm: ArrayLike) -> NDArray[np.float64]:
     """The light a point ``s_mm`` inside a straight shadow edge receives from the lit
     half-plane, as a fraction of the lit level, for a radial profile ``profile`` (unit area,
     1/mm^2) sampled at ``r_mm``: ``ESF(s) = Int_s^inf P(r) 2 r arccos(s / r) dr`` (0.5 at the
@@ -74,14 +75,14 @@ def profile_grid(r_max: float) -> np.ndarray:
     return np.concatenate([[0.0], np.geomspace(1e-5 * r_max, 40.0 * r_max, PROFILE_RADII)])
 
 
-def fit_profile(tables: Tables, method: str, *, albedo=None) -> ProfileFit:
+def fit_profile(tables: Tables, method: str, *, albedo: ArrayLike | None = None) -> ProfileFit:
     """Fit the Subsurface Radius (mm, per channel) of ``method`` (``BURLEY``, ``RANDOM_WALK``,
     ``RANDOM_WALK_SKIN``) so that its edge response matches the tables' profile's (RMS over
     distances up to the tables' last radius).  ``albedo`` (per channel): the colour the random
     walk sees, default the skin's diffuse albedo ``pi skin_diffuse``."""
     if method not in cc.SUBSURFACE_METHODS:
         raise ValueError(f"method must be one of {cc.SUBSURFACE_METHODS}, got {method!r}")
-    albedo = np.clip(np.pi * np.asarray(tables.skin_diffuse, float) if albedo is None
+    colour = np.clip(np.pi * np.asarray(tables.skin_diffuse, float) if albedo is None
                      else np.broadcast_to(np.asarray(albedo, float), (3,)), 0.0, 1.0)
     r_max = float(tables.radius_mm[-1])
     r = profile_grid(r_max)
@@ -92,18 +93,18 @@ def fit_profile(tables: Tables, method: str, *, albedo=None) -> ProfileFit:
     worst: list[float] = []
     done: dict[tuple, int] = {}
     for c in range(3):
-        key = (reference[:, c].tobytes(), float(albedo[c]))
+        key = (reference[:, c].tobytes(), float(colour[c]))
         if key in done:
             for values in (radii, errors, worst):
                 values.append(values[done[key]])
             continue
         done[key] = c
 
-        def difference(log_radius, c=c):
-            model = cc.subsurface_profile(r, float(np.exp(log_radius)), albedo[c], method)
+        def difference(log_radius: float, c: int = c) -> NDArray[np.float64]:
+            model = cc.subsurface_profile(r, float(np.exp(log_radius)), colour[c], method)
             return edge_response(r, model, s) - reference[:, c]
 
-        def rms(log_radius):
+        def rms(log_radius: float) -> float:
             return float(np.sqrt(np.mean(np.square(difference(log_radius)))))
 
         # Half the reference's mean spread (mm) centres the search window (log radius).
@@ -114,7 +115,7 @@ def fit_profile(tables: Tables, method: str, *, albedo=None) -> ProfileFit:
         errors.append(error)
         worst.append(float(np.max(np.abs(difference(log_radius)))))
     return ProfileFit(method=method, radius_mm=np.array(radii), error=np.array(errors),
-                      max_error=np.array(worst), albedo=None if method == "BURLEY" else albedo)
+                      max_error=np.array(worst), albedo=None if method == "BURLEY" else colour)
 
 
 PROFILE_FIT_CACHE_SIZE = 16
@@ -123,7 +124,7 @@ albedo), so every foundation on one skin shares them."""
 _PROFILE_FITS = LRUCache(PROFILE_FIT_CACHE_SIZE)
 
 
-def fit_profiles(tables: Tables, **options) -> dict[str, ProfileFit]:
+def fit_profiles(tables: Tables, **options: ArrayLike) -> dict[str, ProfileFit]:
     """:func:`fit_profile` for every Blender subsurface method, by method name; remembered by
     the tables' radial grid, profile, skin albedo and ``options`` (the fits read nothing
     else)."""

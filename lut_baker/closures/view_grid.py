@@ -27,8 +27,10 @@ from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..numerics.quadrature import mirror_quadrature
+from ..tables.table_set import Tables
 from . import cycles as cc
 
 __all__ = ["ViewGrid", "view_grid", "FIT_VIEWS", "ERROR_VIEWS"]
@@ -73,26 +75,26 @@ class ViewGrid:
         return cc.microfacet_from_cosines(self.cos_h, self.cos_hi, self.cos_i, self.cos_o,
                                           roughness, distribution)
 
-    def error(self, f_fit, f_ref) -> float:
+    def error(self, f_fit: ArrayLike, f_ref: ArrayLike) -> float:
         """Relative RMS of the radiance ``f cos(theta_i)``, channels pooled (``f``:
         ``(V, A, P)`` or ``(V, A, P, C)``)."""
-        f_fit, f_ref = np.asarray(f_fit, float), np.asarray(f_ref, float)
+        fit, ref = np.asarray(f_fit, float), np.asarray(f_ref, float)
         weight = self.weight * np.square(self.cos_i)
-        if f_ref.ndim == 4 or f_fit.ndim == 4:
+        if ref.ndim == 4 or fit.ndim == 4:
             weight = weight[..., None]
-        num = np.sum(weight * np.square(f_fit - f_ref))
-        den = np.sum(weight * np.square(f_ref))
+        num = np.sum(weight * np.square(fit - ref))
+        den = np.sum(weight * np.square(ref))
         return float(np.sqrt(num / den)) if den > 0 else float(np.sqrt(num))
 
-    def view_albedo(self, f) -> np.ndarray:
+    def view_albedo(self, f: ArrayLike) -> NDArray[np.float64]:
         """``Int f cos(theta_i) dw_i`` per view, ``(V,)`` or ``(V, C)``."""
-        f = np.asarray(f, float)
+        values = np.asarray(f, float)
         weight = self.light_weight * self.cos_i
-        if f.ndim == 4:
-            return np.einsum("vapc,vap->vc", f, weight)
-        return np.sum(f * weight, axis=(1, 2))
+        if values.ndim == 4:
+            return np.einsum("vapc,vap->vc", values, weight)
+        return np.sum(values * weight, axis=(1, 2))
 
-    def albedo_error(self, f_fit, f_ref) -> float:
+    def albedo_error(self, f_fit: ArrayLike, f_ref: ArrayLike) -> float:
         """Largest relative error of :meth:`view_albedo` over views and channels."""
         fit, ref = self.view_albedo(f_fit), self.view_albedo(f_ref)
         return float(np.max(np.abs(fit - ref) / np.maximum(np.abs(ref), 1e-12)))
@@ -124,7 +126,7 @@ def view_grid(width_deg: float, views: int = FIT_VIEWS,
     return grid
 
 
-def lobe_widths_deg(tables) -> dict[str, float]:
+def lobe_widths_deg(tables: Tables) -> dict[str, float]:
     """The 1/e half-widths (degrees, 1/n of eq. 2's D) of the film's and the skin's gloss, by
     surface-gloss name; path 3 is at least as wide as the skin's (it is the skin's gloss seen
     through the film's broad transmission)."""

@@ -11,6 +11,7 @@ float image that the node group reads at ``u = cos(theta_o)``: :data:`LUT_ROWS` 
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 __all__ = ["LUT_ROWS", "EEVEE_LUT_ROWS", "DEFAULT_LUT_SIZE", "lut_nodes", "sample_lut"]
 
@@ -31,12 +32,18 @@ def lut_nodes(size: int = DEFAULT_LUT_SIZE) -> np.ndarray:
     return (np.arange(size) + 0.5) / size
 
 
-def sample_lut(lut, cos_view) -> np.ndarray:
+def sample_lut(lut: ArrayLike, cos_view: ArrayLike) -> NDArray[np.float64]:
     """What Blender's Image Texture (Linear, EXTEND) returns for a row ``lut`` ``(size[, C])``
-    at ``u = cos_view``: linear between texel centres, the edge texel beyond them."""
-    lut = np.asarray(lut, float)
-    nodes = lut_nodes(lut.shape[0])
-    cos_view = np.asarray(cos_view, float)
-    if lut.ndim == 1:
-        return np.interp(cos_view, nodes, lut)
-    return np.stack([np.interp(cos_view, nodes, lut[:, c]) for c in range(lut.shape[1])], -1)
+    at ``u = cos_view``: linear between texel centres, the edge texel beyond them.
+
+    >>> print(np.round(lut_nodes(4), 3))  # the texel centres of a row of 4
+    [0.125 0.375 0.625 0.875]
+    >>> print(sample_lut([0.0, 1.0, 2.0, 3.0], [0.0, 0.25, 0.5, 1.0]))  # held beyond them
+    [0.  0.5 1.5 3. ]
+    """
+    row = np.asarray(lut, float)
+    nodes = lut_nodes(row.shape[0])
+    u = np.asarray(cos_view, float)
+    if row.ndim == 1:
+        return np.interp(u, nodes, row)
+    return np.stack([np.interp(u, nodes, row[:, c]) for c in range(row.shape[1])], -1)

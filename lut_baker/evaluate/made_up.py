@@ -10,8 +10,10 @@ Functions
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..model.albedo import grid_for, reflection_albedo
+from ..model.layers import Layer
 from ..model.made_up_skin import (
     MadeUpSkin,
     combine,
@@ -28,14 +30,15 @@ __all__ = [
 ]
 
 
-def _rgb(values: np.ndarray, *layers) -> np.ndarray:
+def _rgb(values: np.ndarray, *layers: Layer) -> np.ndarray:
     """Broadcast a result of ``layers`` to RGB: ``(...)`` for scalar layers -> ``(..., 3)``."""
     values = np.asarray(values)
     rgb = any(layer.channels for layer in layers)
     return values if rgb else np.repeat(values[..., None], 3, axis=-1)
 
 
-def made_up_reflection(wi, wo, skin: MadeUpSkin, *, level: int = 0):
+def made_up_reflection(wi: ArrayLike, wo: ArrayLike, skin: MadeUpSkin, *,
+                       level: int = 0) -> NDArray[np.float64]:
     """Made-up skin BRDF, paths 1 + 3 (paper eq. 9) mixed with bare skin by coverage
     (docs/model.md §4): ``(1 - w) f_r,s + w (f_r,c + f_cs)`` with the film's absorption in its
     layers (:func:`~lut_baker.model.made_up_skin.coverage_weights`), in 1/sr, RGB: shape
@@ -54,7 +57,8 @@ def made_up_reflection(wi, wo, skin: MadeUpSkin, *, level: int = 0):
                    bare=bare)
 
 
-def directional_albedo(theta_i_deg, skin: MadeUpSkin, *, level: int = 0) -> np.ndarray:
+def directional_albedo(theta_i_deg: ArrayLike, skin: MadeUpSkin, *,
+                       level: int = 0) -> NDArray[np.float64]:
     """Paths 1 + 3 (with coverage) integrated over the view hemisphere, per RGB channel:
     ``Int f(wi, wo) cos(theta_o) dwo`` (dimensionless) at incidence ``theta_i_deg`` (degrees).
     A white furnace test asserts it is <= 1.  Shape ``theta_i_deg.shape + (3,)``."""

@@ -32,8 +32,10 @@ The single layer's integrals (its albedo, the film's transmittance) are in
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..model.albedo import (
+    LayerFourier,
     drop_channel_axis,
     grid_for,
     hemisphere_factor,
@@ -58,8 +60,9 @@ POINT_CHUNK = 64
 """Evaluation points processed together (bounds memory at a few tens of MB)."""
 
 
-def inner_matrices(grid: HemisphereGrid, film_transmission, skin_reflection: ReflectionLayer,
-                    fourier=layer_fourier_kernel) -> np.ndarray:
+def inner_matrices(grid: HemisphereGrid, film_transmission: TransmissionLayer,
+                   skin_reflection: ReflectionLayer,
+                   fourier: LayerFourier = layer_fourier_kernel) -> NDArray[np.float64]:
     """``c_m^2 W B_m W`` on the grid's polar nodes: shape ``(orders, N, N, C)``."""
     b = fourier(skin_reflection, grid.theta, grid.theta, grid.n_phi)
     w = grid.weight
@@ -74,9 +77,11 @@ def _batched_matmul(left: np.ndarray, right: np.ndarray) -> np.ndarray:
     return np.moveaxis(left_c @ right_c, 1, -1)  # (M, P, Q, C)
 
 
-def layered_fourier_matrices(theta_i, theta_o, film_transmission, skin_reflection,
-                             grid: HemisphereGrid, *,
-                             fourier=layer_fourier_kernel, orders: int | None = None):
+def layered_fourier_matrices(theta_i: ArrayLike, theta_o: ArrayLike,
+                             film_transmission: TransmissionLayer,
+                             skin_reflection: ReflectionLayer, grid: HemisphereGrid, *,
+                             fourier: LayerFourier = layer_fourier_kernel,
+                             orders: int | None = None) -> NDArray[np.float64]:
     """Fourier matrices ``F_m(theta_i, theta_o)`` of path 3: ``f_cs = sum_m F_m cos(m phi)``.
 
     ``theta_i``, ``theta_o``: polar angles (radians) of the outer directions; returns shape
@@ -93,9 +98,12 @@ def layered_fourier_matrices(theta_i, theta_o, film_transmission, skin_reflectio
     return _batched_matmul(_batched_matmul(rows, inner), np.swapaxes(cols, 1, 2))
 
 
-def inter_reflection_fourier_matrices(theta_i, theta_o, film_transmission, skin_reflection, grid,
-                                      *, film_below=None,
-                                      fourier=layer_fourier_kernel):
+def inter_reflection_fourier_matrices(theta_i: ArrayLike, theta_o: ArrayLike,
+                                      film_transmission: TransmissionLayer,
+                                      skin_reflection: ReflectionLayer, grid: HemisphereGrid,
+                                      *, film_below: ReflectionLayer | None = None,
+                                      fourier: LayerFourier = layer_fourier_kernel
+                                      ) -> NDArray[np.float64]:
     """Fourier matrices of all inter-reflections between film and skin (the adding equation).
 
     Path 3 is the first term of ``T (I - R_s R_f)^-1 R_s T``, where ``R_f`` is the film's
@@ -130,9 +138,10 @@ def _fourier_sum(matrices_diag: np.ndarray, phi: np.ndarray) -> np.ndarray:
     return np.einsum("mpc,mp->pc", matrices_diag, cosines)
 
 
-def layered_reflection(wi, wo, film_transmission: TransmissionLayer,
+def layered_reflection(wi: ArrayLike, wo: ArrayLike, film_transmission: TransmissionLayer,
                        skin_reflection: ReflectionLayer, *,
-                       level: int = 0, grid: HemisphereGrid | None = None):
+                       level: int = 0, grid: HemisphereGrid | None = None
+                       ) -> NDArray[np.float64]:
     """Path 3 of made-up skin, ``f_cs(wi, wo)`` (paper eq. 7, docs/model.md §3), without the cosine.
 
     ``wi``, ``wo``: unit vectors ``(..., 3)``; 0 where either is below the surface.  Units:
@@ -164,8 +173,10 @@ def layered_reflection(wi, wo, film_transmission: TransmissionLayer,
                              skin_reflection)
 
 
-def layered_reflection_converged(wi, wo, film_transmission, skin_reflection, *, rtol: float = 1e-4,
-                                 max_level: int = 3):
+def layered_reflection_converged(wi: ArrayLike, wo: ArrayLike,
+                                 film_transmission: TransmissionLayer,
+                                 skin_reflection: ReflectionLayer, *, rtol: float = 1e-4,
+                                 max_level: int = 3) -> tuple[NDArray[np.float64], float, int]:
     """The exact evaluator of path 3: :func:`layered_reflection` at increasing ``level`` until
     two successive levels agree within ``rtol`` relative (of the larger of the value and 1e-3
     of the batch's peak).  Returns ``(values, achieved_relative_change, level)``; raises
@@ -184,14 +195,15 @@ def layered_reflection_converged(wi, wo, film_transmission, skin_reflection, *, 
     )
 
 
-def transmission_factor(w, film_transmission: TransmissionLayer, dipole: Dipole, *, level: int = 0):
+def transmission_factor(w: ArrayLike, film_transmission: TransmissionLayer, dipole: Dipole, *,
+                        level: int = 0) -> NDArray[np.float64]:
     """Path 4's angular factor ``t(w) = Int f_t(w, -u) F_t(eta_s, u) cos(theta_u) du``
     (paper eq. 8, docs/model.md §3): light through the film into the skin (or out of it, by
     reciprocity).  ``w``: unit vectors ``(..., 3)``, 0 below the surface."""
-    w = check_directions("w", w)
+    directions = check_directions("w", w)
     grid = grid_for(film_transmission, level=level)
     # (N, C): the dipole may be RGB through its coefficients with a scalar eta.
     fresnel_t = fresnel_transmittance(np.cos(grid.theta)[:, None], np.atleast_1d(dipole.eta))
     fresnel_t = np.broadcast_to(fresnel_t, (grid.theta.size, 3 if dipole.channels else 1))
-    return hemisphere_factor(w, grid, film_transmission, fresnel_t, dipole)
+    return hemisphere_factor(directions, grid, film_transmission, fresnel_t, dipole)
 

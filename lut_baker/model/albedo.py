@@ -24,21 +24,26 @@ Functions
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..numerics.geometry import direction
 from ..numerics.quadrature import (
     HemisphereGrid,
+    Kernel,
     fourier_kernel,
     gauss_legendre,
     hemisphere_grid,
     mirror_quadrature,
     order0_integral,
 )
-from .layers import ReflectionLayer, TransmissionLayer
+from .layers import Layer, ReflectionLayer, TransmissionLayer
 from .microfacet import (
+    Fresnel,
     check_directions,
-    fresnel_term,
+    fresnel_reflectance,
     ts_reflection,
     ts_specular_from_cosines,
     ts_transmission,
@@ -62,43 +67,51 @@ __all__ = [
 ]
 
 
-def with_channel_axis(values: np.ndarray, layer) -> np.ndarray:
+def with_channel_axis(values: np.ndarray, layer: Layer) -> np.ndarray:
     """Give per-layer values a trailing channel axis (length 1 for scalar layers)."""
     return values if layer.channels else values[..., None]
 
 
-def drop_channel_axis(values: np.ndarray, *layers) -> np.ndarray:
+def drop_channel_axis(values: np.ndarray, *layers: Layer) -> np.ndarray:
     """Drop the channel axis again when every layer involved is scalar."""
     return values if any(layer.channels for layer in layers) else values[..., 0]
 
 
-def grid_for(*layers, level: int = 0) -> HemisphereGrid:
+def grid_for(*layers: Layer, level: int = 0) -> HemisphereGrid:
     """The hemisphere grid that resolves the narrowest lobe of ``layers`` at ``level``."""
-    widths = [1.0 / float(np.max(layer.n)) for layer in layers if hasattr(layer, "n")]
+    widths = [1.0 / float(np.max(layer.n)) for layer in layers
+              if isinstance(layer, ReflectionLayer | TransmissionLayer)]  # a dipole has no lobe
     return hemisphere_grid(min(widths, default=90.0), level)
 
 
-def transmission_kernel(film_transmission: TransmissionLayer):
+def transmission_kernel(film_transmission: TransmissionLayer) -> Kernel:
     """``(w_top, u) -> f_t(w_top, -u)`` with channel axis: light from ``w_top`` leaving
     downward along ``-u`` (both arguments upper-hemisphere directions)."""
 
-    def kernel(w_top, u):
+    def kernel(w_top: NDArray[np.float64], u: NDArray[np.float64]) -> NDArray[np.float64]:
         return with_channel_axis(ts_transmission(w_top, -u, film_transmission, check=False),
                                  film_transmission)
 
     return kernel
 
 
-def reflection_kernel(layer: ReflectionLayer):
+def reflection_kernel(layer: ReflectionLayer) -> Kernel:
     """``(wi, wo) -> f_r(wi, wo)`` with channel axis."""
 
-    def kernel(wi, wo):
+    def kernel(wi: NDArray[np.float64], wo: NDArray[np.float64]) -> NDArray[np.float64]:
         return with_channel_axis(ts_reflection(wi, wo, layer, check=False), layer)
 
     return kernel
 
 
-def layer_fourier_kernel(layer, theta_a, theta_b, n_phi: int) -> np.ndarray:
+LayerFourier = Callable[[ReflectionLayer | TransmissionLayer, ArrayLike, ArrayLike, int],
+                        NDArray[np.float64]]
+"""A layer's cosine coefficients between two polar grids: :func:`layer_fourier_kernel` or an
+accelerator of it (the bake's)."""
+
+
+def layer_fourier_kernel(layer: ReflectionLayer | TransmissionLayer, theta_a: ArrayLike,
+                         theta_b: ArrayLike, n_phi: int) -> NDArray[np.float64]:
     """Cosine coefficients ``(orders, A, B, C)`` of a layer's kernel between polar angles
     ``theta_a``, ``theta_b`` (radians): ``f_r(wa, wb)`` of a :class:`ReflectionLayer`,
     ``f_t(wa, -wb)`` of a :class:`TransmissionLayer` (see :func:`quadrature.fourier_kernel`)."""
@@ -107,22 +120,26 @@ def layer_fourier_kernel(layer, theta_a, theta_b, n_phi: int) -> np.ndarray:
     return fourier_kernel(transmission_kernel(layer), theta_a, theta_b, n_phi)
 
 
-def transmission_rows(theta, grid: HemisphereGrid, film_transmission,
-                       fourier=layer_fourier_kernel) -> np.ndarray:
+def transmission_rows(theta: ArrayLike, grid: HemisphereGrid,
+                      film_transmission: TransmissionLayer,
+                      fourier: LayerFourier = layer_fourier_kernel) -> NDArray[np.float64]:
     """``T_m(theta, theta_u)`` for outer polar angles ``theta``: shape ``(orders, P, N, C)``."""
     return fourier(film_transmission, theta, grid.theta, grid.n_phi)
 
 
-def film_transmittance(w, film_transmission: TransmissionLayer, *, level: int = 0):
+def film_transmittance(w: ArrayLike, film_transmission: TransmissionLayer, *,
+                       level: int = 0) -> NDArray[np.float64]:
     """The film's directional transmittance ``Int f_t(w, -u) cos(theta_u) du`` (eq. 4
     integrated): how much of the light arriving from ``w`` crosses the film."""
-    w = check_directions("w", w)
+    directions = check_directions("w", w)
     grid = grid_for(film_transmission, level=level)
-    return hemisphere_factor(w, grid, film_transmission, np.ones((grid.theta.size, 1)),
-                             film_transmission)
+    return hemisphere_factor(directions, grid, film_transmission,
+                             np.ones((grid.theta.size, 1)), film_transmission)
 
 
-def hemisphere_factor(w, grid, film_transmission, below_weight, *layers):
+def hemisphere_factor(w: NDArray[np.float64], grid: HemisphereGrid,
+                      film_transmission: TransmissionLayer, below_weight: NDArray[np.float64],
+                      *layers: Layer) -> NDArray[np.float64]:
     """``2 pi sum_u T_0(theta_w, theta_u) below_weight(u) W_u`` (order 0: azimuth integrated)."""
     batch = w.shape[:-1]
     theta = np.arccos(np.clip(w.reshape(-1, 3)[:, 2], 0.0, 1.0))
@@ -143,13 +160,14 @@ lobes best at grazing, grows as the inverse square of the width and stops resolv
 degrees (:data:`lut_baker.numerics.quadrature.NARROWEST_LOBE_DEG`)."""
 
 
-def specular_albedo(theta_i_deg, layer: ReflectionLayer, *, level: int = 0,
-                    fresnel=fresnel_term):
+def specular_albedo(theta_i_deg: ArrayLike, layer: ReflectionLayer, *, level: int = 0,
+                    fresnel: Fresnel = fresnel_reflectance) -> NDArray[np.float64]:
     """Directional albedo of eq. 2's specular term alone, ``Int P_s D G F_r cos(theta_o)
     dwo``, at incidence ``theta_i_deg`` (degrees, any shape), through the half vector
     (:func:`lut_baker.numerics.quadrature.mirror_quadrature`, panels sized by the lobe): the
-    same cost for a lobe of any width.  ``fresnel``: :func:`fresnel_term` or an accelerator of
-    it.  Shape ``theta.shape + (C,)`` (C the layer's channels, 1 for a scalar layer)."""
+    same cost for a lobe of any width.  ``fresnel``: :func:`fresnel_reflectance` or an
+    accelerator of it.  Shape ``theta.shape + (C,)`` (C the layer's channels, 1 for a scalar
+    layer)."""
     theta = np.radians(np.asarray(theta_i_deg, float))
     scale = 2**int(level)
     quad = mirror_quadrature(theta.ravel(), 1.0 / float(np.max(layer.n)),
@@ -163,11 +181,20 @@ def specular_albedo(theta_i_deg, layer: ReflectionLayer, *, level: int = 0,
     return value.reshape(theta.shape + (value.shape[-1],))
 
 
-def reflection_albedo(theta_i_deg, layer: ReflectionLayer, *, level: int = 0):
+def reflection_albedo(theta_i_deg: ArrayLike, layer: ReflectionLayer, *,
+                      level: int = 0) -> NDArray[np.float64]:
     """Directional albedo ``Int f_r(wi, wo) cos(theta_o) dwo`` of a reflecting layer (eq. 2
     integrated) at incidence ``theta_i_deg`` (degrees, any shape): the azimuthal Fourier
     expansion's order 0, or for a lobe narrower than :data:`MIRROR_BELOW_DEG`, ``pi P_d`` plus
-    :func:`specular_albedo`."""
+    :func:`specular_albedo`.
+
+    >>> matte = ReflectionLayer(P_d=0.5 / np.pi, P_s=0.0, n=0.1, eta=1.5)  # albedo pi P_d
+    >>> print(np.round(reflection_albedo([0.0, 60.0, 85.0], matte), 4))
+    [0.5 0.5 0.5]
+    >>> gloss = ReflectionLayer(P_d=0.0, P_s=1.0, n=0.1, eta=1.5)  # a 10-degree lobe
+    >>> print(np.round(reflection_albedo([0.0, 60.0], gloss), 4))
+    [0.0141 0.0077]
+    """
     theta = np.radians(np.asarray(theta_i_deg, float))
     if 1.0 / float(np.max(layer.n)) < MIRROR_BELOW_DEG:
         diffuse = np.pi * with_channel_axis(np.asarray(layer.P_d, float), layer)
@@ -179,8 +206,14 @@ def reflection_albedo(theta_i_deg, layer: ReflectionLayer, *, level: int = 0):
     return drop_channel_axis(value.reshape(theta.shape + (value.shape[-1],)), layer)
 
 
-def transmission_albedo(theta_i_deg, film_transmission: TransmissionLayer, *, level: int = 0):
-    """Directional transmittance of the film at incidence ``theta_i_deg`` (degrees)."""
+def transmission_albedo(theta_i_deg: ArrayLike, film_transmission: TransmissionLayer, *,
+                        level: int = 0) -> NDArray[np.float64]:
+    """Directional transmittance of the film at incidence ``theta_i_deg`` (degrees).
+
+    >>> diffuse = TransmissionLayer(P_d=0.9 / np.pi, P_t=0.0, n=0.05, eta=1.3)
+    >>> print(np.round(transmission_albedo([0.0, 60.0], diffuse), 4))
+    [0.9 0.9]
+    """
     theta = np.radians(np.asarray(theta_i_deg, float))
     return film_transmittance(direction(theta, 0.0), film_transmission, level=level)
 
@@ -189,11 +222,16 @@ BIHEMISPHERICAL_NODES = 48
 """Gauss-Legendre nodes in ``cos(theta)`` of :func:`bihemispherical`."""
 
 
-def bihemispherical(directional, nodes: int = BIHEMISPHERICAL_NODES) -> np.ndarray:
+def bihemispherical(directional: Callable[[NDArray[np.float64]], ArrayLike],
+                    nodes: int = BIHEMISPHERICAL_NODES) -> NDArray[np.float64]:
     """``2 Int_0^1 a(mu) mu dmu``: the directional albedo ``directional(theta_deg)`` (degrees
     in, ``(N,)`` or ``(N, C)`` out) averaged over uniform, cosine-weighted incident light (the
     bihemispherical albedo; by reciprocity also the mean radiance a convex object shows under a
-    uniform white sky)."""
+    uniform white sky).
+
+    >>> round(float(bihemispherical(lambda theta_deg: np.cos(np.radians(theta_deg)))), 6)
+    0.666667
+    """
     mu, w = gauss_legendre(nodes, 0.0, 1.0)
     values = np.asarray(directional(np.degrees(np.arccos(mu))), dtype=float)
     weight = (2.0 * w * mu).reshape((-1,) + (1,) * (values.ndim - 1))

@@ -23,9 +23,10 @@ for Subsurface Light Transport", SIGGRAPH 2001.
 from __future__ import annotations
 
 from dataclasses import Field, dataclass, fields
-from typing import Any, cast
+from typing import Any, Self, cast
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 __all__ = [
     "ReflectionLayer",
@@ -37,7 +38,8 @@ __all__ = [
 ]
 
 
-def check_parameter(name: str, value, low: float, high: float, *, low_open: bool, high_open: bool):
+def check_parameter(name: str, value: ArrayLike, low: float, high: float, *, low_open: bool,
+                    high_open: bool) -> NDArray[np.float64]:
     """Validate one parameter: a finite scalar or RGB triple within ``[low, high]`` (open at an
     end where ``low_open``/``high_open``); returns it as a read-only float array."""
     array = np.asarray(value, dtype=float)
@@ -54,7 +56,7 @@ def check_parameter(name: str, value, low: float, high: float, *, low_open: bool
     return array
 
 
-def _fields(layer) -> tuple[Field, ...]:
+def _fields(layer: Layer) -> tuple[Field, ...]:
     """The dataclass fields of a layer (every subclass of :class:`Layer` is a dataclass)."""
     return fields(cast(Any, layer))
 
@@ -64,7 +66,7 @@ class Layer:
 
     _ranges: dict[str, tuple[float, float, bool, bool]] = {}
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         for field in _fields(self):
             low, high, low_open, high_open = self._ranges[field.name]
             checked = check_parameter(
@@ -78,7 +80,7 @@ class Layer:
         """``()`` when every field is scalar, ``(3,)`` when any is RGB."""
         return (3,) if any(getattr(self, f.name).shape == (3,) for f in _fields(self)) else ()
 
-    def channel(self, index: int):
+    def channel(self, index: int) -> Self:
         """The same layer restricted to one RGB channel (scalars stay as they are)."""
         values = {
             f.name: (v[index] if (v := getattr(self, f.name)).shape == (3,) else v)
@@ -86,7 +88,7 @@ class Layer:
         }
         return type(self)(**values)
 
-    def scaled(self, **factors):
+    def scaled(self, **factors: ArrayLike) -> Self:
         """A copy with the named fields multiplied by ``factors`` (scalar or RGB)."""
         values = {f.name: getattr(self, f.name) for f in _fields(self)}
         for name, factor in factors.items():
@@ -151,7 +153,7 @@ class Dipole(Layer):
         "eta": (1.0, np.inf, False, True),
     }
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         super().__post_init__()
         if np.any(self.sigma_s * (1.0 - self.g) + self.sigma_a <= 0.0):
             raise ValueError(

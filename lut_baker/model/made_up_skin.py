@@ -26,7 +26,7 @@ The made-up skin's reflection and albedo, which sum these parts, are evaluated i
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import NamedTuple
+from typing import Any, NamedTuple, TypeVar
 
 import numpy as np
 
@@ -54,7 +54,10 @@ TRANSMISSION_SHUTTER_S = 10.0
 """Shutter time of the paper's transmission measurement (4.1.2), seconds."""
 
 
-def per_second(layer, shutter_s: float):
+_Scaled = TypeVar("_Scaled", ReflectionLayer, TransmissionLayer)
+
+
+def per_second(layer: _Scaled, shutter_s: float) -> _Scaled:
     """``layer`` with its intensity scales (``P_d``, ``P_s``/``P_t``) divided by ``shutter_s``."""
     if not shutter_s > 0:
         raise ValueError(f"shutter_s must be > 0 seconds, got {shutter_s!r}")
@@ -71,7 +74,7 @@ def normalisation_constant(film_reflection: ReflectionLayer,
     For RGB layers the brightest channel sets ``K``.
     """
 
-    def total(theta_deg):
+    def total(theta_deg: float) -> float:
         value = reflection_albedo(theta_deg, film_reflection) + transmission_albedo(
             theta_deg, film_transmission
         )
@@ -100,11 +103,11 @@ class MadeUpSkin:
     skin_reflection: ReflectionLayer
     dipole: Dipole
     coverage: float = 1.0
-    absorption: object = 0.0
+    absorption: Any = 0.0
     K: float | None = None
     name: str = field(default="custom")
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         coverage = check_parameter("coverage", self.coverage, 0.0, 1.0,
                                    low_open=False, high_open=False)
         if coverage.shape != ():
@@ -118,7 +121,7 @@ class MadeUpSkin:
             if not isinstance(getattr(self, name), kind):
                 raise ValueError(f"{name} must be a {kind.__name__}")
 
-    def replace(self, **changes) -> MadeUpSkin:
+    def replace(self, **changes: Any) -> MadeUpSkin:
         """A copy with some fields changed (validated again)."""
         values = {name: getattr(self, name) for name in self.__dataclass_fields__}
         values.update(changes)
@@ -129,7 +132,7 @@ def from_paper_counts(film: ReflectionLayer, film_transmission: TransmissionLaye
                       skin: ReflectionLayer, dipole: Dipole, *,
                       reflection_shutter_s: float = REFLECTION_SHUTTER_S,
                       transmission_shutter_s: float = TRANSMISSION_SHUTTER_S,
-                      **options) -> MadeUpSkin:
+                      **options: Any) -> MadeUpSkin:
     """Layers in the paper's pixel counts -> :class:`MadeUpSkin` in albedo units
     (docs/model.md §4)."""
     film_s = per_second(film, reflection_shutter_s)
@@ -159,7 +162,7 @@ class CoverageWeights(NamedTuple):
     """``(1 - A)^2``: what is left of light that crosses it twice (paths 3 and 4)."""
 
 
-def coverage_weights(coverage, absorption) -> CoverageWeights:
+def coverage_weights(coverage: Any, absorption: Any) -> CoverageWeights:
     """The mixing weights of coverage ``w`` and absorption ``A`` (docs/model.md §4, dimensionless;
     ``A`` per channel).  The made-up skin is::
 
@@ -171,7 +174,12 @@ def coverage_weights(coverage, absorption) -> CoverageWeights:
     crosses it twice; so does path 4).  Every mix of the made-up skin's parts uses these
     weights: the exact evaluator, the tables, the closures' tiers, the Auto tier and the
     reference images.  The add-on's node group (makeup_skin_addon/nodes.py) builds the same mix
-    from math nodes and must follow it.
+    from math nodes and must follow it.  ``coverage`` and ``absorption``: numbers and arrays,
+    or a node group's sockets.
+
+    >>> weights = coverage_weights(0.6, [0.2, 0.5, 0.8])
+    >>> print(round(weights.bare, 6), weights.covered, weights.once, np.round(weights.twice, 4))
+    0.4 0.6 [0.8 0.5 0.2] [0.64 0.25 0.04]
     """
     if isinstance(absorption, (list, tuple)):
         absorption = np.asarray(absorption, dtype=float)
@@ -181,7 +189,8 @@ def coverage_weights(coverage, absorption) -> CoverageWeights:
     return CoverageWeights(bare=1.0 - coverage, covered=coverage, once=once, twice=once**2)
 
 
-def combine(weights: CoverageWeights, *, top=None, once=None, twice=None, bare=None):
+def combine(weights: CoverageWeights, *, top: Any = None, once: Any = None, twice: Any = None,
+            bare: Any = None) -> Any:
     """The made-up skin's mix of its parts (docs/model.md §4, :func:`coverage_weights`)::
 
         covered [top + once (1 - A) + twice (1 - A)^2] + bare (1 - w)
@@ -190,11 +199,18 @@ def combine(weights: CoverageWeights, *, top=None, once=None, twice=None, bare=N
     whose layers hold the absorption already); ``once``: what crosses it once (its diffuse
     reflection); ``twice``: what crosses it twice (the skin seen through it, paths 3 and 4);
     ``bare``: the bare skin.  Any unit, any broadcasting shapes (RGB last); a part not given
-    is no term at all, so a grey part stays a scalar (and a node group's Math node)."""
-    def times(weight, part):
+    is no term at all, so a grey part stays a scalar (and a node group's Math node).
+
+    >>> weights = coverage_weights(0.6, [0.2, 0.5, 0.8])
+    >>> print(np.round(combine(weights, top=0.05, once=0.3, twice=0.5, bare=0.4), 4))
+    [0.526 0.355 0.238]
+    >>> round(combine(weights, bare=0.4), 6)  # a grey part alone stays a number
+    0.16
+    """
+    def times(weight: Any, part: Any) -> Any:
         return None if part is None else weight * part
 
-    def total(parts):
+    def total(parts: list[Any]) -> Any:
         given = [part for part in parts if part is not None]
         return sum(given[1:], given[0]) if given else None
 

@@ -32,7 +32,9 @@ from __future__ import annotations
 
 import tomllib
 from dataclasses import fields
+from os import PathLike
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -83,7 +85,7 @@ def skin_from_dict(data: dict) -> MadeUpSkin:
         raise ValueError(f"incomplete made-up skin parameters: {error}") from None
 
 
-def _shown(value) -> str:
+def _shown(value: object) -> str:
     """A parsed TOML value as it reads in the file (``true``, ``'text'``, ``[1, 2]``)."""
     if isinstance(value, bool):
         return "true" if value else "false"
@@ -92,19 +94,19 @@ def _shown(value) -> str:
     return repr(value)
 
 
-def _is_number(value) -> bool:
+def _is_number(value: object) -> bool:
     """An int or float of TOML (a boolean is not a number)."""
     return isinstance(value, (int, float)) and not isinstance(value, bool)
 
 
-def _check(key: str, value, ok: bool, expected: str):
+def _check(key: str, value: Any, ok: bool, expected: str) -> Any:
     """``value`` if ``ok``, else ``ValueError`` naming ``key``, what it expects and the value."""
     if not ok:
         raise ValueError(f"{key}: expected {expected}, got {_shown(value)}")
     return value
 
 
-def _rgb(key: str, value):
+def _rgb(key: str, value: Any) -> Any:
     """A field value: one number or a list of 3 numbers."""
     ok = _is_number(value) or (isinstance(value, list) and len(value) == 3
                                and all(map(_is_number, value)))
@@ -134,7 +136,8 @@ def _section(mapping: dict, name: str) -> dict:
     return {field: _rgb(f"[{name}] {field}", value) for field, value in section.items()}
 
 
-def _layer(kind, name: str, fields: dict):
+def _layer(kind: type[ReflectionLayer] | type[TransmissionLayer] | type[Dipole], name: str,
+           fields: dict) -> Any:
     try:
         return kind(**fields)
     except ValueError as error:
@@ -184,20 +187,20 @@ def params_from_mapping(mapping: dict) -> MadeUpSkin:
         raise ValueError(str(error)) from None
 
 
-def read_mapping(path) -> dict:
+def read_mapping(path: str | PathLike[str]) -> dict:
     """The parsed TOML of a parameter file; ``ValueError`` naming the file if it is missing or
     not TOML."""
-    path = Path(path)
+    file = Path(path)
     try:
-        with path.open("rb") as stream:
+        with file.open("rb") as stream:
             return tomllib.load(stream)
     except FileNotFoundError:
-        raise ValueError(f"parameter file {str(path)!r} does not exist") from None
+        raise ValueError(f"parameter file {str(file)!r} does not exist") from None
     except (OSError, tomllib.TOMLDecodeError, UnicodeDecodeError) as error:
-        raise ValueError(f"parameter file {str(path)!r} is not valid TOML: {error}") from None
+        raise ValueError(f"parameter file {str(file)!r} is not valid TOML: {error}") from None
 
 
-def load_params(path) -> MadeUpSkin:
+def load_params(path: str | PathLike[str]) -> MadeUpSkin:
     """Read a TOML parameter file; ``ValueError`` naming the file and the problem if it is
     missing, not TOML, or holds an invalid value."""
     mapping = read_mapping(path)

@@ -27,6 +27,7 @@ from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .dipole import dipole_total_reflectance
 from .layers import Dipole, ReflectionLayer, TransmissionLayer
@@ -121,12 +122,14 @@ def paper() -> MadeUpSkin:
     return from_paper_counts(film, film_transmission, skin, dipole, name="paper")
 
 
-def paper_layers():
+def paper_layers() -> tuple[ReflectionLayer, TransmissionLayer, ReflectionLayer, Dipole]:
     """``(film reflection, film transmission, skin reflection, skin dipole)`` in counts."""
     return PAPER_FILM_REFLECTION, PAPER_FILM_TRANSMISSION, PAPER_SKIN_REFLECTION, PAPER_SKIN_DIPOLE
 
 
-def _literature_skin(sigma_s_reduced, sigma_a, eta=1.3):
+def _literature_skin(sigma_s_reduced: tuple[float, float, float],
+                     sigma_a: tuple[float, float, float],
+                     eta: float = 1.3) -> tuple[ReflectionLayer, Dipole]:
     """Surface layer and dipole of a skin given by reduced scattering and absorption (1/mm).
 
     Diffuse: ``P_d = Rd / pi`` (the dipole's closed-form total reflectance is the skin's diffuse
@@ -155,7 +158,7 @@ SKINS: dict[str, dict] = {
 }
 
 
-def skin_layers(name: str):
+def skin_layers(name: str) -> tuple[ReflectionLayer, Dipole]:
     """``(surface ReflectionLayer, Dipole)`` of a named skin, in albedo units."""
     if name not in SKINS:
         raise ValueError(f"skin must be one of {sorted(SKINS)}, got {name!r}")
@@ -174,7 +177,7 @@ def skin_albedo(name: str) -> np.ndarray:
 
 
 def made_up_skin(foundation: str = "paper_natural", skin: str = "paper_bioplate", *,
-                 coverage: float = 1.0, absorption=None) -> MadeUpSkin:
+                 coverage: float = 1.0, absorption: ArrayLike | None = None) -> MadeUpSkin:
     """A named foundation on a named skin.  ``absorption`` (scalar or RGB in [0, 1]) overrides
     the shade's own."""
     if foundation not in FOUNDATIONS:

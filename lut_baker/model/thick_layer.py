@@ -38,7 +38,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
+from ..numerics import Real
 from ..numerics.cache import LRUCache
 from .albedo import bihemispherical, reflection_albedo, transmission_albedo
 from .layers import ReflectionLayer, TransmissionLayer
@@ -65,15 +67,15 @@ class FilmExchange:
     and diffuse ``r_diffuse = pi P_d`` parts, and its transmittance ``t_0``, all without
     absorption (docs/model.md §4); floats, or RGB arrays for a film with RGB parameters."""
 
-    r_gloss: float
-    r_diffuse: float
-    t_0: float
+    r_gloss: Real
+    r_diffuse: Real
+    t_0: Real
 
-    def r(self, absorption):
+    def r(self, absorption: ArrayLike) -> NDArray[np.float64]:
         """``r(A) = r_gloss + (1 - A) r_diffuse``: the film's reflectance at absorption ``A``."""
         return self.r_gloss + (1.0 - np.asarray(absorption, float)) * self.r_diffuse
 
-    def t(self, absorption):
+    def t(self, absorption: ArrayLike) -> NDArray[np.float64]:
         """``t(A) = (1 - A) t_0``: the film's transmittance at absorption ``A``."""
         return (1.0 - np.asarray(absorption, float)) * self.t_0
 
@@ -81,10 +83,10 @@ class FilmExchange:
 _EXCHANGES = LRUCache(EXCHANGE_CACHE_SIZE)
 
 
-def _number(values):
+def _number(values: ArrayLike) -> Real:
     """A float for a scalar film, else the per-channel array."""
-    values = np.asarray(values, float)
-    return float(values) if values.ndim == 0 else values
+    array = np.asarray(values, float)
+    return float(array) if array.ndim == 0 else array
 
 
 def film_exchange(film: ReflectionLayer, transmission: TransmissionLayer) -> FilmExchange:
@@ -97,7 +99,7 @@ def film_exchange(film: ReflectionLayer, transmission: TransmissionLayer) -> Fil
     key = (tuple(sorted((k, repr(v)) for k, v in film.as_dict().items())),
            tuple(sorted((k, repr(v)) for k, v in transmission.as_dict().items())))
 
-    def compute():
+    def compute() -> FilmExchange:
         gloss = film.scaled(P_d=0.0)
         r_gloss = (0.0 if not np.any(gloss.P_s > 0.0)
                    else bihemispherical(lambda t: reflection_albedo(t, gloss)))
@@ -132,9 +134,17 @@ def preset_film_exchange() -> FilmExchange:
     return FilmExchange(**MEASURED_FILM_EXCHANGE)
 
 
-def stack_reflectance(absorption, exchange: FilmExchange) -> np.ndarray:
+def stack_reflectance(absorption: ArrayLike, exchange: FilmExchange) -> NDArray[np.float64]:
     """``R_inf(A)``: the film stacked on itself without end (the adding equation's fixed point,
-    the root below 1 of ``r R^2 - (1 + r^2 - t^2) R + r = 0``)."""
+    the root below 1 of ``r R^2 - (1 + r^2 - t^2) R + r = 0``).
+
+    >>> lossless = FilmExchange(r_gloss=0.0, r_diffuse=0.5, t_0=0.5)  # r + t = 1 at A = 0
+    >>> round(float(stack_reflectance(0.0, lossless)), 6)  # a thick stack reflects it all
+    1.0
+    >>> film = FilmExchange(r_gloss=0.04, r_diffuse=0.5, t_0=0.4)
+    >>> print(np.round(stack_reflectance([0.0, 0.5, 1.0], film), 4))  # down to r_gloss
+    [0.735  0.3033 0.04  ]
+    """
     r = exchange.r(absorption)
     t = exchange.t(absorption)
     b = 1.0 + r**2 - t**2
@@ -143,20 +153,29 @@ def stack_reflectance(absorption, exchange: FilmExchange) -> np.ndarray:
     return 2.0 * r / (b + disc)
 
 
-def solve_absorption(target, exchange: FilmExchange) -> tuple[np.ndarray, np.ndarray]:
+def solve_absorption(target: ArrayLike, exchange: FilmExchange
+                     ) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
     """``(A, clamped)`` per entry of ``target``: ``R_inf(A) = target`` by bisection on [0, 1]
     (``R_inf`` falls with ``A``).  Targets above ``R_inf(0)`` give ``A = 0``, below
-    ``R_inf(1) = r_gloss`` give ``A = 1``; ``clamped`` marks them."""
-    target = np.asarray(target, dtype=float)
-    low = np.zeros_like(target)
-    high = np.ones_like(target)
+    ``R_inf(1) = r_gloss`` give ``A = 1``; ``clamped`` marks them.
+
+    >>> film = FilmExchange(r_gloss=0.04, r_diffuse=0.5, t_0=0.4)
+    >>> absorption, clamped = solve_absorption([0.3, 0.9, 0.01], film)
+    >>> print(np.round(absorption, 4), clamped)  # 0.9 is out of reach, and 0.01 below the gloss
+    [0.5057 0.     1.    ] [False  True  True]
+    >>> print(np.round(stack_reflectance(absorption, film), 4))
+    [0.3   0.735 0.04 ]
+    """
+    goal = np.asarray(target, dtype=float)
+    low = np.zeros_like(goal)
+    high = np.ones_like(goal)
     for _ in range(BISECTION_STEPS):
         mid = 0.5 * (low + high)
-        above = stack_reflectance(mid, exchange) > target
+        above = stack_reflectance(mid, exchange) > goal
         low = np.where(above, mid, low)
         high = np.where(above, high, mid)
     absorption = 0.5 * (low + high)
-    too_light = target > stack_reflectance(0.0, exchange)
-    too_dark = target < stack_reflectance(1.0, exchange)
+    too_light = goal > stack_reflectance(0.0, exchange)
+    too_dark = goal < stack_reflectance(1.0, exchange)
     absorption = np.where(too_light, 0.0, np.where(too_dark, 1.0, absorption))
     return absorption, too_light | too_dark

@@ -22,6 +22,7 @@ Functions
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 __all__ = [
     "VIEW",
@@ -41,7 +42,7 @@ VIEW = np.array([0.0, 0.0, 1.0])
 """Direction toward the orthographic camera, world frame."""
 
 
-def direction(theta, phi) -> np.ndarray:
+def direction(theta: ArrayLike, phi: ArrayLike) -> NDArray[np.float64]:
     """Unit vectors ``(..., 3)`` for polar angle ``theta`` and azimuth ``phi`` (radians)."""
     theta, phi = np.broadcast_arrays(np.asarray(theta, float), np.asarray(phi, float))
     s = np.sin(theta)
@@ -78,7 +79,8 @@ def light_direction(angle_from_view_deg: float) -> np.ndarray:
     return np.array([np.sin(a), 0.0, np.cos(a)])
 
 
-def sphere_normals(resolution: int, extent: float = 1.0):
+def sphere_normals(resolution: int, extent: float = 1.0
+                   ) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
     """``(normals (n, n, 3), mask (n, n))`` at the pixel centres of a ``resolution`` x
     ``resolution`` image spanning ``extent`` sphere radii either side of the centre (1: the
     sphere's disk exactly).  Rows run top-down (+y first) as images do; ``mask`` marks the
@@ -91,7 +93,7 @@ def sphere_normals(resolution: int, extent: float = 1.0):
     return np.where(mask[..., None], np.stack([x, y, z], axis=-1), 0.0), mask
 
 
-def tangent_frame(normals: np.ndarray):
+def tangent_frame(normals: np.ndarray) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """An orthonormal tangent and bitangent per normal (any: the model is isotropic)."""
     helper = np.where(np.abs(normals[..., 2:3]) < 0.9, [0.0, 0.0, 1.0], [1.0, 0.0, 0.0])
     tangent = np.cross(helper, normals)
@@ -107,7 +109,8 @@ def local_directions(world: np.ndarray, normals: np.ndarray) -> np.ndarray:
     return local / np.linalg.norm(local, axis=-1, keepdims=True)
 
 
-def sphere_directions(resolution: int, light_angle_deg: float):
+def sphere_directions(resolution: int, light_angle_deg: float
+                      ) -> tuple[NDArray[np.bool_], NDArray[np.float64], NDArray[np.float64]]:
     """``(lit (n, n) booleans, wi (P, 3), wo (P, 3))`` of the reference sphere's image under a
     distant light ``light_angle_deg`` (degrees) from the view: the pixels whose centre sees a
     lit point of the sphere, and at those points (row-major order) the local unit directions

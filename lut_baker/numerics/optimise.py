@@ -19,7 +19,10 @@ Functions
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 __all__ = ["golden_minimum", "stencil_minimum", "REFINE_STEPS", "REFINE_PRECISION",
            "brent_minimum", "BRENT_XTOL", "least_squares", "scanned_least_squares"]
@@ -38,7 +41,8 @@ the point after such a step is within ~1e-12 of the interval of the fixed point,
 start."""
 
 
-def stencil_minimum(function, x: float, low: float, high: float, step: float):
+def stencil_minimum(function: Callable[[float], float], x: float, low: float, high: float,
+                    step: float) -> tuple[float, float] | None:
     """``(x, f)``: the point of ``[low, high]`` where ``function(x - step) = function(x +
     step)`` (the minimum of the parabola through three points ``step`` apart, moved until it
     is the middle one), found from a start ``x`` near it; ``f``: ``function`` at the last
@@ -54,7 +58,7 @@ def stencil_minimum(function, x: float, low: float, high: float, step: float):
     if not 0.0 < 2.0 * step < span:
         raise ValueError(f"need 0 < 2 step < high - low, got step {step} on [{low}, {high}]")
 
-    def held(point):  # the stencil's middle for a point: inside [low + step, high - step]
+    def held(point: float) -> float:  # the stencil's middle: inside [low + step, high - step]
         return min(max(point, low + step), high - step)
 
     for _ in range(REFINE_STEPS):
@@ -74,7 +78,8 @@ def stencil_minimum(function, x: float, low: float, high: float, step: float):
     return None
 
 
-def golden_minimum(function, low: float, high: float, *, tol: float = 1e-4,
+def golden_minimum(function: Callable[[float], float], low: float, high: float, *,
+                   tol: float = 1e-4,
                    coarse: int = 9) -> tuple[float, float]:
     """``(x, f(x))`` minimising a 1-D ``function`` on ``[low, high]``: the best of ``coarse``
     evenly spaced samples, golden-section search in the bracket around it down to a few
@@ -90,9 +95,9 @@ def golden_minimum(function, low: float, high: float, *, tol: float = 1e-4,
     sample's)."""
     span = high - low
     step = tol * span
-    known = {}
+    known: dict[float, float] = {}
 
-    def function_once(x):  # the refinement's first middle point is the search's best
+    def function_once(x: float) -> float:  # the refinement's first middle: the search's best
         x = float(x)
         if x not in known:
             known[x] = function(x)
@@ -122,7 +127,8 @@ def golden_minimum(function, low: float, high: float, *, tol: float = 1e-4,
     return float(best[1]), float(best[0])
 
 
-def brent_minimum(function, low: float, high: float, *, xtol: float = BRENT_XTOL,
+def brent_minimum(function: Callable[[float], float], low: float, high: float, *,
+                  xtol: float = BRENT_XTOL,
                   coarse: int = 9, max_steps: int = 200) -> tuple[float, float]:
     """``(x, f(x))`` minimising a 1-D ``function`` on ``[low, high]``: the best of ``coarse``
     evenly spaced samples, then Brent's bounded minimisation (as ``fminbound``: parabolic
@@ -181,8 +187,13 @@ def brent_minimum(function, low: float, high: float, *, xtol: float = BRENT_XTOL
     return float(best[1]), float(best[0])
 
 
-def least_squares(residuals, start, lower, upper, *, xtol: float = 1e-9,
-                  max_steps: int = 100, step: float = 1e-6) -> tuple[np.ndarray, float]:
+Residuals = Callable[[NDArray[np.float64]], ArrayLike]
+"""A least-squares problem: the residuals (1-D) at a parameter vector."""
+
+
+def least_squares(residuals: Residuals, start: ArrayLike, lower: ArrayLike, upper: ArrayLike,
+                  *, xtol: float = 1e-9, max_steps: int = 100,
+                  step: float = 1e-6) -> tuple[NDArray[np.float64], float]:
     """``(x, sum(r^2))`` minimising ``sum(residuals(x)^2)`` over ``lower <= x <= upper``
     from ``start``: Levenberg-Marquardt with a forward-difference Jacobian (steps ``step``
     times ``max(1, |x_j|)``, taken inwards at an upper bound) and steps clipped to the box;
@@ -206,7 +217,7 @@ def least_squares(residuals, start, lower, upper, *, xtol: float = 1e-9,
         scale = np.maximum(np.diag(normal), 1e-300)
         while True:
             delta = np.linalg.solve(normal + damping * np.diag(scale), -gradient)
-            trial = np.clip(x + delta, lower, upper)
+            trial: NDArray[np.float64] = np.clip(x + delta, lower, upper)
             r_trial = np.asarray(residuals(trial), float)
             cost_trial = float(r_trial @ r_trial)
             if cost_trial < cost:
@@ -222,18 +233,20 @@ def least_squares(residuals, start, lower, upper, *, xtol: float = 1e-9,
     return x, cost
 
 
-def scanned_least_squares(residuals, axes, *, xtol: float = 1e-9):
+def scanned_least_squares(residuals: Residuals, axes: list[ArrayLike] | tuple[ArrayLike, ...],
+                          *, xtol: float = 1e-9
+                          ) -> tuple[NDArray[np.float64], float, NDArray[np.float64]]:
     """``(x, sum(r^2), scan)``: :func:`least_squares` over the box the ``axes`` span (one
     increasing array of values per parameter), started from the best point of their grid;
     ``scan`` is the cost at every grid point, shaped like the grid (what a caller checks for a
     second valley near the best one's cost)."""
-    axes = [np.asarray(axis, float) for axis in axes]
-    points = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1)
+    grid = [np.asarray(axis, float) for axis in axes]
+    points = np.stack(np.meshgrid(*grid, indexing="ij"), axis=-1)
     scan = np.empty(points.shape[:-1])
     for index in np.ndindex(scan.shape):
         r = np.asarray(residuals(points[index]), float)
         scan[index] = float(r @ r)
     start = points[np.unravel_index(int(np.argmin(scan)), scan.shape)]
-    x, cost = least_squares(residuals, start, [a[0] for a in axes], [a[-1] for a in axes],
+    x, cost = least_squares(residuals, start, [a[0] for a in grid], [a[-1] for a in grid],
                             xtol=xtol)
     return x, cost, scan

@@ -26,10 +26,12 @@ Functions
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from .geometry import direction
 
@@ -257,7 +259,8 @@ def mirror_alpha_edges(width_deg: float) -> np.ndarray:
     return np.radians(np.array(edges))
 
 
-def mirror_quadrature(theta, width_deg: float, *, alpha_points: int = MIRROR_ALPHA_POINTS,
+def mirror_quadrature(theta: ArrayLike, width_deg: float, *,
+                      alpha_points: int = MIRROR_ALPHA_POINTS,
                       phi_points: int = MIRROR_PHI_POINTS) -> MirrorQuadrature:
     """:class:`MirrorQuadrature` for fixed directions at polar angles ``theta`` (radians) and
     lobes no narrower than ``width_deg`` (degrees, the 1/e half-width in the half vector's
@@ -268,29 +271,30 @@ def mirror_quadrature(theta, width_deg: float, *, alpha_points: int = MIRROR_ALP
     ``tan(psi) = tan(theta) cos(phi)``, so every panel integrates a smooth function (a
     Lambertian integrates to 1 within 1e-8 at 6 x 16 nodes per panel, up to 89 degrees).
     Panels beyond ``alpha_max`` have zero length and zero weight."""
-    theta = np.atleast_1d(np.asarray(theta, float))
+    angles = np.atleast_1d(np.asarray(theta, float))
     edges = mirror_alpha_edges(width_deg)
     x, wx = gauss_legendre(alpha_points)
     phi, wphi = gauss_legendre(phi_points, 0.0, np.pi)
-    sin_t, cos_t = np.sin(theta)[:, None], np.cos(theta)[:, None]
+    sin_t, cos_t = np.sin(angles)[:, None], np.cos(angles)[:, None]
     alpha_max = 0.5 * np.arctan2(sin_t * np.cos(phi), cos_t) + 0.25 * np.pi  # (N, P)
     low = np.minimum(edges[None, :-1, None], alpha_max[:, None, :])  # (N, K, P)
     length = np.minimum(edges[None, 1:, None], alpha_max[:, None, :]) - low
     alpha = (low[:, :, None] + length[:, :, None] * x[None, None, :, None])
-    alpha = alpha.reshape(theta.size, -1, phi.size)
+    alpha = alpha.reshape(angles.size, -1, phi.size)
     d_alpha = (length[:, :, None] * wx[None, None, :, None]).reshape(alpha.shape)
     sin_a, cos_a = np.sin(alpha), np.cos(alpha)
     h = np.stack([sin_a * np.cos(phi), sin_a * np.sin(phi), cos_a], axis=-1)
-    fixed = np.stack([sin_t[:, 0], np.zeros_like(theta), cos_t[:, 0]], axis=-1)
+    fixed = np.stack([sin_t[:, 0], np.zeros_like(angles), cos_t[:, 0]], axis=-1)
     cos_dh = np.clip(np.einsum("nc,napc->nap", fixed, h), 0.0, 1.0)
     other = 2.0 * cos_dh[..., None] * h - fixed[:, None, None, :]
     other[..., 2] = np.maximum(other[..., 2], 0.0)  # rounding at the horizon
     weight = 2.0 * 4.0 * cos_dh * sin_a * d_alpha * wphi
-    return MirrorQuadrature(theta=theta, fixed=fixed, other=other, weight=weight,
+    return MirrorQuadrature(theta=angles, fixed=fixed, other=other, weight=weight,
                             cos_h=cos_a, cos_dh=cos_dh)
 
 
-def order0_integral(matrix0: np.ndarray, grid: HemisphereGrid, weight=None) -> np.ndarray:
+def order0_integral(matrix0: np.ndarray, grid: HemisphereGrid,
+                    weight: NDArray[np.float64] | None = None) -> NDArray[np.float64]:
     """``2 pi sum_u K_0(theta, theta_u) weight_u W_u``: an order-0 kernel ``matrix0``
     ``(P, N, C)`` (cosine coefficients on ``grid``'s polar nodes) integrated over the hemisphere
     (projected solid angle), ``weight`` ``(N, C)`` or None a factor per node: ``(P, C)``."""
@@ -305,19 +309,24 @@ def azimuth_convolution_factor(orders: int) -> np.ndarray:
     return factor
 
 
-def fourier_kernel(kernel, theta_a, theta_b, n_phi: int) -> np.ndarray:
+Kernel = Callable[[NDArray[np.float64], NDArray[np.float64]], NDArray[np.float64]]
+"""An isotropic kernel ``kernel(wa, wb)`` of unit vectors ``(..., 3)``: ``(..., C)``."""
+
+
+def fourier_kernel(kernel: Kernel, theta_a: ArrayLike, theta_b: ArrayLike,
+                   n_phi: int) -> NDArray[np.float64]:
     """Cosine coefficients of an isotropic kernel.
 
     ``kernel(wa, wb)`` takes direction arrays ``(A, B, n_phi, 3)`` with ``wa`` at azimuth 0 and
     ``wb`` at azimuth ``2 pi k / n_phi`` and returns ``(A, B, n_phi, C)``.  Returns ``K_m`` of
     shape ``(n_phi // 2 + 1, A, B, C)`` with ``K(dphi) = sum_m K_m cos(m dphi)``.
     """
-    theta_a = np.atleast_1d(np.asarray(theta_a, float))
-    theta_b = np.atleast_1d(np.asarray(theta_b, float))
+    angles_a = np.atleast_1d(np.asarray(theta_a, float))
+    angles_b = np.atleast_1d(np.asarray(theta_b, float))
     phi = uniform_azimuths(n_phi)
-    wa = direction(theta_a[:, None, None], np.zeros((1, 1, 1)))
-    wb = direction(theta_b[None, :, None], phi[None, None, :])
-    wa = np.broadcast_to(wa, (theta_a.size, theta_b.size, n_phi, 3))
+    wa = direction(angles_a[:, None, None], np.zeros((1, 1, 1)))
+    wb = direction(angles_b[None, :, None], phi[None, None, :])
+    wa = np.broadcast_to(wa, (angles_a.size, angles_b.size, n_phi, 3))
     values = kernel(wa, wb)
     spectrum = np.fft.rfft(values, axis=2).real / n_phi
     spectrum[:, :, 1:] *= 2.0

@@ -61,7 +61,7 @@ WRITE_PROBLEMS = {
 """errno -> what went wrong, in words (``folder``: the nearest existing output folder)."""
 
 
-def _one_line(message: str) -> str:
+def _one_line(message: object) -> str:
     """OpenImageIO's (multi-line) error text as one line."""
     return " ".join(str(message).split())[:400]
 

@@ -42,6 +42,7 @@ Functions and types
 from __future__ import annotations
 
 import json
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -78,7 +79,7 @@ LUMINANCE_WEIGHTS = np.array([0.2126, 0.7152, 0.0722])
 
 LOBE_STDERR_LIMIT = 0.10
 """A channel's lobe counts as determined when the standard error of its roughness ``n`` is at
-most this fraction of ``n`` (the fits' own limit, ``layer_fit.Limits.relative_stderr``)."""
+most this fraction of ``n`` (the fits' own limit, ``fit_results.Limits.relative_stderr``)."""
 
 
 def preset_gloss(layers, finish: str) -> dict:
@@ -96,7 +97,7 @@ def preset_gloss(layers, finish: str) -> dict:
 
 
 def lobe_determined(fit) -> tuple[bool, str]:
-    """``(determined, why)`` for one channel's eq. 2 fit (a ``layer_fit.FitResult``): its lobe
+    """``(determined, why)`` for one channel's eq. 2 fit (a ``fit_results.FitResult``): its lobe
     is determined when the roughness ``n`` was fitted, did not end at its bound and has a
     standard error of at most :data:`LOBE_STDERR_LIMIT` of ``n`` (docs/model.md §4, "Presets
     from measured thick layers": a matte product's fit has no lobe to take)."""
@@ -113,7 +114,7 @@ def lobe_determined(fit) -> tuple[bool, str]:
 
 
 def auto_finish(fits) -> tuple[str, str]:
-    """``(finish, why)`` from the per-channel fits (R, G, B ``layer_fit.FitResult``): ``"dewy"``
+    """``(finish, why)`` from the per-channel fits (R, G, B ``fit_results.FitResult``): ``"dewy"``
     when every channel's lobe is determined (:func:`lobe_determined`), else ``"matte"``.  On the
     four published products this gives their published finishes (103, 108 matte; 105, 112
     dewy)."""
@@ -133,7 +134,7 @@ def derive_preset(name: str, finish: str, layers, exchange: FilmExchange | None 
     absorption) and ``clamped``."""
     _check_layers(layers)
     exchange = exchange or paper_film_exchange()
-    target = np.array([float(bihemispherical(lambda t, layer=layer: reflection_albedo(t, layer)))
+    target = np.array([float(bihemispherical(partial(reflection_albedo, layer=layer)))
                        for layer in layers])
     absorption, clamped = solve_absorption(target, exchange)
     if label is None:

@@ -27,8 +27,10 @@ Drawing functions
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from contextlib import contextmanager
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -57,6 +59,9 @@ from .measured.protocols import (
     transmission_geometry,
     transmission_sweep,
 )
+
+if TYPE_CHECKING:
+    from matplotlib.typing import RcKeyType
 
 __all__ = [
     "DPI",
@@ -101,7 +106,7 @@ CURVE_STEP_DEG = 0.25
 MADE_UP_STEP_DEG = 1.0
 """The same for fig. 14, whose path 3 costs a quadrature per point (and is smooth)."""
 
-_STYLE = {
+_STYLE: dict[RcKeyType, Any] = {
     "font.size": 9,
     "axes.titlesize": 9.5,
     "axes.labelsize": 9,
@@ -230,7 +235,7 @@ def made_up_profile_curves(skin: MadeUpSkin | None = None, angle_deg: float = 30
     d = profile_distances(max_mm, step_mm)
     profile = _red(dipole_profile(d, skin.dipole)) / np.pi
     cosines = np.array([[wi[2]], [wo[2]]])  # (2, 1): broadcasts against a scalar or RGB eta
-    fresnel_t = 1.0 - _red(fresnel_reflectance(cosines, skin.dipole.eta))
+    fresnel_t = 1.0 - _red(fresnel_reflectance(cosines, skin.dipole.eta, check=True))
     t = _red(transmission_factor(np.stack([wi, wo]), film_transmission_layer(skin), skin.dipole))
     bare = profile * fresnel_t[0] * fresnel_t[1]
     made_up = profile * t[0] * t[1]
@@ -458,7 +463,7 @@ def fig16_directional_albedo(foundations=None, skin: str = "paper_bioplate"):
     return figure
 
 
-FIGURES = {
+FIGURES: dict[str, Callable[[], Any]] = {
     "fig05_film_reflection": fig05_film_reflection,
     "fig07_film_transmission": fig07_film_transmission,
     "fig11_skin_reflection": fig11_skin_reflection,

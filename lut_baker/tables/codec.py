@@ -158,7 +158,7 @@ def sidecar_data(tables: Tables, layout: dict, digest: str, image_name: str) -> 
     }
 
 
-def check_sidecar(meta, where: str) -> dict:
+def check_sidecar(meta: object, where: str) -> dict:
     """``meta`` if it is sidecar data of this format version; else :class:`TableFileError`
     naming ``where`` (the sidecar's file)."""
     if not isinstance(meta, dict) or meta.get("format") != FORMAT_NAME:

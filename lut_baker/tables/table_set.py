@@ -72,6 +72,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field, fields
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..model.layers import ReflectionLayer
 from ..model.made_up_skin import combine, coverage_weights
@@ -139,7 +140,7 @@ def _check_spacing(spacing: str, allowed: tuple[str, ...], name: str) -> None:
         raise ValueError(f"{name} must be one of {list(allowed)}, got {spacing!r}")
 
 
-def _grazing(theta_deg, offset: float):
+def _grazing(theta_deg: ArrayLike, offset: float) -> tuple[float, NDArray[np.float64]]:
     """``(q, atanh(q tan(theta / 2)))`` of the ``grazing`` spacing."""
     if not 0.0 < offset < 1.0:
         raise ValueError(f"theta_offset must lie in (0, 1), got {offset!r}")
@@ -166,7 +167,7 @@ def theta_nodes(n: int, spacing: str, theta_max_deg: float,
     return nodes
 
 
-def theta_index(theta_deg, n: int, spacing: str, theta_max_deg: float,
+def theta_index(theta_deg: ArrayLike, n: int, spacing: str, theta_max_deg: float,
                 offset: float = THETA_OFFSET) -> np.ndarray:
     """Fractional index (unclamped) of polar angles ``theta_deg`` on :func:`theta_nodes`."""
     _check_spacing(spacing, THETA_SPACINGS, "theta_spacing")
@@ -181,22 +182,24 @@ def theta_index(theta_deg, n: int, spacing: str, theta_max_deg: float,
     return x / top * (n - 1)
 
 
-def phi_index(wi, wo, n: int, spacing: str = "half_vector") -> np.ndarray:
+def phi_index(wi: ArrayLike, wo: ArrayLike, n: int,
+              spacing: str = "half_vector") -> NDArray[np.float64]:
     """Fractional index of the azimuth coordinate of unit directions ``wi``, ``wo``
     ``(..., 3)`` on ``n`` nodes over [0, 180] (module docstring)."""
     _check_spacing(spacing, PHI_SPACINGS, "phi_spacing")
-    wi, wo = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
+    to_light, to_view = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
     if spacing == "uniform":
-        return folded_azimuth_deg(wi, wo) / 180.0 * (n - 1)
-    theta_i, theta_o = polar_angle_deg(wi), polar_angle_deg(wo)
-    alpha = polar_angle_deg(half_vector(wi, wo))
+        return folded_azimuth_deg(to_light, to_view) / 180.0 * (n - 1)
+    theta_i, theta_o = polar_angle_deg(to_light), polar_angle_deg(to_view)
+    alpha = polar_angle_deg(half_vector(to_light, to_view))
     span = np.minimum(theta_i, theta_o)
     fraction = (0.5 * (theta_i + theta_o) - alpha) / np.where(span > 1e-9, span, 1.0)
-    return np.where(span > 1e-9, np.clip(fraction, 0.0, 1.0), 0.0) * (n - 1)
+    share: NDArray[np.float64] = np.where(span > 1e-9, np.clip(fraction, 0.0, 1.0), 0.0)
+    return share * (n - 1)
 
 
-def node_cos_azimuths(theta_i_deg, theta_o_deg, phi_deg,
-                      spacing: str = "half_vector") -> np.ndarray:
+def node_cos_azimuths(theta_i_deg: ArrayLike, theta_o_deg: ArrayLike, phi_deg: ArrayLike,
+                      spacing: str = "half_vector") -> NDArray[np.float64]:
     """Cosine of the relative azimuth of angular nodes at polar angles ``theta_i_deg``,
     ``theta_o_deg`` (broadcasting, e.g. ``(I, 1)`` and ``(1, O)`` or paired ``(P,)``) and
     azimuth coordinates ``phi_deg`` ``(n_phi,)``: shape ``broadcast + (n_phi,)``; the inverse
@@ -225,7 +228,8 @@ def radius_nodes(n: int, spacing: str, radius_max_mm: float) -> np.ndarray:
     return radius_max_mm * (s * s if spacing == "quadratic" else s)
 
 
-def radius_index(d_mm, n: int, spacing: str, radius_max_mm: float) -> np.ndarray:
+def radius_index(d_mm: ArrayLike, n: int, spacing: str,
+                 radius_max_mm: float) -> NDArray[np.float64]:
     """Fractional index (unclamped) of distances ``d_mm`` on :func:`radius_nodes`."""
     _check_spacing(spacing, RADIUS_SPACINGS, "radius_spacing")
     s = np.asarray(d_mm, float) / radius_max_mm
@@ -295,9 +299,10 @@ class Tables:
     radius_spacing: str = "quadratic"
     theta_offset: float = THETA_OFFSET
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         n_theta, n_phi, n_radius = self.theta_deg.size, self.phi_deg.size, self.radius_mm.size
-        expected = {name: (n_theta, n_theta, n_phi, 3) for name in ANGULAR}
+        expected: dict[str, tuple[int, ...]] = {name: (n_theta, n_theta, n_phi, 3)
+                                                for name in ANGULAR}
         expected.update({name: (n_theta, 3) for name in DIRECTIONAL})
         expected.update({name: (3,) for name in CONSTANT})
         expected.update({name: (n_radius, 3) for name in RADIAL})
@@ -348,7 +353,8 @@ class Tables:
         except TypeError as error:
             raise ValueError(f"tables' {SURFACE_GLOSS[name]!r} parameters: {error}") from None
 
-    def surface_gloss(self, name: str, wi, wo) -> np.ndarray:
+    def surface_gloss(self, name: str, wi: NDArray[np.float64],
+                      wo: NDArray[np.float64]) -> NDArray[np.float64]:
         """Surface gloss ``name`` (:data:`SURFACE_GLOSS`, 1/sr) at unit directions ``(..., 3)``
         in closed form (eq. 2's specular term), ``(..., 3)``; 0 below the surface."""
         value = ts_reflection(wi, wo, self.surface_layer(name), check=False)
@@ -365,17 +371,18 @@ class Tables:
     # ----------------------------------------------------------------------------------------
     # Lookups (the linear interpolation a shader does)
     # ----------------------------------------------------------------------------------------
-    def theta_index(self, theta_deg) -> np.ndarray:
+    def theta_index(self, theta_deg: ArrayLike) -> NDArray[np.float64]:
         """Fractional table index of polar angles (degrees), unclamped."""
         return theta_index(theta_deg, self.theta_deg.size, self.theta_spacing,
                            float(self.theta_deg[-1]), self.theta_offset)
 
-    def radius_index(self, d_mm) -> np.ndarray:
+    def radius_index(self, d_mm: ArrayLike) -> NDArray[np.float64]:
         """Fractional table index of distances (mm), unclamped."""
         return radius_index(d_mm, self.radius_mm.size, self.radius_spacing,
                             float(self.radius_mm[-1]))
 
-    def node_azimuths(self, theta_index=None, phi_index=None) -> np.ndarray:
+    def node_azimuths(self, theta_index: NDArray[np.intp] | None = None,
+                      phi_index: NDArray[np.intp] | None = None) -> NDArray[np.float64]:
         """Relative azimuth (degrees) of every angular node, ``(n_theta, n_theta, n_phi)``, or
         of the sub-grid of polar nodes ``theta_index`` and azimuth nodes ``phi_index``."""
         theta = self.theta_deg if theta_index is None else self.theta_deg[theta_index]
@@ -383,7 +390,9 @@ class Tables:
         return np.degrees(np.arccos(node_cos_azimuths(
             theta[:, None], theta[None, :], phi, self.phi_spacing)))
 
-    def node_directions(self, theta_index=None, phi_index=None):
+    def node_directions(self, theta_index: NDArray[np.intp] | None = None,
+                        phi_index: NDArray[np.intp] | None = None
+                        ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """``(wi, wo)`` unit vectors ``(n_theta, n_theta, n_phi, 3)`` of the angular nodes (or
         of the sub-grid ``theta_index``, ``phi_index``): ``wo`` at azimuth 0, ``wi`` at the
         node's relative azimuth (:meth:`node_azimuths`)."""
@@ -394,35 +403,39 @@ class Tables:
         wo = direction(np.broadcast_to(theta[None, :, None], phi.shape), 0.0)
         return wi, wo
 
-    def angular(self, name: str, wi, wo) -> np.ndarray:
+    def angular(self, name: str, wi: ArrayLike, wo: ArrayLike) -> NDArray[np.float64]:
         """Angular part ``name`` at unit directions ``(..., 3)``, shape ``(..., 3)``: a
         table interpolated trilinearly, or a surface gloss in closed form
         (:data:`SURFACE_GLOSS`)."""
-        wi, wo = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
+        to_light, to_view = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
         if name in SURFACE_GLOSS:
-            return self.surface_gloss(name, wi, wo)
-        return _trilinear(np.asarray(getattr(self, name)), self.theta_index(polar_angle_deg(wi)),
-                          self.theta_index(polar_angle_deg(wo)),
-                          phi_index(wi, wo, self.phi_deg.size, self.phi_spacing))
+            return self.surface_gloss(name, to_light, to_view)
+        return _trilinear(np.asarray(getattr(self, name)),
+                          self.theta_index(polar_angle_deg(to_light)),
+                          self.theta_index(polar_angle_deg(to_view)),
+                          phi_index(to_light, to_view, self.phi_deg.size, self.phi_spacing))
 
-    def directional(self, name: str, theta_deg) -> np.ndarray:
+    def directional(self, name: str, theta_deg: ArrayLike) -> NDArray[np.float64]:
         """Directional table ``name`` interpolated at polar angles (degrees); ``(..., 3)``."""
         return _linear(np.asarray(getattr(self, name)), self.theta_index(theta_deg))
 
-    def radial(self, d_mm) -> np.ndarray:
+    def radial(self, d_mm: ArrayLike) -> NDArray[np.float64]:
         """The normalised profile ``R(d) / Rd`` (1/mm^2) at distances (mm); 0 beyond the grid."""
         d = np.asarray(d_mm, float)
         value = _linear(np.asarray(self.profile), self.radius_index(d))
         return np.where((d <= self.radius_mm[-1])[..., None], value, 0.0)
 
-    def coverage_and_absorption(self, coverage=None, absorption=None) -> tuple[float, np.ndarray]:
+    def coverage_and_absorption(self, coverage: float | None = None,
+                                absorption: ArrayLike | None = None
+                                ) -> tuple[float, NDArray[np.float64]]:
         """``(coverage, absorption (3,))``: the given ones, or where None those the tables were
         baked for (``parameters``)."""
         w = self.parameters.get("coverage", 1.0) if coverage is None else coverage
         a = self.parameters.get("absorption", 0.0) if absorption is None else absorption
         return float(w), np.broadcast_to(np.asarray(a, float), (3,))
 
-    def _combine(self, parts: dict, t_i, t_o, coverage, absorption) -> np.ndarray:
+    def _combine(self, parts: dict, t_i: NDArray[np.float64], t_o: NDArray[np.float64],
+                 coverage: float | None, absorption: ArrayLike | None) -> NDArray[np.float64]:
         """The module docstring's formula from angular ``parts`` (by table name) and the film
         transmittances ``t_i``, ``t_o``; the inter-reflection part, baked at one absorption,
         is scaled by ``((1 - A) / (1 - A_baked))^2``."""
@@ -440,22 +453,24 @@ class Tables:
         """The tabulated angular parts."""
         return ANGULAR + (("inter_reflection",) if self.inter_reflection is not None else ())
 
-    def made_up_reflection(self, wi, wo, coverage=None, absorption=None) -> np.ndarray:
+    def made_up_reflection(self, wi: ArrayLike, wo: ArrayLike, coverage: float | None = None,
+                           absorption: ArrayLike | None = None) -> NDArray[np.float64]:
         """Made-up skin BRDF (1/sr, ``(..., 3)``) interpolated from the tables: the module
         docstring's formula, plus the inter-reflection table if baked (exact at the baked
         absorption only).  ``coverage``, ``absorption`` default to the baked ones; 0 where
         ``wi`` or ``wo`` is below the surface."""
-        wi, wo = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
-        parts = {name: self.angular(name, wi, wo)
+        to_light, to_view = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
+        parts = {name: self.angular(name, to_light, to_view)
                  for name in self._angular_names() + tuple(SURFACE_GLOSS)}
-        t_i = self.directional("film_transmittance", polar_angle_deg(wi))
-        t_o = self.directional("film_transmittance", polar_angle_deg(wo))
+        t_i = self.directional("film_transmittance", polar_angle_deg(to_light))
+        t_o = self.directional("film_transmittance", polar_angle_deg(to_view))
         value = self._combine(parts, t_i, t_o, coverage, absorption)
-        upper = (wi[..., 2] >= 0.0) & (wo[..., 2] >= 0.0)
+        upper = (to_light[..., 2] >= 0.0) & (to_view[..., 2] >= 0.0)
         return np.where(upper[..., None], value, 0.0)
 
-    def node_values(self, coverage=None, absorption=None, theta_index=None,
-                    phi_index=None) -> np.ndarray:
+    def node_values(self, coverage: float | None = None, absorption: ArrayLike | None = None,
+                    theta_index: NDArray[np.intp] | None = None,
+                    phi_index: NDArray[np.intp] | None = None) -> NDArray[np.float64]:
         """:meth:`made_up_reflection` at the angular nodes, ``(n_theta, n_theta, n_phi, 3)``
         (no interpolation: the directions of :meth:`node_azimuths`), or on the sub-grid
         ``theta_index``, ``phi_index`` (integer arrays)."""
@@ -470,7 +485,8 @@ class Tables:
         t = np.asarray(self.film_transmittance)[it]
         return self._combine(parts, t[:, None, None], t[None, :, None], coverage, absorption)
 
-    def directional_albedo(self, theta_deg, coverage=None, absorption=None) -> np.ndarray:
+    def directional_albedo(self, theta_deg: ArrayLike, coverage: float | None = None,
+                           absorption: ArrayLike | None = None) -> NDArray[np.float64]:
         """``Int f(wi, wo) cos(theta_o) dwo`` (paths 1 + 3, no inter-reflection) at incidence
         ``theta_deg`` (degrees) from the albedo tables; shape ``(..., 3)``."""
         weights = coverage_weights(*self.coverage_and_absorption(coverage, absorption))

@@ -37,9 +37,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..model.albedo import bihemispherical
 from ..model.made_up_skin import combine, coverage_weights
+from .table_set import Tables
 
 __all__ = [
     "UniformLight",
@@ -66,10 +68,10 @@ class UniformLight:
     skin_gloss: np.ndarray
 
 
-def uniform_light(tables) -> UniformLight:
+def uniform_light(tables: Tables) -> UniformLight:
     """The :class:`UniformLight` parts of baked ``tables`` (their 1-D albedo and transmittance
     tables averaged over incidence, :func:`lut_baker.model.albedo.bihemispherical`)."""
-    def average(name):
+    def average(name: str) -> NDArray[np.float64]:
         return bihemispherical(lambda theta: tables.directional(name, theta))
 
     return UniformLight(
@@ -82,7 +84,8 @@ def uniform_light(tables) -> UniformLight:
     )
 
 
-def _parts(light: UniformLight, skin_albedo, gloss: float) -> dict:
+def _parts(light: UniformLight, skin_albedo: ArrayLike,
+           gloss: float) -> dict[str, NDArray[np.float64]]:
     """The mixing rule's parts for skin albedo ``skin_albedo`` (RGB) and gloss factor ``gloss``."""
     a = np.broadcast_to(np.asarray(skin_albedo, float), (3,))
     return {"top": gloss * light.film_gloss, "once": light.film_diffuse,
@@ -90,42 +93,68 @@ def _parts(light: UniformLight, skin_albedo, gloss: float) -> dict:
             "bare": gloss * light.skin_gloss + a}
 
 
-def made_up_colour(light: UniformLight, coverage: float, absorption, skin_albedo,
-                   gloss: float = 1.0) -> np.ndarray:
+def made_up_colour(light: UniformLight, coverage: float, absorption: ArrayLike,
+                   skin_albedo: ArrayLike, gloss: float = 1.0) -> NDArray[np.float64]:
     """The made-up skin's colour (linear RGB, ``(3,)``) under uniform white light at
     ``coverage`` and ``absorption``, on skin of diffuse albedo ``skin_albedo``, gloss lobes
-    times ``gloss`` (the node group's Gloss)."""
+    times ``gloss`` (the node group's Gloss).
+
+    >>> light = UniformLight(film_gloss=np.full(3, 0.03), film_diffuse=np.full(3, 0.5),
+    ...                      path3_gloss=np.full(3, 0.01), through_film=np.full(3, 0.3),
+    ...                      skin_gloss=np.full(3, 0.04))
+    >>> skin = [0.6, 0.4, 0.3]
+    >>> print(np.round(made_up_colour(light, 0.0, 0.0, skin), 4))  # bare: gloss + albedo
+    [0.64 0.44 0.34]
+    >>> print(np.round(made_up_colour(light, 1.0, [0.2, 0.4, 0.6], skin), 4))
+    [0.5516 0.3768 0.246 ]
+    >>> print(np.round(made_up_colour(light, 0.5, [0.2, 0.4, 0.6], skin), 4))  # half of each
+    [0.5958 0.4084 0.293 ]
+    """
     weights = coverage_weights(coverage, np.broadcast_to(np.asarray(absorption, float), (3,)))
     return combine(weights, **_parts(light, skin_albedo, gloss))
 
 
-def covered_colour(light: UniformLight, absorption, skin_albedo,
-                   gloss: float = 1.0) -> np.ndarray:
+def covered_colour(light: UniformLight, absorption: ArrayLike, skin_albedo: ArrayLike,
+                   gloss: float = 1.0) -> NDArray[np.float64]:
     """:func:`made_up_colour` at full coverage: the film over the skin."""
     return made_up_colour(light, 1.0, absorption, skin_albedo, gloss)
 
 
-def bare_colour(light: UniformLight, skin_albedo, gloss: float = 1.0) -> np.ndarray:
+def bare_colour(light: UniformLight, skin_albedo: ArrayLike,
+                gloss: float = 1.0) -> NDArray[np.float64]:
     """:func:`made_up_colour` at coverage 0: the skin's own colour (its gloss and diffuse
     albedo)."""
     return made_up_colour(light, 0.0, 0.0, skin_albedo, gloss)
 
 
-def matching_absorption(light: UniformLight, target, skin_albedo,
-                        gloss: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+def matching_absorption(light: UniformLight, target: ArrayLike, skin_albedo: ArrayLike,
+                        gloss: float = 1.0) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
     """``(A, clamped)`` per channel: the absorption whose covered colour
     (:func:`covered_colour`) is ``target`` (linear RGB).  With ``x = 1 - A`` the covered colour
     is ``top + once x + twice x^2``, increasing in ``x`` on [0, 1], so ``x`` is the quadratic's
     root there; a target above the covered colour at ``A = 0`` gets ``A = 0``, one below it at
-    ``A = 1`` (the film's gloss alone) gets ``A = 1``, and ``clamped`` marks them."""
+    ``A = 1`` (the film's gloss alone) gets ``A = 1``, and ``clamped`` marks them.
+
+    >>> light = UniformLight(film_gloss=np.full(3, 0.03), film_diffuse=np.full(3, 0.5),
+    ...                      path3_gloss=np.full(3, 0.01), through_film=np.full(3, 0.3),
+    ...                      skin_gloss=np.full(3, 0.04))
+    >>> skin = [0.6, 0.4, 0.3]
+    >>> colour = covered_colour(light, [0.2, 0.4, 0.6], skin)
+    >>> absorption, clamped = matching_absorption(light, colour, skin)
+    >>> print(np.round(absorption, 6), clamped)
+    [0.2 0.4 0.6] [False False False]
+    >>> absorption, clamped = matching_absorption(light, [0.9, 0.3, 0.01], skin)
+    >>> print(np.round(absorption, 4), clamped)  # red out of reach, blue below the gloss
+    [0.     0.5199 1.    ] [ True False  True]
+    """
     parts = _parts(light, skin_albedo, gloss)
     top, once, twice = parts["top"], parts["once"], parts["twice"]
-    target = np.broadcast_to(np.asarray(target, float), (3,))
-    rise = np.maximum(target - top, 0.0)
+    goal = np.broadcast_to(np.asarray(target, float), (3,))
+    rise = np.maximum(goal - top, 0.0)
     # x = (-once + sqrt(once^2 + 4 twice rise)) / (2 twice), written without cancellation.
     denominator = once + np.sqrt(once**2 + 4.0 * twice * rise)
     x = np.divide(2.0 * rise, denominator, out=np.zeros(3), where=denominator > 0.0)
-    too_light = target > top + once + twice
-    too_dark = target < top
+    too_light = goal > top + once + twice
+    too_dark = goal < top
     absorption = np.where(too_light, 0.0, np.where(too_dark, 1.0, np.clip(1.0 - x, 0.0, 1.0)))
     return absorption, too_light | too_dark

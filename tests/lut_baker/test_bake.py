@@ -102,7 +102,8 @@ def test_tabulated_fresnel_is_checked_and_falls_back_near_eta_1():
     c = np.random.default_rng(2).uniform(0.0, 1.0, (5000, 1))
     for eta in (1.19, 1.26, 1.0001, 0.8):
         np.testing.assert_allclose(bake.fresnel_interpolated(c, eta),
-                                   microfacet.fresnel_term(c, eta), rtol=bake.FRESNEL_TOLERANCE)
+                                   microfacet.fresnel_reflectance(c, eta),
+                                   rtol=bake.FRESNEL_TOLERANCE)
 
 
 @pytest.mark.parametrize("width_deg", [30.4, 10.0, 5.0, 1.0])

@@ -9,7 +9,9 @@ from lut_baker.model import presets
 
 
 @pytest.fixture
-def record():
+def record(bpy_factory):
+    """A bake record: ``storage`` imports bpy, which only the fixture may import first (and
+    the fixture marks the tests ``bpy``, so that ``-m "not bpy"`` leaves them out)."""
     from makeup_skin_addon import storage
 
     return storage.bake_record(presets.made_up_skin("light_ivory", "jensen_skin1"), "preview")

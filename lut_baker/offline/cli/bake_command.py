@@ -95,7 +95,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
     from ...bake import RESOLUTIONS
     from ...model.presets import FOUNDATIONS, SKINS
 
-    parser.error = types.MethodType(_one_line_error, parser)
+    parser.error = types.MethodType(_one_line_error, parser)  # type: ignore[method-assign]
     parser.add_argument("--preset", choices=PRESETS, default="paper",
                         help="base parameters: the paper's film ('natural' liquid foundation) "
                              "on its skin substitute, in albedo units (1/sr) normalised by K "

@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import json
 import sys
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -40,6 +41,7 @@ import numpy as np
 from ...model.layers import Dipole, ReflectionLayer
 from ...model.presets import paper_layers
 from ..atomic_files import write_text
+from ..measured.fit_results import FitResult
 from ..measured.layer_fit import D_MIN_MM, fit_dipole, fit_reflection, fit_transmission
 from ..measured.measurements import (
     MAX_NOISE,
@@ -60,7 +62,8 @@ HELP = ("fit reflection/transmission/dipole layers to CSV measurements, synthesi
 STRICT_EXIT = 3
 """Exit code of a fit that warned when ``--strict`` is given."""
 
-_FITS = {
+_FITS: dict[str, tuple[type[ReflectionData] | type[TransmissionData] | type[ProfileData],
+                       Callable[..., FitResult]]] = {
     "reflection": (ReflectionData, fit_reflection),
     "transmission": (TransmissionData, fit_transmission),
     "dipole": (ProfileData, fit_dipole),
@@ -235,7 +238,7 @@ def _check_options(options: dict) -> None:
 
 
 def result_document(result) -> dict:
-    """The output block of a :class:`~lut_baker.offline.measured.layer_fit.FitResult` as
+    """The output block of a :class:`~lut_baker.offline.measured.fit_results.FitResult` as
     nested plain data."""
     data = result.as_dict()
     return {

@@ -2,6 +2,7 @@
 
     python -m lut_baker foundations [--out docs/foundations] [--data data/lanza2024]
                                     [--presets lut_baker/model/measured_foundations.json]
+                                    [--notes docs/foundations/notes.md]
 
 Reads the in-plane spectral measurements of four foundations (Lanza et al. 2024,
 data/lanza2024/README.md), converts them to linear Rec.709 reflectance factors, fits
@@ -10,7 +11,9 @@ with the sample's tilt, in the form whose every parameter the data determine, an
 product ``<product>.csv`` and ``<product>.png`` and one ``README.md`` report to the output
 folder, and derives from the fits the thin-film foundation presets (docs/model.md §4, "Presets
 from measured thick layers") into the runtime's preset file, which
-:mod:`lut_baker.model.presets` reads.  Needs scipy, matplotlib and colour-science.
+:mod:`lut_baker.model.presets` reads.  The report's written notes come from a Markdown file
+(:func:`lut_baker.offline.foundations.read_notes`; default ``notes.md`` in the output folder,
+when there is one).  Needs scipy, matplotlib and colour-science.
 """
 
 from __future__ import annotations
@@ -35,6 +38,9 @@ def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--presets", type=Path, default=None, metavar="FILE",
                         help="JSON file for the derived foundation presets (default: the "
                              "runtime's, lut_baker/model/measured_foundations.json)")
+    parser.add_argument("--notes", type=Path, default=None, metavar="FILE",
+                        help="Markdown file of the notes written below the report's tables "
+                             "(default: notes.md in the --out folder, if it is there)")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -46,13 +52,15 @@ def run(args: argparse.Namespace) -> int:
         except ModuleNotFoundError as error:
             raise ValueError(f"the foundations command needs {package}: "
                              f"pip install {package}") from error
-    from ..foundations import write_all
+    from ..foundations import read_notes, write_all
 
     if not args.data.is_dir():
         raise ValueError(f"--data {args.data} is not a folder")
     from ..foundation_presets import PRESET_FILE
 
     presets = PRESET_FILE if args.presets is None else args.presets
-    for path in write_all(args.data, args.out, presets_path=presets):
+    notes_file = args.out / "notes.md" if args.notes is None else args.notes
+    notes = read_notes(notes_file) if args.notes is not None or notes_file.is_file() else None
+    for path in write_all(args.data, args.out, presets_path=presets, notes=notes):
         print(path)
     return 0

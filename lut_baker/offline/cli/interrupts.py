@@ -25,6 +25,7 @@ import contextlib
 import signal
 import sys
 import threading
+from typing import Any
 
 __all__ = ["Interrupted", "SIGNALS", "RETRY_S", "signals_interrupt", "take_signals",
            "release_signals", "ignore_signals", "raise_held", "report"]
@@ -124,7 +125,7 @@ def signals_interrupt():
     ignored until the block is left, so that clean-up is not cut short.  Signals the process
     was started to ignore stay ignored; outside the main thread nothing changes; inside an
     enclosing block (or after :func:`take_signals`) the enclosing handling goes on."""
-    replaced = {}
+    replaced: dict[int, Any] = {}  # signal number -> the handler it had
     try:
         _take(replaced)
         yield

@@ -93,7 +93,7 @@ def read_inplane(path) -> InPlaneData:
                   for column, cell in enumerate(cells, start=1)]
         _check_row(values, path, line)
         rows.append(values)
-    if not rows:
+    if not rows or width is None:  # (set together)
         raise ValueError(f"{path}: no data rows")
     table = np.array(rows, dtype=float)
     return InPlaneData(table[:, 0], table[:, 1], table[:, 2:], _LAYOUTS[width])

@@ -74,7 +74,9 @@ import numpy as np
 
 from ...model.layers import ReflectionLayer
 from ...model.presets import paper
-from .layer_fit import TILT, FitResult, JointFit, fit_reflection_sets
+from .fit_results import FitResult, JointFit
+from .fit_solver import TILT
+from .layer_fit import fit_reflection_sets
 from .measurements import ReflectionData, reflection_counts
 from .spectra import luminance
 
@@ -173,7 +175,7 @@ class ChannelFits:
     (``fit_model``), the incidences fitted (``fitted_deg``) and the rows' ``model`` factors
     ``(N, 3)`` (the tilt included)."""
 
-    fits: tuple[FitResult, FitResult, FitResult]
+    fits: tuple[FitResult[ReflectionLayer], ...]
     fitted_deg: tuple[float, ...]
     theta_i_deg: np.ndarray
     theta_o_deg: np.ndarray
@@ -300,6 +302,8 @@ def _worst(fits: ChannelFits, names) -> tuple[float, str, bool]:
 
 
 def _check_tilt(fits: ChannelFits) -> Decision:
+    if fits.tilt is None:  # (checked only when the tilt is fitted)
+        raise ValueError("the tilt was not fitted")
     value, stderr = fits.tilt
     if fits.joint.at_bound(TILT):
         return Decision("tilt", False, f"the tilt ran to its bound ({value:+.3g} degrees)",

@@ -98,8 +98,23 @@ def _groups(key: np.ndarray):
         yield key[first[group]], np.flatnonzero(inverse == group)
 
 
+class _ReflectionDirections:
+    """The unit vectors ``(N, 3)`` a :class:`ReflectionData` sets from its columns (not
+    fields: no column of the file)."""
+
+    wi: np.ndarray
+    wo: np.ndarray
+
+
+class _TransmissionDirections:
+    """The unit vectors ``(N, 3)`` a :class:`TransmissionData` sets from its columns."""
+
+    wi: np.ndarray
+    wt: np.ndarray
+
+
 @dataclass(frozen=True, eq=False)
-class ReflectionData:
+class ReflectionData(_ReflectionDirections):
     """Reflection samples (docs/model.md §6): light-camera angle ``psi_deg``, signed ``alpha_deg``
     (degrees) and ``intensity_counts`` per sample.  ``wi``/``wo`` are the directions."""
 
@@ -119,7 +134,7 @@ class ReflectionData:
 
 
 @dataclass(frozen=True, eq=False)
-class TransmissionData:
+class TransmissionData(_TransmissionDirections):
     """Transmission samples (docs/model.md §6): ``incidence_deg``, signed ``theta_t_deg`` (degrees
     from -z) and ``intensity_counts`` per sample.  ``wi``/``wt`` are the directions."""
 
@@ -216,17 +231,18 @@ class ReflectionCounts:
 
     def __init__(self, data: ReflectionData):
         self._wi, self._wo = data.wi, data.wo
-        self._tilt = None
-        self._cosines = None
+        self._tilt: float | None = None
+        self._cosines: tuple[np.ndarray, ...] | None = None
 
     def __call__(self, layer, tilt_deg: float = 0.0) -> np.ndarray:
         tilt = float(tilt_deg)
-        if tilt != self._tilt:
+        cosines = self._cosines
+        if cosines is None or tilt != self._tilt:
             wi, wo = (self._wi, self._wo) if tilt == 0.0 else (tilted(self._wi, tilt),
                                                                  tilted(self._wo, tilt))
-            self._cosines = reflection_cosines(wi, wo)
+            cosines = self._cosines = reflection_cosines(wi, wo)
             self._tilt = tilt
-        n_dot_h, v_dot_h, n_dot_v, n_dot_l = (channel_axis(c, layer) for c in self._cosines)
+        n_dot_h, v_dot_h, n_dot_v, n_dot_l = (channel_axis(c, layer) for c in cosines)
         value = ts_reflection_from_cosines(n_dot_h, v_dot_h, n_dot_v, n_dot_l, layer)
         nominal = channel_axis(self._wi[:, 2], layer)
         return np.where((n_dot_l >= 0.0) & (n_dot_v >= 0.0), value * nominal, 0.0)
@@ -316,7 +332,7 @@ def _kind_of(header: list[str], path: Path):
             return kind
         if len(absent) < len(wanted) and (missing is None or len(absent) < len(missing)):
             best, missing = kind, absent
-    if best is None:
+    if best is None or missing is None:  # (set together)
         expected = "; ".join(",".join(kind.COLUMNS) for kind in _KINDS)
         raise ValueError(f"{path}: unknown columns {','.join(header)!r}; expected one of: "
                          f"{expected}")

@@ -58,8 +58,8 @@ def step_angles(limit_deg: float) -> np.ndarray:
             positive.append(round(positive[-1] + step, 6))
         if positive[-1] + STEP_RULE[-1][1] > limit_deg and bound >= limit_deg:
             break
-    positive = np.array(positive)
-    return np.concatenate([-positive[:0:-1], positive])
+    nodes = np.array(positive)
+    return np.concatenate([-nodes[:0:-1], nodes])
 
 
 def in_plane_direction(angle_deg) -> np.ndarray:

@@ -296,8 +296,9 @@ def check_regime(item: Regime, *, bake_resolution: str = "preview", error_points
     tables, baked = _bake(item, skin, bake_resolution, error_points if affordable else 0)
     points = model_points if affordable or model_points == 0 else min(model_points or 2, 2)
     model = _model(item, skin, points, model_albedo) if points != 0 else None
-    wi, wo, exact = model.pop("_values") if model is not None else (None, None, None)
-    if model is not None and not affordable:  # the bake's error at the pairs afforded
+    values = model.pop("_values") if model is not None else None
+    if values is not None and not affordable:  # the bake's error at the pairs afforded
+        wi, wo, exact = values
         peak = tables.node_values().reshape(-1, 3).max(axis=0)
         error = np.abs(tables.made_up_reflection(wi, wo) - exact) / np.maximum(
             np.abs(exact), 0.1 * peak)

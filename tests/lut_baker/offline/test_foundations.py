@@ -102,3 +102,24 @@ def test_unknown_products_and_missing_files_are_one_line(tmp_path):
         FD.analyse("x", DATA)
     with pytest.raises(ValueError, match="no such file"):
         FD.analyse("clarins_103", tmp_path)
+
+
+def test_the_notes_page_has_a_section_per_product_and_its_lines_join(tmp_path):
+    """docs/foundations/notes.md holds the prose (not the code): one section per product, the
+    presets' and the conclusion; a paragraph's lines join with single spaces."""
+    notes = FD.read_notes(Path(__file__).parents[3] / "docs" / "foundations" / "notes.md")
+    assert set(notes) == set(FD.PRODUCTS) | set(FD.NOTE_SECTIONS)
+    assert all(text and "\n\n\n" not in text for text in notes.values())
+    page = tmp_path / "notes.md"
+    page.write_text("# Notes\n\nignored preamble\n\n## clarins_105\n\nOne\nparagraph.\n\n"
+                    "Two.\n\n## conclusion\nEnd.\n")
+    assert FD.read_notes(page) == {"clarins_105": "One paragraph.\n\nTwo.", "conclusion": "End."}
+
+
+def test_a_note_for_no_section_or_no_file_is_an_error(tmp_path):
+    page = tmp_path / "notes.md"
+    page.write_text("## clarins_999\n\nA typo.\n")
+    with pytest.raises(ValueError, match="'clarins_999' is neither a product"):
+        FD.read_notes(page)
+    with pytest.raises(ValueError, match="notes '.*absent.md'"):
+        FD.read_notes(tmp_path / "absent.md")

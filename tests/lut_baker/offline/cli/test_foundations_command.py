@@ -58,3 +58,13 @@ def test_a_missing_data_folder_exits_2_with_one_line(tmp_path, capsys):
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "is not a folder" in err
     assert not (tmp_path / "o").exists()
+
+
+def test_notes_asked_for_but_missing_exit_2_with_one_line(tmp_path, capsys):
+    with pytest.raises(SystemExit) as info:
+        main(["foundations", "--out", str(tmp_path / "o"), "--data", str(DATA),
+              "--notes", str(tmp_path / "absent.md")])
+    assert info.value.code == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "absent.md" in err
+    assert not (tmp_path / "o").exists()

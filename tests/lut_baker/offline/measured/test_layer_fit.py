@@ -14,6 +14,7 @@ import pytest
 
 from lut_baker.model.layers import Dipole, TransmissionLayer
 from lut_baker.model.presets import paper_layers
+from lut_baker.offline.measured import fit_results, fit_solver, fit_starts
 from lut_baker.offline.measured import layer_fit as F
 from lut_baker.offline.measured import measurements as M
 
@@ -139,8 +140,9 @@ def test_transmission_flags_eta(round_trips):
         assert any(w.startswith("another minimum") for w in result.warnings)
         assert result.starts.reached < result.starts.count
         assert result.relative_stderr["eta"] > 0.10
-    counts = {"film reflection": len(F.ETA_STARTS) + 1, "skin reflection": len(F.ETA_STARTS) + 1,
-              "film transmission, eta fixed": F.N_GRID_PARTS + 1, "skin dipole": None}
+    counts = {"film reflection": len(fit_starts.ETA_STARTS) + 1,
+              "skin reflection": len(fit_starts.ETA_STARTS) + 1,
+              "film transmission, eta fixed": fit_starts.N_GRID_PARTS + 1, "skin dipole": None}
     for name, count in counts.items():  # the others: every start ends in the same minimum
         for result, _, _ in round_trips[name]:
             assert result.starts.reached == result.starts.count >= 3, name
@@ -188,7 +190,7 @@ def test_stricter_limits_flag_the_film_reflection_correlation():
     """P_s and eta correlate at -0.98 on the paper's protocol: quiet at the default 0.99."""
     data = M.paper_protocols(NOISE, 0)["film_reflection"]
     assert F.fit_reflection(data).ok
-    strict = F.fit_reflection(data, limits=F.Limits(correlation=0.95))
+    strict = F.fit_reflection(data, limits=fit_results.Limits(correlation=0.95))
     assert any(w.startswith("P_s and eta are degenerate") for w in strict.warnings)
 
 
@@ -288,19 +290,19 @@ def tilted():
 
 def test_a_shared_tilt_is_fitted_with_its_standard_error(tilted):
     joint = tilted[1]
-    tilt, stderr = joint.nuisance[F.TILT]
+    tilt, stderr = joint.nuisance[fit_solver.TILT]
     assert 0.0 < stderr < 0.1 and abs(tilt - 1.2) < 4 * stderr
-    assert joint.labels == ("R", "G", "B") and joint.names[-1] == F.TILT
+    assert joint.labels == ("R", "G", "B") and joint.names[-1] == fit_solver.TILT
     assert joint.names[:4] == ("R.P_d", "R.P_s", "R.n", "R.eta")
-    assert joint.starts.count == len(F.ETA_STARTS) * len(F.TILT_STARTS_DEG)
+    assert joint.starts.count == len(fit_starts.ETA_STARTS) * len(fit_starts.TILT_STARTS_DEG)
     assert joint.starts.reached == joint.starts.count and not joint.warnings
     for fit, truth in zip(joint.fits, CHANNEL_LAYERS, strict=True):
-        assert fit.derived[F.TILT] == (tilt, stderr) and fit.ok
+        assert fit.derived[fit_solver.TILT] == (tilt, stderr) and fit.ok
         errors = F.relative_errors(fit.params, truth)
         assert abs(errors["n"]) < 0.05 and abs(errors["P_s/P_d"]) < 0.10
     # Untilted data, tilt fitted: zero within its error; exact data give the truth.
     exact = F.fit_reflection_sets(_channels(0.0, 0.0, 0), tilt=True)
-    assert abs(exact.nuisance[F.TILT][0]) < 1e-8
+    assert abs(exact.nuisance[fit_solver.TILT][0]) < 1e-8
     for fit, truth in zip(exact.fits, CHANNEL_LAYERS, strict=True):
         assert all(abs(e) < 1e-7 for e in F.relative_errors(fit.params, truth).values())
 
@@ -363,7 +365,7 @@ def test_the_fits_are_determined_by_their_data(name, fit):
 def test_a_joint_tilted_fit_is_determined_by_its_data(tilted):
     data, reference = tilted
     moved = F.fit_reflection_sets([_perturbed(d, seed=s) for s, d in enumerate(data)], tilt=True)
-    assert abs(moved.nuisance[F.TILT][0] - reference.nuisance[F.TILT][0]) < 1e-6
+    assert abs(moved.nuisance[fit_solver.TILT][0] - reference.nuisance[fit_solver.TILT][0]) < 1e-6
     for a, b in zip(reference.fits, moved.fits, strict=True):
         for key, value in _values(a).items():
             assert abs(_values(b)[key] / value - 1.0) < 1e-6, key
