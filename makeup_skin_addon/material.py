@@ -11,6 +11,7 @@ group by name and bakes, fits and hashes nothing; otherwise it bakes and fits on
 - :func:`skin_from_settings` -- the panel's settings as a :class:`MadeUpSkin` (coverage 1,
   absorption 0: those two are socket values, applied after the bake; :mod:`.shade`).
 - :func:`resolve_tier` -- the tier for the settings and scene (Auto: from a measurement).
+- :func:`fitted_tiers` -- the tiers Apply fits: the scene engine's and the settings' own.
 - :func:`engine_note` -- the report's sentence when a tier is not made for the scene's engine.
 - :func:`socket_values` -- the settings' group-node socket values; :func:`update_sockets`
   sets them on a material's group node.
@@ -43,6 +44,7 @@ __all__ = [
     "resolve_tier",
     "engine_note",
     "forced_method",
+    "fitted_tiers",
     "group_for_tables",
     "group_of",
     "apply_to_object",
@@ -68,7 +70,7 @@ def _auto_choice(material, scene, measured) -> tuple[str, dict]:
     """``(tier, record for the panel)`` of the Auto choice for ``material`` in ``scene``."""
     traits = fits.traits(measured) if measured is not None else None
     if traits is None:
-        traits = scene_fit.material_traits(material, may_fit=False)
+        traits = scene_fit.material_traits(material, may_fit=False, scene=scene)
     choice, _ = scene_fit.choose_with(traits, material, scene)
     chosen = choice.chosen
     return chosen.candidate.tier, {"tier": chosen.candidate.tier, "error": chosen.error,
@@ -171,22 +173,44 @@ def _reusable(group, key: str, tier: str, method, messages: list) -> bool:
     return not problems
 
 
+def fitted_tiers(settings, scene, also=()) -> tuple:
+    """The tiers Apply fits for ``settings`` in ``scene``: those made for the scene's engine
+    (:data:`lut_baker.auto_tier.ENGINE_TIERS`, among which Tier Auto chooses), the settings'
+    tier when it is fixed to another, and ``also``; in :data:`lut_baker.closures.tiers.TIERS`
+    order.  A tier asked for later (another tier or engine chosen) is fitted then."""
+    wanted = {*auto_tier.ENGINE_TIERS[scene_fit.render_engine(scene)], *also}
+    if settings.tier in tiers.TIERS:
+        wanted.add(settings.tier)
+    return tuple(tier for tier in tiers.TIERS if tier in wanted)
+
+
 class _Bake:
     """One bake record's tables, fit and measurement, made when first asked for (a group that
-    can be reused needs none of them)."""
+    can be reused needs none of them): the fit of ``tiers``, for a group over the artist's
+    shader if ``over``.  Nothing here touches bpy: a worker thread may make them
+    (:mod:`.live`), and the group is built from them on the main thread."""
 
-    def __init__(self, record: dict, method, coverage: float, absorption, progress=None):
+    def __init__(self, record: dict, method, coverage: float, absorption, progress=None, *,
+                 tiers=tiers.TIERS, over: bool = False):
         self.record, self.method = record, method
         self.coverage, self.absorption = float(coverage), [float(a) for a in absorption]
         self.progress = progress
+        self.tiers, self.over = tuple(tiers), bool(over)
         self._measured: dict | None = None
+        self._fitted: tuple | None = None
 
-    def fitted(self):
-        """``(tables, fit)`` (:func:`.fits.baked`)."""
-        return fits.baked(self.record, method=self.method,
-                          errors_at=(self.coverage, self.absorption),
-                          bake_progress=_stage(self.progress, 0.0, BAKE_SHARE),
-                          fit_progress=_stage(self.progress, BAKE_SHARE, MEASURE_SHARE))
+    def fitted(self, tier: str | None = None):
+        """``(tables, fit)`` (:func:`.fits.baked`), the fit holding :attr:`tiers` (and
+        ``tier``, added to them if need be)."""
+        if tier is not None and tier not in self.tiers:
+            self.tiers = tuple(t for t in tiers.TIERS if t in {*self.tiers, tier})
+        if self._fitted is None or not set(self.tiers) <= set(self._fitted[1].tiers):
+            self._fitted = fits.baked(
+                self.record, method=self.method, tiers=self.tiers, over_shader=self.over,
+                errors_at=(self.coverage, self.absorption),
+                bake_progress=_stage(self.progress, 0.0, BAKE_SHARE),
+                fit_progress=_stage(self.progress, BAKE_SHARE, MEASURE_SHARE))
+        return self._fitted
 
     def adopt(self, measured: dict | None) -> None:
         """Take a measurement a group's record kept at this coverage and absorption."""
@@ -200,7 +224,7 @@ class _Bake:
             tables, fit = self.fitted()
             measured = fits.measure(tables, fit, self.coverage, self.absorption,
                                     self.method or fit.subsurface_method,
-                                    with_traits=with_traits)
+                                    with_traits=with_traits, over_shader=self.over)
             self._measured = measured
             report = _stage(self.progress, MEASURE_SHARE, 1.0)
             if report is not None:
@@ -219,49 +243,50 @@ def _existing(record: dict, tier: str, method, messages: list, over: bool):
     return None
 
 
-def _stored_measurement(work: _Bake, over: bool):
-    """What any group of this bake (either tier) keeps measured at the coverage and
-    absorption, with the Auto tier's traits, or None."""
+def _stored_measurement(work: _Bake):
+    """What any group of this bake (any tier) keeps measured at the coverage and absorption,
+    of the tiers fitted, with the Auto tier's traits, or None."""
     for tier in tiers.TIERS:
         group = bpy.data.node_groups.get(group_name(tier, work.record["key"], work.method,
-                                                    over))
+                                                    work.over))
         if group is not None:
             measured = fits.measured_at(nodes.read_meta(group), work.coverage, work.absorption,
-                                        with_traits=True)
+                                        with_traits=True, tiers=work.tiers)
             if measured is not None:
                 return measured
     return None
 
 
-def _build(work: _Bake, tier: str, group=None, over: bool = False):
+def _build(work: _Bake, tier: str, group=None):
     """The group of ``tier`` built from the bake (rebuilt in place when ``group`` is given),
-    its record keeping the measurement; ``over``: over the artist's shader."""
-    _, fit = work.fitted()
+    its record keeping the measurement; over the artist's shader if ``work.over``."""
+    _, fit = work.fitted(tier)
     return nodes.build_group(tier, work.record, fit, group, method=work.method,
-                             measured=work.measured(), over=over)
+                             measured=work.measured(), over=work.over)
 
 
-def _group_for(material, settings, scene, work: _Bake, messages: list, group=None,
-               over: bool = False):
+def _group_for(material, settings, scene, work: _Bake, messages: list, group=None):
     """``(group, measured, tier, auto record or None)`` for the settings: the existing group
     of the tier reused when intact (nothing baked or fitted), else built (``group`` given:
-    rebuilt in place, always); ``over``: a group over the artist's shader."""
+    rebuilt in place, always); over the artist's shader if ``work.over``."""
     auto = None
     tier = settings.tier
+    over = work.over
     if tier == "AUTO":
-        work.adopt(_stored_measurement(work, over))
+        work.adopt(_stored_measurement(work))
         tier, auto = _auto_choice(material, scene, work.measured(with_traits=True))
     existing = None if group is not None else _existing(work.record, tier, work.method,
                                                         messages, over)
     if existing is not None:
-        stored = fits.measured_at(nodes.read_meta(existing), work.coverage, work.absorption)
+        stored = fits.measured_at(nodes.read_meta(existing), work.coverage, work.absorption,
+                                  tiers=work.tiers)
         if stored is None:  # the group was built at another coverage or absorption
             nodes.write_measured(existing, work.measured())
         return existing, stored or work.measured(), tier, auto
     if group is None:
         group = bpy.data.node_groups.get(group_name(tier, work.record["key"], work.method,
                                                     over))
-    return _build(work, tier, group, over), work.measured(), tier, auto
+    return _build(work, tier, group), work.measured(), tier, auto
 
 
 def group_for_tables(tables, tier: str, *, resolution: str = "default", group=None,
@@ -484,9 +509,9 @@ def apply_to_object(context, obj, *, resolution=None) -> tuple:
                                  resolution or settings.resolution)
     with _Progress(context) as progress:
         work = _Bake(record, forced_method(settings), settings.coverage,
-                     settings.effective_absorption(), progress)
-        group, measured, tier, auto = _group_for(material, settings, scene, work, report,
-                                                 over=reading is not None)
+                     settings.effective_absorption(), progress,
+                     tiers=fitted_tiers(settings, scene), over=reading is not None)
+        group, measured, tier, auto = _group_for(material, settings, scene, work, report)
     _record_errors(material, measured, record["key"])
     _record_auto(material, auto)
     installed = setup_material(material, group, scene, reading)
@@ -530,9 +555,10 @@ def rebuild_from_settings(context, material, group, resolution: str) -> None:
     over = settings.over_shader and convert.artist_tree(material) is not None
     with _Progress(context) as progress:
         work = _Bake(record, forced_method(settings), settings.coverage,
-                     settings.effective_absorption(), progress)
+                     settings.effective_absorption(), progress,
+                     tiers=fitted_tiers(settings, context.scene), over=over)
         group, measured, _, auto = _group_for(material, settings, context.scene, work, [],
-                                              group=group, over=over)
+                                              group=group)
     _record_errors(material, measured, record["key"])
     _record_auto(material, auto)
     setup_material(material, group, context.scene)
@@ -570,8 +596,11 @@ def check_material(context, material) -> tuple[bool, str]:
     if not problems and nodes.has_interface(group):
         return True, f"{name!r}: intact."
     settings = material.makeup_skin
+    tier = meta.get("tier", "LAYERED")
     work = _Bake({k: meta[k] for k in ("key", "parameters", "resolution")},
-                 meta.get("forced_method"), settings.coverage, settings.effective_absorption())
-    _build(work, meta.get("tier", "LAYERED"), group, nodes.over_shader(group))
+                 meta.get("forced_method"), settings.coverage, settings.effective_absorption(),
+                 tiers=fitted_tiers(settings, context.scene, (tier,)),
+                 over=nodes.over_shader(group))
+    _build(work, tier, group)
     what = "; ".join(problems) if problems else "its inputs were of an older version"
     return False, f"{name!r}: {what}; rebuilt it from a re-bake."

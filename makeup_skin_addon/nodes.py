@@ -378,6 +378,8 @@ def build_group(tier: str, record: dict, fit, group=None, *, method=None, measur
     made-up skin, bare skin included (:data:`INPUTS`)."""
     if tier not in tiers.TIERS:
         raise ValueError(f"tier must be one of {tiers.TIERS}, got {tier!r}")
+    if tier not in fit.tiers:
+        raise ValueError(f"the fit holds no {tier} tier (it has {', '.join(fit.tiers)})")
     key = record["key"]
     name = group_name(tier, key, method, over)
     if group is None:
@@ -391,7 +393,8 @@ def build_group(tier: str, record: dict, fit, group=None, *, method=None, measur
     forced = method
     method = method or (tiers.EEVEE_SUBSURFACE_METHOD if tier == "EEVEE"
                         else fit.subsurface_method)
-    radius = fit.profiles[method].radius_mm
+    # Over the artist's shader the radius is theirs (a fit for it may have no profiles).
+    radius = None if over else fit.profiles[method].radius_mm
     ior = fit.subsurface_ior
     images = []
     if tier == "PRINCIPLED":

@@ -32,7 +32,7 @@ import json
 import math
 
 from . import convert, fits, nodes, storage
-from .core import auto_tier
+from .core import auto_tier, closure_fit
 from .keys import CHOICE_KEY, SAVED_GLOSS_KEY, SAVED_SCALE_KEY
 
 __all__ = ["ENVIRONMENT_LIGHT_DEG", "units_per_mm", "render_engine", "describe_scene",
@@ -149,31 +149,36 @@ def _meta(material) -> dict:
     return nodes.read_meta(node.node_tree) if node is not None else {}
 
 
-def _measurement(meta: dict, coverage: float, absorption, *, may_fit: bool):
-    """What the group's fit measured at this coverage and absorption: kept in its record, or
-    measured now from this session's fit, or (``may_fit``) from a new bake and fit; None
-    when none of these can be had."""
-    measured = fits.measured_at(meta, coverage, absorption, with_traits=True)
+def _measurement(meta: dict, coverage: float, absorption, *, may_fit: bool, tiers):
+    """What the group's fit measured at this coverage and absorption, of ``tiers`` at least:
+    kept in its record, or measured now from this session's fit, or (``may_fit``) from a new
+    bake and fit (or the missing tiers fitted onto it); None when none of these can be
+    had."""
+    measured = fits.measured_at(meta, coverage, absorption, with_traits=True, tiers=tiers)
     if measured is not None or "parameters" not in meta:
         return measured
     method = meta.get("forced_method")
+    over = bool(meta.get("over_shader"))
     try:
-        got = fits.cached(meta, method)
+        got = fits.cached(meta, method, tiers=tiers, over_shader=over)
         if got is None and may_fit:
-            got = fits.baked(meta, method=method, errors_at=(coverage, absorption))
+            got = fits.baked(meta, method=method, tiers=tiers, over_shader=over,
+                             errors_at=(coverage, absorption))
     except storage.StorageError:
         return None
     if got is None:
         return None
-    return fits.measure(*got, coverage, absorption, method=meta.get("subsurface_method"))
+    return fits.measure(*got, coverage, absorption, method=meta.get("subsurface_method"),
+                        over_shader=over)
 
 
-def material_traits(material, *, refit: bool = False, may_fit: bool = True):
+def material_traits(material, *, refit: bool = False, may_fit: bool = True, scene=None):
     """The :class:`lut_baker.auto_tier.MaterialTraits` of a made-up material at its coverage
     and absorption, the Subsurface Scale and Gloss applied (the values Fit to Scene saved if
-    it set them to 0): what its group's fit measured there (:mod:`.fits`; ``refit``: measured
-    again rather than read from the record; without ``may_fit`` never a new bake or fit).
-    Without either: the paper preset's traits."""
+    it set them to 0): what its group's fit measured there, of the tiers made for ``scene``'s
+    engine (default: every tier) (:mod:`.fits`; ``refit``: measured again rather than read
+    from the record; without ``may_fit`` never a new bake or fit).  Without either: the
+    paper preset's traits."""
     settings = material.makeup_skin
     coverage = float(settings.coverage)
     absorption = [float(a) for a in settings.effective_absorption()]
@@ -182,7 +187,9 @@ def material_traits(material, *, refit: bool = False, may_fit: bool = True):
     meta = _meta(material)
     if refit:
         meta = {key: value for key, value in meta.items() if key != "measured"}
-    measured = _measurement(meta, coverage, absorption, may_fit=may_fit)
+    tiers = (auto_tier.ENGINE_TIERS[render_engine(scene)] if scene is not None
+             else closure_fit.TIERS)
+    measured = _measurement(meta, coverage, absorption, may_fit=may_fit, tiers=tiers)
     traits = fits.traits(measured) if measured is not None else None
     return (traits or auto_tier.paper_traits()).scaled(scale, gloss)
 
@@ -212,7 +219,7 @@ def choose_for(material, scene, *, obj=None, tolerance=None, refit=False, may_fi
     description = describe_scene(scene, material, obj)
     tolerance = auto_tier.DEFAULT_TOLERANCE if tolerance is None else tolerance
     choice = auto_tier.choose(description or _unknown_scene(scene),
-                       material_traits(material, refit=refit, may_fit=may_fit),
+                       material_traits(material, refit=refit, may_fit=may_fit, scene=scene),
                        tolerance=tolerance)
     return choice, description
 
