@@ -19,7 +19,9 @@ group by name and bakes, fits and hashes nothing; otherwise it bakes and fits on
 - :func:`group_for_tables` -- the group for baked tables (tests and tools; reused when the same
   tables, tier and method were built before and its images are intact).
 - :func:`apply_to_object` -- the Apply operator's work; :func:`revert_material` Revert's.
-- :func:`rebuild_from_settings` -- the live preview's re-bake.
+- :func:`rebuild_from_settings` -- a rebuild from the settings at once; :class:`Rebuild`,
+  :func:`prepare_rebuild`, :func:`finish_rebuild` -- the same in steps, its costly one on a
+  worker thread (the live preview's).
 - :func:`check_material` -- verify a made-up material against its bake record, repair it.
 """
 
@@ -40,6 +42,9 @@ __all__ = [
     "refuse_linked",
     "revert_material",
     "rebuild_from_settings",
+    "Rebuild",
+    "prepare_rebuild",
+    "finish_rebuild",
     "skin_from_settings",
     "resolve_tier",
     "engine_note",
@@ -148,6 +153,9 @@ class _Progress:
         return False
 
 
+PREVIEW = "preview"
+"""The resolution an Apply bakes at first when asked to (``preview_first``), and the live
+preview's."""
 BAKE_SHARE = 0.15
 """Share of Apply's progress bar the bake takes (the closure fit and its measurement take the
 rest)."""
@@ -392,11 +400,13 @@ def _material_for(obj) -> tuple:
 
 class Report(list):
     """The sentences of an Apply, in order; ``warnings``: those that say what could not be
-    carried over (the operator reports them as warnings)."""
+    carried over (the operator reports them as warnings); ``refine``: the resolution the
+    group is still to be rebuilt at (an Apply at preview first), or None."""
 
     def __init__(self):
         super().__init__()
         self.warnings: list[str] = []
+        self.refine: str | None = None
 
     def warn(self, sentence: str) -> None:
         self.append(sentence)
@@ -463,12 +473,24 @@ def _record_auto(material, auto) -> None:
         del material[AUTO_KEY]
 
 
-def apply_to_object(context, obj, *, resolution=None) -> tuple:
+def _has_group(record: dict, method, over: bool) -> bool:
+    """Whether the file has a group of this bake (any tier)."""
+    return any(bpy.data.node_groups.get(group_name(tier, record["key"], method, over))
+               for tier in tiers.TIERS)
+
+
+def apply_to_object(context, obj, *, resolution=None, preview_first: bool = False) -> tuple:
     """Find or build the group for the settings of ``obj``'s active material and make it the
     material's surface, converted in place (:func:`setup_material`); an object without a
     material gets a new one.  Returns ``(material, report)``: the report's sentences
     (:class:`Report`: what was carried over, what was not as warnings, how many objects
     share the material).
+
+    ``resolution``: of the bake (default the settings').  ``preview_first``: when the file
+    has no group of that bake, bake and fit at preview resolution instead (about a quarter of
+    the bake's time, and the first Apply's match with it) and say so in ``report.refine``
+    (the resolution to rebuild at, which the caller does on a worker thread:
+    :func:`.live.refine`); else ``report.refine`` is None.
 
     Over the artist's shader (:func:`.convert.artist_tree`) the skin under the film is read
     from it again at every Apply (:func:`.artist_skin.read_material`).  Settings Apply has
@@ -494,19 +516,26 @@ def apply_to_object(context, obj, *, resolution=None) -> tuple:
     else:
         with shade.assigning():
             settings.over_shader = False
+    target = resolution or settings.resolution
+    quick = preview_first and target != PREVIEW
     if first and settings.shade_source == "DEFAULT":
         # A shade never chosen: match the skin (the artist's first step), before the fit
-        # measures the tiers at the absorption.
+        # measures the tiers at the absorption; on the tables Apply bakes.
         with skin_sampling.progress_bar(getattr(context, "window_manager", None)):
-            film, result = matching.first_shade(material, reading)
+            film, result = matching.first_shade(material, reading,
+                                                PREVIEW if quick else target)
         if film is not None:
             with shade.assigning():
                 settings.foundation = film
                 settings.film_roughness = shade.foundation_roughness(film)
         matching.assign(settings, result, "MATCH")
         report += result.sentences
-    record = storage.bake_record(skin_from_settings(settings),
-                                 resolution or settings.resolution)
+    record = storage.bake_record(skin_from_settings(settings), target)
+    if quick and not _has_group(record, forced_method(settings), reading is not None):
+        record = storage.bake_record(skin_from_settings(settings), PREVIEW)
+        report.refine = target
+        report.append(f"Baked at preview resolution first: the {target} tables follow in "
+                      f"the background.")
     with _Progress(context) as progress:
         work = _Bake(record, forced_method(settings), settings.coverage,
                      settings.effective_absorption(), progress,
@@ -546,22 +575,87 @@ def revert_material(material) -> str:
     return f"Reverted {material.name!r}: {restored}."
 
 
-def rebuild_from_settings(context, material, group, resolution: str) -> None:
-    """Bake the material's settings at ``resolution``, rebuild ``group`` (its group, or a copy
-    of it) in place and make it the material's surface: the live preview's re-bake, and Check
-    Tables' repair when the group's record cannot be used."""
+class _Checked:
+    """A progress for :class:`_Bake` that reports nothing but calls ``check()`` at every step
+    (which raises to stop the work)."""
+
+    def __init__(self, check):
+        self.check = check
+
+    def stage(self, start: float, end: float):
+        def report(fraction: float, message: str = "") -> None:
+            self.check()
+        return report
+
+
+class Rebuild:
+    """A rebuild of a material's group from its settings, in three steps so that the costly
+    one runs off the main thread (:mod:`.live`): :func:`prepare_rebuild` reads the settings
+    and the scene, :meth:`compute` bakes, fits and measures (and makes the Auto tier's choice
+    once, which leaves its costly part cached), touching no bpy, and :func:`finish_rebuild`
+    builds the group from what was computed.  ``material``: the name, ``uid``: the
+    material's ``session_uid`` (another file's material of the same name is not it), ``key``:
+    the bake's."""
+
+    def __init__(self, material, work: _Bake, where):
+        self.material, self.uid = material.name, material.session_uid
+        self.key, self.resolution = work.record["key"], work.record["resolution"]
+        self.work, self.where = work, where
+
+    def compute(self, check=None) -> None:
+        """Bake, fit and measure (no bpy: any thread); ``check()``: called at every step of
+        the bake and the fit, raises to stop them."""
+        before = self.work.progress
+        if check is not None:
+            self.work.progress = _Checked(check)
+        try:
+            self.work.fitted()
+            measured = self.work.measured(with_traits=self.where is not None)
+            if self.where is not None:
+                traits = fits.traits(measured)
+                if traits is not None:
+                    self.where.choose(traits)
+        finally:
+            self.work.progress = before
+
+
+def prepare_rebuild(context, material, resolution: str) -> Rebuild:
+    """What the rebuild of ``material``'s group at ``resolution`` needs of Blender: its
+    settings' bake record, the tiers to fit (:func:`fitted_tiers`), whether it goes over the
+    artist's shader, and with Tier Auto the scene the choice judges in."""
     settings = material.makeup_skin
     record = storage.bake_record(skin_from_settings(settings), resolution)
     over = settings.over_shader and convert.artist_tree(material) is not None
-    with _Progress(context) as progress:
-        work = _Bake(record, forced_method(settings), settings.coverage,
-                     settings.effective_absorption(), progress,
-                     tiers=fitted_tiers(settings, context.scene), over=over)
-        group, measured, _, auto = _group_for(material, settings, context.scene, work, [],
-                                              group=group)
-    _record_errors(material, measured, record["key"])
+    work = _Bake(record, forced_method(settings), settings.coverage,
+                 settings.effective_absorption(),
+                 tiers=fitted_tiers(settings, context.scene), over=over)
+    where = scene_fit.choice_scene(material, context.scene) if settings.tier == "AUTO" else None
+    return Rebuild(material, work, where)
+
+
+def finish_rebuild(context, material, group, rebuild: Rebuild) -> None:
+    """Rebuild ``group`` (the material's group, or a copy of it) in place from ``rebuild``
+    (computed: nothing is baked or fitted again) and make it the material's surface."""
+    settings = material.makeup_skin
+    group, measured, _, auto = _group_for(material, settings, context.scene, rebuild.work, [],
+                                          group=group)
+    _record_errors(material, measured, rebuild.key)
     _record_auto(material, auto)
     setup_material(material, group, context.scene)
+
+
+def rebuild_from_settings(context, material, group, resolution: str) -> None:
+    """Bake the material's settings at ``resolution``, rebuild ``group`` (its group, or a copy
+    of it) in place and make it the material's surface, all at once: Check Tables' repair when
+    the group's record cannot be used, and the live preview without an event loop."""
+    rebuild = prepare_rebuild(context, material, resolution)
+    with _Progress(context) as progress:
+        rebuild.work.progress = progress
+        try:
+            rebuild.compute()
+            finish_rebuild(context, material, group, rebuild)
+        finally:
+            rebuild.work.progress = None
 
 
 def check_material(context, material) -> tuple[bool, str]:

@@ -140,7 +140,7 @@ def profile_mean_radius_mm(radius_mm, profile) -> float:
     return float(np.max(mean / np.maximum(mass, 1e-300)))
 
 
-@dataclass(frozen=True)
+@dataclass
 class _Sphere:
     """A sphere's lit pixels under one distant light (orthographic, the reference's
     framing): their directions, ``cos(theta_i)`` ``(N, 1)`` and the tables' radiance
@@ -151,6 +151,13 @@ class _Sphere:
     cos_i: np.ndarray
     total: np.ndarray
     norm: float
+    _bare: np.ndarray | None = None
+
+    def bare(self, tables, absorption) -> np.ndarray:
+        """The tables' bare skin's BRDF at the pixels (computed once)."""
+        if self._bare is None:
+            self._bare = tables.made_up_reflection(self.wi, self.wo, 0.0, absorption)
+        return self._bare
 
 
 def _sphere(tables, light_deg: float, w, a, resolution: int) -> _Sphere:
@@ -193,8 +200,10 @@ def _omission(tables, fit, tier: str, sphere: _Sphere, w, a, over_shader: bool) 
     norm = sphere.norm
     if not norm > 0:
         return 0.0
+    bare = sphere.bare(tables, a) if over_shader else None
     kept, left_out = (tier_reflection(fit, tables, tier, w, a, gloss, (sphere.wi, sphere.wo),
-                                      over_shader=over_shader) for gloss in (1.0, 0.0))
+                                      over_shader=over_shader, bare=bare)
+                      for gloss in (1.0, 0.0))
     return float(np.sqrt(np.mean(((kept - left_out) * sphere.cos_i) ** 2)) / norm)
 
 

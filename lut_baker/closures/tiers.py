@@ -213,18 +213,21 @@ TIER_REPLICAS = {"PRINCIPLED": principled_tier_reflection, "LAYERED": layered_ti
 
 
 def tier_reflection(fit: ClosureFit, tables: Tables, tier: str, coverage: float, absorption,
-                    gloss: float = 1.0, directions=None, *, over_shader: bool = False):
+                    gloss: float = 1.0, directions=None, *, over_shader: bool = False,
+                    bare=None):
     """``tier``'s BRDF ``(..., 3)`` (:data:`TIER_REPLICAS`) at the angular nodes or at
     ``directions``.  ``over_shader``: the group goes over the artist's shader, which is the
     bare skin (the tables' bare skin stands for it, the Gloss input leaves it alone): the
-    tier's covered skin (its replica at coverage 1) and the tables' bare skin, mixed by
+    tier's covered skin (its replica at coverage 1) and the tables' bare skin (``bare``, if
+    already computed at these directions: ``made_up_reflection`` at coverage 0), mixed by
     coverage as areas."""
     replica = TIER_REPLICAS[tier]
     if not over_shader:
         return replica(fit, tables, coverage, absorption, gloss, directions)
     wi, wo = tables.node_directions() if directions is None else directions
     covered = replica(fit, tables, 1.0, absorption, gloss, (wi, wo))
-    bare = tables.made_up_reflection(wi, wo, 0.0, absorption)
+    if bare is None:
+        bare = tables.made_up_reflection(wi, wo, 0.0, absorption)
     return combine(coverage_weights(coverage, 0.0), top=covered, bare=bare)
 
 
@@ -241,12 +244,13 @@ def tier_errors(fit: ClosureFit, tables: Tables, coverage: float, absorption,
     grid = view_grid(min(lobe_widths_deg(tables).values()), ERROR_VIEWS)
     directions = grid.directions
     reference = tables.made_up_reflection(*directions, coverage, absorption)
+    bare = tables.made_up_reflection(*directions, 0.0, absorption) if over_shader else None
     out = {}
     for tier in TIER_REPLICAS:
         if tier not in tiers:
             continue
         f = tier_reflection(fit, tables, tier, coverage, absorption, gloss, directions,
-                            over_shader=over_shader)
+                            over_shader=over_shader, bare=bare)
         out[tier] = TierError(tier=tier, coverage=float(coverage),
                               absorption=tuple(_absorption(absorption).tolist()),
                               rms=grid.error(f, reference),
