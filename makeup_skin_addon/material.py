@@ -591,53 +591,67 @@ class _Checked:
 class Rebuild:
     """A rebuild of a material's group from its settings, in three steps so that the costly
     one runs off the main thread (:mod:`.live`): :func:`prepare_rebuild` reads the settings
-    and the scene, :meth:`compute` bakes, fits and measures (and makes the Auto tier's choice
-    once, which leaves its costly part cached), touching no bpy, and :func:`finish_rebuild`
-    builds the group from what was computed.  ``material``: the name, ``uid``: the
-    material's ``session_uid`` (another file's material of the same name is not it), ``key``:
-    the bake's."""
+    and the scene, :meth:`compute` makes the made-up skin, bakes, fits and measures (and
+    makes the Auto tier's choice once, which leaves its costly part cached), touching no bpy,
+    and :func:`finish_rebuild` builds the group from what was computed.  ``material``: the
+    name, ``uid``: the material's ``session_uid`` (another file's material of the same name
+    is not it); ``work``: the :class:`_Bake` (made by :meth:`compute`)."""
 
-    def __init__(self, material, work: _Bake, where):
+    def __init__(self, material, skin: shade.SkinSettings, resolution: str, bake: dict,
+                 where):
         self.material, self.uid = material.name, material.session_uid
-        self.key, self.resolution = work.record["key"], work.record["resolution"]
-        self.work, self.where = work, where
+        self.skin, self.resolution, self.bake, self.where = skin, resolution, bake, where
+        self.work: _Bake | None = None
+        self.progress = None
 
-    def compute(self, check=None) -> None:
-        """Bake, fit and measure (no bpy: any thread); ``check()``: called at every step of
-        the bake and the fit, raises to stop them."""
-        before = self.work.progress
-        if check is not None:
-            self.work.progress = _Checked(check)
+    @property
+    def key(self) -> str:
+        """The bake's key (once :meth:`compute` made it)."""
+        if self.work is None:
+            raise AssertionError("the rebuild is not computed")
+        return self.work.record["key"]
+
+    def compute(self, check=None) -> _Bake:
+        """Make the skin, bake, fit and measure (no bpy: any thread); ``check()``: called at
+        every step of the bake and the fit, raises to stop them.  Returns :attr:`work`."""
+        work = self.work
+        if work is None:
+            record = storage.bake_record(skin_from_settings(self.skin), self.resolution)
+            work = self.work = _Bake(record, **self.bake)
+        before = work.progress
+        work.progress = self.progress if check is None else _Checked(check)
         try:
-            self.work.fitted()
-            measured = self.work.measured(with_traits=self.where is not None)
+            work.fitted()
+            measured = work.measured(with_traits=self.where is not None)
             if self.where is not None:
                 traits = fits.traits(measured)
                 if traits is not None:
                     self.where.choose(traits)
         finally:
-            self.work.progress = before
+            work.progress = before
+        return work
 
 
 def prepare_rebuild(context, material, resolution: str) -> Rebuild:
-    """What the rebuild of ``material``'s group at ``resolution`` needs of Blender: its
-    settings' bake record, the tiers to fit (:func:`fitted_tiers`), whether it goes over the
-    artist's shader, and with Tier Auto the scene the choice judges in."""
+    """What the rebuild of ``material``'s group at ``resolution`` needs of Blender (main
+    thread, a few milliseconds): its settings (:func:`.shade.skin_settings`), the tiers to fit
+    (:func:`fitted_tiers`), whether it goes over the artist's shader, and with Tier Auto the
+    scene the choice judges in."""
     settings = material.makeup_skin
-    record = storage.bake_record(skin_from_settings(settings), resolution)
     over = settings.over_shader and convert.artist_tree(material) is not None
-    work = _Bake(record, forced_method(settings), settings.coverage,
-                 settings.effective_absorption(),
-                 tiers=fitted_tiers(settings, context.scene), over=over)
+    bake = {"method": forced_method(settings), "coverage": settings.coverage,
+            "absorption": settings.effective_absorption(),
+            "tiers": fitted_tiers(settings, context.scene), "over": over}
     where = scene_fit.choice_scene(material, context.scene) if settings.tier == "AUTO" else None
-    return Rebuild(material, work, where)
+    return Rebuild(material, shade.skin_settings(settings), resolution, bake, where)
 
 
 def finish_rebuild(context, material, group, rebuild: Rebuild) -> None:
     """Rebuild ``group`` (the material's group, or a copy of it) in place from ``rebuild``
     (computed: nothing is baked or fitted again) and make it the material's surface."""
     settings = material.makeup_skin
-    group, measured, _, auto = _group_for(material, settings, context.scene, rebuild.work, [],
+    work = rebuild.work if rebuild.work is not None else rebuild.compute()
+    group, measured, _, auto = _group_for(material, settings, context.scene, work, [],
                                           group=group)
     _record_errors(material, measured, rebuild.key)
     _record_auto(material, auto)
@@ -650,12 +664,9 @@ def rebuild_from_settings(context, material, group, resolution: str) -> None:
     the group's record cannot be used, and the live preview without an event loop."""
     rebuild = prepare_rebuild(context, material, resolution)
     with _Progress(context) as progress:
-        rebuild.work.progress = progress
-        try:
-            rebuild.compute()
-            finish_rebuild(context, material, group, rebuild)
-        finally:
-            rebuild.work.progress = None
+        rebuild.progress = progress
+        rebuild.compute()
+        finish_rebuild(context, material, group, rebuild)
 
 
 def check_material(context, material) -> tuple[bool, str]:
