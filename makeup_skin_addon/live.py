@@ -27,7 +27,7 @@ the workers, so that nothing is left behind (bpy 4.5 hangs at exit otherwise).
   whether it will be swapped in by itself.
 - :func:`flush` -- everything at once; :func:`wait` -- wait for the workers (tests, scripts).
 - :func:`pending`, :func:`in_flight` -- what is marked or computing; :func:`cancel` -- drop a
-  material's.
+  material's; :func:`forget` -- drop everything (a file opened).
 """
 
 from __future__ import annotations
@@ -40,7 +40,7 @@ from . import material as made_up
 
 __all__ = ["DEBOUNCE_S", "POLL_S", "JOIN_TIMEOUT_S", "sockets_changed", "tables_changed",
            "start", "poll", "refine", "can_refine", "flush", "wait", "pending", "in_flight",
-           "cancel",
+           "cancel", "forget",
            "rebake_timer", "poll_timer", "register", "unregister"]
 
 DEBOUNCE_S = 0.3
@@ -157,6 +157,13 @@ def cancel(material) -> None:
     """Drop what is pending for ``material`` (an Apply or a Revert makes it stale)."""
     _dirty.pop(material.name, None)
     _supersede(material.name)
+
+
+def forget() -> None:
+    """Drop everything pending (another file was opened: its materials are not these)."""
+    _dirty.clear()
+    for name in list(_jobs):
+        _supersede(name)
 
 
 def _usable(material) -> str | None:

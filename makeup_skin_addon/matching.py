@@ -67,11 +67,13 @@ def light_for(settings, foundation: str | None = None, resolution: str | None = 
                                  lambda: uniform_light.uniform_light(storage.rebake(record)))
 
 
-def skin_target(material, reading=None, light=None) -> SkinTarget:
+def skin_target(material, reading=None, light=None, resolution: str | None = None
+                ) -> SkinTarget:
     """What the material's shade matches: over the artist's shader its colour under uniform
     light and its body colour (``reading``: :class:`.artist_skin.SkinReading`, read now if not
     given); the skin preset's made-up skin matches its own bare skin (Skin Color, or the mean
-    of the image feeding it, with the preset's gloss, ``light``)."""
+    of the image feeding it, with the preset's gloss, ``light``: default the settings' at
+    ``resolution``)."""
     settings = material.makeup_skin
     if reading is None:
         reading = artist_skin.read_material(material)
@@ -80,7 +82,7 @@ def skin_target(material, reading=None, light=None) -> SkinTarget:
         return SkinTarget(np.asarray(reading.target, float), np.asarray(reading.body, float),
                           f"the artist's shader under uniform light{notes}")
     skin = shade.skin_colour(material)
-    light = light_for(settings) if light is None else light
+    light = light_for(settings, resolution=resolution) if light is None else light
     bare = uniform_light.bare_colour(light, skin.rgb, float(settings.gloss))
     return SkinTarget(np.asarray(bare, float), np.asarray(skin.rgb, float),
                       f"its diffuse albedo {_rgb(skin.rgb)} with the skin preset's gloss; the "
@@ -176,7 +178,7 @@ def first_shade(material, reading=None, resolution: str | None = None
     skin (:class:`.artist_skin.SkinReading`), if read; ``resolution``: of the tables (default
     the settings': Apply's own, so that the match's bake is Apply's)."""
     settings = material.makeup_skin
-    skin = skin_target(material, reading)
+    skin = skin_target(material, reading, resolution=resolution)
     result = matched(material, skin=skin, resolution=resolution)
     too_dark = np.any(result.clamped & (result.absorption == 1.0))
     if not too_dark or settings.foundation == MATTE_FILM:
