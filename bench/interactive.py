@@ -39,9 +39,12 @@ assignment and its callbacks), ``start``, ``poll``, ``swap``, the worker's CPU a
 checkout without the worker thread blocks for the whole rebuild in ``live.flush()`` (what
 its debounce timer ran): that is its ``flush`` step.
 
-Every figure also times 3 (``x3``): a machine three times slower.  Run with the venv's python
-of the Blender line to measure (``$(tools/venv.sh)/bin/python``); the machine's load is
-recorded at the start and the end.
+Every figure also times 3 (``x3``): a machine three times slower.  The measured processes run
+with one BLAS thread (``--blas-threads``): numpy's OpenBLAS threads spin between the bake's
+matrix products, and ``time.process_time`` counts that spinning as CPU (on an idle core up to
+twice the computation; the wall time hardly moves).  Run with the venv's python of the Blender
+line to measure (``$(tools/venv.sh)/bin/python``); the machine's load is recorded at the start
+and the end.
 """
 
 from __future__ import annotations
@@ -233,11 +236,17 @@ def worker(bpy, support, case: str, mode: str, with_live: bool) -> dict:
 LIVE_CASES = ("defaults/sphere", "defaults/principled")
 
 
-def _run(repo: Path, case: str, mode: str, with_live: bool) -> dict:
+BLAS_VARIABLES = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
+
+
+def _run(repo: Path, case: str, mode: str, with_live: bool, blas_threads) -> dict:
     command = [sys.executable, str(HERE), "--repo", str(repo), "--worker", case, mode]
     if not with_live:
         command.append("--no-live")
-    result = subprocess.run(command, capture_output=True, text=True, check=False)
+    env = dict(os.environ)
+    if blas_threads is not None:
+        env.update({name: str(blas_threads) for name in BLAS_VARIABLES})
+    result = subprocess.run(command, capture_output=True, text=True, check=False, env=env)
     for line in result.stdout.splitlines():
         if line.startswith("RESULT "):
             return json.loads(line[len("RESULT "):])
@@ -251,12 +260,16 @@ def _median_runs(runs: list[dict]) -> dict:
             "apply_cpu_all_s": [run.get("apply_cpu_s") for run in runs]}
 
 
-def measure(repo: Path, names: list[str], repeats: int, with_live: bool) -> dict:
+def measure(repo: Path, names: list[str], repeats: int, with_live: bool,
+            blas_threads=1) -> dict:
     results: dict = {"repo": str(repo), "commit": commit(repo), "load_start": machine_load(),
-                     "cases": []}
+                     "blas_threads": blas_threads, "cases": []}
     for case in names:
         for mode in ("full", "preview"):
-            runs = [_run(repo, case, mode, with_live) for _ in range(repeats)]
+            runs = [_run(repo, case, mode, with_live, blas_threads)]
+            if "unavailable" not in runs[0]:
+                runs += [_run(repo, case, mode, with_live, blas_threads)
+                         for _ in range(repeats - 1)]
             row = _median_runs(runs)
             results["cases"].append(row)
             print(_apply_line(row), flush=True)
@@ -281,7 +294,8 @@ def _apply_line(row: dict) -> str:
 
 def print_report(results: dict) -> None:
     print(f"\n{results['repo']} ({results['commit']}), load {results['load_start']} -> "
-          f"{results['load_end']}; seconds (x{SLOWER:g} in brackets)\n")
+          f"{results['load_end']}, BLAS threads {results.get('blas_threads') or 'default'}; "
+          f"seconds (x{SLOWER:g} in brackets)\n")
     print("First Apply: CPU (every thread) and wall; preview: Apply at preview resolution, "
           "then the refine on a worker")
     for row in results["cases"]:
@@ -322,6 +336,10 @@ def main(argv=None) -> int:
     parser.add_argument("--repeats", type=int, default=1,
                         help="fresh processes per case and mode (default 1)")
     parser.add_argument("--no-live", action="store_true", help="leave out the live changes")
+    parser.add_argument("--blas-threads", default="1",
+                        help="BLAS threads of the measured processes (default 1: numpy's "
+                             "OpenBLAS threads spin between calls, which process_time counts "
+                             "as CPU; 'default' leaves the environment as it is)")
     parser.add_argument("--json", type=Path, help="write the figures here")
     parser.add_argument("--worker", nargs=2, help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
@@ -336,7 +354,8 @@ def main(argv=None) -> int:
         return 0
     use_checkout(repo, ("lut_baker",), who="interactive")
     names = args.cases or cases(_foundations())
-    results = measure(repo, names, args.repeats, not args.no_live)
+    threads = None if args.blas_threads == "default" else int(args.blas_threads)
+    results = measure(repo, names, args.repeats, not args.no_live, threads)
     print_report(results)
     write_figures(args.json, results)
     return 0

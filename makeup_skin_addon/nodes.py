@@ -42,7 +42,9 @@ and anisotropic filtering, which mixes the image's rows wherever ``cos(theta_o)`
 quickly across the screen (docs/addon.md, "Why the Layered tier breaks in EEVEE").
 
 - :func:`build_group` -- create or rebuild (in place) a group from a fit and its bake record,
-  named by :func:`.keys.group_name` (tier, tables key, a forced subsurface method).
+  named by :func:`.keys.group_name` (tier, tables key, a forced subsurface method); a group
+  rebuilt with the same structure keeps its nodes, only values and links set anew
+  (:class:`.node_algebra.Builder` ``reuse``).
 - :func:`read_meta` -- a group's record (bake, fit summary, image hashes).
 - :func:`set_inputs` -- socket values on a group node from the panel's settings.
 """

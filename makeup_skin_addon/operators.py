@@ -117,7 +117,7 @@ class MAKEUPSKIN_OT_apply(bpy.types.Operator):
             live.cancel(obj.active_material)  # a live rebuild in flight is stale now
         try:
             # With an event loop, a new bake is done at preview resolution first and refined
-            # on a worker thread (docs/addon.md, "Apply, timed").
+            # on a worker thread (docs/addon.md, "Apply and Live Update, timed").
             material, messages = made_up.apply_to_object(
                 context, obj, resolution=resolution, preview_first=live.can_refine())
         except (ValueError, RuntimeError) as error:

@@ -33,7 +33,8 @@ Where each part lives: the lobes :mod:`~lut_baker.closures.lobes`, the subsurfac
 image :mod:`~lut_baker.closures.view_image`.
 
 - :func:`fit_closures` -- the fits of some tiers (default all) to one set of tables, or of
-  more tiers onto a fit, and their errors; :data:`TIER_PARTS` -- each tier's parts.
+  more tiers onto a fit (over the artist's shader: without the bare skin's lobes), and their
+  errors.
 - :func:`subsurface_ior` -- the Subsurface IOR from the tables' parameters.
 """
 
@@ -62,7 +63,7 @@ from .tiers import tier_errors
 from .view_grid import FIT_VIEWS, lobe_widths_deg, view_grid
 from .view_image import DEFAULT_LUT_SIZE, EEVEE_LUT_ROWS, LUT_ROWS, lut_nodes
 
-__all__ = ["fit_closures", "subsurface_ior", "TIER_PARTS"]
+__all__ = ["fit_closures", "subsurface_ior"]
 
 
 def _cosine_mean(values: np.ndarray, theta_deg: np.ndarray) -> np.ndarray:
@@ -241,10 +242,10 @@ def _eevee_parts(targets: _Targets, over_shader: bool) -> dict:
             "eevee_lut": _image(targets, eevee_glossy, EEVEE_LUT_ROWS)}
 
 
-TIER_PARTS = {"PRINCIPLED": _principled_parts, "LAYERED": _layered_parts,
+_TIER_PARTS = {"PRINCIPLED": _principled_parts, "LAYERED": _layered_parts,
               "EEVEE": _eevee_parts}
 """Each tier's parts of a fit, by tier."""
-TIER_SHARES = {"PRINCIPLED": 0.25, "LAYERED": 0.35, "EEVEE": 0.4}
+_TIER_SHARES = {"PRINCIPLED": 0.25, "LAYERED": 0.35, "EEVEE": 0.4}
 """Each tier's rough share of a full fit's time (for the progress reported)."""
 
 
@@ -296,12 +297,12 @@ def fit_closures(tables: Tables, *, tiers=TIERS, over_shader: bool = False,
     wanted = tiers if onto is None else tuple(t for t in tiers if t not in onto.tiers)
     targets = _Targets(tables, lut_size)
     parts: dict = {}
-    total = sum(TIER_SHARES[tier] for tier in wanted) or 1.0
+    total = sum(_TIER_SHARES[tier] for tier in wanted) or 1.0
     done = 0.0
     for tier in wanted:
         report(0.8 * done / total, f"fitting the {tier.title()} tier")
-        parts.update(TIER_PARTS[tier](targets, over_shader))
-        done += TIER_SHARES[tier]
+        parts.update(_TIER_PARTS[tier](targets, over_shader))
+        done += _TIER_SHARES[tier]
     if onto is not None:
         fit = replace(onto, **parts)
         if onto.errors:
