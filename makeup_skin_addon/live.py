@@ -223,7 +223,9 @@ def _swap(context, job: _Job) -> list[str]:
     thread), unless the rebuild was superseded or its material changed meanwhile."""
     rebuild = job.rebuild
     material = bpy.data.materials.get(rebuild.material)
-    if job.stopped or material is None or material.session_uid != rebuild.uid:
+    if material is None or material.session_uid != rebuild.uid:  # renamed meanwhile?
+        material = next((m for m in bpy.data.materials if m.session_uid == rebuild.uid), None)
+    if job.stopped or material is None:
         return []
     reason = _usable(material)
     if reason is not None:
