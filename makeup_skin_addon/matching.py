@@ -56,21 +56,24 @@ class SkinTarget:
     source: str
 
 
-def light_for(settings, foundation: str | None = None):
+def light_for(settings, foundation: str | None = None, resolution: str | None = None):
     """The settings' made-up skin (with ``foundation``'s film instead, if given) under uniform
     light (:func:`lut_baker.tables.uniform_light.uniform_light` of their tables, re-baked once
-    per session)."""
+    per session) at ``resolution`` (default the settings': the colours move by about 1e-4
+    between resolutions)."""
     record = storage.bake_record(shade.skin_from_settings(settings, foundation),
-                                 settings.resolution)
+                                 resolution or settings.resolution)
     return _LIGHT.get_or_compute(record["key"],
                                  lambda: uniform_light.uniform_light(storage.rebake(record)))
 
 
-def skin_target(material, reading=None, light=None) -> SkinTarget:
+def skin_target(material, reading=None, light=None, resolution: str | None = None
+                ) -> SkinTarget:
     """What the material's shade matches: over the artist's shader its colour under uniform
     light and its body colour (``reading``: :class:`.artist_skin.SkinReading`, read now if not
     given); the skin preset's made-up skin matches its own bare skin (Skin Color, or the mean
-    of the image feeding it, with the preset's gloss, ``light``)."""
+    of the image feeding it, with the preset's gloss, ``light``: default the settings' at
+    ``resolution``)."""
     settings = material.makeup_skin
     if reading is None:
         reading = artist_skin.read_material(material)
@@ -80,7 +83,7 @@ def skin_target(material, reading=None, light=None) -> SkinTarget:
         return SkinTarget(np.asarray(reading.target, float), np.asarray(reading.body, float),
                           f"the artist's shader under uniform light{where}{notes}")
     skin = shade.skin_colour(material)
-    light = light_for(settings) if light is None else light
+    light = light_for(settings, resolution=resolution) if light is None else light
     bare = uniform_light.bare_colour(light, skin.rgb, float(settings.gloss))
     return SkinTarget(np.asarray(bare, float), np.asarray(skin.rgb, float),
                       f"its diffuse albedo {_rgb(skin.rgb)} with the skin preset's gloss; the "
@@ -141,13 +144,14 @@ def _reach_sentences(shade_: Shade, light, gloss: float) -> list[str]:
     return sentences
 
 
-def matched(material, foundation: str | None = None, skin: SkinTarget | None = None) -> Shade:
+def matched(material, foundation: str | None = None, skin: SkinTarget | None = None,
+            resolution: str | None = None) -> Shade:
     """The shade whose covered skin has the skin's colour before Apply under uniform light
     (:func:`skin_target`), so that the made-up skin has it at any coverage, with the report's
     sentences; ``foundation``: on that preset's film instead of the settings'; ``skin``: the
-    target if known."""
+    target if known; ``resolution``: of the tables (default the settings')."""
     settings = material.makeup_skin
-    light = light_for(settings, foundation)
+    light = light_for(settings, foundation, resolution)
     skin = skin_target(material, light=light) if skin is None else skin
     result = _solve(settings, light, skin.target, skin)
     result.base = result.target
@@ -166,19 +170,21 @@ def _shortfall(result: Shade) -> float:
                         / np.maximum(result.target, 1e-6)))
 
 
-def first_shade(material, reading=None) -> tuple[str | None, Shade]:
+def first_shade(material, reading=None, resolution: str | None = None
+                ) -> tuple[str | None, Shade]:
     """The first Apply's shade (docs/addon.md, "A first Apply"): :func:`matched` on the
     settings' film; when the skin is darker than that film's own gloss in some channel
     (clamped at full absorption) and the matte film (:data:`MATTE_FILM`) reaches it better,
     matched on that instead, and its name returned (else None).  ``reading``: the artist's
-    skin (:class:`.artist_skin.SkinReading`), if read."""
+    skin (:class:`.artist_skin.SkinReading`), if read; ``resolution``: of the tables (default
+    the settings': Apply's own, so that the match's bake is Apply's)."""
     settings = material.makeup_skin
-    skin = skin_target(material, reading)
-    result = matched(material, skin=skin)
+    skin = skin_target(material, reading, resolution=resolution)
+    result = matched(material, skin=skin, resolution=resolution)
     too_dark = np.any(result.clamped & (result.absorption == 1.0))
     if not too_dark or settings.foundation == MATTE_FILM:
         return None, result
-    matte = matched(material, MATTE_FILM, skin)
+    matte = matched(material, MATTE_FILM, skin, resolution)
     if _shortfall(matte) >= _shortfall(result):
         return None, result
     label = presets.FOUNDATIONS[MATTE_FILM]["label"]

@@ -11,6 +11,7 @@ group by name and bakes, fits and hashes nothing; otherwise it bakes and fits on
 - :func:`skin_from_settings` -- the panel's settings as a :class:`MadeUpSkin` (coverage 1,
   absorption 0: those two are socket values, applied after the bake; :mod:`.shade`).
 - :func:`resolve_tier` -- the tier for the settings and scene (Auto: from a measurement).
+- :func:`fitted_tiers` -- the tiers Apply fits: the scene engine's and the settings' own.
 - :func:`engine_note` -- the report's sentence when a tier is not made for the scene's engine.
 - :func:`socket_values` -- the settings' group-node socket values; :func:`update_sockets`
   sets them on a material's group node.
@@ -18,7 +19,9 @@ group by name and bakes, fits and hashes nothing; otherwise it bakes and fits on
 - :func:`group_for_tables` -- the group for baked tables (tests and tools; reused when the same
   tables, tier and method were built before and its images are intact).
 - :func:`apply_to_object` -- the Apply operator's work; :func:`revert_material` Revert's.
-- :func:`rebuild_from_settings` -- the live preview's re-bake.
+- :func:`rebuild_from_settings` -- a rebuild from the settings at once; :class:`Rebuild`,
+  :func:`prepare_rebuild`, :func:`finish_rebuild` -- the same in steps, its costly one on a
+  worker thread (the live preview's).
 - :func:`check_material` -- verify a made-up material against its bake record, repair it.
 """
 
@@ -39,10 +42,14 @@ __all__ = [
     "refuse_linked",
     "revert_material",
     "rebuild_from_settings",
+    "Rebuild",
+    "prepare_rebuild",
+    "finish_rebuild",
     "skin_from_settings",
     "resolve_tier",
     "engine_note",
     "forced_method",
+    "fitted_tiers",
     "group_for_tables",
     "group_of",
     "apply_to_object",
@@ -68,7 +75,7 @@ def _auto_choice(material, scene, measured) -> tuple[str, dict]:
     """``(tier, record for the panel)`` of the Auto choice for ``material`` in ``scene``."""
     traits = fits.traits(measured) if measured is not None else None
     if traits is None:
-        traits = scene_fit.material_traits(material, may_fit=False)
+        traits = scene_fit.material_traits(material, may_fit=False, scene=scene)
     choice, _ = scene_fit.choose_with(traits, material, scene)
     chosen = choice.chosen
     return chosen.candidate.tier, {"tier": chosen.candidate.tier, "error": chosen.error,
@@ -146,6 +153,9 @@ class _Progress:
         return False
 
 
+PREVIEW = "preview"
+"""The resolution an Apply bakes at first when asked to (``preview_first``), and the live
+preview's."""
 BAKE_SHARE = 0.15
 """Share of Apply's progress bar the bake takes (the closure fit and its measurement take the
 rest)."""
@@ -171,22 +181,44 @@ def _reusable(group, key: str, tier: str, method, messages: list) -> bool:
     return not problems
 
 
+def fitted_tiers(settings, scene, also=()) -> tuple:
+    """The tiers Apply fits for ``settings`` in ``scene``: those made for the scene's engine
+    (:data:`lut_baker.auto_tier.ENGINE_TIERS`, among which Tier Auto chooses), the settings'
+    tier when it is fixed to another, and ``also``; in :data:`lut_baker.closures.tiers.TIERS`
+    order.  A tier asked for later (another tier or engine chosen) is fitted then."""
+    wanted = {*auto_tier.ENGINE_TIERS[scene_fit.render_engine(scene)], *also}
+    if settings.tier in tiers.TIERS:
+        wanted.add(settings.tier)
+    return tuple(tier for tier in tiers.TIERS if tier in wanted)
+
+
 class _Bake:
     """One bake record's tables, fit and measurement, made when first asked for (a group that
-    can be reused needs none of them)."""
+    can be reused needs none of them): the fit of ``tiers``, for a group over the artist's
+    shader if ``over``.  Nothing here touches bpy: a worker thread may make them
+    (:mod:`.live`), and the group is built from them on the main thread."""
 
-    def __init__(self, record: dict, method, coverage: float, absorption, progress=None):
+    def __init__(self, record: dict, method, coverage: float, absorption, progress=None, *,
+                 tiers=tiers.TIERS, over: bool = False):
         self.record, self.method = record, method
         self.coverage, self.absorption = float(coverage), [float(a) for a in absorption]
         self.progress = progress
+        self.tiers, self.over = tuple(tiers), bool(over)
         self._measured: dict | None = None
+        self._fitted: tuple | None = None
 
-    def fitted(self):
-        """``(tables, fit)`` (:func:`.fits.baked`)."""
-        return fits.baked(self.record, method=self.method,
-                          errors_at=(self.coverage, self.absorption),
-                          bake_progress=_stage(self.progress, 0.0, BAKE_SHARE),
-                          fit_progress=_stage(self.progress, BAKE_SHARE, MEASURE_SHARE))
+    def fitted(self, tier: str | None = None):
+        """``(tables, fit)`` (:func:`.fits.baked`), the fit holding :attr:`tiers` (and
+        ``tier``, added to them if need be)."""
+        if tier is not None and tier not in self.tiers:
+            self.tiers = tuple(t for t in tiers.TIERS if t in {*self.tiers, tier})
+        if self._fitted is None or not set(self.tiers) <= set(self._fitted[1].tiers):
+            self._fitted = fits.baked(
+                self.record, method=self.method, tiers=self.tiers, over_shader=self.over,
+                errors_at=(self.coverage, self.absorption),
+                bake_progress=_stage(self.progress, 0.0, BAKE_SHARE),
+                fit_progress=_stage(self.progress, BAKE_SHARE, MEASURE_SHARE))
+        return self._fitted
 
     def adopt(self, measured: dict | None) -> None:
         """Take a measurement a group's record kept at this coverage and absorption."""
@@ -200,7 +232,7 @@ class _Bake:
             tables, fit = self.fitted()
             measured = fits.measure(tables, fit, self.coverage, self.absorption,
                                     self.method or fit.subsurface_method,
-                                    with_traits=with_traits)
+                                    with_traits=with_traits, over_shader=self.over)
             self._measured = measured
             report = _stage(self.progress, MEASURE_SHARE, 1.0)
             if report is not None:
@@ -219,49 +251,50 @@ def _existing(record: dict, tier: str, method, messages: list, over: bool):
     return None
 
 
-def _stored_measurement(work: _Bake, over: bool):
-    """What any group of this bake (either tier) keeps measured at the coverage and
-    absorption, with the Auto tier's traits, or None."""
+def _stored_measurement(work: _Bake):
+    """What any group of this bake (any tier) keeps measured at the coverage and absorption,
+    of the tiers fitted, with the Auto tier's traits, or None."""
     for tier in tiers.TIERS:
         group = bpy.data.node_groups.get(group_name(tier, work.record["key"], work.method,
-                                                    over))
+                                                    work.over))
         if group is not None:
             measured = fits.measured_at(nodes.read_meta(group), work.coverage, work.absorption,
-                                        with_traits=True)
+                                        with_traits=True, tiers=work.tiers)
             if measured is not None:
                 return measured
     return None
 
 
-def _build(work: _Bake, tier: str, group=None, over: bool = False):
+def _build(work: _Bake, tier: str, group=None):
     """The group of ``tier`` built from the bake (rebuilt in place when ``group`` is given),
-    its record keeping the measurement; ``over``: over the artist's shader."""
-    _, fit = work.fitted()
+    its record keeping the measurement; over the artist's shader if ``work.over``."""
+    _, fit = work.fitted(tier)
     return nodes.build_group(tier, work.record, fit, group, method=work.method,
-                             measured=work.measured(), over=over)
+                             measured=work.measured(), over=work.over)
 
 
-def _group_for(material, settings, scene, work: _Bake, messages: list, group=None,
-               over: bool = False):
+def _group_for(material, settings, scene, work: _Bake, messages: list, group=None):
     """``(group, measured, tier, auto record or None)`` for the settings: the existing group
     of the tier reused when intact (nothing baked or fitted), else built (``group`` given:
-    rebuilt in place, always); ``over``: a group over the artist's shader."""
+    rebuilt in place, always); over the artist's shader if ``work.over``."""
     auto = None
     tier = settings.tier
+    over = work.over
     if tier == "AUTO":
-        work.adopt(_stored_measurement(work, over))
+        work.adopt(_stored_measurement(work))
         tier, auto = _auto_choice(material, scene, work.measured(with_traits=True))
     existing = None if group is not None else _existing(work.record, tier, work.method,
                                                         messages, over)
     if existing is not None:
-        stored = fits.measured_at(nodes.read_meta(existing), work.coverage, work.absorption)
+        stored = fits.measured_at(nodes.read_meta(existing), work.coverage, work.absorption,
+                                  tiers=work.tiers)
         if stored is None:  # the group was built at another coverage or absorption
             nodes.write_measured(existing, work.measured())
         return existing, stored or work.measured(), tier, auto
     if group is None:
         group = bpy.data.node_groups.get(group_name(tier, work.record["key"], work.method,
                                                     over))
-    return _build(work, tier, group, over), work.measured(), tier, auto
+    return _build(work, tier, group), work.measured(), tier, auto
 
 
 def group_for_tables(tables, tier: str, *, resolution: str = "default", group=None,
@@ -367,11 +400,13 @@ def _material_for(obj) -> tuple:
 
 class Report(list):
     """The sentences of an Apply, in order; ``warnings``: those that say what could not be
-    carried over (the operator reports them as warnings)."""
+    carried over (the operator reports them as warnings); ``refine``: the resolution the
+    group is still to be rebuilt at (an Apply at preview first), or None."""
 
     def __init__(self):
         super().__init__()
         self.warnings: list[str] = []
+        self.refine: str | None = None
 
     def warn(self, sentence: str) -> None:
         self.append(sentence)
@@ -438,12 +473,24 @@ def _record_auto(material, auto) -> None:
         del material[AUTO_KEY]
 
 
-def apply_to_object(context, obj, *, resolution=None) -> tuple:
+def _has_group(record: dict, method, over: bool) -> bool:
+    """Whether the file has a group of this bake (any tier)."""
+    return any(bpy.data.node_groups.get(group_name(tier, record["key"], method, over))
+               for tier in tiers.TIERS)
+
+
+def apply_to_object(context, obj, *, resolution=None, preview_first: bool = False) -> tuple:
     """Find or build the group for the settings of ``obj``'s active material and make it the
     material's surface, converted in place (:func:`setup_material`); an object without a
     material gets a new one.  Returns ``(material, report)``: the report's sentences
     (:class:`Report`: what was carried over, what was not as warnings, how many objects
     share the material).
+
+    ``resolution``: of the bake (default the settings').  ``preview_first``: when the file
+    has no group of that bake, bake and fit at preview resolution instead (about a quarter of
+    the bake's time, and the first Apply's match with it) and say so in ``report.refine``
+    (the resolution to rebuild at, which the caller does on a worker thread:
+    :func:`.live.refine`); else ``report.refine`` is None.
 
     Over the artist's shader (:func:`.convert.artist_tree`) the skin under the film is read
     from it again at every Apply (:func:`.artist_skin.read_material`).  Settings Apply has
@@ -469,24 +516,31 @@ def apply_to_object(context, obj, *, resolution=None) -> tuple:
     else:
         with shade.assigning():
             settings.over_shader = False
+    target = resolution or settings.resolution
+    quick = preview_first and target != PREVIEW
     if first and settings.shade_source == "DEFAULT":
         # A shade never chosen: match the skin (the artist's first step), before the fit
-        # measures the tiers at the absorption.
+        # measures the tiers at the absorption; on the tables Apply bakes.
         with skin_sampling.progress_bar(getattr(context, "window_manager", None)):
-            film, result = matching.first_shade(material, reading)
+            film, result = matching.first_shade(material, reading,
+                                                PREVIEW if quick else target)
         if film is not None:
             with shade.assigning():
                 settings.foundation = film
                 settings.film_roughness = shade.foundation_roughness(film)
         matching.assign(settings, result, "MATCH")
         report += result.sentences
-    record = storage.bake_record(skin_from_settings(settings),
-                                 resolution or settings.resolution)
+    record = storage.bake_record(skin_from_settings(settings), target)
+    if quick and not _has_group(record, forced_method(settings), reading is not None):
+        record = storage.bake_record(skin_from_settings(settings), PREVIEW)
+        report.refine = target
+        report.append(f"Baked at preview resolution first: the {target} tables follow in "
+                      f"the background.")
     with _Progress(context) as progress:
         work = _Bake(record, forced_method(settings), settings.coverage,
-                     settings.effective_absorption(), progress)
-        group, measured, tier, auto = _group_for(material, settings, scene, work, report,
-                                                 over=reading is not None)
+                     settings.effective_absorption(), progress,
+                     tiers=fitted_tiers(settings, scene), over=reading is not None)
+        group, measured, tier, auto = _group_for(material, settings, scene, work, report)
     _record_errors(material, measured, record["key"])
     _record_auto(material, auto)
     installed = setup_material(material, group, scene, reading)
@@ -521,21 +575,98 @@ def revert_material(material) -> str:
     return f"Reverted {material.name!r}: {restored}."
 
 
-def rebuild_from_settings(context, material, group, resolution: str) -> None:
-    """Bake the material's settings at ``resolution``, rebuild ``group`` (its group, or a copy
-    of it) in place and make it the material's surface: the live preview's re-bake, and Check
-    Tables' repair when the group's record cannot be used."""
+class _Checked:
+    """A progress for :class:`_Bake` that reports nothing but calls ``check()`` at every step
+    (which raises to stop the work)."""
+
+    def __init__(self, check):
+        self.check = check
+
+    def stage(self, start: float, end: float):
+        def report(fraction: float, message: str = "") -> None:
+            self.check()
+        return report
+
+
+class Rebuild:
+    """A rebuild of a material's group from its settings, in three steps so that the costly
+    one runs off the main thread (:mod:`.live`): :func:`prepare_rebuild` reads the settings
+    and the scene, :meth:`compute` makes the made-up skin, bakes, fits and measures (and
+    makes the Auto tier's choice once, which leaves its costly part cached), touching no bpy,
+    and :func:`finish_rebuild` builds the group from what was computed.  ``material``: the
+    name, ``uid``: the material's ``session_uid`` (another file's material of the same name
+    is not it); ``work``: the :class:`_Bake` (made by :meth:`compute`)."""
+
+    def __init__(self, material, skin: shade.SkinSettings, resolution: str, bake: dict,
+                 where):
+        self.material, self.uid = material.name, material.session_uid
+        self.skin, self.resolution, self.bake, self.where = skin, resolution, bake, where
+        self.work: _Bake | None = None
+        self.progress = None
+
+    @property
+    def key(self) -> str:
+        """The bake's key (once :meth:`compute` made it)."""
+        if self.work is None:
+            raise AssertionError("the rebuild is not computed")
+        return self.work.record["key"]
+
+    def compute(self, check=None) -> _Bake:
+        """Make the skin, bake, fit and measure (no bpy: any thread); ``check()``: called at
+        every step of the bake and the fit, raises to stop them.  Returns :attr:`work`."""
+        work = self.work
+        if work is None:
+            record = storage.bake_record(skin_from_settings(self.skin), self.resolution)
+            work = self.work = _Bake(record, **self.bake)
+        before = work.progress
+        work.progress = self.progress if check is None else _Checked(check)
+        try:
+            work.fitted()
+            measured = work.measured(with_traits=self.where is not None)
+            if self.where is not None:
+                traits = fits.traits(measured)
+                if traits is not None:
+                    self.where.choose(traits)
+        finally:
+            work.progress = before
+        return work
+
+
+def prepare_rebuild(context, material, resolution: str) -> Rebuild:
+    """What the rebuild of ``material``'s group at ``resolution`` needs of Blender (main
+    thread, a few milliseconds): its settings (:func:`.shade.skin_settings`), the tiers to fit
+    (:func:`fitted_tiers`), whether it goes over the artist's shader, and with Tier Auto the
+    scene the choice judges in."""
     settings = material.makeup_skin
-    record = storage.bake_record(skin_from_settings(settings), resolution)
     over = settings.over_shader and convert.artist_tree(material) is not None
-    with _Progress(context) as progress:
-        work = _Bake(record, forced_method(settings), settings.coverage,
-                     settings.effective_absorption(), progress)
-        group, measured, _, auto = _group_for(material, settings, context.scene, work, [],
-                                              group=group, over=over)
-    _record_errors(material, measured, record["key"])
+    bake = {"method": forced_method(settings), "coverage": settings.coverage,
+            "absorption": settings.effective_absorption(),
+            "tiers": fitted_tiers(settings, context.scene), "over": over}
+    where = scene_fit.choice_scene(material, context.scene) if settings.tier == "AUTO" else None
+    return Rebuild(material, shade.skin_settings(settings), resolution, bake, where)
+
+
+def finish_rebuild(context, material, group, rebuild: Rebuild) -> None:
+    """Rebuild ``group`` (the material's group, or a copy of it) in place from ``rebuild``
+    (computed: nothing is baked or fitted again) and make it the material's surface."""
+    settings = material.makeup_skin
+    work = rebuild.work if rebuild.work is not None else rebuild.compute()
+    group, measured, _, auto = _group_for(material, settings, context.scene, work, [],
+                                          group=group)
+    _record_errors(material, measured, rebuild.key)
     _record_auto(material, auto)
     setup_material(material, group, context.scene)
+
+
+def rebuild_from_settings(context, material, group, resolution: str) -> None:
+    """Bake the material's settings at ``resolution``, rebuild ``group`` (its group, or a copy
+    of it) in place and make it the material's surface, all at once: Check Tables' repair when
+    the group's record cannot be used, and the live preview without an event loop."""
+    rebuild = prepare_rebuild(context, material, resolution)
+    with _Progress(context) as progress:
+        rebuild.progress = progress
+        rebuild.compute()
+        finish_rebuild(context, material, group, rebuild)
 
 
 def check_material(context, material) -> tuple[bool, str]:
@@ -570,8 +701,11 @@ def check_material(context, material) -> tuple[bool, str]:
     if not problems and nodes.has_interface(group):
         return True, f"{name!r}: intact."
     settings = material.makeup_skin
+    tier = meta.get("tier", "LAYERED")
     work = _Bake({k: meta[k] for k in ("key", "parameters", "resolution")},
-                 meta.get("forced_method"), settings.coverage, settings.effective_absorption())
-    _build(work, meta.get("tier", "LAYERED"), group, nodes.over_shader(group))
+                 meta.get("forced_method"), settings.coverage, settings.effective_absorption(),
+                 tiers=fitted_tiers(settings, context.scene, (tier,)),
+                 over=nodes.over_shader(group))
+    _build(work, tier, group)
     what = "; ".join(problems) if problems else "its inputs were of an older version"
     return False, f"{name!r}: {what}; rebuilt it from a re-bake."

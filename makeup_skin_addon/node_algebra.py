@@ -1,7 +1,9 @@
 """Shader-node arithmetic: the tiers' formulas (lut_baker.closures.tier_formulas) emitted as
 Math and Vector Math nodes.
 
-- :class:`Builder` -- adds nodes to a tree, lays them out, links sockets or sets values.
+- :class:`Builder` -- adds nodes to a tree, lays them out, links sockets or sets values; or
+  takes a tree's nodes again in the order an earlier build added them (:class:`Mismatch` when
+  they are not those).
 - :class:`NodeValue` -- a node socket that takes part in ``+ - * /`` and ``** 2`` with other
   sockets and with constants (numbers, numpy arrays of 1 or 3 values): each operation adds one
   node, or none when the result is known (``x * 1``, ``x + 0``, ``x * 0``, two constants).
@@ -16,7 +18,7 @@ from __future__ import annotations
 import bpy
 import numpy as np
 
-__all__ = ["Builder", "NodeValue", "NodeAlgebra", "socket", "value_of"]
+__all__ = ["Builder", "Mismatch", "NodeValue", "NodeAlgebra", "socket", "value_of"]
 
 
 def socket(sockets, identifier: str):
@@ -27,15 +29,39 @@ def socket(sockets, identifier: str):
     raise KeyError(identifier)
 
 
+SAME_NODE = {"ShaderNodeBsdfGlossy": "ShaderNodeBsdfAnisotropic"}
+"""Node types Blender adds as another (the Glossy BSDF is the Anisotropic one since 4.0)."""
+
+
+class Mismatch(Exception):
+    """A :class:`Builder` reusing a tree's nodes met one that is not what it would add."""
+
+
 class Builder:
     """Adds nodes to a tree and links them; values may be sockets, :class:`NodeValue` or
-    constants."""
+    constants.
 
-    def __init__(self, tree):
+    ``reuse``: the tree holds what an earlier build of the same structure added, in the same
+    order (a group rebuilt from a new fit of the same tier): its nodes are taken in turn
+    instead of added, and only the settings, values and links that differ are set, which
+    costs a fraction of adding them (a live update's group swap on the main thread).  Every
+    input the build feeds is fed again, so a node taken for another of its type ends up as a
+    new one would.  A node of another type or label, or nodes or links left over
+    (:meth:`finish`), raise :class:`Mismatch`: the caller then clears the tree and builds
+    anew."""
+
+    def __init__(self, tree, *, reuse: bool = False):
         self.tree = tree
         self.count = 0
+        self._old = list(tree.nodes) if reuse else None
+        # The tree's links by their input (a socket's own ``links`` walks every link).
+        self._into = {link.to_socket.as_pointer(): link for link in tree.links} if reuse \
+            else {}
+        self._links = 0
 
     def node(self, kind: str, label: str = "", **props):
+        if self._old is not None:
+            return self._reused(kind, label, props)
         node = self.tree.nodes.new(kind)
         node.location = (200 * (self.count // 10) - 400, -160 * (self.count % 10))
         self.count += 1
@@ -45,20 +71,62 @@ class Builder:
             setattr(node, name, value)
         return node
 
+    def _reused(self, kind: str, label: str, props: dict):
+        """The next node of the tree, if it is of the type and label :meth:`node` would add
+        (its settings set where they differ: an operation, a distribution, an image)."""
+        if self._old is None or self.count >= len(self._old):
+            raise Mismatch("more nodes than the tree holds")
+        node = self._old[self.count]
+        self.count += 1
+        if node.bl_idname != SAME_NODE.get(kind, kind) or node.label != label:
+            raise Mismatch(f"{node.bl_idname} {node.label!r} where {kind} {label!r} goes")
+        for name, value in props.items():
+            if getattr(node, name) != value:
+                setattr(node, name, value)
+        return node
+
+    def link(self, source, target) -> None:
+        """Link output ``source`` into input ``target`` (reusing: unless it is linked so)."""
+        if self._old is None:
+            self.tree.links.new(source, target)
+            return
+        self._links += 1
+        key = target.as_pointer()
+        old = self._into.get(key)
+        if old is not None and old.from_socket.as_pointer() == source.as_pointer():
+            return
+        self._into[key] = self.tree.links.new(source, target)
+
+    def finish(self) -> None:
+        """Reusing: :class:`Mismatch` unless every node and link of the tree was taken."""
+        if self._old is not None and (self.count != len(self._old)
+                                      or self._links != len(self.tree.links)):
+            raise Mismatch("the tree holds nodes or links this build does not add")
+
     def feed(self, target, value):
-        """Link a socket into ``target`` or set its default value."""
+        """Link a socket into ``target`` or set its default value (reusing: only if it
+        differs, and a link where a value goes removed)."""
         value = value_of(value)
         if isinstance(value, bpy.types.NodeSocket):
-            self.tree.links.new(value, target)
-        elif target.type in ("VECTOR", "RGBA") and np.size(value) == 1:
+            self.link(value, target)
+            return
+        if target.type in ("VECTOR", "RGBA") and np.size(value) == 1:
             n = len(target.default_value)
-            target.default_value = (float(np.ravel(value)[0]),) * n
+            new = (float(np.ravel(value)[0]),) * n
         elif target.type == "RGBA" and len(value) == 3:
-            target.default_value = (*map(float, value), 1.0)
+            new = (*map(float, value), 1.0)
         elif np.ndim(value) == 0 or np.size(value) == 1:
-            target.default_value = float(np.ravel(value)[0])
+            new = float(np.ravel(value)[0])
         else:
-            target.default_value = tuple(map(float, value))
+            new = tuple(map(float, value))
+        if self._old is not None:
+            link = self._into.pop(target.as_pointer(), None)
+            if link is not None:
+                self.tree.links.remove(link)
+            old = target.default_value
+            if (tuple(old) if isinstance(new, tuple) else old) == new:
+                return
+        target.default_value = new
 
     def math(self, operation: str, a, b=0.0, label: str = ""):
         node = self.node("ShaderNodeMath", label, operation=operation)
@@ -74,8 +142,7 @@ class Builder:
 
     def mix_vector(self, factor, a, b, label: str = ""):
         """``a + factor (b - a)``, factor unclamped."""
-        node = self.node("ShaderNodeMix", label, data_type="VECTOR")
-        node.clamp_factor = False
+        node = self.node("ShaderNodeMix", label, data_type="VECTOR", clamp_factor=False)
         self.feed(socket(node.inputs, "Factor_Float"), factor)
         self.feed(socket(node.inputs, "A_Vector"), a)
         self.feed(socket(node.inputs, "B_Vector"), b)

@@ -42,7 +42,9 @@ and anisotropic filtering, which mixes the image's rows wherever ``cos(theta_o)`
 quickly across the screen (docs/addon.md, "Why the Layered tier breaks in EEVEE").
 
 - :func:`build_group` -- create or rebuild (in place) a group from a fit and its bake record,
-  named by :func:`.keys.group_name` (tier, tables key, a forced subsurface method).
+  named by :func:`.keys.group_name` (tier, tables key, a forced subsurface method); a group
+  rebuilt with the same structure keeps its nodes, only values and links set anew
+  (:class:`.node_algebra.Builder` ``reuse``).
 - :func:`read_meta` -- a group's record (bake, fit summary, image hashes).
 - :func:`set_inputs` -- socket values on a group node from the panel's settings.
 """
@@ -57,7 +59,7 @@ import numpy as np
 from . import storage
 from .core import tier_formulas, tiers
 from .keys import FIT_KEY, LEGACY_TABLES_REF, group_name, lut_image_name
-from .node_algebra import Builder, NodeAlgebra, NodeValue, socket
+from .node_algebra import Builder, Mismatch, NodeAlgebra, NodeValue, socket
 
 __all__ = ["INPUTS", "OVER_SHADER_INPUTS", "NORMAL_INPUTS", "build_group", "read_meta",
            "write_measured", "set_inputs", "socket", "has_interface", "over_shader",
@@ -220,10 +222,10 @@ def _finish(build: Builder, inputs, output, shader, over: bool) -> None:
     if over:
         mix = build.node("ShaderNodeMixShader", "coverage (areal mix over the artist's shader)")
         build.feed(socket(mix.inputs, "Fac"), inputs.outputs["Coverage"])
-        build.tree.links.new(inputs.outputs["Skin Shader"], socket(mix.inputs, "Shader"))
-        build.tree.links.new(shader, socket(mix.inputs, "Shader_001"))
+        build.link(inputs.outputs["Skin Shader"], socket(mix.inputs, "Shader"))
+        build.link(shader, socket(mix.inputs, "Shader_001"))
         shader = mix.outputs[0]
-    build.tree.links.new(shader, output.inputs["Shader"])
+    build.link(shader, output.inputs["Shader"])
 
 
 def _build_principled(build: Builder, fit, method: str, radius_mm, ior: float, over: bool):
@@ -289,7 +291,7 @@ def _lut_rows(build: Builder, lut, names: tuple, coordinates: dict, bounds=None)
             build.feed(coordinate.inputs["Y"], (j + 0.5) / len(names))
             texture = build.node("ShaderNodeTexImage", name, image=lut,
                                  interpolation="Closest", extension="EXTEND")
-            build.tree.links.new(coordinate.outputs[0], texture.inputs["Vector"])
+            build.link(coordinate.outputs[0], texture.inputs["Vector"])
             samples.append(texture.outputs["Color"])
         value = build.mix_vector(weight, samples[0], samples[1], label=f"row {name}")
         if bounds is not None:
@@ -306,8 +308,8 @@ def _add(build: Builder, shaders: list):
     total = shaders[0]
     for shader in shaders[1:]:
         node = build.node("ShaderNodeAddShader")
-        build.tree.links.new(total, node.inputs[0])
-        build.tree.links.new(shader, node.inputs[1])
+        build.link(total, node.inputs[0])
+        build.link(shader, node.inputs[1])
         total = node.outputs[0]
     return total
 
@@ -355,7 +357,7 @@ def _build_view_weighted(build: Builder, fit, parts, lut, method: str, radius_mm
             return node.outputs[0]
         weighted = build.node("ShaderNodeMixShader", f"{closure.name} (weight)")
         build.feed(socket(weighted.inputs, "Fac"), closure.weight)
-        build.tree.links.new(node.outputs[0], socket(weighted.inputs, "Shader_001"))
+        build.link(node.outputs[0], socket(weighted.inputs, "Shader_001"))
         return weighted.outputs[0]
 
     covered = _add(build, [emit(c) for c in closures.covered])
@@ -364,11 +366,27 @@ def _build_view_weighted(build: Builder, fit, parts, lut, method: str, radius_mm
         return
     mix = build.node("ShaderNodeMixShader", "coverage (areal mix)")
     build.feed(socket(mix.inputs, "Fac"), closures.coverage)
-    build.tree.links.new(_add(build, [emit(c) for c in closures.bare]),
+    build.link(_add(build, [emit(c) for c in closures.bare]),
                          socket(mix.inputs, "Shader"))
-    build.tree.links.new(covered, socket(mix.inputs, "Shader_001"))
+    build.link(covered, socket(mix.inputs, "Shader_001"))
     shaded = _add(build, [mix.outputs[0], *(emit(c) for c in closures.shared)])
     _finish(build, inputs, output, shaded, over)
+
+
+def _emit(group, emit, reuse: bool) -> None:
+    """Run ``emit(builder)`` on ``group``: over its nodes again when ``reuse`` (a group of the
+    same tier and kind: the same structure, new values; :class:`.node_algebra.Builder`), or
+    on a cleared group (at once, or when the structure turns out to differ)."""
+    if reuse:
+        build = Builder(group, reuse=True)
+        try:
+            emit(build)
+            build.finish()
+            return
+        except Mismatch:
+            pass
+    group.nodes.clear()
+    emit(Builder(group))
 
 
 def build_group(tier: str, record: dict, fit, group=None, *, method=None, measured=None,
@@ -384,6 +402,8 @@ def build_group(tier: str, record: dict, fit, group=None, *, method=None, measur
     made-up skin, bare skin included (:data:`INPUTS`)."""
     if tier not in tiers.TIERS:
         raise ValueError(f"tier must be one of {tiers.TIERS}, got {tier!r}")
+    if tier not in fit.tiers:
+        raise ValueError(f"the fit holds no {tier} tier (it has {', '.join(fit.tiers)})")
     key = record["key"]
     name = group_name(tier, key, method, over)
     if group is None:
@@ -391,22 +411,28 @@ def build_group(tier: str, record: dict, fit, group=None, *, method=None, measur
                                                                            "ShaderNodeTree")
     elif group.name != name and bpy.data.node_groups.get(name) is None:
         group.name = name
+    before = read_meta(group)
+    reuse = (bool(group.nodes) and (before.get("tier"), before.get("over_shader")) == (tier, over)
+             and has_interface(group))
     _interface(group, fit.skin_albedo, over)
-    group.nodes.clear()
-    build = Builder(group)
     forced = method
     method = method or (tiers.EEVEE_SUBSURFACE_METHOD if tier == "EEVEE"
                         else fit.subsurface_method)
-    radius = fit.profiles[method].radius_mm
+    # Over the artist's shader the radius is theirs (a fit for it may have no profiles).
+    radius = None if over else fit.profiles[method].radius_mm
     ior = fit.subsurface_ior
     images = []
     if tier == "PRINCIPLED":
-        _build_principled(build, fit, method, radius, ior, over)
+        def emit(build):
+            _build_principled(build, fit, method, radius, ior, over)
     else:
         parts = tiers.view_weighted_parts(fit, tier)
         lut = storage.lut_image(lut_image_name(key, tier), parts.lut)
         images.append(storage.image_record(lut))
-        _build_view_weighted(build, fit, parts, lut, method, radius, ior, over)
+
+        def emit(build):
+            _build_view_weighted(build, fit, parts, lut, method, radius, ior, over)
+    _emit(group, emit, reuse)
     group[FIT_KEY] = json.dumps({**record, "tier": tier, "forced_method": forced,
                                  "over_shader": over,
                                  "images": images, **fit.summary(),

@@ -31,8 +31,8 @@ import math
 
 import bpy
 
+from . import live, nodes, shade, storage
 from . import material as made_up
-from . import nodes, shade, storage
 from .core import presets, roughness
 from .keys import FIT_KEY, SETTINGS_VERSION
 
@@ -132,7 +132,9 @@ def repair_file(context) -> list[str]:
 @bpy.app.handlers.persistent
 def check_on_load(*_args) -> None:
     """The ``load_post`` handler: :func:`upgrade_file`, then :func:`repair_file`, each
-    sentence printed on the console."""
+    sentence printed on the console; the live rebuilds pending for the file before are
+    dropped (:func:`.live.forget`)."""
+    live.forget()
     _notices.clear()
     upgraded = upgrade_file()
     if upgraded:

@@ -113,11 +113,18 @@ class MAKEUPSKIN_OT_apply(bpy.types.Operator):
     def execute(self, context):
         obj = context.active_object
         resolution = None if self.resolution == "SETTINGS" else self.resolution
+        if obj.active_material is not None:
+            live.cancel(obj.active_material)  # a live rebuild in flight is stale now
         try:
-            material, messages = made_up.apply_to_object(context, obj, resolution=resolution)
+            # With an event loop, a new bake is done at preview resolution first and refined
+            # on a worker thread (docs/addon.md, "Apply and Live Update, timed").
+            material, messages = made_up.apply_to_object(
+                context, obj, resolution=resolution, preview_first=live.can_refine())
         except (ValueError, RuntimeError) as error:
             self.report({"ERROR"}, f"Made-up Skin: {_sentence(error)}")
             return {"CANCELLED"}
+        if messages.refine is not None:
+            live.refine(context, material, messages.refine)
         warnings = getattr(messages, "warnings", [])
         for message in messages:
             self.report({"WARNING"} if message in warnings else {"INFO"},
@@ -145,6 +152,7 @@ class MAKEUPSKIN_OT_revert(bpy.types.Operator):
 
     def execute(self, context):
         try:
+            live.cancel(context.active_object.active_material)
             message = made_up.revert_material(context.active_object.active_material)
         except ValueError as error:
             self.report({"ERROR"}, f"Made-up Skin: {_sentence(error)}")

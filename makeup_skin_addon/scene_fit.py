@@ -13,7 +13,8 @@ coverage and absorption (kept in its group's record, :mod:`.fits`).
 - :func:`material_traits` -- the material as the model sees it.
 - :func:`choose_with` -- the choice for a material of given traits in a scene (Apply's Auto
   tier: the traits of the foundation being applied); :func:`choose_for` -- the same with the
-  material's own traits (Fit to Scene).
+  material's own traits (Fit to Scene); :func:`choice_scene` -- what the choice reads of
+  Blender, so that a worker thread can make it (:class:`ChoiceScene`).
 - :func:`set_choice` -- a choice's settings on the material: the tier, Subsurface Scale 0 when
   the scene does not resolve the subsurface, Gloss 0 when the gloss lobes change the image by
   less than the tolerance allows (below the noise); the values before are kept and given back
@@ -30,14 +31,15 @@ from __future__ import annotations
 
 import json
 import math
+from dataclasses import dataclass
 
 from . import convert, fits, nodes, storage
-from .core import auto_tier
+from .core import auto_tier, closure_fit
 from .keys import CHOICE_KEY, SAVED_GLOSS_KEY, SAVED_SCALE_KEY
 
 __all__ = ["ENVIRONMENT_LIGHT_DEG", "units_per_mm", "render_engine", "describe_scene",
-           "material_traits", "choose_with", "choose_for", "set_choice", "record_choice",
-           "last_choice", "register", "unregister"]
+           "material_traits", "choose_with", "choose_for", "ChoiceScene", "choice_scene",
+           "set_choice", "record_choice", "last_choice", "register", "unregister"]
 
 ENVIRONMENT_LIGHT_DEG = 45.0
 """Light angle (degrees from the view) assumed when the scene has no lamp (world light)."""
@@ -149,31 +151,36 @@ def _meta(material) -> dict:
     return nodes.read_meta(node.node_tree) if node is not None else {}
 
 
-def _measurement(meta: dict, coverage: float, absorption, *, may_fit: bool):
-    """What the group's fit measured at this coverage and absorption: kept in its record, or
-    measured now from this session's fit, or (``may_fit``) from a new bake and fit; None
-    when none of these can be had."""
-    measured = fits.measured_at(meta, coverage, absorption, with_traits=True)
+def _measurement(meta: dict, coverage: float, absorption, *, may_fit: bool, tiers):
+    """What the group's fit measured at this coverage and absorption, of ``tiers`` at least:
+    kept in its record, or measured now from this session's fit, or (``may_fit``) from a new
+    bake and fit (or the missing tiers fitted onto it); None when none of these can be
+    had."""
+    measured = fits.measured_at(meta, coverage, absorption, with_traits=True, tiers=tiers)
     if measured is not None or "parameters" not in meta:
         return measured
     method = meta.get("forced_method")
+    over = bool(meta.get("over_shader"))
     try:
-        got = fits.cached(meta, method)
+        got = fits.cached(meta, method, tiers=tiers, over_shader=over)
         if got is None and may_fit:
-            got = fits.baked(meta, method=method, errors_at=(coverage, absorption))
+            got = fits.baked(meta, method=method, tiers=tiers, over_shader=over,
+                             errors_at=(coverage, absorption))
     except storage.StorageError:
         return None
     if got is None:
         return None
-    return fits.measure(*got, coverage, absorption, method=meta.get("subsurface_method"))
+    return fits.measure(*got, coverage, absorption, method=meta.get("subsurface_method"),
+                        over_shader=over)
 
 
-def material_traits(material, *, refit: bool = False, may_fit: bool = True):
+def material_traits(material, *, refit: bool = False, may_fit: bool = True, scene=None):
     """The :class:`lut_baker.auto_tier.MaterialTraits` of a made-up material at its coverage
     and absorption, the Subsurface Scale and Gloss applied (the values Fit to Scene saved if
-    it set them to 0): what its group's fit measured there (:mod:`.fits`; ``refit``: measured
-    again rather than read from the record; without ``may_fit`` never a new bake or fit).
-    Without either: the paper preset's traits."""
+    it set them to 0): what its group's fit measured there, of the tiers made for ``scene``'s
+    engine (default: every tier) (:mod:`.fits`; ``refit``: measured again rather than read
+    from the record; without ``may_fit`` never a new bake or fit).  Without either: the
+    paper preset's traits."""
     settings = material.makeup_skin
     coverage = float(settings.coverage)
     absorption = [float(a) for a in settings.effective_absorption()]
@@ -182,7 +189,9 @@ def material_traits(material, *, refit: bool = False, may_fit: bool = True):
     meta = _meta(material)
     if refit:
         meta = {key: value for key, value in meta.items() if key != "measured"}
-    measured = _measurement(meta, coverage, absorption, may_fit=may_fit)
+    tiers = (auto_tier.ENGINE_TIERS[render_engine(scene)] if scene is not None
+             else closure_fit.TIERS)
+    measured = _measurement(meta, coverage, absorption, may_fit=may_fit, tiers=tiers)
     traits = fits.traits(measured) if measured is not None else None
     return (traits or auto_tier.paper_traits()).scaled(scale, gloss)
 
@@ -193,17 +202,38 @@ def _unknown_scene(scene):
                                                    denoise=denoise, **UNKNOWN_SCENE)
 
 
+@dataclass(frozen=True)
+class ChoiceScene:
+    """What the Auto tier's choice for a material reads of Blender: ``used``, the scene it
+    judges in (the described scene, or a close-up), ``described`` (None: the scene was
+    unknown), and the material's Subsurface Scale and Gloss (:func:`_kept_value`)."""
+
+    used: object
+    described: object
+    scale: float
+    gloss: float
+
+    def choose(self, traits, tolerance=None):
+        """The choice for a material of ``traits`` here (no bpy: any thread may ask)."""
+        tolerance = auto_tier.DEFAULT_TOLERANCE if tolerance is None else tolerance
+        return auto_tier.choose(self.used, traits.scaled(self.scale, self.gloss),
+                                tolerance=tolerance)
+
+
+def choice_scene(material, scene, *, obj=None) -> ChoiceScene:
+    """The :class:`ChoiceScene` of ``material`` in ``scene`` (for ``obj``, default the nearest
+    object wearing it; an unknown scene counts as a close-up: :data:`UNKNOWN_SCENE`)."""
+    description = describe_scene(scene, material, obj)
+    return ChoiceScene(used=description or _unknown_scene(scene), described=description,
+                       scale=_kept_value(material, "subsurface_scale", SAVED_SCALE_KEY),
+                       gloss=_kept_value(material, "gloss", SAVED_GLOSS_KEY))
+
+
 def choose_with(traits, material, scene, *, obj=None, tolerance=None):
     """``(Choice, SceneDescription or None)`` for a material of ``traits`` (the Subsurface
-    Scale and Gloss of its settings applied here) in ``scene`` (an unknown scene counts as a
-    close-up: :data:`UNKNOWN_SCENE`)."""
-    description = describe_scene(scene, material, obj)
-    scale = _kept_value(material, "subsurface_scale", SAVED_SCALE_KEY)
-    gloss = _kept_value(material, "gloss", SAVED_GLOSS_KEY)
-    tolerance = auto_tier.DEFAULT_TOLERANCE if tolerance is None else tolerance
-    choice = auto_tier.choose(description or _unknown_scene(scene), traits.scaled(scale, gloss),
-                       tolerance=tolerance)
-    return choice, description
+    Scale and Gloss of its settings applied here) in ``scene`` (:func:`choice_scene`)."""
+    where = choice_scene(material, scene, obj=obj)
+    return where.choose(traits, tolerance), where.described
 
 
 def choose_for(material, scene, *, obj=None, tolerance=None, refit=False, may_fit=True):
@@ -212,7 +242,7 @@ def choose_for(material, scene, *, obj=None, tolerance=None, refit=False, may_fi
     description = describe_scene(scene, material, obj)
     tolerance = auto_tier.DEFAULT_TOLERANCE if tolerance is None else tolerance
     choice = auto_tier.choose(description or _unknown_scene(scene),
-                       material_traits(material, refit=refit, may_fit=may_fit),
+                       material_traits(material, refit=refit, may_fit=may_fit, scene=scene),
                        tolerance=tolerance)
     return choice, description
 

@@ -1,6 +1,7 @@
 """What the panel's shade, film and skin settings mean in the model.
 
-- The settings as a made-up skin (:func:`skin_from_settings`): the foundation and skin presets,
+- The settings as a made-up skin (:func:`skin_from_settings`, of the settings or of their
+  plain values, :func:`skin_settings`): the foundation and skin presets,
   Film Roughness and Skin Roughness (Blender roughness, :mod:`lut_baker.model.roughness`: the
   preset's own unless moved), Film IOR with its override, and over the artist's shader its
   skin's index.
@@ -34,6 +35,8 @@ __all__ = [
     "skin_roughness",
     "has_film_gloss",
     "skin_from_settings",
+    "SkinSettings",
+    "skin_settings",
     "colour_seen",
     "absorption_for_colour",
     "preset_colour",
@@ -87,6 +90,27 @@ def _roughened(layer, value: float, own: float):
     return _ROUGHENED.get_or_compute(key, lambda: roughness.with_roughness(layer, float(value)))
 
 
+@dataclass(frozen=True)
+class SkinSettings:
+    """What :func:`skin_from_settings` reads of the panel's settings, as plain values (read on
+    the main thread, the skin made from them on a worker: :func:`skin_settings`)."""
+
+    foundation: str
+    skin: str
+    film_roughness: float
+    skin_roughness: float
+    over_shader: bool
+    skin_ior: float
+    override_film: bool
+    film_ior: float
+
+
+def skin_settings(settings) -> SkinSettings:
+    """The :class:`SkinSettings` of a material's settings now."""
+    return SkinSettings(**{name: getattr(settings, name)
+                           for name in SkinSettings.__dataclass_fields__})
+
+
 def skin_from_settings(settings, foundation: str | None = None):
     """The made-up skin the settings describe, at coverage 1 and absorption 0 (both are socket
     values, applied after the bake).  Film Roughness reshapes the film surface's gloss and
@@ -96,7 +120,8 @@ def skin_from_settings(settings, foundation: str | None = None):
     surface and of its transmission's Fresnel term; the film's transmission lobe stays the
     foundation's, since it is set by the pigment the light crosses, not by the surface
     (docs/model.md §4).  ``foundation``: another foundation preset's film instead of the
-    settings' (at its own roughness)."""
+    settings' (at its own roughness).  ``settings``: the material's, or their
+    :class:`SkinSettings` (no bpy: any thread)."""
     name = settings.foundation if foundation is None else foundation
     skin = presets.made_up_skin(name, settings.skin, coverage=1.0, absorption=0.0)
     own = foundation_roughness(name)

@@ -18,7 +18,7 @@ import numpy as np
 
 from ..bake import RESOLUTIONS, profile_radius
 from ..closures.profiles import edge_response, profile_grid
-from ..closures.tiers import TIER_REPLICAS, TIERS, tier_errors
+from ..closures.tiers import tier_errors, tier_reflection
 from ..model.dipole import dipole_profile, dipole_total_reflectance
 from ..model.made_up_skin import combine, coverage_weights
 from ..model.presets import made_up_skin
@@ -140,18 +140,37 @@ def profile_mean_radius_mm(radius_mm, profile) -> float:
     return float(np.max(mean / np.maximum(mass, 1e-300)))
 
 
-def gloss_and_skin_shares(tables, light_deg: float, coverage=None, absorption=None, *,
-                          resolution: int = 48) -> tuple[float, float]:
-    """``(gloss share, skin share)`` of a sphere's image under one distant light
-    ``light_deg`` from the view (orthographic, the reference's framing): relative RMS over
-    the lit pixels of the gloss lobes' radiance (film, path-3 and skin gloss at the coverage
-    and absorption) and of the skin's diffuse part (what spreads), against the total radiance
-    ``f cos(theta_i)`` from the tables."""
+@dataclass
+class _Sphere:
+    """A sphere's lit pixels under one distant light (orthographic, the reference's
+    framing): their directions, ``cos(theta_i)`` ``(N, 1)`` and the tables' radiance
+    ``f cos(theta_i)`` at a coverage and absorption, with its RMS ``norm``."""
+
+    wi: np.ndarray
+    wo: np.ndarray
+    cos_i: np.ndarray
+    total: np.ndarray
+    norm: float
+    _bare: np.ndarray | None = None
+
+    def bare(self, tables, absorption) -> np.ndarray:
+        """The tables' bare skin's BRDF at the pixels (computed once)."""
+        if self._bare is None:
+            self._bare = tables.made_up_reflection(self.wi, self.wo, 0.0, absorption)
+        return self._bare
+
+
+def _sphere(tables, light_deg: float, w, a, resolution: int) -> _Sphere:
     _, wi, wo = sphere_directions(resolution, light_deg)
-    w, a = tables.coverage_and_absorption(coverage, absorption)
-    weights = coverage_weights(w, a)
     cos_i = wi[:, 2:3]
     total = tables.made_up_reflection(wi, wo, w, a) * cos_i
+    return _Sphere(wi, wo, cos_i, total, float(np.sqrt(np.mean(total**2))))
+
+
+def _shares(tables, sphere: _Sphere, w, a) -> tuple[float, float]:
+    """:func:`gloss_and_skin_shares` on a sphere's pixels."""
+    wi, wo, cos_i = sphere.wi, sphere.wo, sphere.cos_i
+    weights = coverage_weights(w, a)
     gloss = combine(weights, top=tables.angular("film_gloss", wi, wo),
                     twice=tables.angular("path3_gloss", wi, wo),
                     bare=tables.angular("skin_gloss", wi, wo)) * cos_i
@@ -159,38 +178,63 @@ def gloss_and_skin_shares(tables, light_deg: float, coverage=None, absorption=No
     t_o = tables.directional("film_transmittance", polar_angle_deg(wo))
     skin = combine(weights, twice=tables.skin_diffuse * t_i * t_o,
                    bare=tables.skin_diffuse) * cos_i
-    norm = np.sqrt(np.mean(total**2))
+    norm = sphere.norm
     if not norm > 0:
         return 0.0, 0.0
     return float(np.sqrt(np.mean(gloss**2)) / norm), float(np.sqrt(np.mean(skin**2)) / norm)
 
 
-def gloss_omission_error(tables, fit, tier: str, light_deg: float, coverage=None,
-                         absorption=None, *, resolution: int = 48) -> float:
-    """Relative RMS change of a sphere's image (orthographic, one distant light ``light_deg``
-    from the view, the lit pixels) when ``tier``'s Gloss input goes from 1 to 0: the tier's
-    replica (:data:`lut_baker.closures.tiers.TIER_REPLICAS` with the closure fit ``fit``) with
-    and without its gloss lobes, over the RMS of the tables' radiance ``f cos(theta_i)``, at
-    the coverage and absorption (default: the tables')."""
-    _, wi, wo = sphere_directions(resolution, light_deg)
+def gloss_and_skin_shares(tables, light_deg: float, coverage=None, absorption=None, *,
+                          resolution: int = 48) -> tuple[float, float]:
+    """``(gloss share, skin share)`` of a sphere's image under one distant light
+    ``light_deg`` from the view (orthographic, the reference's framing): relative RMS over
+    the lit pixels of the gloss lobes' radiance (film, path-3 and skin gloss at the coverage
+    and absorption) and of the skin's diffuse part (what spreads), against the total radiance
+    ``f cos(theta_i)`` from the tables."""
     w, a = tables.coverage_and_absorption(coverage, absorption)
-    cos_i = wi[:, 2:3]
-    norm = np.sqrt(np.mean((tables.made_up_reflection(wi, wo, w, a) * cos_i) ** 2))
+    return _shares(tables, _sphere(tables, light_deg, w, a, resolution), w, a)
+
+
+def _omission(tables, fit, tier: str, sphere: _Sphere, w, a, over_shader: bool) -> float:
+    """:func:`gloss_omission_error` on a sphere's pixels."""
+    norm = sphere.norm
     if not norm > 0:
         return 0.0
-    replica = TIER_REPLICAS[tier]
-    kept, left_out = (replica(fit, tables, w, a, gloss, (wi, wo)) for gloss in (1.0, 0.0))
-    return float(np.sqrt(np.mean(((kept - left_out) * cos_i) ** 2)) / norm)
+    bare = sphere.bare(tables, a) if over_shader else None
+    kept, left_out = (tier_reflection(fit, tables, tier, w, a, gloss, (sphere.wi, sphere.wo),
+                                      over_shader=over_shader, bare=bare)
+                      for gloss in (1.0, 0.0))
+    return float(np.sqrt(np.mean(((kept - left_out) * sphere.cos_i) ** 2)) / norm)
+
+
+def gloss_omission_error(tables, fit, tier: str, light_deg: float, coverage=None,
+                         absorption=None, *, resolution: int = 48,
+                         over_shader: bool = False) -> float:
+    """Relative RMS change of a sphere's image (orthographic, one distant light ``light_deg``
+    from the view, the lit pixels) when ``tier``'s Gloss input goes from 1 to 0: the tier's
+    replica (:func:`lut_baker.closures.tiers.tier_reflection` with the closure fit ``fit``;
+    ``over_shader``: the bare skin the artist's, which Gloss leaves alone) with and without
+    its gloss lobes, over the RMS of the tables' radiance ``f cos(theta_i)``, at the coverage
+    and absorption (default: the tables')."""
+    w, a = tables.coverage_and_absorption(coverage, absorption)
+    return _omission(tables, fit, tier, _sphere(tables, light_deg, w, a, resolution), w, a,
+                     over_shader)
 
 
 def gloss_omissions(tables, fit, coverage=None, absorption=None, *,
-                    lights_deg=None) -> dict:
-    """:func:`gloss_omission_error` of every tier at ``lights_deg`` (default
-    :data:`SHARE_LIGHTS_DEG`): ``{tier: {light angle: error}}``."""
+                    lights_deg=None, tiers=None, over_shader: bool = False) -> dict:
+    """:func:`gloss_omission_error` of ``tiers`` (default: every tier ``fit`` holds) at
+    ``lights_deg`` (default :data:`SHARE_LIGHTS_DEG`): ``{tier: {light angle: error}}``."""
     lights = SHARE_LIGHTS_DEG if lights_deg is None else lights_deg
-    return {tier: {float(light): gloss_omission_error(tables, fit, tier, light, coverage,
-                                                      absorption)
-                   for light in lights} for tier in TIERS}
+    w, a = tables.coverage_and_absorption(coverage, absorption)
+    spheres = {float(light): _sphere(tables, light, w, a, 48) for light in lights}
+    return _omissions(tables, fit, spheres, w, a, fit.tiers if tiers is None else tiers,
+                      over_shader)
+
+
+def _omissions(tables, fit, spheres: dict, w, a, tiers, over_shader: bool) -> dict:
+    return {tier: {light: _omission(tables, fit, tier, sphere, w, a, over_shader)
+                   for light, sphere in spheres.items()} for tier in tiers}
 
 
 def profile_mismatch(tables, fit_error) -> float:
@@ -213,24 +257,31 @@ shares."""
 
 def traits_from_tables(tables, fit, coverage=None, absorption=None, *,
                        lights_deg=SHARE_LIGHTS_DEG, method: str | None = None,
-                       errors: dict | None = None) -> MaterialTraits:
+                       errors: dict | None = None, over_shader: bool = False
+                       ) -> MaterialTraits:
     """:class:`MaterialTraits` of baked ``tables`` and their
     :class:`lut_baker.closures.closure_fit.ClosureFit` ``fit`` at a coverage and absorption
-    (default:
-    the tables'); ``errors``: the fit's :func:`lut_baker.closures.tiers.tier_errors` there,
-    if already measured."""
+    (default: the tables'), for the tiers ``fit`` holds; ``errors``: the fit's
+    :func:`lut_baker.closures.tiers.tier_errors` there, if already measured.
+    ``over_shader``: a fit for a group over the artist's shader (``fit_closures(...,
+    over_shader=True)``): the bare skin is the artist's (the tiers' errors and gloss
+    omissions leave it as it is) and so is the subsurface closure under the film, radius and
+    method, which spreads light as the artist's skin does: no profile mismatch."""
     w, a = tables.coverage_and_absorption(coverage, absorption)
-    errors = tier_errors(fit, tables, w, a) if errors is None else errors
-    shares = {float(angle): gloss_and_skin_shares(tables, angle, w, a) for angle in lights_deg}
+    errors = tier_errors(fit, tables, w, a, over_shader=over_shader) if errors is None \
+        else errors
+    spheres = {float(angle): _sphere(tables, angle, w, a, 48) for angle in lights_deg}
+    shares = {angle: _shares(tables, sphere, w, a) for angle, sphere in spheres.items()}
+    mismatch = 0.0 if over_shader else profile_mismatch(
+        tables, fit.profiles[method or fit.subsurface_method].error)
     return MaterialTraits(
         tier_errors={tier: float(e.rms) for tier, e in errors.items()},
         radius_mm=np.asarray(tables.radius_mm, float),
         profile=np.asarray(tables.profile, float),
-        profile_mismatch=profile_mismatch(
-            tables, fit.profiles[method or fit.subsurface_method].error),
+        profile_mismatch=mismatch,
         skin_share={angle: value[1] for angle, value in shares.items()},
         gloss_share={angle: value[0] for angle, value in shares.items()},
-        gloss_omission=gloss_omissions(tables, fit, w, a, lights_deg=lights_deg),
+        gloss_omission=_omissions(tables, fit, spheres, w, a, fit.tiers, over_shader),
     )
 
 

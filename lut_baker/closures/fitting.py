@@ -32,7 +32,9 @@ Where each part lives: the lobes :mod:`~lut_baker.closures.lobes`, the subsurfac
 :mod:`~lut_baker.closures.tiers`, the grids :mod:`~lut_baker.closures.view_grid`, the view-angle
 image :mod:`~lut_baker.closures.view_image`.
 
-- :func:`fit_closures` -- every fit of one set of tables, and the tiers' errors.
+- :func:`fit_closures` -- the fits of some tiers (default all) to one set of tables, or of
+  more tiers onto a fit (over the artist's shader: without the bare skin's lobes), and their
+  errors.
 - :func:`subsurface_ior` -- the Subsurface IOR from the tables' parameters.
 """
 
@@ -45,8 +47,16 @@ import numpy as np
 from ..numerics.quadrature import trapezoid_weights
 from ..tables.table_set import Tables
 from . import cycles as cc
-from .closure_fit import ClosureFit
-from .lobes import EEVEE_GLOSSY, fit_coat, fit_glossy, fit_glossy_pair, fit_specular
+from .closure_fit import TIERS, ClosureFit
+from .lobes import (
+    EEVEE_GLOSSY,
+    ROUGHNESS_RANGE,
+    LobeFit,
+    fit_coat,
+    fit_glossy,
+    fit_glossy_pair,
+    fit_specular,
+)
 from .profiles import REPLICA_EDGE_ERROR, fit_profiles
 from .tier_formulas import SPECULAR_IOR
 from .tiers import tier_errors
@@ -54,7 +64,6 @@ from .view_grid import FIT_VIEWS, lobe_widths_deg, view_grid
 from .view_image import DEFAULT_LUT_SIZE, EEVEE_LUT_ROWS, LUT_ROWS, lut_nodes
 
 __all__ = ["fit_closures", "subsurface_ior"]
-
 
 
 def _cosine_mean(values: np.ndarray, theta_deg: np.ndarray) -> np.ndarray:
@@ -96,85 +105,81 @@ def subsurface_ior(parameters: dict) -> float:
     return float(np.clip(eta, 1.01, 3.8))
 
 
-def fit_closures(tables: Tables, *, lut_size: int = DEFAULT_LUT_SIZE,
-                 subsurface_method: str | None = None, errors_at=None,
-                 progress=None) -> ClosureFit:
-    """Fit both tiers to ``tables`` and measure their errors at ``errors_at`` = ``(coverage,
-    absorption)`` (default: those the tables were baked for).  ``subsurface_method``: force
-    one (default: the method whose edge response, fitted error and replica error combined,
-    is closest to the tables'; all three are fitted and reported).  ``progress(fraction,
-    message)``: called as the fit advances (fraction 0..1).
+class _Targets:
+    """What the lobes of one set of tables are fitted to, computed when first asked for: the
+    grids sized by the film's and the skin's gloss (:func:`lobe_widths_deg`), the film's gloss,
+    the skin's gloss and path 3 on them, the film's transmittance rows of the view-angle
+    image."""
 
-    The film's gloss is fitted on a grid sized by its own lobe, the skin's gloss and path 3 on
-    one sized by the skin's (:func:`lobe_widths_deg`, :func:`lut_baker.closures.view_grid.
-    view_grid`), so the cost does not depend on how narrow either lobe is."""
-    report = progress or (lambda fraction, message="": None)
-    report(0.0, "fitting the Principled tier")
-    widths = lobe_widths_deg(tables)
-    film_grid = view_grid(widths["film_gloss"], FIT_VIEWS)
-    skin_grid = view_grid(widths["skin_gloss"], FIT_VIEWS)
-    film_gloss = tables.surface_gloss("film_gloss", *film_grid.directions)
-    skin_gloss = tables.surface_gloss("skin_gloss", *skin_grid.directions)
-    path3 = tables.angular("path3_gloss", *skin_grid.directions)
+    def __init__(self, tables: Tables, lut_size: int):
+        self.tables, self.lut_size = tables, lut_size
+        self.theta_deg = np.asarray(tables.theta_deg, float)
+        self._found: dict = {}
 
+    def _once(self, name, compute):
+        if name not in self._found:
+            self._found[name] = compute()
+        return self._found[name]
+
+    def grid(self, surface: str):
+        """The view grid sized by ``surface``'s gloss (``film_gloss`` or ``skin_gloss``)."""
+        return self._once(("grid", surface), lambda: view_grid(
+            lobe_widths_deg(self.tables)[surface], FIT_VIEWS))
+
+    def target(self, name: str):
+        """``(grid, table)`` of a gloss part: ``film_gloss`` on the film's grid,
+        ``path3_gloss`` and ``skin_gloss`` on the skin's."""
+        def compute():
+            if name == "path3_gloss":
+                grid = self.grid("skin_gloss")
+                return grid, self.tables.angular(name, *grid.directions)
+            grid = self.grid(name)
+            return grid, self.tables.surface_gloss(name, *grid.directions)
+        return self._once(("target", name), compute)
+
+    def albedo(self, name: str) -> np.ndarray:
+        """A gloss part's directional albedo table ``(n_theta, 3)``."""
+        return np.asarray(getattr(self.tables, name + "_albedo"))
+
+    def transmittance_rows(self) -> np.ndarray:
+        """The film's transmittance at the view-angle image's texels, ``(size, 3)``."""
+        def compute():
+            transmittance = np.asarray(self.tables.film_transmittance, float)
+            mu = lut_nodes(self.lut_size)
+            return np.stack([np.interp(np.degrees(np.arccos(mu)), self.theta_deg,
+                                       transmittance[:, c]) for c in range(3)], -1)
+        return self._once("transmittance_rows", compute)
+
+
+def _left_out_glossy(size: int) -> LobeFit:
+    """A Glossy lobe left out (a fit over the artist's shader has no bare skin of its own):
+    weights 0, error 1 (what leaving a lobe out errs)."""
+    return LobeFit(roughness=ROUGHNESS_RANGE[1], error=1.0, lut=np.zeros((size, 3)))
+
+
+def _principled_parts(targets: _Targets, over_shader: bool) -> dict:
+    """The PRINCIPLED tier's parts of a :class:`ClosureFit`: the coat, the two speculars (over
+    the artist's shader the bare one left out: level 0) and their mean layering albedos."""
+    tables, theta_deg = targets.tables, targets.theta_deg
+    film_grid, film_gloss = targets.target("film_gloss")
+    skin_grid, path3 = targets.target("path3_gloss")
     coat = fit_coat(film_grid, film_gloss)
     e_coat = cc.coat_view_terms(skin_grid.cos_view, coat.roughness, coat.ior)[1]
-    specular_bare = fit_specular(skin_grid, skin_gloss)
     specular_film = fit_specular(skin_grid, path3, attenuation=1.0 - e_coat)
-    # The node group mixes the two roughnesses by coverage: a dropped lobe (level 0) takes the
-    # other's, so that mixing never sharpens the remaining lobe.
-    if specular_film.level == 0.0:
-        specular_film = replace(specular_film, roughness=specular_bare.roughness)
-    elif specular_bare.level == 0.0:
-        specular_bare = replace(specular_bare, roughness=specular_film.roughness)
-
-    theta_deg = np.asarray(tables.theta_deg, float)
-    transmittance = np.asarray(tables.film_transmittance, float)
-    mu = lut_nodes(lut_size)
-    t_rows = np.stack([np.interp(np.degrees(np.arccos(mu)), theta_deg, transmittance[:, c])
-                       for c in range(3)], -1)
-
-    targets = {"film_gloss": (film_grid, film_gloss), "path3_gloss": (skin_grid, path3),
-               "skin_gloss": (skin_grid, skin_gloss)}
-
-    def lobe(name, closures):
-        grid, table = targets[name]
-        return fit_glossy(grid, table, np.asarray(getattr(tables, name + "_albedo")),
-                          theta_deg, lut_size, companion=name == "film_gloss",
-                          closures=closures)
-
-    def image(lobes, rows):
-        """The view-angle image of ``lobes``, rows named ``rows``."""
-        found = {**{name: lobes[name].lut for name in lobes}, "film_transmittance": t_rows,
-                 "film_gloss_diffuse": lobes["film_gloss"].diffuse_lut}
-        if any(found.get(name) is None for name in rows):
-            raise AssertionError("the lobes give every view-angle row")
-        return np.stack([found[name] for name in rows])
-
-    report(0.3, "fitting the Layered tier's gloss lobes")
-    glossy = {name: lobe(name, cc.GLOSSY_DISTRIBUTIONS) for name in targets}
-    lut = image(glossy, LUT_ROWS)
-    report(0.45, "fitting the EEVEE tier's gloss lobes")
-    # EEVEE draws GGX alone: the film's gloss takes two lobes and the companion.
-    first, second = fit_glossy_pair(film_grid, film_gloss,
-                                    np.asarray(tables.film_gloss_albedo), theta_deg, lut_size)
-    eevee_glossy = {"film_gloss": first, "film_gloss_2": second,
-                    **{name: lobe(name, (EEVEE_GLOSSY,)) for name in ("path3_gloss",
-                                                                       "skin_gloss")}}
-    eevee_lut = image(eevee_glossy, EEVEE_LUT_ROWS)
+    if over_shader:
+        specular_bare = LobeFit(roughness=specular_film.roughness, ior=SPECULAR_IOR,
+                                level=0.0, error=1.0)
+    else:
+        specular_bare = fit_specular(skin_grid, targets.target("skin_gloss")[1])
+        # The node group mixes the two roughnesses by coverage: a dropped lobe (level 0) takes
+        # the other's, so that mixing never sharpens the remaining lobe.
+        if specular_film.level == 0.0:
+            specular_film = replace(specular_film, roughness=specular_bare.roughness)
+        elif specular_bare.level == 0.0:
+            specular_bare = replace(specular_bare, roughness=specular_film.roughness)
     coat_ior = coat.ior
     if coat_ior is None:
         raise AssertionError("fit_coat gives an IOR")
-
-    report(0.6, "fitting the subsurface profile")
-    ior = subsurface_ior(tables.parameters)
-    profiles = fit_profiles(tables)
-    if subsurface_method is None:
-        subsurface_method = min(cc.SUBSURFACE_METHODS, key=lambda m: np.hypot(
-            profiles[m].worst_error, REPLICA_EDGE_ERROR[m]))
-    elif subsurface_method not in cc.SUBSURFACE_METHODS:
-        raise ValueError(f"subsurface_method must be one of {cc.SUBSURFACE_METHODS}, "
-                         f"got {subsurface_method!r}")
 
     def specular_mean(lobe):
         if lobe.level == 0.0:
@@ -182,29 +187,141 @@ def fit_closures(tables: Tables, *, lut_size: int = DEFAULT_LUT_SIZE,
         f0 = float(cc.f0_from_ior(SPECULAR_IOR)) * 2.0 * lobe.level
         return _layering_mean(lobe.roughness, float(cc.ior_from_f0(f0)), f0)
 
-    fit = ClosureFit(
-        coat=coat,
-        specular_bare=specular_bare,
-        specular_film=specular_film,
-        coat_albedo_mean=_coat_layering_mean(coat.roughness, coat_ior),
-        specular_albedo_mean=(specular_mean(specular_bare), specular_mean(specular_film)),
-        gloss_to_diffuse=(_cosine_mean(np.asarray(tables.path3_gloss_albedo), theta_deg)
-                          if specular_film.level == 0.0 else np.zeros(3)),
-        glossy=glossy,
-        transmittance_mean=_cosine_mean(transmittance, theta_deg),
-        film_albedo=np.pi * np.asarray(tables.film_diffuse, float),
-        skin_albedo=np.pi * np.asarray(tables.skin_diffuse, float),
-        profiles=profiles,
-        subsurface_method=subsurface_method,
-        subsurface_ior=ior,
-        lut=lut,
-        eevee_glossy=eevee_glossy,
-        eevee_lut=eevee_lut,
-    )
+    return {
+        "coat": coat,
+        "specular_bare": specular_bare,
+        "specular_film": specular_film,
+        "coat_albedo_mean": _coat_layering_mean(coat.roughness, coat_ior),
+        "specular_albedo_mean": (specular_mean(specular_bare), specular_mean(specular_film)),
+        "gloss_to_diffuse": (_cosine_mean(np.asarray(tables.path3_gloss_albedo), theta_deg)
+                             if specular_film.level == 0.0 else np.zeros(3)),
+    }
+
+
+def _image(targets: _Targets, lobes: dict, rows: tuple) -> np.ndarray:
+    """The view-angle image of ``lobes``, rows named ``rows``."""
+    found = {**{name: lobes[name].lut for name in lobes},
+             "film_transmittance": targets.transmittance_rows(),
+             "film_gloss_diffuse": lobes["film_gloss"].diffuse_lut}
+    if any(found.get(name) is None for name in rows):
+        raise AssertionError("the lobes give every view-angle row")
+    return np.stack([found[name] for name in rows])
+
+
+def _glossy(targets: _Targets, name: str, closures: tuple) -> LobeFit:
+    """:func:`fit_glossy` of one gloss part (the film's with its Lambertian companion)."""
+    grid, table = targets.target(name)
+    return fit_glossy(grid, table, targets.albedo(name), targets.theta_deg, targets.lut_size,
+                      companion=name == "film_gloss", closures=closures)
+
+
+def _view_weighted_lobes(targets: _Targets, names: tuple, closures: tuple,
+                         over_shader: bool) -> dict:
+    """Glossy lobes of ``names`` (over the artist's shader ``skin_gloss`` left out)."""
+    return {name: (_left_out_glossy(targets.lut_size) if over_shader and name == "skin_gloss"
+                   else _glossy(targets, name, closures)) for name in names}
+
+
+def _layered_parts(targets: _Targets, over_shader: bool) -> dict:
+    """The LAYERED tier's parts: Cycles' Glossy lobes and their view-angle image."""
+    glossy = _view_weighted_lobes(targets, ("film_gloss", "path3_gloss", "skin_gloss"),
+                                  cc.GLOSSY_DISTRIBUTIONS, over_shader)
+    return {"glossy": glossy, "lut": _image(targets, glossy, LUT_ROWS)}
+
+
+def _eevee_parts(targets: _Targets, over_shader: bool) -> dict:
+    """The EEVEE tier's parts: EEVEE's GGX lobes (the film's gloss two of them and the
+    companion, :func:`fit_glossy_pair`) and their view-angle image."""
+    film_grid, film_gloss = targets.target("film_gloss")
+    first, second = fit_glossy_pair(film_grid, film_gloss, targets.albedo("film_gloss"),
+                                    targets.theta_deg, targets.lut_size)
+    eevee_glossy = {"film_gloss": first, "film_gloss_2": second,
+                    **_view_weighted_lobes(targets, ("path3_gloss", "skin_gloss"),
+                                           (EEVEE_GLOSSY,), over_shader)}
+    return {"eevee_glossy": eevee_glossy,
+            "eevee_lut": _image(targets, eevee_glossy, EEVEE_LUT_ROWS)}
+
+
+_TIER_PARTS = {"PRINCIPLED": _principled_parts, "LAYERED": _layered_parts,
+              "EEVEE": _eevee_parts}
+"""Each tier's parts of a fit, by tier."""
+_TIER_SHARES = {"PRINCIPLED": 0.25, "LAYERED": 0.35, "EEVEE": 0.4}
+"""Each tier's rough share of a full fit's time (for the progress reported)."""
+
+
+def _subsurface(tables: Tables, method: str | None, over_shader: bool) -> dict:
+    """The subsurface parts of a fit: the profiles and the method (``method`` forced, else the
+    one whose edge response, fitted error and replica error combined, is closest to the
+    tables'), the Subsurface IOR.  Over the artist's shader with a forced method no profile is
+    fitted (the radius is the artist's)."""
+    if method is not None and method not in cc.SUBSURFACE_METHODS:
+        raise ValueError(f"subsurface_method must be one of {cc.SUBSURFACE_METHODS}, "
+                         f"got {method!r}")
+    ior = subsurface_ior(tables.parameters)
+    profiles = {} if over_shader and method is not None else fit_profiles(tables)
+    if method is None:
+        method = min(cc.SUBSURFACE_METHODS, key=lambda m: np.hypot(
+            profiles[m].worst_error, REPLICA_EDGE_ERROR[m]))
+    return {"profiles": profiles, "subsurface_method": method, "subsurface_ior": ior}
+
+
+def _checked_tiers(tiers) -> tuple:
+    """``tiers`` in :data:`TIERS` order (``ValueError`` for a name not in it)."""
+    tiers = tuple(tiers)
+    unknown = [tier for tier in tiers if tier not in TIERS]
+    if unknown:
+        raise ValueError(f"tiers must be among {TIERS}, got {unknown}")
+    return tuple(tier for tier in TIERS if tier in tiers)
+
+
+def fit_closures(tables: Tables, *, tiers=TIERS, over_shader: bool = False,
+                 onto: ClosureFit | None = None, lut_size: int = DEFAULT_LUT_SIZE,
+                 subsurface_method: str | None = None, errors_at=None,
+                 progress=None) -> ClosureFit:
+    """Fit the ``tiers`` (default: all of :data:`TIERS`) to ``tables`` and measure their
+    errors at ``errors_at`` = ``(coverage, absorption)`` (default: those the tables were baked
+    for).  ``subsurface_method``: force one (default: the method whose edge response, fitted
+    error and replica error combined, is closest to the tables'; all three are fitted and
+    reported).  ``over_shader``: for a group over the artist's own shader, which is the bare
+    skin there: the bare skin's gloss lobes are not fitted nor, with a forced method, the
+    subsurface profiles (:class:`ClosureFit`), and the errors take the bare skin from the
+    tables.  ``onto``: a fit of the same tables, method and ``over_shader`` whose tiers are
+    kept: only the others are fitted, and measured where its errors were.
+    ``progress(fraction, message)``: called as the fit advances (fraction 0..1).
+
+    The film's gloss is fitted on a grid sized by its own lobe, the skin's gloss and path 3 on
+    one sized by the skin's (:func:`lobe_widths_deg`, :func:`lut_baker.closures.view_grid.
+    view_grid`), so the cost does not depend on how narrow either lobe is."""
+    report = progress or (lambda fraction, message="": None)
+    tiers = _checked_tiers(tiers)
+    wanted = tiers if onto is None else tuple(t for t in tiers if t not in onto.tiers)
+    targets = _Targets(tables, lut_size)
+    parts: dict = {}
+    total = sum(_TIER_SHARES[tier] for tier in wanted) or 1.0
+    done = 0.0
+    for tier in wanted:
+        report(0.8 * done / total, f"fitting the {tier.title()} tier")
+        parts.update(_TIER_PARTS[tier](targets, over_shader))
+        done += _TIER_SHARES[tier]
+    if onto is not None:
+        fit = replace(onto, **parts)
+        if onto.errors:
+            first = next(iter(onto.errors.values()))
+            errors_at = (first.coverage, first.absorption)
+    else:
+        report(0.75, "fitting the subsurface profile")
+        fit = ClosureFit(
+            transmittance_mean=_cosine_mean(np.asarray(tables.film_transmittance, float),
+                                            targets.theta_deg),
+            film_albedo=np.pi * np.asarray(tables.film_diffuse, float),
+            skin_albedo=np.pi * np.asarray(tables.skin_diffuse, float),
+            **_subsurface(tables, subsurface_method, over_shader), **parts)
     if errors_at is None:
         errors_at = (float(tables.parameters.get("coverage", 1.0)),
                      tables.parameters.get("absorption", 0.0))
     report(0.8, "measuring the tiers' errors")
-    fit = replace(fit, errors=tier_errors(fit, tables, *errors_at))
+    errors = {**(onto.errors if onto is not None else {}),
+              **tier_errors(fit, tables, *errors_at, tiers=wanted, over_shader=over_shader)}
+    fit = replace(fit, errors={tier: errors[tier] for tier in TIERS if tier in errors})
     report(1.0, "fitted")
     return fit

@@ -13,7 +13,9 @@ Cycles renders the node group, then compared with the tables on a view grid.
   :data:`TIER_REPLICAS` -- each by name.
 - :func:`view_weighted_parts` -- what the LAYERED and EEVEE tiers take from a fit (the replicas
   here and the node group alike).
-- :func:`tier_errors` -- every tier against the tables at one coverage and absorption.
+- :func:`tier_reflection` -- a tier's BRDF as a made-up material renders it (over the
+  artist's shader: the bare skin is theirs).
+- :func:`tier_errors` -- the tiers of a fit against the tables at one coverage and absorption.
 """
 
 from __future__ import annotations
@@ -26,7 +28,7 @@ from ..model.made_up_skin import combine, coverage_weights
 from ..tables.table_set import Tables
 from . import cycles as cc
 from . import eevee
-from .closure_fit import ClosureFit
+from .closure_fit import TIERS, ClosureFit
 from .tier_formulas import (
     NumpyAlgebra,
     TierInputs,
@@ -40,11 +42,8 @@ from .view_image import EEVEE_LUT_ROWS, LUT_ROWS
 __all__ = ["TIERS", "TierError", "principled_inputs", "principled_tier_reflection",
            "view_weighted_reflection", "view_weighted_tier", "layered_tier_reflection",
            "eevee_tier_reflection", "TIER_REPLICAS", "EEVEE_SUBSURFACE_METHOD", "tier_errors",
-           "ViewWeightedParts", "view_weighted_parts"]
+           "ViewWeightedParts", "view_weighted_parts", "tier_reflection"]
 
-TIERS = ("PRINCIPLED", "LAYERED", "EEVEE")
-"""The node group's tiers: the two made for Cycles, cheapest first, then the one made for
-EEVEE."""
 EEVEE_SUBSURFACE_METHOD = "BURLEY"
 """The EEVEE tier's subsurface method: EEVEE's screen-space subsurface is Burley's profile
 whatever the node asks for, and Cycles renders the same method when the file is rendered
@@ -132,16 +131,20 @@ def view_weighted_parts(fit: ClosureFit, tier: str) -> ViewWeightedParts:
     or the EEVEE tier's (lobes fitted as EEVEE renders GGX, the film's gloss in two, its own
     image, the plain colour EEVEE's subsurface takes, one Subsurface closure for both sides:
     EEVEE picks one Diffuse or Subsurface closure per sample, and fewer are less noise)."""
+    if tier not in ("LAYERED", "EEVEE"):
+        raise ValueError(f"{tier!r} is not a view-weighted tier (LAYERED, EEVEE)")
+    lobes, lut = (fit.glossy, fit.lut) if tier == "LAYERED" else (fit.eevee_glossy,
+                                                                  fit.eevee_lut)
+    if lobes is None or lut is None:
+        raise ValueError(f"the fit holds no {tier} tier (it has {', '.join(fit.tiers)}): fit "
+                         f"it with fit_closures(..., tiers=...)")
     if tier == "LAYERED":
-        return ViewWeightedParts(fit.glossy, fit.lut, LUT_ROWS, ("film_gloss",),
-                                 tinted_subsurface=True)
-    if tier == "EEVEE":
-        # The film gloss's second lobe is a closure only where its fit kept two.
-        second = np.any(fit.eevee_glossy["film_gloss_2"].lut)
-        return ViewWeightedParts(fit.eevee_glossy, fit.eevee_lut, EEVEE_LUT_ROWS,
-                                 ("film_gloss", "film_gloss_2") if second else ("film_gloss",),
-                                 tinted_subsurface=False, one_subsurface=True)
-    raise ValueError(f"{tier!r} is not a view-weighted tier (LAYERED, EEVEE)")
+        return ViewWeightedParts(lobes, lut, LUT_ROWS, ("film_gloss",), tinted_subsurface=True)
+    # The film gloss's second lobe is a closure only where its fit kept two.
+    second = np.any(lobes["film_gloss_2"].lut)
+    return ViewWeightedParts(lobes, lut, EEVEE_LUT_ROWS,
+                             ("film_gloss", "film_gloss_2") if second else ("film_gloss",),
+                             tinted_subsurface=False, one_subsurface=True)
 
 
 def view_weighted_reflection(closures: ViewWeightedClosures, lobe_of, wi, wo) -> np.ndarray:
@@ -209,18 +212,45 @@ TIER_REPLICAS = {"PRINCIPLED": principled_tier_reflection, "LAYERED": layered_ti
 """Each tier's replica, ``(fit, tables, coverage, absorption, gloss=1, directions=None)``."""
 
 
+def tier_reflection(fit: ClosureFit, tables: Tables, tier: str, coverage: float, absorption,
+                    gloss: float = 1.0, directions=None, *, over_shader: bool = False,
+                    bare=None):
+    """``tier``'s BRDF ``(..., 3)`` (:data:`TIER_REPLICAS`) at the angular nodes or at
+    ``directions``.  ``over_shader``: the group goes over the artist's shader, which is the
+    bare skin (the tables' bare skin stands for it, the Gloss input leaves it alone): the
+    tier's covered skin (its replica at coverage 1) and the tables' bare skin (``bare``, if
+    already computed at these directions: ``made_up_reflection`` at coverage 0), mixed by
+    coverage as areas."""
+    replica = TIER_REPLICAS[tier]
+    if not over_shader:
+        return replica(fit, tables, coverage, absorption, gloss, directions)
+    wi, wo = tables.node_directions() if directions is None else directions
+    covered = replica(fit, tables, 1.0, absorption, gloss, (wi, wo))
+    if bare is None:
+        bare = tables.made_up_reflection(wi, wo, 0.0, absorption)
+    return combine(coverage_weights(coverage, 0.0), top=covered, bare=bare)
+
+
 def tier_errors(fit: ClosureFit, tables: Tables, coverage: float, absorption,
-                gloss: float = 1.0) -> dict:
-    """:class:`TierError` of every tier against the tables at one coverage and absorption
-    (``gloss``: the group's Gloss input; at 0 the error includes all of the gloss left out),
-    on a :class:`lut_baker.closures.view_grid.ViewGrid` of :data:`ERROR_VIEWS` views that
+                gloss: float = 1.0, *, tiers=None, over_shader: bool = False) -> dict:
+    """:class:`TierError` of ``tiers`` (default: every tier ``fit`` holds) against the tables
+    at one coverage and absorption (``gloss``: the group's Gloss input; at 0 the error
+    includes all of the gloss left out; ``over_shader``: :func:`tier_reflection`'s), on a
+    :class:`lut_baker.closures.view_grid.ViewGrid` of :data:`ERROR_VIEWS` views that
     resolves the narrower of the two surfaces' gloss lobes."""
+    tiers = fit.tiers if tiers is None else tiers
+    if not tiers:
+        return {}
     grid = view_grid(min(lobe_widths_deg(tables).values()), ERROR_VIEWS)
     directions = grid.directions
     reference = tables.made_up_reflection(*directions, coverage, absorption)
+    bare = tables.made_up_reflection(*directions, 0.0, absorption) if over_shader else None
     out = {}
-    for tier, replica in TIER_REPLICAS.items():
-        f = replica(fit, tables, coverage, absorption, gloss, directions)
+    for tier in TIER_REPLICAS:
+        if tier not in tiers:
+            continue
+        f = tier_reflection(fit, tables, tier, coverage, absorption, gloss, directions,
+                            over_shader=over_shader, bare=bare)
         out[tier] = TierError(tier=tier, coverage=float(coverage),
                               absorption=tuple(_absorption(absorption).tolist()),
                               rms=grid.error(f, reference),

@@ -2,7 +2,10 @@
 
 ``functools.lru_cache`` memoises a function of hashable arguments; :class:`LRUCache` is for the
 other cases: the key is built from arrays or records by the caller, or only some results may
-be kept.  Plain Python (it runs inside Blender).
+be kept.  Plain Python (it runs inside Blender).  Safe to share between threads (the add-on
+bakes and fits on a worker thread): every read and write holds a lock; a value is computed
+outside it, so two threads asking for the same missing key may both compute it (the last
+stored wins; both are the same value).
 
 Types
 -----
@@ -12,6 +15,7 @@ Types
 
 from __future__ import annotations
 
+import threading
 from collections import OrderedDict
 
 __all__ = ["LRUCache"]
@@ -26,36 +30,44 @@ class LRUCache:
             raise ValueError(f"size must be >= 1 or None, got {size!r}")
         self.size = size
         self._values: OrderedDict = OrderedDict()
+        self._lock = threading.RLock()
 
     def __len__(self) -> int:
-        return len(self._values)
+        with self._lock:
+            return len(self._values)
 
     def __contains__(self, key) -> bool:
-        return key in self._values
+        with self._lock:
+            return key in self._values
 
     def get(self, key, default=None):
         """The value stored under ``key`` (now the most recently used), else ``default``."""
-        if key not in self._values:
-            return default
-        self._values.move_to_end(key)
-        return self._values[key]
+        with self._lock:
+            if key not in self._values:
+                return default
+            self._values.move_to_end(key)
+            return self._values[key]
 
     def put(self, key, value) -> None:
         """Store ``value`` under ``key``, dropping the least recently used beyond ``size``."""
-        self._values[key] = value
-        self._values.move_to_end(key)
-        while self.size is not None and len(self._values) > self.size:
-            self._values.popitem(last=False)
+        with self._lock:
+            self._values[key] = value
+            self._values.move_to_end(key)
+            while self.size is not None and len(self._values) > self.size:
+                self._values.popitem(last=False)
 
     def get_or_compute(self, key, compute):
-        """The value under ``key``; if there is none, ``compute()`` stored under it first."""
-        if key in self._values:
-            self._values.move_to_end(key)
-            return self._values[key]
+        """The value under ``key``; if there is none, ``compute()`` (outside the lock)
+        stored under it first."""
+        missing = object()
+        value = self.get(key, missing)
+        if value is not missing:
+            return value
         value = compute()
         self.put(key, value)
         return value
 
     def clear(self) -> None:
         """Forget every value."""
-        self._values.clear()
+        with self._lock:
+            self._values.clear()

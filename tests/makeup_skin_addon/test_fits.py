@@ -72,3 +72,36 @@ def test_traits_read_back_as_they_were(record):
     assert traits.skin_share == direct.skin_share and traits.gloss_share == direct.gloss_share
     assert traits.gloss_omission == direct.gloss_omission
     assert fits.traits({"traits": {"tier_errors": {}}}) is None
+
+
+def test_the_tiers_asked_for_are_fitted_and_others_when_asked(record, monkeypatch):
+    """A fit asked for the Cycles tiers holds those alone; asking for the EEVEE tier later
+    fits it onto the cached fit (nothing fitted again); a fit over the artist's shader is
+    another fit.  A measurement serves only if it holds the tiers asked for."""
+    from lut_baker.closures import fitting
+    from makeup_skin_addon import fits
+
+    fits.clear()
+    calls = []
+    original = fitting.fit_closures
+    monkeypatch.setattr(fitting, "fit_closures", lambda *a, **k: (
+        calls.append((k["tiers"], k["onto"] is not None, k["over_shader"])),
+        original(*a, **k))[1])
+    cycles = ("PRINCIPLED", "LAYERED")
+    tables, fit = fits.baked(record, tiers=cycles)
+    assert fit.tiers == cycles and calls == [(cycles, False, False)]
+    assert fits.cached(record, tiers=cycles)[1] is fit
+    assert fits.cached(record, tiers=("EEVEE",)) is None  # cached() never fits
+    _, every = fits.baked(record, tiers=("EEVEE",))
+    assert every.tiers == ("PRINCIPLED", "LAYERED", "EEVEE") and every.glossy is fit.glossy
+    assert calls[-1] == (("EEVEE",), True, False)
+    assert fits.baked(record, tiers=cycles)[1] is every and len(calls) == 2
+    _, over = fits.baked(record, tiers=cycles, over_shader=True)
+    assert calls[-1] == (cycles, False, True) and over is not every
+    measured = fits.measure(tables, fit, 0.6, (0.1, 0.2, 0.3))
+    assert set(measured["errors"]) == set(cycles)
+    meta = {"measured": measured}
+    assert fits.measured_at(meta, 0.6, (0.1, 0.2, 0.3), tiers=cycles) is measured
+    assert fits.measured_at(meta, 0.6, (0.1, 0.2, 0.3), tiers=("EEVEE",)) is None
+    assert fits.measured_at(meta, 0.6, (0.1, 0.2, 0.3), with_traits=True,
+                            tiers=("LAYERED",)) is measured

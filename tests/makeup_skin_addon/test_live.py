@@ -69,3 +69,176 @@ def test_roughness_moves_the_gloss_live_and_a_picked_colour_at_once(sphere):
     assert tuple(node.inputs["Foundation Absorption"].default_value)[:3] == pytest.approx(
         presets.FOUNDATIONS["clarins_108"]["absorption"], abs=1e-6)
     assert not live.pending() and counts()[0] == groups
+
+
+def _fingerprint(group):
+    """Every node of ``group`` in order (type, label, operation or distribution, image name),
+    the values of its unlinked inputs (rounded far below a render's precision) and its
+    links: two groups of the same fingerprint render alike."""
+    def value(item):
+        data = getattr(item, "default_value", None)
+        if data is None or isinstance(data, str):
+            return None
+        try:
+            return tuple(round(float(v), 9) for v in data)
+        except TypeError:
+            return round(float(data), 9)
+
+    index = {node.name: i for i, node in enumerate(group.nodes)}
+    nodes = [(node.bl_idname, node.label, getattr(node, "operation", None),
+              getattr(node, "distribution", None),
+              getattr(getattr(node, "image", None), "name", None),
+              tuple((item.identifier, value(item)) for item in node.inputs
+                    if not item.is_linked and item.enabled))
+             for node in group.nodes]
+    links = sorted((index[link.from_node.name], link.from_socket.identifier,
+                    index[link.to_node.name], link.to_socket.identifier)
+                   for link in group.links)
+    return nodes, links
+
+
+def _rebuilt_in_background(material):
+    """Set the pending rebuild off on a worker (what the debounce timer does), wait for it
+    and swap it in (what the poll timer does)."""
+    import bpy
+
+    from makeup_skin_addon import live
+
+    assert live.start(bpy.context) == []
+    assert material.name in live.in_flight()
+    assert live.wait(60.0)
+    assert live.poll(bpy.context) == []
+    assert material.name not in live.pending()
+
+
+@pytest.mark.parametrize("tier", ["PRINCIPLED", "LAYERED", "EEVEE"])
+def test_a_rebuild_in_the_background_gives_the_synchronous_group(sphere, tier):
+    """A Foundation pick rebuilt on a worker thread and swapped in gives the group a
+    synchronous rebuild gives: the same nodes, values and links, the same record.  The
+    worker's group takes the group's own nodes again where its structure allows (the Layered
+    tier's does here: its first node is the one it had), the synchronous one is built anew in
+    a new group."""
+    import bpy
+
+    from makeup_skin_addon import live, nodes
+    from makeup_skin_addon import material as made_up
+
+    material, _ = apply_pipeline(sphere, tier, foundation="light_ivory")
+    made_up.group_of(material).node_tree.nodes[0]["first"] = True
+    material.makeup_skin.foundation = "clarins_112"
+    _rebuilt_in_background(material)
+    group = made_up.group_of(material).node_tree
+    if tier == "LAYERED":
+        assert group.nodes[0].get("first")  # its nodes taken again, values set anew
+    background = _fingerprint(group), nodes.read_meta(group)
+    fresh = bpy.data.node_groups.new("fresh", "ShaderNodeTree")
+    made_up.rebuild_from_settings(bpy.context, material, fresh, live.PREVIEW)
+    assert made_up.group_of(material).node_tree == fresh
+    assert _fingerprint(fresh) == background[0]
+    meta = nodes.read_meta(fresh)
+    for key in ("key", "tier", "parameters", "glossy", "eevee_glossy", "measured"):
+        assert meta.get(key) == background[1].get(key), key
+
+
+def test_a_newer_change_supersedes_a_rebuild_in_flight(sphere):
+    """A change while a rebuild is in flight stops it and drops its result (never swapped
+    in, even when it finished first); the newer settings' rebuild is what the material gets.
+    Apply and Revert drop what is pending too."""
+    import bpy
+
+    from makeup_skin_addon import live, nodes
+    from makeup_skin_addon import material as made_up
+
+    material, _ = apply_pipeline(sphere, "LAYERED")
+    settings = material.makeup_skin
+    before = nodes.read_meta(made_up.group_of(material).node_tree)["key"]
+    settings.foundation = "clarins_105"
+    live.start(bpy.context)
+    settings.foundation = "deep_mocha"  # supersedes clarins_105's rebuild
+    assert live.in_flight() == set() and material.name in live.pending()
+    assert live.wait(60.0)
+    live.poll(bpy.context)
+    assert nodes.read_meta(made_up.group_of(material).node_tree)["key"] == before
+    _rebuilt_in_background(material)
+    meta = nodes.read_meta(made_up.group_of(material).node_tree)
+    assert meta["parameters"]["film"] == nodes.read_meta(made_up.group_of(
+        apply_pipeline(sphere, "LAYERED")[0]).node_tree)["parameters"]["film"]
+    assert meta["key"] != before
+    settings.foundation = "clarins_108"
+    live.start(bpy.context)
+    live.cancel(material)  # what Apply and Revert do first
+    assert live.pending() == set()
+    assert live.wait(60.0) and live.poll(bpy.context) == []
+    assert nodes.read_meta(made_up.group_of(material).node_tree)["key"] == meta["key"]
+
+
+def test_flush_waits_for_a_rebuild_in_flight(sphere):
+    """Headless, flush does everything at once: a rebuild in flight is waited for and
+    swapped in, one only marked is computed there."""
+    import bpy
+
+    from makeup_skin_addon import live, nodes
+    from makeup_skin_addon import material as made_up
+
+    material, _ = apply_pipeline(sphere, "PRINCIPLED")
+    material.makeup_skin.foundation = "medium_beige"
+    live.start(bpy.context)
+    assert material.name in live.in_flight()
+    assert live.flush(bpy.context) == []
+    assert live.pending() == set()
+    meta = nodes.read_meta(made_up.group_of(material).node_tree)
+    assert meta["parameters"]["film"] == nodes.read_meta(made_up.group_of(apply_pipeline(
+        sphere, "PRINCIPLED", foundation="medium_beige")[0]).node_tree)["parameters"]["film"]
+
+
+def test_an_apply_at_preview_first_is_refined_in_the_background(sphere):
+    """With an event loop Apply bakes a new bake at preview resolution first, and the
+    settings' resolution follows from a worker (:func:`live.refine`): the same group as an
+    Apply at that resolution.  An Apply whose bake the file has is not done twice."""
+    import bpy
+
+    from makeup_skin_addon import live, nodes
+    from makeup_skin_addon import material as made_up
+
+    sphere.data.materials.append(bpy.data.materials.new("Skin"))
+    settings = sphere.active_material.makeup_skin
+    settings.tier, settings.resolution = "LAYERED", "default"
+    material, report = made_up.apply_to_object(bpy.context, sphere, preview_first=True)
+    group = made_up.group_of(material).node_tree
+    assert report.refine == "default" and nodes.read_meta(group)["resolution"] == "preview"
+    assert any("preview resolution first" in sentence for sentence in report)
+    live.refine(bpy.context, material, report.refine)
+    live.wait(60.0)
+    live.poll(bpy.context)
+    refined = made_up.group_of(material).node_tree
+    meta = nodes.read_meta(refined)
+    assert meta["resolution"] == "default" and refined == group  # rebuilt in place
+    again, report = made_up.apply_to_object(bpy.context, sphere, preview_first=True)
+    assert report.refine is None and made_up.group_of(again).node_tree == refined
+    assert nodes.read_meta(refined)["key"] == meta["key"]
+
+
+def test_unregister_leaves_no_worker_or_timer(addon, bpy_factory):
+    """Unregistering while a rebuild is in flight stops its worker and waits for it: no
+    thread, timer or pending material is left behind (bpy 4.5 hangs at exit otherwise)."""
+    import threading
+
+    import bpy
+    from support import sphere_scene
+
+    from makeup_skin_addon import live
+
+    sphere = sphere_scene.add_sphere(bpy.context.scene, 0.03, size=32, samples=1)
+    material, _ = apply_pipeline(sphere, "LAYERED")
+    material.makeup_skin.foundation = "deep_mocha"
+    live.start(bpy.context)
+    assert material.name in live.in_flight()
+    addon.unregister()
+    try:
+        assert not any(thread.name.startswith("Made-up Skin") for thread in
+                       threading.enumerate())
+        assert not bpy.app.timers.is_registered(live.rebake_timer)
+        assert not bpy.app.timers.is_registered(live.poll_timer)
+        assert live.pending() == set()
+    finally:
+        addon.register()

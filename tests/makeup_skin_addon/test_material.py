@@ -34,7 +34,9 @@ def test_apply_and_render(sphere, tmp_path, tier):
     if tier == "EEVEE":  # EEVEE's screen-space subsurface is Burley's
         assert meta["subsurface_method"] == "BURLEY"
     errors = json.loads(material["makeup_skin_errors"])
-    assert set(errors) == {"PRINCIPLED", "LAYERED", "EEVEE"}
+    # A Cycles scene: the Cycles tiers are fitted and measured, and the tier chosen (the
+    # session's fit may hold more: test_apply_fits_the_engines_tiers... starts cold).
+    assert {"PRINCIPLED", "LAYERED", tier} <= set(errors)
     # The scene renders with Cycles: the EEVEE tier is reported as made for EEVEE.
     assert any("made for EEVEE" in m for m in messages) == (tier == "EEVEE"), messages
     pixels = render(tmp_path)
@@ -71,6 +73,29 @@ def test_report_says_when_a_tier_is_not_made_for_the_engine(sphere):
     _, messages = apply_pipeline(sphere, "EEVEE")
     assert any("made for EEVEE" in m and "the Layered tier is fitted to Cycles" in m
                for m in messages), messages
+
+
+def test_apply_fits_the_engines_tiers_and_another_when_it_is_asked_for(sphere):
+    """Apply fits and measures the tiers made for the scene's engine (in Cycles not the
+    EEVEE tier's film pair); switched to EEVEE, Tier Auto fits the EEVEE tier then, onto the
+    same fit, and chooses it."""
+    import bpy
+
+    from makeup_skin_addon import fits, nodes
+
+    cold_caches()
+    material, _ = apply_pipeline(sphere, "AUTO")
+    meta = nodes.read_meta(group_node(material).node_tree)
+    assert set(json.loads(material["makeup_skin_errors"])) == {"PRINCIPLED", "LAYERED"}
+    assert fits.cached(meta, tiers=("PRINCIPLED", "LAYERED")) is not None
+    assert fits.cached(meta, tiers=("EEVEE",)) is None
+    bpy.context.scene.render.engine = "BLENDER_EEVEE" if bpy.app.version >= (5, 0, 0) else \
+        "BLENDER_EEVEE_NEXT"
+    material, _ = apply_pipeline(sphere, "AUTO")
+    assert nodes.read_meta(group_node(material).node_tree)["tier"] == "EEVEE"
+    assert set(json.loads(material["makeup_skin_errors"])) == {"PRINCIPLED", "LAYERED",
+                                                                "EEVEE"}
+    assert fits.cached(meta, tiers=("PRINCIPLED", "LAYERED", "EEVEE")) is not None
 
 
 def test_apply_operator_and_twice_creates_no_duplicates(sphere):

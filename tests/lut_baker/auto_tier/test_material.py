@@ -60,3 +60,26 @@ def test_gloss_omission_is_the_tiers_gloss(paper_tables, paper_fit, matte):
     for tier in tiers.TIERS:
         assert max(traits.gloss_omission[tier].values()) < 0.015, tier
         assert traits.gloss_error(tier, 45.0) == traits.gloss_omission[tier][45.0]
+
+
+def test_traits_of_a_fit_of_some_tiers(paper_tables, paper_fit):
+    """The traits hold the tiers the fit holds (the Auto tier asks only for the engine's),
+    those tiers' values as a full fit gives them; over the artist's shader the subsurface
+    closure under the film is theirs, radius and method: no profile mismatch."""
+    from lut_baker.closures import fitting
+
+    cycles = fitting.fit_closures(paper_tables, tiers=("PRINCIPLED", "LAYERED"))
+    traits = auto_tier.traits_from_tables(paper_tables, cycles, 0.6, 0.2)
+    full = auto_tier.traits_from_tables(paper_tables, paper_fit, 0.6, 0.2)
+    assert set(traits.tier_errors) == set(traits.gloss_omission) == {"PRINCIPLED", "LAYERED"}
+    for tier in traits.tier_errors:
+        assert traits.tier_errors[tier] == pytest.approx(full.tier_errors[tier], rel=1e-9)
+        assert traits.gloss_omission[tier] == pytest.approx(full.gloss_omission[tier],
+                                                            rel=1e-9)
+    assert traits.profile_mismatch == full.profile_mismatch > 0.0
+    over = fitting.fit_closures(paper_tables, tiers=("LAYERED",), over_shader=True,
+                                subsurface_method="BURLEY")
+    traits = auto_tier.traits_from_tables(paper_tables, over, 0.6, 0.2, over_shader=True)
+    assert traits.profile_mismatch == 0.0 and set(traits.tier_errors) == {"LAYERED"}
+    # Gloss 0 leaves the artist's bare skin as it is: what it changes is the covered part's.
+    assert 0.0 < traits.gloss_error("LAYERED", 45.0) < full.gloss_error("LAYERED", 45.0)

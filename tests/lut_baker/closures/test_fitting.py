@@ -75,3 +75,66 @@ def test_fits_of_a_narrow_gloss_cost_what_a_broad_one_does():
     assert sizes[0] <= 3 * sizes[1]
     errors = fitting.fit_closures(narrow_tables, errors_at=(1.0, 0.0)).errors["LAYERED"]
     assert errors.rms < 0.03 and errors.albedo < 0.01
+
+
+def _assert_same_parts(fit, reference, tiers):
+    """``fit``'s parts of ``tiers`` are ``reference``'s (fitted the same way, within rounding)."""
+    assert fit.tiers == tuple(tiers)
+    summary, expected = fit.summary(), reference.summary()
+    for name in ("coat", "specular_bare", "specular_film"):
+        if name in summary:
+            assert summary[name] == pytest.approx(expected[name], rel=1e-9), name
+    for name in ("glossy", "eevee_glossy"):
+        for lobe, values in summary.get(name, {}).items():
+            values, reference_values = dict(values), dict(expected[name][lobe])
+            assert values.pop("distribution", None) == reference_values.pop("distribution",
+                                                                            None)
+            assert values == pytest.approx(reference_values, rel=1e-9), (name, lobe)
+    for lut in ("lut", "eevee_lut"):
+        if getattr(fit, lut) is not None:
+            np.testing.assert_allclose(getattr(fit, lut), getattr(reference, lut), rtol=1e-9,
+                                       atol=1e-12)
+    for tier in tiers:
+        assert fit.errors[tier].rms == pytest.approx(reference.errors[tier].rms, rel=1e-9)
+
+
+def test_a_fit_holds_the_tiers_asked_for_and_takes_more_later(paper_tables, paper_fit):
+    """Fitting some tiers fits and measures those alone (the others' parts are None and a
+    tier's closures cannot be had of a fit without it); the rest fitted onto that fit later
+    give what fitting them all at once gives."""
+    from lut_baker.closures import tiers
+
+    layered = fitting.fit_closures(paper_tables, tiers=("LAYERED",))
+    assert layered.tiers == ("LAYERED",) and set(layered.errors) == {"LAYERED"}
+    assert layered.coat is None and layered.eevee_glossy is None and layered.eevee_lut is None
+    with pytest.raises(ValueError, match="no EEVEE tier"):
+        tiers.view_weighted_parts(layered, "EEVEE")
+    _assert_same_parts(layered, paper_fit, ("LAYERED",))
+    every = fitting.fit_closures(paper_tables, tiers=("EEVEE", "PRINCIPLED"), onto=layered)
+    _assert_same_parts(every, paper_fit, tiers.TIERS)
+    assert every.glossy is layered.glossy  # kept, not fitted again
+    with pytest.raises(ValueError, match="tiers must be among"):
+        fitting.fit_closures(paper_tables, tiers=("CYCLES",))
+
+
+def test_a_fit_over_the_artists_shader_leaves_out_the_bare_skin(paper_tables, paper_fit):
+    """Over the artist's shader (the bare skin is theirs, and so is the radius) the bare skin's
+    lobes and, the method given, the profiles are not fitted; what covers the skin is what a
+    full fit gives, and at coverage 1 (no bare skin) so are the errors."""
+    fit = fitting.fit_closures(paper_tables, tiers=("PRINCIPLED", "LAYERED"),
+                               over_shader=True, subsurface_method="RANDOM_WALK",
+                               errors_at=(1.0, 0.0))
+    assert fit.profiles == {} and fit.subsurface_method == "RANDOM_WALK"
+    assert fit.specular_bare.level == 0.0 and fit.specular_albedo_mean[0] == 0.0
+    assert not np.any(fit.glossy["skin_gloss"].lut)
+    assert fit.coat.roughness == pytest.approx(paper_fit.coat.roughness, rel=1e-12)
+    for name in ("film_gloss", "path3_gloss"):
+        np.testing.assert_allclose(fit.glossy[name].lut, paper_fit.glossy[name].lut,
+                                   rtol=1e-12)
+    reference = fitting.fit_closures(paper_tables, tiers=("PRINCIPLED", "LAYERED"),
+                                     errors_at=(1.0, 0.0))
+    for tier in fit.tiers:
+        assert fit.errors[tier].rms == pytest.approx(reference.errors[tier].rms, rel=1e-9)
+    # Without a method the profiles choose it, as for any fit.
+    chosen = fitting.fit_closures(paper_tables, tiers=("PRINCIPLED",), over_shader=True)
+    assert chosen.subsurface_method == paper_fit.subsurface_method and chosen.profiles

@@ -93,3 +93,23 @@ def test_replicas_take_any_directions(paper_tables, paper_fit):
         assert not np.isinf(poisoned[0, 0]).any(), tier
         np.testing.assert_allclose(poisoned[1], batch[1], rtol=1e-12, err_msg=tier)
         np.testing.assert_allclose(poisoned[0, 1:], batch[0, 1:], rtol=1e-12, err_msg=tier)
+
+
+def test_over_the_artists_shader_the_bare_skin_is_the_tables(paper_tables, paper_fit):
+    """Over the artist's shader a tier's BRDF is its covered skin mixed by coverage with the
+    tables' bare skin (the artist's shader stands there): at coverage 0 it is that bare skin,
+    at 1 the tier's own, and its errors are measured so (some tiers at a time)."""
+    wi, wo = paper_tables.node_directions()
+    bare = paper_tables.made_up_reflection(wi, wo, 0.0, 0.3)
+    for tier in tiers.TIERS:
+        at_zero = tiers.tier_reflection(paper_fit, paper_tables, tier, 0.0, 0.3,
+                                        over_shader=True)
+        np.testing.assert_allclose(at_zero, bare, rtol=1e-12, atol=1e-15)
+        at_one = tiers.tier_reflection(paper_fit, paper_tables, tier, 1.0, 0.3,
+                                       over_shader=True)
+        np.testing.assert_allclose(at_one, tiers.TIER_REPLICAS[tier](paper_fit, paper_tables,
+                                                                     1.0, 0.3), rtol=1e-12)
+    over = tiers.tier_errors(paper_fit, paper_tables, 0.5, 0.3, tiers=("LAYERED",),
+                             over_shader=True)
+    whole = tiers.tier_errors(paper_fit, paper_tables, 0.5, 0.3, tiers=("LAYERED",))
+    assert set(over) == {"LAYERED"} and over["LAYERED"].rms < whole["LAYERED"].rms
