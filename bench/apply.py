@@ -63,6 +63,7 @@ from pathlib import Path
 from checkout import (  # bench/checkout.py
     MB,
     Memory,
+    addon_attribute,
     commit,
     machine_load,
     packages_commit,
@@ -151,7 +152,6 @@ def _apply_once(bpy) -> float:
 def worker(bpy, support, case: str, tier: str) -> dict:
     """Cold Apply, repeated Apply, panel draws of one case in this (fresh) process."""
     character, panel_layout, _ = support
-    from makeup_skin_addon import material as made_up
     from makeup_skin_addon import ui
 
     bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
@@ -195,7 +195,7 @@ def worker(bpy, support, case: str, tier: str) -> dict:
     out.update(repeat_s=statistics.median(repeats), repeat_runs=repeats,
                repeat_cpu_s=statistics.median(CPU_SECONDS[-len(repeats):]),
                repeat_mb=max(peaks))
-    out["resolved_tier"] = (made_up.resolve_tier(settings, bpy.context.scene)
+    out["resolved_tier"] = (addon_attribute("resolve_tier")(settings, bpy.context.scene)
                             if tier == "AUTO" else tier)
     settings.tier = "AUTO"  # headless: marks the material for a preview re-bake, nothing more
     out["draw_auto_first_ms"], out["draw_auto_ms"] = _draw_ms(

@@ -5,6 +5,8 @@ bench/apply.py, bench/tier_accuracy.py).
   check they came from there; then this repository's ``tests`` (for ``support``) last.
 - :func:`commit` -- the checkout's ``HEAD``, marked ``+changes`` when its packages differ from it;
   :func:`packages_commit` -- the last commit that changed its packages.
+- :func:`addon_attribute` -- a function of the measured checkout's add-on, wherever that
+  checkout keeps it.
 - :func:`machine_load` -- the load averages, recorded beside the figures.
 - :func:`write_figures` -- a benchmark's results as JSON (``--json FILE``).
 - :class:`Memory` -- the memory a step adds: its peak resident set (VmHWM, reset before it)
@@ -25,7 +27,7 @@ OWN_ROOT = Path(__file__).resolve().parents[1]
 OWN_TESTS = OWN_ROOT / "tests"
 
 __all__ = ["OWN_ROOT", "OWN_TESTS", "MB", "use_checkout", "commit", "packages_commit",
-           "machine_load", "write_figures", "Memory"]
+           "addon_attribute", "machine_load", "write_figures", "Memory"]
 
 MB = 1e6
 
@@ -70,6 +72,24 @@ def packages_commit(repo: Path, packages=("makeup_skin_addon", "lut_baker")) -> 
                               check=True).stdout.strip() or "unknown"
     except (OSError, subprocess.CalledProcessError):
         return "unknown"
+
+
+ADDON_MODULES = ("apply", "groups", "tier_choice", "rebuild", "bakes", "material")
+"""Where the add-on's Apply functions may live: its modules now, then ``material``, which held
+them all before Apply was split by job."""
+
+
+def addon_attribute(name: str):
+    """``name`` (a function, a class) of the add-on imported (the measured checkout's), from
+    the first of :data:`ADDON_MODULES` that the checkout has and that holds it."""
+    for module in ADDON_MODULES:
+        try:
+            found = importlib.import_module(f"makeup_skin_addon.{module}")
+        except ImportError:
+            continue
+        if hasattr(found, name):
+            return getattr(found, name)
+    raise AttributeError(f"the add-on has no {name!r} in {ADDON_MODULES}")
 
 
 def machine_load() -> list[float]:

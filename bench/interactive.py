@@ -59,7 +59,13 @@ import tempfile
 import time
 from pathlib import Path
 
-from checkout import commit, machine_load, use_checkout, write_figures  # bench/checkout.py
+from checkout import (  # bench/checkout.py
+    addon_attribute,
+    commit,
+    machine_load,
+    use_checkout,
+    write_figures,
+)
 
 HERE = Path(__file__).resolve()
 KINDS = ("principled", "in_group", "two_principled", "mix_glossy", "dark_value", "pale_value")
@@ -172,7 +178,8 @@ def _background(bpy, live, name: str, start) -> dict:
 def first_apply(bpy, support, case: str, mode: str) -> dict:
     """One case's first Apply in this (fresh) process, ``full`` or ``preview``."""
     from makeup_skin_addon import live
-    from makeup_skin_addon import material as made_up
+
+    apply_to_object, group_of = addon_attribute("apply_to_object"), addon_attribute("group_of")
 
     obj = _scene(bpy, *support, case)
     out: dict = {"case": case, "mode": mode}
@@ -180,16 +187,16 @@ def first_apply(bpy, support, case: str, mode: str) -> dict:
         if not hasattr(live, "refine"):
             return {**out, "unavailable": "no worker thread in this checkout"}
         with _Clock() as clock:
-            material, report = made_up.apply_to_object(bpy.context, obj, preview_first=True)
+            material, report = apply_to_object(bpy.context, obj, preview_first=True)
         out.update(apply_cpu_s=clock.cpu, apply_wall_s=clock.wall, refined=report.refine)
         if report.refine is not None:
             out["refine"] = _background(bpy, live, material.name, lambda: live.refine(
                 bpy.context, material, report.refine))
     else:
         with _Clock() as clock:
-            material, _ = made_up.apply_to_object(bpy.context, obj)
+            material, _ = apply_to_object(bpy.context, obj)
         out.update(apply_cpu_s=clock.cpu, apply_wall_s=clock.wall)
-    meta = json.loads(made_up.group_of(material).node_tree["makeup_skin_fit"])
+    meta = json.loads(group_of(material).node_tree["makeup_skin_fit"])
     out.update(tier=meta["tier"], resolution=meta["resolution"],
                fitted=sorted(json.loads(material["makeup_skin_errors"])))
     return out
@@ -225,11 +232,9 @@ def live_changes(bpy, material) -> list[dict]:
 def worker(bpy, support, case: str, mode: str, with_live: bool) -> dict:
     out = first_apply(bpy, support, case, mode)
     if with_live and mode == "full" and case in LIVE_CASES:
-        from makeup_skin_addon import material as made_up
-
         obj = bpy.context.view_layer.objects.active
         out["live"] = live_changes(bpy, obj.active_material)
-        assert made_up.group_of(obj.active_material) is not None
+        assert addon_attribute("group_of")(obj.active_material) is not None
     return out
 
 

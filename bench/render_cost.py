@@ -80,7 +80,7 @@ def measure(repeats: int) -> list[dict]:
     bench_scene.set_material(sphere, artist)
     materials = {"artist": (artist, None)}
     with sphere_scene.addon_registered():
-        from makeup_skin_addon import material as made_up
+        from makeup_skin_addon import apply, groups
 
         for name, tier, coverage, over, method in _configs()[1:]:
             if over:
@@ -89,7 +89,7 @@ def measure(repeats: int) -> list[dict]:
                 bench_scene.set_material(sphere, material)
                 material.makeup_skin.tier = tier
                 bpy.context.view_layer.objects.active = sphere
-                made_up.apply_to_object(bpy.context, sphere)
+                apply.apply_to_object(bpy.context, sphere)
             else:
                 sphere.data.materials.clear()
                 sphere.data.materials.append(bpy.data.materials.new(name))
@@ -97,9 +97,9 @@ def measure(repeats: int) -> list[dict]:
                 material.makeup_skin.tier = tier
                 if method is not None:
                     material.makeup_skin.subsurface_method = method
-                made_up.apply_to_object(bpy.context, sphere)
+                apply.apply_to_object(bpy.context, sphere)
             material.makeup_skin.coverage = coverage
-            made_up.update_sockets(material)
+            groups.update_sockets(material)
             materials[name] = (material, coverage)
         times: dict = {name: [] for name in materials}
         for seed in range(repeats):

@@ -31,7 +31,7 @@ Parts, each in fresh Blender processes (so the first call is truly cold), this c
   match_skin()`` (the first: the colour cold, the session's uniform-light tables baked),
   ``shade_step(direction="LIGHTER")``, ``shade_step(direction="DARKER")``, Match Skin again;
   and, in another process, a first Apply at the defaults
-  (:func:`makeup_skin_addon.material.apply_to_object`: the match, then the bake and fit).  Each
+  (:func:`makeup_skin_addon.apply.apply_to_object`: the match, then the bake and fit).  Each
   with the part spent in reading the skin's colour (over the artist's shader
   ``artist_skin.read_material``; an older checkout's ``skin_sampling.surface_mean`` or
   ``shade.image_mean``) and, for Apply, in the match (``matching.first_shade``, or
@@ -60,7 +60,16 @@ import tempfile
 import time
 from pathlib import Path
 
-from checkout import MB, OWN_ROOT, Memory, commit, machine_load, use_checkout, write_figures
+from checkout import (
+    MB,
+    OWN_ROOT,
+    Memory,
+    addon_attribute,
+    commit,
+    machine_load,
+    use_checkout,
+    write_figures,
+)
 from doc_block import replace_block
 
 HERE = Path(__file__).resolve()
@@ -170,6 +179,19 @@ def _timed(module, name: str, spent: dict):
 
 
 
+def _sampling_parts():
+    """``(points, image)``: the modules of the measured checkout that spread the points and
+    reduce the image (``surface_points`` and ``image_texels``; ``skin_sampling`` both, before
+    they were split from it)."""
+    if importlib.util.find_spec("makeup_skin_addon.image_texels") is None:
+        from makeup_skin_addon import skin_sampling
+
+        return skin_sampling, skin_sampling
+    from makeup_skin_addon import image_texels, surface_points
+
+    return surface_points, image_texels
+
+
 # -- the workers (one fresh process each) -------------------------------------------------------
 
 def sampling_worker(cache: Path, repo: Path) -> dict:
@@ -185,7 +207,7 @@ def sampling_worker(cache: Path, repo: Path) -> dict:
     texture.image.filepath = str(working)
 
     spent: dict = {}
-    _timed(skin_sampling, "reduced_image", spent)
+    _timed(_sampling_parts()[1], "reduced_image", spent)
 
     def mean():
         spent.clear()
@@ -246,24 +268,26 @@ def accuracy_worker(cache: Path, repo: Path) -> dict:
     ours = skin_sampling.surface_mean(image, material)
     out = {"exact": [float(c) for c in exact], "ours": relative(ours.rgb),
            "its standard error (2^16 points)": relative(exact + ours.error)}
-    points = skin_sampling.object_points(head, material, layer, skin_sampling.BUDGET)
+    spread, texels = _sampling_parts()
+    points = spread.object_points(head, material, layer, spread.BUDGET)
     out["points in the whole image"] = relative(
-        skin_sampling.read_texels(full, points.uv).mean(axis=0))
-    many = skin_sampling.object_points(head, material, layer, 1 << 20)
+        texels.read_texels(full, points.uv).mean(axis=0))
+    many = spread.object_points(head, material, layer, 1 << 20)
     out["2^20 points in the whole image"] = relative(
-        skin_sampling.read_texels(full, many.uv).mean(axis=0))
+        texels.read_texels(full, many.uv).mean(axis=0))
     for size in (256, 512, 1024, 2048):
-        reduced = skin_sampling.reduced_image(image, size)
+        reduced = texels.reduced_image(image, size)
         out[f"2^20 points at {size} px"] = relative(
-            skin_sampling.read_texels(reduced.pixels, many.uv).mean(axis=0))
+            texels.read_texels(reduced.pixels, many.uv).mean(axis=0))
     return out
 
 
 def operators_worker(cache: Path, repo: Path, which: str) -> dict:
     bpy, head = _open(cache, repo)
     import makeup_skin_addon
-    from makeup_skin_addon import material as made_up
     from makeup_skin_addon import shade
+
+    apply_to_object = addon_attribute("apply_to_object")
 
     spent: dict = {}
     over_shader = importlib.util.find_spec("makeup_skin_addon.artist_skin") is not None
@@ -290,14 +314,14 @@ def operators_worker(cache: Path, repo: Path, which: str) -> dict:
         if which == "match" and over_shader:
             # Match Skin waits for Apply (greyed out before): Apply, then forget the colour
             # read (a made-up file opened anew: the first Match Skin reads it cold).
-            made_up.apply_to_object(bpy.context, head)
+            apply_to_object(bpy.context, head)
             skin_sampling.clear_cache()
         steps = ([("match_skin", lambda: bpy.ops.makeup_skin.match_skin()),
                   ("lighter", lambda: bpy.ops.makeup_skin.shade_step(direction="LIGHTER")),
                   ("darker", lambda: bpy.ops.makeup_skin.shade_step(direction="DARKER")),
                   ("match_skin again", lambda: bpy.ops.makeup_skin.match_skin())]
                  if which == "match" else
-                 [("first apply", lambda: made_up.apply_to_object(bpy.context, head))])
+                 [("first apply", lambda: apply_to_object(bpy.context, head))])
         out = {}
         for name, run in steps:
             spent.clear()

@@ -7,20 +7,22 @@ its own, and only at module level (no import inside a function, no cycle):
    material and image names, the ``bl_idname`` prefixes, the presets folder (no bpy).
 2. ``package`` -- the add-on's package names, and whether it runs installed (no bpy).
    ``core`` -- lut_baker's runtime modules, imported by ordinary statements, from beside the
-   add-on when installed, top level from a checkout (no bpy).
-3. ``convert`` -- the artist's material converted in place and back (install, revert): the
-   skin shader followed through mixes and groups, its albedo, normal and film normal carried.
-4. ``storage`` -- what the .blend keeps: bake records, re-bakes, packed images and their hashes.
-   ``fits`` -- the session's tables and closure fits by bake key.
-   ``skin_sampling`` -- the mean of an image over a material's surface (points on its faces,
-   the image reduced), cached per mesh and per image.
-   ``shade`` -- the settings as the model (roughness, IOR), the colour seen, the skin's own
-   colour, Match Skin and the shade steps.
-5. ``nodes`` -- the node groups built from closure fits, and their records.
-6. ``scene_fit`` -- the scene and the material as the Auto tier sees them, the choice, and its
-   settings (units per mm, Auto tier, Fit to Scene's settings and record).
-7. ``material`` -- the apply pipeline: Apply, Revert, Check Tables, the rebuild from settings.
-8. ``live`` -- the live preview: socket updates at once, debounced preview re-bakes.
+   add-on when installed, top level from a checkout (no bpy).  ``progress`` -- where a slow
+   step's progress goes.
+3. The artist's material: ``artist_shader`` (its shader read as a tree), ``node_maths`` and
+   ``surface_values`` (what feeds an input, evaluated with numpy), ``node_copy``,
+   ``skin_nodes`` and ``convert`` (the material converted in place and back).
+4. The session's bakes: ``storage`` (the images the .blend keeps, their hashes), ``bakes`` (a
+   bake's key and record, one cache of tables and closure fits, :class:`.bakes.Bake`).
+5. The skin: ``surface_points``, ``image_texels`` and ``skin_sampling`` (an image's mean over a
+   material's faces), ``skin_colour`` (the skin preset's own colour), ``artist_skin`` (the
+   skin the artist's shader describes), ``shade`` and ``skin_model`` (the settings as the
+   model), ``matching`` (Match Skin, Lighter / Darker).
+6. The group: ``node_algebra`` and ``nodes`` (built from closure fits), ``tier_choice`` (the
+   tiers fitted, Tier Auto's choice, Fit to Scene's settings), ``groups`` (reused or built,
+   made a material's surface), ``rebuild`` (from the settings, in steps).
+7. ``apply`` -- Apply step by step, Revert, Check Tables.
+8. ``live`` -- the live preview: socket updates at once, rebuilds on a worker thread.
 9. ``on_load`` -- on opening a file, older settings upgraded and the made-up materials'
    images checked (packed bytes' hashes) and repaired before the first render (a
    ``load_post`` handler).
@@ -30,6 +32,9 @@ its own, and only at module level (no import inside a function, no cycle):
     the preset menu and its operator.
 12. ``ui`` -- the panels: settings, buttons, the group's record and errors, Fit to Scene, a
     repair on opening.
+
+The exact order is ``tools/check_imports.py``'s; docs/architecture.md follows Foundation from
+the panel to the node group through them.
 
 This package (the top) registers the modules with classes or session state in that order
 (:data:`modules`) and unregisters them in reverse.  A new operator goes into ``operators``, a
@@ -46,11 +51,11 @@ own exit disables it again.
 
 import atexit
 
-from . import live, on_load, operators, properties, scene_fit, ui
+from . import live, on_load, operators, properties, tier_choice, ui
 
 __all__ = ["modules", "register", "unregister"]
 
-modules = (scene_fit, live, on_load, properties, operators, ui)
+modules = (tier_choice, live, on_load, properties, operators, ui)
 
 _registered = False
 """Whether :func:`register` ran and :func:`unregister` has not since."""

@@ -21,7 +21,7 @@ Custom properties of a material (JSON strings unless said otherwise):
 
 - :data:`RECORD_KEY` -- the surface before Apply, for Revert (:mod:`.convert`).
 - :data:`ERRORS_KEY` -- the tiers' errors at the settings of the last Apply (:mod:`.material`).
-- :data:`CHOICE_KEY` -- the last Fit to Scene choice (:mod:`.scene_fit`).
+- :data:`CHOICE_KEY` -- the last Fit to Scene choice (:mod:`.tier_choice`).
 - :data:`AUTO_KEY` -- the tier the last Apply chose for Tier = Auto, for the panel
   (:mod:`.material`).
 - :data:`SAVED_SCALE_KEY`, :data:`SAVED_GLOSS_KEY` -- floats: the Subsurface Scale and Gloss

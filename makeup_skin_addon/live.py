@@ -5,9 +5,9 @@ to the material's group node.  Settings that change the tables (foundation, skin
 Skin Roughness, Film IOR, tier, subsurface method) mark the material and start one debounce
 timer (:func:`rebake_timer`); when it fires, each marked material's rebuild at preview
 resolution is prepared on the main thread (its settings read:
-:func:`.material.prepare_rebuild`) and computed on a worker thread (bake, fit, measurement:
+:func:`.rebuild.prepare_rebuild`) and computed on a worker thread (bake, fit, measurement:
 numpy only, no bpy), and a poll timer (:func:`poll_timer`) swaps the new group in on the main
-thread when it is ready (:func:`.material.finish_rebuild`: the group rebuilt in place, copied
+thread when it is ready (:func:`.rebuild.finish_rebuild`: the group rebuilt in place, copied
 first if other materials share it).  So the interface never waits for a bake or a fit: the
 main thread only reads the settings, polls and builds the group.  A newer change supersedes a
 rebuild in flight: the worker stops at its next step and its result is dropped, as is one
@@ -36,7 +36,8 @@ import threading
 
 import bpy
 
-from . import material as made_up
+from . import apply, groups
+from .rebuild import Rebuild, finish_rebuild, prepare_rebuild
 
 __all__ = ["DEBOUNCE_S", "POLL_S", "JOIN_TIMEOUT_S", "sockets_changed", "tables_changed",
            "start", "poll", "refine", "can_refine", "flush", "wait", "pending", "in_flight",
@@ -50,7 +51,7 @@ POLL_S = 0.05
 JOIN_TIMEOUT_S = 10.0
 """Longest wait for a stopped worker at unregister (it stops at its next step, well within
 a second)."""
-PREVIEW = made_up.PREVIEW
+PREVIEW = apply.PREVIEW
 
 _dirty: dict[str, str] = {}
 """Materials marked for a rebuild, by name: the resolution to rebuild at."""
@@ -66,10 +67,10 @@ class _Superseded(Exception):
 
 
 class _Job:
-    """A material's rebuild (:class:`.material.Rebuild`) computed by its own worker thread;
+    """A material's rebuild (:class:`.rebuild.Rebuild`) computed by its own worker thread;
     :meth:`stop` makes the worker stop at its next step."""
 
-    def __init__(self, rebuild: made_up.Rebuild):
+    def __init__(self, rebuild: Rebuild):
         self.rebuild = rebuild
         self.error: BaseException | None = None
         self._stop = threading.Event()
@@ -110,7 +111,7 @@ def sockets_changed(settings) -> None:
     """A socket-level setting moved: set the group node's sockets."""
     material = _material_of(settings)
     if material is not None and settings.is_made_up:
-        made_up.update_sockets(material)
+        groups.update_sockets(material)
 
 
 def _supersede(name: str) -> None:
@@ -171,8 +172,8 @@ def _usable(material) -> str | None:
     if material is None or not material.makeup_skin.is_made_up:
         return "gone"
     try:
-        made_up.refuse_linked(None, material)
-    except made_up.LinkedDataError as error:
+        apply.refuse_linked(None, material)
+    except apply.LinkedDataError as error:
         return f"Made-up Skin: no preview: {error}."
     return None
 
@@ -185,7 +186,7 @@ def _prepared(context, name: str, resolution: str) -> _Job | str | None:
     if reason is not None:
         return None if reason == "gone" else reason
     try:
-        return _Job(made_up.prepare_rebuild(context, material, resolution))
+        return _Job(prepare_rebuild(context, material, resolution))
     except (ValueError, RuntimeError) as error:
         return f"Made-up Skin: the preview of {name!r} failed: {error}."
 
@@ -232,12 +233,12 @@ def _swap(context, job: _Job) -> list[str]:
         return [] if reason == "gone" else [reason]
     if job.error is not None:
         return [f"Made-up Skin: the preview of {rebuild.material!r} failed: {job.error}."]
-    node = made_up.group_of(material)
+    node = groups.group_of(material)
     group = node.node_tree if node is not None else None
     if group is not None and group.users > 1:
         group = group.copy()  # others keep their look; this material gets its own
     try:
-        made_up.finish_rebuild(context, material, group, rebuild)
+        finish_rebuild(context, material, group, rebuild)
     except (ValueError, RuntimeError) as error:
         return [f"Made-up Skin: the preview of {rebuild.material!r} failed: {error}."]
     return []
@@ -316,4 +317,4 @@ def unregister():
     _stopped.clear()
     _dirty.clear()
     _messages.clear()
-    made_up.clear_cache()
+    apply.clear_cache()

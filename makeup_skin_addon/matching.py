@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import artist_skin, shade, storage
+from . import artist_skin, bakes, shade, skin_colour, skin_model
 from .core import cache, presets, uniform_light
 
 __all__ = ["SHADE_STEP", "MATTE_FILM", "SkinTarget", "Shade", "skin_target", "light_for",
@@ -61,10 +61,10 @@ def light_for(settings, foundation: str | None = None, resolution: str | None = 
     light (:func:`lut_baker.tables.uniform_light.uniform_light` of their tables, re-baked once
     per session) at ``resolution`` (default the settings': the colours move by about 1e-4
     between resolutions)."""
-    record = storage.bake_record(shade.skin_from_settings(settings, foundation),
+    record = bakes.bake_record(skin_model.skin_from_settings(settings, foundation),
                                  resolution or settings.resolution)
     return _LIGHT.get_or_compute(record["key"],
-                                 lambda: uniform_light.uniform_light(storage.rebake(record)))
+                                 lambda: uniform_light.uniform_light(bakes.rebake(record)))
 
 
 def skin_target(material, reading=None, light=None, resolution: str | None = None
@@ -82,7 +82,7 @@ def skin_target(material, reading=None, light=None, resolution: str | None = Non
         where = f" {reading.where}" if reading.where else ""
         return SkinTarget(np.asarray(reading.target, float), np.asarray(reading.body, float),
                           f"the artist's shader under uniform light{where}{notes}")
-    skin = shade.skin_colour(material)
+    skin = skin_colour.skin_colour(material)
     light = light_for(settings, resolution=resolution) if light is None else light
     bare = uniform_light.bare_colour(light, skin.rgb, float(settings.gloss))
     return SkinTarget(np.asarray(bare, float), np.asarray(skin.rgb, float),
@@ -206,10 +206,10 @@ def stepped(material, steps: int) -> Shade:
     if settings.shade_source == "MATCH" and settings.is_property_set("shade_base"):
         base, count = np.asarray(settings.shade_base, float), int(settings.shade_steps)
     else:
-        base = uniform_light.covered_colour(light, settings.effective_absorption(), skin.body,
+        base = uniform_light.covered_colour(light, list(settings.absorption), skin.body,
                                             gloss)
         count = 0
-    current = uniform_light.covered_colour(light, settings.effective_absorption(), skin.body,
+    current = uniform_light.covered_colour(light, list(settings.absorption), skin.body,
                                            gloss)
     count += int(steps)
     result = _solve(settings, light, base * SHADE_STEP ** count, skin)

@@ -393,11 +393,11 @@ def build_group(tier: str, record: dict, fit, group=None, *, method=None, measur
                 over: bool = False):
     """Create (or, given ``group``, rebuild in place) the node group of ``tier`` from a
     :class:`ClosureFit` ``fit`` of the tables that the bake record ``record`` describes
-    (:func:`storage.bake_record`).  ``method``: a subsurface method forced by the user, else the
+    (:func:`.bakes.bake_record`).  ``method``: a subsurface method forced by the user, else the
     fit's choice.  The group's :data:`.keys.FIT_KEY` holds the bake record, the fit's summary,
     the SHA-256 of every image the group reads (:func:`storage.image_record`) and
     ``measured``, what the fit measured at the settings' coverage and absorption
-    (:func:`.fits.measure`), if given.  ``over``: a group over the artist's shader (its
+    (:func:`.bakes.measure`), if given.  ``over``: a group over the artist's shader (its
     Skin Shader input is the bare skin, :data:`OVER_SHADER_INPUTS`), else the skin preset's
     made-up skin, bare skin included (:data:`INPUTS`)."""
     if tier not in tiers.TIERS:
@@ -427,7 +427,7 @@ def build_group(tier: str, record: dict, fit, group=None, *, method=None, measur
             _build_principled(build, fit, method, radius, ior, over)
     else:
         parts = tiers.view_weighted_parts(fit, tier)
-        lut = storage.lut_image(lut_image_name(key, tier), parts.lut)
+        lut = storage.view_image(lut_image_name(key, tier), parts.lut)
         images.append(storage.image_record(lut))
 
         def emit(build):
@@ -444,7 +444,7 @@ def build_group(tier: str, record: dict, fit, group=None, *, method=None, measur
 
 
 def write_measured(group, measured: dict) -> None:
-    """Replace the measurement a group's record keeps (:func:`.fits.measure`)."""
+    """Replace the measurement a group's record keeps (:func:`.bakes.measure`)."""
     group[FIT_KEY] = json.dumps({**read_meta(group), "measured": measured}, default=float)
 
 

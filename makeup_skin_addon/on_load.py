@@ -31,8 +31,7 @@ import math
 
 import bpy
 
-from . import live, nodes, shade, storage
-from . import material as made_up
+from . import apply, groups, live, nodes, shade, storage
 from .core import presets, roughness
 from .keys import FIT_KEY, SETTINGS_VERSION
 
@@ -113,16 +112,16 @@ def repair_file(context) -> list[str]:
         return []
     sentences = []
     for material in bpy.data.materials:
-        node = made_up.group_of(material)
+        node = groups.group_of(material)
         group = node.node_tree if node is not None else None
         if group not in damaged:
             continue
         del damaged[group]
         try:
-            sentence = made_up.check_material(context, material)[1]
+            sentence = apply.check_material(context, material)[1]
         except (ValueError, RuntimeError) as error:
             sentence = f"{material.name!r} could not be repaired: {error}"
-        node = made_up.group_of(material)
+        node = groups.group_of(material)
         repaired = node is not None and not _problems(node.node_tree)
         _notices[material.name] = REPAIRED if repaired else NOT_REPAIRED
         sentences.append(sentence)

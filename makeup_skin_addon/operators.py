@@ -1,6 +1,6 @@
 """Operators: Apply, Revert, Check Tables, Fit to Scene, Match Skin and the shade steps
 (Lighter / Darker), and the preset menu with its add/remove operator.  Each operator's work is
-a function of a lower module (:mod:`.material`, :mod:`.scene_fit`, :mod:`.live`,
+a function of a lower module (:mod:`.apply`, :mod:`.tier_choice`, :mod:`.live`,
 :mod:`.shade`); here it is run and reported.  Idnames are
 ``makeup_skin.<name>`` (:data:`.keys.OPERATOR_PREFIX`).
 
@@ -13,9 +13,9 @@ from __future__ import annotations
 import bpy
 from bl_operators.presets import AddPresetBase
 
-from . import convert, live, matching, scene_fit, skin_sampling
-from . import material as made_up
+from . import apply, convert, groups, live, matching, tier_choice
 from .keys import OPERATOR_PREFIX, PRESET_SUBDIR, SETTINGS_ATTRIBUTE
+from .progress import progress_bar
 from .properties import RESOLUTION_ITEMS
 
 __all__ = ["MAKEUPSKIN_OT_apply", "MAKEUPSKIN_OT_revert", "MAKEUPSKIN_OT_check_tables",
@@ -64,8 +64,8 @@ def _linked_reason(obj, material) -> str | None:
     """Why the data Apply, Fit to Scene or a shade would change cannot be changed here: the
     material, its group, or (no material) ``obj``'s mesh linked from a library."""
     try:
-        made_up.refuse_linked(obj, material)
-    except made_up.LinkedDataError as error:
+        apply.refuse_linked(obj, material)
+    except apply.LinkedDataError as error:
         return str(error)
     return None
 
@@ -118,7 +118,7 @@ class MAKEUPSKIN_OT_apply(bpy.types.Operator):
         try:
             # With an event loop, a new bake is done at preview resolution first and refined
             # on a worker thread (docs/addon.md, "Apply and Live Update, timed").
-            material, messages = made_up.apply_to_object(
+            material, messages = apply.apply_to_object(
                 context, obj, resolution=resolution, preview_first=live.can_refine())
         except (ValueError, RuntimeError) as error:
             self.report({"ERROR"}, f"Made-up Skin: {_sentence(error)}")
@@ -153,7 +153,7 @@ class MAKEUPSKIN_OT_revert(bpy.types.Operator):
     def execute(self, context):
         try:
             live.cancel(context.active_object.active_material)
-            message = made_up.revert_material(context.active_object.active_material)
+            message = apply.revert_material(context.active_object.active_material)
         except ValueError as error:
             self.report({"ERROR"}, f"Made-up Skin: {_sentence(error)}")
             return {"CANCELLED"}
@@ -176,7 +176,7 @@ class MAKEUPSKIN_OT_check_tables(bpy.types.Operator):
                 continue
             checked += 1
             try:
-                intact, sentence = made_up.check_material(context, material)
+                intact, sentence = apply.check_material(context, material)
             except (ValueError, RuntimeError) as error:
                 intact = False
                 sentence = f"{material.name!r} could not be repaired: {_sentence(error)}"
@@ -213,22 +213,22 @@ class MAKEUPSKIN_OT_fit_to_scene(bpy.types.Operator):
         material = obj.active_material
         context.view_layer.update()  # object matrices follow moves only after an update
         try:
-            made_up.refuse_linked(obj, material)
+            apply.refuse_linked(obj, material)
             if material is None or not material.makeup_skin.is_made_up:
-                material, _ = made_up.apply_to_object(context, obj)
+                material, _ = apply.apply_to_object(context, obj)
             elif material.name in live.pending():
                 live.flush(context)  # judge the tables the settings describe now
-            choice, description = scene_fit.choose_for(material, context.scene, obj=obj,
+            choice, description = tier_choice.choose_for(material, context.scene, obj=obj,
                                                        tolerance=self.tolerance)
             changes = []
             if self.apply:
-                changes = scene_fit.set_choice(material, choice.candidate)
-                made_up.apply_to_object(context, obj)
+                changes = tier_choice.set_choice(material, choice.candidate)
+                apply.apply_to_object(context, obj)
         except (ValueError, RuntimeError) as error:
             self.report({"ERROR"}, f"Made-up Skin: Fit to Scene changed nothing: {error}.")
             return {"CANCELLED"}
         chosen = choice.chosen
-        scene_fit.record_choice(material, choice, description)
+        tier_choice.record_choice(material, choice, description)
         if description is None:
             self.report({"WARNING"}, "Made-up Skin: no camera or object in the scene: assumed "
                                      "a close-up")
@@ -260,14 +260,14 @@ def _set_shade(operator, context, solve) -> set:
     or a step), store it and report; the material's group takes it at once."""
     material = context.active_object.active_material
     try:
-        made_up.refuse_linked(None, material)
-        with skin_sampling.progress_bar(context.window_manager):
+        apply.refuse_linked(None, material)
+        with progress_bar(context.window_manager):
             result = solve(material)
     except (ValueError, RuntimeError) as error:
         operator.report({"ERROR"}, f"Made-up Skin: {_sentence(error)}")
         return {"CANCELLED"}
     matching.assign(material.makeup_skin, result, "MATCH")
-    made_up.update_sockets(material)
+    groups.update_sockets(material)
     for sentence in result.sentences:
         operator.report({"WARNING"} if "out of reach" in sentence else {"INFO"},
                         f"Made-up Skin: {sentence}")

@@ -292,10 +292,6 @@ class MakeupSkinSettings(bpy.types.PropertyGroup):
         name="Live Update", default=True,
         description="Re-bake at preview resolution while sliders move (Apply bakes in full)")
 
-    def effective_absorption(self):
-        """Absorption per channel (a picked colour is solved into it when picked)."""
-        return list(self.absorption)
-
 
 classes = (MakeupSkinSettings,)
 

@@ -1,20 +1,11 @@
-"""What a made-up material keeps in the .blend: the images its render reads and the record of
-its bake, never the tables themselves.
+"""What a made-up material keeps in the .blend: the images its render reads and their hashes,
+never the tables themselves (those are re-baked from the group's bake record, :mod:`.bakes`).
 
-A bake is identified by its record (:func:`bake_record`): the made-up skin's parameters, the
-resolution name and their key (:func:`bake_key`, a hash of those two and of the tables' format:
-the same settings give the same key on any machine, without baking).  Baking is deterministic
-and takes a fraction of a second, so the tables are re-baked from the record when Check Tables
-or a re-fit needs them (:func:`rebake`, cached for the session) instead of travelling in every
-saved file.  The
-images a group reads (the Layered tier's view-angle image) are packed, and the group records
-the SHA-256 of their pixels and of their packed bytes (:func:`image_record`), so damage is
-found before Blender decodes the image (:func:`image_problem`).
+The images a group reads (the Layered and EEVEE tiers' view-angle image) are packed, and the
+group records the SHA-256 of their pixels and of their packed bytes (:func:`image_record`), so
+damage is found before Blender decodes the image (:func:`image_problem`).
 
-- :func:`bake_key`, :func:`bake_record`, :func:`rebake` -- a bake's key and record, and the
-  tables again from it.
-- :func:`lut_image` -- the Layered tier's view-angle image (named by
-  :func:`.keys.lut_image_name`).
+- :func:`view_image` -- a tier's view-angle image (named by :func:`.keys.lut_image_name`).
 - :func:`image_record`, :func:`image_problem` -- an image's hashes, and what is wrong with it;
   :func:`image_problems` for a group's images.
 - :func:`write_pixels` -- pixels into an image, packed.
@@ -23,98 +14,20 @@ found before Blender decodes the image (:func:`image_problem`).
 from __future__ import annotations
 
 import hashlib
-import json
+from typing import Any
 
 import bpy
 import numpy as np
 
-from .core import bake, cache, codec, params_file, table_set
+from .core import codec
 
 __all__ = [
-    "StorageError",
-    "bake_key",
-    "bake_record",
-    "remember",
-    "rebake",
-    "clear_cache",
-    "lut_image",
+    "view_image",
     "image_record",
     "image_problem",
     "image_problems",
     "write_pixels",
 ]
-
-REBAKE_CACHE_SIZE = 8
-"""Re-baked tables kept per bake key in this session."""
-KEY_LENGTH = 16
-"""Hex digits of a bake key (64 bits: no two bakes of one file collide)."""
-
-
-class StorageError(ValueError):
-    """A bake record cannot be re-baked; the message says why, as a sentence's end."""
-
-
-def bake_key(parameters: dict, resolution: str) -> str:
-    """The key of a bake: SHA-256 (first :data:`KEY_LENGTH` hex digits) of the made-up skin's
-    ``parameters`` (:func:`lut_baker.model.params_file.skin_to_dict`), the resolution name and
-    the tables' format version, as canonical JSON (floats by ``repr``: the same on every
-    machine)."""
-    version = table_set.FORMAT_VERSION
-    text = json.dumps({"parameters": parameters, "resolution": str(resolution),
-                       "format": version}, sort_keys=True, separators=(",", ":"))
-    return hashlib.sha256(text.encode("utf-8")).hexdigest()[:KEY_LENGTH]
-
-
-def bake_record(skin, resolution: str) -> dict:
-    """What identifies a bake: ``{"key", "parameters", "resolution"}`` (plain data, no bake
-    needed)."""
-    parameters = params_file.skin_to_dict(skin)
-    return {"key": bake_key(parameters, resolution), "parameters": parameters,
-            "resolution": str(resolution)}
-
-
-_TABLES = cache.LRUCache(REBAKE_CACHE_SIZE)
-
-
-def clear_cache() -> None:
-    """Forget the session's re-baked tables (the add-on's unregister calls it)."""
-    _TABLES.clear()
-
-
-def remember(record: dict, tables) -> None:
-    """Keep ``tables`` as this session's bake of ``record`` (for a caller that baked them
-    itself: tests and tools)."""
-    _TABLES.put(record["key"], tables)
-
-
-def rebake(record: dict, *, progress=None):
-    """The tables of a :func:`bake_record`, baked once per session (cached by key);
-    ``progress(fraction, message)``: the bake's, when it runs.
-
-    Raises
-    ------
-    StorageError
-        If the record has no readable parameters or resolution, or its key is not theirs.
-    """
-    try:
-        key = bake_key(record["parameters"], record["resolution"])
-    except (KeyError, TypeError, ValueError):
-        raise StorageError("its bake record cannot be read (a parameter or the resolution is "
-                           "missing)") from None
-    if key != record.get("key"):
-        raise StorageError("its bake record does not match its key (it was edited, or written "
-                           "by another version)")
-    tables = _TABLES.get(key)
-    if tables is not None:
-        return tables
-    try:
-        skin = params_file.skin_from_dict(record["parameters"])
-        tables = bake.bake(skin, record["resolution"], progress=progress)
-    except (KeyError, TypeError, ValueError):
-        raise StorageError("its bake record cannot be re-baked (a parameter is missing or "
-                           "unreadable)") from None
-    _TABLES.put(key, tables)
-    return tables
 
 
 def _new_float_image(name: str, width: int, height: int) -> bpy.types.Image:
@@ -132,19 +45,19 @@ def write_pixels(image: bpy.types.Image, rgba: np.ndarray) -> None:
     image.pack()
 
 
-def _pixel_digest(image) -> str:
+def _pixel_digest(image: Any) -> str:
     width, height = image.size
     pixels = np.empty(width * height * image.channels, dtype=np.float32)
     image.pixels.foreach_get(pixels)
     return codec.pixel_hash(pixels)
 
 
-def _packed_digest(image) -> str | None:
+def _packed_digest(image: Any) -> str | None:
     packed = image.packed_file
     return None if packed is None else hashlib.sha256(bytes(packed.data)).hexdigest()
 
 
-def image_record(image) -> dict:
+def image_record(image: Any) -> dict:
     """``{"name", "sha256", "packed_sha256"}``: the image's name, the SHA-256 of its float32
     pixels and of its packed file's bytes (None if not packed)."""
     return {"name": image.name, "sha256": _pixel_digest(image),
@@ -175,13 +88,13 @@ def image_problem(record: dict, *, decode: bool = True) -> str | None:
     return None
 
 
-def image_problems(records, *, decode: bool = True) -> list[str]:
+def image_problems(records: Any, *, decode: bool = True) -> list[str]:
     """:func:`image_problem` of each record, the intact ones left out."""
     problems = (image_problem(record, decode=decode) for record in records)
     return [problem for problem in problems if problem]
 
 
-def lut_image(name: str, rows: np.ndarray) -> bpy.types.Image:
+def view_image(name: str, rows: np.ndarray) -> bpy.types.Image:
     """The view-angle image ``name``: ``rows`` ``(n_rows, size, 3)``, row ``j`` at texel row
     ``j`` from the bottom (sample it at ``v = (j + 0.5) / n_rows``); float, Non-Color, linear
     filtering, EXTEND, packed.  An existing image of that name is replaced (it is the add-on's:

@@ -18,6 +18,8 @@ axis of 3 (colours and vectors) or 1 (floats).
 - :class:`Samples` -- what evaluation needs of the surface: UVs by map, image lookups.
 - :func:`values` -- an input's values at the samples (:class:`.artist_shader.Source`).
 - :func:`mean` -- their mean (RGB or a float).
+
+What the colour and math nodes compute is written in :mod:`.node_maths`.
 """
 
 from __future__ import annotations
@@ -27,6 +29,7 @@ from typing import Protocol
 
 import numpy as np
 
+from . import node_maths
 from .artist_shader import Source, source
 
 __all__ = ["Samples", "values", "mean", "NEUTRAL"]
@@ -200,14 +203,14 @@ class _Evaluator:
             t = np.clip(t, 0.0, 1.0)
         if data != "RGBA":
             return a + t * (b - a)
-        result = _blend(node.blend_type, t, a, b)
+        result = node_maths.blend(node.blend_type, t, a, b)
         if result is None:
             return self.note(node, f"Mix {node.blend_type}")
         return np.clip(result, 0.0, 1.0) if node.clamp_result else result
 
     def node_mix_rgb(self, node, socket, groups):
         t = np.clip(self.input(node, "Fac", groups, "VALUE"), 0.0, 1.0)
-        result = _blend(node.blend_type, t, self.input(node, "Color1", groups),
+        result = node_maths.blend(node.blend_type, t, self.input(node, "Color1", groups),
                         self.input(node, "Color2", groups))
         if result is None:
             return self.note(node, f"MixRGB {node.blend_type}")
@@ -235,11 +238,11 @@ class _Evaluator:
         hue = self.input(node, "Hue", groups, "VALUE")
         saturation = self.input(node, "Saturation", groups, "VALUE")
         value = self.input(node, "Value", groups, "VALUE")
-        h, s, v = _rgb_to_hsv(colour)
+        h, s, v = node_maths.rgb_to_hsv(colour)
         h = np.mod(h + hue[:, 0] - 0.5, 1.0)
         s = np.clip(s * saturation[:, 0], 0.0, 1.0)
         v = v * value[:, 0]
-        shifted = _hsv_to_rgb(h, s, v)
+        shifted = node_maths.hsv_to_rgb(h, s, v)
         return colour + t * (shifted - colour)
 
     def node_valtorgb(self, node, socket, groups):
@@ -263,7 +266,7 @@ class _Evaluator:
         a = self.input(node, node.inputs[0].identifier, groups, "VALUE")
         b = self.input(node, node.inputs[1].identifier, groups, "VALUE")
         c = self.input(node, node.inputs[2].identifier, groups, "VALUE")
-        result = _math(node.operation, a, b, c)
+        result = node_maths.math_node(node.operation, a, b, c)
         if result is None:
             return self.note(node, f"Math {node.operation}")
         return np.clip(result, 0.0, 1.0) if node.use_clamp else result
@@ -279,7 +282,7 @@ class _Evaluator:
             value = (np.sum(a * b, axis=1, keepdims=True) if operation == "DOT_PRODUCT"
                      else np.linalg.norm(a, axis=1, keepdims=True))
             return value
-        result = _math(operation, a, b, 0.0)
+        result = node_maths.math_node(operation, a, b, 0.0)
         return self.note(node, f"Vector Math {operation}") if result is None else result
 
     def node_clamp(self, node, socket, groups):
@@ -327,83 +330,6 @@ class _Evaluator:
     def node_combxyz(self, node, socket, groups):
         channels = [self.input(node, key, groups, "VALUE") for key in ("X", "Y", "Z")]
         return np.concatenate(np.broadcast_arrays(*channels), axis=1)
-
-
-def _lerp(t, a, b):
-    return a + t * (b - a)
-
-
-def _blend(mode: str, t, a, b):
-    """Blender's colour blend ``mode`` of ``a`` (below) and ``b`` at factor ``t``, or None."""
-    if mode == "MIX":
-        return _lerp(t, a, b)
-    if mode == "ADD":
-        return a + t * b
-    if mode == "SUBTRACT":
-        return a - t * b
-    if mode == "MULTIPLY":
-        return _lerp(t, a, a * b)
-    if mode == "SCREEN":
-        return 1.0 - (1.0 - t + t * (1.0 - b)) * (1.0 - a)
-    if mode == "DIVIDE":
-        return np.where(b != 0.0, _lerp(t, a, a / np.where(b != 0.0, b, 1.0)), a)
-    if mode == "DIFFERENCE":
-        return _lerp(t, a, np.abs(a - b))
-    if mode == "EXCLUSION":
-        return np.maximum(_lerp(t, a, a + b - 2.0 * a * b), 0.0)
-    if mode == "DARKEN":
-        return _lerp(t, a, np.minimum(a, b))
-    if mode == "LIGHTEN":
-        return _lerp(t, a, np.maximum(a, b))
-    if mode == "OVERLAY":
-        return np.where(a < 0.5, a * (1.0 - t + 2.0 * t * b),
-                        1.0 - (1.0 - t + 2.0 * t * (1.0 - b)) * (1.0 - a))
-    if mode == "SOFT_LIGHT":
-        screen = 1.0 - (1.0 - b) * (1.0 - a)
-        return (1.0 - t) * a + t * ((1.0 - a) * b * a + a * screen)
-    if mode == "LINEAR_LIGHT":
-        return a + t * (2.0 * b - 1.0)
-    return None
-
-
-def _math(operation: str, a, b, c):
-    """Blender's Math (or Vector Math, per component) ``operation``, or None."""
-    with np.errstate(divide="ignore", invalid="ignore"):
-        table = {
-            "ADD": lambda: a + b, "SUBTRACT": lambda: a - b, "MULTIPLY": lambda: a * b,
-            "DIVIDE": lambda: np.where(b != 0.0, a / np.where(b != 0.0, b, 1.0), 0.0),
-            "MULTIPLY_ADD": lambda: a * b + c,
-            "POWER": lambda: np.where(a >= 0.0, np.abs(a) ** b, 0.0),
-            "MINIMUM": lambda: np.minimum(a, b), "MAXIMUM": lambda: np.maximum(a, b),
-            "ABSOLUTE": lambda: np.abs(a), "SQRT": lambda: np.sqrt(np.maximum(a, 0.0)),
-            "FLOOR": lambda: np.floor(a), "CEIL": lambda: np.ceil(a),
-            "FRACTION": lambda: a - np.floor(a), "ROUND": lambda: np.floor(a + 0.5),
-            "GREATER_THAN": lambda: (a > b).astype(float),
-            "LESS_THAN": lambda: (a < b).astype(float),
-        }
-        function = table.get(operation)
-        return None if function is None else function() * np.ones(1)
-
-
-def _rgb_to_hsv(rgb):
-    high, low = rgb.max(axis=1), rgb.min(axis=1)
-    delta = high - low
-    safe = np.where(delta > 0.0, delta, 1.0)
-    r, g, b = rgb[:, 0], rgb[:, 1], rgb[:, 2]
-    h = np.where(high == r, (g - b) / safe, np.where(high == g, 2.0 + (b - r) / safe,
-                                                      4.0 + (r - g) / safe))
-    h = np.where(delta > 0.0, np.mod(h / 6.0, 1.0), 0.0)
-    s = np.where(high > 0.0, delta / np.where(high > 0.0, high, 1.0), 0.0)
-    return h, s, high
-
-
-def _hsv_to_rgb(h, s, v):
-    i = np.floor(h * 6.0)
-    f = h * 6.0 - i
-    p, q, t = v * (1.0 - s), v * (1.0 - s * f), v * (1.0 - s * (1.0 - f))
-    i = i.astype(int) % 6
-    choices = [(v, t, p), (q, v, p), (p, v, t), (p, q, v), (t, p, v), (v, p, q)]
-    return np.stack([np.choose(i, [c[k] for c in choices]) for k in range(3)], axis=1)
 
 
 def values(where: Source, samples: Samples, notes: list, kind: str = "RGBA") -> np.ndarray:

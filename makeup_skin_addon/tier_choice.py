@@ -1,12 +1,16 @@
-"""Fit to Scene: the Auto tier chosen from the scene.
+"""The tier for a material in a scene: Tier Auto's choice (Fit to Scene's too), the tiers Apply
+fits.
 
 What the scene looks like to the model (:class:`lut_baker.auto_tier.SceneDescription`) comes
 from the active camera, the render resolution, the objects wearing the material (the nearest
 one: the largest on screen), the lights and the render engine; what the material is
 (:class:`lut_baker.auto_tier.MaterialTraits`) from what its closure fit measured at its
-coverage and absorption (kept in its group's record, :mod:`.fits`).
+coverage and absorption (kept in its group's record, :mod:`.bakes`).
 :func:`lut_baker.auto_tier.choose` then picks the cheapest candidate within the tolerance.
 
+- :func:`resolve_tier` -- the tier Apply builds for the settings and scene (Auto: from a
+  measurement); :func:`fitted_tiers` -- the tiers Apply fits: the scene engine's and the
+  settings' own; :func:`forced_method` -- the subsurface method the settings force.
 - :func:`units_per_mm` -- scene units in one millimetre, from the scene's unit scale.
 - :func:`render_engine` -- ``CYCLES`` or ``EEVEE``, as the Auto tier names the scene's engine.
 - :func:`describe_scene` -- the scene as the model sees it (None without a camera or object).
@@ -32,12 +36,14 @@ from __future__ import annotations
 import json
 import math
 from dataclasses import dataclass
+from typing import Any
 
-from . import convert, fits, nodes, storage
-from .core import auto_tier, closure_fit
+from . import bakes, convert, nodes
+from .core import auto_tier, closure_fit, tiers
 from .keys import CHOICE_KEY, SAVED_GLOSS_KEY, SAVED_SCALE_KEY
 
-__all__ = ["ENVIRONMENT_LIGHT_DEG", "units_per_mm", "render_engine", "describe_scene",
+__all__ = ["ENVIRONMENT_LIGHT_DEG", "resolve_tier", "auto_choice", "fitted_tiers",
+           "forced_method", "units_per_mm", "render_engine", "describe_scene",
            "material_traits", "choose_with", "choose_for", "ChoiceScene", "choice_scene",
            "set_choice", "record_choice", "last_choice", "register", "unregister"]
 
@@ -45,6 +51,43 @@ ENVIRONMENT_LIGHT_DEG = 45.0
 """Light angle (degrees from the view) assumed when the scene has no lamp (world light)."""
 UNKNOWN_SCENE = {"object_size_mm": 100.0, "footprint_mm": 0.01}
 """Without a camera or an object wearing the material: a close-up (everything resolved)."""
+
+
+def resolve_tier(settings: Any, scene: Any, measured: dict | None = None) -> str:
+    """The tier to build: the settings' own, or for Auto the one :func:`choose_with` picks in
+    ``scene`` for a material whose fit measured ``measured`` (:func:`.bakes.measure`; default:
+    what the material's group keeps, never a new bake; in EEVEE the EEVEE tier)."""
+    if settings.tier != "AUTO":
+        return settings.tier
+    return auto_choice(settings.id_data, scene, measured)[0]
+
+
+def auto_choice(material: Any, scene: Any, measured: dict | None) -> tuple[str, dict]:
+    """``(tier, record for the panel)`` of the Auto choice for ``material`` in ``scene``
+    (``measured``: :func:`.bakes.measure`, else what its group keeps)."""
+    traits = bakes.traits(measured) if measured is not None else None
+    if traits is None:
+        traits = material_traits(material, may_fit=False, scene=scene)
+    choice, _ = choose_with(traits, material, scene)
+    chosen = choice.chosen
+    return chosen.candidate.tier, {"tier": chosen.candidate.tier, "error": chosen.error,
+                                   "engine": scene.render.engine}
+
+
+def fitted_tiers(settings: Any, scene: Any, also: tuple[str, ...] = ()) -> tuple[str, ...]:
+    """The tiers Apply fits for ``settings`` in ``scene``: those made for the scene's engine
+    (:data:`lut_baker.auto_tier.ENGINE_TIERS`, among which Tier Auto chooses), the settings'
+    tier when it is fixed to another, and ``also``; in :data:`lut_baker.closures.tiers.TIERS`
+    order.  A tier asked for later (another tier or engine chosen) is fitted then."""
+    wanted = {*auto_tier.ENGINE_TIERS[render_engine(scene)], *also}
+    if settings.tier in tiers.TIERS:
+        wanted.add(settings.tier)
+    return tuple(tier for tier in tiers.TIERS if tier in wanted)
+
+
+def forced_method(settings: Any) -> str | None:
+    """The subsurface method the settings force, or None (Auto: the fit's best)."""
+    return None if settings.subsurface_method == "AUTO" else settings.subsurface_method
 
 
 def units_per_mm(scene) -> float:
@@ -156,21 +199,21 @@ def _measurement(meta: dict, coverage: float, absorption, *, may_fit: bool, tier
     kept in its record, or measured now from this session's fit, or (``may_fit``) from a new
     bake and fit (or the missing tiers fitted onto it); None when none of these can be
     had."""
-    measured = fits.measured_at(meta, coverage, absorption, with_traits=True, tiers=tiers)
+    measured = bakes.measured_at(meta, coverage, absorption, with_traits=True, tiers=tiers)
     if measured is not None or "parameters" not in meta:
         return measured
     method = meta.get("forced_method")
     over = bool(meta.get("over_shader"))
     try:
-        got = fits.cached(meta, method, tiers=tiers, over_shader=over)
+        got = bakes.cached(meta, method, tiers=tiers, over_shader=over)
         if got is None and may_fit:
-            got = fits.baked(meta, method=method, tiers=tiers, over_shader=over,
+            got = bakes.baked(meta, method=method, tiers=tiers, over_shader=over,
                              errors_at=(coverage, absorption))
-    except storage.StorageError:
+    except bakes.BakeRecordError:
         return None
     if got is None:
         return None
-    return fits.measure(*got, coverage, absorption, method=meta.get("subsurface_method"),
+    return bakes.measure(*got, coverage, absorption, method=meta.get("subsurface_method"),
                         over_shader=over)
 
 
@@ -178,12 +221,12 @@ def material_traits(material, *, refit: bool = False, may_fit: bool = True, scen
     """The :class:`lut_baker.auto_tier.MaterialTraits` of a made-up material at its coverage
     and absorption, the Subsurface Scale and Gloss applied (the values Fit to Scene saved if
     it set them to 0): what its group's fit measured there, of the tiers made for ``scene``'s
-    engine (default: every tier) (:mod:`.fits`; ``refit``: measured again rather than read
+    engine (default: every tier) (:mod:`.bakes`; ``refit``: measured again rather than read
     from the record; without ``may_fit`` never a new bake or fit).  Without either: the
     paper preset's traits."""
     settings = material.makeup_skin
     coverage = float(settings.coverage)
-    absorption = [float(a) for a in settings.effective_absorption()]
+    absorption = [float(a) for a in settings.absorption]
     scale = _kept_value(material, "subsurface_scale", SAVED_SCALE_KEY)
     gloss = _kept_value(material, "gloss", SAVED_GLOSS_KEY)
     meta = _meta(material)
@@ -192,14 +235,16 @@ def material_traits(material, *, refit: bool = False, may_fit: bool = True, scen
     tiers = (auto_tier.ENGINE_TIERS[render_engine(scene)] if scene is not None
              else closure_fit.TIERS)
     measured = _measurement(meta, coverage, absorption, may_fit=may_fit, tiers=tiers)
-    traits = fits.traits(measured) if measured is not None else None
+    traits = bakes.traits(measured) if measured is not None else None
     return (traits or auto_tier.paper_traits()).scaled(scale, gloss)
 
 
 def _unknown_scene(scene):
     samples, denoise = _samples(scene)
-    return auto_tier.SceneDescription(engine=render_engine(scene), samples=samples,
-                                                   denoise=denoise, **UNKNOWN_SCENE)
+    return auto_tier.SceneDescription(
+        object_size_mm=UNKNOWN_SCENE["object_size_mm"],
+        footprint_mm=UNKNOWN_SCENE["footprint_mm"], engine=render_engine(scene),
+        samples=samples, denoise=denoise)
 
 
 @dataclass(frozen=True)
@@ -208,8 +253,8 @@ class ChoiceScene:
     judges in (the described scene, or a close-up), ``described`` (None: the scene was
     unknown), and the material's Subsurface Scale and Gloss (:func:`_kept_value`)."""
 
-    used: object
-    described: object
+    used: auto_tier.SceneDescription
+    described: auto_tier.SceneDescription | None
     scale: float
     gloss: float
 
@@ -323,4 +368,4 @@ def register():
 
 
 def unregister():
-    """Nothing to forget: the session's fits are :mod:`.fits`'."""
+    """Nothing to forget: the session's fits are :mod:`.bakes`'."""

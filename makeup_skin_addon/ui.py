@@ -8,11 +8,11 @@ button and the last choice).
 from __future__ import annotations
 
 import json
+from typing import TYPE_CHECKING, Any
 
 import bpy
 
-from . import material as made_up
-from . import on_load, scene_fit, shade
+from . import groups, on_load, shade, tier_choice
 from .core import presets
 from .keys import AUTO_KEY, CLASS_PREFIX, ERRORS_KEY, FIT_KEY
 from .operators import (
@@ -137,7 +137,7 @@ def draw_settings(layout, context) -> None:
     else:
         col.prop(settings, "skin")
         colour = col.row()
-        linked = node_input_linked(made_up.group_of(material), "Skin Color")
+        linked = node_input_linked(groups.group_of(material), "Skin Color")
         colour.enabled = not linked
         colour.prop(settings, "skin_colour", **({"text": "Skin Color (linked)"} if linked
                                                  else {}))
@@ -156,7 +156,7 @@ def draw_settings(layout, context) -> None:
     row = layout.row(align=True)
     row.operator(MAKEUPSKIN_OT_apply.bl_idname, icon="MATERIAL")
     row.operator(MAKEUPSKIN_OT_revert.bl_idname, text="", icon="LOOP_BACK")
-    node = made_up.group_of(material)
+    node = groups.group_of(material)
     if node is not None and node.node_tree is not None:
         box = layout.box()
         box.label(text=f"Group: {node.node_tree.name}", icon="NODETREE")
@@ -181,10 +181,10 @@ def draw_settings(layout, context) -> None:
 
 
 def draw_fit(layout, context) -> None:
-    """The Fit to Scene button and the last choice (:func:`.scene_fit.last_choice`), below
+    """The Fit to Scene button and the last choice (:func:`.tier_choice.last_choice`), below
     :func:`draw_settings` in both panels."""
     layout.operator(MAKEUPSKIN_OT_fit_to_scene.bl_idname, icon="SCENE_DATA")
-    last = scene_fit.last_choice(context.material)
+    last = tier_choice.last_choice(context.material)
     if last is None:
         return
     box = layout.box()
@@ -198,8 +198,10 @@ class _SettingsPanel:
     bl_label = "Made-up Skin"
     bl_description = ("Foundation on skin: the active object's material made up (Apply, "
                       "Revert), its settings, and Fit to Scene")
+    if TYPE_CHECKING:  # bpy.types.Panel's, given by the panel class it is mixed into (an
+        layout: Any    # annotation at run time would be taken for a property)
 
-    def draw(self, context):
+    def draw(self, context: Any) -> None:
         draw_settings(self.layout, context)
         draw_fit(self.layout, context)
 

@@ -83,9 +83,9 @@ def test_apply_from_the_installed_extension(installed, tmp_path):
     group = material.node_tree.nodes["Made-up Skin"].node_tree
     assert group.name.startswith("Made-up Skin Layered")
     # The installed copy did the work: its modules live in the temporary repository.
-    made_up = sys.modules[installed["module"] + ".makeup_skin_addon.material"]
-    assert Path(made_up.__file__).is_relative_to(installed["repo_dir"])
-    assert made_up.check_material(bpy.context, material)[0]  # re-bakes to its recorded hash
+    apply = sys.modules[installed["module"] + ".makeup_skin_addon.apply"]
+    assert Path(apply.__file__).is_relative_to(installed["repo_dir"])
+    assert apply.check_material(bpy.context, material)[0]  # re-bakes to its recorded hash
 
     sphere_scene.light_and_camera(scene, 0.03, light_deg=0.0)
     sphere_scene.cycles_settings(scene, size=32, samples=8)

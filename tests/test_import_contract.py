@@ -47,9 +47,9 @@ BREAKS = {
          "lut_baker/offline/cli/main.py": ""},
         "the add-on imports offline lut_baker.offline.cli.main"),
     "two add-on modules importing each other in functions": (
-        {"makeup_skin_addon/live.py": "def f():\n    from . import material\n",
-         "makeup_skin_addon/material.py": "def g():\n    from . import live\n"},
-        "import cycle: makeup_skin_addon.live -> makeup_skin_addon.material"),
+        {"makeup_skin_addon/live.py": "def f():\n    from . import apply\n",
+         "makeup_skin_addon/apply.py": "def g():\n    from . import live\n"},
+        "import cycle: makeup_skin_addon.apply -> makeup_skin_addon.live"),
     "a module outside every layer": (
         {"makeup_skin_addon/helpers.py": ""},
         "makeup_skin_addon.helpers is in no layer"),

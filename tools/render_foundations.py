@@ -101,7 +101,7 @@ def spheres(args, skins, tmp: Path) -> list[list[np.ndarray]]:
     """The sphere grid's tiles, one row per skin."""
     from lut_baker import bake
     from lut_baker.model import presets
-    from makeup_skin_addon import material as made_up
+    from makeup_skin_addon import groups
 
     sphere = sphere_scene.build_scene(size=args.sphere_size, samples=args.samples,
                                       light_deg=args.light_deg, seed=args.seed)
@@ -122,7 +122,7 @@ def spheres(args, skins, tmp: Path) -> list[list[np.ndarray]]:
                 # sets the chosen skin's (properties._update_skin), and so does this grid.
                 albedo = presets.skin_albedo(skin)
                 material.makeup_skin.skin_colour = albedo.tolist()
-                made_up.group_of(material).inputs["Skin Color"].default_value = (*albedo, 1.0)
+                groups.group_of(material).inputs["Skin Color"].default_value = (*albedo, 1.0)
                 row.append(_shoot(tmp, f"sphere {product} on {skin}", "sphere, Layered"))
             rows.append(row)
     return rows

@@ -1,4 +1,4 @@
-"""The apply pipeline (makeup_skin_addon.material), headless: Apply and render every tier on
+"""The apply pipeline (makeup_skin_addon.apply), headless: Apply and render every tier on
 a sphere, the report when a tier is not made for the scene's engine, reuse without
 duplicates, the scene's unit scale; on the textured head, a shared material converted once,
 the active slot only, linked library data refused, and the progress through bake and fit.
@@ -81,21 +81,21 @@ def test_apply_fits_the_engines_tiers_and_another_when_it_is_asked_for(sphere):
     same fit, and chooses it."""
     import bpy
 
-    from makeup_skin_addon import fits, nodes
+    from makeup_skin_addon import bakes, nodes
 
     cold_caches()
     material, _ = apply_pipeline(sphere, "AUTO")
     meta = nodes.read_meta(group_node(material).node_tree)
     assert set(json.loads(material["makeup_skin_errors"])) == {"PRINCIPLED", "LAYERED"}
-    assert fits.cached(meta, tiers=("PRINCIPLED", "LAYERED")) is not None
-    assert fits.cached(meta, tiers=("EEVEE",)) is None
+    assert bakes.cached(meta, tiers=("PRINCIPLED", "LAYERED")) is not None
+    assert bakes.cached(meta, tiers=("EEVEE",)) is None
     bpy.context.scene.render.engine = "BLENDER_EEVEE" if bpy.app.version >= (5, 0, 0) else \
         "BLENDER_EEVEE_NEXT"
     material, _ = apply_pipeline(sphere, "AUTO")
     assert nodes.read_meta(group_node(material).node_tree)["tier"] == "EEVEE"
     assert set(json.loads(material["makeup_skin_errors"])) == {"PRINCIPLED", "LAYERED",
                                                                 "EEVEE"}
-    assert fits.cached(meta, tiers=("PRINCIPLED", "LAYERED", "EEVEE")) is not None
+    assert bakes.cached(meta, tiers=("PRINCIPLED", "LAYERED", "EEVEE")) is not None
 
 
 def test_apply_operator_and_twice_creates_no_duplicates(sphere):
@@ -188,7 +188,7 @@ def test_apply_progress_covers_bake_and_fit(head):
     """The progress bar rises through the closure fit, not only the bake."""
     import bpy
 
-    from makeup_skin_addon import material as made_up
+    from makeup_skin_addon import apply, bakes
 
     class WindowManager:
         def __init__(self):
@@ -209,51 +209,20 @@ def test_apply_progress_covers_bake_and_fit(head):
 
     cold_caches()  # so that the bake and the fit run
     head.active_material.makeup_skin.resolution = "preview"
-    made_up.apply_to_object(Context, head)
+    apply.apply_to_object(Context, head)
     values = Context.window_manager.values
-    bake_share = 100 * made_up.BAKE_SHARE
+    bake_share = 100 * bakes.BAKE_SHARE
     assert values == sorted(values) and values[-1] == 100
     assert len([v for v in values if bake_share < v < 100]) >= 3  # the fit's stages
-
-
-def _count_calls(monkeypatch):
-    """Count the bakes, closure fits and content hashes from here on."""
-    from lut_baker import bake
-    from lut_baker.closures import fitting
-    from lut_baker.tables import codec
-
-    calls = []
-    for module, name in ((bake, "bake"), (fitting, "fit_closures"), (codec, "content_hash")):
-        original = getattr(module, name)
-        monkeypatch.setattr(module, name, lambda *a, _n=name, _f=original, **k: (
-            calls.append(_n), _f(*a, **k))[1])
-    return calls
-
-
-@pytest.mark.parametrize("tier", ["LAYERED", "AUTO"])
-def test_apply_again_with_the_same_settings_bakes_and_fits_nothing(sphere, monkeypatch, tier):
-    """The settings name their bake (a hash of the parameters, not of the tables): an Apply
-    that repeats one finds its group and bakes, fits and hashes nothing, and Tier Auto makes
-    the same choice."""
-    import bpy
-
-    from makeup_skin_addon import material as made_up
-
-    material, _ = apply_pipeline(sphere, tier, foundation="clarins_105")
-    group = made_up.group_of(material).node_tree
-    calls = _count_calls(monkeypatch)
-    again, _ = apply_pipeline(sphere, tier, foundation="clarins_105")
-    assert calls == [] and made_up.group_of(again).node_tree == group
-    assert bpy.data.node_groups.get(group.name) == group
 
 
 def test_auto_decides_from_the_foundation_being_applied(sphere):
     """Tier Auto judges the foundation it applies, not the one the material had: after
     another foundation, two Applies of the same settings build the same group."""
-    from makeup_skin_addon import material as made_up
+    from makeup_skin_addon import groups
 
     apply_pipeline(sphere, "AUTO", foundation="paper_natural")
     first, _ = apply_pipeline(sphere, "AUTO", foundation="clarins_103")
-    first_group = made_up.group_of(first).node_tree.name
+    first_group = groups.group_of(first).node_tree.name
     second, _ = apply_pipeline(sphere, "AUTO", foundation="clarins_103")
-    assert made_up.group_of(second).node_tree.name == first_group
+    assert groups.group_of(second).node_tree.name == first_group

@@ -1,4 +1,4 @@
-"""The session's bakes and fits by key, and what a fit measured (makeup_skin_addon.fits),
+"""The session's bakes and fits by key, and what a fit measured (makeup_skin_addon.bakes),
 without Blender state: a bake record is baked and fitted once, a measurement is found again
 only at its own coverage and absorption, and its traits read back as they were."""
 
@@ -10,50 +10,51 @@ from lut_baker.model import presets
 
 @pytest.fixture
 def record(bpy_factory):
-    """A bake record: ``storage`` imports bpy, which only the fixture may import first (and
-    the fixture marks the tests ``bpy``, so that ``-m "not bpy"`` leaves them out)."""
-    from makeup_skin_addon import storage
+    """A bake record: importing the add-on imports bpy, which only the fixture may import
+    first (and the fixture marks the tests ``bpy``, so that ``-m "not bpy"`` leaves them
+    out)."""
+    from makeup_skin_addon import bakes
 
-    return storage.bake_record(presets.made_up_skin("light_ivory", "jensen_skin1"), "preview")
+    return bakes.bake_record(presets.made_up_skin("light_ivory", "jensen_skin1"), "preview")
 
 
 def test_a_record_is_baked_and_fitted_once(record, monkeypatch):
     from lut_baker.closures import fitting
-    from makeup_skin_addon import fits
+    from makeup_skin_addon import bakes
 
-    fits.clear()
+    bakes.clear()
     calls = []
     original = fitting.fit_closures
     monkeypatch.setattr(fitting, "fit_closures",
                         lambda *a, **k: (calls.append(1), original(*a, **k))[1])
-    assert fits.cached(record) is None
-    tables, fit = fits.baked(record)
-    again = fits.baked(record)
+    assert bakes.cached(record) is None
+    tables, fit = bakes.baked(record)
+    again = bakes.baked(record)
     assert again[0] is tables and again[1] is fit and len(calls) == 1
-    assert fits.cached(record)[1] is fit
-    assert fits.cached(record, "RANDOM_WALK") is None  # a forced method is another fit
+    assert bakes.cached(record)[1] is fit
+    assert bakes.cached(record, "RANDOM_WALK") is None  # a forced method is another fit
 
 
 def test_a_measurement_is_found_at_its_own_coverage_and_absorption(record):
-    from makeup_skin_addon import fits
+    from makeup_skin_addon import bakes
 
-    tables, fit = fits.baked(record)
-    measured = fits.measure(tables, fit, 0.6, (0.1, 0.2, 0.3))
+    tables, fit = bakes.baked(record)
+    measured = bakes.measure(tables, fit, 0.6, (0.1, 0.2, 0.3))
     meta = {"measured": measured}
-    assert fits.measured_at(meta, 0.6, (0.1, 0.2, 0.3)) is measured
-    assert fits.measured_at(meta, 0.6 + 1e-9, (0.1, 0.2, 0.3)) is measured
-    assert fits.measured_at(meta, 0.7, (0.1, 0.2, 0.3)) is None
-    assert fits.measured_at(meta, 0.6, (0.1, 0.2, 0.4)) is None
-    assert fits.measured_at({}, 0.6, (0.1, 0.2, 0.3)) is None
+    assert bakes.measured_at(meta, 0.6, (0.1, 0.2, 0.3)) is measured
+    assert bakes.measured_at(meta, 0.6 + 1e-9, (0.1, 0.2, 0.3)) is measured
+    assert bakes.measured_at(meta, 0.7, (0.1, 0.2, 0.3)) is None
+    assert bakes.measured_at(meta, 0.6, (0.1, 0.2, 0.4)) is None
+    assert bakes.measured_at({}, 0.6, (0.1, 0.2, 0.3)) is None
     assert set(measured["errors"]) == {"PRINCIPLED", "LAYERED", "EEVEE"}
     # An older add-on's measurement, without the EEVEE tier, is taken again.
     older = {**measured, "errors": {tier: e for tier, e in measured["errors"].items()
                                     if tier != "EEVEE"}}
-    assert fits.measured_at({"measured": older}, 0.6, (0.1, 0.2, 0.3)) is None
+    assert bakes.measured_at({"measured": older}, 0.6, (0.1, 0.2, 0.3)) is None
     # Without traits a measurement does not serve the Auto tier.
-    bare = fits.measure(tables, fit, 0.6, (0.1, 0.2, 0.3), with_traits=False)
+    bare = bakes.measure(tables, fit, 0.6, (0.1, 0.2, 0.3), with_traits=False)
     assert bare["traits"] is None
-    assert fits.measured_at({"measured": bare}, 0.6, (0.1, 0.2, 0.3), with_traits=True) is None
+    assert bakes.measured_at({"measured": bare}, 0.6, (0.1, 0.2, 0.3), with_traits=True) is None
     assert bare["errors"] == measured["errors"]
 
 
@@ -61,17 +62,17 @@ def test_traits_read_back_as_they_were(record):
     import json
 
     from lut_baker import auto_tier
-    from makeup_skin_addon import fits
+    from makeup_skin_addon import bakes
 
-    tables, fit = fits.baked(record)
-    measured = json.loads(json.dumps(fits.measure(tables, fit, 1.0, (0.0, 0.0, 0.0))))
-    traits = fits.traits(measured)
+    tables, fit = bakes.baked(record)
+    measured = json.loads(json.dumps(bakes.measure(tables, fit, 1.0, (0.0, 0.0, 0.0))))
+    traits = bakes.traits(measured)
     direct = auto_tier.traits_from_tables(tables, fit, 1.0, (0.0, 0.0, 0.0))
     assert traits.tier_errors == pytest.approx(direct.tier_errors, rel=1e-12)
     np.testing.assert_array_equal(traits.profile, direct.profile)
     assert traits.skin_share == direct.skin_share and traits.gloss_share == direct.gloss_share
     assert traits.gloss_omission == direct.gloss_omission
-    assert fits.traits({"traits": {"tier_errors": {}}}) is None
+    assert bakes.traits({"traits": {"tier_errors": {}}}) is None
 
 
 def test_the_tiers_asked_for_are_fitted_and_others_when_asked(record, monkeypatch):
@@ -79,29 +80,29 @@ def test_the_tiers_asked_for_are_fitted_and_others_when_asked(record, monkeypatc
     fits it onto the cached fit (nothing fitted again); a fit over the artist's shader is
     another fit.  A measurement serves only if it holds the tiers asked for."""
     from lut_baker.closures import fitting
-    from makeup_skin_addon import fits
+    from makeup_skin_addon import bakes
 
-    fits.clear()
+    bakes.clear()
     calls = []
     original = fitting.fit_closures
     monkeypatch.setattr(fitting, "fit_closures", lambda *a, **k: (
         calls.append((k["tiers"], k["onto"] is not None, k["over_shader"])),
         original(*a, **k))[1])
     cycles = ("PRINCIPLED", "LAYERED")
-    tables, fit = fits.baked(record, tiers=cycles)
+    tables, fit = bakes.baked(record, tiers=cycles)
     assert fit.tiers == cycles and calls == [(cycles, False, False)]
-    assert fits.cached(record, tiers=cycles)[1] is fit
-    assert fits.cached(record, tiers=("EEVEE",)) is None  # cached() never fits
-    _, every = fits.baked(record, tiers=("EEVEE",))
+    assert bakes.cached(record, tiers=cycles)[1] is fit
+    assert bakes.cached(record, tiers=("EEVEE",)) is None  # cached() never fits
+    _, every = bakes.baked(record, tiers=("EEVEE",))
     assert every.tiers == ("PRINCIPLED", "LAYERED", "EEVEE") and every.glossy is fit.glossy
     assert calls[-1] == (("EEVEE",), True, False)
-    assert fits.baked(record, tiers=cycles)[1] is every and len(calls) == 2
-    _, over = fits.baked(record, tiers=cycles, over_shader=True)
+    assert bakes.baked(record, tiers=cycles)[1] is every and len(calls) == 2
+    _, over = bakes.baked(record, tiers=cycles, over_shader=True)
     assert calls[-1] == (cycles, False, True) and over is not every
-    measured = fits.measure(tables, fit, 0.6, (0.1, 0.2, 0.3))
+    measured = bakes.measure(tables, fit, 0.6, (0.1, 0.2, 0.3))
     assert set(measured["errors"]) == set(cycles)
     meta = {"measured": measured}
-    assert fits.measured_at(meta, 0.6, (0.1, 0.2, 0.3), tiers=cycles) is measured
-    assert fits.measured_at(meta, 0.6, (0.1, 0.2, 0.3), tiers=("EEVEE",)) is None
-    assert fits.measured_at(meta, 0.6, (0.1, 0.2, 0.3), with_traits=True,
+    assert bakes.measured_at(meta, 0.6, (0.1, 0.2, 0.3), tiers=cycles) is measured
+    assert bakes.measured_at(meta, 0.6, (0.1, 0.2, 0.3), tiers=("EEVEE",)) is None
+    assert bakes.measured_at(meta, 0.6, (0.1, 0.2, 0.3), with_traits=True,
                             tiers=("LAYERED",)) is measured

@@ -64,21 +64,6 @@ def test_apply_goes_over_the_artists_shader(head):
         0.5 * skin_map.inputs["Strength"].default_value, rel=1e-6)
 
 
-def test_the_film_normal_follows_the_panel(head):
-    """Film Follows Pores off unlinks the film's normal (a smooth film: the pores filled), on
-    links it again; its strength is the panel's fraction of the skin's."""
-    material = apply_operator(head)
-    settings, group = material.makeup_skin, group_node(material)
-    film = material.node_tree.nodes["Made-up Skin Film Normal"]
-    base = material.node_tree.nodes["Normal Map"].inputs["Strength"].default_value
-    settings.film_follows_pores = False
-    assert not group.inputs["Film Normal"].is_linked
-    settings.film_normal_strength = 0.25
-    settings.film_follows_pores = True
-    assert group.inputs["Film Normal"].links[0].from_node == film
-    assert film.inputs["Strength"].default_value == pytest.approx(0.25 * base, rel=1e-6)
-
-
 def _skin_shader_tree(material, kind):
     """Rebuild the head's material as ``kind``: "mix" (Principled + 10% Translucent through a
     Mix Shader), "group" (the Principled inside a node group whose Base Color and Normal come
@@ -235,9 +220,9 @@ def test_blenders_untouched_default_shader_is_no_skin_of_the_artists(addon, blan
 def _apply_without_material(obj):
     import bpy
 
-    from makeup_skin_addon import material as made_up
+    from makeup_skin_addon import apply
 
-    return made_up.apply_to_object(bpy.context, obj, resolution="preview")
+    return apply.apply_to_object(bpy.context, obj, resolution="preview")
 
 
 @pytest.mark.slow  # a second head: ~1 s

@@ -29,17 +29,16 @@ def test_live_update_rebakes_at_preview_resolution(sphere):
 def test_choosing_a_foundation_updates_its_gloss_live(sphere):
     """The Foundation dropdown sets everything the product is: its absorption at once, its
     gloss (the film's lobe: roughness, index) by the debounced preview re-fit."""
-    from makeup_skin_addon import live, nodes
-    from makeup_skin_addon import material as made_up
+    from makeup_skin_addon import groups, live, nodes
 
     material, _ = apply_pipeline(sphere, "LAYERED", foundation="clarins_103")
-    matte = nodes.read_meta(made_up.group_of(material).node_tree)
+    matte = nodes.read_meta(groups.group_of(material).node_tree)
     material.makeup_skin.foundation = "clarins_112"
     assert material.name in live.pending()
     assert list(material.makeup_skin.absorption) == pytest.approx(
         presets.FOUNDATIONS["clarins_112"]["absorption"])
     live.flush()
-    dewy = nodes.read_meta(made_up.group_of(material).node_tree)
+    dewy = nodes.read_meta(groups.group_of(material).node_tree)
     assert dewy["parameters"]["film"] != matte["parameters"]["film"]
     assert dewy["parameters"]["film"]["P_s"] > 0.0 == matte["parameters"]["film"]["P_s"]
     assert dewy["glossy"]["film_gloss"] != matte["glossy"]["film_gloss"]
@@ -50,25 +49,24 @@ def test_roughness_moves_the_gloss_live_and_a_picked_colour_at_once(sphere):
     a colour picked sets the group's absorption at once, with no re-bake."""
     from support.addon_steps import counts
 
-    from makeup_skin_addon import live, nodes
-    from makeup_skin_addon import material as made_up
+    from makeup_skin_addon import groups, live, nodes
 
     material, _ = apply_pipeline(sphere, "LAYERED", resolution="preview")
     settings = material.makeup_skin
-    before = nodes.read_meta(made_up.group_of(material).node_tree)["parameters"]
+    before = nodes.read_meta(groups.group_of(material).node_tree)["parameters"]
     settings.film_roughness = 0.4
     settings.skin_roughness = 0.55
     assert material.name in live.pending()
     live.flush()
-    after = nodes.read_meta(made_up.group_of(material).node_tree)["parameters"]
+    after = nodes.read_meta(groups.group_of(material).node_tree)["parameters"]
     assert after["film"]["n"] > before["film"]["n"] and after["skin"]["n"] > before["skin"]["n"]
-    groups = counts()[0]
+    before_groups = counts()[0]
     settings.absorption_mode = "COLOUR"
     settings.shade_colour = presets.FOUNDATIONS["clarins_108"]["colour"]
-    node = made_up.group_of(material)
+    node = groups.group_of(material)
     assert tuple(node.inputs["Foundation Absorption"].default_value)[:3] == pytest.approx(
         presets.FOUNDATIONS["clarins_108"]["absorption"], abs=1e-6)
-    assert not live.pending() and counts()[0] == groups
+    assert not live.pending() and counts()[0] == before_groups
 
 
 def _fingerprint(group):
@@ -120,20 +118,19 @@ def test_a_rebuild_in_the_background_gives_the_synchronous_group(sphere, tier):
     a new group."""
     import bpy
 
-    from makeup_skin_addon import live, nodes
-    from makeup_skin_addon import material as made_up
+    from makeup_skin_addon import groups, live, nodes, rebuild
 
     material, _ = apply_pipeline(sphere, tier, foundation="light_ivory")
-    made_up.group_of(material).node_tree.nodes[0]["first"] = True
+    groups.group_of(material).node_tree.nodes[0]["first"] = True
     material.makeup_skin.foundation = "clarins_112"
     _rebuilt_in_background(material)
-    group = made_up.group_of(material).node_tree
+    group = groups.group_of(material).node_tree
     if tier == "LAYERED":
         assert group.nodes[0].get("first")  # its nodes taken again, values set anew
     background = _fingerprint(group), nodes.read_meta(group)
     fresh = bpy.data.node_groups.new("fresh", "ShaderNodeTree")
-    made_up.rebuild_from_settings(bpy.context, material, fresh, live.PREVIEW)
-    assert made_up.group_of(material).node_tree == fresh
+    rebuild.rebuild_from_settings(bpy.context, material, fresh, live.PREVIEW)
+    assert groups.group_of(material).node_tree == fresh
     assert _fingerprint(fresh) == background[0]
     meta = nodes.read_meta(fresh)
     for key in ("key", "tier", "parameters", "glossy", "eevee_glossy", "measured"):
@@ -146,22 +143,21 @@ def test_a_newer_change_supersedes_a_rebuild_in_flight(sphere):
     Apply and Revert drop what is pending too."""
     import bpy
 
-    from makeup_skin_addon import live, nodes
-    from makeup_skin_addon import material as made_up
+    from makeup_skin_addon import groups, live, nodes
 
     material, _ = apply_pipeline(sphere, "LAYERED")
     settings = material.makeup_skin
-    before = nodes.read_meta(made_up.group_of(material).node_tree)["key"]
+    before = nodes.read_meta(groups.group_of(material).node_tree)["key"]
     settings.foundation = "clarins_105"
     live.start(bpy.context)
     settings.foundation = "deep_mocha"  # supersedes clarins_105's rebuild
     assert live.in_flight() == set() and material.name in live.pending()
     assert live.wait(60.0)
     live.poll(bpy.context)
-    assert nodes.read_meta(made_up.group_of(material).node_tree)["key"] == before
+    assert nodes.read_meta(groups.group_of(material).node_tree)["key"] == before
     _rebuilt_in_background(material)
-    meta = nodes.read_meta(made_up.group_of(material).node_tree)
-    assert meta["parameters"]["film"] == nodes.read_meta(made_up.group_of(
+    meta = nodes.read_meta(groups.group_of(material).node_tree)
+    assert meta["parameters"]["film"] == nodes.read_meta(groups.group_of(
         apply_pipeline(sphere, "LAYERED")[0]).node_tree)["parameters"]["film"]
     assert meta["key"] != before
     settings.foundation = "clarins_108"
@@ -169,7 +165,7 @@ def test_a_newer_change_supersedes_a_rebuild_in_flight(sphere):
     live.cancel(material)  # what Apply and Revert do first
     assert live.pending() == set()
     assert live.wait(60.0) and live.poll(bpy.context) == []
-    assert nodes.read_meta(made_up.group_of(material).node_tree)["key"] == meta["key"]
+    assert nodes.read_meta(groups.group_of(material).node_tree)["key"] == meta["key"]
 
 
 def test_flush_waits_for_a_rebuild_in_flight(sphere):
@@ -177,8 +173,7 @@ def test_flush_waits_for_a_rebuild_in_flight(sphere):
     swapped in, one only marked is computed there."""
     import bpy
 
-    from makeup_skin_addon import live, nodes
-    from makeup_skin_addon import material as made_up
+    from makeup_skin_addon import groups, live, nodes
 
     material, _ = apply_pipeline(sphere, "PRINCIPLED")
     material.makeup_skin.foundation = "medium_beige"
@@ -186,8 +181,8 @@ def test_flush_waits_for_a_rebuild_in_flight(sphere):
     assert material.name in live.in_flight()
     assert live.flush(bpy.context) == []
     assert live.pending() == set()
-    meta = nodes.read_meta(made_up.group_of(material).node_tree)
-    assert meta["parameters"]["film"] == nodes.read_meta(made_up.group_of(apply_pipeline(
+    meta = nodes.read_meta(groups.group_of(material).node_tree)
+    assert meta["parameters"]["film"] == nodes.read_meta(groups.group_of(apply_pipeline(
         sphere, "PRINCIPLED", foundation="medium_beige")[0]).node_tree)["parameters"]["film"]
 
 
@@ -197,24 +192,23 @@ def test_an_apply_at_preview_first_is_refined_in_the_background(sphere):
     Apply at that resolution.  An Apply whose bake the file has is not done twice."""
     import bpy
 
-    from makeup_skin_addon import live, nodes
-    from makeup_skin_addon import material as made_up
+    from makeup_skin_addon import apply, groups, live, nodes
 
     sphere.data.materials.append(bpy.data.materials.new("Skin"))
     settings = sphere.active_material.makeup_skin
     settings.tier, settings.resolution = "LAYERED", "default"
-    material, report = made_up.apply_to_object(bpy.context, sphere, preview_first=True)
-    group = made_up.group_of(material).node_tree
+    material, report = apply.apply_to_object(bpy.context, sphere, preview_first=True)
+    group = groups.group_of(material).node_tree
     assert report.refine == "default" and nodes.read_meta(group)["resolution"] == "preview"
     assert any("preview resolution first" in sentence for sentence in report)
     live.refine(bpy.context, material, report.refine)
     live.wait(60.0)
     live.poll(bpy.context)
-    refined = made_up.group_of(material).node_tree
+    refined = groups.group_of(material).node_tree
     meta = nodes.read_meta(refined)
     assert meta["resolution"] == "default" and refined == group  # rebuilt in place
-    again, report = made_up.apply_to_object(bpy.context, sphere, preview_first=True)
-    assert report.refine is None and made_up.group_of(again).node_tree == refined
+    again, report = apply.apply_to_object(bpy.context, sphere, preview_first=True)
+    assert report.refine is None and groups.group_of(again).node_tree == refined
     assert nodes.read_meta(refined)["key"] == meta["key"]
 
 

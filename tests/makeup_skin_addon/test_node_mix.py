@@ -87,10 +87,10 @@ def baked():
 
 
 def _group(tier, baked):
-    from makeup_skin_addon import nodes, storage
+    from makeup_skin_addon import bakes, nodes
 
     skin, tables, fit = baked
-    return nodes.build_group(tier, storage.bake_record(skin, "preview"), fit)
+    return nodes.build_group(tier, bakes.bake_record(skin, "preview"), fit)
 
 
 def _source(target):

@@ -89,7 +89,7 @@ def test_skin_colour_texture_matches_a_bake_at_that_albedo(addon, blank_scene, t
 
     from lut_baker import bake
     from lut_baker.model import presets
-    from makeup_skin_addon import material as made_up
+    from makeup_skin_addon import groups
 
     colour = np.array([0.62, 0.41, 0.33])
     obj = sphere_scene.add_sphere(blank_scene, 0.03, light_deg=40.0, size=HEAD_PX, samples=16)
@@ -102,15 +102,15 @@ def test_skin_colour_texture_matches_a_bake_at_that_albedo(addon, blank_scene, t
     texture.image.colorspace_settings.name = "Non-Color"
     texture.image.pixels.foreach_set(np.tile([*colour, 1.0], 16).astype(np.float32))
     material.node_tree.links.new(texture.outputs["Color"],
-                                 made_up.group_of(material).inputs["Skin Color"])
+                                 groups.group_of(material).inputs["Skin Color"])
     textured = render(tmp_path, "textured")
 
     own = skin.replace(skin_reflection=dataclasses.replace(skin.skin_reflection,
                                                            P_d=colour / np.pi))
-    group, _ = made_up.group_for_tables(bake.bake(own, "preview"), tier, resolution="preview")
+    group, _ = groups.group_for_tables(bake.bake(own, "preview"), tier, resolution="preview")
     material.node_tree.nodes.remove(texture)
-    made_up.group_of(material).node_tree = group
-    made_up.group_of(material).inputs["Skin Color"].default_value = (*colour, 1.0)
+    groups.group_of(material).node_tree = group
+    groups.group_of(material).inputs["Skin Color"].default_value = (*colour, 1.0)
     baked = render(tmp_path, "baked")
     assert np.abs(textured - baked).max() < 1e-5 * max(baked.max(), 1.0)
 
@@ -170,13 +170,13 @@ def test_view_angle_rows_read_in_eevee_as_in_cycles(addon, paper_tables):
     from lut_baker.closures import view_image
     from lut_baker.numerics.geometry import sphere_normals
     from lut_baker.offline.validation import compare
-    from makeup_skin_addon import material as made_up
+    from makeup_skin_addon import groups
 
     size = 48
     sphere = scene_module.sphere_scene(size=size, samples=1)
     scene = bpy.context.scene
     scene_module.use_eevee(scene, 1)
-    group, fit = made_up.group_for_tables(paper_tables, "EEVEE", resolution="preview")
+    group, fit = groups.group_for_tables(paper_tables, "EEVEE", resolution="preview")
     normals, mask = sphere_normals(size)
     expected = np.zeros((size, size, 3))
     row = "film_transmittance"  # non-zero at every view: the error is relative to it

@@ -6,94 +6,13 @@ messages for a missing UV map, a material without faces, a missing file; nothing
 bpy.data; progress reported only when something is read."""
 
 import numpy as np
-import pytest
 from support import exact_mean
-
-# Two faces of a hand-made mesh: colours as sRGB bytes (exact in an 8-bit image).
-LEFT_BYTES = (200, 120, 90)
-RIGHT_BYTES = (60, 90, 220)
-OTHER_BYTES = (10, 250, 10)
-
-
-_linear = exact_mean.srgb_to_linear
-
-
-def _image(name, columns, height=8, colorspace="sRGB"):
-    """An 8-bit image of vertical bands, one per colour of ``columns`` (bytes), 16 texels
-    each."""
-    import bpy
-
-    width = 16 * len(columns)
-    image = bpy.data.images.new(name, width, height)
-    image.colorspace_settings.name = colorspace  # first: it regenerates the pixels
-    pixels = np.ones((height, width, 4), np.float32)
-    for i, colour in enumerate(columns):
-        pixels[:, 16 * i:16 * (i + 1), :3] = np.asarray(colour) / 255.0
-    image.pixels.foreach_set(pixels.ravel())
-    return image
-
-
-def _textured(material, image, uv_map=None):
-    """``material``'s Base Color fed by an Image Texture of ``image`` (through a UV Map node
-    reading ``uv_map`` if given); returns the texture node."""
-    tree = material.node_tree
-    principled = next(n for n in tree.nodes if n.type == "BSDF_PRINCIPLED")
-    texture = tree.nodes.new("ShaderNodeTexImage")
-    texture.image = image
-    tree.links.new(texture.outputs["Color"], principled.inputs["Base Color"])
-    if uv_map is not None:
-        node = tree.nodes.new("ShaderNodeUVMap")
-        node.uv_map = uv_map
-        tree.links.new(node.outputs["UV"], texture.inputs["Vector"])
-    return texture
-
-
-def _material(name):
-    import bpy
-
-    material = bpy.data.materials.new(name)
-    if material.node_tree is None:  # 4.5: a new material has no tree
-        material.use_nodes = True
-    return material
-
-
-def _two_faces(skin, other=None):
-    """A mesh of three quads: a unit square standing in the XZ plane (UVs in the first band),
-    a 3 x 1 rectangle lying in the XY plane (second band), and, in a second slot holding
-    ``other``, a 10 x 10 square (third band).  Returns the object."""
-    import bpy
-
-    vertices = [(0, 0, 0), (1, 0, 0), (1, 0, 1), (0, 0, 1),
-                (2, 0, 0), (5, 0, 0), (5, 1, 0), (2, 1, 0),
-                (0, 5, 0), (10, 5, 0), (10, 15, 0), (0, 15, 0)]
-    faces = [(0, 1, 2, 3), (4, 5, 6, 7), (8, 9, 10, 11)]
-    mesh = bpy.data.meshes.new("Two Faces")
-    mesh.from_pydata(vertices, [], faces)
-    layer = mesh.uv_layers.new(name="UVMap")
-    square = [(0.1, 0.1), (0.9, 0.1), (0.9, 0.9), (0.1, 0.9)]
-    uv = [(u / 3 + band / 3, v) for band in range(3) for u, v in square]
-    layer.data.foreach_set("uv", np.ravel(uv))
-    mesh.materials.append(skin)
-    if other is not None:
-        mesh.materials.append(other)
-        mesh.polygons[2].material_index = 1
-    obj = bpy.data.objects.new("Two Faces", mesh)
-    bpy.context.scene.collection.objects.link(obj)
-    return obj
-
-
-@pytest.fixture
-def two_faces(addon, blank_scene):
-    """``(object, skin material, texture node)``: :func:`_two_faces` with its image."""
-    skin, other = _material("Skin"), _material("Other")
-    obj = _two_faces(skin, other)
-    texture = _textured(skin, _image("Bands", (LEFT_BYTES, RIGHT_BYTES, OTHER_BYTES)))
-    return obj, skin, texture
-
-
-def _exact_two_faces(left_area, right_area):
-    left, right = _linear(np.asarray(LEFT_BYTES) / 255), _linear(np.asarray(RIGHT_BYTES) / 255)
-    return (left_area * left + right_area * right) / (left_area + right_area)
+from support.two_faces import (
+    RIGHT_BYTES,
+    build_two_faces,
+    exact_two_faces,
+    linear,
+)
 
 
 def test_two_faces_of_known_areas_and_colours(two_faces):
@@ -109,15 +28,15 @@ def test_two_faces_of_known_areas_and_colours(two_faces):
     obj, skin, texture = two_faces
     mean = skin_sampling.surface_mean(texture.image, skin, reader=texture.name)
     assert mean.problem == "" and mean.faces == 2 and mean.objects == ("Two Faces",)
-    np.testing.assert_allclose(mean.rgb, _exact_two_faces(1.0, 3.0), atol=2e-5)
+    np.testing.assert_allclose(mean.rgb, exact_two_faces(1.0, 3.0), atol=2e-5)
     obj.scale = (1.0, 1.0, 3.0)
     bpy.context.view_layer.update()
     mean = skin_sampling.surface_mean(texture.image, skin)
-    np.testing.assert_allclose(mean.rgb, _exact_two_faces(3.0, 3.0), atol=2e-5)
+    np.testing.assert_allclose(mean.rgb, exact_two_faces(3.0, 3.0), atol=2e-5)
     obj.scale = (1.0, 1.0, 0.0)  # flattened: the standing face has no area left
     bpy.context.view_layer.update()
     mean = skin_sampling.surface_mean(texture.image, skin)
-    np.testing.assert_allclose(mean.rgb, _exact_two_faces(0.0, 3.0), atol=1e-6)
+    np.testing.assert_allclose(mean.rgb, exact_two_faces(0.0, 3.0), atol=1e-6)
 
 
 def test_the_heads_mean_is_within_its_sampling_error(head):
@@ -145,7 +64,7 @@ def test_the_heads_mean_is_within_its_sampling_error(head):
     np.testing.assert_allclose(reduced.rgb, exact, rtol=2e-3)
     scene = bpy.context.scene
     scene.camera = None  # with a camera, the points count by how much of them it sees
-    reading = artist_skin.read_material(material, scene)
+    reading = artist_skin.readnew_material(material, scene)
     np.testing.assert_allclose(reading.leaves[0].base, mean.rgb, rtol=1e-9)
     assert reading.notes == []
 
@@ -160,86 +79,6 @@ def test_the_same_mesh_gives_the_same_points(head):
     skin_sampling.clear_cache()
     np.testing.assert_allclose(skin_sampling.surface_mean(image, material).rgb, first,
                                rtol=1e-12)
-
-
-def test_the_cache_is_kept_until_the_mesh_changes(two_faces):
-    """A second call reuses the points; moving a vertex (the standing face made twice as tall),
-    reassigning a face's slot or changing the UVs reads the mesh again, and the mean follows."""
-    import bpy
-
-    from makeup_skin_addon import skin_sampling
-
-    obj, skin, texture = two_faces
-    layer = obj.data.uv_layers["UVMap"]
-    points = skin_sampling.object_points(obj, skin, layer)
-    assert skin_sampling.object_points(obj, skin, layer) is points
-    mesh = obj.data
-    for i in (2, 3):
-        mesh.vertices[i].co.z = 2.0
-    mesh.update()
-    moved = skin_sampling.object_points(obj, skin, layer)
-    assert moved is not points and moved.area == pytest.approx(5.0, rel=1e-6)
-    np.testing.assert_allclose(skin_sampling.surface_mean(texture.image, skin).rgb,
-                               _exact_two_faces(2.0, 3.0), atol=2e-5)
-    mesh.polygons[1].material_index = 1  # the rectangle now in the other slot
-    mesh.update()
-    mean = skin_sampling.surface_mean(texture.image, skin)
-    assert mean.faces == 1
-    np.testing.assert_allclose(mean.rgb, _exact_two_faces(1.0, 0.0), atol=1e-6)
-    uv = np.empty(2 * len(mesh.loops), np.float32)
-    layer.data.foreach_get("uv", uv)
-    uv[:8:2] += 1 / 3  # the standing face's UVs moved onto the second band
-    layer.data.foreach_set("uv", uv)
-    mesh.update()
-    np.testing.assert_allclose(skin_sampling.surface_mean(texture.image, skin).rgb,
-                               _exact_two_faces(0.0, 1.0), atol=1e-6)
-    assert bpy.data.images.get("Bands") is texture.image
-
-
-def test_the_cache_is_kept_until_the_image_changes(two_faces, tmp_path):
-    """An image from a file is read once (the same reduced pixels twice); written again and
-    reloaded, or its colour space changed, it is read again; an image edited in Blender
-    (unsaved) is read at every call, with its edits."""
-    import bpy
-
-    from makeup_skin_addon import skin_sampling
-
-    obj, skin, texture = two_faces
-    generated = texture.image
-    path = str(tmp_path / "bands.png")
-    generated.filepath_raw = path
-    generated.file_format = "PNG"
-    generated.save()  # now a file image, "Bands"
-    image = bpy.data.images.load(path, check_existing=False)
-    image.colorspace_settings.name = "sRGB"
-    texture.image = image
-    first = skin_sampling.reduced_image(image)
-    assert skin_sampling.reduced_image(image) is first
-    np.testing.assert_allclose(skin_sampling.surface_mean(image, skin).rgb,
-                               _exact_two_faces(1.0, 3.0), atol=2e-5)
-    # The file painted over elsewhere (the left band now grey 128) and reloaded.
-    pixels = np.empty(len(generated.pixels), np.float32)
-    generated.pixels.foreach_get(pixels)
-    pixels = pixels.reshape(8, 48, 4)
-    pixels[:, :16, :3] = 128 / 255
-    generated.pixels.foreach_set(pixels.ravel())
-    generated.save()
-    image.reload()
-    grey = _linear(np.full(3, 128 / 255))
-    right = _linear(np.asarray(RIGHT_BYTES) / 255)
-    np.testing.assert_allclose(skin_sampling.surface_mean(image, skin).rgb,
-                               (grey + 3 * right) / 4, atol=2e-5)
-    image.colorspace_settings.name = "Non-Color"
-    np.testing.assert_allclose(skin_sampling.surface_mean(image, skin).rgb,
-                               (128 / 255 + 3 * np.asarray(RIGHT_BYTES) / 255) / 4, atol=2e-5)
-    # Painted in Blender, not saved: read again at each call.
-    image.colorspace_settings.name = "sRGB"
-    for value in (0.2, 0.6):
-        pixels[:, 16:32, :3] = value
-        image.pixels.foreach_set(pixels.ravel())
-        assert image.is_dirty
-        np.testing.assert_allclose(skin_sampling.surface_mean(image, skin).rgb,
-                                   (grey + 3 * _linear(np.full(3, value))) / 4, atol=2e-5)
 
 
 def test_nothing_is_left_in_the_file(head):
@@ -283,7 +122,7 @@ def test_messages(two_faces):
     assert _source(skin) == (f"{SOURCE}; 'Two Faces' has no UV map 'UVMap.001' (read by "
                              f"{texture.name!r}): read at UV (0, 0)")
     skin.node_tree.links.remove(texture.inputs["Vector"].links[0])
-    bare = _two_faces(skin)
+    bare = build_two_faces(skin)
     bare.name = "Bare"
     bare.data.uv_layers.remove(bare.data.uv_layers[0])
     assert f"; 'Bare' has no UV map (read by {texture.name!r}): left out" in _source(skin)
@@ -310,61 +149,6 @@ def test_messages(two_faces):
                              f"pixels (its file '//gone.png' is missing)")
 
 
-def test_progress_is_reported_only_when_something_is_read(two_faces, tmp_path):
-    """A cold call reports progress (the image, then the faces), a warm one nothing; a window
-    manager's progress is begun on the first report and ended after."""
-    from makeup_skin_addon import skin_sampling
-
-    obj, skin, texture = two_faces
-    texture.image.filepath_raw = str(tmp_path / "bands.png")
-    texture.image.file_format = "PNG"
-    texture.image.save()  # a file image, not dirty: cached once read
-    reports = []
-    with skin_sampling.reporting(lambda fraction, message="": reports.append(fraction)):
-        skin_sampling.surface_mean(texture.image, skin)
-        assert len(reports) == 3 and reports[0] == 0.0 and reports[-1] == 1.0
-        reports.clear()
-        skin_sampling.surface_mean(texture.image, skin)
-        assert reports == []
-
-    class Manager:
-        def __init__(self):
-            self.calls = []
-
-        def progress_begin(self, low, high):
-            self.calls.append(("begin", low, high))
-
-        def progress_update(self, value):
-            self.calls.append(("update", value))
-
-        def progress_end(self):
-            self.calls.append(("end",))
-
-    manager = Manager()
-    with skin_sampling.progress_bar(manager):
-        skin_sampling.surface_mean(texture.image, skin)
-    assert manager.calls == []
-    skin_sampling.clear_cache()
-    with skin_sampling.progress_bar(manager):
-        skin_sampling.surface_mean(texture.image, skin)
-    assert manager.calls == [("begin", 0, 100), ("update", 0), ("update", 60), ("update", 100),
-                             ("end",)]
-
-
-def test_texels_wrap_as_the_texture_extension_does(addon):
-    """REPEAT wraps, MIRROR reflects, EXTEND clamps, CLIP is black outside the image."""
-    from makeup_skin_addon import skin_sampling
-
-    pixels = np.arange(1, 5, dtype=np.float32).reshape(1, 4, 1).repeat(3, axis=2)
-    uv = np.array([[0.1, 0.5], [1.1, 0.5], [-0.1, 0.5], [1.6, 0.5]])
-    expected = {"REPEAT": (1, 1, 4, 3), "MIRROR": (1, 4, 1, 2), "EXTEND": (1, 4, 1, 4),
-                "CLIP": (1, 0, 0, 0)}
-    for extension, values in expected.items():
-        read = skin_sampling.read_texels(pixels, uv, extension)
-        np.testing.assert_allclose(read, np.repeat(np.array(values, float)[:, None], 3, 1),
-                                   atol=1e-12, err_msg=extension)
-
-
 def test_with_a_camera_the_points_count_by_what_it_sees(two_faces):
     """A camera looking straight down at the lying face (the standing one is seen edge on):
     the shader is read as the camera sees it, the lying face's colour; turned away, over the
@@ -382,13 +166,13 @@ def test_with_a_camera_the_points_count_by_what_it_sees(two_faces):
     camera.location = (3.5, 0.5, 5.0)
     scene.camera = camera
     scene.render.resolution_x = scene.render.resolution_y = 64
-    seen = artist_skin.read_material(skin, scene).leaves[0].base
-    np.testing.assert_allclose(seen, _linear(np.asarray(RIGHT_BYTES) / 255), atol=2e-5)
+    seen = artist_skin.readnew_material(skin, scene).leaves[0].base
+    np.testing.assert_allclose(seen, linear(np.asarray(RIGHT_BYTES) / 255), atol=2e-5)
     scene.camera = None
-    everywhere = artist_skin.read_material(skin, scene).leaves[0].base
-    np.testing.assert_allclose(everywhere, _exact_two_faces(1.0, 3.0), atol=1e-4)
+    everywhere = artist_skin.readnew_material(skin, scene).leaves[0].base
+    np.testing.assert_allclose(everywhere, exact_two_faces(1.0, 3.0), atol=1e-4)
     scene.camera = camera
     camera.rotation_euler = (3.14159, 0.0, 0.0)  # looking up, away from the faces
-    away = artist_skin.read_material(skin, scene)
+    away = artist_skin.readnew_material(skin, scene)
     np.testing.assert_allclose(away.leaves[0].base, everywhere, atol=1e-6)
     assert any("sees none of it" in note for note in away.notes)

@@ -16,7 +16,7 @@ from support.addon_steps import apply_operator, apply_pipeline, group_node, lut_
 def test_save_reload_renders_the_same_and_keeps_only_what_the_render_reads(sphere, tmp_path):
     import bpy
 
-    from makeup_skin_addon import material as made_up
+    from makeup_skin_addon import apply
 
     name = apply_pipeline(sphere, "LAYERED")[0].name
     first = render(tmp_path, "first")
@@ -29,7 +29,7 @@ def test_save_reload_renders_the_same_and_keeps_only_what_the_render_reads(spher
     assert saved == [luts[0].name]  # no tables travel in the file
     assert luts[0].size[0] * luts[0].size[1] <= 64 * 8
     material = bpy.data.materials[name]
-    assert made_up.check_material(bpy.context, material) == (
+    assert apply.check_material(bpy.context, material) == (
         True, f"{material.name!r}: intact.")  # re-bakes to the recorded hash
     second = render(tmp_path, "second")
     np.testing.assert_array_equal(first, second)
@@ -39,20 +39,20 @@ def test_save_reload_renders_the_same_and_keeps_only_what_the_render_reads(spher
 def test_altered_lookup_image_is_found_and_rebuilt(sphere, tmp_path):
     import bpy
 
-    from makeup_skin_addon import material as made_up
+    from makeup_skin_addon import apply
 
     material, _ = apply_pipeline(sphere, "LAYERED")
     before = render(tmp_path, "before")
     lut = lut_images()[0]
     lut.pixels.foreach_set(np.zeros(len(lut.pixels), np.float32))  # what the render reads
-    intact, sentence = made_up.check_material(bpy.context, material)
+    intact, sentence = apply.check_material(bpy.context, material)
     assert not intact and "was altered" in sentence and "rebuilt it from a re-bake" in sentence
-    assert made_up.check_material(bpy.context, material)[0]
+    assert apply.check_material(bpy.context, material)[0]
     np.testing.assert_array_equal(render(tmp_path, "after"), before)
     # Deleted: the operator reports it in one sentence and rebuilds it, never raises.
     bpy.data.images.remove(lut_images()[0])
     assert bpy.ops.makeup_skin.check_tables() == {"FINISHED"}
-    assert len(lut_images()) == 1 and made_up.check_material(bpy.context, material)[0]
+    assert len(lut_images()) == 1 and apply.check_material(bpy.context, material)[0]
     group = material.node_tree.nodes["Made-up Skin"].node_tree
     textures = [n for n in group.nodes if n.type == "TEX_IMAGE"]
     assert textures and all(n.image == lut_images()[0] for n in textures)
@@ -62,29 +62,28 @@ def test_altered_lookup_image_is_found_and_rebuilt(sphere, tmp_path):
 def test_apply_rebuilds_a_damaged_group_instead_of_reusing_it(sphere):
     import bpy
 
-    from makeup_skin_addon import material as made_up
+    from makeup_skin_addon import apply
 
     material, _ = apply_pipeline(sphere, "LAYERED")
     lut = lut_images()[0]
     lut.pixels.foreach_set(np.zeros(len(lut.pixels), np.float32))
     _, messages = apply_pipeline(sphere, "LAYERED")  # must not raise, nor reuse the zeroed image
     assert len(messages) == 1 and "was altered" in messages[0]
-    assert made_up.check_material(bpy.context, material)[0]
+    assert apply.check_material(bpy.context, material)[0]
     assert np.asarray(lut_images()[0].pixels[:]).max() > 0.0
 
 
 def test_check_tables_reports_one_sentence_per_material(sphere):
     import bpy
 
-    from makeup_skin_addon import material as made_up
-    from makeup_skin_addon import nodes
+    from makeup_skin_addon import apply, nodes
 
     material, _ = apply_pipeline(sphere, "PRINCIPLED")
     group = material.node_tree.nodes["Made-up Skin"].node_tree
     meta = json.loads(group[nodes.FIT_KEY])
     meta["parameters"]["film"]["n"] = "not a number"
     group[nodes.FIT_KEY] = json.dumps(meta)
-    intact, sentence = made_up.check_material(bpy.context, material)
+    intact, sentence = apply.check_material(bpy.context, material)
     assert not intact and sentence.startswith(f"{material.name!r}: its group's bake record "
                                               f"does not match its key")
     assert sentence.endswith("re-baked it from the panel's settings.")
@@ -147,10 +146,10 @@ import bpy
 bpy.ops.wm.open_mainfile(filepath={path!r}, load_ui=False)
 from support import sphere_scene
 with sphere_scene.addon_registered():
-    from makeup_skin_addon import material as made_up
+    from makeup_skin_addon import apply
     material = bpy.data.materials["Head Skin"]
-    found = made_up.check_material(bpy.context, material)
-    again = made_up.check_material(bpy.context, material)
+    found = apply.check_material(bpy.context, material)
+    again = apply.check_material(bpy.context, material)
     print("RESULT", json.dumps([found, again]))
 """
 

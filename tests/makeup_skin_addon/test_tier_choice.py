@@ -1,4 +1,4 @@
-"""Fit to Scene (makeup_skin_addon.scene_fit) and the Auto tier's choices rendered.
+"""Fit to Scene (makeup_skin_addon.tier_choice) and the Auto tier's choices rendered.
 
 A distant scene renders with the chosen and the fullest candidate (Cycles CPU, 48 px, 256
 samples) against lut_baker's reference: bare skin (the subsurface left out), a film whose
@@ -133,59 +133,58 @@ def test_fit_to_scene_operator(addon):
 
     import bpy
 
-    from makeup_skin_addon import material as made_up
-    from makeup_skin_addon import scene_fit
+    from makeup_skin_addon import groups, tier_choice
 
     # Close-up: a 60 mm sphere 300 mm from a 50 mm lens at 1000 px (0.216 mm per px).
     scene, sphere = _scene_with_sphere(30.0, 1000, camera_distance_mm=300.0)
     bpy.context.view_layer.update()  # matrix_world follows location only after an update
-    described = scene_fit.describe_scene(scene, obj=sphere)
+    described = tier_choice.describe_scene(scene, obj=sphere)
     assert described.footprint_mm == pytest.approx((300.0 - 0.0) * 36.0 / (50.0 * 1000.0),
                                                    rel=1e-3)
     assert described.object_size_mm == pytest.approx(60.0, rel=1e-3)
     assert described.lights_deg == (30.0,)
     assert bpy.ops.makeup_skin.fit_to_scene() == {"FINISHED"}
     material = sphere.active_material
-    close = json.loads(material[scene_fit.CHOICE_KEY])
+    close = json.loads(material[tier_choice.CHOICE_KEY])
     assert close["subsurface"] and material.makeup_skin.subsurface_scale == 1.0
-    assert made_up.group_of(material).node_tree.name.startswith(
+    assert groups.group_of(material).node_tree.name.startswith(
         f"Made-up Skin {close['tier'].title()}")
     # The same sphere 50 m away (36 mm per px): no subsurface, a cheaper choice.
     sphere.location.y = 50.0 - 0.3
     bpy.context.view_layer.update()
     assert bpy.ops.makeup_skin.fit_to_scene() == {"FINISHED"}
-    far = json.loads(material[scene_fit.CHOICE_KEY])
+    far = json.loads(material[tier_choice.CHOICE_KEY])
     assert not far["subsurface"] and far["cost"] < close["cost"]
     assert far["gloss"] and material.makeup_skin.gloss == 1.0  # the paper's gloss: 19%
     assert material.makeup_skin.subsurface_scale == 0.0
-    assert material[scene_fit.SAVED_SCALE_KEY] == 1.0
-    node = made_up.group_of(material)
+    assert material[tier_choice.SAVED_SCALE_KEY] == 1.0
+    node = groups.group_of(material)
     assert node.inputs["Subsurface Scale"].default_value == 0.0
     # Back to the close-up: the subsurface and the artist's scale come back.
     sphere.location.y = 0.0
     bpy.context.view_layer.update()
     assert bpy.ops.makeup_skin.fit_to_scene() == {"FINISHED"}
     assert material.makeup_skin.subsurface_scale == 1.0
-    assert scene_fit.SAVED_SCALE_KEY not in material
+    assert tier_choice.SAVED_SCALE_KEY not in material
     # A film of index 1.01 (its gloss 0.9% of the image, under the noise): Gloss 0 on the
     # material and its group node, the value before kept; the change re-bakes first (the
     # panel's live update, which the operator flushes).  The paper's film again: Gloss 1.
     settings = material.makeup_skin
     settings.override_film, settings.film_ior = True, 1.01
     assert bpy.ops.makeup_skin.fit_to_scene() == {"FINISHED"}
-    matte = json.loads(material[scene_fit.CHOICE_KEY])
+    matte = json.loads(material[tier_choice.CHOICE_KEY])
     assert matte["subsurface"] and not matte["gloss"], matte["reasons"]
-    assert settings.gloss == 0.0 and material[scene_fit.SAVED_GLOSS_KEY] == 1.0
-    assert made_up.group_of(material).inputs["Gloss"].default_value == 0.0
+    assert settings.gloss == 0.0 and material[tier_choice.SAVED_GLOSS_KEY] == 1.0
+    assert groups.group_of(material).inputs["Gloss"].default_value == 0.0
     settings.override_film = False
     assert bpy.ops.makeup_skin.fit_to_scene() == {"FINISHED"}
-    assert json.loads(material[scene_fit.CHOICE_KEY])["gloss"] and settings.gloss == 1.0
-    assert scene_fit.SAVED_GLOSS_KEY not in material
-    assert made_up.group_of(material).inputs["Gloss"].default_value == 1.0
+    assert json.loads(material[tier_choice.CHOICE_KEY])["gloss"] and settings.gloss == 1.0
+    assert tier_choice.SAVED_GLOSS_KEY not in material
+    assert groups.group_of(material).inputs["Gloss"].default_value == 1.0
     # EEVEE: the EEVEE tier, through Auto as well.
     scene.render.engine = "BLENDER_EEVEE" if bpy.app.version >= (5, 0, 0) else \
         "BLENDER_EEVEE_NEXT"
     material.makeup_skin.tier = "AUTO"
-    assert made_up.resolve_tier(material.makeup_skin, scene) == "EEVEE"
+    assert tier_choice.resolve_tier(material.makeup_skin, scene) == "EEVEE"
     assert bpy.ops.makeup_skin.fit_to_scene(apply=False) == {"FINISHED"}
-    assert json.loads(material[scene_fit.CHOICE_KEY])["tier"] == "EEVEE"
+    assert json.loads(material[tier_choice.CHOICE_KEY])["tier"] == "EEVEE"

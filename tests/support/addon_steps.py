@@ -11,7 +11,7 @@ does, or through the pipeline), render, and read node trees and images back.
 - :func:`group_node` -- a material's Made-up Skin group node.
 - :func:`lut_images` -- the add-on's view-angle images.
 - :func:`counts` -- how many node groups, images and materials the file holds.
-- :func:`session_caches` -- the add-on's session caches (re-baked tables, closure fits).
+- :func:`session_caches` -- the add-on's session cache (re-baked tables and closure fits).
 - :func:`cold_caches` -- empty them: the next Apply bakes and fits.
 - :func:`registered_classes` -- the classes of a package registered with Blender.
 - :func:`ui_texts` -- every text the add-on's registered classes show (labels, names,
@@ -52,7 +52,7 @@ def apply_pipeline(obj, tier="PRINCIPLED", resolution="preview", **settings):
     (warnings only)."""
     import bpy
 
-    from makeup_skin_addon import material as made_up
+    from makeup_skin_addon import apply
 
     if obj.active_material is None:
         obj.data.materials.append(bpy.data.materials.new("Skin"))
@@ -61,7 +61,7 @@ def apply_pipeline(obj, tier="PRINCIPLED", resolution="preview", **settings):
     values.resolution = resolution
     for name, value in settings.items():
         setattr(values, name, value)
-    return made_up.apply_to_object(bpy.context, obj)
+    return apply.apply_to_object(bpy.context, obj)
 
 
 def render(tmp_path, name="render"):
@@ -99,11 +99,11 @@ def counts():
 
 
 def session_caches() -> dict:
-    """The add-on's session caches by name: ``tables`` (re-baked, :mod:`makeup_skin_addon.storage`)
-    and ``fits`` (closure fits, :mod:`makeup_skin_addon.fits`), both keyed by bake key."""
-    from makeup_skin_addon import fits, storage
+    """The add-on's session caches by name: ``bakes`` (re-baked tables and their closure fits,
+    keyed by bake key: :mod:`makeup_skin_addon.bakes`)."""
+    from makeup_skin_addon import bakes
 
-    return {"tables": storage._TABLES, "fits": fits._FITS}
+    return {"bakes": bakes._BAKES}
 
 
 def cold_caches():

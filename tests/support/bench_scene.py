@@ -20,7 +20,7 @@ exposure 1, Standard view transform, a seed), then made to match the reference e
 
 Units: the scene is in metres (``unit_settings.scale_length = 1``), the sphere's radius is
 ``radius_mm * 1e-3``; the add-on's "Units per mm" and the baseline's Subsurface Scale come
-from :func:`makeup_skin_addon.material.units_per_mm` of the scene (0.001), so a radius of
+from :func:`makeup_skin_addon.tier_choice.units_per_mm` of the scene (0.001), so a radius of
 ``R`` mm in the reference is ``R`` mm in the render.
 
 Functions
@@ -157,7 +157,10 @@ def baseline_material(baseline, scene):
     :class:`lut_baker.offline.validation.baseline.Baseline` (its subsurface method; distribution
     GGX, which the fit's replica models: the default Multiscatter GGX would add ~1% to its specular;
     Subsurface Scale = the scene's units per mm)."""
-    from makeup_skin_addon.material import units_per_mm
+    try:
+        from makeup_skin_addon.tier_choice import units_per_mm
+    except ImportError:  # a checkout before Apply was split by job (bench --repo)
+        from makeup_skin_addon.material import units_per_mm
 
     inputs = dict(baseline.socket_values(), **{"Subsurface Scale": units_per_mm(scene)})
     return shader_material("Baseline", "ShaderNodeBsdfPrincipled", inputs,

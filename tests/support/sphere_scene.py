@@ -134,9 +134,9 @@ def made_up_material(obj, tables, tier="LAYERED", *, coverage=None, absorption=N
     registered: :func:`addon_registered`).  Coverage and absorption default to the tables'."""
     import bpy
 
-    from makeup_skin_addon import material as made_up
+    from makeup_skin_addon import groups, keys
 
-    material = bpy.data.materials.new(made_up.MATERIAL_NAME)
+    material = bpy.data.materials.new(keys.MATERIAL_NAME)
     obj.data.materials.append(material)
     settings = material.makeup_skin
     settings.is_made_up = True
@@ -145,16 +145,16 @@ def made_up_material(obj, tables, tier="LAYERED", *, coverage=None, absorption=N
     settings.coverage = tables.parameters.get("coverage", 1.0) if coverage is None else coverage
     absorption = tables.parameters.get("absorption", 0.0) if absorption is None else absorption
     settings.absorption = [absorption] * 3 if isinstance(absorption, float) else absorption
-    group, _ = made_up.group_for_tables(tables, tier, errors_at=(settings.coverage,
+    group, _ = groups.group_for_tables(tables, tier, errors_at=(settings.coverage,
                                                                  list(settings.absorption)))
-    made_up.setup_material(material, group, bpy.context.scene)
+    groups.setup_material(material, group, bpy.context.scene)
     return material
 
 
 def coverage_ramp(material, obj) -> None:
     """Link a left-to-right ramp (coverage 0 at the sphere's left edge, 1 at its right) into
     the group's Coverage socket: what a painted coverage texture does."""
-    from makeup_skin_addon import material as made_up
+    from makeup_skin_addon import groups
 
     tree = material.node_tree
     coordinates = tree.nodes.new("ShaderNodeTexCoord")
@@ -166,7 +166,7 @@ def coverage_ramp(material, obj) -> None:
     radius = max(obj.dimensions) / 2
     ramp.inputs["From Min"].default_value = -radius
     ramp.inputs["From Max"].default_value = radius
-    tree.links.new(ramp.outputs["Result"], made_up.group_of(material).inputs["Coverage"])
+    tree.links.new(ramp.outputs["Result"], groups.group_of(material).inputs["Coverage"])
 
 
 def render(png_path) -> float:

@@ -1,6 +1,6 @@
 """The Auto tier's choice (lut_baker.auto_tier.choice): close-up against distant, half a
 pixel, each engine's tier, the gloss rule, the tolerance; it runs without scipy, as inside
-Blender.  tests/makeup_skin_addon/test_scene_fit.py renders its choices and runs Fit to Scene."""
+Blender.  tests/makeup_skin_addon/test_tier_choice.py renders its choices and runs Fit to Scene."""
 
 import subprocess
 import sys

@@ -1,0 +1,309 @@
+"""The session's bakes: a bake's key and record, its tables and closure fits in one cache, what
+a fit measured, and :class:`Bake`, which makes them when first asked for (no bpy).
+
+A bake is identified by its record (:func:`bake_record`): the made-up skin's parameters, the
+resolution name and their key (:func:`bake_key`, a hash of those two and of the tables' format:
+the same settings give the same key on any machine, without baking).  Baking is deterministic
+and takes a fraction of a second, so the tables are re-baked from the record when Check Tables
+or a re-fit needs them (:func:`rebake`) instead of travelling in every saved file; an Apply
+that repeats a bake finds its group by the key (:mod:`.groups`) and bakes, fits and hashes
+nothing.
+
+One cache holds, per bake key, the tables and their closure fits (one per forced subsurface
+method and kind of group: a fit for a group over the artist's shader leaves out the bare
+skin's lobes, :func:`lut_baker.closures.fitting.fit_closures`).  A fit holds the tiers it was
+asked for (Apply asks for those of the scene's engine, :data:`lut_baker.auto_tier.ENGINE_TIERS`,
+and the settings' tier if it is fixed to another); a tier asked for later is fitted then, onto
+the same fit.  What a fit measured at a coverage and absorption (the tiers' errors, what Gloss
+0 would change, the Auto tier's traits) is plain data that the group's record keeps
+(:mod:`.nodes`), so a reopened file knows it too.  The cache may be read and filled from a
+worker thread (:mod:`.live`): nothing here touches bpy.
+
+- :func:`bake_key`, :func:`bake_record` -- a bake's key and record.
+- :func:`rebake` -- the tables of a record, baked once per session; :func:`remember` -- tables
+  a caller baked itself, kept as the record's.
+- :func:`baked` -- ``(tables, fit)`` of a record, baked and fitted once per session;
+  :func:`cached` -- the same if this session has them, else None (never fits).
+- :func:`measure` -- what a fit measures at a coverage and absorption, as plain data;
+  :func:`measured_at` -- a stored measurement if it was taken there, of the tiers asked for;
+  :func:`traits` -- the Auto tier's :class:`lut_baker.auto_tier.MaterialTraits` of one.
+- :class:`Bake` -- one record's tables, fit and measurement, made when first asked for.
+- :func:`clear` -- forget the session's bakes and fits.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+from collections.abc import Iterable, Sequence
+from typing import Any
+
+from .core import auto_tier, bake, cache, closure_fit, fitting, params_file, table_set, tiers
+from .progress import Report, Stages, stage
+
+__all__ = ["BakeRecordError", "KEY_LENGTH", "CACHE_SIZE", "TOLERANCE", "BAKE_SHARE",
+           "MEASURE_SHARE", "bake_key", "bake_record", "remember", "rebake", "baked", "cached",
+           "measure", "measured_at", "traits", "Bake", "clear"]
+
+KEY_LENGTH = 16
+"""Hex digits of a bake key (64 bits: no two bakes of one file collide)."""
+CACHE_SIZE = 8
+"""Bakes (their tables and fits) kept in this session, by bake key."""
+TOLERANCE = 1e-6
+"""How close a coverage or an absorption must be to count as the same (the panel's sliders
+store floats)."""
+BAKE_SHARE = 0.15
+"""Share of Apply's progress bar the bake takes (the closure fit and its measurement take the
+rest)."""
+MEASURE_SHARE = 0.85
+"""Where on Apply's progress bar the fit ends and its measurement begins."""
+
+
+class BakeRecordError(ValueError):
+    """A bake record cannot be re-baked; the message says why, as a sentence's end."""
+
+
+class _Entry:
+    """One bake in the cache: its tables (None until baked) and its fits by ``(forced method,
+    over the artist's shader)``."""
+
+    def __init__(self) -> None:
+        self.tables: table_set.Tables | None = None
+        self.fits: dict[tuple, closure_fit.ClosureFit] = {}
+
+
+_BAKES = cache.LRUCache(CACHE_SIZE)
+
+
+def _entry(key: str) -> _Entry:
+    """The cache's entry of bake ``key``, made empty if there is none."""
+    entry = _BAKES.get(key)
+    if entry is None:
+        entry = _Entry()
+        _BAKES.put(key, entry)
+    return entry
+
+
+def bake_key(parameters: dict, resolution: str) -> str:
+    """The key of a bake: SHA-256 (first :data:`KEY_LENGTH` hex digits) of the made-up skin's
+    ``parameters`` (:func:`lut_baker.model.params_file.skin_to_dict`), the resolution name and
+    the tables' format version, as canonical JSON (floats by ``repr``: the same on every
+    machine)."""
+    version = table_set.FORMAT_VERSION
+    text = json.dumps({"parameters": parameters, "resolution": str(resolution),
+                       "format": version}, sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(text.encode("utf-8")).hexdigest()[:KEY_LENGTH]
+
+
+def bake_record(skin: Any, resolution: str) -> dict:
+    """What identifies a bake: ``{"key", "parameters", "resolution"}`` (plain data, no bake
+    needed)."""
+    parameters = params_file.skin_to_dict(skin)
+    return {"key": bake_key(parameters, resolution), "parameters": parameters,
+            "resolution": str(resolution)}
+
+
+def remember(record: dict, tables: table_set.Tables) -> None:
+    """Keep ``tables`` as this session's bake of ``record`` (for a caller that baked them
+    itself: tests and tools)."""
+    _entry(record["key"]).tables = tables
+
+
+def rebake(record: dict, *, progress: Report | None = None) -> table_set.Tables:
+    """The tables of a :func:`bake_record`, baked once per session (cached by key);
+    ``progress(fraction, message)``: the bake's, when it runs.
+
+    Raises
+    ------
+    BakeRecordError
+        If the record has no readable parameters or resolution, or its key is not theirs.
+    """
+    try:
+        key = bake_key(record["parameters"], record["resolution"])
+    except (KeyError, TypeError, ValueError):
+        raise BakeRecordError("its bake record cannot be read (a parameter or the resolution "
+                              "is missing)") from None
+    if key != record.get("key"):
+        raise BakeRecordError("its bake record does not match its key (it was edited, or "
+                              "written by another version)")
+    entry = _entry(key)
+    if entry.tables is not None:
+        return entry.tables
+    try:
+        skin = params_file.skin_from_dict(record["parameters"])
+        tables = bake.bake(skin, record["resolution"], progress=progress)
+    except (KeyError, TypeError, ValueError):
+        raise BakeRecordError("its bake record cannot be re-baked (a parameter is missing or "
+                              "unreadable)") from None
+    entry.tables = tables
+    return tables
+
+
+def cached(record: dict, method: str | None = None, *,
+           tiers: Iterable[str] = closure_fit.TIERS, over_shader: bool = False
+           ) -> tuple[table_set.Tables, closure_fit.ClosureFit] | None:
+    """``(tables, fit)`` of ``record`` if this session baked and fitted them (``tiers`` among
+    the fit's), else None."""
+    entry = _BAKES.get(record["key"])
+    fit = None if entry is None else entry.fits.get((method, bool(over_shader)))
+    if fit is None or not set(tiers) <= set(fit.tiers):
+        return None
+    return rebake(record), fit
+
+
+def baked(record: dict, *, method: str | None = None,
+          tiers: Iterable[str] = closure_fit.TIERS, over_shader: bool = False,
+          errors_at: tuple[float, Sequence[float]] | None = None,
+          bake_progress: Report | None = None, fit_progress: Report | None = None
+          ) -> tuple[table_set.Tables, closure_fit.ClosureFit]:
+    """``(tables, fit)`` of a bake record (:func:`bake_record`): re-baked (:func:`rebake`) and
+    fitted once per session.  ``method``: a subsurface method forced by the user, else None;
+    ``tiers``: those the fit must hold (a cached fit without some gets them fitted onto it);
+    ``over_shader``: a fit for a group over the artist's shader; ``errors_at``: ``(coverage,
+    absorption)`` at which a new fit measures the tiers (default: the bake's).
+
+    Raises
+    ------
+    BakeRecordError
+        If the record cannot be baked (:func:`rebake`).
+    """
+    tables = rebake(record, progress=bake_progress)
+    fits = _entry(record["key"]).fits
+    which = (method, bool(over_shader))
+    fit = fits.get(which)
+    tiers = tuple(tiers)
+    if fit is None or not set(tiers) <= set(fit.tiers):
+        fit = fitting.fit_closures(
+            tables, tiers=tiers, over_shader=over_shader, onto=fit, subsurface_method=method,
+            errors_at=errors_at, progress=fit_progress)
+        fits[which] = fit
+    return tables, fit
+
+
+def _same(a: Iterable[float], b: Iterable[float]) -> bool:
+    a, b = list(a), list(b)
+    return len(a) == len(b) and all(math.isclose(x, y, abs_tol=TOLERANCE)
+                                    for x, y in zip(a, b, strict=True))
+
+
+def measure(tables: table_set.Tables, fit: closure_fit.ClosureFit, coverage: float,
+            absorption: Iterable[float], method: str | None = None, *,
+            with_traits: bool = True, over_shader: bool = False) -> dict:
+    """What ``fit`` measures at ``coverage`` and ``absorption`` (per channel), of the tiers it
+    holds, as plain data: ``{"coverage", "absorption", "method", "errors": {tier: {"rms",
+    "albedo"}}, "traits": MaterialTraits.as_dict() or None}`` (the traits, which hold the
+    gloss omissions too, only ``with_traits``: the Auto tier's, about 10 ms a tier more).
+    ``over_shader``: ``fit`` is for a group over the artist's shader.  The fit's own errors
+    are reused when it was measured there."""
+    coverage = float(coverage)
+    absorption = [float(a) for a in absorption]
+    errors = fit.errors
+    first = next(iter(errors.values()), None)
+    if first is None or not (_same([first.coverage], [coverage])
+                             and _same(first.absorption, absorption)):
+        errors = tiers.tier_errors(fit, tables, coverage, absorption, over_shader=over_shader)
+    traits = auto_tier.traits_from_tables(tables, fit, coverage, absorption, method=method,
+                                          errors=errors, over_shader=over_shader) \
+        if with_traits else None
+    return {"coverage": coverage, "absorption": absorption, "method": method,
+            "errors": {tier: {"rms": float(e.rms), "albedo": float(e.albedo)}
+                       for tier, e in errors.items()},
+            "traits": None if traits is None else traits.as_dict()}
+
+
+def measured_at(meta: dict, coverage: float, absorption: Iterable[float], *,
+                with_traits: bool = False, tiers: Iterable[str] = closure_fit.TIERS
+                ) -> dict | None:
+    """The measurement a group's record keeps (``meta["measured"]``) if it was taken at this
+    coverage and absorption (and holds the Auto tier's traits, ``with_traits``), else None.
+    A measurement without the errors of every tier of ``tiers`` (default all: an older
+    add-on's, before the EEVEE tier; one of another engine's tiers) is None too: it is
+    measured again."""
+    measured = meta.get("measured") if isinstance(meta, dict) else None
+    if not isinstance(measured, dict) or (with_traits and not measured.get("traits")):
+        return None
+    tiers = set(tiers)
+    if not tiers <= set(measured.get("errors") or ()):
+        return None
+    if with_traits and not tiers <= set((measured["traits"] or {}).get("tier_errors") or ()):
+        return None
+    try:
+        if _same([measured["coverage"]], [coverage]) and _same(measured["absorption"],
+                                                              absorption):
+            return measured
+    except (KeyError, TypeError):
+        return None
+    return None
+
+
+def traits(measured: dict) -> auto_tier.MaterialTraits | None:
+    """The :class:`lut_baker.auto_tier.MaterialTraits` a measurement keeps, or None if they
+    cannot be read."""
+    try:
+        return auto_tier.MaterialTraits.from_dict(measured["traits"])
+    except (KeyError, TypeError, ValueError):
+        return None
+
+
+class Bake:
+    """One bake record's tables, fit and measurement, made when first asked for (a group that
+    can be reused needs none of them): the fit of ``tiers`` for the forced subsurface
+    ``method`` (None: the fit's choice), measured at ``coverage`` and ``absorption``, for a
+    group over the artist's shader if ``over``.  ``progress``: Apply's (:class:`.progress.
+    Stages`).  Nothing here touches bpy: a worker thread may make them (:mod:`.live`), and
+    the group is built from them on the main thread (:mod:`.groups`)."""
+
+    def __init__(self, record: dict, method: str | None, coverage: float,
+                 absorption: Iterable[float], progress: Stages | None = None, *,
+                 tiers: Iterable[str] = tiers.TIERS, over: bool = False):
+        self.record, self.method = record, method
+        self.coverage, self.absorption = float(coverage), [float(a) for a in absorption]
+        self.progress = progress
+        self.tiers, self.over = tuple(tiers), bool(over)
+        self._measured: dict | None = None
+        self._fitted: tuple[table_set.Tables, closure_fit.ClosureFit] | None = None
+
+    @property
+    def key(self) -> str:
+        """The bake's key."""
+        return self.record["key"]
+
+    def fitted(self, tier: str | None = None
+               ) -> tuple[table_set.Tables, closure_fit.ClosureFit]:
+        """``(tables, fit)`` (:func:`baked`), the fit holding :attr:`tiers` (and ``tier``,
+        added to them if need be)."""
+        if tier is not None and tier not in self.tiers:
+            self.tiers = tuple(t for t in tiers.TIERS if t in {*self.tiers, tier})
+        if self._fitted is None or not set(self.tiers) <= set(self._fitted[1].tiers):
+            self._fitted = baked(
+                self.record, method=self.method, tiers=self.tiers, over_shader=self.over,
+                errors_at=(self.coverage, self.absorption),
+                bake_progress=stage(self.progress, 0.0, BAKE_SHARE),
+                fit_progress=stage(self.progress, BAKE_SHARE, MEASURE_SHARE))
+        return self._fitted
+
+    def adopt(self, measured: dict | None) -> None:
+        """Take a measurement a group's record kept at this coverage and absorption."""
+        if measured is not None:
+            self._measured = measured
+
+    def measured(self, *, with_traits: bool = False) -> dict:
+        """What the fit measures at the coverage and absorption (baking and fitting if need
+        be), the Auto tier's traits too if ``with_traits``."""
+        if self._measured is None or (with_traits and not self._measured["traits"]):
+            tables, fit = self.fitted()
+            measured = measure(tables, fit, self.coverage, self.absorption,
+                               self.method or fit.subsurface_method,
+                               with_traits=with_traits, over_shader=self.over)
+            self._measured = measured
+            report = stage(self.progress, MEASURE_SHARE, 1.0)
+            if report is not None:
+                report(1.0, "measured")
+            return measured
+        return self._measured
+
+
+def clear() -> None:
+    """Forget the session's bakes and fits (the add-on's unregister calls it)."""
+    _BAKES.clear()

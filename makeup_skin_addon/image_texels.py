@@ -1,0 +1,225 @@
+"""An image as its texture node reads it, box-filtered small: the skin's mean colour and the
+artist's shader read at points of the surface (:mod:`.skin_sampling`).
+
+The image is read box-filtered to at most :data:`IMAGE_SIZE` texels across (a temporary copy
+scaled down, removed at once), never as the whole float buffer, and linearised as the texture
+node does.  The reduced pixels are cached for the session until the image changes (source,
+file and its date, packed data, colour space; an image with unsaved changes is read again each
+time).
+
+- :func:`reduced_image` -- an image box-filtered to at most :data:`IMAGE_SIZE`, linear
+  (cached, :class:`ReducedImage`); :func:`is_cached` -- whether it is.
+- :func:`box_factor`, :func:`box_reduce` -- the filter in numpy; :func:`srgb_to_linear` -- the
+  sRGB curve.
+- :func:`read_texels` -- a reduced image at UVs, wrapped as the texture's extension says.
+- :func:`clear_cache` -- forget the reduced images.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+from dataclasses import dataclass
+from typing import Any
+
+import bpy
+import numpy as np
+
+from .core import cache
+from .progress import report
+
+__all__ = ["IMAGE_SIZE", "ReducedImage", "reduced_image", "is_cached", "box_factor",
+           "box_reduce", "srgb_to_linear", "read_texels", "clear_cache"]
+
+IMAGE_SIZE = 512
+"""The longest side, in texels, the image is box-filtered down to before it is read."""
+LINEAR_SPACES = frozenset({"Linear Rec.709", "scene_linear", "Non-Color"})
+"""Colour spaces whose values a texture node reads as they are (Blender's scene linear)."""
+IMAGES_CACHE_SIZE = 4
+"""Reduced images kept (3 MB each at :data:`IMAGE_SIZE`)."""
+
+_IMAGES = cache.LRUCache(IMAGES_CACHE_SIZE)
+
+
+@dataclass(frozen=True)
+class ReducedImage:
+    """An image as its texture node reads it, box-filtered: ``pixels`` ((h, w, 3) float32,
+    linear; None when the image has none), a ``note`` on how it was read (or "") and the
+    ``problem`` that left it without pixels (or "")."""
+
+    pixels: np.ndarray | None
+    note: str = ""
+    problem: str = ""
+
+
+def srgb_to_linear(values: np.ndarray) -> np.ndarray:
+    """The sRGB curve undone (IEC 61966-2-1), as Blender linearises an sRGB texture."""
+    values = np.asarray(values)  # float32 stays float32
+    return np.where(values <= 0.04045, values / 12.92, ((values + 0.055) / 1.055) ** 2.4)
+
+
+def box_factor(width: int, height: int, size: int) -> int:
+    """The smallest whole factor that brings both sides to at most ``size``."""
+    return max(1, -(-max(width, height) // size))
+
+
+def box_reduce(pixels: np.ndarray, factor: int) -> np.ndarray:
+    """``pixels`` ((h, w, c)) averaged over boxes of ``factor`` x ``factor`` texels (boxes at
+    the far edges may be smaller), float32."""
+    if factor == 1:
+        return np.asarray(pixels, np.float32)
+    height, width = pixels.shape[:2]
+    rows = np.arange(0, height, factor)
+    columns = np.arange(0, width, factor)
+    summed = np.add.reduceat(np.add.reduceat(pixels, rows, axis=0, dtype=float), columns,
+                             axis=1)
+    counts = np.diff(rows, append=height)[:, None] * np.diff(columns, append=width)[None, :]
+    return (summed / counts[..., None]).astype(np.float32)
+
+
+def _rgb(values: np.ndarray, width: int, height: int) -> np.ndarray:
+    """Flat pixels of any channel count as (height, width, 3): grey repeated."""
+    pixels = values.reshape(height, width, -1)
+    return pixels[..., :3] if pixels.shape[-1] >= 3 else np.repeat(pixels[..., :1], 3, axis=-1)
+
+
+def _linearised(rgb: np.ndarray, is_float: bool, settings) -> tuple[np.ndarray, str]:
+    """``(linear values, note)``: as a texture node reads pixels of this colour space.  Float
+    buffers are scene linear once loaded; byte buffers keep their colour space's encoding."""
+    space = settings.name
+    if is_float or settings.is_data or space in LINEAR_SPACES:
+        return rgb, ""
+    if space.startswith("Linear") or space in {"ACEScg", "ACES2065-1"}:
+        return rgb, f"its colour space {space!r} was read as Linear Rec.709"
+    note = "" if space == "sRGB" else f"its colour space {space!r} was read as sRGB"
+    return srgb_to_linear(rgb), note
+
+
+def _whole(image, size: int) -> ReducedImage:
+    """An image whose pixels live only in memory (generated, or with unsaved changes), which a
+    copy would not have: read whole (16 bytes a texel), linearised and box-filtered a band of
+    rows at a time."""
+    width, height = image.size
+    if width * height == 0:
+        return ReducedImage(None, problem=f"image {image.name!r} has no pixels")
+    values = np.empty(width * height * image.channels, np.float32)
+    image.pixels.foreach_get(values)
+    rgb = _rgb(values, width, height)
+    factor = box_factor(width, height, size)
+    band = factor * max(1, (1 << 20) // (factor * width))
+    parts, note = [], ""
+    for start in range(0, height, band):
+        linear, note = _linearised(rgb[start:start + band], image.is_float,
+                                   image.colorspace_settings)
+        parts.append(box_reduce(linear, factor))
+    return ReducedImage(np.concatenate(parts), note)
+
+
+def _scaled_copy(image, size: int) -> ReducedImage | None:
+    """An image read through a temporary copy scaled down by Blender's box filter (never the
+    whole float buffer), the copy removed whatever happens; None when the copy has no pixels
+    (the file is missing)."""
+    copy = image.copy()
+    try:
+        width, height = copy.size
+        if width * height == 0:
+            return None
+        factor = box_factor(width, height, size)
+        if factor > 1:
+            width, height = -(-width // factor), -(-height // factor)
+            copy.scale(width, height)
+        values = np.empty(width * height * copy.channels, np.float32)
+        copy.pixels.foreach_get(values)
+        is_float = copy.is_float
+    finally:
+        bpy.data.images.remove(copy)
+    linear, note = _linearised(_rgb(values, width, height), is_float, image.colorspace_settings)
+    return ReducedImage(np.ascontiguousarray(linear, np.float32), note)
+
+
+def _image_fingerprint(image) -> tuple:
+    """What an image's pixels depend on, without decoding it: its source, file (path, date,
+    size), packed data, colour space, generated settings, alpha."""
+    stat = None
+    if image.source in {"FILE", "SEQUENCE", "MOVIE", "TILED"} and not image.packed_files:
+        with contextlib.suppress(OSError):
+            info = os.stat(bpy.path.abspath(image.filepath, library=image.library))
+            stat = (info.st_mtime_ns, info.st_size)
+    packed = tuple((p.packed_file.size, p.packed_file.as_pointer()) for p in image.packed_files)
+    generated = ((image.generated_width, image.generated_height, image.generated_type,
+                  tuple(image.generated_color), image.use_generated_float)
+                 if image.source == "GENERATED" else None)
+    return (image.source, image.filepath_raw, stat, packed, image.colorspace_settings.name,
+            image.alpha_mode, generated, image.is_dirty)
+
+
+def reduced_image(image, size: int = IMAGE_SIZE) -> ReducedImage:
+    """``image`` as its texture node reads it (linear), box-filtered down to at most ``size``
+    texels across; kept until the image changes (an image with unsaved changes is read again
+    each time: nothing cheap tells a second paint stroke from the first)."""
+    reduced = _cached_image(image, size)
+    if reduced is None:
+        report(0.0, f"Reading image {image.name!r}")
+        reduced = _read(image, size)
+        _IMAGES.put((image.session_uid, size), (_image_fingerprint(image), reduced))
+    return reduced
+
+
+def is_cached(image: Any, size: int = IMAGE_SIZE) -> bool:
+    """Whether :func:`reduced_image` has ``image`` at ``size`` and it has not changed since."""
+    return _cached_image(image, size) is not None
+
+
+def _cached_image(image: Any, size: int) -> ReducedImage | None:
+    entry = _IMAGES.get((image.session_uid, size))
+    if entry is None or image.is_dirty or entry[0] != _image_fingerprint(image):
+        return None
+    return entry[1]
+
+
+def _read(image, size: int) -> ReducedImage:
+    reduced = _read_pixels(image, size)
+    if image.source == "TILED" and reduced.pixels is not None:
+        tiled = f"image {image.name!r} is tiled: its first tile was read for every UV"
+        return ReducedImage(reduced.pixels, "; ".join(n for n in (reduced.note, tiled) if n))
+    return reduced
+
+
+def _read_pixels(image, size: int) -> ReducedImage:
+    if image.source == "VIEWER":
+        return ReducedImage(None, problem=f"image {image.name!r} is a render result")
+    if image.is_dirty or image.source == "GENERATED":
+        return _whole(image, size)
+    reduced = _scaled_copy(image, size)
+    if reduced is not None:
+        return reduced
+    if image.has_data:  # loaded before its file went missing
+        return _whole(image, size)
+    path = f" {image.filepath!r}" if image.filepath else ""
+    return ReducedImage(None, problem=f"image {image.name!r} has no pixels (its file{path} is "
+                                      f"missing)")
+
+
+def read_texels(pixels: np.ndarray, uv: np.ndarray, extension: str = "REPEAT") -> np.ndarray:
+    """The texels of ``pixels`` ((h, w, 3), rows bottom-up) nearest each UV ((n, 2)), the UVs
+    wrapped as an image texture's ``extension`` does: REPEAT, MIRROR, EXTEND (clamped) or CLIP
+    (black outside the image)."""
+    height, width = pixels.shape[:2]
+    uv = np.asarray(uv, float)
+    if extension == "REPEAT":
+        wrapped = uv - np.floor(uv)
+    elif extension == "MIRROR":
+        wrapped = 1.0 - np.abs(np.mod(uv, 2.0) - 1.0)
+    else:
+        wrapped = uv
+    column = np.clip((wrapped[:, 0] * width).astype(np.int64), 0, width - 1)
+    row = np.clip((wrapped[:, 1] * height).astype(np.int64), 0, height - 1)
+    values = pixels[row, column].astype(float)
+    if extension == "CLIP":
+        values[np.any((uv < 0.0) | (uv > 1.0), axis=1)] = 0.0
+    return values
+
+
+def clear_cache() -> None:
+    """Forget the reduced images."""
+    _IMAGES.clear()

@@ -1,0 +1,266 @@
+"""Points on a material's faces, spread in proportion to their area in the world: where the
+skin's mean colour and the artist's shader are read (:mod:`.skin_sampling`).
+
+A fixed budget of points (:data:`BUDGET` in all) is spread over the faces of the material's
+slots on every mesh object that uses it: stratified along the faces' cumulative area, with a
+fixed seed (:data:`SEED`), so the same mesh gives the same points on every run and machine.
+Only what the points need is read: the faces' areas and material indices, their corners,
+positions and UVs (Blender's attribute arrays, copied whole: not the loop triangles,
+docs/addon.md "Match Skin").  An object's points are cached for the session until its mesh,
+UVs, material slots or transform change (a CRC of the arrays, read again at each call: about
+15 ms on a million-triangle head).
+
+- :func:`face_points` -- area-weighted, stratified points over given faces and their UVs
+  (numpy only).
+- :func:`object_points` -- the points of one object's faces of the material (cached);
+  :class:`Surface` -- one object's faces at a UV map, their area read once.
+- :func:`shares` -- the budget split between objects by area.
+- :func:`users` -- the mesh objects whose slots hold a material.
+- :func:`clear_cache` -- forget the cached points.
+"""
+
+from __future__ import annotations
+
+import zlib
+from dataclasses import dataclass
+
+import bpy
+import numpy as np
+
+from .core import cache
+
+__all__ = ["BUDGET", "SEED", "Points", "Surface", "face_points", "object_points", "shares",
+           "users", "clear_cache"]
+
+BUDGET = 1 << 16
+"""Points in all, split between the objects by area: the mean's standard error is the texture's
+spread over the surface divided by 256 (0.06-0.13% on the production head of docs/addon.md
+"Match Skin"; the points, stratified, err by a third of that)."""
+SEED = 20251203
+"""The points' seed: the same mesh gives the same points, hence the same mean, everywhere."""
+POINTS_CACHE_SIZE = 128
+"""Objects (per material and UV map) whose points are kept: 8 bytes a point, 0.5 MB per
+material however many objects share it, 64 MB at most; a material on more objects than this is
+read again at each click."""
+
+_POINTS = cache.LRUCache(POINTS_CACHE_SIZE)
+
+
+@dataclass(frozen=True)
+class Points:
+    """Points on one object's faces of a material: their UVs ``uv`` ((n, 2) float32, in the UV
+    map read), the faces' world area ``area`` (square metres) and how many faces ``faces``;
+    ``position`` and ``normal`` ((n, 3) float32, the object's own space: the point and its
+    face's normal), or None."""
+
+    uv: np.ndarray
+    area: float
+    faces: int
+    position: np.ndarray | None = None
+    normal: np.ndarray | None = None
+
+
+def users(material) -> list:
+    """The mesh objects with ``material`` in one of their slots."""
+    return [obj for obj in bpy.data.objects if obj.type == "MESH"
+            and any(slot.material == material for slot in obj.material_slots)]
+
+
+def face_points(face_area, loop_start, loop_total, corner_vert, positions, corner_uv,
+                count: int, seed: int = SEED, *, with_positions: bool = False):
+    """UVs ((count, 2) float32) of ``count`` points spread over the faces in proportion to
+    ``face_area`` (zero: a face not counted), uniform within each face: stratified along the
+    cumulative area (point i falls in the i-th of ``count`` equal shares, at a random place in
+    it), then a triangle of the face's fan from its first corner by its area (``positions`` of
+    the corners ``corner_vert``), then a uniform point in it, its UV interpolated from the
+    corners' ``corner_uv``.  Faces are given by ``loop_start`` and ``loop_total`` (corners);
+    fans assume convex faces.  ``with_positions``: ``(uv, position (count, 3), face index
+    (count,))``."""
+    rng = np.random.default_rng(seed)
+    draws = rng.random((4, count))
+    face_area = np.asarray(face_area, float)
+    cumulative = np.cumsum(face_area)
+    shares = (np.arange(count) + draws[0]) * (cumulative[-1] / count)
+    last = np.flatnonzero(face_area > 0.0)[-1]  # a share rounded up to the total lands here
+    face = np.minimum(np.searchsorted(cumulative, shares, side="right"), last)
+    start = np.asarray(loop_start)[face].astype(np.int64)
+    corners = np.asarray(loop_total)[face]
+    uv = np.empty((count, 2), np.float32)
+    xyz = np.empty((count, 3), np.float32) if with_positions else None
+    for k in np.unique(corners):
+        pick = np.flatnonzero(corners == k)
+        loops = start[pick, None] + np.arange(k)
+        second = np.ones(len(pick), np.int64)
+        if k > 3:
+            p = positions[corner_vert[loops]]
+            fan = 0.5 * np.linalg.norm(np.cross(p[:, 1:-1] - p[:, :1], p[:, 2:] - p[:, :1]),
+                                       axis=-1)
+            partial = np.cumsum(fan, axis=1)
+            below = partial < draws[1, pick, None] * partial[:, -1:]
+            second += np.minimum(below.sum(axis=1), k - 3)
+        rows = np.arange(len(pick))
+        root = np.sqrt(draws[2, pick])
+        weights = np.stack([1.0 - root, root * (1.0 - draws[3, pick]), root * draws[3, pick]])
+        triangle = np.stack([loops[:, 0], loops[rows, second], loops[rows, second + 1]])
+        uv[pick] = np.einsum("tn,tnc->nc", weights, corner_uv[triangle])
+        if xyz is not None:
+            xyz[pick] = np.einsum("tn,tnc->nc", weights, positions[corner_vert[triangle]])
+    return (uv, xyz, face) if with_positions else uv
+
+
+def _array(collection, name: str, count: int, dtype) -> np.ndarray:
+    values = np.empty(count, dtype)
+    collection.foreach_get(name, values)
+    return values
+
+
+def _attribute(mesh, name: str, fallback, field_name: str, width: int, dtype) -> np.ndarray:
+    """A mesh attribute's values, copied whole (Blender's arrays, no per-item access), or
+    ``fallback()`` when the attribute is absent."""
+    attribute = mesh.attributes.get(name)
+    if attribute is None:
+        return fallback()
+    return _array(attribute.data, field_name, len(attribute.data) * width, dtype)
+
+
+def _positions(mesh) -> np.ndarray:
+    count = len(mesh.vertices)
+    return _attribute(mesh, "position", lambda: _array(mesh.vertices, "co", 3 * count,
+                                                       np.float32),
+                      "vector", 3, np.float32).reshape(-1, 3)
+
+
+def _corner_verts(mesh) -> np.ndarray:
+    count = len(mesh.loops)
+    return _attribute(mesh, ".corner_vert", lambda: _array(mesh.loops, "vertex_index", count,
+                                                           np.int32), "value", 1, np.int32)
+
+
+def _material_indices(mesh) -> np.ndarray:
+    count = len(mesh.polygons)
+    return _attribute(mesh, "material_index", lambda: np.zeros(count, np.int32), "value", 1,
+                      np.int32)
+
+
+def _corner_uvs(layer) -> np.ndarray:
+    return _array(layer.uv, "vector", 2 * len(layer.uv), np.float32).reshape(-1, 2)
+
+
+def _slots(obj, material) -> tuple:
+    return tuple(i for i, slot in enumerate(obj.material_slots) if slot.material == material)
+
+
+def _linear_part(obj) -> np.ndarray:
+    return np.array(obj.matrix_world, float)[:3, :3]
+
+
+def _fingerprint(obj, layer, slots: tuple) -> tuple:
+    """What the points of ``obj`` depend on, cheaply: the counts, the UV map's name, the slots,
+    the transform's linear part and a CRC-32 of the positions, corners, material indices and
+    UVs (the arrays copied whole: about 15 ms on a million triangles)."""
+    mesh = obj.data
+    crc = 0
+    for read in (_positions, _corner_verts, _material_indices):  # one array at a time
+        crc = zlib.crc32(np.ascontiguousarray(read(mesh)).data, crc)
+    crc = zlib.crc32(_corner_uvs(layer).data, crc)
+    return (len(mesh.vertices), len(mesh.loops), len(mesh.polygons), layer.name, slots,
+            tuple(_linear_part(obj).ravel()), crc)
+
+
+def _face_areas(obj, slots: tuple) -> tuple[np.ndarray, int]:
+    """``(areas, faces)``: the world areas (square metres, float64) of ``obj``'s faces, zero
+    for faces of other slots, and how many faces the slots have (a material index beyond the
+    slots counts as the last slot, as Blender draws it)."""
+    mesh = obj.data
+    count = len(mesh.polygons)
+    area = _array(mesh.polygons, "area", count, np.float32).astype(float)
+    index = np.minimum(_material_indices(mesh), max(len(obj.material_slots) - 1, 0))
+    used = np.isin(index, slots)
+    area[~used] = 0.0
+    faces = int(np.count_nonzero(used))
+    linear = _linear_part(obj)
+    gram = linear.T @ linear
+    scale = np.trace(gram) / 3.0
+    if np.allclose(gram, scale * np.eye(3), rtol=0.0, atol=1e-9 * max(scale, 1e-30)):
+        return area * scale, faces  # a rotation and a uniform scale: areas times its square
+    # Otherwise a face's area grows by |cof(M) n| along its unit normal n, cof(M) = det(M)
+    # M^-T, whose columns are the cross products of M's (defined for a flattened M too).
+    normal = _array(mesh.polygons, "normal", 3 * count, np.float32).reshape(-1, 3)
+    a, b, c = linear.T
+    cofactor = np.column_stack([np.cross(b, c), np.cross(c, a), np.cross(a, b)])
+    return area * np.linalg.norm(normal @ cofactor.T, axis=1), faces
+
+
+def _points(obj, layer, area: np.ndarray, faces: int, count: int) -> Points:
+    mesh = obj.data
+    loop_start = _array(mesh.polygons, "loop_start", len(mesh.polygons), np.int32)
+    if np.all(np.diff(loop_start) > 0):
+        loop_total = np.diff(loop_start, append=len(mesh.loops))
+    else:
+        loop_total = _array(mesh.polygons, "loop_total", len(mesh.polygons), np.int32)
+    uv, position, face = face_points(area, loop_start, loop_total, _corner_verts(mesh),
+                                     _positions(mesh), _corner_uvs(layer), count,
+                                     with_positions=True)
+    normal = _array(mesh.polygons, "normal", 3 * len(mesh.polygons), np.float32).reshape(-1, 3)
+    return Points(uv, float(area.sum()), faces, position, normal[face])
+
+
+class Surface:
+    """One object's faces of a material at a UV map: their fingerprint, and their points from
+    the cache while it matches."""
+
+    def __init__(self, obj, material, layer):
+        self.obj, self.layer = obj, layer
+        self.slots = _slots(obj, material)
+        self.key = (obj.session_uid, material.session_uid, layer.name)
+        self.fingerprint = _fingerprint(obj, layer, self.slots)
+        entry = _POINTS.get(self.key)
+        self.cached = entry[1] if entry is not None and entry[0] == self.fingerprint else None
+        self._areas: tuple[np.ndarray, int] | None = None
+
+    def areas(self) -> tuple[np.ndarray, int]:
+        """``(areas, faces)`` of :func:`_face_areas`, read once."""
+        if self._areas is None:
+            self._areas = _face_areas(self.obj, self.slots)
+        return self._areas
+
+    def area(self) -> float:
+        """The faces' world area, from the cache when it holds them."""
+        return self.cached.area if self.cached is not None else float(self.areas()[0].sum())
+
+    def points(self, count: int) -> Points:
+        if self.cached is not None and len(self.cached.uv) == count:
+            return self.cached
+        areas, faces = self.areas()
+        points = (_points(self.obj, self.layer, areas, faces, count)
+                  if count > 0 and areas.sum() > 0.0
+                  else Points(np.empty((0, 2), np.float32), float(areas.sum()), faces))
+        _POINTS.put(self.key, (self.fingerprint, points))
+        self.cached = points
+        return points
+
+
+def object_points(obj, material, layer, count: int = BUDGET) -> Points:
+    """``count`` points of ``obj``'s faces that use ``material``, at the UV map ``layer``
+    (:func:`face_points`), kept until the mesh, its UVs, slots or transform change.  Faces of
+    other slots do not count."""
+    return Surface(obj, material, layer).points(int(count))
+
+
+def shares(areas: list[float], budget: int) -> list[int]:
+    """The budget split by area (largest remainders), at least one point per object with
+    area."""
+    total = sum(areas)
+    if total <= 0.0:
+        return [0] * len(areas)
+    exact = [budget * a / total for a in areas]
+    counts = [int(e) for e in exact]
+    order = sorted(range(len(areas)), key=lambda i: counts[i] - exact[i])
+    for i in order[:budget - sum(counts)]:
+        counts[i] += 1
+    return [max(c, 1) if a > 0.0 else 0 for c, a in zip(counts, areas, strict=True)]
+
+
+def clear_cache() -> None:
+    """Forget the cached points."""
+    _POINTS.clear()

@@ -1,0 +1,66 @@
+"""An image as its texture node reads it, box-filtered (makeup_skin_addon.image_texels): kept
+until the image changes (a file rewritten and reloaded, its colour space, unsaved edits read at
+every call), and its texels read at UVs as the texture's extension wraps them."""
+
+import numpy as np
+from support.two_faces import RIGHT_BYTES, exact_two_faces, linear
+
+
+def test_the_cache_is_kept_until_the_image_changes(two_faces, tmp_path):
+    """An image from a file is read once (the same reduced pixels twice); written again and
+    reloaded, or its colour space changed, it is read again; an image edited in Blender
+    (unsaved) is read at every call, with its edits."""
+    import bpy
+
+    from makeup_skin_addon import image_texels, skin_sampling
+
+    obj, skin, texture = two_faces
+    generated = texture.image
+    path = str(tmp_path / "bands.png")
+    generated.filepath_raw = path
+    generated.file_format = "PNG"
+    generated.save()  # now a file image, "Bands"
+    image = bpy.data.images.load(path, check_existing=False)
+    image.colorspace_settings.name = "sRGB"
+    texture.image = image
+    first = image_texels.reduced_image(image)
+    assert image_texels.reduced_image(image) is first
+    np.testing.assert_allclose(skin_sampling.surface_mean(image, skin).rgb,
+                               exact_two_faces(1.0, 3.0), atol=2e-5)
+    # The file painted over elsewhere (the left band now grey 128) and reloaded.
+    pixels = np.empty(len(generated.pixels), np.float32)
+    generated.pixels.foreach_get(pixels)
+    pixels = pixels.reshape(8, 48, 4)
+    pixels[:, :16, :3] = 128 / 255
+    generated.pixels.foreach_set(pixels.ravel())
+    generated.save()
+    image.reload()
+    grey = linear(np.full(3, 128 / 255))
+    right = linear(np.asarray(RIGHT_BYTES) / 255)
+    np.testing.assert_allclose(skin_sampling.surface_mean(image, skin).rgb,
+                               (grey + 3 * right) / 4, atol=2e-5)
+    image.colorspace_settings.name = "Non-Color"
+    np.testing.assert_allclose(skin_sampling.surface_mean(image, skin).rgb,
+                               (128 / 255 + 3 * np.asarray(RIGHT_BYTES) / 255) / 4, atol=2e-5)
+    # Painted in Blender, not saved: read again at each call.
+    image.colorspace_settings.name = "sRGB"
+    for value in (0.2, 0.6):
+        pixels[:, 16:32, :3] = value
+        image.pixels.foreach_set(pixels.ravel())
+        assert image.is_dirty
+        np.testing.assert_allclose(skin_sampling.surface_mean(image, skin).rgb,
+                                   (grey + 3 * linear(np.full(3, value))) / 4, atol=2e-5)
+
+
+def test_texels_wrap_as_the_texture_extension_does(addon):
+    """REPEAT wraps, MIRROR reflects, EXTEND clamps, CLIP is black outside the image."""
+    from makeup_skin_addon import image_texels
+
+    pixels = np.arange(1, 5, dtype=np.float32).reshape(1, 4, 1).repeat(3, axis=2)
+    uv = np.array([[0.1, 0.5], [1.1, 0.5], [-0.1, 0.5], [1.6, 0.5]])
+    expected = {"REPEAT": (1, 1, 4, 3), "MIRROR": (1, 4, 1, 2), "EXTEND": (1, 4, 1, 4),
+                "CLIP": (1, 0, 0, 0)}
+    for extension, values in expected.items():
+        read = image_texels.read_texels(pixels, uv, extension)
+        np.testing.assert_allclose(read, np.repeat(np.array(values, float)[:, None], 3, 1),
+                                   atol=1e-12, err_msg=extension)
