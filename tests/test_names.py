@@ -1,7 +1,8 @@
-"""One spelling in lut_baker's and the add-on's identifiers: "colour", as the project writes it; the names that
-transcribe a Blender socket keep Blender's "Color", so that the socket can be found (the
-Principled BSDF's Base Color, the node group's Skin Color), as the interface does
-(docs/architecture.md).  Other libraries' own names (matplotlib's ``color=``) are theirs."""
+"""One spelling in lut_baker's and the add-on's identifiers: "colour", as the project writes
+it; the names that transcribe a Blender socket keep Blender's "Color", so that the socket can be
+found (the Principled BSDF's Base Color, the node group's Skin Color), as the interface does
+(docs/architecture.md), and so do Blender's own attributes and node types the add-on names.
+Other libraries' own names (matplotlib's ``color=``) are theirs."""
 
 import ast
 from pathlib import Path

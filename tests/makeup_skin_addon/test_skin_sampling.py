@@ -64,7 +64,7 @@ def test_the_heads_mean_is_within_its_sampling_error(head):
     np.testing.assert_allclose(reduced.rgb, exact, rtol=2e-3)
     scene = bpy.context.scene
     scene.camera = None  # with a camera, the points count by how much of them it sees
-    reading = artist_skin.readnew_material(material, scene)
+    reading = artist_skin.read_material(material, scene)
     np.testing.assert_allclose(reading.leaves[0].base, mean.rgb, rtol=1e-9)
     assert reading.notes == []
 
@@ -166,13 +166,13 @@ def test_with_a_camera_the_points_count_by_what_it_sees(two_faces):
     camera.location = (3.5, 0.5, 5.0)
     scene.camera = camera
     scene.render.resolution_x = scene.render.resolution_y = 64
-    seen = artist_skin.readnew_material(skin, scene).leaves[0].base
+    seen = artist_skin.read_material(skin, scene).leaves[0].base
     np.testing.assert_allclose(seen, linear(np.asarray(RIGHT_BYTES) / 255), atol=2e-5)
     scene.camera = None
-    everywhere = artist_skin.readnew_material(skin, scene).leaves[0].base
+    everywhere = artist_skin.read_material(skin, scene).leaves[0].base
     np.testing.assert_allclose(everywhere, exact_two_faces(1.0, 3.0), atol=1e-4)
     scene.camera = camera
     camera.rotation_euler = (3.14159, 0.0, 0.0)  # looking up, away from the faces
-    away = artist_skin.readnew_material(skin, scene)
+    away = artist_skin.read_material(skin, scene)
     np.testing.assert_allclose(away.leaves[0].base, everywhere, atol=1e-6)
     assert any("sees none of it" in note for note in away.notes)
