@@ -54,6 +54,7 @@ from numpy.typing import ArrayLike, NDArray
 from .evaluate.two_layer import inter_reflection_fourier_matrices, layered_fourier_matrices
 from .model.albedo import specular_albedo
 from .model.dipole import dipole_profile, dipole_total_reflectance
+from .model.film_slab import relative_thickness
 from .model.layers import Dipole, ReflectionLayer, TransmissionLayer
 from .model.made_up_skin import MadeUpSkin, film_reflection_layer, film_transmission_layer
 from .model.microfacet import (
@@ -63,12 +64,11 @@ from .model.microfacet import (
     ts_specular_from_cosines,
     ts_transmission_from_cosines,
 )
-from .model.film_slab import relative_thickness
 from .model.params_file import skin_to_dict
 from .model.slab_skin import foundation_slab, slab_skin_parts
 from .numerics import Real
-from .numerics.cache import LRUCache
 from .numerics.adding_doubling import from_star, star_albedo, star_scale
+from .numerics.cache import LRUCache
 from .numerics.quadrature import (
     hemisphere_panels,
     order0_integral,
@@ -604,7 +604,7 @@ def bake_slab(skin: MadeUpSkin, resolution_name: str | Resolution = "default", *
         kernel = from_star(parts.top, scale)  # (C, M, N, N) 1/sr
         on_table = np.moveaxis(lagrange @ kernel @ lagrange.T, 0, -1)  # (M, I, I, C)
         top.append(np.asarray(_cosine_series(on_table, pairs)))
-        top_albedo.append(rgb_view((lagrange @ star_albedo(parts.top[:, 0], scale[0]).T)))
+        top_albedo.append(rgb_view(lagrange @ star_albedo(parts.top[:, 0], scale[0]).T))
         through.append(rgb_view(lagrange @ parts.through.T))
         through_mean.append(np.broadcast_to(parts.through @ (2.0 * grid.weight), (3,)))
         below.append(np.broadcast_to(parts.below, (3,)))
