@@ -32,6 +32,9 @@ Functions and types
   through the half vector (any lobe width).
 - :func:`path3_width_deg` -- the narrowest lobe path 3 goes through (degrees).
 - :func:`inter_reflection_albedo` -- what the inter-reflections add to the albedo.
+- :data:`PAPER_FILM`, :data:`SLAB_RESOLUTION` -- the bake's film modes and the slab tables' grids.
+- :func:`bake_slab` -- the film as a slab at every thickness of the axis
+  (:class:`lut_baker.tables.slab_tables.SlabTables`).
 - :func:`profile_radius` -- where the dipole's R(d) falls to a fraction of its peak (mm).
 - :func:`rgb_view` -- a channel axis of 1 or 3 as 3, without a copy.
 
@@ -51,6 +54,7 @@ from numpy.typing import ArrayLike, NDArray
 from .evaluate.two_layer import inter_reflection_fourier_matrices, layered_fourier_matrices
 from .model.albedo import specular_albedo
 from .model.dipole import dipole_profile, dipole_total_reflectance
+from .model.film_slab import relative_thickness
 from .model.layers import Dipole, ReflectionLayer, TransmissionLayer
 from .model.made_up_skin import MadeUpSkin, film_reflection_layer, film_transmission_layer
 from .model.microfacet import (
@@ -61,13 +65,17 @@ from .model.microfacet import (
     ts_transmission_from_cosines,
 )
 from .model.params_file import skin_to_dict
+from .model.slab_skin import foundation_slab, slab_skin_parts
 from .numerics import Real
+from .numerics.adding_doubling import from_star, star_albedo, star_scale
 from .numerics.cache import LRUCache
 from .numerics.quadrature import (
     hemisphere_panels,
     order0_integral,
+    panel_interpolation,
     uniform_azimuths,
 )
+from .tables.slab_tables import SlabTables, thickness_nodes
 from .tables.table_set import THETA_OFFSET, Tables, node_cos_azimuths, radius_nodes, theta_nodes
 
 __all__ = [
@@ -91,6 +99,9 @@ __all__ = [
     "lobe_scale",
     "scaled_count",
     "REFERENCE_LOBE_DEG",
+    "PAPER_FILM",
+    "SLAB_RESOLUTION",
+    "bake_slab",
 ]
 
 PROFILE_FLOOR = 1e-4
@@ -431,7 +442,8 @@ def _stage(progress: Progress | None, fraction: float, message: str) -> None:
 
 
 def bake(skin: MadeUpSkin, resolution_name: str | Resolution = "default", *,
-         inter_reflection: bool = False, progress: Progress | None = None) -> Tables:
+         inter_reflection: bool = False, progress: Progress | None = None,
+         film: str | float = "paper") -> Tables:
     """Bake the tables of one made-up skin (see :mod:`lut_baker.tables.table_set` for their
     meaning).
 
@@ -441,7 +453,13 @@ def bake(skin: MadeUpSkin, resolution_name: str | Resolution = "default", *,
     ``inter_reflection``: also bake the film-skin inter-reflections beyond path 3 (the adding
     equation, film underside reflecting like its top, at the skin's absorption).
     ``progress(fraction, message)``: called as the bake advances (fraction 0..1).
+    ``film``: :data:`PAPER_FILM` (``"paper"``, the default), the paper's model as published
+    (paths 1 + 3, its 150 um free film; the tables as they always were), or a thickness in
+    micrometres: the tables also hold the film as a slab at every thickness of the axis, every
+    inter-reflection in (``tables.slab``, :func:`bake_slab`), and ``parameters`` record the
+    thickness (``film_thickness_um``) as the lookups' default.
     """
+    thickness_um = _film_thickness(film)
     if not isinstance(skin, MadeUpSkin):
         raise ValueError(f"skin must be a MadeUpSkin, got {type(skin).__name__}")
     res = resolution(resolution_name).for_lobe(path3_width_deg(skin))
@@ -481,6 +499,11 @@ def bake(skin: MadeUpSkin, resolution_name: str | Resolution = "default", *,
                                          fourier=kernels)
         extra = _cosine_series(full - first, pairs)
 
+    slab = None
+    if thickness_um is not None:
+        _stage(progress, 0.8, "the film as a slab at every thickness")
+        slab = bake_slab(skin, res)
+
     _stage(progress, 0.9, "radial profile")
     radius_mm = radius_nodes(res.n_radius, res.radius_spacing, profile_radius(skin.dipole))
     total = np.atleast_1d(dipole_total_reflectance(skin.dipole))
@@ -501,8 +524,10 @@ def bake(skin: MadeUpSkin, resolution_name: str | Resolution = "default", *,
         total_reflectance=rgb_view(total),
         film_transmittance_integral=rgb_view(order0_integral(inner_t[None], grid)[0]),
         profile=rgb_view(profile),
-        parameters=skin_to_dict(skin),
+        parameters=(skin_to_dict(skin) if thickness_um is None
+                    else {**skin_to_dict(skin), "film_thickness_um": thickness_um}),
         inter_reflection=extra,
+        slab=slab,
         theta_spacing=res.theta_spacing,
         theta_offset=res.theta_offset,
         phi_spacing=res.phi_spacing,
@@ -529,3 +554,63 @@ def inter_reflection_albedo(skin: MadeUpSkin, theta_deg: ArrayLike,
     first = layered_fourier_matrices(theta, grid.theta, film_transmission, skin.skin_reflection,
                                      grid, fourier=kernels)
     return rgb_view(order0_integral(full[0] - first[0], grid))
+
+
+PAPER_FILM = "paper"
+"""The bake's film mode of the paper's model as published (:func:`bake`'s ``film``)."""
+SLAB_RESOLUTION = {"preview": (32, 17), "default": (48, 33), "high": (64, 49)}
+"""The slab tables' angular grid per resolution, ``(n_theta, n_phi)``: coarser than path 3's
+table, because the slab is known on the quadrature's polar nodes (30 at default) and
+interpolated from them, and it is held at every thickness (docs/baking.md)."""
+
+
+def _film_thickness(film: str | float) -> float | None:
+    """None for :data:`PAPER_FILM`, else the thickness in micrometres (checked)."""
+    if isinstance(film, str):
+        if film != PAPER_FILM:
+            raise ValueError(f"film must be {PAPER_FILM!r} or a thickness in micrometres, "
+                             f"got {film!r}")
+        return None
+    relative_thickness(film)  # raises on a negative thickness
+    return float(film)
+
+
+def bake_slab(skin: MadeUpSkin, resolution_name: str | Resolution = "default", *,
+              thicknesses_um: ArrayLike | None = None) -> SlabTables:
+    """The film as a slab over the skin at every thickness of the axis
+    (:func:`lut_baker.tables.slab_tables.thickness_nodes`, or ``thicknesses_um``), at the
+    skin's absorption: per thickness, the parts of :func:`lut_baker.model.slab_skin.
+    slab_skin_parts` computed on the bake's quadrature (Gauss-Legendre panels), interpolated
+    to the tables' polar nodes panel by panel (:func:`~lut_baker.numerics.quadrature.
+    panel_interpolation`) and summed as cosine series at the tables' azimuths."""
+    res = resolution(resolution_name)
+    grid = hemisphere_panels(res.quad_panels, res.quad_points, res.quad_phi)
+    n_theta, n_phi = SLAB_RESOLUTION.get(res.name, SLAB_RESOLUTION["default"])
+    theta_deg = theta_nodes(n_theta, res.theta_spacing, res.theta_max_deg, res.theta_offset)
+    phi_deg = np.linspace(0.0, 180.0, n_phi)
+    pairs = _NodePairs(theta_deg, phi_deg, res.phi_spacing)
+    lagrange = panel_interpolation(np.radians(theta_deg), res.quad_points, 0.0, np.pi / 2,
+                                   res.quad_panels)
+    axis = (thickness_nodes() if thicknesses_um is None
+            else np.asarray(thicknesses_um, float))
+    absorption = np.broadcast_to(np.asarray(skin.absorption, float), (3,))
+    film = foundation_slab(skin.film, skin.film_transmission, grid, absorption)
+    face = gloss_albedos((skin.film,), np.degrees(grid.theta))[0].T  # (3, N), a_g
+    scale = star_scale(grid)
+    top, top_albedo, through, through_mean, below = [], [], [], [], []
+    for h in axis:
+        parts = slab_skin_parts(film, np.inf if np.isinf(h) else relative_thickness(h),
+                                skin.skin_reflection, face)
+        kernel = from_star(parts.top, scale)  # (C, M, N, N) 1/sr
+        on_table = np.moveaxis(lagrange @ kernel @ lagrange.T, 0, -1)  # (M, I, I, C)
+        top.append(np.asarray(_cosine_series(on_table, pairs)))
+        top_albedo.append(rgb_view(lagrange @ star_albedo(parts.top[:, 0], scale[0]).T))
+        through.append(rgb_view(lagrange @ parts.through.T))
+        through_mean.append(np.broadcast_to(parts.through @ (2.0 * grid.weight), (3,)))
+        below.append(np.broadcast_to(parts.below, (3,)))
+    return SlabTables(thickness_um=axis, theta_deg=theta_deg, phi_deg=phi_deg,
+                      top=np.stack(top), top_albedo=np.stack(top_albedo),
+                      through=np.stack(through), through_mean=np.stack(through_mean),
+                      below=np.stack(below), absorption=absorption.copy(),
+                      theta_spacing=res.theta_spacing, theta_offset=res.theta_offset,
+                      phi_spacing=res.phi_spacing)

@@ -46,6 +46,9 @@ Functions and types
 - :func:`bihemispherical_on_grid` -- a directional albedo at the nodes averaged over uniform
   light.
 - :func:`solve_thick_absorption` -- the absorption whose thick film has a target colour.
+- :func:`skin_star` -- a skin's eq. 2 kernel in the star form (cached per skin and grid).
+- :func:`increasing_root` -- per entry, where an increasing function of [0, 1] meets a target
+  (false position, vectorised).
 """
 
 from __future__ import annotations
@@ -94,6 +97,8 @@ __all__ = [
     "thick_limit_albedo",
     "bihemispherical_on_grid",
     "solve_thick_absorption",
+    "skin_star",
+    "increasing_root",
     "ROOT_STEPS",
 ]
 
@@ -282,13 +287,13 @@ def _passive(generator: SlabGenerator, target: float | np.ndarray, face: np.ndar
     film absorbs."""
     scale0 = star_scale(grid)[0]
     order0 = SlabGenerator(basis=generator.basis[..., :1, :, :], rates=generator.rates[..., :1, :])
-    relief = _increasing_root(
+    relief = increasing_root(
         lambda r: _free_film_albedo(passive_generator(order0, scale0, r), face, scale0, grid),
         np.broadcast_to(np.asarray(target, float), (face.shape[0],)), RELIEF_STEPS)
     return passive_generator(generator, scale0, relief)
 
 
-def _increasing_root(function, target: np.ndarray, steps: int) -> np.ndarray:
+def increasing_root(function, target: np.ndarray, steps: int) -> np.ndarray:
     """Per entry, ``x`` in [0, 1] with ``function(x) = target`` for an increasing ``function``
     (vectorised over the entries), by the Illinois variant of false position (the bracket
     always holds the root; it shrinks superlinearly) until :data:`ROOT_TOLERANCE`; 0 or 1
@@ -389,7 +394,7 @@ def free_film_matrices(film: FilmSlab, thickness: float, face=None):
 _SKINS = LRUCache(MEASURED_CACHE_SIZE)
 
 
-def _skin_star(skin: ReflectionLayer, grid: HemisphereGrid) -> np.ndarray:
+def skin_star(skin: ReflectionLayer, grid: HemisphereGrid) -> np.ndarray:
     """The skin's eq. 2 kernel in the star form, ``(C, orders, N, N)``, once per skin and grid."""
     key = (repr(skin.as_dict()), grid.theta.tobytes(), grid.weight.tobytes(), grid.n_phi)
 
@@ -414,9 +419,9 @@ def made_up_matrices(film: FilmSlab, thickness: float, skin: ReflectionLayer, fa
     (the adding equations).  Add the surface's gloss (eq. 2's specular term, closed form) for
     the whole BRDF."""
     face = film.measured_face if face is None else np.asarray(face, float)
-    skin_star = _skin_star(skin, film.grid)[:, :film.orders]
+    skin_matrix = skin_star(skin, film.grid)[:, :film.orders]
     stack = add_layers(add_layers(face_layer(face, film.orders), _body_layer(film, thickness)),
-                       _skin_layer(skin_star))
+                       _skin_layer(skin_matrix))
     return stack.top
 
 
@@ -461,7 +466,7 @@ def solve_thick_absorption(target, film: ReflectionLayer, transmission: Transmis
                            optical_thickness=optical_thickness, passive=passive, orders=1)
         return bihemispherical_on_grid(thick_limit_albedo(slab_a, face), grid)
 
-    absorption = _increasing_root(lambda a: -limit(a), -target, ROOT_STEPS)
+    absorption = increasing_root(lambda a: -limit(a), -target, ROOT_STEPS)
     too_light = target > limit(np.zeros_like(target))
     too_dark = target < limit(np.ones_like(target))
     return absorption, too_light | too_dark

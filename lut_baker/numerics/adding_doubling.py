@@ -45,6 +45,7 @@ Functions and types
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 from typing import NamedTuple
 
 import numpy as np
@@ -162,9 +163,9 @@ class SlabGenerator:
     basis: np.ndarray
     rates: np.ndarray
 
-    @property
+    @cached_property
     def inverse(self) -> np.ndarray:
-        """``B^-1``."""
+        """``B^-1`` (computed once)."""
         return np.linalg.inv(self.basis)
 
 

@@ -8,6 +8,8 @@ becomes a product of matrices per Fourier order (docs/model.md §3).
 Functions
 ---------
 - :func:`gauss_legendre` -- composite Gauss-Legendre nodes and weights on an interval.
+- :func:`panel_interpolation` -- values at those nodes interpolated to other points, panel by
+  panel (Lagrange).
 - :func:`midpoint_nodes` -- the midpoint rule's nodes on an interval.
 - :func:`trapezoid_weights` -- trapezoid-rule weights on any monotonic grid.
 - :func:`cumulative_trapezoid` -- the running trapezoid integral.
@@ -37,6 +39,7 @@ from .geometry import direction
 
 __all__ = [
     "gauss_legendre",
+    "panel_interpolation",
     "midpoint_nodes",
     "trapezoid_weights",
     "cumulative_trapezoid",
@@ -84,6 +87,38 @@ def gauss_legendre(points: int, start: float = 0.0, stop: float = 1.0,
     weights = np.tile(half * w, panels)
     _read_only(nodes, weights)
     return nodes, weights
+
+
+def panel_interpolation(x: ArrayLike, points: int, start: float = 0.0, stop: float = 1.0,
+                        panels: int = 1) -> np.ndarray:
+    """The matrix ``(len(x), panels * points)`` that interpolates values at the nodes of
+    :func:`gauss_legendre` (same arguments) to the points ``x``: within each panel the
+    polynomial through its ``points`` nodes (barycentric Lagrange weights), ``x`` outside
+    [``start``, ``stop``] taken by the first or last panel.
+
+    >>> nodes, _ = gauss_legendre(4, 0.0, 1.0, 2)
+    >>> x = np.array([0.0, 0.3, 0.75, 1.0])
+    >>> bool(np.allclose(panel_interpolation(x, 4, 0.0, 1.0, 2) @ nodes**3, x**3))
+    True
+    """
+    targets = np.atleast_1d(np.asarray(x, float))
+    nodes, _ = gauss_legendre(points, start, stop, panels)
+    local = nodes[:points] - nodes[0]
+    bary = 1.0 / np.prod(local[:, None] - local[None, :] + np.eye(points), axis=1)
+    width = (stop - start) / panels
+    panel = np.clip(np.floor((targets - start) / width).astype(np.intp), 0, panels - 1)
+    matrix = np.zeros((targets.size, nodes.size))
+    for row, (value, k) in enumerate(zip(targets, panel, strict=True)):
+        own = nodes[k * points:(k + 1) * points]
+        offset = value - own
+        hit = np.isclose(offset, 0.0, rtol=0.0, atol=1e-14)
+        if np.any(hit):
+            weights = hit.astype(float)
+        else:
+            weights = bary / offset
+            weights = weights / weights.sum()
+        matrix[row, k * points:(k + 1) * points] = weights
+    return matrix
 
 
 def midpoint_nodes(count: int, start: float, stop: float) -> np.ndarray:

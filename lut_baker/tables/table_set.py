@@ -70,6 +70,7 @@ Contents
 from __future__ import annotations
 
 from dataclasses import dataclass, field, fields
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -274,7 +275,9 @@ class Tables:
     ``film`` and ``skin`` layers give the closed-form surface gloss (:data:`SURFACE_GLOSS`).
     ``inter_reflection``: optional angular table, the full adding-equation sum minus path 3
     (1/sr), or None; unlike the other tables it holds the film's absorption as baked
-    (``parameters["absorption"]``).  Arrays may be read-only (the bake broadcasts a channel
+    (``parameters["absorption"]``).  ``slab``: optional, the film as a slab at every thickness
+    (:class:`lut_baker.tables.slab_tables.SlabTables`, at the baked absorption), or None (the
+    paper's film only).  Arrays may be read-only (the bake broadcasts a channel
     axis of 1 to 3 without copying): copy before writing into them.
     """
 
@@ -294,6 +297,7 @@ class Tables:
     profile: np.ndarray
     parameters: dict = field(default_factory=dict)
     inter_reflection: np.ndarray | None = None
+    slab: Any = None
     theta_spacing: str = "grazing"
     phi_spacing: str = "half_vector"
     radius_spacing: str = "quadratic"

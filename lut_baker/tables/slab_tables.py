@@ -1,0 +1,240 @@
+"""Made-up skin at every thickness as the tables hold it: the film as a slab over the skin,
+every inter-reflection in, tabulated over a small thickness axis so that a thickness (or a
+painted thickness map) is a lookup, not a bake (docs/baking.md, "The film as a slab in the
+tables"; docs/model.md, "Made-up skin at a thickness").
+
+Per thickness ``h`` (micrometres) and channel, with ``a`` the skin's diffuse albedo (free: a
+texture, a socket) and the film's surface gloss ``film_gloss`` in closed form
+(:meth:`lut_baker.tables.table_set.Tables.surface_gloss`)::
+
+    f = film_gloss + top(h) + a t_h(theta_i) t_h(theta_o) / (pi (1 - a c_h))
+
+``top`` (angular, 1/sr): the film's body through its surface and the skin's gloss through the
+film, every inter-reflection (what does not depend on ``a``); ``through`` ``t`` (directional,
+dimensionless): the film's transmittance into the skin's diffuse light; ``below`` ``c``: the
+film's reflectance seen from the skin (:mod:`lut_baker.model.slab_skin`).  The diffuse term is
+what spreads under the skin (the dipole's normalised profile).  Absorption is part of the bake
+(the slab is not linear in it); coverage stays an areal mix with the bare skin.
+
+The thickness axis: ``thickness_um`` holds ``n - 1`` log-spaced thicknesses from
+:data:`THICKNESS_MIN_UM` to :data:`THICKNESS_MAX_UM`, then the thick limit (``inf``).  The
+fractional index of ``h`` is::
+
+    x = ln(h / h_min) / ln(h_max / h_min) (n - 2)            h <= h_max
+    x = (n - 2) + (1 - h_max / h)                             h >  h_max (in 1 / h to the limit)
+
+clamped to ``[0, n - 1]``, and every table is interpolated linearly in ``x`` (and, for the
+angular table, trilinearly in its own angular grid, as :mod:`lut_baker.tables.table_set`).
+
+Functions and types
+-------------------
+- :data:`THICKNESS_MIN_UM`, :data:`THICKNESS_MAX_UM`, :data:`THICKNESS_NODES` -- the axis.
+- :func:`thickness_nodes`, :func:`thickness_index` -- its nodes and the closed-form index.
+- :class:`SlabTables` -- the tables, with ``at`` (the 1-D parts at a thickness).
+- :class:`SlabParts` -- the 1-D parts at one thickness.
+- :func:`slab_reflection` -- made-up skin's BRDF at a thickness from the tables.
+- :func:`slab_directional_albedo`, :func:`slab_colour` -- its directional albedo and its colour
+  under uniform light.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import NamedTuple
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ..model.albedo import bihemispherical
+from ..numerics.geometry import polar_angle_deg
+from .table_set import THETA_OFFSET, Tables, _linear, _trilinear, phi_index, theta_index
+
+__all__ = [
+    "THICKNESS_MIN_UM",
+    "THICKNESS_MAX_UM",
+    "THICKNESS_NODES",
+    "thickness_nodes",
+    "thickness_index",
+    "SlabTables",
+    "SlabParts",
+    "slab_reflection",
+    "slab_directional_albedo",
+    "slab_colour",
+]
+
+THICKNESS_MIN_UM = 1.0
+"""The thinnest tabulated film, micrometres (sheer: a few; thinner is clamped to it)."""
+THICKNESS_MAX_UM = 300.0
+"""The thickest finite node, micrometres (twice the paper's film); beyond, interpolation in
+``1 / h`` to the thick limit."""
+THICKNESS_NODES = 10
+"""Nodes of the axis: 9 log-spaced (a ratio of 2.04) and the thick limit
+(docs/baking.md measures the interpolation error)."""
+
+
+def thickness_nodes(n: int = THICKNESS_NODES, h_min: float = THICKNESS_MIN_UM,
+                    h_max: float = THICKNESS_MAX_UM) -> NDArray[np.float64]:
+    """The axis (micrometres): ``n - 1`` log-spaced thicknesses from ``h_min`` to ``h_max``
+    and ``inf``."""
+    if n < 3 or not 0.0 < h_min < h_max:
+        raise ValueError(f"need n >= 3 and 0 < h_min < h_max, got {n}, {h_min}, {h_max}")
+    return np.append(np.geomspace(h_min, h_max, n - 1), np.inf)
+
+
+def thickness_index(thickness_um: ArrayLike, n: int = THICKNESS_NODES,
+                    h_min: float = THICKNESS_MIN_UM,
+                    h_max: float = THICKNESS_MAX_UM) -> NDArray[np.float64]:
+    """The fractional index (clamped to ``[0, n - 1]``) of thicknesses on
+    :func:`thickness_nodes` (module docstring)."""
+    h = np.maximum(np.asarray(thickness_um, float), h_min)
+    finite = np.log(np.minimum(h, h_max) / h_min) / np.log(h_max / h_min) * (n - 2)
+    beyond = (n - 2) + (1.0 - h_max / np.maximum(h, h_max))
+    return np.clip(np.where(h <= h_max, finite, beyond), 0.0, n - 1.0)
+
+
+class SlabParts(NamedTuple):
+    """The 1-D parts at one thickness: ``top_albedo`` ``(..., 3)`` (``top``'s directional
+    albedo, at the angles asked), ``through`` ``(..., 3)`` (``t``), ``through_mean`` ``(3,)``
+    (``t`` averaged over uniform light, ``2 Int t mu dmu``), ``below`` ``(3,)`` (``c``)."""
+
+    top_albedo: np.ndarray
+    through: np.ndarray
+    through_mean: np.ndarray
+    below: np.ndarray
+
+
+@dataclass(frozen=True, eq=False)
+class SlabTables:
+    """Made-up skin at every thickness (module docstring), at the baked ``absorption`` (3,).
+
+    ``thickness_um`` (K,): the axis (:func:`thickness_nodes`).  Angular grid of its own,
+    ``theta_deg`` (n_theta,) and ``phi_deg`` (n_phi,), laid out as ``theta_spacing``,
+    ``theta_offset`` and ``phi_spacing`` say (the closed forms of
+    :mod:`lut_baker.tables.table_set`).  ``top`` (K, n_theta, n_theta, n_phi, 3) 1/sr;
+    ``top_albedo``, ``through`` (K, n_theta, 3); ``through_mean``, ``below`` (K, 3)."""
+
+    thickness_um: np.ndarray
+    theta_deg: np.ndarray
+    phi_deg: np.ndarray
+    top: np.ndarray
+    top_albedo: np.ndarray
+    through: np.ndarray
+    through_mean: np.ndarray
+    below: np.ndarray
+    absorption: np.ndarray
+    theta_spacing: str = "grazing"
+    theta_offset: float = THETA_OFFSET
+    phi_spacing: str = "half_vector"
+
+    def __post_init__(self) -> None:
+        k, n, p = self.thickness_um.size, self.theta_deg.size, self.phi_deg.size
+        shapes = {"top": (k, n, n, p, 3), "top_albedo": (k, n, 3), "through": (k, n, 3),
+                  "through_mean": (k, 3), "below": (k, 3), "absorption": (3,)}
+        for name, shape in shapes.items():
+            if np.shape(getattr(self, name)) != shape:
+                raise ValueError(f"slab table {name!r} must have shape {shape}, "
+                                 f"got {np.shape(getattr(self, name))}")
+        expected = thickness_nodes(k, float(self.thickness_um[0]),
+                                   float(self.thickness_um[-2]))
+        if not np.allclose(self.thickness_um, expected, rtol=1e-12):
+            raise ValueError("thickness_um does not follow its closed form (thickness_nodes)")
+
+    def thickness_index(self, thickness_um: ArrayLike) -> NDArray[np.float64]:
+        """Fractional index on the axis (clamped)."""
+        return thickness_index(thickness_um, self.thickness_um.size,
+                               float(self.thickness_um[0]), float(self.thickness_um[-2]))
+
+    def theta_index(self, theta_deg: ArrayLike) -> NDArray[np.float64]:
+        """Fractional index of polar angles (degrees) on the angular grid, unclamped."""
+        return theta_index(theta_deg, self.theta_deg.size, self.theta_spacing,
+                           float(self.theta_deg[-1]), self.theta_offset)
+
+    def _along(self, table: np.ndarray, thickness_um: float) -> np.ndarray:
+        """``table[k, ...]`` interpolated linearly at one thickness."""
+        return _linear(np.asarray(table), np.asarray(self.thickness_index(thickness_um)))
+
+    def at(self, thickness_um: float, theta_deg: ArrayLike) -> SlabParts:
+        """The 1-D parts at ``thickness_um`` and polar angles ``theta_deg`` (degrees)."""
+        x = self.theta_index(theta_deg)
+        return SlabParts(top_albedo=_linear(self._along(self.top_albedo, thickness_um), x),
+                         through=_linear(self._along(self.through, thickness_um), x),
+                         through_mean=self._along(self.through_mean, thickness_um),
+                         below=self._along(self.below, thickness_um))
+
+    def top_at(self, thickness_um: float, wi: ArrayLike, wo: ArrayLike) -> NDArray[np.float64]:
+        """``top`` (1/sr, ``(..., 3)``) at one thickness and unit directions ``(..., 3)``."""
+        to_light, to_view = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
+        return _trilinear(self._along(self.top, thickness_um),
+                          self.theta_index(polar_angle_deg(to_light)),
+                          self.theta_index(polar_angle_deg(to_view)),
+                          phi_index(to_light, to_view, self.phi_deg.size, self.phi_spacing))
+
+
+def _slab(tables: Tables) -> SlabTables:
+    slab = getattr(tables, "slab", None)
+    if not isinstance(slab, SlabTables):
+        raise ValueError("these tables hold the paper's film only: bake with a film thickness "
+                         "(bake(..., film=thickness_um)) for the slab's tables")
+    return slab
+
+
+def _thickness(tables: Tables, thickness_um: float | None) -> float:
+    if thickness_um is not None:
+        return float(thickness_um)
+    value = tables.parameters.get("film_thickness_um")
+    if value is None:
+        raise ValueError("no thickness given and none baked")
+    return float(value)
+
+
+def _albedo(tables: Tables, skin_albedo: ArrayLike | None) -> NDArray[np.float64]:
+    if skin_albedo is None:
+        return np.pi * np.asarray(tables.skin_diffuse, float)
+    return np.broadcast_to(np.asarray(skin_albedo, float), (3,))
+
+
+def slab_reflection(tables: Tables, wi: ArrayLike, wo: ArrayLike,
+                    thickness_um: float | None = None, skin_albedo: ArrayLike | None = None,
+                    coverage: float = 1.0) -> NDArray[np.float64]:
+    """Made-up skin's BRDF (1/sr, ``(..., 3)``) from the tables at ``thickness_um`` (default
+    the baked one) on skin of diffuse albedo ``skin_albedo`` (default the baked skin's
+    ``pi P_d``), mixed by area with the bare skin at ``coverage``; 0 below the surface."""
+    slab = _slab(tables)
+    h = _thickness(tables, thickness_um)
+    a = _albedo(tables, skin_albedo)
+    to_light, to_view = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
+    parts_i = slab.at(h, polar_angle_deg(to_light))
+    t_o = _linear(slab._along(slab.through, h), slab.theta_index(polar_angle_deg(to_view)))
+    diffuse = a / (np.pi * (1.0 - a * parts_i.below)) * parts_i.through * t_o
+    covered = (tables.surface_gloss("film_gloss", to_light, to_view)
+               + slab.top_at(h, to_light, to_view) + diffuse)
+    bare = tables.surface_gloss("skin_gloss", to_light, to_view) + a / np.pi
+    value = coverage * covered + (1.0 - coverage) * bare
+    upper = (to_light[..., 2] >= 0.0) & (to_view[..., 2] >= 0.0)
+    return np.where(upper[..., None], value, 0.0)
+
+
+def slab_directional_albedo(tables: Tables, theta_deg: ArrayLike,
+                            thickness_um: float | None = None,
+                            skin_albedo: ArrayLike | None = None,
+                            coverage: float = 1.0) -> NDArray[np.float64]:
+    """``Int f cos(theta_o) dwo`` at incidences ``theta_deg`` from the tables' 1-D parts,
+    ``(..., 3)``: the film's gloss albedo, ``top``'s, ``a t(theta) t_mean / (1 - a c)``; the
+    bare skin's by ``1 - coverage``."""
+    slab = _slab(tables)
+    h = _thickness(tables, thickness_um)
+    a = _albedo(tables, skin_albedo)
+    parts = slab.at(h, theta_deg)
+    covered = (tables.directional("film_gloss_albedo", theta_deg) + parts.top_albedo
+               + a * parts.through * parts.through_mean / (1.0 - a * parts.below))
+    bare = tables.directional("skin_gloss_albedo", theta_deg) + a
+    return coverage * covered + (1.0 - coverage) * bare
+
+
+def slab_colour(tables: Tables, thickness_um: float | None = None,
+                skin_albedo: ArrayLike | None = None,
+                coverage: float = 1.0) -> NDArray[np.float64]:
+    """The colour under uniform white light ``(3,)``: :func:`slab_directional_albedo`
+    averaged over incidence (:func:`lut_baker.model.albedo.bihemispherical`)."""
+    return bihemispherical(lambda theta: slab_directional_albedo(
+        tables, theta, thickness_um, skin_albedo, coverage))

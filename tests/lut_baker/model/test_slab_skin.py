@@ -1,0 +1,132 @@
+"""Made-up skin at a thickness in closed form (lut_baker.model.slab_skin; docs/model.md, "Made-up
+skin at a thickness"): the split into an albedo-free part and a rank-one diffuse part is the
+adding equation exactly, the white furnace holds at every thickness and incidence, and Match
+Skin matches the docs' three skins at sheer, default and full thickness."""
+
+import numpy as np
+import pytest
+
+from lut_baker.model import film_slab as FS
+from lut_baker.model import presets
+from lut_baker.model import slab_skin as SS
+from lut_baker.model.albedo import bihemispherical, reflection_albedo
+from lut_baker.model.layers import ReflectionLayer
+from lut_baker.numerics import adding_doubling as AD
+from lut_baker.numerics.quadrature import hemisphere_panels
+
+GRID = hemisphere_panels(3, 10, 33)  # the bake's default quadrature
+THICKNESSES_UM = (0.5, 2.0, FS.DEFAULT_THICKNESS_UM, 50.0, 150.0, 1500.0)
+SHEER_UM, FULL_UM = 2.0, 50.0
+
+# The skins of docs/addon.md, "Match Skin": the artist's render under uniform light, and the
+# foundation each was matched with.
+SKINS = {
+    "medium": ((0.661, 0.346, 0.243), "paper_natural"),
+    "darker": ((0.299, 0.151, 0.103), "clarins_103"),
+    "lighter": ((0.791, 0.478, 0.369), "paper_natural"),
+}
+
+
+@pytest.fixture(scope="module")
+def paper():
+    return presets.paper()
+
+
+def bare_gloss(skin: ReflectionLayer) -> float:
+    """The skin's gloss albedo under uniform light (the bare skin is it plus its albedo)."""
+    return float(bihemispherical(lambda t: reflection_albedo(t, skin.scaled(P_d=0.0))))
+
+
+@pytest.mark.parametrize("um", THICKNESSES_UM + (np.inf,))
+def test_the_closed_form_is_the_adding_equation(paper, um):
+    """top + a / (1 - a c) v v^T against film_slab.made_up_matrices (surface, body, skin with
+    gloss and diffuse part, every inter-reflection): equal to rounding, every order."""
+    film = SS.foundation_slab(paper.film, paper.film_transmission, GRID, [0.1, 0.3, 0.6])
+    skin = presets.skin_layers("jensen_skin1")[0]
+    face = FS.face_albedo(paper.film, GRID)
+    x = np.inf if np.isinf(um) else FS.relative_thickness(um)
+    parts = SS.slab_skin_parts(film, x, skin, face)
+    albedo = np.pi * np.asarray(skin.P_d)
+    exact = FS.made_up_matrices(film, FS.relative_thickness(1e9) if np.isinf(um) else x, skin,
+                                face)
+    assert np.allclose(SS.parts_matrices(parts, albedo, GRID), exact, rtol=0.0, atol=1e-14)
+    assert np.allclose(SS.parts_albedo(parts, albedo, GRID),
+                       FS.made_up_albedo(film, FS.relative_thickness(1e9) if np.isinf(um)
+                                         else x, skin, face), rtol=1e-12, atol=1e-14)
+
+
+def test_without_skin_gloss_the_parts_are_the_films_transmittance_and_reflectance(paper):
+    """A Lambertian skin under any layer: t is the film's directional transmittance, c its
+    hemispherical reflectance from below."""
+    film = SS.foundation_slab(paper.film, paper.film_transmission, GRID)
+    matte = ReflectionLayer(P_d=0.2, P_s=0.0, n=0.05, eta=1.3)
+    x = FS.relative_thickness(FS.DEFAULT_THICKNESS_UM)
+    parts = SS.slab_skin_parts(film, x, matte)
+    layer = SS._film_layer(film, x, film.measured_face)
+    scale0 = AD.star_scale(GRID)[0]
+    transmittance = AD.star_albedo(layer.down[:, 0], scale0)
+    assert np.allclose(parts.through, transmittance, rtol=1e-12)
+    below = FS.bihemispherical_on_grid(AD.star_albedo(layer.bottom[:, 0], scale0), GRID)
+    assert np.allclose(parts.below, below, rtol=1e-12)
+
+
+@pytest.mark.parametrize("um", THICKNESSES_UM + (np.inf,))
+def test_white_furnace_at_every_thickness_and_incidence(paper, um):
+    """No absorption, over a white skin (albedo 1), every inter-reflection in: at most 1 at
+    every incidence, and no more than the light the film's gloss and body keep back lost."""
+    film = SS.foundation_slab(paper.film, paper.film_transmission, GRID)
+    white = ReflectionLayer(P_d=1.0 / np.pi, P_s=0.0, n=0.05, eta=1.3)
+    parts = SS.slab_skin_parts(film, np.inf if np.isinf(um) else FS.relative_thickness(um),
+                               white)
+    albedo = SS.parts_albedo(parts, 1.0, GRID)
+    assert np.max(albedo) <= 1.0 + 1e-9
+    assert np.min(albedo) > 0.7
+
+
+def test_a_matte_film_the_skins_colour_looks_the_same_at_every_thickness():
+    """Kubelka-Munk's fact, which the slab keeps: a film without surface gloss whose thick
+    limit has the skin's colour leaves it unchanged at every thickness (the darker skin's
+    shade under the matte Clarins 103 is the same from 2 to 50 um)."""
+    target, foundation = SKINS["darker"]
+    film = presets.foundation_film(foundation)
+    paper = presets.paper()
+    skin = paper.skin_reflection
+    albedo = np.array(target) - bare_gloss(skin)
+    shades = [SS.matching_absorption(target, film, paper.film_transmission, skin, albedo, um,
+                                     GRID)[0] for um in (SHEER_UM, FULL_UM)]
+    assert np.allclose(shades[0], shades[1], atol=0.01)
+
+
+@pytest.mark.parametrize("name", list(SKINS))
+def test_match_skin_at_sheer_default_and_full(name, paper):
+    """Every skin of the docs' set within 3% per channel under uniform light at 2, 9.6 and
+    50 um (exact evaluation; the skin under the film: the paper's skin gloss and the albedo
+    that gives the bare skin the target).  The shade is the foundation's absorption; only
+    where a sheer glossy film stays too light at full absorption is the skin under it darkened
+    (the medium skin's green and blue, the lighter skin's blue at 2 um)."""
+    target, foundation = SKINS[name]
+    film = presets.foundation_film(foundation)
+    skin = paper.skin_reflection
+    albedo = np.array(target) - bare_gloss(skin)
+    for um in (SHEER_UM, FS.DEFAULT_THICKNESS_UM, FULL_UM):
+        absorption, under, clamped = SS.matching_shade(target, film, paper.film_transmission,
+                                                       skin, albedo, um, GRID)
+        colour = SS.slab_colour(film, paper.film_transmission, skin, under, um, GRID,
+                                absorption)
+        assert np.all(np.abs(colour / np.array(target) - 1.0) < 0.03), (name, um, colour)
+        assert not clamped.any()
+        if um > SHEER_UM:
+            assert np.array_equal(under, albedo)  # the absorption alone matches
+        assert np.all(under <= albedo)
+
+
+def test_matching_skin_albedo_round_trips(paper):
+    film = SS.foundation_slab(paper.film, paper.film_transmission, GRID, [0.2, 0.4, 0.6],
+                              orders=1)
+    parts = SS.slab_skin_parts(film, FS.relative_thickness(20.0), paper.skin_reflection)
+    albedo = np.array([0.7, 0.4, 0.2])
+    colour = SS.parts_colour(parts, albedo, GRID)
+    solved, clamped = SS.matching_skin_albedo(parts, colour, GRID)
+    assert np.allclose(solved, albedo, rtol=1e-12) and not clamped.any()
+    solved, clamped = SS.matching_skin_albedo(parts, [0.0, 2.0, colour[2]], GRID)
+    assert list(solved[:2]) == [0.0, 1.0] and list(clamped) == [True, True, False]
