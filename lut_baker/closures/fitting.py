@@ -311,8 +311,7 @@ def fit_closures(tables: Tables, *, tiers=TIERS, over_shader: bool = False,
     else:
         report(0.75, "fitting the subsurface profile")
         fit = ClosureFit(
-            transmittance_mean=_cosine_mean(np.asarray(tables.film_transmittance, float),
-                                            targets.theta_deg),
+            transmittance_mean=tables.film_transmittance_mean,
             film_albedo=np.pi * np.asarray(tables.film_diffuse, float),
             skin_albedo=np.pi * np.asarray(tables.skin_diffuse, float),
             **_subsurface(tables, subsurface_method, over_shader), **parts)

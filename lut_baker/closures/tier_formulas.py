@@ -28,7 +28,7 @@ from typing import Any, Protocol
 
 import numpy as np
 
-from ..model.made_up_skin import combine, coverage_weights
+from ..model.made_up_skin import combine, coverage_weights, mix_slots
 from .view_image import sample_lut
 
 __all__ = ["Algebra", "NumpyAlgebra", "TierInputs", "Closure", "ViewWeightedClosures",
@@ -126,8 +126,10 @@ def principled_sockets(fit, x: TierInputs, ops: Algebra) -> dict:
     linear in ``g`` (exact at both ends)."""
     weights = coverage_weights(x.coverage, x.absorption)
     g = x.gloss
-    skin = combine(weights, twice=x.skin_color * fit.transmittance_mean**2, bare=x.skin_color)
-    total = skin + combine(weights, once=fit.film_albedo, twice=g * fit.gloss_to_diffuse)
+    skin = combine(weights, **mix_slots(through_film=x.skin_color * fit.transmittance_mean**2,
+                                        skin=x.skin_color))
+    total = skin + combine(weights, **mix_slots(film_diffuse=fit.film_albedo,
+                                                path3_gloss=g * fit.gloss_to_diffuse))
     e_spec = combine(weights, top=fit.specular_albedo_mean[1], bare=fit.specular_albedo_mean[0])
     coat = g * weights.covered * fit.coat.level
     base = total / ((1.0 - coat * fit.coat_albedo_mean) * (1.0 - g * e_spec))
