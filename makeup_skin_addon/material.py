@@ -3,7 +3,7 @@ own material (converted in place, :mod:`.convert`); Revert and Check Tables.
 
 A bake is named by its record's key (:func:`.storage.bake_record`: the settings' parameters and
 resolution, hashed; no bake needed to know it) and a group by its tier, key and forced
-subsurface method (:func:`.keys.group_name`).  Apply with settings it has seen before finds the
+subsurface method (:func:`.nodes.group_name`).  Apply with settings it has seen before finds the
 group by name and bakes, fits and hashes nothing; otherwise it bakes and fits once per session
 (:mod:`.fits`).  Tier = Auto decides from what the fit of the foundation being applied measured
 (kept in the group's record), so the same settings in the same scene give the same tier.
@@ -32,8 +32,9 @@ import json
 import bpy
 
 from . import artist_skin, convert, fits, matching, nodes, scene_fit, shade, skin_sampling, storage
-from .core import auto_tier, params_file, tiers
-from .keys import AUTO_KEY, ERRORS_KEY, MATERIAL_NAME, SETTINGS_VERSION, TIER_LABELS, group_name
+from .core import auto_tier, params_file, tier_registry, tiers
+from .keys import AUTO_KEY, ERRORS_KEY, MATERIAL_NAME, SETTINGS_VERSION
+from .nodes import group_name
 from .scene_fit import units_per_mm
 from .shade import ROUGHNESS_MAX, SKIN_ROUGHNESS_MIN, skin_from_settings
 
@@ -93,14 +94,15 @@ def engine_note(material, tier: str, scene, measured: dict | None = None) -> str
     suited = auto_tier.ENGINE_TIERS[engine][0]
     error = ((measured or {}).get("errors") or {}).get(suited, {}).get("rms")
     at = f" ({100 * error:.1f}% angular error here)" if error is not None else ""
-    label, better = TIER_LABELS[tier], TIER_LABELS[suited]
+    label, better, made_for = (*(tier_registry.tier(t).label for t in (tier, suited)),
+                               tier_registry.tier(tier).engines[0])
     if engine == "EEVEE":
         why = ("EEVEE draws every Glossy lobe as GGX through its own approximation, which "
                "the Cycles tiers are not fitted to")
     else:
         why = "Cycles renders its GGX lobes exactly, which they are not fitted to"
     return (f"{material.name!r} uses the {label} tier, made for "
-            f"{'EEVEE' if tier == 'EEVEE' else 'Cycles'}, but the scene renders with "
+            f"{'EEVEE' if made_for == 'EEVEE' else 'Cycles'}, but the scene renders with "
             f"{'EEVEE' if engine == 'EEVEE' else 'Cycles'}: {why}; the {better} tier is "
             f"fitted to {'EEVEE' if engine == 'EEVEE' else 'Cycles'}{at}: choose it, or Tier "
             f"Auto.")
@@ -701,7 +703,7 @@ def check_material(context, material) -> tuple[bool, str]:
     if not problems and nodes.has_interface(group):
         return True, f"{name!r}: intact."
     settings = material.makeup_skin
-    tier = meta.get("tier", "LAYERED")
+    tier = meta.get("tier", tier_registry.UNRECORDED)
     work = _Bake({k: meta[k] for k in ("key", "parameters", "resolution")},
                  meta.get("forced_method"), settings.coverage, settings.effective_absorption(),
                  tiers=fitted_tiers(settings, context.scene, (tier,)),
