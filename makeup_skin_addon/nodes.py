@@ -48,8 +48,7 @@ import json
 import bpy
 import numpy as np
 
-from . import storage
-from . import keys
+from . import keys, storage
 from .core import tier_formulas, tier_registry, view_image
 from .keys import FIT_KEY, LEGACY_TABLES_REF, lut_image_name
 from .node_algebra import Builder, Mismatch, NodeAlgebra, NodeShaders, NodeValue, socket

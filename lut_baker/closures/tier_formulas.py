@@ -311,7 +311,7 @@ def view_weighted_shader(fit: Any, x: TierInputs, ops: ShaderAlgebra,
                          subsurface_weight: Any = None, *, tinted_subsurface: bool = True,
                          film_lobes: Sequence[str] = ("film_gloss",),
                          one_subsurface: bool = False) -> Any:
-    """:func:`view_weighted_closures` :func:`assemble`\ d; over the artist's shader (a
+    r""":func:`view_weighted_closures` :func:`assemble`\ d; over the artist's shader (a
     ``subsurface_weight``) the bare side is theirs, so nothing is shared with it."""
     return assemble(view_weighted_closures(
         fit, x, ops, tinted_subsurface=tinted_subsurface, film_lobes=film_lobes,

@@ -31,7 +31,7 @@ from .lobes import (
     fit_specular,
 )
 from .tier_formulas import SPECULAR_IOR
-from .view_grid import FIT_VIEWS, ViewGrid, lobe_widths_deg, view_grid
+from .view_grid import FIT_VIEWS, lobe_widths_deg, view_grid
 from .view_image import EEVEE_LUT_ROWS, LUT_ROWS, lut_nodes
 
 __all__ = ["FitTargets", "principled_parts", "layered_parts", "eevee_parts"]

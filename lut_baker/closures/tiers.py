@@ -138,7 +138,9 @@ def tier_replica(fit: ClosureFit, tables: Tables, name: str | Tier, coverage: fl
     image = found.image(fit)
     rows = {} if image is None else dict(zip(image.rows, image.lut, strict=True))
     ops = NumpyShaders(wi, wo, rows, found.lobes(fit), found.glossy)
-    return np.asarray(found.shader(fit, _inputs(fit, coverage, absorption, gloss), ops, None))
+    value = np.asarray(found.shader(fit, _inputs(fit, coverage, absorption, gloss), ops, None))
+    shape = np.broadcast_shapes(wi.shape, wo.shape)[:-1] + (3,)
+    return value if value.shape == shape else np.broadcast_to(value, shape).copy()
 
 
 def tier_reflection(fit: ClosureFit, tables: Tables, name: str, coverage: float,
