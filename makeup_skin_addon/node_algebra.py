@@ -113,6 +113,7 @@ class Builder:
         if isinstance(value, bpy.types.NodeSocket):
             self.link(value, target)
             return
+        new: float | tuple[float, ...]
         if target.type in ("VECTOR", "RGBA") and np.size(value) == 1:
             n = len(target.default_value)
             new = (float(np.ravel(value)[0]),) * n

@@ -127,7 +127,10 @@ def principled_parts(targets: FitTargets, over_shader: bool) -> dict:
     film_grid, film_gloss = targets.target("film_gloss")
     skin_grid, path3 = targets.target("path3_gloss")
     coat = fit_coat(film_grid, film_gloss)
-    e_coat = cc.coat_view_terms(skin_grid.cos_view, coat.roughness, coat.ior)[1]
+    coat_ior = coat.ior
+    if coat_ior is None:
+        raise AssertionError("fit_coat gives an IOR")
+    e_coat = cc.coat_view_terms(skin_grid.cos_view, coat.roughness, coat_ior)[1]
     specular_film = fit_specular(skin_grid, path3, attenuation=1.0 - e_coat)
     if over_shader:
         specular_bare = LobeFit(roughness=specular_film.roughness, ior=SPECULAR_IOR,
@@ -140,9 +143,6 @@ def principled_parts(targets: FitTargets, over_shader: bool) -> dict:
             specular_film = replace(specular_film, roughness=specular_bare.roughness)
         elif specular_bare.level == 0.0:
             specular_bare = replace(specular_bare, roughness=specular_film.roughness)
-    coat_ior = coat.ior
-    if coat_ior is None:
-        raise AssertionError("fit_coat gives an IOR")
 
     def specular_mean(lobe):
         if lobe.level == 0.0:
