@@ -272,10 +272,10 @@ class NodeAlgebra:
             return np.floor(np.asarray(a, float))
         return a._op("FLOOR", a, 0.0)
 
-    def lerp(self, t, a, b):
+    def lerp(self, t, a, b, label: str = ""):
         """``a + t (b - a)`` of two colours (a Mix node, factor unclamped)."""
         return NodeValue(self.build, self.build.mix_vector(value_of(t), value_of(a),
-                                                           value_of(b)), True)
+                                                           value_of(b), label=label), True)
 
     def channel_mean(self, colour):
         if not isinstance(colour, NodeValue):

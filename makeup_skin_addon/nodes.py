@@ -256,7 +256,7 @@ def _lut_rows(build: Builder, lut, names: tuple, coordinates: dict, bounds) -> d
             build.link(coordinate.outputs[0], texture.inputs["Vector"])
             return NodeValue(build, texture.outputs["Color"], True)
 
-        value = algebra.lerp(weight, texel(u0, 0), texel(u1, 1))
+        value = algebra.lerp(weight, texel(u0, 0), texel(u1, 1), label=f"row {name}")
         rows[name] = NodeValue(build, build.vector(
             "MINIMUM", build.vector("MAXIMUM", value.socket, (0.0, 0.0, 0.0)),
             tuple(map(float, bounds[j])), label=f"row {name} (bounded)"), True)
