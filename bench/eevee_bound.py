@@ -59,10 +59,10 @@ def measure_case(foundation: str, coverage: float) -> list[dict]:
     reflections = {
         "eevee_bound": bound_reflection(bounds["EEVEE"]),
         "cycles_bound": bound_reflection(bounds["CYCLES"]),
-        "eevee_tier": lambda wi, wo: tiers.eevee_tier_reflection(fit, high, w, a,
-                                                                 directions=(wi, wo)),
-        "layered_tier": lambda wi, wo: tiers.layered_tier_reflection(fit, high, w, a,
-                                                                     directions=(wi, wo)),
+        "eevee_tier": lambda wi, wo: tiers.tier_replica(fit, high, "EEVEE", w, a,
+                                                        directions=(wi, wo)),
+        "layered_tier": lambda wi, wo: tiers.tier_replica(fit, high, "LAYERED", w, a,
+                                                          directions=(wi, wo)),
     }
     rows = []
     for light in LIGHTS_DEG:

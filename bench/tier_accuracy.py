@@ -8,7 +8,7 @@ benchmark, not a test).
 For each foundation of the checkout's ``lut_baker.model.presets.FOUNDATIONS`` on the skin
 ``paper_bioplate``: bake and fit as Apply does (``bake(made_up_skin(foundation, skin, coverage=1,
 absorption=0), "default")``, ``fit_closures(tables)``), then compare each tier's BRDF replica
-(``closures.tiers.TIER_REPLICAS[tier](fit, tables, coverage, absorption, 1, directions)``) with
+(``closures.tiers.tier_replica(fit, tables, tier, coverage, absorption, 1, directions)``) with
 the exact made-up skin (``evaluate.made_up.made_up_reflection`` of ``made_up_skin(foundation,
 skin, coverage=w, absorption=the preset's)``) at coverages 1 and 0.5.
 
@@ -358,10 +358,17 @@ def narrowest_lobe_deg(skin) -> float:
 
 def _tier_errors(fit, tables, coverage, absorption, pairs, exact, albedo_pairs,
                  albedo_exact) -> dict:
-    from lut_baker.closures.fitting import TIER_REPLICAS
+    try:  # a checkout with the tier registry
+        from lut_baker.closures.tiers import TIERS, tier_replica
+
+        replicas = {tier: (lambda fit, tables, *rest, tier=tier, **options:
+                           tier_replica(fit, tables, tier, *rest, **options))
+                    for tier in TIERS}
+    except ImportError:  # an older one
+        from lut_baker.closures.fitting import TIER_REPLICAS as replicas
 
     out = {}
-    for tier, replica in TIER_REPLICAS.items():
+    for tier, replica in replicas.items():
         f = replica(fit, tables, coverage, absorption, 1.0, directions=(pairs["wi"], pairs["wo"]))
         swapped = replica(fit, tables, coverage, absorption, 1.0,
                           directions=(albedo_pairs["wo"], albedo_pairs["wi"]))

@@ -48,8 +48,8 @@ from . import (
     tier_choice,
 )
 from .bakes import Bake
-from .core import auto_tier
-from .keys import MATERIAL_NAME, SETTINGS_VERSION, TIER_LABELS
+from .core import auto_tier, tier_registry
+from .keys import MATERIAL_NAME, SETTINGS_VERSION
 from .progress import Progress, progress_bar
 
 __all__ = [
@@ -288,14 +288,15 @@ def engine_note(material: Any, tier: str, scene: Any, measured: dict | None = No
     suited = auto_tier.ENGINE_TIERS[engine][0]
     error = ((measured or {}).get("errors") or {}).get(suited, {}).get("rms")
     at = f" ({100 * error:.1f}% angular error here)" if error is not None else ""
-    label, better = TIER_LABELS[tier], TIER_LABELS[suited]
+    label, better, made_for = (*(tier_registry.tier(t).label for t in (tier, suited)),
+                               tier_registry.tier(tier).engines[0])
     if engine == "EEVEE":
         why = ("EEVEE draws every Glossy lobe as GGX through its own approximation, which "
                "the Cycles tiers are not fitted to")
     else:
         why = "Cycles renders its GGX lobes exactly, which they are not fitted to"
     return (f"{material.name!r} uses the {label} tier, made for "
-            f"{'EEVEE' if tier == 'EEVEE' else 'Cycles'}, but the scene renders with "
+            f"{'EEVEE' if made_for == 'EEVEE' else 'Cycles'}, but the scene renders with "
             f"{'EEVEE' if engine == 'EEVEE' else 'Cycles'}: {why}; the {better} tier is "
             f"fitted to {'EEVEE' if engine == 'EEVEE' else 'Cycles'}{at}: choose it, or Tier "
             f"Auto.")
@@ -350,7 +351,7 @@ def check_material(context: Any, material: Any) -> tuple[bool, str]:
     if not problems and nodes.has_interface(group):
         return True, f"{name!r}: intact."
     settings = material.makeup_skin
-    tier = meta.get("tier", "LAYERED")
+    tier = meta.get("tier", tier_registry.UNRECORDED)
     work = Bake({k: meta[k] for k in ("key", "parameters", "resolution")},
                 meta.get("forced_method"), settings.coverage, settings.absorption,
                 tiers=tier_choice.fitted_tiers(settings, context.scene, (tier,)),

@@ -19,6 +19,7 @@ if INSTALLED:
         principled_albedo,
         profiles,
         tier_formulas,
+        tier_registry,
         tiers,
         view_image,
     )
@@ -33,6 +34,7 @@ else:
         principled_albedo,
         profiles,
         tier_formulas,
+        tier_registry,
         tiers,
         view_image,
     )
@@ -42,4 +44,4 @@ else:
 
 __all__ = ["auto_tier", "bake", "cache", "closure_fit", "codec", "fitting", "params_file",
            "presets", "principled_albedo", "profiles", "roughness", "table_set", "thick_layer",
-           "tier_formulas", "tiers", "uniform_light", "view_image"]
+           "tier_formulas", "tier_registry", "tiers", "uniform_light", "view_image"]

@@ -2,7 +2,7 @@
 bake's fit; and made a material's surface, its sockets set from the settings.
 
 A group is named by its tier, its bake's key, the forced subsurface method and its kind (over
-the artist's shader or not, :func:`.keys.group_name`).  A group of that name built by this
+the artist's shader or not, :func:`.nodes.group_name`).  A group of that name built by this
 version, whose images are intact, is reused: nothing is baked, fitted or hashed.  Otherwise
 the :class:`.bakes.Bake` is asked for its fit (baked and fitted once per session) and the group
 is built (:func:`.nodes.build_group`), in place of one of the same name.  Tier Auto decides
@@ -28,7 +28,8 @@ import bpy
 from . import bakes, convert, nodes, storage, tier_choice
 from .bakes import Bake
 from .core import params_file, table_set, tiers
-from .keys import AUTO_KEY, ERRORS_KEY, group_name
+from .keys import AUTO_KEY, ERRORS_KEY
+from .nodes import group_name
 
 __all__ = ["group_for", "build", "has_group", "group_for_tables", "group_of", "setup_material",
            "socket_values", "update_sockets", "record_measurement"]

@@ -45,7 +45,7 @@ group"; Apply finds groups and images by name and reuses them):
   the film's nodes, copies of nodes from the artist's groups, the film's normal): Revert
   removes exactly these; :data:`SKIN_FRAME_NAME`, :data:`SKIN_FRAME_LABEL` -- their frame.
 - :func:`group_name` -- ``Made-up Skin <Tier> [<method>] <key>`` (:data:`GROUP_PREFIX`,
-  :data:`TIER_LABELS`, :data:`METHOD_LABELS`).
+  the tier's label, :data:`METHOD_LABELS`).
 - :func:`lut_image_name` -- ``MakeupSkin LUT <Tier> <key>`` (:data:`LUT_PREFIX`).
 """
 
@@ -76,7 +76,6 @@ __all__ = [
     "SKIN_FRAME_LABEL",
     "OVER_LABEL",
     "GROUP_PREFIX",
-    "TIER_LABELS",
     "METHOD_LABELS",
     "LUT_PREFIX",
     "group_name",
@@ -150,8 +149,6 @@ SKIN_FRAME_LABEL = "Made-up Skin: the skin under the film (from the shader)"
 """Label of that frame."""
 GROUP_PREFIX = "Made-up Skin"
 """Start of every node group name (:func:`group_name`)."""
-TIER_LABELS = {"PRINCIPLED": "Principled", "LAYERED": "Layered", "EEVEE": "EEVEE"}
-"""A tier's part of group and image names."""
 METHOD_LABELS = {"BURLEY": "Burley", "RANDOM_WALK": "RW", "RANDOM_WALK_SKIN": "RW Skin"}
 """A forced subsurface method's part of a group name."""
 LUT_PREFIX = "MakeupSkin LUT "
@@ -163,15 +160,16 @@ OVER_LABEL = "over Shader"
 its Skin Shader input), not over the skin preset's closures."""
 
 
-def group_name(tier: str, key: str, method: str | None = None, over_shader: bool = False) -> str:
-    """``Made-up Skin <Tier> [<method>] [over Shader] <key>``; no method: the fit's own
+def group_name(tier_label: str, key: str, method: str | None = None,
+               over_shader: bool = False) -> str:
+    """``Made-up Skin <Tier> [<method>] [over Shader] <key>`` (``tier_label``: the tier's
+    label, :attr:`lut_baker.closures.tier_registry.Tier.label`); no method: the fit's own
     choice; ``over_shader``: a group whose bare skin is the artist's shader."""
     label = f" {METHOD_LABELS[method]}" if method else ""
     over = f" {OVER_LABEL}" if over_shader else ""
-    return f"{GROUP_PREFIX} {TIER_LABELS[tier]}{label}{over} {key[:8]}"
+    return f"{GROUP_PREFIX} {tier_label}{label}{over} {key[:8]}"
 
 
-def lut_image_name(key: str, tier: str = "LAYERED") -> str:
-    """``MakeupSkin LUT <Tier> <key>``: the name of a tier's view-angle image (Layered,
-    EEVEE)."""
-    return f"{LUT_PREFIX}{TIER_LABELS[tier]} {key[:16]}"
+def lut_image_name(key: str, tier_label: str) -> str:
+    """``MakeupSkin LUT <Tier> <key>``: the name of a tier's view-angle image."""
+    return f"{LUT_PREFIX}{tier_label} {key[:16]}"

@@ -10,7 +10,9 @@ Math and Vector Math nodes.
   Scalars are float sockets (Math nodes), colours vector sockets (Vector Math nodes); a scalar
   meeting a colour is linked into the vector input, where Blender reads it as grey.
 - :class:`NodeAlgebra` -- the tier formulas' algebra on :class:`NodeValue`: ``maximum``,
-  ``minimum``, ``channel_mean``, ``channel_max``, ``row``.
+  ``minimum``, ``floor``, ``lerp``, ``channel_mean``, ``channel_max``, ``row``.
+- :class:`NodeShaders` -- the tier formulas' shader algebra on nodes: a closure, a Principled
+  BSDF, their sum (Add Shader) and the areal mix by coverage (Mix Shader).
 """
 
 from __future__ import annotations
@@ -18,7 +20,8 @@ from __future__ import annotations
 import bpy
 import numpy as np
 
-__all__ = ["Builder", "Mismatch", "NodeValue", "NodeAlgebra", "socket", "value_of"]
+__all__ = ["Builder", "Mismatch", "NodeValue", "NodeAlgebra", "NodeShaders", "socket",
+           "value_of"]
 
 
 def socket(sockets, identifier: str):
@@ -110,6 +113,7 @@ class Builder:
         if isinstance(value, bpy.types.NodeSocket):
             self.link(value, target)
             return
+        new: float | tuple[float, ...]
         if target.type in ("VECTOR", "RGBA") and np.size(value) == 1:
             n = len(target.default_value)
             new = (float(np.ravel(value)[0]),) * n
@@ -263,6 +267,16 @@ class NodeAlgebra:
     def minimum(self, a, b):
         return self._either("MINIMUM", a, b, np.minimum)
 
+    def floor(self, a):
+        if not isinstance(a, NodeValue):
+            return np.floor(np.asarray(a, float))
+        return a._op("FLOOR", a, 0.0)
+
+    def lerp(self, t, a, b, label: str = ""):
+        """``a + t (b - a)`` of two colours (a Mix node, factor unclamped)."""
+        return NodeValue(self.build, self.build.mix_vector(value_of(t), value_of(a),
+                                                           value_of(b), label=label), True)
+
     def channel_mean(self, colour):
         if not isinstance(colour, NodeValue):
             return float(np.mean(np.asarray(colour, float) * np.ones(3)))
@@ -287,3 +301,71 @@ class NodeAlgebra:
 
     def row(self, name: str):
         return self._rows[name]
+
+
+class NodeShaders(NodeAlgebra):
+    """The shader algebra of :mod:`lut_baker.closures.tier_formulas` on nodes: a closure is a
+    Glossy (its lobe of ``lobes``), Diffuse or Subsurface BSDF node (``subsurface``: its
+    ``(method, radius, scale, ior)``), through a Mix Shader when it has a weight; its normal
+    ``normals[surface]``; a Principled BSDF (GGX) takes the sockets of
+    :func:`~lut_baker.closures.tier_formulas.principled_sockets`, the subsurface's and the
+    normals (Coat Normal the film's).  A colour of 0 (Gloss 0) is a closure Cycles does not
+    allocate (``bsdf_alloc``'s cutoff)."""
+
+    def __init__(self, build: Builder, rows: dict, *, lobes: dict, normals: dict,
+                 subsurface: tuple):
+        super().__init__(build, rows)
+        self.lobes, self.normals, self.subsurface = lobes, normals, subsurface
+
+    def closure(self, closure):
+        build = self.build
+        method, radius, scale, ior = self.subsurface
+        if closure.kind == "glossy":
+            lobe = self.lobes[closure.name]
+            node = build.node("ShaderNodeBsdfGlossy", closure.name.replace("_", " "),
+                              distribution=lobe.distribution)
+            build.feed(node.inputs["Roughness"], lobe.roughness)
+        elif closure.kind == "diffuse":
+            node = build.node("ShaderNodeBsdfDiffuse", closure.name)
+        else:
+            node = build.node("ShaderNodeSubsurfaceScattering", closure.name, falloff=method)
+            build.feed(socket(node.inputs, "Radius"), radius)
+            build.feed(socket(node.inputs, "Scale"), scale)
+            build.feed(socket(node.inputs, "IOR"), ior)
+        build.feed(socket(node.inputs, "Color"), closure.colour)
+        build.feed(socket(node.inputs, "Normal"), self.normals[closure.surface])
+        if closure.weight is None:
+            return node.outputs[0]
+        weighted = build.node("ShaderNodeMixShader", f"{closure.name} (weight)")
+        build.feed(socket(weighted.inputs, "Fac"), closure.weight)
+        build.link(node.outputs[0], socket(weighted.inputs, "Shader_001"))
+        return weighted.outputs[0]
+
+    def principled(self, sockets: dict):
+        build = self.build
+        method, radius, scale, ior = self.subsurface
+        bsdf = build.node("ShaderNodeBsdfPrincipled", "Made-up skin", distribution="GGX",
+                          subsurface_method=method)
+        values = {**sockets, "Subsurface Radius": radius, "Subsurface Scale": scale,
+                  "Subsurface IOR": ior, "Normal": self.normals["skin"],
+                  "Coat Normal": self.normals["film"]}
+        for name, value in values.items():
+            # By identifier: a socket the method leaves unavailable is not found by name in 5.0.
+            build.feed(socket(bsdf.inputs, name), value)
+        return bsdf.outputs[0]
+
+    def add(self, *shaders):
+        total = shaders[0]
+        for shader in shaders[1:]:
+            node = self.build.node("ShaderNodeAddShader")
+            self.build.link(total, node.inputs[0])
+            self.build.link(shader, node.inputs[1])
+            total = node.outputs[0]
+        return total
+
+    def mix(self, coverage, bare, covered):
+        mix = self.build.node("ShaderNodeMixShader", "coverage (areal mix)")
+        self.build.feed(socket(mix.inputs, "Fac"), coverage)
+        self.build.link(bare, socket(mix.inputs, "Shader"))
+        self.build.link(covered, socket(mix.inputs, "Shader_001"))
+        return mix.outputs[0]

@@ -17,32 +17,24 @@ first-order paths (bare skin, and path 3 through the film) as a factor, and the 
 are per unit albedo, so a texture scales them exactly.  What stays the preset's: the subsurface
 radius (fitted to the skin's profile), the skin's gloss and the film.
 
-Each tier's formulas are :mod:`lut_baker.closures.tier_formulas`, emitted as Math and Vector
-Math nodes by :mod:`.node_algebra`: the group computes exactly what the replicas (and so the
-measured errors and the Auto tier) compute.
-PRINCIPLED: one Principled BSDF (GGX, coat = the film, specular and base/subsurface = the skin),
-its sockets :func:`lut_baker.closures.tier_formulas.principled_sockets` (Gloss scales Coat Weight
-and Specular IOR Level: at 0 ``svm_node_closure_bsdf`` skips the coat, ``coat_weight >
-CLOSURE_WEIGHT_CUTOFF``, and the specular, ``eta != 1``).
-LAYERED: the Glossy, Diffuse and Subsurface closures of
-:func:`lut_baker.closures.tier_formulas.view_weighted_closures` (Gloss scales the three Glossy
-colours: a closure of weight 0 is never allocated, ``bsdf_alloc``), view-dependent factors read
-from one float image (rows :data:`lut_baker.closures.view_image.LUT_ROWS`) at ``u =
-cos(theta_o)``, and a Mix Shader by Coverage between bare skin and made-up skin: an areal mix
-of closures, so a painted coverage fades out without fringe or halo.
-EEVEE: the LAYERED tier's closures and mix, every Glossy BSDF GGX (fitted as EEVEE renders it),
-the film's gloss in two Glossy BSDFs, its own view-angle image (``fit.eevee_lut``, rows
-:data:`lut_baker.closures.view_image.EEVEE_LUT_ROWS`), the skin through the film its plain
-colour, subsurface Christensen-Burley.
+Each tier is a :class:`lut_baker.closures.tier_registry.Tier`: its shader, written over the
+tier formulas' algebra (:mod:`lut_baker.closures.tier_formulas`), is emitted here as nodes
+(:class:`.node_algebra.NodeShaders`: closures, Add and Mix Shaders, Math and Vector Math
+nodes), so the group computes exactly what the replicas (and so the measured errors and the
+Auto tier) compute, and no tier is spelled here.  Gloss scales the gloss closures: at 0 none is
+allocated (a Glossy closure of colour 0, ``bsdf_alloc``; a Principled BSDF's coat and specular,
+``svm_node_closure_bsdf``).  Coverage mixes the two sides as areas (a Mix Shader), so a
+painted coverage fades out without fringe or halo.
 
-The view-angle rows are read by :func:`_lut_rows`: two Closest lookups at neighbouring texel
-centres mixed linearly, which is what a Linear lookup gives in Cycles
-(:func:`lut_baker.closures.view_image.sample_lut`); EEVEE samples a Linear image through mipmaps
-and anisotropic filtering, which mixes the image's rows wherever ``cos(theta_o)`` changes
-quickly across the screen (docs/addon.md, "Why the Layered tier breaks in EEVEE").
+A tier's view-angle rows (:attr:`~lut_baker.closures.tier_registry.Tier.image`) are read by
+:func:`_lut_rows` as :func:`lut_baker.closures.view_image.read_row` reads them: two Closest
+lookups at neighbouring texel centres mixed linearly, which is what a Linear lookup gives in
+Cycles; EEVEE samples a Linear image through mipmaps and anisotropic filtering, which mixes the
+image's rows wherever ``cos(theta_o)`` changes quickly across the screen (docs/addon.md, "Why
+the Layered tier breaks in EEVEE").
 
 - :func:`build_group` -- create or rebuild (in place) a group from a fit and its bake record,
-  named by :func:`.keys.group_name` (tier, tables key, a forced subsurface method); a group
+  named by :func:`group_name` (tier, tables key, a forced subsurface method); a group
   rebuilt with the same structure keeps its nodes, only values and links set anew
   (:class:`.node_algebra.Builder` ``reuse``).
 - :func:`read_meta` -- a group's record (bake, fit summary, image hashes).
@@ -56,12 +48,13 @@ import json
 import bpy
 import numpy as np
 
-from . import storage
-from .core import tier_formulas, tiers
-from .keys import FIT_KEY, LEGACY_TABLES_REF, group_name, lut_image_name
-from .node_algebra import Builder, Mismatch, NodeAlgebra, NodeValue, socket
+from . import keys, storage
+from .core import tier_formulas, tier_registry, view_image
+from .keys import FIT_KEY, LEGACY_TABLES_REF, lut_image_name
+from .node_algebra import Builder, Mismatch, NodeAlgebra, NodeShaders, NodeValue, socket
 
-__all__ = ["INPUTS", "OVER_SHADER_INPUTS", "NORMAL_INPUTS", "build_group", "read_meta",
+__all__ = ["INPUTS", "OVER_SHADER_INPUTS", "NORMAL_INPUTS", "build_group", "group_name",
+           "read_meta",
            "write_measured", "set_inputs", "socket", "has_interface", "over_shader",
            "inputs_of"]
 
@@ -114,6 +107,12 @@ NORMAL_INPUTS = ("Normal", "Film Normal")
 """Vector inputs whose value is hidden: unlinked, a closure's Normal is the shading normal
 (Blender leaves a hidden-value group input unlinked inside the group), and the view-angle
 lookups use the Geometry node's normal instead (:func:`_normal_or_shading`)."""
+
+
+def group_name(tier: str, key: str, method: str | None = None, over: bool = False) -> str:
+    """The name of ``tier``'s group of the tables ``key`` (:func:`.keys.group_name` with the
+    tier's label)."""
+    return keys.group_name(tier_registry.tier(tier).label, key, method, over)
 
 
 def _input_names(group) -> list[str]:
@@ -228,149 +227,63 @@ def _finish(build: Builder, inputs, output, shader, over: bool) -> None:
     build.link(shader, output.inputs["Shader"])
 
 
-def _build_principled(build: Builder, fit, method: str, radius_mm, ior: float, over: bool):
-    """One Principled BSDF whose formula sockets are
-    :func:`lut_baker.closures.tier_formulas.principled_sockets` emitted as nodes (over the
-    artist's shader: the film at full coverage, its subsurface the artist's radius and weight,
-    mixed with the Skin Shader by Coverage)."""
-    inputs, output, x, (radius, scale) = _group_io(build, over)
-    bsdf = build.node("ShaderNodeBsdfPrincipled", "Made-up skin", distribution="GGX",
-                      subsurface_method=method)
-    sockets = tier_formulas.principled_sockets(fit, x, NodeAlgebra(build))
-    if over:
-        sockets["Subsurface Weight"] = sockets["Subsurface Weight"] * NodeValue(
-            build, inputs.outputs["Subsurface Weight"], False)
-    values = {
-        **sockets,
-        "Subsurface Radius": radius if over else tuple(map(float, radius_mm)),
-        "Subsurface Scale": scale, "Subsurface IOR": ior, "Normal": inputs.outputs["Normal"],
-        "Coat Normal": inputs.outputs["Film Normal"],
-    }
-    for name, value in values.items():
-        # By identifier: a socket the method leaves unavailable is not found by name in 5.0.
-        build.feed(socket(bsdf.inputs, name), value)
-    _finish(build, inputs, output, bsdf.outputs[0], over)
-
-
-def _texel_pair(build: Builder, u, size: int, label: str):
-    """``(u0, u1, t)`` for reading a row of ``size`` texels at ``u`` linearly: the texel
-    centres ``(i + 0.5) / size`` around ``u`` (the edge texel twice beyond the centres) and
-    the weight of the second, ``x = clamp(u size - 0.5, 0, size - 1)``, ``i = floor(x)``,
-    ``t = x - i``."""
-    x = build.math("MINIMUM", build.math("MAXIMUM", build.math(
-        "MULTIPLY", u, float(size), label=f"{label}: u size"), 0.5), size - 0.5)
-    x = build.math("SUBTRACT", x, 0.5, label=f"{label}: texel coordinate")
-    index = build.math("FLOOR", x, label=f"{label}: texel")
-    weight = build.math("SUBTRACT", x, index, label=f"{label}: t")
-    u0 = build.math("DIVIDE", build.math("ADD", index, 0.5), float(size))
-    u1 = build.math("DIVIDE", build.math("MINIMUM", build.math("ADD", index, 1.5),
-                                         size - 0.5), float(size))
-    return u0, u1, weight
-
-
-def _lut_rows(build: Builder, lut, names: tuple, coordinates: dict, bounds=None) -> dict:
+def _lut_rows(build: Builder, lut, names: tuple, coordinates: dict, bounds) -> dict:
     """Every row of the view-angle image ``lut`` (rows named ``names``), read at
-    ``u = coordinates[name]`` (a socket per row name) linearly between texel centres and held
-    beyond them, as :func:`lut_baker.closures.view_image.sample_lut` reads it: two Closest
-    lookups mixed, so that EEVEE reads what Cycles does (its Linear filter goes through
-    mipmaps, which mix rows).  The texel pair is built once per coordinate socket.  Colour
-    :class:`NodeValue` by row name."""
+    ``u = coordinates[name]`` (a socket per row name) as
+    :func:`lut_baker.closures.view_image.read_row` reads it: two Closest lookups mixed, so
+    that EEVEE reads what Cycles does (its Linear filter goes through mipmaps, which mix
+    rows).  The texel pair is built once per coordinate socket.  Each row is kept within its
+    range as baked (``bounds``): an image damaged in a file read where the add-on cannot
+    repair it (a render farm) renders wrong, not blown out.  Colour :class:`NodeValue` by row
+    name."""
     size = lut.size[0]
+    algebra = NodeAlgebra(build)
     pairs: dict = {}
     rows = {}
     for j, name in enumerate(names):
         u = coordinates[name]
-        key = u.as_pointer()
-        if key not in pairs:
-            pairs[key] = _texel_pair(build, u, size, name)
-        u0, u1, weight = pairs[key]
-        samples = []
-        for k, at in enumerate((u0, u1)):
+        if u.as_pointer() not in pairs:
+            pairs[u.as_pointer()] = view_image.texel_pair(NodeValue(build, u, False), size,
+                                                          algebra)
+        u0, u1, weight = pairs[u.as_pointer()]
+
+        def texel(at, k, j=j, name=name):
             coordinate = build.node("ShaderNodeCombineXYZ", f"row {name}, texel {k}")
             build.feed(coordinate.inputs["X"], at)
             build.feed(coordinate.inputs["Y"], (j + 0.5) / len(names))
             texture = build.node("ShaderNodeTexImage", name, image=lut,
                                  interpolation="Closest", extension="EXTEND")
             build.link(coordinate.outputs[0], texture.inputs["Vector"])
-            samples.append(texture.outputs["Color"])
-        value = build.mix_vector(weight, samples[0], samples[1], label=f"row {name}")
-        if bounds is not None:
-            # Within the row's own range as baked: an image damaged in a file read where the
-            # add-on cannot repair it (a render farm) renders wrong, not blown out.
-            value = build.vector("MINIMUM", build.vector("MAXIMUM", value, (0.0, 0.0, 0.0)),
-                                 tuple(map(float, bounds[j])), label=f"row {name} (bounded)")
-        rows[name] = NodeValue(build, value, True)
+            return NodeValue(build, texture.outputs["Color"], True)
+
+        value = algebra.lerp(weight, texel(u0, 0), texel(u1, 1), label=f"row {name}")
+        rows[name] = NodeValue(build, build.vector(
+            "MINIMUM", build.vector("MAXIMUM", value.socket, (0.0, 0.0, 0.0)),
+            tuple(map(float, bounds[j])), label=f"row {name} (bounded)"), True)
     return rows
 
 
-def _add(build: Builder, shaders: list):
-    """The sum of shader sockets (Add Shader nodes)."""
-    total = shaders[0]
-    for shader in shaders[1:]:
-        node = build.node("ShaderNodeAddShader")
-        build.link(total, node.inputs[0])
-        build.link(shader, node.inputs[1])
-        total = node.outputs[0]
-    return total
-
-
-def _build_view_weighted(build: Builder, fit, parts, lut, method: str, radius_mm,
-                         ior: float, over: bool):
-    """The closures of :func:`lut_baker.closures.tier_formulas.view_weighted_closures` (the
-    LAYERED and EEVEE tiers: their :class:`lut_baker.closures.tiers.ViewWeightedParts`
-    ``parts``, their view-angle image ``lut``): a
-    Glossy, Diffuse or Subsurface node per closure, its colour and weight emitted as nodes,
-    each side's closures added, the two sides mixed by Coverage (a Mix Shader: an areal mix,
-    so a painted coverage fades out without fringe or halo), the shared closures added to
-    the mix."""
+def _build(build: Builder, tier, fit, image, lut, method: str, radius_mm, ior: float,
+           over: bool) -> None:
+    """``tier``'s shader (:attr:`lut_baker.closures.tier_registry.Tier.shader`) emitted as
+    nodes (:class:`.node_algebra.NodeShaders`): its view-angle ``image`` (or None) read from
+    the image datablock ``lut`` at the view angle against the normal of the surface each row
+    describes; over the artist's shader at full coverage, its subsurface the artist's radius
+    and weight, mixed with the Skin Shader by Coverage (:func:`_finish`)."""
     inputs, output, x, (radius, scale) = _group_io(build, over)
-    geometry = build.node("ShaderNodeNewGeometry")
     normals = {"film": inputs.outputs["Film Normal"], "skin": inputs.outputs["Normal"]}
-    # Each row is read at the view angle against the normal of the surface it describes.
-    cosines = {surface: _cos_view(build, normal, geometry, f"cos theta_o ({surface})")
-               for surface, normal in normals.items()}
-    rows = _lut_rows(build, lut, parts.rows, {
-        name: cosines[tier_formulas.ROW_SURFACE.get(name, "film")] for name in parts.rows},
-        bounds=np.max(np.asarray(parts.lut, float), axis=1))
+    rows = {}
+    if image is not None:
+        geometry = build.node("ShaderNodeNewGeometry")
+        cosines = {surface: _cos_view(build, normal, geometry, f"cos theta_o ({surface})")
+                   for surface, normal in normals.items()}
+        rows = _lut_rows(build, lut, image.rows, {
+            name: cosines[tier_formulas.ROW_SURFACE.get(name, "film")] for name in image.rows},
+            np.max(np.asarray(image.lut, float), axis=1))
+    shaders = NodeShaders(build, rows, lobes=tier.lobes(fit), normals=normals, subsurface=(
+        method, radius if over else tuple(map(float, radius_mm)), scale, ior))
     weight = NodeValue(build, inputs.outputs["Subsurface Weight"], False) if over else None
-    closures = parts.closures(fit, x, NodeAlgebra(build, rows), subsurface_weight=weight)
-    lobes = parts.lobes
-
-    def emit(closure):
-        if closure.kind == "glossy":
-            lobe = lobes[closure.name]
-            node = build.node("ShaderNodeBsdfGlossy", closure.name.replace("_", " "),
-                              distribution=lobe.distribution)
-            build.feed(node.inputs["Roughness"], lobe.roughness)
-        elif closure.kind == "diffuse":
-            node = build.node("ShaderNodeBsdfDiffuse", closure.name)
-        else:
-            node = build.node("ShaderNodeSubsurfaceScattering", closure.name, falloff=method)
-            build.feed(socket(node.inputs, "Radius"),
-                       radius if over else tuple(map(float, radius_mm)))
-            build.feed(socket(node.inputs, "Scale"), scale)
-            build.feed(socket(node.inputs, "IOR"), ior)
-        # A colour of 0 (Gloss 0) is a closure Cycles does not allocate (bsdf_alloc's cutoff).
-        build.feed(socket(node.inputs, "Color"), closure.colour)
-        build.feed(socket(node.inputs, "Normal"), normals[closure.surface])
-        if closure.weight is None:
-            return node.outputs[0]
-        weighted = build.node("ShaderNodeMixShader", f"{closure.name} (weight)")
-        build.feed(socket(weighted.inputs, "Fac"), closure.weight)
-        build.link(node.outputs[0], socket(weighted.inputs, "Shader_001"))
-        return weighted.outputs[0]
-
-    covered = _add(build, [emit(c) for c in closures.covered])
-    if over:
-        _finish(build, inputs, output, covered, over)
-        return
-    mix = build.node("ShaderNodeMixShader", "coverage (areal mix)")
-    build.feed(socket(mix.inputs, "Fac"), closures.coverage)
-    build.link(_add(build, [emit(c) for c in closures.bare]),
-                         socket(mix.inputs, "Shader"))
-    build.link(covered, socket(mix.inputs, "Shader_001"))
-    shaded = _add(build, [mix.outputs[0], *(emit(c) for c in closures.shared)])
-    _finish(build, inputs, output, shaded, over)
+    _finish(build, inputs, output, tier.shader(fit, x, shaders, weight), over)
 
 
 def _emit(group, emit, reuse: bool) -> None:
@@ -400,10 +313,7 @@ def build_group(tier: str, record: dict, fit, group=None, *, method=None, measur
     (:func:`.bakes.measure`), if given.  ``over``: a group over the artist's shader (its
     Skin Shader input is the bare skin, :data:`OVER_SHADER_INPUTS`), else the skin preset's
     made-up skin, bare skin included (:data:`INPUTS`)."""
-    if tier not in tiers.TIERS:
-        raise ValueError(f"tier must be one of {tiers.TIERS}, got {tier!r}")
-    if tier not in fit.tiers:
-        raise ValueError(f"the fit holds no {tier} tier (it has {', '.join(fit.tiers)})")
+    found = tier_registry.held(fit, tier)
     key = record["key"]
     name = group_name(tier, key, method, over)
     if group is None:
@@ -416,22 +326,16 @@ def build_group(tier: str, record: dict, fit, group=None, *, method=None, measur
              and has_interface(group))
     _interface(group, fit.skin_albedo, over)
     forced = method
-    method = method or (tiers.EEVEE_SUBSURFACE_METHOD if tier == "EEVEE"
-                        else fit.subsurface_method)
+    method = method or found.subsurface_method or fit.subsurface_method
     # Over the artist's shader the radius is theirs (a fit for it may have no profiles).
     radius = None if over else fit.profiles[method].radius_mm
-    ior = fit.subsurface_ior
-    images = []
-    if tier == "PRINCIPLED":
-        def emit(build):
-            _build_principled(build, fit, method, radius, ior, over)
-    else:
-        parts = tiers.view_weighted_parts(fit, tier)
-        lut = storage.view_image(lut_image_name(key, tier), parts.lut)
+    image, lut, images = found.image(fit), None, []
+    if image is not None:
+        lut = storage.view_image(lut_image_name(key, found.label), image.lut)
         images.append(storage.image_record(lut))
 
-        def emit(build):
-            _build_view_weighted(build, fit, parts, lut, method, radius, ior, over)
+    def emit(build):
+        _build(build, found, fit, image, lut, method, radius, fit.subsurface_ior, over)
     _emit(group, emit, reuse)
     group[FIT_KEY] = json.dumps({**record, "tier": tier, "forced_method": forced,
                                  "over_shader": over,

@@ -23,25 +23,28 @@ import math
 import bpy
 
 from . import live, shade
-from .core import presets
+from .core import presets, tier_registry
 from .keys import SETTINGS_ATTRIBUTE, SETTINGS_VERSION
 from .shade import FILM_ROUGHNESS_MIN, ROUGHNESS_MAX, SKIN_ROUGHNESS_MIN
 
-__all__ = ["MakeupSkinSettings", "register", "unregister", "TIER_ITEMS", "SUBSURFACE_ITEMS",
+__all__ = ["MakeupSkinSettings", "register", "unregister", "AUTO_TIER", "tier_items",
+           "SUBSURFACE_ITEMS",
            "RESOLUTION_ITEMS", "SETTINGS_VERSION", "ROUGHNESS_MAX", "FILM_ROUGHNESS_MIN",
            "SKIN_ROUGHNESS_MIN"]
 
-TIER_ITEMS = (
-    ("AUTO", "Auto", "The cheapest tier within 2% of the best one's error in this scene (camera, "
-                     "resolution, object size, lights, engine, samples); Fit to Scene also "
-                     "drops the subsurface and gloss the scene does not need"),
-    ("PRINCIPLED", "Principled", "One Principled BSDF: coat = film, subsurface = skin; cheapest, "
-                                 "no images"),
-    ("LAYERED", "Layered", "Glossy, Diffuse and Subsurface closures with view-angle weights "
-                           "from a lookup image; closest to the tables in Cycles"),
-    ("EEVEE", "EEVEE", "The Layered closures fitted as EEVEE renders them (GGX lobes, its "
-                       "own lookup image, Burley subsurface); closest to the tables in EEVEE"),
-)
+AUTO_TIER = ("AUTO", "Auto", "The cheapest tier within 2% of the best one's error in this "
+                             "scene (camera, resolution, object size, lights, engine, "
+                             "samples); Fit to Scene also drops the subsurface and gloss the "
+                             "scene does not need", "NONE", 0)
+"""The Tier setting's first item (stored as 0, as files keep it)."""
+
+
+def tier_items(self=None, context=None) -> list:
+    """The Tier setting's items: Auto, then every registered tier
+    (:mod:`lut_baker.closures.tier_registry`) with its label, description and stored
+    number."""
+    return [AUTO_TIER, *((t.name, t.label, t.description, "NONE", t.number)
+                         for t in map(tier_registry.tier, tier_registry.TIERS))]
 SUBSURFACE_ITEMS = (
     ("AUTO", "Auto", "The method whose shadow-edge blur is closest to the skin's (Burley)"),
     ("BURLEY", "Christensen-Burley", "Burley's profile: Cycles and EEVEE, fitted exactly"),
@@ -283,7 +286,7 @@ class MakeupSkinSettings(bpy.types.PropertyGroup):
         description="Blender subsurface method (its radius is fitted to the skin's profile)",
         update=_update_tables)
     tier: bpy.props.EnumProperty(
-        name="Tier", items=TIER_ITEMS, default="AUTO",
+        name="Tier", items=_cached("tier", tier_items), default=0,
         description="Node group tier (cost against accuracy)", update=_update_tables)
     resolution: bpy.props.EnumProperty(
         name="Bake Resolution", items=RESOLUTION_ITEMS, default="default",

@@ -60,6 +60,7 @@ from .candidates import (
                          NOISE_K,
                          RELATIVE_COST,
                          Candidate,
+                         candidates,
                          noise,
                          relative_cost,
 )
@@ -84,7 +85,8 @@ from .material import (
 from .scene import SceneDescription, pixel_footprint_mm
 
 __all__ = [
-    "Candidate", "CANDIDATES", "EEVEE_CANDIDATES", "FULLEST", "ENGINES", "ENGINE_TIERS",
+    "Candidate", "candidates", "CANDIDATES", "EEVEE_CANDIDATES", "FULLEST", "ENGINES",
+    "ENGINE_TIERS",
     "RELATIVE_COST", "EEVEE_RELATIVE_COST", "NOISE_K", "COST_SKIN_SHARE", "relative_cost",
     "DEFAULT_TOLERANCE", "SceneDescription", "pixel_footprint_mm", "MaterialTraits",
     "paper_traits", "PAPER_TIER_ERRORS", "PAPER_SKIN_SHARE", "PAPER_GLOSS_SHARE",

@@ -1,6 +1,12 @@
 """The Auto tier's candidates, what each costs to render and how noisy one render is.
 
-- :class:`Candidate`, :data:`CANDIDATES` (Cycles), :data:`EEVEE_CANDIDATES`, :data:`FULLEST`,
+The candidates are the registered tiers' (:mod:`lut_baker.closures.tier_registry`), each with
+and without its subsurface and its gloss; a tier's engines say where it is a candidate, and its
+costs come from ``measured.json`` or, for a tier not measured there, from its own
+:class:`~lut_baker.closures.tier_registry.Costs`.
+
+- :class:`Candidate`, :func:`candidates` (an engine's, read from the registry),
+  :data:`CANDIDATES` (Cycles' measured ones), :data:`EEVEE_CANDIDATES`, :data:`FULLEST`,
   :data:`ENGINES`, :data:`ENGINE_TIERS`, :data:`DEFAULT_TOLERANCE`.
 - :data:`RELATIVE_COST`, :data:`NOISE_K`, :data:`COST_SKIN_SHARE`,
   :data:`EEVEE_RELATIVE_COST` -- measured (:mod:`.measured`); :func:`relative_cost`,
@@ -10,13 +16,16 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
 
 import numpy as np
 
+from ..closures.tier_registry import engine_tiers, tier
 from .measured import by_candidate, by_number, load
 
-__all__ = ["Candidate", "CANDIDATES", "EEVEE_CANDIDATES", "FULLEST", "ENGINES", "ENGINE_TIERS",
+__all__ = ["Candidate", "candidates", "CANDIDATES", "EEVEE_CANDIDATES", "FULLEST", "ENGINES",
+           "ENGINE_TIERS",
            "DEFAULT_TOLERANCE", "RELATIVE_COST", "NOISE_K", "COST_SKIN_SHARE",
            "EEVEE_RELATIVE_COST", "COST_COMMAND", "EEVEE_COST_COMMAND", "relative_cost",
            "noise"]
@@ -26,8 +35,8 @@ _MEASURED = load()
 
 @dataclass(frozen=True)
 class Candidate:
-    """One way to shade made-up skin: an add-on ``tier`` (``PRINCIPLED``, ``LAYERED`` or
-    ``EEVEE``) with or without its subsurface closure and its gloss lobes.  The add-on
+    """One way to shade made-up skin: a registered ``tier`` (by name) with or without its
+    subsurface closure and its gloss lobes.  The add-on
     realises ``subsurface=False`` with Subsurface Scale 0 (Cycles then turns subsurface
     closures into diffuse ones) and ``gloss=False`` with the group's Gloss input at 0 (Cycles
     then allocates no Glossy closure, coat or specular, and EEVEE picks none: their weights
@@ -39,7 +48,7 @@ class Candidate:
 
     @property
     def name(self) -> str:
-        parts = ["EEVEE" if self.tier == "EEVEE" else self.tier.title()]
+        parts = [tier(self.tier).label]
         if not self.subsurface:
             parts.append("no subsurface")
         if not self.gloss:
@@ -47,20 +56,47 @@ class Candidate:
         return ", ".join(parts)
 
 
-CANDIDATES = tuple(Candidate(tier, subsurface, gloss) for tier in ("LAYERED", "PRINCIPLED")
-                   for gloss in (True, False) for subsurface in (True, False))
-"""Every candidate of the Cycles tiers, the fullest first."""
-EEVEE_CANDIDATES = tuple(Candidate("EEVEE", subsurface, gloss) for gloss in (True, False)
-                         for subsurface in (True, False))
-"""Every candidate of the EEVEE tier, the fullest first."""
-FULLEST = CANDIDATES[0]
-"""The LAYERED tier with subsurface and gloss: the most accurate, the costliest (Cycles)."""
 ENGINES = ("CYCLES", "EEVEE")
-ENGINE_TIERS = {"CYCLES": ("LAYERED", "PRINCIPLED"), "EEVEE": ("EEVEE",)}
-"""Tiers per engine: each engine gets the tiers made for it.  The Layered tier's fits choose
+
+
+class _EngineTiers(Mapping[str, tuple[str, ...]]):
+    """``{engine: tier names}`` read live from the registry, the fullest first."""
+
+    def __getitem__(self, engine: str) -> tuple[str, ...]:
+        if engine not in ENGINES:
+            raise KeyError(engine)
+        return engine_tiers(engine)
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(ENGINES)
+
+    def __len__(self) -> int:
+        return len(ENGINES)
+
+
+ENGINE_TIERS: Mapping[str, tuple[str, ...]] = _EngineTiers()
+"""Tiers per engine (:attr:`~lut_baker.closures.tier_registry.Tier.engines`), the fullest
+first: each engine gets the tiers made for it.  The Layered tier's fits choose
 Ashikhmin-Shirley and Beckmann lobes that EEVEE renders as GGX, and EEVEE renders GGX itself
 through a linearly transformed cosine (:mod:`lut_baker.closures.eevee`); the EEVEE tier is
 fitted to that, and Cycles renders its GGX lobes exactly, which they were not fitted to."""
+
+
+def candidates(engine: str, *, measured: bool = False) -> tuple[Candidate, ...]:
+    """Every candidate of the tiers made for ``engine`` (:data:`ENGINE_TIERS`), the fullest
+    first: per tier, with and without gloss, each with and without subsurface; ``measured``:
+    only the tiers whose costs ``measured.json`` holds."""
+    return tuple(Candidate(name, subsurface, gloss) for name in ENGINE_TIERS[engine]
+                 if not (measured and tier(name).costs is not None)
+                 for gloss in (True, False) for subsurface in (True, False))
+
+
+CANDIDATES = candidates("CYCLES", measured=True)
+"""Every measured candidate of the Cycles tiers, the fullest first."""
+EEVEE_CANDIDATES = candidates("EEVEE", measured=True)
+"""Every measured candidate of the EEVEE tiers, the fullest first."""
+FULLEST = CANDIDATES[0]
+"""The fullest Cycles tier with subsurface and gloss: the most accurate, the costliest."""
 DEFAULT_TOLERANCE = 0.02
 """Error a cheaper candidate may add to the best one's (relative RMS)."""
 
@@ -88,7 +124,8 @@ in EEVEE (5.0.1 on software OpenGL, 64 px, 64 samples, light 45 degrees), as
 20-40 s, so differences under ~30% are not resolved (docs/stability.md, "The Auto tier")."""
 
 
-def _by_share(table: dict, candidate: Candidate, skin_share: float) -> float:
+def _by_share(table: dict[float, dict[Candidate, float]], candidate: Candidate,
+              skin_share: float) -> float:
     """Interpolate a per-coverage table of :data:`RELATIVE_COST`, :data:`EEVEE_RELATIVE_COST`
     or :data:`NOISE_K` to a skin share (held beyond the measured ones)."""
     shares = [COST_SKIN_SHARE[c] for c in (1.0, 0.0)]
@@ -98,8 +135,12 @@ def _by_share(table: dict, candidate: Candidate, skin_share: float) -> float:
 
 def relative_cost(candidate: Candidate, skin_share: float = COST_SKIN_SHARE[1.0]) -> float:
     """:data:`RELATIVE_COST` of ``candidate`` (:data:`EEVEE_RELATIVE_COST` for the EEVEE
-    tier's) for a material whose skin share is ``skin_share`` (default: the paper's film)."""
-    table = EEVEE_RELATIVE_COST if candidate.tier == "EEVEE" else RELATIVE_COST
+    tiers') for a material whose skin share is ``skin_share`` (default: the paper's film);
+    for a tier not measured, its own :class:`~lut_baker.closures.tier_registry.Costs`."""
+    costs = tier(candidate.tier).costs
+    if costs is not None:
+        return costs.relative_cost
+    table = EEVEE_RELATIVE_COST if candidate in EEVEE_RELATIVE_COST[1.0] else RELATIVE_COST
     return _by_share(table, candidate, skin_share)
 
 
@@ -109,4 +150,6 @@ def noise(candidate: Candidate, samples: int, *, engine: str = "CYCLES",
     denoiser; ``k`` of :data:`NOISE_K` at the material's ``skin_share``), else 0."""
     if engine != "CYCLES" or denoise:
         return 0.0
-    return _by_share(NOISE_K, candidate, skin_share) / math.sqrt(max(int(samples), 1))
+    costs = tier(candidate.tier).costs
+    k = costs.noise_k if costs is not None else _by_share(NOISE_K, candidate, skin_share)
+    return k / math.sqrt(max(int(samples), 1))

@@ -16,15 +16,14 @@ import numpy as np
 from ..numerics.cache import LRUCache
 from .blur import subsurface_omission_error
 from .candidates import (
-    CANDIDATES,
     DEFAULT_TOLERANCE,
-    EEVEE_CANDIDATES,
     ENGINE_TIERS,
     FULLEST,
     Candidate,
     noise,
     relative_cost,
 )
+from .candidates import candidates as engine_candidates
 from .material import MaterialTraits, paper_traits
 from .scene import SceneDescription
 
@@ -128,8 +127,9 @@ def needs_subsurface(scene: SceneDescription, traits: MaterialTraits) -> bool:
 def choose(scene: SceneDescription, traits: MaterialTraits | None = None, *,
            tolerance: float = DEFAULT_TOLERANCE, candidates=None) -> Choice:
     """The cheapest candidate whose predicted error is within ``tolerance`` of the best one's,
-    among ``candidates`` (default: :data:`CANDIDATES` and :data:`EEVEE_CANDIDATES`) made for
-    the scene's engine (:data:`ENGINE_TIERS`), keep
+    among ``candidates`` (default: every registered tier's,
+    :func:`~lut_baker.auto_tier.candidates.candidates`) made for the scene's engine
+    (:data:`ENGINE_TIERS`), keep
     the subsurface closure if :func:`needs_subsurface` (and drop it when the Subsurface
     Scale is 0: Cycles then shades no spread anyway; likewise the gloss lobes when the
     artist's Gloss is 0).  ``traits`` default to the paper preset's (:func:`paper_traits`)."""
@@ -137,7 +137,7 @@ def choose(scene: SceneDescription, traits: MaterialTraits | None = None, *,
         raise ValueError(f"tolerance must be >= 0, got {tolerance}")
     traits = paper_traits() if traits is None else traits
     needed = needs_subsurface(scene, traits)
-    pool = [c for c in (candidates or CANDIDATES + EEVEE_CANDIDATES)
+    pool = [c for c in (candidates or engine_candidates(scene.engine))
             if c.tier in ENGINE_TIERS[scene.engine]
             and not (needed and not c.subsurface)
             and not (traits.subsurface_scale <= 0.0 and c.subsurface)

@@ -20,7 +20,7 @@ from ..bake import RESOLUTIONS, profile_radius
 from ..closures.profiles import edge_response, profile_grid
 from ..closures.tiers import tier_errors, tier_reflection
 from ..model.dipole import dipole_profile, dipole_total_reflectance
-from ..model.made_up_skin import combine, coverage_weights
+from ..model.made_up_skin import combine, coverage_weights, mix_slots
 from ..model.presets import made_up_skin
 from ..numerics.geometry import polar_angle_deg, sphere_directions
 from ..numerics.quadrature import trapezoid_weights
@@ -171,13 +171,13 @@ def _shares(tables, sphere: _Sphere, w, a) -> tuple[float, float]:
     """:func:`gloss_and_skin_shares` on a sphere's pixels."""
     wi, wo, cos_i = sphere.wi, sphere.wo, sphere.cos_i
     weights = coverage_weights(w, a)
-    gloss = combine(weights, top=tables.angular("film_gloss", wi, wo),
-                    twice=tables.angular("path3_gloss", wi, wo),
-                    bare=tables.angular("skin_gloss", wi, wo)) * cos_i
+    gloss = combine(weights, **mix_slots(film_gloss=tables.angular("film_gloss", wi, wo),
+                                         path3_gloss=tables.angular("path3_gloss", wi, wo),
+                                         skin_gloss=tables.angular("skin_gloss", wi, wo))) * cos_i
     t_i = tables.directional("film_transmittance", polar_angle_deg(wi))
     t_o = tables.directional("film_transmittance", polar_angle_deg(wo))
-    skin = combine(weights, twice=tables.skin_diffuse * t_i * t_o,
-                   bare=tables.skin_diffuse) * cos_i
+    skin = combine(weights, **mix_slots(through_film=tables.skin_diffuse * t_i * t_o,
+                                        skin=tables.skin_diffuse)) * cos_i
     norm = sphere.norm
     if not norm > 0:
         return 0.0, 0.0

@@ -9,13 +9,9 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from .lobes import LobeFit
+from .tier_registry import TIERS, tier
 
 __all__ = ["TIERS", "ClosureFit"]
-
-
-TIERS = ("PRINCIPLED", "LAYERED", "EEVEE")
-"""The node group's tiers: the two made for Cycles, cheapest first, then the one made for
-EEVEE."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -36,7 +32,8 @@ class ClosureFit:
     view-angle image).  EEVEE: ``eevee_glossy`` (the same lobes, GGX as EEVEE renders it, the
     film gloss in two: ``film_gloss`` and ``film_gloss_2``) and ``eevee_lut`` (their
     view-angle image, rows :data:`lut_baker.closures.view_image.EEVEE_LUT_ROWS`); its
-    subsurface is Burley's (:data:`lut_baker.closures.tiers.EEVEE_SUBSURFACE_METHOD`).
+    subsurface is Burley's.  ``extra``: the parts of tiers registered beyond these, by tier
+    (:mod:`lut_baker.closures.tier_registry`).
 
     A fit for a group over the artist's own shader (``fit_closures(..., over_shader=True)``),
     whose bare skin is that shader, leaves out the bare skin's gloss lobes (``specular_bare``
@@ -62,12 +59,12 @@ class ClosureFit:
     eevee_glossy: dict | None = None
     eevee_lut: np.ndarray | None = None
     errors: dict = field(default_factory=dict)
+    extra: dict = field(default_factory=dict)
 
     @property
     def tiers(self) -> tuple:
         """The tiers this fit holds the parts of, in :data:`TIERS` order."""
-        present = {"PRINCIPLED": self.coat, "LAYERED": self.glossy, "EEVEE": self.eevee_glossy}
-        return tuple(tier for tier in TIERS if present[tier] is not None)
+        return tuple(name for name in TIERS if tier(name).holds(self))
 
     @property
     def subsurface_radius_mm(self) -> np.ndarray:

@@ -1,31 +1,12 @@
 """Fitting Blender closures to baked tables: the fit that ties the lobes, the profiles and the
 tiers together.
 
-A Cycles shader sees the view direction but not the light's, so the add-on's tiers are
-closures (replicated in :mod:`lut_baker.closures.cycles`) whose parameters are fitted to the
-tables of :mod:`lut_baker.tables.table_set`, with weights that may depend on the view angle
-through 1-D lookup images.  Everything is numpy only (it runs inside Blender, which ships no
-scipy).
-
-Tiers
------
-``PRINCIPLED``: one Principled BSDF.  Coat = the film's gloss (Coat Weight = coverage; none
-for a film without gloss, or one no coat follows; Coat Roughness and Coat IOR fitted);
-specular = the skin's gloss, bare or through the film (Roughness and Specular IOR Level
-fitted per case, mixed by coverage); base colour = the diffuse albedo (film diffuse + skin seen
-through the film, or bare skin), divided by the mean attenuation of the layers above it;
-Subsurface Weight = the skin's share of it.
-``LAYERED``: closures added with view-dependent weights: film gloss, path-3 gloss and skin gloss
-(Glossy, roughness fitted, weight = table albedo / closure albedo read from a 1-D image by
-``cos(theta_o)``; the film gloss shares its albedo with a Lambertian companion, its own row),
-film diffuse plus that companion (one Diffuse), the skin through the film and bare
-(Subsurface), mixed by coverage.
-``EEVEE``: the LAYERED tier's closures and mix, made for EEVEE: every Glossy lobe is GGX (EEVEE
-renders no other distribution) fitted to the tables as EEVEE renders it under a lamp, a
-linearly transformed cosine (:mod:`lut_baker.closures.eevee`), the film's gloss as two such
-lobes and the companion (:func:`~lut_baker.closures.lobes.fit_glossy_pair`), with its own
-view-angle rows; subsurface Christensen-Burley (EEVEE's screen-space method).
-The formulas of all three: :mod:`lut_baker.closures.tier_formulas`.
+Each tier of the registry (:mod:`lut_baker.closures.tier_registry`) fits its own parts
+(:attr:`~lut_baker.closures.tier_registry.Tier.fit`; the built-in tiers' in
+:mod:`~lut_baker.closures.tier_parts`); what every tier shares (the film's and the skin's
+albedos, the mean transmittance, the subsurface profiles and method) is fitted here once, and
+each tier's replica is measured against the tables (:func:`~lut_baker.closures.tiers.
+tier_errors`).  Everything is numpy only (it runs inside Blender, which ships no scipy).
 
 Where each part lives: the lobes :mod:`~lut_baker.closures.lobes`, the subsurface radii
 :mod:`~lut_baker.closures.profiles`, the tiers' replicas and errors
@@ -40,61 +21,22 @@ image :mod:`~lut_baker.closures.view_image`.
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterable
 from dataclasses import replace
+from typing import Any
 
 import numpy as np
 
-from ..numerics.quadrature import trapezoid_weights
 from ..tables.table_set import Tables
 from . import cycles as cc
-from .closure_fit import TIERS, ClosureFit
-from .lobes import (
-    EEVEE_GLOSSY,
-    ROUGHNESS_RANGE,
-    LobeFit,
-    fit_coat,
-    fit_glossy,
-    fit_glossy_pair,
-    fit_specular,
-)
+from .closure_fit import ClosureFit
 from .profiles import REPLICA_EDGE_ERROR, fit_profiles
-from .tier_formulas import SPECULAR_IOR
+from .tier_parts import FitTargets
+from .tier_registry import TIERS, Tier, tier
 from .tiers import tier_errors
-from .view_grid import FIT_VIEWS, lobe_widths_deg, view_grid
-from .view_image import DEFAULT_LUT_SIZE, EEVEE_LUT_ROWS, LUT_ROWS, lut_nodes
+from .view_image import DEFAULT_LUT_SIZE
 
 __all__ = ["fit_closures", "subsurface_ior"]
-
-
-def _cosine_mean(values: np.ndarray, theta_deg: np.ndarray) -> np.ndarray:
-    """``2 Int v(mu) mu dmu`` of a directional table ``(n_theta[, C])`` (its hemispherical
-    cosine-weighted mean), trapezoid in ``mu``, held at its last value beyond ``theta_max``."""
-    mu = np.cos(np.radians(np.asarray(theta_deg, float)))[::-1]
-    values = np.asarray(values, float)[::-1]
-    mu = np.concatenate([[0.0], mu])
-    values = np.concatenate([values[:1], values])
-    w = trapezoid_weights(mu)
-    return 2.0 * np.tensordot(w * mu, values, axes=(0, 0))
-
-
-def _view_mean(albedo_of) -> float:
-    """``2 Int a(mu) mu dmu``: the cosine-weighted mean over view angles of ``albedo_of(mu)``
-    (trapezoid on 33 view cosines)."""
-    mu = np.linspace(0.0, 1.0, 33)
-    return float(2.0 * np.sum(trapezoid_weights(mu) * mu * albedo_of(mu)))
-
-
-def _coat_layering_mean(roughness: float, ior: float) -> float:
-    """:func:`_view_mean` of the coat's layering albedo
-    (:func:`lut_baker.closures.cycles.coat_view_terms`)."""
-    return _view_mean(lambda mu: cc.coat_view_terms(mu, roughness, ior)[1])
-
-
-def _layering_mean(roughness: float, ior: float, f0=None) -> float:
-    """:func:`_view_mean` of :func:`lut_baker.closures.cycles.layering_albedo` (its largest
-    channel)."""
-    return _view_mean(lambda mu: np.max(
-        np.atleast_2d(cc.layering_albedo(mu, roughness, ior, f0).T).T, axis=-1))
 
 
 def subsurface_ior(parameters: dict) -> float:
@@ -105,148 +47,6 @@ def subsurface_ior(parameters: dict) -> float:
     return float(np.clip(eta, 1.01, 3.8))
 
 
-class _Targets:
-    """What the lobes of one set of tables are fitted to, computed when first asked for: the
-    grids sized by the film's and the skin's gloss (:func:`lobe_widths_deg`), the film's gloss,
-    the skin's gloss and path 3 on them, the film's transmittance rows of the view-angle
-    image."""
-
-    def __init__(self, tables: Tables, lut_size: int):
-        self.tables, self.lut_size = tables, lut_size
-        self.theta_deg = np.asarray(tables.theta_deg, float)
-        self._found: dict = {}
-
-    def _once(self, name, compute):
-        if name not in self._found:
-            self._found[name] = compute()
-        return self._found[name]
-
-    def grid(self, surface: str):
-        """The view grid sized by ``surface``'s gloss (``film_gloss`` or ``skin_gloss``)."""
-        return self._once(("grid", surface), lambda: view_grid(
-            lobe_widths_deg(self.tables)[surface], FIT_VIEWS))
-
-    def target(self, name: str):
-        """``(grid, table)`` of a gloss part: ``film_gloss`` on the film's grid,
-        ``path3_gloss`` and ``skin_gloss`` on the skin's."""
-        def compute():
-            if name == "path3_gloss":
-                grid = self.grid("skin_gloss")
-                return grid, self.tables.angular(name, *grid.directions)
-            grid = self.grid(name)
-            return grid, self.tables.surface_gloss(name, *grid.directions)
-        return self._once(("target", name), compute)
-
-    def albedo(self, name: str) -> np.ndarray:
-        """A gloss part's directional albedo table ``(n_theta, 3)``."""
-        return np.asarray(getattr(self.tables, name + "_albedo"))
-
-    def transmittance_rows(self) -> np.ndarray:
-        """The film's transmittance at the view-angle image's texels, ``(size, 3)``."""
-        def compute():
-            transmittance = np.asarray(self.tables.film_transmittance, float)
-            mu = lut_nodes(self.lut_size)
-            return np.stack([np.interp(np.degrees(np.arccos(mu)), self.theta_deg,
-                                       transmittance[:, c]) for c in range(3)], -1)
-        return self._once("transmittance_rows", compute)
-
-
-def _left_out_glossy(size: int) -> LobeFit:
-    """A Glossy lobe left out (a fit over the artist's shader has no bare skin of its own):
-    weights 0, error 1 (what leaving a lobe out errs)."""
-    return LobeFit(roughness=ROUGHNESS_RANGE[1], error=1.0, lut=np.zeros((size, 3)))
-
-
-def _principled_parts(targets: _Targets, over_shader: bool) -> dict:
-    """The PRINCIPLED tier's parts of a :class:`ClosureFit`: the coat, the two speculars (over
-    the artist's shader the bare one left out: level 0) and their mean layering albedos."""
-    tables, theta_deg = targets.tables, targets.theta_deg
-    film_grid, film_gloss = targets.target("film_gloss")
-    skin_grid, path3 = targets.target("path3_gloss")
-    coat = fit_coat(film_grid, film_gloss)
-    e_coat = cc.coat_view_terms(skin_grid.cos_view, coat.roughness, coat.ior)[1]
-    specular_film = fit_specular(skin_grid, path3, attenuation=1.0 - e_coat)
-    if over_shader:
-        specular_bare = LobeFit(roughness=specular_film.roughness, ior=SPECULAR_IOR,
-                                level=0.0, error=1.0)
-    else:
-        specular_bare = fit_specular(skin_grid, targets.target("skin_gloss")[1])
-        # The node group mixes the two roughnesses by coverage: a dropped lobe (level 0) takes
-        # the other's, so that mixing never sharpens the remaining lobe.
-        if specular_film.level == 0.0:
-            specular_film = replace(specular_film, roughness=specular_bare.roughness)
-        elif specular_bare.level == 0.0:
-            specular_bare = replace(specular_bare, roughness=specular_film.roughness)
-    coat_ior = coat.ior
-    if coat_ior is None:
-        raise AssertionError("fit_coat gives an IOR")
-
-    def specular_mean(lobe):
-        if lobe.level == 0.0:
-            return 0.0
-        f0 = float(cc.f0_from_ior(SPECULAR_IOR)) * 2.0 * lobe.level
-        return _layering_mean(lobe.roughness, float(cc.ior_from_f0(f0)), f0)
-
-    return {
-        "coat": coat,
-        "specular_bare": specular_bare,
-        "specular_film": specular_film,
-        "coat_albedo_mean": _coat_layering_mean(coat.roughness, coat_ior),
-        "specular_albedo_mean": (specular_mean(specular_bare), specular_mean(specular_film)),
-        "gloss_to_diffuse": (_cosine_mean(np.asarray(tables.path3_gloss_albedo), theta_deg)
-                             if specular_film.level == 0.0 else np.zeros(3)),
-    }
-
-
-def _image(targets: _Targets, lobes: dict, rows: tuple) -> np.ndarray:
-    """The view-angle image of ``lobes``, rows named ``rows``."""
-    found = {**{name: lobes[name].lut for name in lobes},
-             "film_transmittance": targets.transmittance_rows(),
-             "film_gloss_diffuse": lobes["film_gloss"].diffuse_lut}
-    if any(found.get(name) is None for name in rows):
-        raise AssertionError("the lobes give every view-angle row")
-    return np.stack([found[name] for name in rows])
-
-
-def _glossy(targets: _Targets, name: str, closures: tuple) -> LobeFit:
-    """:func:`fit_glossy` of one gloss part (the film's with its Lambertian companion)."""
-    grid, table = targets.target(name)
-    return fit_glossy(grid, table, targets.albedo(name), targets.theta_deg, targets.lut_size,
-                      companion=name == "film_gloss", closures=closures)
-
-
-def _view_weighted_lobes(targets: _Targets, names: tuple, closures: tuple,
-                         over_shader: bool) -> dict:
-    """Glossy lobes of ``names`` (over the artist's shader ``skin_gloss`` left out)."""
-    return {name: (_left_out_glossy(targets.lut_size) if over_shader and name == "skin_gloss"
-                   else _glossy(targets, name, closures)) for name in names}
-
-
-def _layered_parts(targets: _Targets, over_shader: bool) -> dict:
-    """The LAYERED tier's parts: Cycles' Glossy lobes and their view-angle image."""
-    glossy = _view_weighted_lobes(targets, ("film_gloss", "path3_gloss", "skin_gloss"),
-                                  cc.GLOSSY_DISTRIBUTIONS, over_shader)
-    return {"glossy": glossy, "lut": _image(targets, glossy, LUT_ROWS)}
-
-
-def _eevee_parts(targets: _Targets, over_shader: bool) -> dict:
-    """The EEVEE tier's parts: EEVEE's GGX lobes (the film's gloss two of them and the
-    companion, :func:`fit_glossy_pair`) and their view-angle image."""
-    film_grid, film_gloss = targets.target("film_gloss")
-    first, second = fit_glossy_pair(film_grid, film_gloss, targets.albedo("film_gloss"),
-                                    targets.theta_deg, targets.lut_size)
-    eevee_glossy = {"film_gloss": first, "film_gloss_2": second,
-                    **_view_weighted_lobes(targets, ("path3_gloss", "skin_gloss"),
-                                           (EEVEE_GLOSSY,), over_shader)}
-    return {"eevee_glossy": eevee_glossy,
-            "eevee_lut": _image(targets, eevee_glossy, EEVEE_LUT_ROWS)}
-
-
-_TIER_PARTS = {"PRINCIPLED": _principled_parts, "LAYERED": _layered_parts,
-              "EEVEE": _eevee_parts}
-"""Each tier's parts of a fit, by tier."""
-_TIER_SHARES = {"PRINCIPLED": 0.25, "LAYERED": 0.35, "EEVEE": 0.4}
-"""Each tier's rough share of a full fit's time (for the progress reported)."""
 
 
 def _subsurface(tables: Tables, method: str | None, over_shader: bool) -> dict:
@@ -265,19 +65,27 @@ def _subsurface(tables: Tables, method: str | None, over_shader: bool) -> dict:
     return {"profiles": profiles, "subsurface_method": method, "subsurface_ior": ior}
 
 
-def _checked_tiers(tiers) -> tuple:
+def _checked_tiers(tiers: Iterable[str]) -> tuple[Tier, ...]:
     """``tiers`` in :data:`TIERS` order (``ValueError`` for a name not in it)."""
-    tiers = tuple(tiers)
-    unknown = [tier for tier in tiers if tier not in TIERS]
+    names = tuple(tiers)
+    unknown = [name for name in names if name not in TIERS]
     if unknown:
         raise ValueError(f"tiers must be among {TIERS}, got {unknown}")
-    return tuple(tier for tier in TIERS if tier in tiers)
+    return tuple(tier(name) for name in TIERS if name in names)
 
 
-def fit_closures(tables: Tables, *, tiers=TIERS, over_shader: bool = False,
-                 onto: ClosureFit | None = None, lut_size: int = DEFAULT_LUT_SIZE,
-                 subsurface_method: str | None = None, errors_at=None,
-                 progress=None) -> ClosureFit:
+def _merged(parts: dict, more: dict) -> dict:
+    """``parts`` updated with a tier's ``more``; the registered tiers' ``extra`` parts merged
+    by tier."""
+    extra = {**parts.get("extra", {}), **more.get("extra", {})}
+    return {**parts, **more, **({"extra": extra} if extra else {})}
+
+
+def fit_closures(tables: Tables, *, tiers: Iterable[str] | None = None,
+                 over_shader: bool = False, onto: ClosureFit | None = None,
+                 lut_size: int = DEFAULT_LUT_SIZE, subsurface_method: str | None = None,
+                 errors_at: tuple[float, Any] | None = None,
+                 progress: Callable[..., object] | None = None) -> ClosureFit:
     """Fit the ``tiers`` (default: all of :data:`TIERS`) to ``tables`` and measure their
     errors at ``errors_at`` = ``(coverage, absorption)`` (default: those the tables were baked
     for).  ``subsurface_method``: force one (default: the method whose edge response, fitted
@@ -293,26 +101,25 @@ def fit_closures(tables: Tables, *, tiers=TIERS, over_shader: bool = False,
     one sized by the skin's (:func:`lobe_widths_deg`, :func:`lut_baker.closures.view_grid.
     view_grid`), so the cost does not depend on how narrow either lobe is."""
     report = progress or (lambda fraction, message="": None)
-    tiers = _checked_tiers(tiers)
-    wanted = tiers if onto is None else tuple(t for t in tiers if t not in onto.tiers)
-    targets = _Targets(tables, lut_size)
+    asked = _checked_tiers(TIERS if tiers is None else tiers)
+    wanted = asked if onto is None else tuple(t for t in asked if t.name not in onto.tiers)
+    targets = FitTargets(tables, lut_size)
     parts: dict = {}
-    total = sum(_TIER_SHARES[tier] for tier in wanted) or 1.0
+    total = sum(t.fit_share for t in wanted) or 1.0
     done = 0.0
-    for tier in wanted:
-        report(0.8 * done / total, f"fitting the {tier.title()} tier")
-        parts.update(_TIER_PARTS[tier](targets, over_shader))
-        done += _TIER_SHARES[tier]
+    for each in wanted:
+        report(0.8 * done / total, f"fitting the {each.label} tier")
+        parts = _merged(parts, each.fit(targets, over_shader))
+        done += each.fit_share
     if onto is not None:
-        fit = replace(onto, **parts)
+        fit = replace(onto, **_merged({"extra": onto.extra}, parts))
         if onto.errors:
             first = next(iter(onto.errors.values()))
             errors_at = (first.coverage, first.absorption)
     else:
         report(0.75, "fitting the subsurface profile")
         fit = ClosureFit(
-            transmittance_mean=_cosine_mean(np.asarray(tables.film_transmittance, float),
-                                            targets.theta_deg),
+            transmittance_mean=tables.film_transmittance_mean,
             film_albedo=np.pi * np.asarray(tables.film_diffuse, float),
             skin_albedo=np.pi * np.asarray(tables.skin_diffuse, float),
             **_subsurface(tables, subsurface_method, over_shader), **parts)
@@ -321,7 +128,8 @@ def fit_closures(tables: Tables, *, tiers=TIERS, over_shader: bool = False,
                      tables.parameters.get("absorption", 0.0))
     report(0.8, "measuring the tiers' errors")
     errors = {**(onto.errors if onto is not None else {}),
-              **tier_errors(fit, tables, *errors_at, tiers=wanted, over_shader=over_shader)}
-    fit = replace(fit, errors={tier: errors[tier] for tier in TIERS if tier in errors})
+              **tier_errors(fit, tables, *errors_at, tiers=[t.name for t in wanted],
+                            over_shader=over_shader)}
+    fit = replace(fit, errors={name: errors[name] for name in TIERS if name in errors})
     report(1.0, "fitted")
     return fit

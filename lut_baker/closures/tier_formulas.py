@@ -2,38 +2,46 @@
 
 A tier is a set of closures whose colours and weights are arithmetic on the node group's inputs
 (Coverage ``w``, Foundation Absorption ``A``, Skin Color ``S``, Gloss ``g``), on constants of
-the :class:`~lut_baker.closures.closure_fit.ClosureFit` and on the view-angle image's rows.  The
-functions here compute them from those values with Python's operators and the few functions of
-an *algebra* (:class:`Algebra`), so the same code runs on two kinds of value:
+the :class:`~lut_baker.closures.closure_fit.ClosureFit` and on the view-angle image's rows,
+assembled into one shader: closures weighted, each side of the coverage mix summed, the sides
+mixed by coverage as areas.  The functions here compute them from those values with Python's
+operators and the few functions of an *algebra* (:class:`Algebra` for values,
+:class:`ShaderAlgebra` for shaders), so the same code runs on two kinds of value:
 
-- numpy arrays (:class:`NumpyAlgebra`): the replicas, the tiers' errors, the Auto tier;
+- numpy arrays (:class:`NumpyAlgebra`; shaders as BRDFs, the replicas of
+  :mod:`lut_baker.closures.tiers`): the tiers' errors, the Auto tier;
 - node sockets (the add-on's node algebra, makeup_skin_addon/node_algebra.py): the node group
   is generated from these functions, so it cannot drift from what is measured.
 
 Scalars (Coverage, Gloss, weights) and colours (RGB) mix freely, as they do in numpy (scalars
 broadcast) and in nodes (a float socket linked to a colour input is grey).  Every mix of the
-made-up skin's parts goes through :func:`lut_baker.model.made_up_skin.coverage_weights` and
+made-up skin's parts goes through :func:`lut_baker.model.made_up_skin.coverage_weights`,
+:func:`~lut_baker.model.made_up_skin.mix_slots` and
 :func:`~lut_baker.model.made_up_skin.combine` (docs/model.md §4).
 
 - :class:`TierInputs` -- the group's inputs.
-- :func:`principled_sockets` -- the PRINCIPLED tier's Principled BSDF sockets.
-- :func:`view_weighted_closures` -- the LAYERED (and EEVEE) tier's closures, by side of the
-  coverage mix.
+- :func:`principled_sockets` -- one Principled BSDF's sockets; :func:`principled_shader` --
+  that BSDF as a tier's shader.
+- :func:`view_weighted_closures` -- Glossy, Diffuse and Subsurface closures with view-angle
+  weights, by side of the coverage mix; :func:`view_weighted_shader` -- assembled.
+- :func:`assemble` -- closures by side into one shader: summed, mixed by coverage.
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, Protocol
 
 import numpy as np
 
-from ..model.made_up_skin import combine, coverage_weights
+from ..model.made_up_skin import combine, coverage_weights, mix_slots
 from .view_image import sample_lut
 
-__all__ = ["Algebra", "NumpyAlgebra", "TierInputs", "Closure", "ViewWeightedClosures",
-           "principled_sockets", "view_weighted_closures", "SPECULAR_IOR", "ROW_SURFACE",
-           "THROUGH_WEIGHT_FLOOR"]
+__all__ = ["Algebra", "ShaderAlgebra", "NumpyAlgebra", "TierInputs", "Closure",
+           "ViewWeightedClosures", "principled_sockets", "principled_shader",
+           "view_weighted_closures", "view_weighted_shader", "assemble", "SPECULAR_IOR",
+           "ROW_SURFACE", "THROUGH_WEIGHT_FLOOR"]
 
 SPECULAR_IOR = 1.5
 """The Principled BSDF's IOR in the PRINCIPLED tier (its specular level carries the fit)."""
@@ -50,11 +58,24 @@ class Algebra(Protocol):
     """What a formula needs beyond ``+ - * /`` and ``** 2``: each call takes scalars or colours
     of the algebra's kind (or plain numbers) and returns one."""
 
-    def maximum(self, a, b): ...
-    def minimum(self, a, b): ...
-    def channel_mean(self, colour): ...
-    def channel_max(self, colour): ...
-    def row(self, name: str): ...
+    def maximum(self, a: Any, b: Any) -> Any: ...
+    def minimum(self, a: Any, b: Any) -> Any: ...
+    def floor(self, a: Any) -> Any: ...
+    def lerp(self, t: Any, a: Any, b: Any) -> Any: ...
+    def channel_mean(self, colour: Any) -> Any: ...
+    def channel_max(self, colour: Any) -> Any: ...
+    def row(self, name: str) -> Any: ...
+
+
+class ShaderAlgebra(Algebra, Protocol):
+    """An :class:`Algebra` that also makes shaders: one :class:`Closure` (its weight applied),
+    one Principled BSDF from its sockets (:func:`principled_sockets`), their sum, and the areal
+    mix of two by a coverage (``bare`` where it is 0, ``covered`` where 1)."""
+
+    def closure(self, closure: Closure) -> Any: ...
+    def principled(self, sockets: dict[str, Any]) -> Any: ...
+    def add(self, *shaders: Any) -> Any: ...
+    def mix(self, coverage: Any, bare: Any, covered: Any) -> Any: ...
 
 
 class NumpyAlgebra:
@@ -62,22 +83,29 @@ class NumpyAlgebra:
     leading shape, broadcast), rows read at ``cos_view`` (``(...,)``) from ``rows`` (name ->
     ``(size, 3)``) as Blender's Image Texture samples them."""
 
-    def __init__(self, rows: dict | None = None, cos_view=None):
+    def __init__(self, rows: dict[str, Any] | None = None, cos_view: Any = None):
         self._rows = rows or {}
         self._cos = None if cos_view is None else np.asarray(cos_view, float)
 
     maximum = staticmethod(np.maximum)
     minimum = staticmethod(np.minimum)
+    floor = staticmethod(np.floor)
 
     @staticmethod
-    def channel_mean(colour):
+    def lerp(t: Any, a: Any, b: Any) -> Any:
+        return a + t * (b - a)
+
+    @staticmethod
+    def channel_mean(colour: Any) -> Any:
         return np.mean(np.asarray(colour, float) * np.ones(3), axis=-1, keepdims=True)
 
     @staticmethod
-    def channel_max(colour):
+    def channel_max(colour: Any) -> Any:
         return np.max(np.asarray(colour, float) * np.ones(3), axis=-1, keepdims=True)
 
-    def row(self, name: str):
+    def row(self, name: str) -> Any:
+        if self._cos is None:
+            raise ValueError(f"row {name!r} asked of an algebra without view angles")
         return sample_lut(self._rows[name], self._cos)
 
 
@@ -93,19 +121,20 @@ class TierInputs:
     gloss: Any = 1.0
 
     @classmethod
-    def numpy(cls, coverage, absorption, skin_color, gloss=1.0) -> TierInputs:
+    def numpy(cls, coverage: Any, absorption: Any, skin_color: Any,
+              gloss: Any = 1.0) -> TierInputs:
         """Inputs as the numpy algebra takes them: scalars with a trailing axis of 1, colours
         of 3 (a scalar absorption is grey)."""
-        def scalar(x):
+        def scalar(x: Any) -> Any:
             return np.asarray(x, float)[..., None]
 
-        def colour(x):
+        def colour(x: Any) -> Any:
             return np.asarray(x, float) * np.ones(3)
 
         return cls(scalar(coverage), colour(absorption), colour(skin_color), scalar(gloss))
 
 
-def principled_sockets(fit, x: TierInputs, ops: Algebra) -> dict:
+def principled_sockets(fit: Any, x: TierInputs, ops: Algebra) -> dict[str, Any]:
     """The PRINCIPLED tier's Principled BSDF sockets (by name) at inputs ``x``:
 
     - Coat Weight ``g w c`` (``c`` the coat's level: 1, or 0 without a coat), Coat
@@ -126,8 +155,10 @@ def principled_sockets(fit, x: TierInputs, ops: Algebra) -> dict:
     linear in ``g`` (exact at both ends)."""
     weights = coverage_weights(x.coverage, x.absorption)
     g = x.gloss
-    skin = combine(weights, twice=x.skin_color * fit.transmittance_mean**2, bare=x.skin_color)
-    total = skin + combine(weights, once=fit.film_albedo, twice=g * fit.gloss_to_diffuse)
+    skin = combine(weights, **mix_slots(through_film=x.skin_color * fit.transmittance_mean**2,
+                                        skin=x.skin_color))
+    total = skin + combine(weights, **mix_slots(film_diffuse=fit.film_albedo,
+                                                path3_gloss=g * fit.gloss_to_diffuse))
     e_spec = combine(weights, top=fit.specular_albedo_mean[1], bare=fit.specular_albedo_mean[0])
     coat = g * weights.covered * fit.coat.level
     base = total / ((1.0 - coat * fit.coat_albedo_mean) * (1.0 - g * e_spec))
@@ -146,6 +177,17 @@ def principled_sockets(fit, x: TierInputs, ops: Algebra) -> dict:
     }
 
 
+def principled_shader(fit: Any, x: TierInputs, ops: ShaderAlgebra,
+                      subsurface_weight: Any = None) -> Any:
+    """One Principled BSDF of :func:`principled_sockets` (``subsurface_weight``: the share of
+    the skin under the film that scatters below its surface, the artist's, multiplying the
+    fitted one; None: all of it)."""
+    sockets = principled_sockets(fit, x, ops)
+    if subsurface_weight is not None:
+        sockets["Subsurface Weight"] = sockets["Subsurface Weight"] * subsurface_weight
+    return ops.principled(sockets)
+
+
 @dataclass(frozen=True)
 class Closure:
     """One closure of a view-weighted tier: ``kind`` (``"glossy"``, ``"diffuse"`` or
@@ -160,7 +202,7 @@ class Closure:
     weight: Any = None
 
     @property
-    def product(self):
+    def product(self) -> Any:
         """What the closure carries: its colour times its weight (if it has one)."""
         return self.colour if self.weight is None else self.colour * self.weight
 
@@ -171,17 +213,31 @@ class ViewWeightedClosures:
     skin), mixed by ``coverage`` as areas (a Mix Shader), and ``shared`` closures added to
     that mix, their colours mixed by coverage already."""
 
-    covered: tuple
-    bare: tuple
+    covered: tuple[Closure, ...]
+    bare: tuple[Closure, ...]
     coverage: Any
-    shared: tuple = ()
+    shared: tuple[Closure, ...] = ()
 
 
-def view_weighted_closures(fit, x: TierInputs, ops: Algebra, *,
+def assemble(closures: ViewWeightedClosures, ops: ShaderAlgebra) -> Any:
+    """The one shader of a tier's closures: each side's closures summed (each weighted by
+    :meth:`ShaderAlgebra.closure`), the sides mixed by coverage as areas, the shared closures
+    added to the mix.  A coverage of exactly 1 (a group over the artist's shader, whose own
+    mix with the Skin Shader is by Coverage) is the covered side alone."""
+    covered = ops.add(*(ops.closure(c) for c in closures.covered))
+    coverage = closures.coverage
+    if isinstance(coverage, (int, float)) and coverage == 1.0:
+        mixed = covered
+    else:
+        mixed = ops.mix(coverage, ops.add(*(ops.closure(c) for c in closures.bare)), covered)
+    return ops.add(mixed, *(ops.closure(c) for c in closures.shared))
+
+
+def view_weighted_closures(fit: Any, x: TierInputs, ops: Algebra, *,
                            tinted_subsurface: bool = True,
-                           film_lobes: tuple = ("film_gloss",),
+                           film_lobes: Sequence[str] = ("film_gloss",),
                            one_subsurface: bool = False,
-                           subsurface_weight=None) -> ViewWeightedClosures:
+                           subsurface_weight: Any = None) -> ViewWeightedClosures:
     """The LAYERED tier's closures at inputs ``x``, their view-dependent factors read from the
     image rows (``ops.row``, :data:`lut_baker.closures.view_image.LUT_ROWS`):
 
@@ -223,7 +279,7 @@ def view_weighted_closures(fit, x: TierInputs, ops: Algebra, *,
                           "skin", weight=strongest)
     else:
         through = Closure("subsurface", "skin through film", transmitted * x.skin_color, "skin")
-    diffuse_through: tuple = ()
+    diffuse_through: tuple[Closure, ...] = ()
     if subsurface_weight is not None:
         diffuse_through = (Closure("diffuse", "skin through film (diffuse)",
                                    transmitted * x.skin_color, "skin",
@@ -249,3 +305,15 @@ def view_weighted_closures(fit, x: TierInputs, ops: Algebra, *,
                                                  top=through.product, bare=x.skin_color), "skin")
     return ViewWeightedClosures(covered=covered[:-1], bare=bare[:-1], coverage=x.coverage,
                                 shared=(skin,))
+
+
+def view_weighted_shader(fit: Any, x: TierInputs, ops: ShaderAlgebra,
+                         subsurface_weight: Any = None, *, tinted_subsurface: bool = True,
+                         film_lobes: Sequence[str] = ("film_gloss",),
+                         one_subsurface: bool = False) -> Any:
+    r""":func:`view_weighted_closures` :func:`assemble`\ d; over the artist's shader (a
+    ``subsurface_weight``) the bare side is theirs, so nothing is shared with it."""
+    return assemble(view_weighted_closures(
+        fit, x, ops, tinted_subsurface=tinted_subsurface, film_lobes=film_lobes,
+        one_subsurface=one_subsurface and subsurface_weight is None,
+        subsurface_weight=subsurface_weight), ops)

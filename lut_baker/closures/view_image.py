@@ -3,17 +3,23 @@ Blender's Image Texture samples it.
 
 A tier's view-dependent weights are 1-D functions of ``cos(theta_o)``, one per row of a small
 float image that the node group reads at ``u = cos(theta_o)``: :data:`LUT_ROWS` names the rows
-(:data:`EEVEE_LUT_ROWS` the EEVEE tier's),
-:func:`lut_nodes` gives the texel centres, :func:`sample_lut` reads a row as Blender does
-(Linear, EXTEND).
+(:data:`EEVEE_LUT_ROWS` the EEVEE tier's), :func:`lut_nodes` gives the texel centres,
+:func:`texel_pair` and :func:`read_row` read a row at ``u`` as Blender's Linear, EXTEND lookup
+does, written once over an algebra (two Closest lookups at neighbouring texel centres mixed
+linearly: numpy arrays in :func:`sample_lut`, node sockets in the add-on's node group, where
+EEVEE's Linear lookup would mix rows through mipmaps).
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-__all__ = ["LUT_ROWS", "EEVEE_LUT_ROWS", "DEFAULT_LUT_SIZE", "lut_nodes", "sample_lut"]
+__all__ = ["LUT_ROWS", "EEVEE_LUT_ROWS", "DEFAULT_LUT_SIZE", "lut_nodes", "texel_pair",
+           "read_row", "sample_lut"]
 
 LUT_ROWS = ("film_gloss", "path3_gloss", "skin_gloss", "film_transmittance",
             "film_gloss_diffuse")
@@ -32,9 +38,41 @@ def lut_nodes(size: int = DEFAULT_LUT_SIZE) -> np.ndarray:
     return (np.arange(size) + 0.5) / size
 
 
+def texel_pair(u: Any, size: int, ops: Any) -> tuple[Any, Any, Any]:
+    """``(u0, u1, t)`` for reading a row of ``size`` texels at ``u`` linearly between texel
+    centres and held beyond them: ``x = clamp(u size, 0.5, size - 0.5) - 0.5``, the centres
+    ``(i + 0.5) / size`` of texel ``i = floor(x)`` and of the next (the edge one twice beyond
+    the centres), and the weight ``t = x - i`` of the second.  ``ops``: ``minimum``,
+    ``maximum``, ``floor`` of the values' kind (numpy's, or the node group's)."""
+    x = ops.minimum(ops.maximum(u * float(size), 0.5), size - 0.5) - 0.5
+    index = ops.floor(x)
+    return ((index + 0.5) / float(size), ops.minimum(index + 1.5, size - 0.5) / float(size),
+            x - index)
+
+
+def read_row(u: Any, size: int, texel: Callable[[Any], Any], ops: Any) -> Any:
+    """A row of ``size`` texels read at ``u`` as Blender's Linear, EXTEND lookup does: the
+    two texels of :func:`texel_pair` read by ``texel(u)`` (a Closest lookup) and mixed,
+    ``ops.lerp(t, a, b)``."""
+    u0, u1, t = texel_pair(u, size, ops)
+    return ops.lerp(t, texel(u0), texel(u1))
+
+
+class _Numpy:
+    minimum = staticmethod(np.minimum)
+    maximum = staticmethod(np.maximum)
+    floor = staticmethod(np.floor)
+
+    @staticmethod
+    def lerp(t: Any, a: Any, b: Any) -> Any:
+        t = np.asarray(t, float)
+        t = t[..., None] if np.ndim(a) > t.ndim else t
+        return a + t * (b - a)
+
+
 def sample_lut(lut: ArrayLike, cos_view: ArrayLike) -> NDArray[np.float64]:
     """What Blender's Image Texture (Linear, EXTEND) returns for a row ``lut`` ``(size[, C])``
-    at ``u = cos_view``: linear between texel centres, the edge texel beyond them.
+    at ``u = cos_view``: :func:`read_row` on numpy arrays.
 
     >>> print(np.round(lut_nodes(4), 3))  # the texel centres of a row of 4
     [0.125 0.375 0.625 0.875]
@@ -42,8 +80,9 @@ def sample_lut(lut: ArrayLike, cos_view: ArrayLike) -> NDArray[np.float64]:
     [0.  0.5 1.5 3. ]
     """
     row = np.asarray(lut, float)
-    nodes = lut_nodes(row.shape[0])
-    u = np.asarray(cos_view, float)
-    if row.ndim == 1:
-        return np.interp(u, nodes, row)
-    return np.stack([np.interp(u, nodes, row[:, c]) for c in range(row.shape[1])], -1)
+    size = row.shape[0]
+
+    def texel(u: NDArray[np.float64]) -> NDArray[np.float64]:
+        return row[np.clip(np.floor(u * size).astype(int), 0, size - 1)]
+
+    return np.asarray(read_row(np.asarray(cos_view, float), size, texel, _Numpy), float)

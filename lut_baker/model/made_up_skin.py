@@ -14,8 +14,8 @@ Functions and types
 - :class:`MadeUpSkin` -- the bundle in albedo units: film, skin, dipole, coverage, absorption.
 - :func:`from_paper_counts` -- build a :class:`MadeUpSkin` from layers in pixel counts.
 - :func:`coverage_weights` -- the weights of coverage and absorption: how bare skin, the film
-  and the skin seen through the film are mixed; :func:`combine` -- the mix itself, written
-  once.
+  and the skin seen through the film are mixed; :func:`mix_slots` -- which part goes to which
+  slot of the mix; :func:`combine` -- the mix itself, written once.
 - :func:`film_reflection_layer`, :func:`film_transmission_layer` -- the film with its pigment
   absorption applied.
 
@@ -43,6 +43,7 @@ __all__ = [
     "from_paper_counts",
     "CoverageWeights",
     "coverage_weights",
+    "mix_slots",
     "combine",
     "film_reflection_layer",
     "film_transmission_layer",
@@ -187,6 +188,28 @@ def coverage_weights(coverage: Any, absorption: Any) -> CoverageWeights:
     # are sockets (lut_baker.closures.tier_formulas).
     once = 1.0 - absorption
     return CoverageWeights(bare=1.0 - coverage, covered=coverage, once=once, twice=once**2)
+
+
+def mix_slots(*, film_gloss: Any = None, film_diffuse: Any = None, path3_gloss: Any = None,
+              through_film: Any = None, skin_gloss: Any = None,
+              skin: Any = None) -> dict[str, Any]:
+    """The slots of :func:`combine` (``top``, ``once``, ``twice``, ``bare``) filled with the
+    made-up skin's parts, the one place that says which part crosses the film's pigment how
+    often (docs/model.md §4): the film's gloss none (``top``), its diffuse once, the skin's
+    gloss through the film (path 3) and the skin's light through it (``through_film``) twice,
+    the bare skin's gloss and light (``skin``) are the bare slot.  A part not given is no
+    term; a slot with no part is None (no term of :func:`combine`).
+
+    >>> slots = mix_slots(film_gloss=0.05, film_diffuse=0.3, path3_gloss=0.1,
+    ...                   through_film=0.4, skin=0.4)
+    >>> print(slots)
+    {'top': 0.05, 'once': 0.3, 'twice': 0.5, 'bare': 0.4}
+    """
+    def total(first: Any, second: Any) -> Any:
+        return first if second is None else second if first is None else first + second
+
+    return {"top": film_gloss, "once": film_diffuse, "twice": total(path3_gloss, through_film),
+            "bare": total(skin_gloss, skin)}
 
 
 def combine(weights: CoverageWeights, *, top: Any = None, once: Any = None, twice: Any = None,

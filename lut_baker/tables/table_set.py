@@ -76,7 +76,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..model.layers import ReflectionLayer
-from ..model.made_up_skin import combine, coverage_weights
+from ..model.made_up_skin import combine, coverage_weights, mix_slots
 from ..model.microfacet import ts_reflection
 from ..numerics.geometry import direction, folded_azimuth_deg, half_vector, polar_angle_deg
 
@@ -366,6 +366,13 @@ class Tables:
         return np.broadcast_to(value, value.shape[:-1] + (3,))
 
     @property
+    def film_transmittance_mean(self) -> NDArray[np.float64]:
+        """``T_mean`` (RGB): the film's transmittance averaged over the hemisphere with weight
+        ``cos(theta) / pi``, ``film_transmittance_integral / pi``; the one mean transmittance
+        the uniform-light colour and the closure fits read."""
+        return np.asarray(self.film_transmittance_integral, float) / np.pi
+
+    @property
     def spacings(self) -> dict:
         """How the grids are laid out: ``theta_spacing``, ``theta_offset``, ``phi_spacing``,
         ``radius_spacing`` (module docstring)."""
@@ -449,9 +456,10 @@ class Tables:
             baked = coverage_weights(*self.coverage_and_absorption()).once
             ratio = np.where(baked > 0.0, weights.once / np.where(baked > 0.0, baked, 1.0), 0.0)
             top = top + parts["inter_reflection"] * ratio**2
-        return combine(weights, top=top, once=self.film_diffuse,
-                       twice=parts["path3_gloss"] + self.skin_diffuse * t_i * t_o,
-                       bare=parts["skin_gloss"] + self.skin_diffuse)
+        return combine(weights, **mix_slots(
+            film_gloss=top, film_diffuse=self.film_diffuse, path3_gloss=parts["path3_gloss"],
+            through_film=self.skin_diffuse * t_i * t_o, skin_gloss=parts["skin_gloss"],
+            skin=self.skin_diffuse))
 
     def _angular_names(self) -> tuple[str, ...]:
         """The tabulated angular parts."""
@@ -494,10 +502,11 @@ class Tables:
         """``Int f(wi, wo) cos(theta_o) dwo`` (paths 1 + 3, no inter-reflection) at incidence
         ``theta_deg`` (degrees) from the albedo tables; shape ``(..., 3)``."""
         weights = coverage_weights(*self.coverage_and_absorption(coverage, absorption))
-        path3 = (self.directional("path3_gloss_albedo", theta_deg) + self.skin_diffuse
-                 * self.directional("film_transmittance", theta_deg)
-                 * self.film_transmittance_integral)
-        return combine(weights, top=self.directional("film_gloss_albedo", theta_deg),
-                       once=np.pi * self.film_diffuse, twice=path3,
-                       bare=self.directional("skin_gloss_albedo", theta_deg)
-                       + np.pi * self.skin_diffuse)
+        return combine(weights, **mix_slots(
+            film_gloss=self.directional("film_gloss_albedo", theta_deg),
+            film_diffuse=np.pi * self.film_diffuse,
+            path3_gloss=self.directional("path3_gloss_albedo", theta_deg),
+            through_film=(self.skin_diffuse * self.directional("film_transmittance", theta_deg)
+                          * self.film_transmittance_integral),
+            skin_gloss=self.directional("skin_gloss_albedo", theta_deg),
+            skin=np.pi * self.skin_diffuse))

@@ -40,7 +40,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..model.albedo import bihemispherical
-from ..model.made_up_skin import combine, coverage_weights
+from ..model.made_up_skin import combine, coverage_weights, mix_slots
 from .table_set import Tables
 
 __all__ = [
@@ -69,8 +69,9 @@ class UniformLight:
 
 
 def uniform_light(tables: Tables) -> UniformLight:
-    """The :class:`UniformLight` parts of baked ``tables`` (their 1-D albedo and transmittance
-    tables averaged over incidence, :func:`lut_baker.model.albedo.bihemispherical`)."""
+    """The :class:`UniformLight` parts of baked ``tables`` (their 1-D albedo tables averaged
+    over incidence, :func:`lut_baker.model.albedo.bihemispherical`; the transmittance's mean
+    over exit as the tables store it)."""
     def average(name: str) -> NDArray[np.float64]:
         return bihemispherical(lambda theta: tables.directional(name, theta))
 
@@ -78,8 +79,9 @@ def uniform_light(tables: Tables) -> UniformLight:
         film_gloss=average("film_gloss_albedo"),
         film_diffuse=np.pi * np.asarray(tables.film_diffuse, float),
         path3_gloss=average("path3_gloss_albedo"),
-        through_film=(average("film_transmittance")
-                      * np.asarray(tables.film_transmittance_integral, float) / np.pi),
+        # T(theta_i) averaged over incidence as every part is (so the colour stays the
+        # directional albedo's average), T's mean over exit as the tables store it.
+        through_film=average("film_transmittance") * tables.film_transmittance_mean,
         skin_gloss=average("skin_gloss_albedo"),
     )
 
@@ -88,9 +90,9 @@ def _parts(light: UniformLight, skin_albedo: ArrayLike,
            gloss: float) -> dict[str, NDArray[np.float64]]:
     """The mixing rule's parts for skin albedo ``skin_albedo`` (RGB) and gloss factor ``gloss``."""
     a = np.broadcast_to(np.asarray(skin_albedo, float), (3,))
-    return {"top": gloss * light.film_gloss, "once": light.film_diffuse,
-            "twice": gloss * light.path3_gloss + a * light.through_film,
-            "bare": gloss * light.skin_gloss + a}
+    return mix_slots(film_gloss=gloss * light.film_gloss, film_diffuse=light.film_diffuse,
+                     path3_gloss=gloss * light.path3_gloss, through_film=a * light.through_film,
+                     skin_gloss=gloss * light.skin_gloss, skin=a)
 
 
 def made_up_colour(light: UniformLight, coverage: float, absorption: ArrayLike,

@@ -23,12 +23,12 @@ from support.addon_steps import (
 
 @pytest.mark.parametrize("tier", ["PRINCIPLED", "LAYERED", "EEVEE"])
 def test_apply_and_render(sphere, tmp_path, tier):
-    from makeup_skin_addon.keys import TIER_LABELS
+    from lut_baker.closures.tier_registry import tier as registered
 
     material, messages = apply_pipeline(sphere, tier)
     assert material.makeup_skin.is_made_up
     group = material.node_tree.nodes["Made-up Skin"].node_tree
-    assert group.name.startswith(f"Made-up Skin {TIER_LABELS[tier]} ")
+    assert group.name.startswith(f"Made-up Skin {registered(tier).label} ")
     meta = json.loads(group["makeup_skin_fit"])
     assert meta["tier"] == tier and meta["subsurface_method"] in ("BURLEY", "RANDOM_WALK_SKIN")
     if tier == "EEVEE":  # EEVEE's screen-space subsurface is Burley's

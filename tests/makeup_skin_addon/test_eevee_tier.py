@@ -11,6 +11,8 @@ so one render per case is its error.  Bounds: measured on 5.0.1 with margin for 
 Blender line and a busy machine.  Nine EEVEE renders of one shader: ~75 s per Blender line
 on 2 shared cores (each render after the first takes ~10 s on software OpenGL)."""
 
+import dataclasses
+
 import numpy as np
 import pytest
 from support import bench_scene as scene_module
@@ -18,7 +20,7 @@ from support import sphere_scene
 
 from lut_baker import bake
 from lut_baker.closures import cycles as cc
-from lut_baker.closures import fitting, tiers
+from lut_baker.closures import fitting, tier_registry, tiers
 from lut_baker.model import presets
 from lut_baker.offline.validation import compare
 
@@ -120,14 +122,17 @@ def test_eevee_renders_the_tier_as_its_replica(renders, made_up, light):
             lambda wi, wo: reflection(fit, tables, 1.0, 0.0, 1.0, (wi, wo)), SIZE, light,
             scene_module.IRRADIANCE)
 
-    error = compare.relative_rms(image, replica(tiers.eevee_tier_reflection))
+    error = compare.relative_rms(image, replica(
+        lambda fit_, tables_, *rest: tiers.tier_replica(fit_, tables_, "EEVEE", *rest)))
     print(f"light {light:g}: {100 * error:.2f}% against the replica")
     assert error < REPLICA_BOUND
 
+    in_cycles = dataclasses.replace(
+        tier_registry.EEVEE,
+        glossy=lambda wi, wo, lobe: cc.microfacet_reflection(wi, wo, lobe.roughness))
+
     def as_cycles(fit_, tables_, coverage, absorption, gloss, directions):
-        return tiers.view_weighted_tier(
-            fit_, tables_, coverage, absorption, gloss, directions,
-            tiers.view_weighted_parts(fit_, "EEVEE"),
-            lambda wi, wo, lobe: cc.microfacet_reflection(wi, wo, lobe.roughness))
+        return tiers.tier_replica(fit_, tables_, in_cycles, coverage, absorption, gloss,
+                                  directions)
 
     assert error < 0.4 * compare.relative_rms(image, replica(as_cycles))

@@ -34,7 +34,7 @@ import pytest
 
 from lut_baker.bake import bake
 from lut_baker.closures import fitting as cf
-from lut_baker.closures import tier_formulas, tiers
+from lut_baker.closures import tier_formulas, tier_registry, tiers
 from lut_baker.model import presets
 
 CELL = 3
@@ -248,14 +248,29 @@ def _render_grid(scene, materials, views_deg, tmp_path):
     return pixels[CELL // 2::CELL, CELL // 2::CELL]
 
 
-def _numpy(fit, case, parts=None):
+class _Recording(tier_formulas.NumpyAlgebra):
+    """The shader algebra as a list of ``(share, closure)``: each closure with its side's
+    share of the coverage mix."""
+
+    def closure(self, closure):
+        return [(1.0, closure)]
+
+    def add(self, *shaders):
+        return [item for shader in shaders for item in shader]
+
+    def mix(self, coverage, bare, covered):
+        return ([((1.0 - coverage) * share, c) for share, c in bare]
+                + [(coverage * share, c) for share, c in covered])
+
+
+def _numpy(fit, case, name="LAYERED"):
     """The tier formulas' inputs and algebra for one case, as the replicas take them (the
-    image of ``parts``, a view-weighted tier's, or the LAYERED tier's)."""
+    image of tier ``name``)."""
     coverage, absorption, gloss, skin_colour, view_deg = case
     x = tier_formulas.TierInputs.numpy(coverage, absorption, skin_colour, gloss)
-    parts = parts or tiers.view_weighted_parts(fit, "LAYERED")
-    rows = dict(zip(parts.rows, parts.lut, strict=True))
-    return x, tier_formulas.NumpyAlgebra(rows, np.cos(np.radians(view_deg)))
+    image = tier_registry.tier(name).image(fit)
+    rows = dict(zip(image.rows, image.lut, strict=True))
+    return x, _Recording(rows, np.cos(np.radians(view_deg)))
 
 
 def _principled_expected(fit, case):
@@ -266,18 +281,14 @@ def _principled_expected(fit, case):
 
 def _layered_expected(fit, case, eevee=False):
     """Each closure's colour times its weight and its side's share of the coverage mix."""
-    parts = tiers.view_weighted_parts(fit, "EEVEE" if eevee else "LAYERED")
-    x, algebra = _numpy(fit, case, parts)
-    closures = parts.closures(fit, x, algebra)
-    coverage = case[0]
+    name = "EEVEE" if eevee else "LAYERED"
+    x, algebra = _numpy(fit, case, name)
     out = {}
-    for share, side in ((coverage, closures.covered), (1.0 - coverage, closures.bare),
-                        (1.0, closures.shared)):
-        for closure in side:
-            weight = 1.0 if closure.weight is None else closure.weight
-            out[closure.name.replace("_", " ")] = np.ravel(share * closure.colour * weight)
-            if closure.weight is not None:
-                out[f"{closure.name} weight"] = np.broadcast_to(np.ravel(share * weight), (3,))
+    for share, closure in tier_registry.held(fit, name).shader(fit, x, algebra, None):
+        weight = 1.0 if closure.weight is None else closure.weight
+        out[closure.name.replace("_", " ")] = np.ravel(share * closure.colour * weight)
+        if closure.weight is not None:
+            out[f"{closure.name} weight"] = np.broadcast_to(np.ravel(share * weight), (3,))
     return out
 
 

@@ -102,13 +102,13 @@ def test_a_fit_holds_the_tiers_asked_for_and_takes_more_later(paper_tables, pape
     """Fitting some tiers fits and measures those alone (the others' parts are None and a
     tier's closures cannot be had of a fit without it); the rest fitted onto that fit later
     give what fitting them all at once gives."""
-    from lut_baker.closures import tiers
+    from lut_baker.closures import tier_registry, tiers
 
     layered = fitting.fit_closures(paper_tables, tiers=("LAYERED",))
     assert layered.tiers == ("LAYERED",) and set(layered.errors) == {"LAYERED"}
     assert layered.coat is None and layered.eevee_glossy is None and layered.eevee_lut is None
     with pytest.raises(ValueError, match="no EEVEE tier"):
-        tiers.view_weighted_parts(layered, "EEVEE")
+        tier_registry.held(layered, "EEVEE")
     _assert_same_parts(layered, paper_fit, ("LAYERED",))
     every = fitting.fit_closures(paper_tables, tiers=("EEVEE", "PRINCIPLED"), onto=layered)
     _assert_same_parts(every, paper_fit, tiers.TIERS)

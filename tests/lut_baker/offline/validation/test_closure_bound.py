@@ -40,8 +40,8 @@ def test_no_tier_beats_its_renderers_bound(bounds, paper_tables, paper_fit):
     grid = view_grid(min(lobe_widths_deg(paper_tables).values()), BOUND_VIEWS)
     target = paper_tables.made_up_reflection(*grid.directions, w, a)
     for renderer, tier in (("EEVEE", "EEVEE"), ("CYCLES", "LAYERED")):
-        replica = tiers.TIER_REPLICAS[tier](paper_fit, paper_tables, w, a,
-                                            directions=grid.directions)
+        replica = tiers.tier_replica(paper_fit, paper_tables, tier, w, a,
+                                     directions=grid.directions)
         assert bounds[renderer].error <= 1.02 * grid.error(replica, target), renderer
 
 

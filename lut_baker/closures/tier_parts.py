@@ -1,0 +1,205 @@
+"""Each built-in tier's parts of a closure fit, fitted to one set of tables: what the tier
+registry's fits (:attr:`lut_baker.closures.tier_registry.Tier.fit`) return.
+
+A Cycles shader sees the view direction but not the light's, so the tiers are closures
+(replicated in :mod:`lut_baker.closures.cycles` and :mod:`lut_baker.closures.eevee`) whose
+parameters are fitted to the tables, with weights that may depend on the view angle through
+1-D lookup images (:mod:`lut_baker.closures.view_image`).
+
+- :class:`FitTargets` -- what the lobes of one set of tables are fitted to, computed once.
+- :func:`principled_parts` -- one Principled BSDF's coat and speculars.
+- :func:`layered_parts` -- Cycles' Glossy lobes and their view-angle image.
+- :func:`eevee_parts` -- EEVEE's GGX lobes (the film's gloss in two) and their image.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from ..numerics.quadrature import trapezoid_weights
+from ..tables.table_set import Tables
+from . import cycles as cc
+from .lobes import (
+    EEVEE_GLOSSY,
+    ROUGHNESS_RANGE,
+    LobeFit,
+    fit_coat,
+    fit_glossy,
+    fit_glossy_pair,
+    fit_specular,
+)
+from .tier_formulas import SPECULAR_IOR
+from .view_grid import FIT_VIEWS, lobe_widths_deg, view_grid
+from .view_image import EEVEE_LUT_ROWS, LUT_ROWS, lut_nodes
+
+__all__ = ["FitTargets", "principled_parts", "layered_parts", "eevee_parts"]
+
+
+def _cosine_mean(values: np.ndarray, theta_deg: np.ndarray) -> np.ndarray:
+    """``2 Int v(mu) mu dmu`` of a directional table ``(n_theta[, C])`` (its hemispherical
+    cosine-weighted mean), trapezoid in ``mu``, held at its last value beyond ``theta_max``."""
+    mu = np.cos(np.radians(np.asarray(theta_deg, float)))[::-1]
+    values = np.asarray(values, float)[::-1]
+    mu = np.concatenate([[0.0], mu])
+    values = np.concatenate([values[:1], values])
+    w = trapezoid_weights(mu)
+    return 2.0 * np.tensordot(w * mu, values, axes=(0, 0))
+
+
+def _view_mean(albedo_of) -> float:
+    """``2 Int a(mu) mu dmu``: the cosine-weighted mean over view angles of ``albedo_of(mu)``
+    (trapezoid on 33 view cosines)."""
+    mu = np.linspace(0.0, 1.0, 33)
+    return float(2.0 * np.sum(trapezoid_weights(mu) * mu * albedo_of(mu)))
+
+
+def _coat_layering_mean(roughness: float, ior: float) -> float:
+    """:func:`_view_mean` of the coat's layering albedo
+    (:func:`lut_baker.closures.cycles.coat_view_terms`)."""
+    return _view_mean(lambda mu: cc.coat_view_terms(mu, roughness, ior)[1])
+
+
+def _layering_mean(roughness: float, ior: float, f0=None) -> float:
+    """:func:`_view_mean` of :func:`lut_baker.closures.cycles.layering_albedo` (its largest
+    channel)."""
+    return _view_mean(lambda mu: np.max(
+        np.atleast_2d(cc.layering_albedo(mu, roughness, ior, f0).T).T, axis=-1))
+
+
+class FitTargets:
+    """What the lobes of one set of tables are fitted to, computed when first asked for: the
+    grids sized by the film's and the skin's gloss (:func:`lobe_widths_deg`), the film's gloss,
+    the skin's gloss and path 3 on them, the film's transmittance rows of the view-angle
+    image."""
+
+    def __init__(self, tables: Tables, lut_size: int):
+        self.tables, self.lut_size = tables, lut_size
+        self.theta_deg = np.asarray(tables.theta_deg, float)
+        self._found: dict = {}
+
+    def _once(self, name, compute):
+        if name not in self._found:
+            self._found[name] = compute()
+        return self._found[name]
+
+    def grid(self, surface: str):
+        """The view grid sized by ``surface``'s gloss (``film_gloss`` or ``skin_gloss``)."""
+        return self._once(("grid", surface), lambda: view_grid(
+            lobe_widths_deg(self.tables)[surface], FIT_VIEWS))
+
+    def target(self, name: str):
+        """``(grid, table)`` of a gloss part: ``film_gloss`` on the film's grid,
+        ``path3_gloss`` and ``skin_gloss`` on the skin's."""
+        def compute():
+            if name == "path3_gloss":
+                grid = self.grid("skin_gloss")
+                return grid, self.tables.angular(name, *grid.directions)
+            grid = self.grid(name)
+            return grid, self.tables.surface_gloss(name, *grid.directions)
+        return self._once(("target", name), compute)
+
+    def albedo(self, name: str) -> np.ndarray:
+        """A gloss part's directional albedo table ``(n_theta, 3)``."""
+        return np.asarray(getattr(self.tables, name + "_albedo"))
+
+    def transmittance_rows(self) -> np.ndarray:
+        """The film's transmittance at the view-angle image's texels, ``(size, 3)``."""
+        def compute():
+            transmittance = np.asarray(self.tables.film_transmittance, float)
+            mu = lut_nodes(self.lut_size)
+            return np.stack([np.interp(np.degrees(np.arccos(mu)), self.theta_deg,
+                                       transmittance[:, c]) for c in range(3)], -1)
+        return self._once("transmittance_rows", compute)
+
+
+def _left_out_glossy(size: int) -> LobeFit:
+    """A Glossy lobe left out (a fit over the artist's shader has no bare skin of its own):
+    weights 0, error 1 (what leaving a lobe out errs)."""
+    return LobeFit(roughness=ROUGHNESS_RANGE[1], error=1.0, lut=np.zeros((size, 3)))
+
+
+def principled_parts(targets: FitTargets, over_shader: bool) -> dict:
+    """The PRINCIPLED tier's parts of a :class:`ClosureFit`: the coat, the two speculars (over
+    the artist's shader the bare one left out: level 0) and their mean layering albedos."""
+    tables, theta_deg = targets.tables, targets.theta_deg
+    film_grid, film_gloss = targets.target("film_gloss")
+    skin_grid, path3 = targets.target("path3_gloss")
+    coat = fit_coat(film_grid, film_gloss)
+    coat_ior = coat.ior
+    if coat_ior is None:
+        raise AssertionError("fit_coat gives an IOR")
+    e_coat = cc.coat_view_terms(skin_grid.cos_view, coat.roughness, coat_ior)[1]
+    specular_film = fit_specular(skin_grid, path3, attenuation=1.0 - e_coat)
+    if over_shader:
+        specular_bare = LobeFit(roughness=specular_film.roughness, ior=SPECULAR_IOR,
+                                level=0.0, error=1.0)
+    else:
+        specular_bare = fit_specular(skin_grid, targets.target("skin_gloss")[1])
+        # The node group mixes the two roughnesses by coverage: a dropped lobe (level 0) takes
+        # the other's, so that mixing never sharpens the remaining lobe.
+        if specular_film.level == 0.0:
+            specular_film = replace(specular_film, roughness=specular_bare.roughness)
+        elif specular_bare.level == 0.0:
+            specular_bare = replace(specular_bare, roughness=specular_film.roughness)
+
+    def specular_mean(lobe):
+        if lobe.level == 0.0:
+            return 0.0
+        f0 = float(cc.f0_from_ior(SPECULAR_IOR)) * 2.0 * lobe.level
+        return _layering_mean(lobe.roughness, float(cc.ior_from_f0(f0)), f0)
+
+    return {
+        "coat": coat,
+        "specular_bare": specular_bare,
+        "specular_film": specular_film,
+        "coat_albedo_mean": _coat_layering_mean(coat.roughness, coat_ior),
+        "specular_albedo_mean": (specular_mean(specular_bare), specular_mean(specular_film)),
+        "gloss_to_diffuse": (_cosine_mean(np.asarray(tables.path3_gloss_albedo), theta_deg)
+                             if specular_film.level == 0.0 else np.zeros(3)),
+    }
+
+
+def _image(targets: FitTargets, lobes: dict, rows: tuple) -> np.ndarray:
+    """The view-angle image of ``lobes``, rows named ``rows``."""
+    found = {**{name: lobes[name].lut for name in lobes},
+             "film_transmittance": targets.transmittance_rows(),
+             "film_gloss_diffuse": lobes["film_gloss"].diffuse_lut}
+    if any(found.get(name) is None for name in rows):
+        raise AssertionError("the lobes give every view-angle row")
+    return np.stack([found[name] for name in rows])
+
+
+def _glossy(targets: FitTargets, name: str, closures: tuple) -> LobeFit:
+    """:func:`fit_glossy` of one gloss part (the film's with its Lambertian companion)."""
+    grid, table = targets.target(name)
+    return fit_glossy(grid, table, targets.albedo(name), targets.theta_deg, targets.lut_size,
+                      companion=name == "film_gloss", closures=closures)
+
+
+def _view_weighted_lobes(targets: FitTargets, names: tuple, closures: tuple,
+                         over_shader: bool) -> dict:
+    """Glossy lobes of ``names`` (over the artist's shader ``skin_gloss`` left out)."""
+    return {name: (_left_out_glossy(targets.lut_size) if over_shader and name == "skin_gloss"
+                   else _glossy(targets, name, closures)) for name in names}
+
+
+def layered_parts(targets: FitTargets, over_shader: bool) -> dict:
+    """The LAYERED tier's parts: Cycles' Glossy lobes and their view-angle image."""
+    glossy = _view_weighted_lobes(targets, ("film_gloss", "path3_gloss", "skin_gloss"),
+                                  cc.GLOSSY_DISTRIBUTIONS, over_shader)
+    return {"glossy": glossy, "lut": _image(targets, glossy, LUT_ROWS)}
+
+
+def eevee_parts(targets: FitTargets, over_shader: bool) -> dict:
+    """The EEVEE tier's parts: EEVEE's GGX lobes (the film's gloss two of them and the
+    companion, :func:`fit_glossy_pair`) and their view-angle image."""
+    film_grid, film_gloss = targets.target("film_gloss")
+    first, second = fit_glossy_pair(film_grid, film_gloss, targets.albedo("film_gloss"),
+                                    targets.theta_deg, targets.lut_size)
+    eevee_glossy = {"film_gloss": first, "film_gloss_2": second,
+                    **_view_weighted_lobes(targets, ("path3_gloss", "skin_gloss"),
+                                           (EEVEE_GLOSSY,), over_shader)}
+    return {"eevee_glossy": eevee_glossy,
+            "eevee_lut": _image(targets, eevee_glossy, EEVEE_LUT_ROWS)}
