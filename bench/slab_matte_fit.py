@@ -1,24 +1,37 @@
-"""The matte products against a thick slab of a scattering medium instead of eq. 2 (a benchmark
-that prints fit errors; docs/model.md, "The film as a slab"; docs/foundations/README.md).
+"""The matte products as a thick slab (a medium under a surface) instead of eq. 2: fit and
+held-out errors, and whether the data determine the parameters (docs/model.md, "The matte
+products as a slab under a surface"; docs/foundations/README.md).
 
-    python bench/slab_matte_fit.py [--grid PANELS POINTS N_PHI]
+    python bench/slab_matte_fit.py [--products NAME ...] [--forms FORM ...]
+                                   [--grid PANELS POINTS N_PHI] [--starts K]
 
 For Clarins 103 and 108 (data/lanza2024, matte; eq. 2 fits them with P_d alone at 19.4% and
-19.5% rms, 23.1% and 19.0% held out) this fits an infinitely thick slab of a medium with a
-single-scattering albedo per channel and a two-lobe Henyey-Greenstein phase function (g1, g2,
-weight; shared by the channels, as Lanza et al. 2024 fit theirs), no surface, by adding and
-doubling (lut_baker.numerics.adding_doubling: the medium's transport matrices per Fourier
-order, the slab's infinite-thickness limit), read in the plane of incidence by a bicubic spline
-over the grid's polar nodes.  It prints the relative error (model/measured - 1) on every
-incidence, and fitted on alternate incidences predicting the others, as
-lut_baker/offline/foundations.py does for eq. 2.  Several starts; the best is printed.  About
-9 minutes on two cores at the default grid.
+19.5% rms, 23.1% and 19.0% held out) this fits, by adding (lut_baker.offline.matte_slab), an
+infinitely thick medium with a single-scattering albedo per channel in one of the forms
+
+- ``slab``: spheres with a two-lobe Henyey-Greenstein phase function, no surface (6
+  parameters: albedo RGB, g1, g2, weight);
+- ``surface``: spheres with one HG lobe under a rough dielectric surface (GGX, index eta,
+  roughness alpha; 6 parameters);
+- ``flakes_surface``: the same medium with specular flakes (GGX normals, a fraction of the
+  extinction and a roughness) mixed in, under the surface (8 parameters),
+
+read in the plane of incidence by a bicubic spline over the grid's polar nodes (the surface's
+own reflection in closed form).  Physical bounds: |g| <= 0.95, 1.01 <= eta <= 2, 0.05 <= alpha
+<= 1, 0.2 <= flake alpha <= 1.  It prints the relative error (model/measured - 1) on every
+incidence and, fitted on alternate incidences, on the others (as lut_baker/offline/foundations.py
+does for eq. 2); then the check that the fit is determined by its data: refitted from its
+optimum to the measurements moved by 1e-9 (relative, random signs), the largest change of a
+parameter to first order (< 1e-6 passes; :func:`data_response`) and whether a parameter sits at
+its bound (then it is not determined either).  About 2-5 minutes per product and form on
+one core at the default grid.
 """
 
 from __future__ import annotations
 
 import argparse
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -28,9 +41,9 @@ from scipy.optimize import least_squares
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from lut_baker.numerics import adding_doubling as AD  # noqa: E402
-from lut_baker.numerics.quadrature import hemisphere_panels, uniform_azimuths  # noqa: E402
+from lut_baker.numerics.quadrature import hemisphere_panels  # noqa: E402
 from lut_baker.offline.foundations import PRODUCTS  # noqa: E402
+from lut_baker.offline.matte_slab import MatteSlab, ggx_reflection, matte_slab_kernel  # noqa: E402
 from lut_baker.offline.measured.inplane import read_inplane  # noqa: E402
 from lut_baker.offline.measured.inplane_fit import (  # noqa: E402
     alternate_incidences,
@@ -38,111 +51,152 @@ from lut_baker.offline.measured.inplane_fit import (  # noqa: E402
 )
 
 DATA = ROOT / "data" / "lanza2024"
-STARTS = ((-0.3, -0.2, 0.0), (0.5, -0.5, 0.0), (-0.1, 0.6, 0.5), (0.0, 0.0, 0.0))
-"""Starts of (atanh g1, atanh g2, logit weight); the albedos start at logit 3, 2, 1."""
+G_MAX = 0.95
+"""|g| of a Henyey-Greenstein lobe stays below this (a sharper lobe needs more orders)."""
+PERTURBATION = 1e-9
+DETERMINED = 1e-6
+
+# Per form: parameter names after the three albedos, their lower and upper bounds in the
+# fitted (unbounded-style) coordinates, and the starts.
+LOG_ETA = (np.log(0.01), np.log(1.0))
+LOG_ALPHA = (np.log(0.05), 0.0)
+LOG_FLAKE_ALPHA = (np.log(0.2), 0.0)
+FORMS = {
+    "slab": (("g1", "g2", "weight"), ((-4.0, 4.0), (-4.0, 4.0), (-8.0, 8.0)),
+             ((-0.3, 1.2, 0.0), (0.5, -0.5, 0.0))),
+    "surface": (("g", "eta", "alpha"), ((-4.0, 4.0), LOG_ETA, LOG_ALPHA),
+                ((-0.3, np.log(0.4), np.log(0.3)), (0.5, np.log(0.2), np.log(0.6)))),
+    "flakes_surface": (("g", "flakes", "flake_alpha", "eta", "alpha"),
+                       ((-4.0, 4.0), (-8.0, 8.0), LOG_FLAKE_ALPHA, LOG_ETA, LOG_ALPHA),
+                       ((-0.3, 0.0, np.log(0.4), np.log(0.4), np.log(0.3)),
+                        (0.3, 1.0, np.log(0.25), np.log(0.2), np.log(0.6)))),
+}
 
 
-class ThickMedium:
-    """An infinitely thick slab of a two-lobe Henyey-Greenstein medium on one grid."""
-
-    def __init__(self, grid):
-        self.grid = grid
-        self.scale = AD.star_scale(grid)
-        self.mu = np.cos(grid.theta)
-        sin = np.sin(grid.theta)
-        cos_phi = np.cos(uniform_azimuths(grid.n_phi))
-        # cos of the angle between two downgoing directions (transmission-like: straight at
-        # azimuth 0); between a downgoing and an upgoing one it is the negative.
-        self.cos_between = (self.mu[:, None, None] * self.mu[None, :, None]
-                            + sin[:, None, None] * sin[None, :, None] * cos_phi)
-        self.theta_deg = np.degrees(grid.theta)
-
-    def _fourier(self, values):
-        spectrum = np.fft.rfft(values, axis=-1).real / self.grid.n_phi
-        spectrum[..., 1:] *= 2.0
-        return np.moveaxis(spectrum, -1, 0)
-
-    @staticmethod
-    def henyey_greenstein(g, cos_angle):
-        """The Henyey-Greenstein phase function (1/sr, integrating to 1 over the sphere)."""
-        return (1.0 - g * g) / (4.0 * np.pi * (1.0 + g * g - 2.0 * g * cos_angle) ** 1.5)
-
-    def reflection(self, albedo, g1, g2, weight):
-        """The thick slab's reflection kernel (1/sr) per channel and order."""
-        def phase(c):
-            return (weight * self.henyey_greenstein(g1, c)
-                    + (1.0 - weight) * self.henyey_greenstein(g2, c))
-
-        forward = self._fourier(phase(self.cos_between))
-        back = self._fourier(phase(-self.cos_between))
-        s = self.scale
-        k = s[:, :, None] * s[:, None, :] / np.outer(self.mu, self.mu)
-        single = np.asarray(albedo, float)[:, None, None, None]
-        loss = np.eye(self.mu.size) / self.mu[:, None] - single * forward * k
-        scatter = single * back * k
-        # Per unit of full thickness, half the half slab's transport matrices.
-        generator = AD.generator_from_matrices(0.5 * (loss + scatter), 0.5 * (loss - scatter))
-        return AD.from_star(AD.thick_slab(generator), s)
-
-    def in_plane(self, kernel, theta_i, theta_o):
-        """Reflectance factors ``pi f_r`` at ``theta_i`` and signed ``theta_o`` (> 0: the
-        mirror side, azimuth pi), ``(rows, channels)``."""
-        m = np.arange(kernel.shape[1])
-        out = np.empty((theta_i.size, kernel.shape[0]))
-        mirror_side = theta_o >= 0.0
-        for c in range(kernel.shape[0]):
-            values = []
-            for phi in (np.pi, 0.0):
-                plane = np.einsum("mab,m->ab", kernel[c], np.cos(m * phi))
-                spline = RectBivariateSpline(self.theta_deg, self.theta_deg, plane)
-                values.append(spline.ev(theta_i, np.abs(theta_o)))
-            out[:, c] = np.pi * np.where(mirror_side, values[0], values[1])
-        return out
+def _sigmoid(x):
+    return 1.0 / (1.0 + np.exp(-x))
 
 
-def unpack(p):
-    return 1.0 / (1.0 + np.exp(-p[:3])), np.tanh(p[3]), np.tanh(p[4]), 1.0 / (1.0 + np.exp(-p[5]))
+def unpack(form: str, p) -> MatteSlab:
+    """The model of the fitted coordinates ``p`` (albedos as logits, g as ``0.95 tanh``,
+    weights as logits, eta - 1 and roughnesses as logarithms)."""
+    kw: dict = {"albedo": _sigmoid(p[:3])}
+    if form == "slab":
+        kw.update(g1=G_MAX * np.tanh(p[3]), g2=G_MAX * np.tanh(p[4]), weight=_sigmoid(p[5]))
+    else:
+        kw.update(g1=G_MAX * np.tanh(p[3]), eta=1.0 + np.exp(p[-2]), alpha=np.exp(p[-1]))
+    if form == "flakes_surface":
+        kw.update(flakes=_sigmoid(p[4]), flake_alpha=np.exp(p[5]))
+    return MatteSlab(**kw)
 
 
-def fit(medium, theta_i, theta_o, rgb, rows, start):
+def physical(form: str, p) -> np.ndarray:
+    """The fitted model's parameters as numbers (albedo RGB, then the form's own)."""
+    m = unpack(form, p)
+    values = {"g1": m.g1, "g2": m.g2, "weight": m.weight, "g": m.g1, "eta": m.eta,
+              "alpha": m.alpha, "flakes": m.flakes, "flake_alpha": m.flake_alpha}
+    return np.array([*m.albedo, *(values[k] for k in FORMS[form][0])])
+
+
+def in_plane(grid, model: MatteSlab, theta_i, theta_o) -> np.ndarray:
+    """Reflectance factors ``pi f_r`` at ``theta_i`` and signed ``theta_o`` (degrees; > 0 the
+    mirror side), ``(rows, 3)``: the medium's light by a spline over the nodes, the surface's
+    gloss in closed form."""
+    kernel, _ = matte_slab_kernel(grid, model)
+    deg = np.degrees(grid.theta)
+    orders = np.arange(kernel.shape[1])
+    out = np.empty((theta_i.size, kernel.shape[0]))
+    for c in range(kernel.shape[0]):
+        sides = [RectBivariateSpline(deg, deg, np.einsum("mab,m->ab", kernel[c],
+                                                         np.cos(orders * phi)))
+                 .ev(theta_i, np.abs(theta_o)) for phi in (np.pi, 0.0)]
+        out[:, c] = np.pi * np.where(theta_o >= 0.0, sides[0], sides[1])
+    if model.eta > 1.0:
+        out += np.pi * ggx_reflection(np.cos(np.radians(theta_i)),
+                                      np.cos(np.radians(np.abs(theta_o))),
+                                      np.where(theta_o >= 0.0, -1.0, 1.0), model.alpha,
+                                      model.eta)[:, None]
+    return out
+
+
+def fit(grid, form, theta_i, theta_o, rgb, start, *, tight=False):
+    """Least squares of the relative residuals from ``start``, within the form's bounds."""
+    lower = np.array([-12.0] * 3 + [b[0] for b in FORMS[form][1]])
+    upper = np.array([12.0] * 3 + [b[1] for b in FORMS[form][1]])
+
     def residual(p):
-        try:
-            model = medium.in_plane(medium.reflection(*unpack(p)), theta_i[rows], theta_o[rows])
-        except (ValueError, np.linalg.LinAlgError):
-            return np.full(rgb[rows].size, 1e3)
-        return (model / rgb[rows] - 1.0).ravel()
+        return (in_plane(grid, unpack(form, p), theta_i, theta_o) / rgb - 1.0).ravel()
 
-    return least_squares(residual, start, diff_step=1e-4, max_nfev=300).x
+    tol = 1e-15 if tight else 1e-8
+    result = least_squares(residual, np.clip(start, lower + 1e-9, upper - 1e-9),
+                           bounds=(lower, upper), diff_step=1e-7 if tight else 1e-5,
+                           xtol=tol, ftol=tol, gtol=tol, max_nfev=400 if tight else 150)
+    at_bound = (result.x - lower < 1e-6) | (upper - result.x < 1e-6)
+    return result.x, at_bound
+
+
+def data_response(grid, form, theta_i, theta_o, rgb, p, seed: int = 0):
+    """``(change, condition)``: how far the fitted parameters move (largest absolute change of
+    :func:`physical`) when the measurements move by ``PERTURBATION`` (relative, random signs),
+    by the fit's linear response at its optimum ``p`` (the Gauss-Newton step
+    ``-(J^T J)^-1 J^T dr`` with ``J`` by central differences; an exact refit moves by this to
+    first order), and the condition number of ``J``."""
+    def residual(q, data):
+        return (in_plane(grid, unpack(form, q), theta_i, theta_o) / data - 1.0).ravel()
+
+    step = 1e-5
+    jac = np.stack([(residual(p + step * e, rgb) - residual(p - step * e, rgb)) / (2.0 * step)
+                    for e in np.eye(p.size)], axis=1)
+    noise = np.random.default_rng(seed).uniform(-1.0, 1.0, rgb.shape)
+    moved = rgb * (1.0 + PERTURBATION * noise)
+    dr = residual(p, moved) - residual(p, rgb)
+    dp = np.linalg.lstsq(jac, -dr, rcond=None)[0]
+    change = float(np.max(np.abs(physical(form, p + dp) - physical(form, p))))
+    return change, float(np.linalg.cond(jac))
 
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--grid", type=int, nargs=3, default=(6, 8, 65),
+    parser.add_argument("--products", nargs="+", default=["clarins_103", "clarins_108"])
+    parser.add_argument("--forms", nargs="+", default=list(FORMS), choices=list(FORMS))
+    parser.add_argument("--grid", type=int, nargs=3, default=(4, 8, 65),
                         metavar=("PANELS", "POINTS", "N_PHI"))
+    parser.add_argument("--starts", type=int, default=2)
     args = parser.parse_args(argv)
-    medium = ThickMedium(hemisphere_panels(*args.grid))
-    for name in ("clarins_103", "clarins_108"):
+    grid = hemisphere_panels(*args.grid)
+    np.seterr(all="ignore")
+    for name in args.products:
         data = read_inplane(DATA / PRODUCTS[name][0])
         ti, to, rgb = data.theta_i_deg, data.theta_o_deg, data.rgb
-        every = np.ones(ti.size, bool)
-        best = None
-        for start in STARTS:
-            p = fit(medium, ti, to, rgb, every, np.array([3.0, 2.0, 1.0, *start]))
-            err = relative_error(medium.in_plane(medium.reflection(*unpack(p)), ti, to), rgb)
-            if best is None or err[0] < best[0][0]:
-                best = (err, p)
-        (rms, worst), p = best
-        albedo, g1, g2, weight = unpack(p)
         fitted, held = alternate_incidences(data.incidences_deg)
-        q = fit(medium, ti, to, rgb, np.isin(ti, fitted), p)
-        rows = np.isin(ti, held)
-        held_rms, held_worst = relative_error(
-            medium.in_plane(medium.reflection(*unpack(q)), ti[rows], to[rows]), rgb[rows])
-        print(f"{name}: thick two-lobe HG slab, fit on every incidence {100 * rms:.1f}% rms, "
-              f"{100 * worst:.1f}% worst; fitted on {fitted} predicting {held}: "
-              f"{100 * held_rms:.1f}% rms, {100 * held_worst:.1f}% worst")
-        print(f"  single-scattering albedo {np.round(albedo, 4)}, g1 {g1:.3f}, g2 {g2:.3f}, "
-              f"weight of g1 {weight:.3f}")
+        for form in args.forms:
+            clock = time.perf_counter()
+            best = None
+            for start in FORMS[form][2][:args.starts]:
+                p, _ = fit(grid, form, ti, to, rgb, np.array([3.0, 2.0, 1.0, *start]))
+                err = relative_error(in_plane(grid, unpack(form, p), ti, to), rgb)
+                if best is None or err[0] < best[0][0]:
+                    best = (err, p)
+            assert best is not None
+            p, at_bound = fit(grid, form, ti, to, rgb, best[1], tight=True)
+            rms, worst = relative_error(in_plane(grid, unpack(form, p), ti, to), rgb)
+            change, condition = data_response(grid, form, ti, to, rgb, p)
+            rows = np.isin(ti, fitted)
+            q, _ = fit(grid, form, ti[rows], to[rows], rgb[rows], p)
+            out = ~rows
+            held_rms, held_worst = relative_error(
+                in_plane(grid, unpack(form, q), ti[out], to[out]), rgb[out])
+            names = ("albedo_r", "albedo_g", "albedo_b", *FORMS[form][0])
+            bound = [n for n, b in zip(names, at_bound, strict=True) if b]
+            print(f"{name} {form}: fit {100 * rms:.1f}% rms, {100 * worst:.1f}% worst; fitted on "
+                  f"{fitted} predicting {held}: {100 * held_rms:.1f}% rms, "
+                  f"{100 * held_worst:.1f}% worst ({time.perf_counter() - clock:.0f} s)")
+            values = physical(form, p)
+            print("  " + ", ".join(f"{n} {v:.4f}" for n, v in zip(names, values, strict=True)))
+            verdict = "determined" if change < DETERMINED and not bound else "NOT determined"
+            print(f"  data x (1 + {PERTURBATION:g} u): parameters move by {change:.2e} (condition "
+                  f"{condition:.1e}); at a bound: "
+                  f"{', '.join(bound) or 'none'} -> {verdict}", flush=True)
     return 0
 
 

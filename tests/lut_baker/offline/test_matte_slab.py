@@ -1,0 +1,92 @@
+"""The thick medium under a rough surface (lut_baker/offline/matte_slab.py): its formulas'
+properties (normalisation, the smooth and no-surface limits, reciprocity, energy)."""
+
+import numpy as np
+import pytest
+
+from lut_baker.model.microfacet import fresnel_reflectance
+from lut_baker.numerics import adding_doubling as AD
+from lut_baker.numerics.quadrature import hemisphere_panels
+from lut_baker.offline.matte_slab import (
+    MatteSlab,
+    flake_extinction,
+    flake_orders,
+    ggx_albedo,
+    ggx_reflection,
+    matte_slab_kernel,
+    phase_orders,
+    refracted_grid,
+)
+
+GRID = hemisphere_panels(3, 8, 33)
+MU = np.cos(GRID.theta)
+
+
+def _scattered(forward, back):
+    """Each node's kernel integrated over the sphere (order 0), 1/sr * sr."""
+    return ((forward[0] + back[0]) * 2.0 * np.pi * GRID.weight / MU).sum(axis=1)
+
+
+def test_smooth_surface_reflects_fresnel():
+    # GGX of vanishing roughness is the smooth interface: its albedo is Fresnel's.
+    np.testing.assert_allclose(ggx_albedo(MU, 1e-4, 1.5), fresnel_reflectance(MU, 1.5),
+                               atol=2e-3)
+
+
+@pytest.mark.parametrize("alpha", [0.1, 0.5, 1.0])
+def test_surface_is_reciprocal_and_passive(alpha):
+    a = ggx_reflection(0.3, 0.8, -0.4, alpha, 1.5)
+    b = ggx_reflection(0.8, 0.3, -0.4, alpha, 1.5)
+    assert a == pytest.approx(b, rel=1e-12)
+    albedo = ggx_albedo(MU, alpha, 1.5)
+    assert np.all((albedo > 0.0) & (albedo < 1.0))
+
+
+def test_refracted_grid_covers_the_hemisphere():
+    inside = refracted_grid(GRID, 1.4, 8)
+    # Int cos sin dtheta over [0, 90] degrees = 1/2, split at the critical angle.
+    assert inside.weight.sum() == pytest.approx(0.5, rel=1e-9)
+    assert np.degrees(inside.theta[:MU.size]).max() < np.degrees(np.arcsin(1 / 1.4))
+
+
+@pytest.mark.parametrize("alpha", [0.5, 0.8, 1.0])
+def test_flakes_scatter_what_they_intercept(alpha):
+    # sigma(w) p(w -> w') integrates to the projected area sigma(w); isotropic normals
+    # (GGX alpha = 1) project the same area every way.
+    np.testing.assert_allclose(_scattered(*flake_orders(GRID, alpha)),
+                               flake_extinction(MU, alpha), rtol=1e-2)
+    if alpha == 1.0:
+        np.testing.assert_allclose(flake_extinction(MU, alpha), 1.0, rtol=1e-12)
+
+
+def test_phase_function_is_normalised():
+    np.testing.assert_allclose(_scattered(*phase_orders(GRID, 0.6, -0.3, 0.7)), 1.0, rtol=2e-3)
+
+
+MODELS = [
+    MatteSlab(albedo=np.array([0.999, 0.95, 0.6]), g1=0.4),
+    MatteSlab(albedo=np.array([0.999, 0.95, 0.6]), g1=-0.3, eta=1.5, alpha=0.4),
+    MatteSlab(albedo=np.array([0.98, 0.9, 0.6]), g1=0.2, flakes=0.5, flake_alpha=0.6,
+              eta=1.3, alpha=0.8),
+]
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_reciprocal_and_energy_at_most_one(model):
+    kernel, a_g = matte_slab_kernel(GRID, model)
+    scale = AD.star_scale(GRID)
+    star = AD.to_star(kernel, scale)
+    np.testing.assert_allclose(star, np.swapaxes(star, -1, -2), atol=1e-12)
+    total = AD.star_albedo(star[:, 0], scale[0]) + a_g
+    assert np.all(total <= 1.0 + 1e-9)
+    # Darker single scattering reflects less.
+    assert np.all(np.diff(total, axis=0) < 0.0)
+
+
+def test_no_surface_is_the_limit_of_a_vanishing_one():
+    bare = MatteSlab(albedo=np.array([0.9]), g1=0.3)
+    faint = MatteSlab(albedo=np.array([0.9]), g1=0.3, eta=1.0 + 1e-7, alpha=0.3)
+    k_bare, _ = matte_slab_kernel(GRID, bare)
+    k_faint, a_g = matte_slab_kernel(GRID, faint)
+    assert np.max(a_g) < 1e-6
+    np.testing.assert_allclose(k_faint, k_bare, atol=1e-2 * np.max(np.abs(k_bare)))
