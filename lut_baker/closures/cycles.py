@@ -318,7 +318,7 @@ def microfacet_albedo(cos_view: ArrayLike, roughness: float, fresnel: OfCosine |
     hx = sin_h[None, :, None] * np.cos(phi)[None, None, :]
     hz = cos_h[None, :, None]
     h_dot_o = hx * sin_o + hz * mu_o
-    mu_i = 2.0 * h_dot_o * hz - mu_o
+    mu_i = h_dot_o * (2.0 * hz) - mu_o  # 2 h.wo n.h - n.wo (doubling is exact)
     valid = (h_dot_o > 0.0) & (mu_i > 0.0)
     if distribution == "ASHIKHMIN_SHIRLEY":
         value = np.where(valid, mu_i / np.maximum(mu_i, mu_o), 0.0)
