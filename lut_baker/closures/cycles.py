@@ -121,7 +121,7 @@ def beckmann_distribution(cos_h: ArrayLike, alpha: Real) -> NDArray[np.float64]:
         return np.exp(-(1.0 - c2) / (c2 * a2)) / (np.pi * a2 * c2 * c2)
 
 
-def _in_place(values) -> bool:
+def _in_place(values: object) -> bool:
     """Whether ``values`` is an array the caller owns, to be worked on in place (the same
     operations in the same order as on fresh arrays: the same numbers, without a temporary
     array per step on the quadratures' large grids)."""
