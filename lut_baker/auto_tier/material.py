@@ -22,9 +22,9 @@ from ..closures.tiers import tier_errors, tier_reflection
 from ..model.dipole import dipole_profile, dipole_total_reflectance
 from ..model.made_up_skin import combine, coverage_weights, mix_slots
 from ..model.presets import made_up_skin
-from ..numerics.geometry import polar_angle_deg, sphere_directions
+from ..numerics.geometry import sphere_directions
 from ..numerics.quadrature import trapezoid_weights
-from ..tables.table_set import radius_nodes
+from ..tables.table_set import ReflectionParts, radius_nodes
 from .measured import by_number, load
 
 __all__ = ["MaterialTraits", "traits_from_tables", "paper_traits", "profile_mean_radius_mm",
@@ -143,12 +143,15 @@ def profile_mean_radius_mm(radius_mm, profile) -> float:
 @dataclass
 class _Sphere:
     """A sphere's lit pixels under one distant light (orthographic, the reference's
-    framing): their directions, ``cos(theta_i)`` ``(N, 1)`` and the tables' radiance
-    ``f cos(theta_i)`` at a coverage and absorption, with its RMS ``norm``."""
+    framing): their directions, ``cos(theta_i)`` ``(N, 1)``, the tables' lookups there
+    (:meth:`lut_baker.tables.table_set.Tables.reflection_parts`, made once for the total, the
+    bare skin and the shares) and the tables' radiance ``f cos(theta_i)`` at a coverage and
+    absorption, with its RMS ``norm``."""
 
     wi: np.ndarray
     wo: np.ndarray
     cos_i: np.ndarray
+    parts: ReflectionParts
     total: np.ndarray
     norm: float
     _bare: np.ndarray | None = None
@@ -156,26 +159,26 @@ class _Sphere:
     def bare(self, tables, absorption) -> np.ndarray:
         """The tables' bare skin's BRDF at the pixels (computed once)."""
         if self._bare is None:
-            self._bare = tables.made_up_reflection(self.wi, self.wo, 0.0, absorption)
+            self._bare = tables.mixed_reflection(self.parts, 0.0, absorption)
         return self._bare
 
 
 def _sphere(tables, light_deg: float, w, a, resolution: int) -> _Sphere:
     _, wi, wo = sphere_directions(resolution, light_deg)
     cos_i = wi[:, 2:3]
-    total = tables.made_up_reflection(wi, wo, w, a) * cos_i
-    return _Sphere(wi, wo, cos_i, total, float(np.sqrt(np.mean(total**2))))
+    parts = tables.reflection_parts(wi, wo)
+    total = tables.mixed_reflection(parts, w, a) * cos_i
+    return _Sphere(wi, wo, cos_i, parts, total, float(np.sqrt(np.mean(total**2))))
 
 
 def _shares(tables, sphere: _Sphere, w, a) -> tuple[float, float]:
-    """:func:`gloss_and_skin_shares` on a sphere's pixels."""
-    wi, wo, cos_i = sphere.wi, sphere.wo, sphere.cos_i
+    """:func:`gloss_and_skin_shares` on a sphere's pixels (its lookups reused)."""
+    cos_i, looked_up = sphere.cos_i, sphere.parts.angular
     weights = coverage_weights(w, a)
-    gloss = combine(weights, **mix_slots(film_gloss=tables.angular("film_gloss", wi, wo),
-                                         path3_gloss=tables.angular("path3_gloss", wi, wo),
-                                         skin_gloss=tables.angular("skin_gloss", wi, wo))) * cos_i
-    t_i = tables.directional("film_transmittance", polar_angle_deg(wi))
-    t_o = tables.directional("film_transmittance", polar_angle_deg(wo))
+    gloss = combine(weights, **mix_slots(film_gloss=looked_up["film_gloss"],
+                                         path3_gloss=looked_up["path3_gloss"],
+                                         skin_gloss=looked_up["skin_gloss"])) * cos_i
+    t_i, t_o = sphere.parts.t_i, sphere.parts.t_o
     skin = combine(weights, **mix_slots(through_film=tables.skin_diffuse * t_i * t_o,
                                         skin=tables.skin_diffuse)) * cos_i
     norm = sphere.norm

@@ -121,14 +121,36 @@ def beckmann_distribution(cos_h: ArrayLike, alpha: Real) -> NDArray[np.float64]:
         return np.exp(-(1.0 - c2) / (c2 * a2)) / (np.pi * a2 * c2 * c2)
 
 
+def _in_place(values: object) -> bool:
+    """Whether ``values`` is an array the caller owns, to be worked on in place (the same
+    operations in the same order as on fresh arrays: the same numbers, without a temporary
+    array per step on the quadratures' large grids)."""
+    return isinstance(values, np.ndarray) and values.ndim > 0
+
+
 def _alpha_tan2(cos_theta: ArrayLike, alpha: Real) -> NDArray[np.float64]:
-    c2 = np.square(np.asarray(cos_theta, float))
-    return np.square(alpha) * np.maximum(1.0 / np.maximum(c2, 1e-300) - 1.0, 0.0)
+    """``alpha^2 tan^2(theta)`` at ``cos(theta)`` (0 for a cosine of 1 or more)."""
+    t2 = np.square(np.asarray(cos_theta, float))
+    if not _in_place(t2):
+        return np.square(alpha) * np.maximum(1.0 / np.maximum(t2, 1e-300) - 1.0, 0.0)
+    np.maximum(t2, 1e-300, out=t2)
+    np.divide(1.0, t2, out=t2)
+    t2 -= 1.0
+    np.maximum(t2, 0.0, out=t2)
+    t2 *= np.square(alpha)
+    return t2
 
 
 def ggx_lambda(cos_theta: ArrayLike, alpha: Real) -> NDArray[np.float64]:
     """Smith ``Lambda = (sqrt(1 + alpha^2 tan^2) - 1) / 2`` of GGX (Heitz 2014, eq. 72)."""
-    return 0.5 * (np.sqrt(1.0 + _alpha_tan2(cos_theta, alpha)) - 1.0)
+    value = _alpha_tan2(cos_theta, alpha)
+    if not _in_place(value):
+        return 0.5 * (np.sqrt(1.0 + value) - 1.0)
+    value += 1.0
+    np.sqrt(value, out=value)
+    value -= 1.0
+    value *= 0.5
+    return value
 
 
 def beckmann_lambda(cos_theta: ArrayLike, alpha: Real) -> NDArray[np.float64]:
@@ -197,7 +219,13 @@ def microfacet_shadowing(cos_i: ArrayLike, cos_o: ArrayLike, alpha: Real,
     """Height-correlated masking-shadowing ``G2 = 1 / (1 + Lambda_i + Lambda_o)``
     (Cycles ``bsdf_G``)."""
     lam = DISTRIBUTIONS[distribution][1]
-    return 1.0 / (1.0 + lam(cos_i, alpha) + lam(cos_o, alpha))
+    lam_i, lam_o = lam(cos_i, alpha), lam(cos_o, alpha)
+    if not (_in_place(lam_i) and lam_i.shape == np.broadcast_shapes(lam_i.shape,
+                                                                    np.shape(lam_o))):
+        return 1.0 / (1.0 + lam_i + lam_o)
+    lam_i += 1.0
+    lam_i += lam_o
+    return np.divide(1.0, lam_i, out=lam_i)
 
 
 def dielectric_fresnel(cos_theta: ArrayLike, eta: ArrayLike) -> NDArray[np.float64]:
@@ -318,13 +346,15 @@ def microfacet_albedo(cos_view: ArrayLike, roughness: float, fresnel: OfCosine |
     hx = sin_h[None, :, None] * np.cos(phi)[None, None, :]
     hz = cos_h[None, :, None]
     h_dot_o = hx * sin_o + hz * mu_o
-    mu_i = 2.0 * h_dot_o * hz - mu_o
+    mu_i = h_dot_o * (2.0 * hz) - mu_o  # 2 h.wo n.h - n.wo (doubling is exact)
     valid = (h_dot_o > 0.0) & (mu_i > 0.0)
     if distribution == "ASHIKHMIN_SHIRLEY":
         value = np.where(valid, mu_i / np.maximum(mu_i, mu_o), 0.0)
     else:
         g2 = microfacet_shadowing(np.where(valid, mu_i, 1.0), mu_o, alpha, distribution)
-        value = np.where(valid, g2 * h_dot_o / (mu_o * hz), 0.0)
+        g2 *= h_dot_o  # g2 h.wo / (n.wo n.h), in place (a new full-size array)
+        g2 /= mu_o * hz
+        value = np.where(valid, g2, 0.0)
     weights = w_u[None, :, None] / n_phi
     if fresnel is None:
         total = np.sum(value * weights, axis=(1, 2))

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
+from functools import lru_cache
 from typing import TypedDict
 
 import numpy as np
@@ -107,6 +108,20 @@ LobeTimes = Callable[[float], Callable[[float], NDArray[np.float64]]]
 """``lobe_times(roughness)(second)``: the factor per pair a GGX lobe is multiplied by."""
 
 
+def _per_value(compute: Callable[[float], NDArray[np.float64]]
+               ) -> Callable[[float], NDArray[np.float64]]:
+    """``compute`` remembered by its argument: the scan of :func:`_fit_roughness_and` asks for
+    the same :data:`SECOND_SCAN` values of the second parameter at every roughness."""
+    found: dict[float, NDArray[np.float64]] = {}
+
+    def once(value: float) -> NDArray[np.float64]:
+        value = float(value)
+        if value not in found:
+            found[value] = compute(value)
+        return found[value]
+    return once
+
+
 def _fit_roughness_and(grid: ViewGrid, target: ArrayLike, lobe_times: LobeTimes,
                        second_range: tuple[float, float]) -> tuple[float, float, float]:
     """``(roughness, second, error)``: a GGX lobe times ``lobe_times(roughness)(second)`` (a
@@ -148,13 +163,15 @@ def fit_coat(grid: ViewGrid, target: ArrayLike) -> LobeFit:
     if not np.any(np.asarray(target, float)):
         return LobeFit(roughness=ROUGHNESS_RANGE[1], ior=COAT_IOR_RANGE[0], level=0.0,
                        error=0.0)
+    fresnel = _per_value(lambda ior: cc.dielectric_fresnel(grid.cos_hi, ior))
+
     def lobe_times(roughness: float) -> Callable[[float], NDArray[np.float64]]:
-        albedo = cc.microfacet_albedo(grid.cos_view, roughness, **SEARCH_QUADRATURE)
+        albedo = glossy_albedo(grid.cos_view, roughness, "GGX", final=False)
         average = cc.ggx_average_albedo(roughness)
 
         def factor(ior: float) -> NDArray[np.float64]:
             scale = cc.ggx_energy_scale(albedo, average, float(cc.dielectric_fss(ior)))[0]
-            return cc.dielectric_fresnel(grid.cos_hi, ior) * scale[:, None, None]
+            return fresnel(ior) * scale[:, None, None]
         return factor
 
     roughness, ior, error = _fit_roughness_and(grid, target, lobe_times, COAT_IOR_RANGE)
@@ -180,8 +197,10 @@ def fit_specular(grid: ViewGrid, target: ArrayLike,
     scale: float | NDArray[np.float64] = (1.0 if attenuation is None
                                           else np.asarray(attenuation, float)[:, None, None])
 
+    fresnel = _per_value(lambda level: scale * _specular_fresnel(grid.cos_hi, level))
+
     def lobe_times(roughness: float) -> Callable[[float], NDArray[np.float64]]:
-        return lambda level: scale * _specular_fresnel(grid.cos_hi, level)
+        return fresnel
 
     roughness, level, error = _fit_roughness_and(grid, target, lobe_times,
                                                  SPECULAR_LEVEL_RANGE)
@@ -247,8 +266,26 @@ def glossy_albedo(cos_view: ArrayLike, roughness: float, closure: str, *,
     searching), in closed form for EEVEE's."""
     if closure == EEVEE_GLOSSY:
         return eevee.glossy_albedo(cos_view, roughness)
-    return cc.microfacet_albedo(cos_view, roughness, distribution=closure,
-                                **(FINAL_QUADRATURE if final else SEARCH_QUADRATURE))
+    if not final:
+        views = np.ascontiguousarray(cos_view, float)
+        return _search_albedo(views.tobytes(), views.shape, float(roughness), closure)
+    return cc.microfacet_albedo(cos_view, roughness, distribution=closure, **FINAL_QUADRATURE)
+
+
+SEARCH_ALBEDOS = 256
+"""Closure albedos at :data:`SEARCH_QUADRATURE` kept for the session (0.1 kB each): every
+search starts on the same roughnesses at the same views (:data:`ROUGHNESS_SCAN`,
+:data:`lut_baker.closures.view_grid.FIT_VIEWS`), the film's, path 3's and the coat's alike."""
+
+
+@lru_cache(maxsize=SEARCH_ALBEDOS)
+def _search_albedo(views: bytes, shape: tuple, roughness: float,
+                   closure: str) -> NDArray[np.float64]:
+    """:func:`glossy_albedo` while searching, by the views' bytes (read-only: shared)."""
+    albedo = cc.microfacet_albedo(np.frombuffer(views).reshape(shape), roughness,
+                                  distribution=closure, **SEARCH_QUADRATURE)
+    albedo.setflags(write=False)
+    return albedo
 
 
 def fit_glossy(grid: ViewGrid, target: ArrayLike, albedo_table: np.ndarray,

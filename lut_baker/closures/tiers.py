@@ -175,8 +175,9 @@ def tier_errors(fit: ClosureFit, tables: Tables, coverage: float, absorption: Ar
         return {}
     grid = view_grid(min(lobe_widths_deg(tables).values()), ERROR_VIEWS)
     directions = grid.directions
-    reference = tables.made_up_reflection(*directions, coverage, absorption)
-    bare = tables.made_up_reflection(*directions, 0.0, absorption) if over_shader else None
+    looked_up = tables.reflection_parts(*directions)  # one lookup for both coverages
+    reference = tables.mixed_reflection(looked_up, coverage, absorption)
+    bare = tables.mixed_reflection(looked_up, 0.0, absorption) if over_shader else None
     out = {}
     for name in TIERS:
         if name not in tiers:

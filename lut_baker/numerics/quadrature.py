@@ -318,11 +318,15 @@ def mirror_quadrature(theta: ArrayLike, width_deg: float, *,
     alpha = alpha.reshape(angles.size, -1, phi.size)
     d_alpha = (length[:, :, None] * wx[None, None, :, None]).reshape(alpha.shape)
     sin_a, cos_a = np.sin(alpha), np.cos(alpha)
-    h = np.stack([sin_a * np.cos(phi), sin_a * np.sin(phi), cos_a], axis=-1)
+    hx, hy = sin_a * np.cos(phi), sin_a * np.sin(phi)  # h = (hx, hy, cos_a)
     fixed = np.stack([sin_t[:, 0], np.zeros_like(angles), cos_t[:, 0]], axis=-1)
-    cos_dh = np.clip(np.einsum("nc,napc->nap", fixed, h), 0.0, 1.0)
-    other = 2.0 * cos_dh[..., None] * h - fixed[:, None, None, :]
-    other[..., 2] = np.maximum(other[..., 2], 0.0)  # rounding at the horizon
+    sin_d, cos_d = sin_t[:, :, None], cos_t[:, :, None]
+    cos_dh = np.clip(sin_d * hx + cos_d * cos_a, 0.0, 1.0)  # d.h, d = (sin_t, 0, cos_t)
+    twice = 2.0 * cos_dh
+    other = np.empty(alpha.shape + (3,))  # e = 2 (d.h) h - d, component by component
+    np.subtract(twice * hx, sin_d, out=other[..., 0])
+    np.subtract(twice * hy, 0.0, out=other[..., 1])
+    np.maximum(twice * cos_a - cos_d, 0.0, out=other[..., 2])  # rounding at the horizon
     weight = 2.0 * 4.0 * cos_dh * sin_a * d_alpha * wphi
     return MirrorQuadrature(theta=angles, fixed=fixed, other=other, weight=weight,
                             cos_h=cos_a, cos_dh=cos_dh)

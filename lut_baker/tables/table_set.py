@@ -61,8 +61,9 @@ bake's error study measures it against the exact evaluator.
 Contents
 --------
 - :class:`Tables` -- the arrays, with the lookups ``angular``, ``directional``, ``radial``,
-  ``made_up_reflection`` and ``directional_albedo``, and the closed-form surface gloss
-  (``surface_layer``).
+  ``made_up_reflection`` (or ``reflection_parts`` looked up once, then ``mixed_reflection`` at
+  each coverage and absorption) and ``directional_albedo``, and the closed-form surface gloss
+  (``surface_layer``); :class:`ReflectionParts` what ``reflection_parts`` looks up.
 - :func:`theta_nodes`, :func:`theta_index`, :func:`radius_nodes`, :func:`radius_index`,
   :func:`phi_index`, :func:`node_cos_azimuths` -- the closed-form grids and their inverse.
 """
@@ -83,6 +84,7 @@ from ..numerics.geometry import direction, folded_azimuth_deg, half_vector, pola
 __all__ = [
     "FORMAT_VERSION",
     "Tables",
+    "ReflectionParts",
     "ANGULAR",
     "SURFACE_GLOSS",
     "DIRECTIONAL",
@@ -262,6 +264,19 @@ def _trilinear(table: np.ndarray, xi: np.ndarray, xo: np.ndarray, xp: np.ndarray
             for dk, wk in ((0, 1.0 - tk), (1, tk)):
                 out = out + (wi * wj * wk)[..., None] * table[i + di, j + dj, k + dk]
     return out
+
+
+@dataclass(frozen=True, eq=False)
+class ReflectionParts:
+    """The lookups :meth:`Tables.made_up_reflection` mixes, at some directions: ``angular``
+    (each angular part by name, ``(..., 3)``), the film's transmittance toward the light and
+    the view ``t_i``, ``t_o`` ``(..., 3)``, and ``upper`` ``(...)``, where both directions are
+    above the surface."""
+
+    angular: dict
+    t_i: np.ndarray
+    t_o: np.ndarray
+    upper: np.ndarray
 
 
 @dataclass(frozen=True, eq=False)
@@ -465,20 +480,32 @@ class Tables:
         """The tabulated angular parts."""
         return ANGULAR + (("inter_reflection",) if self.inter_reflection is not None else ())
 
+    def reflection_parts(self, wi: ArrayLike, wo: ArrayLike) -> ReflectionParts:
+        """What :meth:`made_up_reflection` looks up at unit directions ``(..., 3)`` before
+        coverage and absorption mix it (:class:`ReflectionParts`): one lookup serves every
+        coverage and absorption at the same directions."""
+        to_light, to_view = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
+        return ReflectionParts(
+            angular={name: self.angular(name, to_light, to_view)
+                     for name in self._angular_names() + tuple(SURFACE_GLOSS)},
+            t_i=self.directional("film_transmittance", polar_angle_deg(to_light)),
+            t_o=self.directional("film_transmittance", polar_angle_deg(to_view)),
+            upper=(to_light[..., 2] >= 0.0) & (to_view[..., 2] >= 0.0))
+
+    def mixed_reflection(self, parts: ReflectionParts, coverage: float | None = None,
+                         absorption: ArrayLike | None = None) -> NDArray[np.float64]:
+        """:meth:`made_up_reflection` from its looked-up ``parts`` (:meth:`reflection_parts`)
+        at a coverage and absorption (default: the baked ones)."""
+        value = self._combine(parts.angular, parts.t_i, parts.t_o, coverage, absorption)
+        return np.where(parts.upper[..., None], value, 0.0)
+
     def made_up_reflection(self, wi: ArrayLike, wo: ArrayLike, coverage: float | None = None,
                            absorption: ArrayLike | None = None) -> NDArray[np.float64]:
         """Made-up skin BRDF (1/sr, ``(..., 3)``) interpolated from the tables: the module
         docstring's formula, plus the inter-reflection table if baked (exact at the baked
         absorption only).  ``coverage``, ``absorption`` default to the baked ones; 0 where
         ``wi`` or ``wo`` is below the surface."""
-        to_light, to_view = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
-        parts = {name: self.angular(name, to_light, to_view)
-                 for name in self._angular_names() + tuple(SURFACE_GLOSS)}
-        t_i = self.directional("film_transmittance", polar_angle_deg(to_light))
-        t_o = self.directional("film_transmittance", polar_angle_deg(to_view))
-        value = self._combine(parts, t_i, t_o, coverage, absorption)
-        upper = (to_light[..., 2] >= 0.0) & (to_view[..., 2] >= 0.0)
-        return np.where(upper[..., None], value, 0.0)
+        return self.mixed_reflection(self.reflection_parts(wi, wo), coverage, absorption)
 
     def node_values(self, coverage: float | None = None, absorption: ArrayLike | None = None,
                     theta_index: NDArray[np.intp] | None = None,

@@ -64,3 +64,17 @@ def test_texels_wrap_as_the_texture_extension_does(addon):
         read = image_texels.read_texels(pixels, uv, extension)
         np.testing.assert_allclose(read, np.repeat(np.array(values, float)[:, None], 3, 1),
                                    atol=1e-12, err_msg=extension)
+
+
+def test_the_srgb_curve_of_rgba_pixels_read_as_rgb(addon):
+    """The RGB view of RGBA pixels (not contiguous) is linearised as float32 values, within
+    single-precision rounding of the IEC 61966-2-1 curve in double precision."""
+    from makeup_skin_addon import image_texels
+
+    rng = np.random.default_rng(3)
+    levels = np.arange(256, dtype=np.float32) * np.float32(1.0 / 255.0)
+    rgba = np.concatenate([levels[rng.integers(0, 256, 4000)],
+                           rng.random(4000).astype(np.float32)]).reshape(-1, 4)
+    read = image_texels.srgb_to_linear(rgba[:, :3])
+    assert read.dtype == np.float32 and read.shape == (2000, 3)
+    np.testing.assert_allclose(read, linear(rgba[:, :3].astype(float)), rtol=1e-6, atol=1e-9)

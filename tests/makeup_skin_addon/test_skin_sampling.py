@@ -176,3 +176,4 @@ def test_with_a_camera_the_points_count_by_what_it_sees(two_faces):
     away = artist_skin.read_material(skin, scene)
     np.testing.assert_allclose(away.leaves[0].base, everywhere, atol=1e-6)
     assert any("sees none of it" in note for note in away.notes)
+
