@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..numerics.geometry import sphere_normals
 
@@ -27,7 +28,8 @@ KERNEL_SUBSAMPLES = 4
 """Sub-samples per cell side when integrating the profile over a kernel cell."""
 
 
-def blur_kernel(cell_mm: float, radius_mm, profile) -> np.ndarray:
+def blur_kernel(cell_mm: float, radius_mm: ArrayLike, profile: ArrayLike
+                ) -> NDArray[np.float64]:
     """The normalised profile integrated over square cells of ``cell_mm``: ``(2h+1, 2h+1, C)``
     weights summing to 1 per channel, ``h`` cells reaching the profile's last distance.  The
     centre cell takes what the others leave (the profile's peak at 0 is integrable but not
@@ -52,7 +54,8 @@ def blur_kernel(cell_mm: float, radius_mm, profile) -> np.ndarray:
     return cells
 
 
-def _convolve(image: np.ndarray, kernel: np.ndarray) -> np.ndarray:
+def _convolve(image: NDArray[np.float64], kernel: NDArray[np.float64]
+              ) -> NDArray[np.float64]:
     """``image`` (m, m) convolved with ``kernel`` (k, k), same size, zero outside (FFT)."""
     m, k = image.shape[0], kernel.shape[0]
     size = m + k - 1
@@ -63,7 +66,8 @@ def _convolve(image: np.ndarray, kernel: np.ndarray) -> np.ndarray:
 
 
 def subsurface_omission_error(footprint_mm: float, object_size_mm: float, light_deg: float,
-                              radius_mm, profile, skin_share: float = 1.0) -> float:
+                              radius_mm: ArrayLike, profile: ArrayLike,
+                              skin_share: float = 1.0) -> float:
     """Relative RMS change of a sphere's image (diameter ``object_size_mm``, pixels of
     ``footprint_mm``, one distant light ``light_deg`` from the view) when the part of its
     radiance that spreads under the skin (``skin_share`` of it) stays where it entered
@@ -88,7 +92,7 @@ def subsurface_omission_error(footprint_mm: float, object_size_mm: float, light_
         return 0.0
     kernel = blur_kernel(cell, radius_mm, profile)
 
-    def pixel_mean(image):
+    def pixel_mean(image: NDArray[np.float64]) -> NDArray[np.float64]:
         return image.reshape(pixels, per_pixel, pixels, per_pixel).mean(axis=(1, 3))
 
     seen = pixel_mean(disk) > 0.0

@@ -9,6 +9,7 @@ within a tolerance of the best.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -56,7 +57,7 @@ def _omission(scene: SceneDescription, traits: MaterialTraits) -> float:
     radius = np.asarray(traits.radius_mm, float)
     profile = np.asarray(traits.profile, float)
 
-    def at(light_deg):
+    def at(light_deg: float) -> float:
         share = traits.share("skin_share", light_deg)
         key = (scene.footprint_mm, scene.object_size_mm, light_deg, scale, share,
                radius.tobytes(), profile.tobytes())
@@ -101,10 +102,10 @@ class Choice:
     (lines for a report)."""
 
     chosen: Prediction
-    predictions: tuple
+    predictions: tuple[Prediction, ...]
     tolerance: float
     best_error: float
-    reasons: tuple = field(default_factory=tuple)
+    reasons: tuple[str, ...] = field(default_factory=tuple)
 
     @property
     def candidate(self) -> Candidate:
@@ -125,7 +126,8 @@ def needs_subsurface(scene: SceneDescription, traits: MaterialTraits) -> bool:
 
 
 def choose(scene: SceneDescription, traits: MaterialTraits | None = None, *,
-           tolerance: float = DEFAULT_TOLERANCE, candidates=None) -> Choice:
+           tolerance: float = DEFAULT_TOLERANCE,
+           candidates: Sequence[Candidate] | None = None) -> Choice:
     """The cheapest candidate whose predicted error is within ``tolerance`` of the best one's,
     among ``candidates`` (default: every registered tier's,
     :func:`~lut_baker.auto_tier.candidates.candidates`) made for the scene's engine

@@ -11,20 +11,24 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, replace
 from functools import lru_cache
+from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..bake import RESOLUTIONS, profile_radius
+from ..closures.closure_fit import ClosureFit
 from ..closures.profiles import edge_response, profile_grid
-from ..closures.tiers import tier_errors, tier_reflection
+from ..closures.tiers import TierError, tier_errors, tier_reflection
 from ..model.dipole import dipole_profile, dipole_total_reflectance
 from ..model.made_up_skin import combine, coverage_weights, mix_slots
 from ..model.presets import made_up_skin
 from ..numerics.geometry import sphere_directions
 from ..numerics.quadrature import trapezoid_weights
-from ..tables.table_set import ReflectionParts, radius_nodes
+from ..tables.table_set import ReflectionParts, Tables, radius_nodes
 from .measured import by_number, load
 
 __all__ = ["MaterialTraits", "traits_from_tables", "paper_traits", "profile_mean_radius_mm",
@@ -48,14 +52,14 @@ class MaterialTraits:
     a sphere's image (:func:`gloss_omissions`; None: ``gloss_share`` stands in for it).
     """
 
-    tier_errors: dict
-    radius_mm: np.ndarray
-    profile: np.ndarray
+    tier_errors: dict[str, float]
+    radius_mm: NDArray[np.float64]
+    profile: NDArray[np.float64]
     profile_mismatch: float
-    skin_share: dict
-    gloss_share: dict
+    skin_share: dict[float, float]
+    gloss_share: dict[float, float]
     subsurface_scale: float = 1.0
-    gloss_omission: dict | None = None
+    gloss_omission: dict[str, dict[float, float]] | None = None
     gloss_scale: float = 1.0
 
     def share(self, name: str, light_deg: float) -> float:
@@ -83,9 +87,9 @@ class MaterialTraits:
         """:func:`profile_mean_radius_mm` with the Subsurface Scale applied."""
         return self.subsurface_scale * profile_mean_radius_mm(self.radius_mm, self.profile)
 
-    def as_dict(self) -> dict:
+    def as_dict(self) -> dict[str, Any]:
         """Plain data (floats, lists, string keys), for a file; :meth:`from_dict` reads it."""
-        def by_angle(table):
+        def by_angle(table: Mapping[float, float]) -> dict[str, float]:
             return {repr(float(angle)): float(value) for angle, value in table.items()}
 
         return {
@@ -102,10 +106,10 @@ class MaterialTraits:
         }
 
     @classmethod
-    def from_dict(cls, data: dict) -> MaterialTraits:
+    def from_dict(cls, data: Mapping[str, Any]) -> MaterialTraits:
         """The traits :meth:`as_dict` wrote (``KeyError``, ``TypeError`` or ``ValueError``
         when an entry is missing or malformed)."""
-        def by_angle(table):
+        def by_angle(table: Mapping[str, Any]) -> dict[float, float]:
             return {float(angle): float(value) for angle, value in table.items()}
 
         omission = data["gloss_omission"]
@@ -123,13 +127,13 @@ class MaterialTraits:
         )
 
 
-def _at_angle(table: dict, light_deg: float) -> float:
+def _at_angle(table: Mapping[float, float], light_deg: float) -> float:
     """A per-light-angle table at ``light_deg`` (linear between its angles, held beyond)."""
     angles = sorted(table)
     return float(np.interp(light_deg, angles, [table[a] for a in angles]))
 
 
-def profile_mean_radius_mm(radius_mm, profile) -> float:
+def profile_mean_radius_mm(radius_mm: ArrayLike, profile: ArrayLike) -> float:
     """Mean distance (mm) between where light enters and leaves: ``Int d P(d) 2 pi d dd`` of
     the normalised profile ``P = R/Rd`` (largest over channels)."""
     d = np.asarray(radius_mm, float)
@@ -148,22 +152,23 @@ class _Sphere:
     bare skin and the shares) and the tables' radiance ``f cos(theta_i)`` at a coverage and
     absorption, with its RMS ``norm``."""
 
-    wi: np.ndarray
-    wo: np.ndarray
-    cos_i: np.ndarray
+    wi: NDArray[np.float64]
+    wo: NDArray[np.float64]
+    cos_i: NDArray[np.float64]
     parts: ReflectionParts
-    total: np.ndarray
+    total: NDArray[np.float64]
     norm: float
-    _bare: np.ndarray | None = None
+    _bare: NDArray[np.float64] | None = None
 
-    def bare(self, tables, absorption) -> np.ndarray:
+    def bare(self, tables: Tables, absorption: ArrayLike) -> NDArray[np.float64]:
         """The tables' bare skin's BRDF at the pixels (computed once)."""
         if self._bare is None:
             self._bare = tables.mixed_reflection(self.parts, 0.0, absorption)
         return self._bare
 
 
-def _sphere(tables, light_deg: float, w, a, resolution: int) -> _Sphere:
+def _sphere(tables: Tables, light_deg: float, w: float, a: ArrayLike, resolution: int
+            ) -> _Sphere:
     _, wi, wo = sphere_directions(resolution, light_deg)
     cos_i = wi[:, 2:3]
     parts = tables.reflection_parts(wi, wo)
@@ -171,7 +176,7 @@ def _sphere(tables, light_deg: float, w, a, resolution: int) -> _Sphere:
     return _Sphere(wi, wo, cos_i, parts, total, float(np.sqrt(np.mean(total**2))))
 
 
-def _shares(tables, sphere: _Sphere, w, a) -> tuple[float, float]:
+def _shares(tables: Tables, sphere: _Sphere, w: float, a: ArrayLike) -> tuple[float, float]:
     """:func:`gloss_and_skin_shares` on a sphere's pixels (its lookups reused)."""
     cos_i, looked_up = sphere.cos_i, sphere.parts.angular
     weights = coverage_weights(w, a)
@@ -187,7 +192,8 @@ def _shares(tables, sphere: _Sphere, w, a) -> tuple[float, float]:
     return float(np.sqrt(np.mean(gloss**2)) / norm), float(np.sqrt(np.mean(skin**2)) / norm)
 
 
-def gloss_and_skin_shares(tables, light_deg: float, coverage=None, absorption=None, *,
+def gloss_and_skin_shares(tables: Tables, light_deg: float, coverage: float | None = None,
+                          absorption: ArrayLike | None = None, *,
                           resolution: int = 48) -> tuple[float, float]:
     """``(gloss share, skin share)`` of a sphere's image under one distant light
     ``light_deg`` from the view (orthographic, the reference's framing): relative RMS over
@@ -198,7 +204,8 @@ def gloss_and_skin_shares(tables, light_deg: float, coverage=None, absorption=No
     return _shares(tables, _sphere(tables, light_deg, w, a, resolution), w, a)
 
 
-def _omission(tables, fit, tier: str, sphere: _Sphere, w, a, over_shader: bool) -> float:
+def _omission(tables: Tables, fit: ClosureFit, tier: str, sphere: _Sphere, w: float,
+              a: ArrayLike, over_shader: bool) -> float:
     """:func:`gloss_omission_error` on a sphere's pixels."""
     norm = sphere.norm
     if not norm > 0:
@@ -210,8 +217,9 @@ def _omission(tables, fit, tier: str, sphere: _Sphere, w, a, over_shader: bool) 
     return float(np.sqrt(np.mean(((kept - left_out) * sphere.cos_i) ** 2)) / norm)
 
 
-def gloss_omission_error(tables, fit, tier: str, light_deg: float, coverage=None,
-                         absorption=None, *, resolution: int = 48,
+def gloss_omission_error(tables: Tables, fit: ClosureFit, tier: str, light_deg: float,
+                         coverage: float | None = None, absorption: ArrayLike | None = None,
+                         *, resolution: int = 48,
                          over_shader: bool = False) -> float:
     """Relative RMS change of a sphere's image (orthographic, one distant light ``light_deg``
     from the view, the lit pixels) when ``tier``'s Gloss input goes from 1 to 0: the tier's
@@ -224,8 +232,11 @@ def gloss_omission_error(tables, fit, tier: str, light_deg: float, coverage=None
                      over_shader)
 
 
-def gloss_omissions(tables, fit, coverage=None, absorption=None, *,
-                    lights_deg=None, tiers=None, over_shader: bool = False) -> dict:
+def gloss_omissions(tables: Tables, fit: ClosureFit, coverage: float | None = None,
+                    absorption: ArrayLike | None = None, *,
+                    lights_deg: Iterable[float] | None = None,
+                    tiers: Iterable[str] | None = None,
+                    over_shader: bool = False) -> dict[str, dict[float, float]]:
     """:func:`gloss_omission_error` of ``tiers`` (default: every tier ``fit`` holds) at
     ``lights_deg`` (default :data:`SHARE_LIGHTS_DEG`): ``{tier: {light angle: error}}``."""
     lights = SHARE_LIGHTS_DEG if lights_deg is None else lights_deg
@@ -235,12 +246,14 @@ def gloss_omissions(tables, fit, coverage=None, absorption=None, *,
                       over_shader)
 
 
-def _omissions(tables, fit, spheres: dict, w, a, tiers, over_shader: bool) -> dict:
+def _omissions(tables: Tables, fit: ClosureFit, spheres: Mapping[float, _Sphere], w: float,
+               a: ArrayLike, tiers: Iterable[str], over_shader: bool
+               ) -> dict[str, dict[float, float]]:
     return {tier: {light: _omission(tables, fit, tier, sphere, w, a, over_shader)
                    for light, sphere in spheres.items()} for tier in tiers}
 
 
-def profile_mismatch(tables, fit_error) -> float:
+def profile_mismatch(tables: Tables, fit_error: ArrayLike) -> float:
     """Relative error of a fitted subsurface closure's blur: ``fit_error`` (per channel, the
     RMS difference of its edge response and the tables', a fraction of the lit level:
     :class:`lut_baker.closures.profiles.ProfileFit` ``error``) over the RMS of the tables' edge
@@ -258,9 +271,12 @@ SHARE_LIGHTS_DEG = (0.0, 45.0, 75.0, 89.0)
 shares."""
 
 
-def traits_from_tables(tables, fit, coverage=None, absorption=None, *,
-                       lights_deg=SHARE_LIGHTS_DEG, method: str | None = None,
-                       errors: dict | None = None, over_shader: bool = False
+def traits_from_tables(tables: Tables, fit: ClosureFit, coverage: float | None = None,
+                       absorption: ArrayLike | None = None, *,
+                       lights_deg: Iterable[float] = SHARE_LIGHTS_DEG,
+                       method: str | None = None,
+                       errors: Mapping[str, TierError] | None = None,
+                       over_shader: bool = False
                        ) -> MaterialTraits:
     """:class:`MaterialTraits` of baked ``tables`` and their
     :class:`lut_baker.closures.closure_fit.ClosureFit` ``fit`` at a coverage and absorption

@@ -17,7 +17,9 @@ from __future__ import annotations
 import json
 import os
 import tempfile
+from collections.abc import Mapping, Sequence
 from pathlib import Path
+from typing import Any, Protocol, TypeVar
 
 __all__ = ["PATH", "SECTIONS", "load", "write_section", "by_candidate", "by_number"]
 
@@ -27,17 +29,27 @@ SECTIONS = ("cycles_costs", "eevee_costs", "paper_traits")
 """Its sections, one per measuring command."""
 
 
-def load(path: Path = PATH) -> dict:
+class _Named(Protocol):
+    """What :func:`by_candidate` reads of a candidate (a :class:`~.candidates.Candidate`)."""
+
+    @property
+    def name(self) -> str: ...
+
+
+_Candidate = TypeVar("_Candidate", bound=_Named)
+
+
+def load(path: Path = PATH) -> dict[str, Any]:
     """Every section of the data file at ``path``."""
     with open(path, encoding="utf-8") as handle:
-        data = json.load(handle)
+        data: dict[str, Any] = json.load(handle)
     missing = [name for name in SECTIONS if name not in data]
     if missing:
         raise ValueError(f"{path} lacks the section(s) {missing}")
     return data
 
 
-def write_section(name: str, section: dict, path: Path = PATH) -> None:
+def write_section(name: str, section: Mapping[str, Any], path: Path = PATH) -> None:
     """Replace section ``name`` of the data file at ``path`` (the others are kept), written to
     a temporary file first so an interrupted write leaves the old file whole."""
     if name not in SECTIONS:
@@ -55,10 +67,11 @@ def write_section(name: str, section: dict, path: Path = PATH) -> None:
         raise
 
 
-def by_candidate(table: dict, candidates) -> dict:
+def by_candidate(table: Mapping[str, Mapping[str, float]], candidates: Sequence[_Candidate]
+                 ) -> dict[float, dict[_Candidate, float]]:
     """``{float coverage: {candidate: value}}`` from a stored ``{"1": {name: value}}``, for
     every one of ``candidates`` (a candidate the file lacks is an error: measure it)."""
-    out = {}
+    out: dict[float, dict[_Candidate, float]] = {}
     for coverage, row in table.items():
         missing = [c.name for c in candidates if c.name not in row]
         if missing:
@@ -67,6 +80,6 @@ def by_candidate(table: dict, candidates) -> dict:
     return out
 
 
-def by_number(table: dict) -> dict:
+def by_number(table: Mapping[str, float]) -> dict[float, float]:
     """``{float: value}`` from a stored ``{"45": value}``."""
     return {float(key): value for key, value in table.items()}

@@ -44,12 +44,12 @@ class SceneDescription:
 
     object_size_mm: float
     footprint_mm: float
-    lights_deg: tuple = (45.0,)
+    lights_deg: tuple[float, ...] = (45.0,)
     engine: str = "CYCLES"
     samples: int = 128
     denoise: bool = False
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         if not (self.object_size_mm > 0 and self.footprint_mm > 0):
             raise ValueError("object_size_mm and footprint_mm must be > 0 (mm)")
         if self.engine not in ENGINES:

@@ -17,30 +17,34 @@ from __future__ import annotations
 
 import threading
 from collections import OrderedDict
+from collections.abc import Callable, Hashable
+from typing import Any, TypeVar
 
 __all__ = ["LRUCache"]
+
+_T = TypeVar("_T")
 
 
 class LRUCache:
     """At most ``size`` values (None: no limit) by hashable key; reading or storing a key makes
     it the most recently used, and storing beyond ``size`` drops the least recently used."""
 
-    def __init__(self, size: int | None):
+    def __init__(self, size: int | None) -> None:
         if size is not None and size < 1:
             raise ValueError(f"size must be >= 1 or None, got {size!r}")
         self.size = size
-        self._values: OrderedDict = OrderedDict()
+        self._values: OrderedDict[Hashable, Any] = OrderedDict()
         self._lock = threading.RLock()
 
     def __len__(self) -> int:
         with self._lock:
             return len(self._values)
 
-    def __contains__(self, key) -> bool:
+    def __contains__(self, key: object) -> bool:
         with self._lock:
             return key in self._values
 
-    def get(self, key, default=None):
+    def get(self, key: Hashable, default: Any = None) -> Any:
         """The value stored under ``key`` (now the most recently used), else ``default``."""
         with self._lock:
             if key not in self._values:
@@ -48,7 +52,7 @@ class LRUCache:
             self._values.move_to_end(key)
             return self._values[key]
 
-    def put(self, key, value) -> None:
+    def put(self, key: Hashable, value: Any) -> None:
         """Store ``value`` under ``key``, dropping the least recently used beyond ``size``."""
         with self._lock:
             self._values[key] = value
@@ -56,7 +60,7 @@ class LRUCache:
             while self.size is not None and len(self._values) > self.size:
                 self._values.popitem(last=False)
 
-    def get_or_compute(self, key, compute):
+    def get_or_compute(self, key: Hashable, compute: Callable[[], _T]) -> _T:
         """The value under ``key``; if there is none, ``compute()`` (outside the lock)
         stored under it first."""
         missing = object()
