@@ -53,9 +53,11 @@ Functions and types
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..numerics.adding_doubling import (
     Layer,
@@ -117,9 +119,17 @@ FOUNDATION_DENSITY_G_PER_CM3 = 1.0
 with some 10-20% pigment; taken as 1 (the pigment would raise it by some 10%)."""
 
 
-def thickness_from_mass(mass_mg_per_cm2, density_g_per_cm3=FOUNDATION_DENSITY_G_PER_CM3):
+def thickness_from_mass(mass_mg_per_cm2: ArrayLike,
+                        density_g_per_cm3: ArrayLike = FOUNDATION_DENSITY_G_PER_CM3
+                        ) -> NDArray[np.float64]:
     """Film thickness in micrometres of a mass per area (mg/cm^2) at a density (g/cm^3):
-    ``10 m / rho`` (1 mg/cm^2 at 1 g/cm^3 is 10 micrometres)."""
+    ``10 m / rho`` (1 mg/cm^2 at 1 g/cm^3 is 10 micrometres).
+
+    >>> float(thickness_from_mass(1.0))  # mg/cm^2, at 1 g/cm^3
+    10.0
+    >>> print(np.round(thickness_from_mass([0.5, APPLIED_MASS_MG_PER_CM2]), 2))  # on a face
+    [5.   9.56]
+    """
     return 10.0 * np.asarray(mass_mg_per_cm2, float) / np.asarray(density_g_per_cm3, float)
 
 
@@ -149,20 +159,24 @@ MEASURED_CACHE_SIZE = 8
 """Films and grids whose measured matrices are kept in this process."""
 
 
-def relative_thickness(thickness_um) -> float:
-    """A thickness in micrometres in units of the paper's film (:data:`PAPER_FILM_THICKNESS_UM`)."""
+def relative_thickness(thickness_um: float) -> float:
+    """A thickness in micrometres in units of the paper's film (:data:`PAPER_FILM_THICKNESS_UM`).
+
+    >>> relative_thickness(15.0)  # a tenth of the film the paper measured
+    0.1
+    """
     value = float(thickness_um)
     if not value >= 0.0:
         raise ValueError(f"thickness must be >= 0 micrometres, got {thickness_um!r}")
     return value / PAPER_FILM_THICKNESS_UM
 
 
-def _channels_first(values: np.ndarray) -> np.ndarray:
+def _channels_first(values: NDArray[np.float64]) -> NDArray[np.float64]:
     """``(..., C)`` to ``(C, ...)``."""
     return np.moveaxis(values, -1, 0)
 
 
-def face_albedo(film: ReflectionLayer, grid: HemisphereGrid) -> np.ndarray:
+def face_albedo(film: ReflectionLayer, grid: HemisphereGrid) -> NDArray[np.float64]:
     """``a_g``: the directional albedo of the film's surface gloss (eq. 2's specular term, its
     ``P_d`` left out) at the grid's polar nodes, ``(C, N)`` (C = 1 for a scalar film), computed
     through the half vector for narrow lobes (:func:`~lut_baker.model.albedo.reflection_albedo`);
@@ -175,7 +189,7 @@ def face_albedo(film: ReflectionLayer, grid: HemisphereGrid) -> np.ndarray:
     return _channels_first(values)
 
 
-def face_layer(albedo: np.ndarray, orders: int) -> Layer:
+def face_layer(albedo: ArrayLike, orders: int) -> Layer:
     """The surface in the star form, ``(C, orders, N, N)``: from above it reflects nothing here
     (its gloss, eq. 2's specular term, is the closed form added outside the grid), transmits
     ``1 - a_g`` straight; from below it reflects ``a_g`` specularly."""
@@ -187,7 +201,7 @@ def face_layer(albedo: np.ndarray, orders: int) -> Layer:
 
 
 def measured_body_matrices(film: ReflectionLayer, transmission: TransmissionLayer,
-                           grid: HemisphereGrid):
+                           grid: HemisphereGrid) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """The measured free film's diffuse reflection (eq. 2's ``P_d``, Lambertian) and
     transmission (eq. 4) in the star form, each ``(C, orders, N, N)``."""
     scale = star_scale(grid)
@@ -200,7 +214,8 @@ def measured_body_matrices(film: ReflectionLayer, transmission: TransmissionLaye
     return to_star(r, scale), to_star(t, scale)
 
 
-def remove_faces(reflection: np.ndarray, transmission: np.ndarray, albedo: np.ndarray):
+def remove_faces(reflection: NDArray[np.float64], transmission: NDArray[np.float64],
+                 albedo: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """The body inside a symmetric free film (surface, body, surface) whose reflection without
     its gloss is ``reflection`` and whose transmission is ``transmission`` (star form,
     ``(C, orders, N, N)``), the surfaces reflecting ``a_g = albedo`` ``(C, N)``.
@@ -217,7 +232,7 @@ def remove_faces(reflection: np.ndarray, transmission: np.ndarray, albedo: np.nd
     rho = mirror(albedo, orders)
     eye = np.eye(albedo.shape[-1])
 
-    def inner(film):
+    def inner(film: NDArray[np.float64]) -> NDArray[np.float64]:
         x = inv[:, None, :, None] * film * inv[:, None, None, :]
         # X (I + rho X)^-1, solved from the right.
         return np.swapaxes(np.linalg.solve(np.swapaxes(eye + rho @ x, -1, -2),
@@ -237,8 +252,8 @@ class FilmSlab:
 
     grid: HemisphereGrid
     generator: SlabGenerator
-    absorption: np.ndarray
-    measured_face: np.ndarray
+    absorption: NDArray[np.float64]
+    measured_face: NDArray[np.float64]
 
     @property
     def orders(self) -> int:
@@ -246,7 +261,7 @@ class FilmSlab:
         return self.generator.rates.shape[-2]
 
     @property
-    def scale(self) -> np.ndarray:
+    def scale(self) -> NDArray[np.float64]:
         """:func:`~lut_baker.numerics.adding_doubling.star_scale` of the grid."""
         return star_scale(self.grid)
 
@@ -254,12 +269,13 @@ class FilmSlab:
 _MEASURED = LRUCache(MEASURED_CACHE_SIZE)
 
 
-def _measured(film: ReflectionLayer, transmission: TransmissionLayer, grid: HemisphereGrid):
+def _measured(film: ReflectionLayer, transmission: TransmissionLayer, grid: HemisphereGrid
+              ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """:func:`measured_body_matrices` and :func:`face_albedo`, computed once per film and grid."""
     key = (repr(film.as_dict()), repr(transmission.as_dict()), grid.theta.tobytes(),
            grid.weight.tobytes(), grid.n_phi)
 
-    def compute():
+    def compute() -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
         arrays = (*measured_body_matrices(film, transmission, grid), face_albedo(film, grid))
         for array in arrays:
             array.setflags(write=False)
@@ -268,8 +284,8 @@ def _measured(film: ReflectionLayer, transmission: TransmissionLayer, grid: Hemi
     return _MEASURED.get_or_compute(key, compute)
 
 
-def _free_film_albedo(generator: SlabGenerator, face: np.ndarray, scale0: np.ndarray,
-                      grid: HemisphereGrid) -> np.ndarray:
+def _free_film_albedo(generator: SlabGenerator, face: NDArray[np.float64],
+                      scale0: NDArray[np.float64], grid: HemisphereGrid) -> NDArray[np.float64]:
     """Bihemispherical ``R + T`` (gloss left out) of the free film of unit thickness, order 0."""
     order0 = SlabGenerator(basis=generator.basis[..., :1, :, :], rates=generator.rates[..., :1, :])
     stand_in = FilmSlab(grid=grid, generator=order0, absorption=np.zeros(face.shape[0]),
@@ -279,7 +295,7 @@ def _free_film_albedo(generator: SlabGenerator, face: np.ndarray, scale0: np.nda
                                    grid)
 
 
-def _passive(generator: SlabGenerator, target: float | np.ndarray, face: np.ndarray,
+def _passive(generator: SlabGenerator, target: ArrayLike, face: NDArray[np.float64],
              grid: HemisphereGrid) -> SlabGenerator:
     """:func:`~lut_baker.numerics.adding_doubling.passive_generator` with the ``relief`` per
     channel (false position on [0, 1]) at which the free film of unit thickness keeps, under uniform
@@ -293,11 +309,16 @@ def _passive(generator: SlabGenerator, target: float | np.ndarray, face: np.ndar
     return passive_generator(generator, scale0, relief)
 
 
-def increasing_root(function, target: np.ndarray, steps: int) -> np.ndarray:
+def increasing_root(function: Callable[[NDArray[np.float64]], NDArray[np.float64]],
+                    target: NDArray[np.float64], steps: int) -> NDArray[np.float64]:
     """Per entry, ``x`` in [0, 1] with ``function(x) = target`` for an increasing ``function``
     (vectorised over the entries), by the Illinois variant of false position (the bracket
     always holds the root; it shrinks superlinearly) until :data:`ROOT_TOLERANCE`; 0 or 1
-    when the target lies outside ``[function(0), function(1)]``."""
+    when the target lies outside ``[function(0), function(1)]``.
+
+    >>> print(increasing_root(lambda x: x**2, np.array([0.25, 0.5, 2.0]), ROOT_STEPS))
+    [0.5        0.70710678 1.        ]
+    """
     low = np.zeros(target.shape)
     high = np.ones(target.shape)
     f_low = function(low) - target
@@ -329,7 +350,8 @@ def increasing_root(function, target: np.ndarray, steps: int) -> np.ndarray:
 
 
 def film_slab(film: ReflectionLayer, transmission: TransmissionLayer, grid: HemisphereGrid, *,
-              absorption=0.0, optical_thickness: float = PAPER_FILM_OPTICAL_THICKNESS,
+              absorption: ArrayLike = 0.0,
+              optical_thickness: float = PAPER_FILM_OPTICAL_THICKNESS,
               passive: bool = True, orders: int | None = None) -> FilmSlab:
     """The body of a measured film (``film``: eq. 2, gloss and ``P_d``; ``transmission``:
     eq. 4; in albedo units) at every thickness, with absorption ``A`` (scalar or RGB in
@@ -344,7 +366,21 @@ def film_slab(film: ReflectionLayer, transmission: TransmissionLayer, grid: Hemi
     the free film's absorption under uniform light; docs/model.md, "The film as a slab": the
     measured film, normalised to be lossless at normal incidence, is not quite a passive slab
     under a lossless surface).  ``orders``: keep the first orders only (1 for albedos under
-    uniform light)."""
+    uniform light).
+
+    >>> from lut_baker.numerics.quadrature import hemisphere_panels
+    >>> grid = hemisphere_panels(1, 4, 3)  # 4 polar nodes, azimuth orders 0 and 1
+    >>> film = ReflectionLayer(P_d=0.155, P_s=10.7, n=0.033, eta=1.19)  # eq. 2, albedo units
+    >>> through = TransmissionLayer(P_d=0.095, P_t=0.039, n=0.035, eta=1.19)  # eq. 4
+    >>> dark = film_slab(film, through, grid, absorption=[0.0, 0.2, 0.5], passive=False)
+    >>> r, t = free_film_matrices(dark, 1.0)  # at the measured thickness: 1 - A of it
+    >>> r_measured, t_measured = measured_body_matrices(film, through, grid)
+    >>> print(np.round(star_albedo(r[:, 0], dark.scale[0])
+    ...                / star_albedo(r_measured[:, 0], dark.scale[0]), 3))
+    [[1.  1.  1.  1. ]
+     [0.8 0.8 0.8 0.8]
+     [0.5 0.5 0.5 0.5]]
+    """
     a = np.atleast_1d(np.asarray(absorption, float))
     if a.shape not in ((1,), (3,)) or np.any(a < 0.0) or np.any(a > 1.0):
         raise ValueError(f"absorption must be a float or RGB in [0, 1], got {absorption!r}")
@@ -369,9 +405,18 @@ def film_slab(film: ReflectionLayer, transmission: TransmissionLayer, grid: Hemi
                     absorption=np.broadcast_to(a, (channels,)).copy(), measured_face=face)
 
 
-def body(film: FilmSlab, thickness: float):
+def body(film: FilmSlab, thickness: float) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """The body's ``(R, T)`` (star form, ``(C, orders, N, N)``) at ``thickness`` in units of
-    the paper's film (:func:`relative_thickness`)."""
+    the paper's film (:func:`relative_thickness`).
+
+    >>> from lut_baker.numerics.quadrature import hemisphere_panels
+    >>> grid = hemisphere_panels(1, 4, 3)  # 4 polar nodes, azimuth orders 0 and 1
+    >>> film = ReflectionLayer(P_d=0.155, P_s=10.7, n=0.033, eta=1.19)  # eq. 2, albedo units
+    >>> through = TransmissionLayer(P_d=0.095, P_t=0.039, n=0.035, eta=1.19)  # eq. 4
+    >>> r, t = body(film_slab(film, through, grid), 0.0)  # no film: R = 0, T = I
+    >>> print(np.abs(r).max(), np.abs(t - np.eye(4)).max())
+    0.0 0.0
+    """
     return slab(film.generator, thickness)
 
 
@@ -380,7 +425,8 @@ def _body_layer(film: FilmSlab, thickness: float) -> Layer:
     return Layer(top=r, bottom=r, down=t)
 
 
-def free_film_matrices(film: FilmSlab, thickness: float, face=None):
+def free_film_matrices(film: FilmSlab, thickness: float, face: ArrayLike | None = None
+                       ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """The free film (surface, body, surface; air on both sides) at ``thickness``: its
     reflection without the top surface's gloss and its transmission, star form.  ``face``: the
     surfaces' ``a_g`` ``(C, N)`` (default: the measured film's)."""
@@ -394,11 +440,11 @@ def free_film_matrices(film: FilmSlab, thickness: float, face=None):
 _SKINS = LRUCache(MEASURED_CACHE_SIZE)
 
 
-def skin_star(skin: ReflectionLayer, grid: HemisphereGrid) -> np.ndarray:
+def skin_star(skin: ReflectionLayer, grid: HemisphereGrid) -> NDArray[np.float64]:
     """The skin's eq. 2 kernel in the star form, ``(C, orders, N, N)``, once per skin and grid."""
     key = (repr(skin.as_dict()), grid.theta.tobytes(), grid.weight.tobytes(), grid.n_phi)
 
-    def compute():
+    def compute() -> NDArray[np.float64]:
         kernel = layer_fourier_kernel(skin, grid.theta, grid.theta, grid.n_phi)
         star = to_star(_channels_first(kernel), star_scale(grid))
         star.setflags(write=False)
@@ -407,12 +453,13 @@ def skin_star(skin: ReflectionLayer, grid: HemisphereGrid) -> np.ndarray:
     return _SKINS.get_or_compute(key, compute)
 
 
-def _skin_layer(skin_star: np.ndarray) -> Layer:
+def _skin_layer(skin_star: NDArray[np.float64]) -> Layer:
     zeros = np.zeros_like(skin_star)
     return Layer(top=skin_star, bottom=zeros, down=zeros)
 
 
-def made_up_matrices(film: FilmSlab, thickness: float, skin: ReflectionLayer, face=None):
+def made_up_matrices(film: FilmSlab, thickness: float, skin: ReflectionLayer,
+                     face: ArrayLike | None = None) -> NDArray[np.float64]:
     """Made-up skin without its top gloss (star form, ``(C, orders, N, N)``): the film's
     surface (``face``, default the measured film's) over its body at ``thickness`` over the
     skin's surface reflection (eq. 2, gloss and diffuse part), every inter-reflection summed
@@ -425,15 +472,33 @@ def made_up_matrices(film: FilmSlab, thickness: float, skin: ReflectionLayer, fa
     return stack.top
 
 
-def made_up_albedo(film: FilmSlab, thickness: float, skin: ReflectionLayer, face=None):
+def made_up_albedo(film: FilmSlab, thickness: float, skin: ReflectionLayer,
+                   face: ArrayLike | None = None) -> NDArray[np.float64]:
     """Directional albedo of made-up skin at the grid's nodes, ``(C, N)``: the surface's gloss
-    ``a_g`` plus :func:`made_up_matrices`' order 0."""
+    ``a_g`` plus :func:`made_up_matrices`' order 0.
+
+    >>> from lut_baker.numerics.quadrature import hemisphere_panels
+    >>> grid = hemisphere_panels(1, 4, 3)  # 4 polar nodes, azimuth orders 0 and 1
+    >>> film = ReflectionLayer(P_d=0.155, P_s=10.7, n=0.033, eta=1.19)  # eq. 2, albedo units
+    >>> through = TransmissionLayer(P_d=0.095, P_t=0.039, n=0.035, eta=1.19)  # eq. 4
+    >>> slab_of = film_slab(film, through, grid)
+    >>> skin = ReflectionLayer(P_d=0.1, P_s=0.0, n=0.05, eta=1.3)  # matte, albedo 0.31
+    >>> for micrometres in (0.0, DEFAULT_THICKNESS_UM, 150.0, 1500.0):  # under uniform light
+    ...     albedo = made_up_albedo(slab_of, relative_thickness(micrometres), skin)
+    ...     print(np.round(bihemispherical_on_grid(albedo, grid), 4))
+    [0.3826]
+    [0.415]
+    [0.6583]
+    [0.8267]
+    >>> print(np.round(bihemispherical_on_grid(thick_limit_albedo(slab_of), grid), 4))
+    [0.8274]
+    """
     face = film.measured_face if face is None else np.asarray(face, float)
     top = made_up_matrices(film, thickness, skin, face)
     return face + star_albedo(top[:, 0], film.scale[0])
 
 
-def thick_limit_albedo(film: FilmSlab, face=None) -> np.ndarray:
+def thick_limit_albedo(film: FilmSlab, face: ArrayLike | None = None) -> NDArray[np.float64]:
     """Directional albedo at the nodes ``(C, N)`` of the film at infinite thickness under its
     surface (``face``, default the measured film's): the gloss ``a_g`` plus
     ``F (I - R_inf rho)^-1 R_inf F``'s order 0."""
@@ -444,29 +509,48 @@ def thick_limit_albedo(film: FilmSlab, face=None) -> np.ndarray:
     return face + star_albedo(stack.top[:, 0], film.scale[0])
 
 
-def bihemispherical_on_grid(albedo: np.ndarray, grid: HemisphereGrid) -> np.ndarray:
+def bihemispherical_on_grid(albedo: ArrayLike, grid: HemisphereGrid) -> NDArray[np.float64]:
     """``2 Int a(mu) mu dmu`` from a directional albedo at the grid's polar nodes (``(..., N)``):
-    ``sum 2 w_j a_j`` (the weights are ``cos sin dtheta``)."""
+    ``sum 2 w_j a_j`` (the weights are ``cos sin dtheta``).
+
+    >>> from lut_baker.numerics.quadrature import hemisphere_panels
+    >>> grid = hemisphere_panels(3, 10, 33)  # the bake's quadrature, 30 polar nodes
+    >>> round(float(bihemispherical_on_grid(np.full(30, 0.3), grid)), 6)  # a constant albedo
+    0.3
+    """
     return np.asarray(albedo, float) @ (2.0 * grid.weight)
 
 
-def solve_thick_absorption(target, film: ReflectionLayer, transmission: TransmissionLayer,
-                           grid: HemisphereGrid, *, face=None,
+def solve_thick_absorption(target: ArrayLike, film: ReflectionLayer,
+                           transmission: TransmissionLayer, grid: HemisphereGrid, *,
+                           face: ArrayLike | None = None,
                            optical_thickness: float = PAPER_FILM_OPTICAL_THICKNESS,
-                           passive: bool = True):
+                           passive: bool = True) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
     """``(A, clamped)`` per channel of ``target`` (a colour under uniform light, RGB): the
     absorption whose film, infinitely thick under its surface (``face``: ``a_g`` ``(C, N)``,
     default the measured film's), has that bihemispherical albedo, by false position on [0, 1]
     (order 0 only; the thick film darkens as ``A`` grows).  Out of reach: ``A = 0`` or 1 and
-    ``clamped``."""
-    target = np.atleast_1d(np.asarray(target, float))
+    ``clamped``.
 
-    def limit(a):
+    >>> from lut_baker.numerics.quadrature import hemisphere_panels
+    >>> grid = hemisphere_panels(1, 4, 3)  # 4 polar nodes, azimuth orders 0 and 1
+    >>> film = ReflectionLayer(P_d=0.155, P_s=10.7, n=0.033, eta=1.19)  # eq. 2, albedo units
+    >>> through = TransmissionLayer(P_d=0.095, P_t=0.039, n=0.035, eta=1.19)  # eq. 4
+    >>> a, clamped = solve_thick_absorption([0.6, 0.5, 0.4], film, through, grid)
+    >>> print(np.round(a, 4), clamped)
+    [0.1802 0.3165 0.483 ] [False False False]
+    >>> thick = film_slab(film, through, grid, absorption=a, orders=1)
+    >>> print(np.round(bihemispherical_on_grid(thick_limit_albedo(thick), grid), 4))
+    [0.6 0.5 0.4]
+    """
+    wanted = np.atleast_1d(np.asarray(target, float))
+
+    def limit(a: NDArray[np.float64]) -> NDArray[np.float64]:
         slab_a = film_slab(film, transmission, grid, absorption=a,
                            optical_thickness=optical_thickness, passive=passive, orders=1)
         return bihemispherical_on_grid(thick_limit_albedo(slab_a, face), grid)
 
-    absorption = increasing_root(lambda a: -limit(a), -target, ROOT_STEPS)
-    too_light = target > limit(np.zeros_like(target))
-    too_dark = target < limit(np.ones_like(target))
+    absorption = increasing_root(lambda a: -limit(a), -wanted, ROOT_STEPS)
+    too_light = wanted > limit(np.zeros_like(wanted))
+    too_dark = wanted < limit(np.ones_like(wanted))
     return absorption, too_light | too_dark

@@ -49,6 +49,7 @@ from functools import cached_property
 from typing import NamedTuple
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from .quadrature import HemisphereGrid, azimuth_convolution_factor
 
@@ -72,14 +73,14 @@ __all__ = [
 ]
 
 
-def star_scale(grid: HemisphereGrid) -> np.ndarray:
+def star_scale(grid: HemisphereGrid) -> NDArray[np.float64]:
     """``sqrt(c_m w_j)``: shape ``(orders, N)``, with ``w`` the grid's polar weights
     (``cos theta sin theta d theta``, sr) and ``c_m`` the azimuth factor (2 pi, then pi)."""
     factor = azimuth_convolution_factor(grid.orders)
     return np.sqrt(factor[:, None] * grid.weight[None, :])
 
 
-def to_star(kernel: np.ndarray, scale: np.ndarray) -> np.ndarray:
+def to_star(kernel: NDArray[np.float64], scale: NDArray[np.float64]) -> NDArray[np.float64]:
     """Kernel coefficients ``(..., orders, N, N)`` (1/sr) into the star form (dimensionless):
     ``s_m,a K_m,ab s_m,b``; ``scale`` from :func:`star_scale` (its orders may be fewer)."""
     orders = kernel.shape[-3]
@@ -87,22 +88,36 @@ def to_star(kernel: np.ndarray, scale: np.ndarray) -> np.ndarray:
     return s[:, :, None] * kernel * s[:, None, :]
 
 
-def from_star(star: np.ndarray, scale: np.ndarray) -> np.ndarray:
+def from_star(star: NDArray[np.float64], scale: NDArray[np.float64]) -> NDArray[np.float64]:
     """The inverse of :func:`to_star`: kernel coefficients in 1/sr."""
     orders = star.shape[-3]
     s = scale[:orders]
     return star / (s[:, :, None] * s[:, None, :])
 
 
-def star_albedo(star0: np.ndarray, scale0: np.ndarray) -> np.ndarray:
+def star_albedo(star0: NDArray[np.float64], scale0: NDArray[np.float64]) -> NDArray[np.float64]:
     """The directional albedo (dimensionless) of an order-0 star matrix ``(..., N, N)`` at each
-    incident node: ``2 pi sum_b K_0,ab w_b`` (the light leaving into the whole hemisphere)."""
+    incident node: ``2 pi sum_b K_0,ab w_b`` (the light leaving into the whole hemisphere).
+
+    >>> from lut_baker.numerics.quadrature import hemisphere_panels
+    >>> grid = hemisphere_panels(1, 4, 3)  # 4 polar nodes, azimuth orders 0 and 1
+    >>> scale = star_scale(grid)
+    >>> lambert = np.zeros((2, 4, 4))
+    >>> lambert[0] = 0.3 / np.pi  # a Lambertian reflector of albedo 0.3 (1/sr, order 0 only)
+    >>> print(np.round(star_albedo(to_star(lambert, scale)[0], scale[0]), 4))
+    [0.3 0.3 0.3 0.3]
+    """
     return (star0 @ scale0) / scale0
 
 
-def mirror(albedo: np.ndarray, orders: int) -> np.ndarray:
+def mirror(albedo: ArrayLike, orders: int) -> NDArray[np.float64]:
     """A specular reflector of albedo ``albedo`` ``(..., N)`` at each node: ``(-1)^m diag(a)``,
-    shape ``(..., orders, N, N)`` (the mirror direction is the relative azimuth pi)."""
+    shape ``(..., orders, N, N)`` (the mirror direction is the relative azimuth pi).
+
+    >>> print(np.diagonal(mirror([0.04, 0.5], 2), axis1=-2, axis2=-1))  # orders 0 and 1
+    [[ 0.04  0.5 ]
+     [-0.04 -0.5 ]]
+    """
     albedo = np.asarray(albedo, float)
     signs = (-1.0) ** np.arange(orders)
     eye = np.eye(albedo.shape[-1])
@@ -114,12 +129,12 @@ class Layer(NamedTuple):
     from above, ``bottom`` of light from below, ``down`` its transmission downward (upward it
     is the transpose, by reciprocity)."""
 
-    top: np.ndarray
-    bottom: np.ndarray
-    down: np.ndarray
+    top: NDArray[np.float64]
+    bottom: NDArray[np.float64]
+    down: NDArray[np.float64]
 
 
-def _t(a: np.ndarray) -> np.ndarray:
+def _t(a: NDArray[np.float64]) -> NDArray[np.float64]:
     return np.swapaxes(a, -1, -2)
 
 
@@ -133,7 +148,15 @@ def add_layers(upper: Layer, lower: Layer) -> Layer:
 
     with ``R1 = upper.top``, ``R1' = upper.bottom``, ``R2 = lower.top``, ``R2' =
     lower.bottom``, ``T1``, ``T2`` their transmissions downward (row vectors: light enters on
-    the left)."""
+    the left).
+
+    >>> generator = slab_generator(np.array([[0.2]]), np.array([[0.7]]))  # one node
+    >>> r, t = slab(generator, 0.5)
+    >>> half = Layer(top=r, bottom=r, down=t)  # half the slab on the other half: the slab
+    >>> whole = add_layers(half, half)
+    >>> print(np.round(whole.top, 6), np.round(whole.down, 6))
+    [[0.2]] [[0.7]]
+    """
     eye = np.eye(upper.top.shape[-1])
     # (I - R2 R1')^-1 applied from the right, as a solve of the transposed system.
     inner = np.linalg.solve(_t(eye - lower.top @ upper.bottom), _t(upper.down))
@@ -145,9 +168,15 @@ def add_layers(upper: Layer, lower: Layer) -> Layer:
     return Layer(top=top, bottom=bottom, down=down)
 
 
-def double_slab(reflection: np.ndarray, transmission: np.ndarray):
+def double_slab(reflection: NDArray[np.float64], transmission: NDArray[np.float64]
+                ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """A symmetric slab ``(R, T)`` on itself (the doubling step, van de Hulst 1980, eq. 4.17;
-    Prahl 1995, eq. 30): ``R2 = R + T (I - R R)^-1 R T``, ``T2 = T (I - R R)^-1 T``."""
+    Prahl 1995, eq. 30): ``R2 = R + T (I - R R)^-1 R T``, ``T2 = T (I - R R)^-1 T``.
+
+    >>> r2, t2 = double_slab(np.array([[0.2]]), np.array([[0.7]]))  # one node
+    >>> print(np.round(r2, 6), np.round(t2, 6))  # 0.2 + 0.7 0.2 0.7 / 0.96, 0.49 / 0.96
+    [[0.302083]] [[0.510417]]
+    """
     eye = np.eye(reflection.shape[-1])
     through = _t(np.linalg.solve(eye - reflection @ reflection, transmission))
     return reflection + through @ reflection @ transmission, through @ transmission
@@ -160,26 +189,26 @@ class SlabGenerator:
     reference thickness) with, at thickness ``x`` (in those units),
     ``Y(x) = B tanh(lambda x) B^T`` and ``Z(x) = B^-T tanh(lambda x) B^-1``; see :func:`slab`."""
 
-    basis: np.ndarray
-    rates: np.ndarray
+    basis: NDArray[np.float64]
+    rates: NDArray[np.float64]
 
     @cached_property
-    def inverse(self) -> np.ndarray:
+    def inverse(self) -> NDArray[np.float64]:
         """``B^-1`` (computed once)."""
         return np.linalg.inv(self.basis)
 
 
-def _symmetric(a: np.ndarray) -> np.ndarray:
+def _symmetric(a: NDArray[np.float64]) -> NDArray[np.float64]:
     return 0.5 * (a + _t(a))
 
 
-def _cayley(a: np.ndarray) -> np.ndarray:
+def _cayley(a: NDArray[np.float64]) -> NDArray[np.float64]:
     """``(I - a)(I + a)^-1`` of a symmetric matrix (symmetric itself: the factors commute)."""
     eye = np.eye(a.shape[-1])
     return _symmetric(np.linalg.solve(eye + a, eye - a))
 
 
-def _sqrt_and_inverse(a: np.ndarray):
+def _sqrt_and_inverse(a: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """``a^(1/2)`` and ``a^(-1/2)`` of symmetric positive definite matrices."""
     values, vectors = np.linalg.eigh(a)
     if np.any(values <= 0.0):
@@ -189,7 +218,7 @@ def _sqrt_and_inverse(a: np.ndarray):
     return (vectors * root) @ _t(vectors), (vectors / root) @ _t(vectors)
 
 
-def slab_generator(reflection: np.ndarray, transmission: np.ndarray, *,
+def slab_generator(reflection: NDArray[np.float64], transmission: NDArray[np.float64], *,
                    max_rate: float = np.inf) -> SlabGenerator:
     """The homogeneous symmetric slab whose matrices at unit thickness are ``(R, T)`` (star form,
     symmetric, ``(..., N, N)``): the doubling relation inverted, for every thickness at once.
@@ -202,7 +231,13 @@ def slab_generator(reflection: np.ndarray, transmission: np.ndarray, *,
     and ``B = Y^(1/2) U tanh(lambda)^(-1/2)``.  A mode the slab extinguishes completely
     (``theta`` at or beyond 1 within rounding, or measured slightly negative) is given the rate
     ``max_rate``: ``rates`` never exceed it (for light straight through an absorbing slab of
-    optical thickness ``tau``, ``max_rate = tau / 2``, the transmission ``exp(-2 lambda x)``)."""
+    optical thickness ``tau``, ``max_rate = tau / 2``, the transmission ``exp(-2 lambda x)``).
+
+    >>> generator = slab_generator(np.array([[0.2]]), np.array([[0.7]]))  # one node
+    >>> r, t = slab(generator, 1.0)  # the reference thickness: the slab given back
+    >>> print(np.round(r, 6), np.round(t, 6))
+    [[0.2]] [[0.7]]
+    """
     eye = np.eye(reflection.shape[-1])
     even = _symmetric(reflection + transmission)
     odd = _symmetric(reflection - transmission)
@@ -218,7 +253,7 @@ def slab_generator(reflection: np.ndarray, transmission: np.ndarray, *,
     return SlabGenerator(basis=basis, rates=rates)
 
 
-def generator_matrices(generator: SlabGenerator):
+def generator_matrices(generator: SlabGenerator) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """``(P, Q)``: the transport matrices per unit thickness, ``P = B lambda B^T``,
     ``Q = B^-T lambda B^-1`` (``P = alpha + beta``, ``Q = alpha - beta`` with ``alpha`` the
     loss along a direction and ``beta`` the scattering back; symmetric)."""
@@ -229,7 +264,7 @@ def generator_matrices(generator: SlabGenerator):
             _symmetric(_t(b_inv) @ (lam[..., :, None] * b_inv)))
 
 
-def generator_from_matrices(p: np.ndarray, q: np.ndarray) -> SlabGenerator:
+def generator_from_matrices(p: NDArray[np.float64], q: NDArray[np.float64]) -> SlabGenerator:
     """The slab of transport matrices ``(P, Q)``: ``P^(1/2) Q P^(1/2) = U lambda^2 U^T``,
     ``B = P^(1/2) U lambda^(-1/2)`` (so that ``Y(x) = P f(Q P)``, ``f(z) = tanh(x sqrt z) /
     sqrt z``)."""
@@ -239,7 +274,8 @@ def generator_from_matrices(p: np.ndarray, q: np.ndarray) -> SlabGenerator:
     return SlabGenerator(basis=(p_half @ vectors) / np.sqrt(rates)[..., None, :], rates=rates)
 
 
-def absorption_per_direction(generator: SlabGenerator, scale0: np.ndarray) -> np.ndarray:
+def absorption_per_direction(generator: SlabGenerator, scale0: NDArray[np.float64]
+                             ) -> NDArray[np.float64]:
     """Energy removed per unit thickness from light along each node, order 0: ``(Q s) / s``
     with ``s`` the order-0 :func:`star_scale` (the net flux through the slab falls by
     ``s^T Q (d + u)`` per unit thickness, ``d``, ``u`` the down- and upgoing radiance in the
@@ -249,7 +285,8 @@ def absorption_per_direction(generator: SlabGenerator, scale0: np.ndarray) -> np
     return (q @ scale0) / scale0
 
 
-def passive_generator(generator: SlabGenerator, scale0: np.ndarray, relief=0.0) -> SlabGenerator:
+def passive_generator(generator: SlabGenerator, scale0: NDArray[np.float64], relief: ArrayLike = 0.0
+                      ) -> SlabGenerator:
     """The slab made passive: with ``a`` the absorption per direction
     (:func:`absorption_per_direction`, order 0), ``d = max(0, -a) - relief max(0, a)`` is added
     as pure absorption, ``alpha += diag(d)``, to every order (absorption does not depend on
@@ -268,10 +305,25 @@ def passive_generator(generator: SlabGenerator, scale0: np.ndarray, relief=0.0) 
     return generator_from_matrices(p + extra, q + extra)
 
 
-def slab(generator: SlabGenerator, thickness: float):
+def slab(generator: SlabGenerator, thickness: float
+         ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """``(R, T)`` of the slab at ``thickness`` (in units of the reference thickness, >= 0):
     ``S = (I - Z)(I + Z)^-1``, ``D = (Y - I)(Y + I)^-1``, ``R = (S + D)/2``, ``T = (S - D)/2``.
-    Thickness 0 gives ``R = 0``, ``T = I`` exactly."""
+    Thickness 0 gives ``R = 0``, ``T = I`` exactly.
+
+    >>> generator = slab_generator(np.array([[0.2, 0.1], [0.1, 0.3]]),  # two nodes
+    ...                            np.array([[0.5, 0.1], [0.1, 0.4]]))
+    >>> r, t = slab(generator, 0.0)  # no slab: nothing reflected, everything straight through
+    >>> print(r, t)
+    [[0. 0.]
+     [0. 0.]] [[1. 0.]
+     [0. 1.]]
+    >>> r2, t2 = double_slab(*slab(generator, 0.5))  # the half slab doubled: the slab
+    >>> print(np.round(r2, 6), np.round(t2, 6))
+    [[0.2 0.1]
+     [0.1 0.3]] [[0.5 0.1]
+     [0.1 0.4]]
+    """
     if not thickness >= 0.0:
         raise ValueError(f"thickness must be >= 0, got {thickness!r}")
     b = generator.basis
@@ -284,8 +336,16 @@ def slab(generator: SlabGenerator, thickness: float):
     return 0.5 * (even + odd), 0.5 * (even - odd)
 
 
-def thick_slab(generator: SlabGenerator) -> np.ndarray:
+def thick_slab(generator: SlabGenerator) -> NDArray[np.float64]:
     """The reflection of the slab at infinite thickness: ``(B B^T - I)(B B^T + I)^-1`` (its
-    transmission is 0)."""
+    transmission is 0).
+
+    >>> generator = slab_generator(np.array([[0.2]]), np.array([[0.7]]))  # one node
+    >>> print(np.round(thick_slab(generator), 6))  # Kubelka-Munk: a - sqrt(a^2 - 1) ...
+    [[0.431271]]
+    >>> a = (1 + 0.2**2 - 0.7**2) / (2 * 0.2)  # ... with a = (1 + R^2 - T^2) / (2 R)
+    >>> round(a - (a * a - 1) ** 0.5, 6)
+    0.431271
+    """
     b = generator.basis
     return -_cayley(_symmetric(b @ _t(b)))
