@@ -29,7 +29,7 @@ import numpy as np
 
 from ..tables.table_set import Tables
 from . import cycles as cc
-from .closure_fit import ClosureFit
+from .closure_fit import ClosureFit, SlabFit
 from .profiles import REPLICA_EDGE_ERROR, fit_profiles
 from .tier_parts import FitTargets
 from .tier_registry import TIERS, Tier, tier
@@ -63,6 +63,22 @@ def _subsurface(tables: Tables, method: str | None, over_shader: bool) -> dict:
         method = min(cc.SUBSURFACE_METHODS, key=lambda m: np.hypot(
             profiles[m].worst_error, REPLICA_EDGE_ERROR[m]))
     return {"profiles": profiles, "subsurface_method": method, "subsurface_ior": ior}
+
+
+def _film_parts(targets: FitTargets) -> dict:
+    """What every tier shares of the film: its mean transmittance and diffuse albedo (the
+    paper's film: ``T_mean`` and ``pi P_d``; the film as a slab at the fit's thickness: ``t``
+    averaged over uniform light, the film body's albedo under uniform light and the
+    :class:`SlabFit`)."""
+    tables = targets.tables
+    if targets.slab is None:
+        return {"transmittance_mean": tables.film_transmittance_mean,
+                "film_albedo": np.pi * np.asarray(tables.film_diffuse, float)}
+    parts = targets.slab_parts(0.0)
+    return {"transmittance_mean": np.asarray(parts.through_mean, float),
+            "film_albedo": np.asarray(targets.film_mean(), float),
+            "slab": SlabFit(thickness_um=float(targets.thickness_um),
+                            below=np.asarray(parts.below, float))}
 
 
 def _checked_tiers(tiers: Iterable[str]) -> tuple[Tier, ...]:
@@ -119,8 +135,7 @@ def fit_closures(tables: Tables, *, tiers: Iterable[str] | None = None,
     else:
         report(0.75, "fitting the subsurface profile")
         fit = ClosureFit(
-            transmittance_mean=tables.film_transmittance_mean,
-            film_albedo=np.pi * np.asarray(tables.film_diffuse, float),
+            **_film_parts(targets),
             skin_albedo=np.pi * np.asarray(tables.skin_diffuse, float),
             **_subsurface(tables, subsurface_method, over_shader), **parts)
     if errors_at is None:
