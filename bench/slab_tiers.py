@@ -9,6 +9,9 @@ view-albedo error against the slab's tables (:func:`lut_baker.closures.tiers.tie
 fitted skin at coverage 1), its colour under uniform light against the exact closed form
 (:func:`lut_baker.model.slab_skin.slab_colour`, per channel, worst channel's relative error),
 the fit's CPU time; and the paper's film (paths 1 + 3) on the same skin for comparison.
+Then, per thickness, the fit at 9.6 um moved there without fitting
+(:func:`lut_baker.closures.fitting.at_thickness`, what a Thickness slider costs): its CPU time
+(best of 5) and the tiers' errors beside those of a fit made there.
 """
 
 from __future__ import annotations
@@ -72,6 +75,19 @@ def main(argv=None) -> None:
                   + "  ".join(f"{n} {e.rms:6.1%} {e.albedo:6.1%} (colour "
                               f"{colour_error(fit, tables, n, exact):5.1%})"
                               for n, e in fit.errors.items()))
+        base = fitting.fit_closures(dataclasses.replace(
+            slab, parameters={**slab.parameters, "film_thickness_um": 9.6}))
+        for h in args.thickness:
+            tables = dataclasses.replace(slab, parameters={**slab.parameters,
+                                                           "film_thickness_um": h})
+            times = []
+            for _ in range(5):
+                start = time.process_time()
+                moved = fitting.at_thickness(base, tables, h)
+                times.append(time.process_time() - start)
+            errors = tiers.tier_errors(moved, tables, 1.0, 0.0)
+            print(f"  9.6 -> {h:6.1f} um  {1e3 * min(times):5.1f} ms  "
+                  + "  ".join(f"{n} {e.rms:6.1%} {e.albedo:6.1%}" for n, e in errors.items()))
 
 
 if __name__ == "__main__":

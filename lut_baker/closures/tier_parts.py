@@ -7,6 +7,7 @@ parameters are fitted to the tables, with weights that may depend on the view an
 1-D lookup images (:mod:`lut_baker.closures.view_image`).
 
 - :class:`FitTargets` -- what the lobes of one set of tables are fitted to, computed once.
+- :func:`cosine_mean` -- a directional table's mean under uniform light.
 - :func:`principled_parts` -- one Principled BSDF's coat and speculars.
 - :func:`layered_parts` -- Cycles' Glossy lobes and their view-angle image.
 - :func:`eevee_parts` -- EEVEE's GGX lobes (the film's gloss in two) and their image.
@@ -37,15 +38,15 @@ from .tier_formulas import SPECULAR_IOR
 from .view_grid import FIT_VIEWS, lobe_widths_deg, view_grid
 from .view_image import EEVEE_LUT_ROWS, LUT_ROWS, lut_nodes
 
-__all__ = ["FitTargets", "principled_parts", "layered_parts", "eevee_parts", "image_rows",
-           "SLAB_ROWS"]
+__all__ = ["FitTargets", "cosine_mean", "principled_parts", "layered_parts", "eevee_parts",
+           "image_rows", "SLAB_ROWS"]
 
 SLAB_ROWS = ("film_body",)
 """The view-angle rows a tier has beyond its own with the film as a slab: the film body's
 directional albedo (its Diffuse closure's weight)."""
 
 
-def _cosine_mean(values: np.ndarray, theta_deg: np.ndarray) -> np.ndarray:
+def cosine_mean(values: np.ndarray, theta_deg: np.ndarray) -> np.ndarray:
     """``2 Int v(mu) mu dmu`` of a directional table ``(n_theta[, C])`` (its hemispherical
     cosine-weighted mean), trapezoid in ``mu``, held at its last value beyond ``theta_max``."""
     mu = np.cos(np.radians(np.asarray(theta_deg, float)))[::-1]
@@ -87,14 +88,18 @@ class FitTargets:
     then the slab's ``top`` less the film's body (Lambertian in the Layered and EEVEE tiers'
     reading: ``alpha(theta_i) alpha(theta_o) / (pi alpha_mean)``, its directional albedo the
     film's ``alpha``), the skin's gloss through the film every order; the transmittance rows
-    are the slab's ``t`` and the film's body has rows of its own (``film_body``)."""
+    are the slab's ``t`` and the film's body has rows of its own (``film_body``).
+    ``thickness_um``: another thickness than the baked one."""
 
-    def __init__(self, tables: Tables, lut_size: int):
+    def __init__(self, tables: Tables, lut_size: int, thickness_um: float | None = None):
         self.tables, self.lut_size = tables, lut_size
         self.theta_deg = np.asarray(tables.theta_deg, float)
         self.slab: SlabTables | None = getattr(tables, "slab", None)
-        self.thickness_um = (0.0 if self.slab is None
-                             else float(tables.parameters["film_thickness_um"]))
+        if self.slab is None:
+            self.thickness_um = 0.0
+        else:
+            self.thickness_um = float(tables.parameters["film_thickness_um"]
+                                      if thickness_um is None else thickness_um)
         self._found: dict = {}
 
     def _once(self, name, compute):
@@ -126,7 +131,7 @@ class FitTargets:
     def film_mean(self) -> np.ndarray:
         """The film body's albedo under uniform light (RGB): ``2 Int alpha mu dmu``."""
         theta = self.slab_tables().theta_deg
-        return self._once("film_mean", lambda: _cosine_mean(
+        return self._once("film_mean", lambda: cosine_mean(
             self.slab_parts(theta).film_albedo, theta))
 
     def target(self, name: str):
@@ -158,7 +163,7 @@ class FitTargets:
             return np.asarray(self.slab.theta_deg, float)
         return self.theta_deg
 
-    def _rows(self, theta_deg, values) -> np.ndarray:
+    def texel_rows(self, theta_deg, values) -> np.ndarray:
         """A directional table ``(n_theta, 3)`` on ``theta_deg`` at the image's texels."""
         mu = lut_nodes(self.lut_size)
         return np.stack([np.interp(np.degrees(np.arccos(mu)), theta_deg, values[:, c])
@@ -170,8 +175,8 @@ class FitTargets:
         def compute():
             if self.slab is not None:
                 theta = np.asarray(self.slab.theta_deg, float)
-                return self._rows(theta, self.slab_parts(theta).through)
-            return self._rows(self.theta_deg, np.asarray(self.tables.film_transmittance,
+                return self.texel_rows(theta, self.slab_parts(theta).through)
+            return self.texel_rows(self.theta_deg, np.asarray(self.tables.film_transmittance,
                                                          float))
         return self._once("transmittance_rows", compute)
 
@@ -179,7 +184,7 @@ class FitTargets:
         """The film body's directional albedo at the texels, ``(size, 3)`` (slab only)."""
         def compute():
             theta = np.asarray(self.slab_tables().theta_deg, dtype=np.float64)
-            return self._rows(theta, self.slab_parts(theta).film_albedo)
+            return self.texel_rows(theta, self.slab_parts(theta).film_albedo)
         return self._once("body_rows", compute)
 
 
@@ -224,7 +229,7 @@ def principled_parts(targets: FitTargets, over_shader: bool) -> dict:
         "specular_film": specular_film,
         "coat_albedo_mean": _coat_layering_mean(coat.roughness, coat_ior),
         "specular_albedo_mean": (specular_mean(specular_bare), specular_mean(specular_film)),
-        "gloss_to_diffuse": (_cosine_mean(targets.albedo("path3_gloss"),
+        "gloss_to_diffuse": (cosine_mean(targets.albedo("path3_gloss"),
                                           targets.albedo_theta("path3_gloss"))
                              if specular_film.level == 0.0 else np.zeros(3)),
     }
