@@ -43,6 +43,8 @@ import math
 from collections.abc import Iterable, Sequence
 from typing import Any
 
+import numpy as np
+
 from .core import auto_tier, bake, cache, closure_fit, fitting, params_file, table_set, tiers
 from .progress import Report, Stages, stage
 
@@ -65,8 +67,9 @@ MEASURE_SHARE = 0.85
 """Where on Apply's progress bar the fit ends and its measurement begins."""
 SLAB_TABLES = "slab"
 """:func:`bake_key`'s thickness for the slab's tables, shared by every thickness."""
-RECORD_FIELDS = ("key", "parameters", "resolution", "film_thickness_um")
-"""A bake record's fields (the thickness only with the film as a slab)."""
+RECORD_FIELDS = ("key", "parameters", "resolution", "film_thickness_um", "skin_under")
+"""A bake record's fields (the thickness and the skin under the film only with the film as a
+slab)."""
 
 
 class BakeRecordError(ValueError):
@@ -100,40 +103,52 @@ def _entry(key: str) -> _Entry:
     return entry
 
 
-def bake_key(parameters: dict, resolution: str, thickness_um: Any = None) -> str:
+def bake_key(parameters: dict, resolution: str, thickness_um: Any = None,
+             skin_under: Any = None) -> str:
     """The key of a bake: SHA-256 (first :data:`KEY_LENGTH` hex digits) of the made-up skin's
     ``parameters`` (:func:`lut_baker.model.params_file.skin_to_dict`), the resolution name,
     the film's thickness (micrometres; None: the paper's film, whose keys are those of every
-    earlier version; ``"slab"``: the slab's tables, whatever the thickness) and the tables'
-    format version, as canonical JSON (floats by ``repr``: the same on every machine)."""
+    earlier version; ``"slab"``: the slab's tables, whatever the thickness), the skin's albedo
+    under the film relative to Skin Color where Match Skin darkened it (``skin_under``, RGB, or
+    None) and the tables' format version, as canonical JSON (floats by ``repr``: the same on
+    every machine)."""
     version = table_set.FORMAT_VERSION
     data: dict[str, Any] = {"parameters": parameters, "resolution": str(resolution),
                             "format": version}
     if thickness_um is not None:
         data["film_thickness_um"] = (thickness_um if thickness_um == SLAB_TABLES
                                      else float(thickness_um))
+    if skin_under is not None:
+        data["skin_under"] = [float(u) for u in skin_under]
     text = json.dumps(data, sort_keys=True, separators=(",", ":"))
     return hashlib.sha256(text.encode("utf-8")).hexdigest()[:KEY_LENGTH]
 
 
-def bake_record(skin: Any, resolution: str, film: Any = "paper") -> dict:
+def bake_record(skin: Any, resolution: str, film: Any = "paper",
+                skin_under: Any = None) -> dict:
     """What identifies a bake: ``{"key", "parameters", "resolution"}`` and, for the film as a
     slab (``film`` a thickness in micrometres, :func:`.skin_model.film_of`),
-    ``"film_thickness_um"`` (plain data, no bake needed).  A slab's skin carries its
-    absorption (the slab is baked at it)."""
+    ``"film_thickness_um"`` and, where Match Skin darkened the skin under it, ``"skin_under"``
+    (:func:`.skin_model.skin_under_of`) (plain data, no bake needed).  A slab's skin carries
+    its absorption (the slab is baked at it)."""
     parameters = params_file.skin_to_dict(skin)
     thickness = None if film == "paper" else float(film)
-    record: dict[str, Any] = {"key": bake_key(parameters, resolution, thickness),
+    under = None if thickness is None or skin_under is None else [float(u)
+                                                                  for u in skin_under]
+    record: dict[str, Any] = {"key": bake_key(parameters, resolution, thickness, under),
                               "parameters": parameters, "resolution": str(resolution)}
     if thickness is not None:
         record["film_thickness_um"] = thickness
+    if under is not None:
+        record["skin_under"] = under
     return record
 
 
 def record_key(record: dict) -> str:
-    """The key a record's parameters, resolution and thickness give (:func:`bake_key`)."""
+    """The key a record's parameters, resolution, thickness and skin under the film give
+    (:func:`bake_key`)."""
     return bake_key(record["parameters"], record["resolution"],
-                    record.get("film_thickness_um"))
+                    record.get("film_thickness_um"), record.get("skin_under"))
 
 
 def _tables_key(record: dict) -> str | None:
@@ -227,17 +242,28 @@ def baked(record: dict, *, method: str | None = None,
     if fit is None and shared is not None:
         other = _SLAB_FITS.get((shared, *which))
         if other is not None and set(tiers) <= set(other.tiers):
-            fit = fitting.at_thickness(other, tables, float(record["film_thickness_um"]))
+            fit = _under(fitting.at_thickness(other, tables,
+                                              float(record["film_thickness_um"])), record)
             fits[which] = fit
             return tables, fit
     if fit is None or not set(tiers) <= set(fit.tiers):
-        fit = fitting.fit_closures(
+        fit = _under(fitting.fit_closures(
             tables, tiers=tiers, over_shader=over_shader, onto=fit, subsurface_method=method,
-            errors_at=errors_at, progress=fit_progress)
+            errors_at=errors_at, progress=fit_progress), record)
         fits[which] = fit
         if shared is not None:
             _SLAB_FITS.put((shared, *which), fit)
     return tables, fit
+
+
+def _under(fit: closure_fit.ClosureFit, record: dict) -> closure_fit.ClosureFit:
+    """A slab fit with the record's skin under the film (its errors then measured again:
+    dropped)."""
+    under = record.get("skin_under")
+    if under is None or fit.slab is None:
+        return fit
+    return dataclasses.replace(fit, errors={}, slab=dataclasses.replace(
+        fit.slab, skin_under=np.asarray(under, float)))
 
 
 def _same(a: Iterable[float], b: Iterable[float]) -> bool:

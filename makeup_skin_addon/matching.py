@@ -13,10 +13,10 @@ is matched as far as it goes and the report says so.
 With the film at a thickness (the Film setting, docs/model.md "Made-up skin at a thickness")
 the covered colour is the slab's, every inter-reflection in, solved on its exact order-0
 evaluation (:func:`lut_baker.model.slab_skin.matching_shade`, at the Gloss of 1 it is baked
-with): Match Skin changes the foundation's absorption only.  Where even full absorption leaves
+with): Match Skin changes the foundation's absorption; only where even full absorption leaves
 the made-up skin too light (a sheer film whose surface gloss adds more than its pigment can
-take away), the skin under the film would have to be darker: the report says by how much, and
-the channel is out of reach (the skin under the film is the artist's).
+take away) is the skin under the film darkened (``skin_under``, relative to Skin Color, baked
+into the group; the bare skin stays the artist's), and the report says by how much.
 
 Lighter and Darker step the covered colour's target by :data:`SHADE_STEP` from where the last
 match (or the current shade) put it, counting steps (``shade_steps``), so that Lighter then
@@ -119,6 +119,14 @@ class Shade:
     base: np.ndarray | None = None
     under: np.ndarray | None = None
 
+    def skin_under(self) -> np.ndarray:
+        """The skin's albedo under the film relative to its own (``under`` over the body
+        colour; 1 where unchanged or without a thickness)."""
+        if self.under is None:
+            return np.ones(3)
+        body = np.asarray(self.skin.body, float)
+        return np.where(self.under < body, self.under / np.maximum(body, 1e-12), 1.0)
+
     def note(self) -> str:
         """The panel's short line about channels out of reach, or ""."""
         out = [name for name, c in zip(CHANNELS, self.clamped, strict=True) if c]
@@ -143,8 +151,11 @@ class SlabLight:
                                                  res.quad_phi)
         self.film_gloss = uniform_light_gloss(self.skin, self.grid)
 
-    def covered(self, absorption, body) -> np.ndarray:
-        """The covered colour at ``absorption`` on a skin of albedo ``body`` (RGB)."""
+    def covered(self, absorption, body, under=None) -> np.ndarray:
+        """The covered colour at ``absorption`` on a skin of albedo ``body`` (RGB; times
+        ``under`` under the film, if given)."""
+        if under is not None:
+            body = np.asarray(body, float) * np.asarray(under, float)
         return np.asarray(slab_skin.slab_colour(
             self.skin.film, self.skin.film_transmission, self.skin.skin_reflection, body,
             self.thickness_um, self.grid, absorption), float).reshape(-1) * np.ones(3)
@@ -171,16 +182,16 @@ def _light(settings, foundation: str | None = None, resolution: str | None = Non
     return light_for(settings, foundation, resolution)
 
 
-def _covered(light, settings, absorption, body) -> np.ndarray:
+def _covered(light, settings, absorption, body, under=None) -> np.ndarray:
     if isinstance(light, SlabLight):
-        return light.covered(absorption, body)
+        return light.covered(absorption, body, under)
     return uniform_light.covered_colour(light, absorption, body, float(settings.gloss))
 
 
 def _solve(settings, light, target, skin: SkinTarget) -> Shade:
     if isinstance(light, SlabLight):
         absorption, under, clamped = light.solve(target, skin.body)
-        reached = light.covered(absorption, skin.body)
+        reached = light.covered(absorption, under)
         return Shade(np.asarray(absorption, float), np.asarray(clamped, bool),
                      np.asarray(target, float), reached, skin, under=np.asarray(under, float))
     gloss = float(settings.gloss)
@@ -195,11 +206,9 @@ def _reach_sentences(shade_: Shade, light, gloss: float) -> list[str]:
         if isinstance(light, SlabLight) and shade_.under is not None and \
                 shade_.under[c] < shade_.skin.body[c] and shade_.absorption[c] == 1.0:
             sentences.append(
-                f"{name} is out of reach: at {light.thickness_um:g} um the film's gloss adds "
-                f"more than full absorption takes away ({shade_.reached[c]:.3f} against "
-                f"{shade_.target[c]:.3f}); the skin under the film would match with albedo "
-                f"{shade_.under[c]:.3f} instead of {shade_.skin.body[c]:.3f}, or a thicker "
-                f"film.")
+                f"{name}: at {light.thickness_um:g} um the film's gloss adds more than full "
+                f"absorption takes away; the skin under the film darkened to "
+                f"{shade_.under[c] / shade_.skin.body[c]:.3f} of its own to match.")
             continue
         if not shade_.clamped[c]:
             continue
@@ -280,7 +289,8 @@ def stepped(material, steps: int) -> Shade:
     light = _light(settings)
     skin = skin_target(material, light=None if isinstance(light, SlabLight) else light)
     gloss = float(settings.gloss)
-    current = _covered(light, settings, list(settings.absorption), skin.body)
+    current = _covered(light, settings, list(settings.absorption), skin.body,
+                       tuple(settings.skin_under))
     if settings.shade_source == "MATCH" and settings.is_property_set("shade_base"):
         base, count = np.asarray(settings.shade_base, float), int(settings.shade_steps)
     else:
@@ -312,6 +322,7 @@ def assign(settings, result: Shade, source: str) -> None:
         if result.base is not None:
             settings.shade_base = [float(b) for b in result.base]
         settings.shade_steps = int(result.steps)
+        settings.skin_under = [float(u) for u in result.skin_under()]
 
 
 def clear_cache() -> None:

@@ -114,10 +114,26 @@ def _update_tables(self, context):
 
 
 def _update_shade(self, context):
-    """The shade reaches the sockets at once; with the film as a slab it is baked too."""
+    """The shade reaches the sockets at once; with the film as a slab it is baked too, and a
+    shade set by hand leaves the skin under the film as it is (Match Skin may darken it)."""
+    if not shade.is_assigning():
+        _reset_skin_under(self)
     _update_sockets(self, context)
     if self.film_mode != PAPER_FILM:
         live.tables_changed(self)
+
+
+def _reset_skin_under(settings) -> None:
+    if tuple(settings.skin_under) != (1.0, 1.0, 1.0):
+        settings.skin_under = (1.0, 1.0, 1.0)
+
+
+def _update_film(self, context):
+    """Film and Thickness change the tables; the skin under the film Match Skin darkened for
+    another film is the skin's own again."""
+    if not shade.is_assigning():
+        _reset_skin_under(self)
+    _update_tables(self, context)
 
 
 def _update_absorption(self, context):
@@ -160,6 +176,7 @@ def _update_foundation(self, context):
             self.film_roughness = shade.foundation_roughness(self.foundation)
             self.shade_note = ""
             self.shade_source = "PRESET"
+            _reset_skin_under(self)
         _update_sockets(self, context)
     # The film's gloss, roughness and index change the tables: a debounced preview re-fit.
     _update_tables(self, context)
@@ -197,13 +214,19 @@ class MakeupSkinSettings(bpy.types.PropertyGroup):
                                                       "it)")),
         default=SLAB_FILM,
         description="How the foundation's film is modelled: at a thickness, or the paper's "
-                    "free film as published", update=_update_tables)
+                    "free film as published", update=_update_film)
     thickness_um: bpy.props.FloatProperty(
         name="Thickness", default=DEFAULT_THICKNESS_UM, min=0.1, soft_min=1.0, soft_max=300.0,
         max=10000.0, precision=1,
         description="The film's thickness in micrometres: how much it hides (sheer a few, "
                     "9.6 a typical application of liquid foundation on a face, 0.96 mg/cm2; "
-                    "the paper's free film 150)", update=_update_tables)
+                    "the paper's free film 150)", update=_update_film)
+    skin_under: bpy.props.FloatVectorProperty(
+        name="Skin Under the Film", size=3, default=(1.0, 1.0, 1.0), min=0.0, max=1.0,
+        description="The skin's albedo under the film relative to Skin Color, per channel: "
+                    "where a sheer film's gloss adds more than full absorption takes away, "
+                    "Match Skin darkens the skin under it (1: the skin's own; internal, reset "
+                    "by a shade or film set by hand)")
     coverage: bpy.props.FloatProperty(
         name="Covered Area", default=0.6, min=0.0, max=1.0, subtype="FACTOR",
         description="Fraction of the surface the film lies on, as an areal mix of made-up "

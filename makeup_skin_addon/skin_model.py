@@ -10,7 +10,8 @@ so the skin carries it, and the bake's film is the thickness (:func:`film_of`).
 
 - :func:`skin_from_settings` -- the made-up skin of the settings, or of their plain values
   (:class:`SkinSettings`, read by :func:`skin_settings` on the main thread, for a worker).
-- :func:`film_of` -- the bake's film: the paper's (``"paper"``) or a thickness.
+- :func:`film_of` -- the bake's film: the paper's (``"paper"``) or a thickness;
+  :func:`skin_under_of` -- the skin under the film where Match Skin darkened it.
 - :func:`clear_cache` -- forget the session's roughened layers.
 """
 
@@ -22,7 +23,8 @@ from typing import Any
 from .core import cache, presets, roughness
 from .shade import ROUGHNESS_TOLERANCE, foundation_roughness, skin_roughness
 
-__all__ = ["SkinSettings", "skin_settings", "skin_from_settings", "film_of", "clear_cache",
+__all__ = ["SkinSettings", "skin_settings", "skin_from_settings", "film_of", "skin_under_of",
+           "clear_cache",
            "PAPER_FILM", "SLAB_FILM"]
 
 PAPER_FILM = "PAPER"
@@ -58,13 +60,24 @@ class SkinSettings:
     film_mode: str = PAPER_FILM
     thickness_um: float = 9.6
     absorption: tuple = (0.0, 0.0, 0.0)
+    skin_under: tuple = (1.0, 1.0, 1.0)
 
 
 def skin_settings(settings: Any) -> SkinSettings:
     """The :class:`SkinSettings` of a material's settings now."""
     values = {name: getattr(settings, name) for name in SkinSettings.__dataclass_fields__}
-    values["absorption"] = tuple(float(a) for a in values["absorption"])
+    for name in ("absorption", "skin_under"):
+        values[name] = tuple(float(a) for a in values[name])
     return SkinSettings(**values)
+
+
+def skin_under_of(settings: Any) -> tuple | None:
+    """The skin's albedo under the film relative to Skin Color where Match Skin darkened it
+    (the film at a thickness only), or None (unchanged)."""
+    if film_of(settings) == "paper":
+        return None
+    under = tuple(float(u) for u in getattr(settings, "skin_under", (1.0, 1.0, 1.0)))
+    return None if all(u == 1.0 for u in under) else under
 
 
 def film_of(settings: Any) -> Any:

@@ -20,10 +20,14 @@ class SlabFit:
     thickness"): ``thickness_um`` (the thickness it was fitted at) and ``below`` (RGB, ``c``:
     the film's reflectance seen from the skin, the skin's diffuse light ``a t t / (1 - a c)``).
     The fit's ``transmittance_mean`` is then the slab's ``t`` averaged over uniform light and
-    its ``film_albedo`` the film body's albedo under uniform light."""
+    its ``film_albedo`` the film body's albedo under uniform light.  ``skin_under`` (RGB, or
+    None for 1): the skin's albedo under the film relative to Skin Color, where Match Skin
+    darkens it (a sheer film whose gloss alone adds more than full absorption takes away,
+    docs/model.md "Made-up skin at a thickness")."""
 
     thickness_um: float
     below: np.ndarray
+    skin_under: np.ndarray | None = None
 
 
 @dataclass(frozen=True, eq=False)

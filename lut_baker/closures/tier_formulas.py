@@ -21,7 +21,8 @@ made-up skin's parts goes through :func:`lut_baker.model.made_up_skin.coverage_w
 
 - :class:`TierInputs` -- the group's inputs.
 - :func:`skin_through_film` -- the skin's diffuse light through the film (the paper's, or
-  the film as a slab with every return from its underside).
+  the film as a slab with every return from its underside); :func:`under_film` -- the skin's
+  albedo under the film.
 - :func:`principled_sockets` -- one Principled BSDF's sockets; :func:`principled_shader` --
   that BSDF as a tier's shader.
 - :func:`view_weighted_closures` -- Glossy, Diffuse and Subsurface closures with view-angle
@@ -43,7 +44,7 @@ from .view_image import sample_lut
 __all__ = ["Algebra", "ShaderAlgebra", "NumpyAlgebra", "TierInputs", "Closure",
            "ViewWeightedClosures", "principled_sockets", "principled_shader",
            "view_weighted_closures", "view_weighted_shader", "assemble", "SPECULAR_IOR",
-           "ROW_SURFACE", "THROUGH_WEIGHT_FLOOR", "skin_through_film"]
+           "ROW_SURFACE", "THROUGH_WEIGHT_FLOOR", "skin_through_film", "under_film"]
 
 SPECULAR_IOR = 1.5
 """The Principled BSDF's IOR in the PRINCIPLED tier (its specular level carries the fit)."""
@@ -151,11 +152,20 @@ def skin_through_film(fit: Any, x: TierInputs) -> Any:
     applies the paper film's absorption): ``S T_mean^2``; with the film as a slab every return
     from the film's underside too, ``S t_mean^2 / (1 - S c)`` (docs/model.md "Made-up skin at
     a thickness"), per pixel since ``S`` is the Skin Color input."""
-    through = x.skin_color * fit.transmittance_mean**2
     slab = _slab(fit)
     if slab is None:
-        return through
-    return through / (1.0 - x.skin_color * slab.below)
+        return x.skin_color * fit.transmittance_mean**2
+    skin = under_film(fit, x)
+    return skin * fit.transmittance_mean**2 / (1.0 - skin * slab.below)
+
+
+def under_film(fit: Any, x: TierInputs) -> Any:
+    """The skin's albedo under the film: Skin Color, times the fit's ``slab.skin_under``
+    where Match Skin darkened it (the film at a thickness only)."""
+    slab = _slab(fit)
+    if slab is None or slab.skin_under is None:
+        return x.skin_color
+    return x.skin_color * slab.skin_under
 
 
 def principled_sockets(fit: Any, x: TierInputs, ops: Algebra) -> dict[str, Any]:
@@ -301,20 +311,20 @@ def view_weighted_closures(fit: Any, x: TierInputs, ops: Algebra, *,
     g = x.gloss
     slab = _slab(fit)
     transmitted = weights.twice * ops.row("film_transmittance") * fit.transmittance_mean
+    skin = under_film(fit, x)
     if slab is not None:  # every return from the film's underside, per pixel
-        transmitted = transmitted / (1.0 - x.skin_color * slab.below)
+        transmitted = transmitted / (1.0 - skin * slab.below)
     if tinted_subsurface:
         strongest = ops.channel_max(transmitted)
         through = Closure("subsurface", "skin through film",
-                          transmitted * x.skin_color / ops.maximum(strongest,
-                                                                   THROUGH_WEIGHT_FLOOR),
+                          transmitted * skin / ops.maximum(strongest, THROUGH_WEIGHT_FLOOR),
                           "skin", weight=strongest)
     else:
-        through = Closure("subsurface", "skin through film", transmitted * x.skin_color, "skin")
+        through = Closure("subsurface", "skin through film", transmitted * skin, "skin")
     diffuse_through: tuple[Closure, ...] = ()
     if subsurface_weight is not None:
         diffuse_through = (Closure("diffuse", "skin through film (diffuse)",
-                                   transmitted * x.skin_color, "skin",
+                                   transmitted * skin, "skin",
                                    weight=1.0 - subsurface_weight),)
         through = Closure(through.kind, through.name, through.colour, through.surface,
                           weight=subsurface_weight if through.weight is None

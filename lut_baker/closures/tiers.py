@@ -169,10 +169,17 @@ def reference_reflection(fit: ClosureFit, tables: Tables, coverage: float,
                          absorption: ArrayLike, directions: Directions) -> NDArray[np.float64]:
     """What a fit's tiers are measured against, ``(..., 3)``: the tables' made-up skin at a
     coverage and absorption, or with the film as a slab (``fit.slab``) the slab's at the fit's
-    thickness (its absorption baked, :func:`lut_baker.tables.slab_tables.slab_reflection`)."""
+    thickness (its absorption baked, :func:`lut_baker.tables.slab_tables.slab_reflection`; the
+    skin under the film darkened by ``slab.skin_under`` where Match Skin set it)."""
     if fit.slab is None:
         return tables.made_up_reflection(*directions, coverage, absorption)
-    return slab_reflection(tables, *directions, fit.slab.thickness_um, coverage=coverage)
+    under = fit.slab.skin_under
+    if under is None:
+        return slab_reflection(tables, *directions, fit.slab.thickness_um, coverage=coverage)
+    covered = slab_reflection(tables, *directions, fit.slab.thickness_um,
+                              skin_albedo=fit.skin_albedo * np.asarray(under, float))
+    bare = slab_reflection(tables, *directions, fit.slab.thickness_um, coverage=0.0)
+    return combine(coverage_weights(coverage, 0.0), top=covered, bare=bare)
 
 
 def tier_errors(fit: ClosureFit, tables: Tables, coverage: float, absorption: ArrayLike,
