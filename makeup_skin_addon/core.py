@@ -23,14 +23,7 @@ if INSTALLED:
         tiers,
         view_image,
     )
-    from ..lut_baker.model import (
-        film_slab,
-        params_file,
-        presets,
-        roughness,
-        slab_skin,
-        thick_layer,
-    )
+    from ..lut_baker.model import film_slab, params_file, presets, roughness, slab_skin, thick_layer
     from ..lut_baker.numerics import cache, quadrature
     from ..lut_baker.tables import codec, slab_tables, table_set, uniform_light
 else:
@@ -45,14 +38,7 @@ else:
         tiers,
         view_image,
     )
-    from lut_baker.model import (
-        film_slab,
-        params_file,
-        presets,
-        roughness,
-        slab_skin,
-        thick_layer,
-    )
+    from lut_baker.model import film_slab, params_file, presets, roughness, slab_skin, thick_layer
     from lut_baker.numerics import cache, quadrature
     from lut_baker.tables import codec, slab_tables, table_set, uniform_light
 
