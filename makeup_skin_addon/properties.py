@@ -129,11 +129,19 @@ def _reset_skin_under(settings) -> None:
 
 
 def _update_film(self, context):
-    """Film and Thickness change the tables; the skin under the film Match Skin darkened for
-    another film is the skin's own again."""
+    """Film changes the tables; the skin under the film Match Skin darkened for another film
+    is the skin's own again."""
     if not shade.is_assigning():
         _reset_skin_under(self)
     _update_tables(self, context)
+
+
+def _update_thickness(self, context):
+    """A Thickness change re-reads the slab's tables (no bake, no fit): a short debounce."""
+    if not shade.is_assigning():
+        _reset_skin_under(self)
+    _stamp(self)
+    live.tables_changed(self, live.THICKNESS_DEBOUNCE_S)
 
 
 def _update_absorption(self, context):
@@ -220,7 +228,7 @@ class MakeupSkinSettings(bpy.types.PropertyGroup):
         max=10000.0, precision=1,
         description="The film's thickness in micrometres: how much it hides (sheer a few, "
                     "9.6 a typical application of liquid foundation on a face, 0.96 mg/cm2; "
-                    "the paper's free film 150)", update=_update_film)
+                    "the paper's free film 150)", update=_update_thickness)
     skin_under: bpy.props.FloatVectorProperty(
         name="Skin Under the Film", size=3, default=(1.0, 1.0, 1.0), min=0.0, max=1.0,
         description="The skin's albedo under the film relative to Skin Color, per channel: "
