@@ -227,8 +227,14 @@ def matching_absorption(target: ArrayLike, film: ReflectionLayer,
     albedo = np.broadcast_to(np.asarray(skin_albedo, float), (3,))
     face = face_albedo(film, grid)
 
-    def colour(a: np.ndarray) -> np.ndarray:
-        return slab_colour(film, transmission, skin, albedo, thickness_um, grid, a, face)
+    known: dict[tuple[float, ...], np.ndarray] = {}
+
+    def colour(a: np.ndarray) -> np.ndarray:  # the ends, asked twice, evaluated once
+        key = tuple(np.broadcast_to(np.asarray(a, float), (3,)).tolist())
+        if key not in known:
+            known[key] = slab_colour(film, transmission, skin, albedo, thickness_um, grid, a,
+                                     face)
+        return known[key]
 
     absorption = increasing_root(lambda a: -colour(a), -goal, ROOT_STEPS)
     too_light = goal > colour(np.zeros(3))
