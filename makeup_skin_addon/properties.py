@@ -25,7 +25,7 @@ import math
 import bpy
 
 from . import live, shade
-from .core import film_slab, presets, tier_registry
+from .core import film_slab, presets, slab_tables, tier_registry
 from .keys import SETTINGS_ATTRIBUTE, SETTINGS_VERSION
 from .shade import FILM_ROUGHNESS_MIN, ROUGHNESS_MAX, SKIN_ROUGHNESS_MIN
 from .skin_model import PAPER_FILM, SLAB_FILM
@@ -82,6 +82,8 @@ FIRST_FOUNDATION = next(iter(presets.FOUNDATIONS))
 Apply, docs/addon.md "A first Apply")."""
 FIRST_SKIN = next(iter(presets.SKINS))
 DEFAULT_THICKNESS_UM = float(film_slab.DEFAULT_THICKNESS_UM)
+THICKNESS_MIN_UM = float(slab_tables.THICKNESS_MIN_UM)
+"""The thinnest film: the slab tables' axis begins there (thinner would be read as it)."""
 """The Thickness setting's default: a typical application on a face (docs/model.md, "The film
 as a slab")."""
 # Enum items must stay referenced while Blender shows them.
@@ -224,8 +226,8 @@ class MakeupSkinSettings(bpy.types.PropertyGroup):
         description="How the foundation's film is modelled: at a thickness, or the paper's "
                     "free film as published", update=_update_film)
     thickness_um: bpy.props.FloatProperty(
-        name="Thickness", default=DEFAULT_THICKNESS_UM, min=0.1, soft_min=1.0, soft_max=300.0,
-        max=10000.0, precision=1,
+        name="Thickness", default=DEFAULT_THICKNESS_UM, min=THICKNESS_MIN_UM,
+        soft_max=300.0, max=10000.0, precision=1,
         description="The film's thickness in micrometres: how much it hides (sheer a few, "
                     "9.6 a typical application of liquid foundation on a face, 0.96 mg/cm2; "
                     "the paper's free film 150)", update=_update_thickness)
