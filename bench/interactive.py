@@ -33,7 +33,8 @@ does; ``swap``: the look that builds the group and installs it), the longest bei
 block.
 
 With ``--live`` (default on) the ``full`` process of ``defaults/sphere`` and of
-``defaults/principled`` then picks every foundation in turn and sets each roughness to each
+``defaults/principled`` then moves the Thickness (2, 50, 9.6 um, where the film is at a
+thickness), picks every foundation in turn and sets each roughness to each
 end (Live Update on), each change measured like the refine: ``update`` (the property's
 assignment and its callbacks), ``start``, ``poll``, ``swap``, the worker's CPU and wall.  A
 checkout without the worker thread blocks for the whole rebuild in ``live.flush()`` (what
@@ -202,16 +203,22 @@ def first_apply(bpy, support, case: str, mode: str) -> dict:
     return out
 
 
+THICKNESS_CHANGES = (2.0, 50.0, 9.6)
+"""Thickness changes (micrometres) measured first where the film is at a thickness."""
+
+
 def live_changes(bpy, material) -> list[dict]:
-    """Every foundation pick, then each roughness end, with Live Update: the main-thread
-    steps and the worker's time of each."""
+    """Each Thickness change (the film at a thickness), every foundation pick, then each
+    roughness end, with Live Update: the main-thread steps and the worker's time of each."""
     from makeup_skin_addon import live
 
     settings = material.makeup_skin
     settings.live_update = True
-    changes = [("foundation", name) for name in _foundations()
-               if name != settings.foundation] + [_roughness(settings, end)
-                                                  for end in ROUGHNESS_ENDS]
+    thickness = ([("thickness_um", value) for value in THICKNESS_CHANGES]
+                 if getattr(settings, "film_mode", "PAPER") == "SLAB" else [])
+    changes = thickness + [("foundation", name) for name in _foundations()
+                           if name != settings.foundation] + [_roughness(settings, end)
+                                                              for end in ROUGHNESS_ENDS]
     out = []
     for name, value in changes:
         with _Clock() as clock:

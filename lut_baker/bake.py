@@ -597,7 +597,7 @@ def bake_slab(skin: MadeUpSkin, resolution_name: str | Resolution = "default", *
     film = foundation_slab(skin.film, skin.film_transmission, grid, absorption)
     face = gloss_albedos((skin.film,), np.degrees(grid.theta))[0].T  # (3, N), a_g
     scale = star_scale(grid)
-    top, top_albedo, through, through_mean, below = [], [], [], [], []
+    top, top_albedo, through, through_mean, below, film_albedo = [], [], [], [], [], []
     for h in axis:
         parts = slab_skin_parts(film, np.inf if np.isinf(h) else relative_thickness(h),
                                 skin.skin_reflection, face)
@@ -608,9 +608,11 @@ def bake_slab(skin: MadeUpSkin, resolution_name: str | Resolution = "default", *
         through.append(rgb_view(lagrange @ parts.through.T))
         through_mean.append(np.broadcast_to(parts.through @ (2.0 * grid.weight), (3,)))
         below.append(np.broadcast_to(parts.below, (3,)))
+        film_albedo.append(rgb_view(lagrange @ np.asarray(parts.film).T))
     return SlabTables(thickness_um=axis, theta_deg=theta_deg, phi_deg=phi_deg,
                       top=np.stack(top), top_albedo=np.stack(top_albedo),
                       through=np.stack(through), through_mean=np.stack(through_mean),
-                      below=np.stack(below), absorption=absorption.copy(),
+                      below=np.stack(below), film_albedo=np.stack(film_albedo),
+                      absorption=absorption.copy(),
                       theta_spacing=res.theta_spacing, theta_offset=res.theta_offset,
                       phi_spacing=res.phi_spacing)

@@ -157,9 +157,10 @@ def _bake_record(settings: Any, target: str, quick: bool, over: bool, report: Re
     """The settings' bake record at ``target``, or (``quick``, and the file has no group of
     that bake) at preview resolution, the refinement to ``target`` noted in ``report``."""
     skin = skin_model.skin_from_settings(settings)
-    record = bakes.bake_record(skin, target)
+    film, under = skin_model.film_of(settings), skin_model.skin_under_of(settings)
+    record = bakes.bake_record(skin, target, film, under)
     if quick and not groups.has_group(record, tier_choice.forced_method(settings), over):
-        record = bakes.bake_record(skin, PREVIEW)
+        record = bakes.bake_record(skin, PREVIEW, film, under)
         report.refine = target
         report.append(f"Baked at preview resolution first: the {target} tables follow in "
                       f"the background.")
@@ -339,7 +340,8 @@ def check_material(context: Any, material: Any) -> tuple[bool, str]:
         return False, (f"{name!r}: its group's record is unreadable or from an older "
                        f"version; re-baked it from the panel's settings.")
     try:
-        key = bakes.bake_key(meta["parameters"], meta.get("resolution", "default"))
+        key = bakes.bake_key(meta["parameters"], meta.get("resolution", "default"),
+                             meta.get("film_thickness_um"), meta.get("skin_under"))
     except (TypeError, ValueError):
         key = None
     if key != meta.get("key"):
@@ -352,7 +354,7 @@ def check_material(context: Any, material: Any) -> tuple[bool, str]:
         return True, f"{name!r}: intact."
     settings = material.makeup_skin
     tier = meta.get("tier", tier_registry.UNRECORDED)
-    work = Bake({k: meta[k] for k in ("key", "parameters", "resolution")},
+    work = Bake({k: meta[k] for k in bakes.RECORD_FIELDS if k in meta},
                 meta.get("forced_method"), settings.coverage, settings.absorption,
                 tiers=tier_choice.fitted_tiers(settings, context.scene, (tier,)),
                 over=nodes.over_shader(group))

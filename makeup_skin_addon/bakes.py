@@ -19,7 +19,10 @@ the same fit.  What a fit measured at a coverage and absorption (the tiers' erro
 (:mod:`.nodes`), so a reopened file knows it too.  The cache may be read and filled from a
 worker thread (:mod:`.live`): nothing here touches bpy.
 
-- :func:`bake_key`, :func:`bake_record` -- a bake's key and record.
+- :func:`bake_key`, :func:`bake_record`, :func:`record_key` -- a bake's key and record (the
+  film as a slab: its thickness in the record; the slab's tables, baked at every thickness,
+  shared by the records of every thickness, and a fit at a new thickness moved from the last
+  one, :func:`lut_baker.closures.fitting.at_thickness`).
 - :func:`rebake` -- the tables of a record, baked once per session; :func:`remember` -- tables
   a caller baked itself, kept as the record's.
 - :func:`baked` -- ``(tables, fit)`` of a record, baked and fitted once per session;
@@ -33,17 +36,21 @@ worker thread (:mod:`.live`): nothing here touches bpy.
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import json
 import math
 from collections.abc import Iterable, Sequence
 from typing import Any
 
+import numpy as np
+
 from .core import auto_tier, bake, cache, closure_fit, fitting, params_file, table_set, tiers
 from .progress import Report, Stages, stage
 
 __all__ = ["BakeRecordError", "KEY_LENGTH", "CACHE_SIZE", "TOLERANCE", "BAKE_SHARE",
-           "MEASURE_SHARE", "bake_key", "bake_record", "remember", "rebake", "baked", "cached",
+           "MEASURE_SHARE", "SLAB_TABLES", "RECORD_FIELDS", "bake_key", "bake_record",
+           "record_key", "remember", "rebake", "baked", "cached",
            "measure", "measured_at", "traits", "Bake", "clear"]
 
 KEY_LENGTH = 16
@@ -58,6 +65,11 @@ BAKE_SHARE = 0.15
 rest)."""
 MEASURE_SHARE = 0.85
 """Where on Apply's progress bar the fit ends and its measurement begins."""
+SLAB_TABLES = "slab"
+""":func:`bake_key`'s thickness for the slab's tables, shared by every thickness."""
+RECORD_FIELDS = ("key", "parameters", "resolution", "film_thickness_um", "skin_under")
+"""A bake record's fields (the thickness and the skin under the film only with the film as a
+slab)."""
 
 
 class BakeRecordError(ValueError):
@@ -74,6 +86,12 @@ class _Entry:
 
 
 _BAKES = cache.LRUCache(CACHE_SIZE)
+_SLABS = cache.LRUCache(CACHE_SIZE)
+"""The slab's tables by the key they share over thicknesses (:func:`_tables_key`)."""
+_SLAB_FITS = cache.LRUCache(4 * CACHE_SIZE)
+"""The last fit of the slab's tables per ``(shared key, forced method, over the artist's
+shader)``: a fit at another thickness moves from it (:func:`lut_baker.closures.fitting.
+at_thickness`) instead of fitting again."""
 
 
 def _entry(key: str) -> _Entry:
@@ -85,23 +103,60 @@ def _entry(key: str) -> _Entry:
     return entry
 
 
-def bake_key(parameters: dict, resolution: str) -> str:
+def bake_key(parameters: dict, resolution: str, thickness_um: Any = None,
+             skin_under: Any = None) -> str:
     """The key of a bake: SHA-256 (first :data:`KEY_LENGTH` hex digits) of the made-up skin's
-    ``parameters`` (:func:`lut_baker.model.params_file.skin_to_dict`), the resolution name and
-    the tables' format version, as canonical JSON (floats by ``repr``: the same on every
-    machine)."""
+    ``parameters`` (:func:`lut_baker.model.params_file.skin_to_dict`), the resolution name,
+    the film's thickness (micrometres; None: the paper's film, whose keys are those of every
+    earlier version; ``"slab"``: the slab's tables, whatever the thickness), the skin's albedo
+    under the film relative to Skin Color where Match Skin darkened it (``skin_under``, RGB, or
+    None) and the tables' format version, as canonical JSON (floats by ``repr``: the same on
+    every machine)."""
     version = table_set.FORMAT_VERSION
-    text = json.dumps({"parameters": parameters, "resolution": str(resolution),
-                       "format": version}, sort_keys=True, separators=(",", ":"))
+    data: dict[str, Any] = {"parameters": parameters, "resolution": str(resolution),
+                            "format": version}
+    if thickness_um is not None:
+        data["film_thickness_um"] = (thickness_um if thickness_um == SLAB_TABLES
+                                     else float(thickness_um))
+    if skin_under is not None:
+        data["skin_under"] = [float(u) for u in skin_under]
+    text = json.dumps(data, sort_keys=True, separators=(",", ":"))
     return hashlib.sha256(text.encode("utf-8")).hexdigest()[:KEY_LENGTH]
 
 
-def bake_record(skin: Any, resolution: str) -> dict:
-    """What identifies a bake: ``{"key", "parameters", "resolution"}`` (plain data, no bake
-    needed)."""
+def bake_record(skin: Any, resolution: str, film: Any = "paper",
+                skin_under: Any = None) -> dict:
+    """What identifies a bake: ``{"key", "parameters", "resolution"}`` and, for the film as a
+    slab (``film`` a thickness in micrometres, :func:`.skin_model.film_of`),
+    ``"film_thickness_um"`` and, where Match Skin darkened the skin under it, ``"skin_under"``
+    (:func:`.skin_model.skin_under_of`) (plain data, no bake needed).  A slab's skin carries
+    its absorption (the slab is baked at it)."""
     parameters = params_file.skin_to_dict(skin)
-    return {"key": bake_key(parameters, resolution), "parameters": parameters,
-            "resolution": str(resolution)}
+    thickness = None if film == "paper" else float(film)
+    under = None if thickness is None or skin_under is None else [float(u)
+                                                                  for u in skin_under]
+    record: dict[str, Any] = {"key": bake_key(parameters, resolution, thickness, under),
+                              "parameters": parameters, "resolution": str(resolution)}
+    if thickness is not None:
+        record["film_thickness_um"] = thickness
+    if under is not None:
+        record["skin_under"] = under
+    return record
+
+
+def record_key(record: dict) -> str:
+    """The key a record's parameters, resolution, thickness and skin under the film give
+    (:func:`bake_key`)."""
+    return bake_key(record["parameters"], record["resolution"],
+                    record.get("film_thickness_um"), record.get("skin_under"))
+
+
+def _tables_key(record: dict) -> str | None:
+    """The key of the slab tables a slab record's bake shares with every other thickness
+    (None for the paper's film)."""
+    if record.get("film_thickness_um") is None:
+        return None
+    return bake_key(record["parameters"], record["resolution"], SLAB_TABLES)
 
 
 def remember(record: dict, tables: table_set.Tables) -> None:
@@ -120,7 +175,7 @@ def rebake(record: dict, *, progress: Report | None = None) -> table_set.Tables:
         If the record has no readable parameters or resolution, or its key is not theirs.
     """
     try:
-        key = bake_key(record["parameters"], record["resolution"])
+        key = record_key(record)
     except (KeyError, TypeError, ValueError):
         raise BakeRecordError("its bake record cannot be read (a parameter or the resolution "
                               "is missing)") from None
@@ -130,13 +185,23 @@ def rebake(record: dict, *, progress: Report | None = None) -> table_set.Tables:
     entry = _entry(key)
     if entry.tables is not None:
         return entry.tables
+    thickness = record.get("film_thickness_um")
+    shared = _tables_key(record)
+    slab = None if shared is None else _SLABS.get(shared)
+    if slab is not None and thickness is not None:  # another thickness: the same bake
+        entry.tables = dataclasses.replace(
+            slab, parameters={**slab.parameters, "film_thickness_um": float(thickness)})
+        return entry.tables
     try:
         skin = params_file.skin_from_dict(record["parameters"])
-        tables = bake.bake(skin, record["resolution"], progress=progress)
+        tables = bake.bake(skin, record["resolution"], progress=progress,
+                           film="paper" if thickness is None else float(thickness))
     except (KeyError, TypeError, ValueError):
         raise BakeRecordError("its bake record cannot be re-baked (a parameter is missing or "
                               "unreadable)") from None
     entry.tables = tables
+    if shared is not None:
+        _SLABS.put(shared, tables)
     return tables
 
 
@@ -173,12 +238,32 @@ def baked(record: dict, *, method: str | None = None,
     which = (method, bool(over_shader))
     fit = fits.get(which)
     tiers = tuple(tiers)
+    shared = _tables_key(record)
+    if fit is None and shared is not None:
+        other = _SLAB_FITS.get((shared, *which))
+        if other is not None and set(tiers) <= set(other.tiers):
+            fit = _under(fitting.at_thickness(other, tables,
+                                              float(record["film_thickness_um"])), record)
+            fits[which] = fit
+            return tables, fit
     if fit is None or not set(tiers) <= set(fit.tiers):
-        fit = fitting.fit_closures(
+        fit = _under(fitting.fit_closures(
             tables, tiers=tiers, over_shader=over_shader, onto=fit, subsurface_method=method,
-            errors_at=errors_at, progress=fit_progress)
+            errors_at=errors_at, progress=fit_progress), record)
         fits[which] = fit
+        if shared is not None:
+            _SLAB_FITS.put((shared, *which), fit)
     return tables, fit
+
+
+def _under(fit: closure_fit.ClosureFit, record: dict) -> closure_fit.ClosureFit:
+    """A slab fit with the record's skin under the film (its errors then measured again:
+    dropped)."""
+    under = record.get("skin_under")
+    if under is None or fit.slab is None:
+        return fit
+    return dataclasses.replace(fit, errors={}, slab=dataclasses.replace(
+        fit.slab, skin_under=np.asarray(under, float)))
 
 
 def _same(a: Iterable[float], b: Iterable[float]) -> bool:
@@ -307,3 +392,5 @@ class Bake:
 def clear() -> None:
     """Forget the session's bakes and fits (the add-on's unregister calls it)."""
     _BAKES.clear()
+    _SLABS.clear()
+    _SLAB_FITS.clear()

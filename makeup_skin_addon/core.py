@@ -23,9 +23,9 @@ if INSTALLED:
         tiers,
         view_image,
     )
-    from ..lut_baker.model import params_file, presets, roughness, thick_layer
-    from ..lut_baker.numerics import cache
-    from ..lut_baker.tables import codec, table_set, uniform_light
+    from ..lut_baker.model import film_slab, params_file, presets, roughness, slab_skin, thick_layer
+    from ..lut_baker.numerics import cache, quadrature
+    from ..lut_baker.tables import codec, slab_tables, table_set, uniform_light
 else:
     from lut_baker import auto_tier, bake
     from lut_baker.closures import (
@@ -38,10 +38,11 @@ else:
         tiers,
         view_image,
     )
-    from lut_baker.model import params_file, presets, roughness, thick_layer
-    from lut_baker.numerics import cache
-    from lut_baker.tables import codec, table_set, uniform_light
+    from lut_baker.model import film_slab, params_file, presets, roughness, slab_skin, thick_layer
+    from lut_baker.numerics import cache, quadrature
+    from lut_baker.tables import codec, slab_tables, table_set, uniform_light
 
-__all__ = ["auto_tier", "bake", "cache", "closure_fit", "codec", "fitting", "params_file",
-           "presets", "principled_albedo", "profiles", "roughness", "table_set", "thick_layer",
-           "tier_formulas", "tier_registry", "tiers", "uniform_light", "view_image"]
+__all__ = ["auto_tier", "bake", "cache", "closure_fit", "codec", "film_slab", "fitting",
+           "params_file", "presets", "principled_albedo", "profiles", "quadrature", "roughness",
+           "slab_skin", "slab_tables", "table_set", "thick_layer", "tier_formulas",
+           "tier_registry", "tiers", "uniform_light", "view_image"]

@@ -92,11 +92,13 @@ SETTINGS_ATTRIBUTE = "makeup_skin"
 ``material.makeup_skin``)."""
 PRESET_SUBDIR = "makeup_skin"
 """Folder under Blender's ``presets`` where parameter sets are saved."""
-SETTINGS_VERSION = 2
+SETTINGS_VERSION = 3
 """What the settings mean, stamped on every change (``settings_version``).  1 (never stamped):
 Shade By Colour was the colour the pigment passes (1 - absorption), Film Roughness a width in
 degrees under Override Film, Coverage 1 and Shade By Absorption the defaults; 2: Colour is the
-colour seen (the thick layer), Film and Skin Roughness are Blender roughness."""
+colour seen (the thick layer), Film and Skin Roughness are Blender roughness; 3: the Film
+setting (the film at a Thickness, the default, or the paper's film as published): every
+material of versions 1 and 2 had the paper's film."""
 
 # --- custom properties of a material ---------------------------------------------------------
 RECORD_KEY = "makeup_skin_previous_surface"

@@ -39,13 +39,18 @@ import bpy
 from . import apply, groups
 from .rebuild import Rebuild, finish_rebuild, prepare_rebuild
 
-__all__ = ["DEBOUNCE_S", "POLL_S", "JOIN_TIMEOUT_S", "sockets_changed", "tables_changed",
+__all__ = ["DEBOUNCE_S", "THICKNESS_DEBOUNCE_S", "POLL_S", "JOIN_TIMEOUT_S", "sockets_changed",
+           "tables_changed",
            "start", "poll", "refine", "can_refine", "flush", "wait", "pending", "in_flight",
            "cancel", "forget",
            "rebake_timer", "poll_timer", "register", "unregister"]
 
 DEBOUNCE_S = 0.3
 """Seconds without a further change before a preview rebuild is set off."""
+THICKNESS_DEBOUNCE_S = 0.02
+"""The debounce of a Thickness change: its rebuild re-reads the slab's tables and moves the fit
+(no bake, no fit: :func:`.bakes.baked`), some 0.1 s of a worker's CPU, so it may follow a
+slider closely."""
 POLL_S = 0.05
 """Seconds between two looks at the rebuilds in flight."""
 JOIN_TIMEOUT_S = 10.0
@@ -122,9 +127,10 @@ def _supersede(name: str) -> None:
         _stopped.append(job)
 
 
-def tables_changed(settings) -> None:
+def tables_changed(settings, debounce_s: float = DEBOUNCE_S) -> None:
     """A setting the tables depend on moved: supersede the material's rebuild in flight and
-    schedule a preview rebuild (debounced)."""
+    schedule a preview rebuild (debounced by ``debounce_s``: :data:`THICKNESS_DEBOUNCE_S` for
+    a Thickness change, whose rebuild bakes and fits nothing)."""
     material = _material_of(settings)
     if material is None or not settings.is_made_up or not settings.live_update:
         return
@@ -134,7 +140,7 @@ def tables_changed(settings) -> None:
         return  # no event loop: flush() runs the rebuild when asked
     if bpy.app.timers.is_registered(rebake_timer):
         bpy.app.timers.unregister(rebake_timer)
-    bpy.app.timers.register(rebake_timer, first_interval=DEBOUNCE_S)
+    bpy.app.timers.register(rebake_timer, first_interval=debounce_s)
 
 
 def pending() -> set[str]:

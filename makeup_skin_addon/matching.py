@@ -10,6 +10,14 @@ bare skin instead.  The covered colour is the model's
 (:func:`lut_baker.tables.uniform_light.matching_absorption`); a colour beyond the film's reach
 is matched as far as it goes and the report says so.
 
+With the film at a thickness (the Film setting, docs/model.md "Made-up skin at a thickness")
+the covered colour is the slab's, every inter-reflection in, solved on its exact order-0
+evaluation (:func:`lut_baker.model.slab_skin.matching_shade`, at the Gloss of 1 it is baked
+with): Match Skin changes the foundation's absorption; only where even full absorption leaves
+the made-up skin too light (a sheer film whose surface gloss adds more than its pigment can
+take away) is the skin under the film darkened (``skin_under``, relative to Skin Color, baked
+into the group; the bare skin stays the artist's), and the report says by how much.
+
 Lighter and Darker step the covered colour's target by :data:`SHADE_STEP` from where the last
 match (or the current shade) put it, counting steps (``shade_steps``), so that Lighter then
 Darker returns to exactly the same shade, clamped or not.
@@ -19,7 +27,8 @@ Darker returns to exactly the same shade, clamped or not.
 - :class:`Shade` -- a solved shade.
 - :func:`matched` -- Match Skin; :func:`first_shade` -- the first Apply's;
   :func:`stepped` -- Lighter / Darker; :func:`assign` -- store a shade on the settings.
-- :func:`light_for` -- the settings' made-up skin under uniform light (cached per bake).
+- :func:`light_for` -- the settings' made-up skin under uniform light (cached per bake);
+  :class:`SlabLight` -- with the film at a thickness (the exact closed form).
 """
 
 from __future__ import annotations
@@ -29,9 +38,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import artist_skin, bakes, shade, skin_colour, skin_model
-from .core import cache, presets, uniform_light
+from .core import bake, cache, film_slab, presets, quadrature, slab_skin, uniform_light
 
-__all__ = ["SHADE_STEP", "MATTE_FILM", "SkinTarget", "Shade", "skin_target", "light_for",
+__all__ = ["SHADE_STEP", "MATTE_FILM", "SkinTarget", "Shade", "SlabLight", "skin_target",
+           "light_for",
            "matched", "first_shade", "stepped", "assign", "clear_cache"]
 
 SHADE_STEP = 1.1
@@ -61,8 +71,8 @@ def light_for(settings, foundation: str | None = None, resolution: str | None = 
     light (:func:`lut_baker.tables.uniform_light.uniform_light` of their tables, re-baked once
     per session) at ``resolution`` (default the settings': the colours move by about 1e-4
     between resolutions)."""
-    record = bakes.bake_record(skin_model.skin_from_settings(settings, foundation),
-                                 resolution or settings.resolution)
+    skin = skin_model.skin_from_settings(settings, foundation).replace(absorption=0.0)
+    record = bakes.bake_record(skin, resolution or settings.resolution)
     return _LIGHT.get_or_compute(record["key"],
                                  lambda: uniform_light.uniform_light(bakes.rebake(record)))
 
@@ -95,7 +105,9 @@ class Shade:
     """A shade solved for the covered skin to have ``target``: ``absorption`` and
     ``clamped`` per channel, the covered colour ``reached``, the skin ``skin``
     (:class:`SkinTarget`), the report's ``sentences``, and the step count and its base that
-    Lighter / Darker keep (``steps``, ``base``)."""
+    Lighter / Darker keep (``steps``, ``base``); with the film at a thickness, ``under``: the
+    skin's albedo under the film that would match where full absorption does not (else the
+    skin's own)."""
 
     absorption: np.ndarray
     clamped: np.ndarray
@@ -105,6 +117,15 @@ class Shade:
     sentences: list = field(default_factory=list)
     steps: int = 0
     base: np.ndarray | None = None
+    under: np.ndarray | None = None
+
+    def skin_under(self) -> np.ndarray:
+        """The skin's albedo under the film relative to its own (``under`` over the body
+        colour; 1 where unchanged or without a thickness)."""
+        if self.under is None:
+            return np.ones(3)
+        body = np.asarray(self.skin.body, float)
+        return np.where(self.under < body, self.under / np.maximum(body, 1e-12), 1.0)
 
     def note(self) -> str:
         """The panel's short line about channels out of reach, or ""."""
@@ -117,7 +138,62 @@ class Shade:
                             if c))
 
 
+class SlabLight:
+    """The settings' made-up skin with the film at a thickness under uniform light: the
+    model's layers (``skin``, with ``foundation``'s film if given), the thickness and the
+    bake's quadrature at ``resolution`` (the slab is derived on it, docs/baking.md)."""
+
+    def __init__(self, settings, foundation: str | None = None, resolution: str | None = None):
+        self.skin = skin_model.skin_from_settings(settings, foundation)
+        self.thickness_um = float(skin_model.film_of(settings))
+        res = bake.resolution(resolution or settings.resolution)
+        self.grid = quadrature.hemisphere_panels(res.quad_panels, res.quad_points,
+                                                 res.quad_phi)
+        self.film_gloss = uniform_light_gloss(self.skin, self.grid)
+
+    def covered(self, absorption, body, under=None) -> np.ndarray:
+        """The covered colour at ``absorption`` on a skin of albedo ``body`` (RGB; times
+        ``under`` under the film, if given)."""
+        if under is not None:
+            body = np.asarray(body, float) * np.asarray(under, float)
+        return np.asarray(slab_skin.slab_colour(
+            self.skin.film, self.skin.film_transmission, self.skin.skin_reflection, body,
+            self.thickness_um, self.grid, absorption), float).reshape(-1) * np.ones(3)
+
+    def solve(self, target, body):
+        """``(A, a, clamped)``: :func:`lut_baker.model.slab_skin.matching_shade`."""
+        return slab_skin.matching_shade(target, self.skin.film, self.skin.film_transmission,
+                                        self.skin.skin_reflection, body, self.thickness_um,
+                                        self.grid)
+
+
+def uniform_light_gloss(skin, grid) -> np.ndarray:
+    """The film surface's gloss under uniform light (RGB): the covered colour's floor."""
+    albedo = film_slab.face_albedo(skin.film, grid)
+    return np.asarray(film_slab.bihemispherical_on_grid(albedo, grid), float).reshape(-1) \
+        * np.ones(3)
+
+
+def _light(settings, foundation: str | None = None, resolution: str | None = None):
+    """What a shade is solved on: :class:`SlabLight` with the film at a thickness, else the
+    paper film's uniform-light parts (:func:`light_for`)."""
+    if skin_model.film_of(settings) != "paper":
+        return SlabLight(settings, foundation, resolution)
+    return light_for(settings, foundation, resolution)
+
+
+def _covered(light, settings, absorption, body, under=None) -> np.ndarray:
+    if isinstance(light, SlabLight):
+        return light.covered(absorption, body, under)
+    return uniform_light.covered_colour(light, absorption, body, float(settings.gloss))
+
+
 def _solve(settings, light, target, skin: SkinTarget) -> Shade:
+    if isinstance(light, SlabLight):
+        absorption, under, clamped = light.solve(target, skin.body)
+        reached = light.covered(absorption, under)
+        return Shade(np.asarray(absorption, float), np.asarray(clamped, bool),
+                     np.asarray(target, float), reached, skin, under=np.asarray(under, float))
     gloss = float(settings.gloss)
     absorption, clamped = uniform_light.matching_absorption(light, target, skin.body, gloss)
     reached = uniform_light.covered_colour(light, absorption, skin.body, gloss)
@@ -127,6 +203,13 @@ def _solve(settings, light, target, skin: SkinTarget) -> Shade:
 def _reach_sentences(shade_: Shade, light, gloss: float) -> list[str]:
     sentences = []
     for c, name in enumerate(CHANNELS):
+        if isinstance(light, SlabLight) and shade_.under is not None and \
+                shade_.under[c] < shade_.skin.body[c] and shade_.absorption[c] == 1.0:
+            sentences.append(
+                f"{name}: at {light.thickness_um:g} um the film's gloss adds more than full "
+                f"absorption takes away; the skin under the film darkened to "
+                f"{shade_.under[c] / shade_.skin.body[c]:.3f} of its own to match.")
+            continue
         if not shade_.clamped[c]:
             continue
         if shade_.absorption[c] == 0.0:
@@ -135,7 +218,8 @@ def _reach_sentences(shade_: Shade, light, gloss: float) -> list[str]:
                 f"{shade_.reached[c]:.3f} (no absorption) against {shade_.target[c]:.3f}: the "
                 f"made-up skin is that much darker where the film covers it.")
         else:
-            floor = gloss * float(light.film_gloss[c])
+            floor = (float(light.film_gloss[c]) if isinstance(light, SlabLight)
+                     else gloss * float(light.film_gloss[c]))
             sentences.append(
                 f"{name} is out of reach: the film's own gloss reflects {floor:.3f} and the "
                 f"covered skin at least {shade_.reached[c]:.3f} (full absorption) against "
@@ -151,8 +235,10 @@ def matched(material, foundation: str | None = None, skin: SkinTarget | None = N
     sentences; ``foundation``: on that preset's film instead of the settings'; ``skin``: the
     target if known; ``resolution``: of the tables (default the settings')."""
     settings = material.makeup_skin
-    light = light_for(settings, foundation, resolution)
-    skin = skin_target(material, light=light) if skin is None else skin
+    light = _light(settings, foundation, resolution)
+    if skin is None:
+        skin = skin_target(material, resolution=resolution, light=None if isinstance(
+            light, SlabLight) else light)
     result = _solve(settings, light, skin.target, skin)
     result.base = result.target
     result.sentences.append(
@@ -200,17 +286,15 @@ def stepped(material, steps: int) -> Shade:
     from the current shade's covered colour when it was set otherwise), so that steps undone
     give back exactly the shade they started from."""
     settings = material.makeup_skin
-    light = light_for(settings)
-    skin = skin_target(material, light=light)
+    light = _light(settings)
+    skin = skin_target(material, light=None if isinstance(light, SlabLight) else light)
     gloss = float(settings.gloss)
+    current = _covered(light, settings, list(settings.absorption), skin.body,
+                       tuple(settings.skin_under))
     if settings.shade_source == "MATCH" and settings.is_property_set("shade_base"):
         base, count = np.asarray(settings.shade_base, float), int(settings.shade_steps)
     else:
-        base = uniform_light.covered_colour(light, list(settings.absorption), skin.body,
-                                            gloss)
-        count = 0
-    current = uniform_light.covered_colour(light, list(settings.absorption), skin.body,
-                                           gloss)
+        base, count = current, 0
     count += int(steps)
     result = _solve(settings, light, base * SHADE_STEP ** count, skin)
     result.steps, result.base = count, base
@@ -238,6 +322,7 @@ def assign(settings, result: Shade, source: str) -> None:
         if result.base is not None:
             settings.shade_base = [float(b) for b in result.base]
         settings.shade_steps = int(result.steps)
+        settings.skin_under = [float(u) for u in result.skin_under()]
 
 
 def clear_cache() -> None:

@@ -16,7 +16,8 @@ The same handler first upgrades the settings of files saved by an earlier add-on
 (:func:`upgrade_settings`, :data:`.keys.SETTINGS_VERSION`): their Shade By Color meant the
 colour the pigment passes (now the colour seen), their film width was in degrees under Override
 Film (now Film Roughness, always on), and their Coverage and Shade By defaulted to 1 and
-Absorption; every value they meant is kept.
+Absorption; every value they meant is kept, and every material made before the Film setting
+(versions 1 and 2) keeps the paper's film.
 
 - :func:`upgrade_settings` -- one material's settings of an older file, upgraded.
 - :func:`damaged_groups` -- the add-on's groups whose images are missing or damaged (no decode).
@@ -31,7 +32,7 @@ import math
 
 import bpy
 
-from . import apply, groups, live, nodes, shade, storage
+from . import apply, groups, live, nodes, shade, skin_model, storage
 from .core import presets, roughness
 from .keys import FIT_KEY, SETTINGS_VERSION
 
@@ -57,15 +58,29 @@ def _problems(group) -> list[str]:
     return storage.image_problems(nodes.read_meta(group).get("images", ()), decode=False)
 
 
+def _paper_film(settings) -> None:
+    """Settings of a version before the Film setting keep the paper's film (their look)."""
+    settings.film_mode = skin_model.PAPER_FILM
+
+
 def upgrade_settings(settings) -> bool:
-    """Upgrade one material's settings written by an earlier add-on (no
-    ``settings_version``, some setting stored) to :data:`.keys.SETTINGS_VERSION`, keeping what
-    they meant; returns whether it did.  Settings of this version, or never touched, are left
+    """Upgrade one material's settings written by an earlier add-on to
+    :data:`.keys.SETTINGS_VERSION`, keeping what they meant; returns whether it did.  Version 1
+    (no ``settings_version``, some setting stored): the colour passed, the film width, the old
+    defaults; versions 1 and 2: the paper's film (the Film setting came with version 3, its
+    default the film at a thickness).  Settings of this version, or never touched, are left
     alone."""
-    if settings.is_property_set("settings_version") or not any(
-            settings.is_property_set(name) for name in OLD_PROPERTIES):
+    if settings.is_property_set("settings_version"):
+        if settings.settings_version >= 3:
+            return False
+        with shade.assigning():
+            _paper_film(settings)
+            settings.settings_version = SETTINGS_VERSION
+        return True
+    if not any(settings.is_property_set(name) for name in OLD_PROPERTIES):
         return False
     with shade.assigning():
+        _paper_film(settings)
         for name, value in OLD_DEFAULTS.items():
             if not settings.is_property_set(name):
                 setattr(settings, name, value)
@@ -136,6 +151,7 @@ def check_on_load(*_args) -> None:
     live.forget()
     _notices.clear()
     upgraded = upgrade_file()
+    live.forget()  # upgraded settings mean what their groups were built from: nothing to redo
     if upgraded:
         print(f"Made-up Skin: on opening the file: upgraded the settings of "
               f"{', '.join(repr(name) for name in upgraded)} from an earlier version.")

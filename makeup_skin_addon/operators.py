@@ -13,7 +13,7 @@ from __future__ import annotations
 import bpy
 from bl_operators.presets import AddPresetBase
 
-from . import apply, convert, groups, live, matching, tier_choice
+from . import apply, convert, groups, live, matching, skin_model, tier_choice
 from .keys import OPERATOR_PREFIX, PRESET_SUBDIR, SETTINGS_ATTRIBUTE
 from .progress import progress_bar
 from .properties import RESOLUTION_ITEMS
@@ -257,7 +257,8 @@ class _ShadePoll:
 
 def _set_shade(operator, context, solve) -> set:
     """Solve a shade for the active material with ``solve(material)`` (:func:`.shade.matched`
-    or a step), store it and report; the material's group takes it at once."""
+    or a step), store it and report; the material's group takes it at once (with the film at
+    a thickness, whose absorption is baked, once rebuilt)."""
     material = context.active_object.active_material
     try:
         apply.refuse_linked(None, material)
@@ -268,6 +269,12 @@ def _set_shade(operator, context, solve) -> set:
         return {"CANCELLED"}
     matching.assign(material.makeup_skin, result, "MATCH")
     groups.update_sockets(material)
+    if skin_model.film_of(material.makeup_skin) != "paper":
+        # The film at a thickness has its absorption baked: its group is rebuilt (on a
+        # worker, swapped in when ready; at once without an event loop).
+        live.refine(context, material, material.makeup_skin.resolution)
+        if not live.can_refine():
+            live.flush(context)
     for sentence in result.sentences:
         operator.report({"WARNING"} if "out of reach" in sentence else {"INFO"},
                         f"Made-up Skin: {sentence}")

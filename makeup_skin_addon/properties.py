@@ -1,8 +1,10 @@
 """The panel's settings: one :class:`MakeupSkinSettings` per material (``material.makeup_skin``).
 
-Coverage, absorption (or the foundation's colour, solved into it), skin colour, subsurface
-scale, gloss and the film's normal are socket values of the material's group node (or of its
-nodes): moving them updates the material at once.  Foundation and skin presets, Film and Skin
+Covered Area (the areal mix, ``coverage``), absorption (or the foundation's colour, solved
+into it), skin colour, subsurface scale, gloss and the film's normal are socket values of the
+material's group node (or of its nodes): moving them updates the material at once (with the
+film at a thickness the absorption is baked too).  Film (at a Thickness, or the paper's film
+as published) and Thickness change the tables.  Foundation and skin presets, Film and Skin
 Roughness, the film's index, tier and resolution change the tables: with live update on, moving
 them schedules a preview re-bake (:mod:`.live`); Apply bakes at full resolution.  The settings
 are registered as ``Material.makeup_skin`` (:data:`.keys.SETTINGS_ATTRIBUTE`).
@@ -23,9 +25,10 @@ import math
 import bpy
 
 from . import live, shade
-from .core import presets, tier_registry
+from .core import film_slab, presets, slab_tables, tier_registry
 from .keys import SETTINGS_ATTRIBUTE, SETTINGS_VERSION
 from .shade import FILM_ROUGHNESS_MIN, ROUGHNESS_MAX, SKIN_ROUGHNESS_MIN
+from .skin_model import PAPER_FILM, SLAB_FILM
 
 __all__ = ["MakeupSkinSettings", "register", "unregister", "AUTO_TIER", "tier_items",
            "SUBSURFACE_ITEMS",
@@ -78,6 +81,11 @@ FIRST_FOUNDATION = next(iter(presets.FOUNDATIONS))
 """The default foundation (the first preset: the paper's film, matched to the skin at the first
 Apply, docs/addon.md "A first Apply")."""
 FIRST_SKIN = next(iter(presets.SKINS))
+DEFAULT_THICKNESS_UM = float(film_slab.DEFAULT_THICKNESS_UM)
+THICKNESS_MIN_UM = float(slab_tables.THICKNESS_MIN_UM)
+"""The thinnest film: the slab tables' axis begins there (thinner would be read as it)."""
+"""The Thickness setting's default: a typical application on a face (docs/model.md, "The film
+as a slab")."""
 # Enum items must stay referenced while Blender shows them.
 _ITEMS_CACHE: dict[str, list] = {}
 
@@ -107,13 +115,44 @@ def _update_tables(self, context):
     live.tables_changed(self)
 
 
+def _update_shade(self, context):
+    """The shade reaches the sockets at once; with the film as a slab it is baked too, and a
+    shade set by hand leaves the skin under the film as it is (Match Skin may darken it)."""
+    if not shade.is_assigning():
+        _reset_skin_under(self)
+    _update_sockets(self, context)
+    if self.film_mode != PAPER_FILM:
+        live.tables_changed(self)
+
+
+def _reset_skin_under(settings) -> None:
+    if tuple(settings.skin_under) != (1.0, 1.0, 1.0):
+        settings.skin_under = (1.0, 1.0, 1.0)
+
+
+def _update_film(self, context):
+    """Film changes the tables; the skin under the film Match Skin darkened for another film
+    is the skin's own again."""
+    if not shade.is_assigning():
+        _reset_skin_under(self)
+    _update_tables(self, context)
+
+
+def _update_thickness(self, context):
+    """A Thickness change re-reads the slab's tables (no bake, no fit): a short debounce."""
+    if not shade.is_assigning():
+        _reset_skin_under(self)
+    _stamp(self)
+    live.tables_changed(self, live.THICKNESS_DEBOUNCE_S)
+
+
 def _update_absorption(self, context):
     if not shade.is_assigning():
         with shade.assigning():
             self.shade_colour = [float(c) for c in shade.colour_seen(self.absorption)]
             self.shade_note = ""
             self.shade_source = "USER"
-    _update_sockets(self, context)
+    _update_shade(self, context)
 
 
 def _update_shade_colour(self, context):
@@ -124,7 +163,7 @@ def _update_shade_colour(self, context):
         self.absorption = [float(a) for a in absorption]
         self.shade_note = shade.colour_note(self.shade_colour, clamped)
         self.shade_source = "USER"
-    _update_sockets(self, context)
+    _update_shade(self, context)
 
 
 def _update_skin(self, context):
@@ -147,6 +186,7 @@ def _update_foundation(self, context):
             self.film_roughness = shade.foundation_roughness(self.foundation)
             self.shade_note = ""
             self.shade_source = "PRESET"
+            _reset_skin_under(self)
         _update_sockets(self, context)
     # The film's gloss, roughness and index change the tables: a debounced preview re-fit.
     _update_tables(self, context)
@@ -172,11 +212,37 @@ class MakeupSkinSettings(bpy.types.PropertyGroup):
         description="Skin under the film: the paper's bio-plate or measured human skin (sets "
                     "Skin Color to its albedo and Skin Roughness to its own)",
         update=_update_skin)
+    film_mode: bpy.props.EnumProperty(
+        name="Film", items=(
+            (SLAB_FILM, "At a Thickness", "The foundation as a film of the Thickness below "
+                                          "over the skin: every inter-reflection, the skin "
+                                          "showing through a sheer film (docs: the film as "
+                                          "a slab)"),
+            (PAPER_FILM, "Paper Film (as Published)", "The paper's measured free film, about "
+                                                      "150 micrometres, paths 1 + 3 as "
+                                                      "published (files made before keep "
+                                                      "it)")),
+        default=SLAB_FILM,
+        description="How the foundation's film is modelled: at a thickness, or the paper's "
+                    "free film as published", update=_update_film)
+    thickness_um: bpy.props.FloatProperty(
+        name="Thickness", default=DEFAULT_THICKNESS_UM, min=THICKNESS_MIN_UM,
+        soft_max=300.0, max=10000.0, precision=1,
+        description="The film's thickness in micrometres: how much it hides (sheer a few, "
+                    "9.6 a typical application of liquid foundation on a face, 0.96 mg/cm2; "
+                    "the paper's free film 150)", update=_update_thickness)
+    skin_under: bpy.props.FloatVectorProperty(
+        name="Skin Under the Film", size=3, default=(1.0, 1.0, 1.0), min=0.0, max=1.0,
+        description="The skin's albedo under the film relative to Skin Color, per channel: "
+                    "where a sheer film's gloss adds more than full absorption takes away, "
+                    "Match Skin darkens the skin under it (1: the skin's own; internal, reset "
+                    "by a shade or film set by hand)")
     coverage: bpy.props.FloatProperty(
-        name="Coverage", default=0.6, min=0.0, max=1.0, subtype="FACTOR",
-        description="Fraction of the surface the film covers (0 bare skin, 1 full film; 0.6 "
-                    "lets the skin read through); link a texture to the group's Coverage "
-                    "socket to paint it",
+        name="Covered Area", default=0.6, min=0.0, max=1.0, subtype="FACTOR",
+        description="Fraction of the surface the film lies on, as an areal mix of made-up "
+                    "and bare skin (0 bare skin, 1 the film everywhere): for painting where "
+                    "the foundation is (link a texture to the group's Coverage socket); how "
+                    "much the film hides is its Thickness",
         update=_update_sockets)
     absorption_mode: bpy.props.EnumProperty(
         name="Shade By", items=(

@@ -50,7 +50,8 @@ class Rebuild:
         work = self.work
         if work is None:
             record = bakes.bake_record(skin_model.skin_from_settings(self.skin),
-                                       self.resolution)
+                                       self.resolution, skin_model.film_of(self.skin),
+                                       skin_model.skin_under_of(self.skin))
             work = self.work = Bake(record, **self.bake)
         before = work.progress
         work.progress = self.progress if check is None else Checked(check)

@@ -4,10 +4,14 @@ The foundation and skin presets give the layers; Film Roughness and Skin Roughne
 their gloss (Blender roughness, :mod:`lut_baker.model.roughness`: the preset's own unless
 moved); Film IOR with its override replaces the film's index; over the artist's shader the
 skin takes its index.  Coverage and absorption are socket values, applied after the bake: the
-skin here has coverage 1 and absorption 0.
+skin here has coverage 1 and absorption 0; with the film as a slab (Film: at a thickness) the
+absorption is baked (the slab is not linear in it, docs/model.md "The tiers at a thickness"),
+so the skin carries it, and the bake's film is the thickness (:func:`film_of`).
 
 - :func:`skin_from_settings` -- the made-up skin of the settings, or of their plain values
   (:class:`SkinSettings`, read by :func:`skin_settings` on the main thread, for a worker).
+- :func:`film_of` -- the bake's film: the paper's (``"paper"``) or a thickness;
+  :func:`skin_under_of` -- the skin under the film where Match Skin darkened it.
 - :func:`clear_cache` -- forget the session's roughened layers.
 """
 
@@ -19,7 +23,14 @@ from typing import Any
 from .core import cache, presets, roughness
 from .shade import ROUGHNESS_TOLERANCE, foundation_roughness, skin_roughness
 
-__all__ = ["SkinSettings", "skin_settings", "skin_from_settings", "clear_cache"]
+__all__ = ["SkinSettings", "skin_settings", "skin_from_settings", "film_of", "skin_under_of",
+           "clear_cache",
+           "PAPER_FILM", "SLAB_FILM"]
+
+PAPER_FILM = "PAPER"
+"""The Film setting of the paper's model as published (its 150 um free film, paths 1 + 3)."""
+SLAB_FILM = "SLAB"
+"""The Film setting of the film as a slab at the Thickness setting (new Applies' default)."""
 
 _ROUGHENED = cache.LRUCache(32)
 
@@ -46,17 +57,41 @@ class SkinSettings:
     skin_ior: float
     override_film: bool
     film_ior: float
+    film_mode: str = PAPER_FILM
+    thickness_um: float = 9.6
+    absorption: tuple = (0.0, 0.0, 0.0)
+    skin_under: tuple = (1.0, 1.0, 1.0)
 
 
 def skin_settings(settings: Any) -> SkinSettings:
     """The :class:`SkinSettings` of a material's settings now."""
-    return SkinSettings(**{name: getattr(settings, name)
-                           for name in SkinSettings.__dataclass_fields__})
+    values = {name: getattr(settings, name) for name in SkinSettings.__dataclass_fields__}
+    for name in ("absorption", "skin_under"):
+        values[name] = tuple(float(a) for a in values[name])
+    return SkinSettings(**values)
+
+
+def skin_under_of(settings: Any) -> tuple | None:
+    """The skin's albedo under the film relative to Skin Color where Match Skin darkened it
+    (the film at a thickness only), or None (unchanged)."""
+    if film_of(settings) == "paper":
+        return None
+    under = tuple(float(u) for u in getattr(settings, "skin_under", (1.0, 1.0, 1.0)))
+    return None if all(u == 1.0 for u in under) else under
+
+
+def film_of(settings: Any) -> Any:
+    """The bake's film of the settings (:func:`lut_baker.bake.bake`'s ``film``): ``"paper"``
+    for the paper's film, else the Thickness in micrometres."""
+    if getattr(settings, "film_mode", PAPER_FILM) == PAPER_FILM:
+        return "paper"
+    return float(settings.thickness_um)
 
 
 def skin_from_settings(settings: Any, foundation: str | None = None) -> Any:
     """The made-up skin the settings describe, at coverage 1 and absorption 0 (both are socket
-    values, applied after the bake).  Film Roughness reshapes the film surface's gloss and
+    values, applied after the bake; with the film as a slab the absorption is the settings',
+    baked: :func:`film_of`).  Film Roughness reshapes the film surface's gloss and
     Skin Roughness the skin's (eq. 2's lobe, its gloss albedo kept,
     :func:`lut_baker.model.roughness.with_roughness`); a roughness equal to the preset's leaves
     its layer as it is.  Film IOR (with Override Film IOR) replaces the index of the film's
@@ -66,7 +101,9 @@ def skin_from_settings(settings: Any, foundation: str | None = None) -> Any:
     settings' (at its own roughness).  ``settings``: the material's, or their
     :class:`SkinSettings` (no bpy: any thread)."""
     name = settings.foundation if foundation is None else foundation
-    skin = presets.made_up_skin(name, settings.skin, coverage=1.0, absorption=0.0)
+    absorption = (0.0 if film_of(settings) == "paper"
+                  else [float(a) for a in settings.absorption])
+    skin = presets.made_up_skin(name, settings.skin, coverage=1.0, absorption=absorption)
     own = foundation_roughness(name)
     film = _roughened(skin.film, settings.film_roughness if foundation is None else own, own)
     surface = _roughened(skin.skin_reflection, settings.skin_roughness,

@@ -25,6 +25,7 @@ from .operators import (
     MAKEUPSKIN_OT_revert,
     MAKEUPSKIN_OT_shade_step,
 )
+from .skin_model import PAPER_FILM
 
 __all__ = ["MAKEUPSKIN_PT_material", "MAKEUPSKIN_PT_node_editor", "draw_settings", "draw_fit",
            "register", "unregister"]
@@ -129,6 +130,10 @@ def draw_settings(layout, context) -> None:
     layout.use_property_decorate = False
     col = layout.column()
     col.prop(settings, "foundation")
+    col.prop(settings, "film_mode")
+    thickness = col.row()
+    thickness.active = settings.film_mode != PAPER_FILM
+    thickness.prop(settings, "thickness_um", text="Thickness (µm)")
     col.prop(settings, "coverage", slider=True)
     _draw_shade(col, settings)
     col.separator()

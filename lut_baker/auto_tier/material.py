@@ -2,7 +2,8 @@
 
 - :class:`MaterialTraits` -- the tiers' angular errors, the skin's profile, the shares of gloss
   and of spreading skin light, the gloss each tier leaves out at Gloss 0.
-- :func:`traits_from_tables` -- a material's traits from its tables and closure fit;
+- :func:`traits_from_tables` -- a material's traits from its tables and closure fit (with the
+  film as a slab, the slab's made-up skin and parts at the fit's thickness);
   :func:`paper_traits` -- the paper preset's (measured, :mod:`.measured`), assumed before a
   material has tables.
 - :func:`profile_mean_radius_mm`, :func:`gloss_and_skin_shares`, :func:`gloss_omission_error`,
@@ -22,11 +23,12 @@ from numpy.typing import ArrayLike, NDArray
 from ..bake import RESOLUTIONS, profile_radius
 from ..closures.closure_fit import ClosureFit
 from ..closures.profiles import edge_response, profile_grid
-from ..closures.tiers import TierError, tier_errors, tier_reflection
+from ..closures.tier_parts import FitTargets
+from ..closures.tiers import TierError, reference_reflection, tier_errors, tier_reflection
 from ..model.dipole import dipole_profile, dipole_total_reflectance
 from ..model.made_up_skin import combine, coverage_weights, mix_slots
 from ..model.presets import made_up_skin
-from ..numerics.geometry import sphere_directions
+from ..numerics.geometry import polar_angle_deg, sphere_directions
 from ..numerics.quadrature import trapezoid_weights
 from ..tables.table_set import ReflectionParts, Tables, radius_nodes
 from .measured import by_number, load
@@ -167,12 +169,17 @@ class _Sphere:
         return self._bare
 
 
-def _sphere(tables: Tables, light_deg: float, w: float, a: ArrayLike, resolution: int
-            ) -> _Sphere:
+def _sphere(tables: Tables, light_deg: float, w: float, a: ArrayLike, resolution: int,
+            fit: ClosureFit | None = None) -> _Sphere:
+    """A sphere's pixels under one light (the tables' lookups kept for the shares); with a
+    slab ``fit`` its made-up skin is the slab's at the fit's thickness
+    (:func:`lut_baker.closures.tiers.reference_reflection`)."""
     _, wi, wo = sphere_directions(resolution, light_deg)
     cos_i = wi[:, 2:3]
     parts = tables.reflection_parts(wi, wo)
-    total = tables.mixed_reflection(parts, w, a) * cos_i
+    reflection = (tables.mixed_reflection(parts, w, a) if fit is None or fit.slab is None
+                  else reference_reflection(fit, tables, w, a, (wi, wo)))
+    total = reflection * cos_i
     return _Sphere(wi, wo, cos_i, parts, total, float(np.sqrt(np.mean(total**2))))
 
 
@@ -186,6 +193,37 @@ def _shares(tables: Tables, sphere: _Sphere, w: float, a: ArrayLike) -> tuple[fl
     t_i, t_o = sphere.parts.t_i, sphere.parts.t_o
     skin = combine(weights, **mix_slots(through_film=tables.skin_diffuse * t_i * t_o,
                                         skin=tables.skin_diffuse)) * cos_i
+    norm = sphere.norm
+    if not norm > 0:
+        return 0.0, 0.0
+    return float(np.sqrt(np.mean(gloss**2)) / norm), float(np.sqrt(np.mean(skin**2)) / norm)
+
+
+def _slab_shares(tables: Tables, fit: ClosureFit, sphere: _Sphere, w: float
+                 ) -> tuple[float, float]:
+    """:func:`_shares` with the film as a slab at the fit's thickness (docs/model.md, "The
+    tiers at a thickness"): the gloss is the film's surface gloss, the skin's gloss through
+    the film (``top`` less the film's body) and the bare skin's; what spreads is the skin's
+    diffuse light ``a t t / (pi (1 - a c))`` and the bare skin's."""
+    wi, wo, cos_i = sphere.wi, sphere.wo, sphere.cos_i
+    slab = fit.slab
+    if slab is None:
+        raise ValueError("the fit holds no slab: use the paper film's shares")
+    h = slab.thickness_um
+    targets = FitTargets(tables, 2, h)
+    weights = coverage_weights(w, 0.0)
+    through_gloss = targets.slab_tables().top_at(h, wi, wo) - targets.film_body(wi, wo)
+    gloss = combine(weights, **mix_slots(film_gloss=tables.angular("film_gloss", wi, wo),
+                                         path3_gloss=through_gloss,
+                                         skin_gloss=tables.angular("skin_gloss", wi, wo))
+                    ) * cos_i
+    albedo = np.asarray(fit.skin_albedo, float)
+    under = albedo * (1.0 if slab.skin_under is None else np.asarray(slab.skin_under, float))
+    t_i = targets.slab_parts(polar_angle_deg(wi)).through
+    t_o = targets.slab_parts(polar_angle_deg(wo)).through
+    skin = combine(weights, **mix_slots(
+        through_film=under * t_i * t_o / (np.pi * (1.0 - under * slab.below)),
+        skin=albedo / np.pi)) * cos_i
     norm = sphere.norm
     if not norm > 0:
         return 0.0, 0.0
@@ -289,8 +327,14 @@ def traits_from_tables(tables: Tables, fit: ClosureFit, coverage: float | None =
     w, a = tables.coverage_and_absorption(coverage, absorption)
     errors = tier_errors(fit, tables, w, a, over_shader=over_shader) if errors is None \
         else errors
-    spheres = {float(angle): _sphere(tables, angle, w, a, 48) for angle in lights_deg}
-    shares = {angle: _shares(tables, sphere, w, a) for angle, sphere in spheres.items()}
+    if fit.slab is not None:  # the film as a slab: its own made-up skin and parts
+        spheres = {float(angle): _sphere(tables, angle, w, a, 48, fit)
+                   for angle in lights_deg}
+        shares = {angle: _slab_shares(tables, fit, sphere, w)
+                  for angle, sphere in spheres.items()}
+    else:
+        spheres = {float(angle): _sphere(tables, angle, w, a, 48) for angle in lights_deg}
+        shares = {angle: _shares(tables, sphere, w, a) for angle, sphere in spheres.items()}
     mismatch = 0.0 if over_shader else profile_mismatch(
         tables, fit.profiles[method or fit.subsurface_method].error)
     return MaterialTraits(

@@ -11,7 +11,23 @@ import numpy as np
 from .lobes import LobeFit
 from .tier_registry import TIERS, tier
 
-__all__ = ["TIERS", "ClosureFit"]
+__all__ = ["TIERS", "ClosureFit", "SlabFit"]
+
+
+@dataclass(frozen=True, eq=False)
+class SlabFit:
+    """What a fit to tables with the film as a slab adds (docs/model.md "The tiers at a
+    thickness"): ``thickness_um`` (the thickness it was fitted at) and ``below`` (RGB, ``c``:
+    the film's reflectance seen from the skin, the skin's diffuse light ``a t t / (1 - a c)``).
+    The fit's ``transmittance_mean`` is then the slab's ``t`` averaged over uniform light and
+    its ``film_albedo`` the film body's albedo under uniform light.  ``skin_under`` (RGB, or
+    None for 1): the skin's albedo under the film relative to Skin Color, where Match Skin
+    darkens it (a sheer film whose gloss alone adds more than full absorption takes away,
+    docs/model.md "Made-up skin at a thickness")."""
+
+    thickness_um: float
+    below: np.ndarray
+    skin_under: np.ndarray | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -33,7 +49,9 @@ class ClosureFit:
     film gloss in two: ``film_gloss`` and ``film_gloss_2``) and ``eevee_lut`` (their
     view-angle image, rows :data:`lut_baker.closures.view_image.EEVEE_LUT_ROWS`); its
     subsurface is Burley's.  ``extra``: the parts of tiers registered beyond these, by tier
-    (:mod:`lut_baker.closures.tier_registry`).
+    (:mod:`lut_baker.closures.tier_registry`).  ``slab``: a :class:`SlabFit` when the tables
+    hold the film as a slab (the tiers then shade it at the fit's thickness, absorption baked
+    in), else None (the paper's film).
 
     A fit for a group over the artist's own shader (``fit_closures(..., over_shader=True)``),
     whose bare skin is that shader, leaves out the bare skin's gloss lobes (``specular_bare``
@@ -60,6 +78,7 @@ class ClosureFit:
     eevee_lut: np.ndarray | None = None
     errors: dict = field(default_factory=dict)
     extra: dict = field(default_factory=dict)
+    slab: SlabFit | None = None
 
     @property
     def tiers(self) -> tuple:
@@ -98,4 +117,5 @@ class ClosureFit:
                          for name, p in self.profiles.items()},
             "errors": {name: asdict(e) for name, e in self.errors.items()},
             "tiers": list(self.tiers),
+            **({"film_thickness_um": self.slab.thickness_um} if self.slab is not None else {}),
         }

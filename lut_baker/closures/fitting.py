@@ -17,6 +17,8 @@ image :mod:`~lut_baker.closures.view_image`.
   more tiers onto a fit (over the artist's shader: without the bare skin's lobes), and their
   errors.
 - :func:`subsurface_ior` -- the Subsurface IOR from the tables' parameters.
+- :func:`at_thickness` -- a fit to the film as a slab moved to another thickness: its lobes
+  kept, what depends on the thickness read from the slab's thickness axis (milliseconds).
 """
 
 from __future__ import annotations
@@ -29,14 +31,14 @@ import numpy as np
 
 from ..tables.table_set import Tables
 from . import cycles as cc
-from .closure_fit import ClosureFit
+from .closure_fit import ClosureFit, SlabFit
 from .profiles import REPLICA_EDGE_ERROR, fit_profiles
-from .tier_parts import FitTargets
+from .tier_parts import FitTargets, cosine_mean
 from .tier_registry import TIERS, Tier, tier
 from .tiers import tier_errors
 from .view_image import DEFAULT_LUT_SIZE
 
-__all__ = ["fit_closures", "subsurface_ior"]
+__all__ = ["fit_closures", "subsurface_ior", "at_thickness"]
 
 
 def subsurface_ior(parameters: dict) -> float:
@@ -63,6 +65,22 @@ def _subsurface(tables: Tables, method: str | None, over_shader: bool) -> dict:
         method = min(cc.SUBSURFACE_METHODS, key=lambda m: np.hypot(
             profiles[m].worst_error, REPLICA_EDGE_ERROR[m]))
     return {"profiles": profiles, "subsurface_method": method, "subsurface_ior": ior}
+
+
+def _film_parts(targets: FitTargets) -> dict:
+    """What every tier shares of the film: its mean transmittance and diffuse albedo (the
+    paper's film: ``T_mean`` and ``pi P_d``; the film as a slab at the fit's thickness: ``t``
+    averaged over uniform light, the film body's albedo under uniform light and the
+    :class:`SlabFit`)."""
+    tables = targets.tables
+    if targets.slab is None:
+        return {"transmittance_mean": tables.film_transmittance_mean,
+                "film_albedo": np.pi * np.asarray(tables.film_diffuse, float)}
+    parts = targets.slab_parts(0.0)
+    return {"transmittance_mean": np.asarray(parts.through_mean, float),
+            "film_albedo": np.asarray(targets.film_mean(), float),
+            "slab": SlabFit(thickness_um=float(targets.thickness_um),
+                            below=np.asarray(parts.below, float))}
 
 
 def _checked_tiers(tiers: Iterable[str]) -> tuple[Tier, ...]:
@@ -119,8 +137,7 @@ def fit_closures(tables: Tables, *, tiers: Iterable[str] | None = None,
     else:
         report(0.75, "fitting the subsurface profile")
         fit = ClosureFit(
-            transmittance_mean=tables.film_transmittance_mean,
-            film_albedo=np.pi * np.asarray(tables.film_diffuse, float),
+            **_film_parts(targets),
             skin_albedo=np.pi * np.asarray(tables.skin_diffuse, float),
             **_subsurface(tables, subsurface_method, over_shader), **parts)
     if errors_at is None:
@@ -133,3 +150,59 @@ def fit_closures(tables: Tables, *, tiers: Iterable[str] | None = None,
     fit = replace(fit, errors={name: errors[name] for name in TIERS if name in errors})
     report(1.0, "fitted")
     return fit
+
+
+
+def _scaled_row(row: np.ndarray, old: np.ndarray, new: np.ndarray) -> np.ndarray:
+    """A Glossy lobe's weight row whose target albedo goes from ``old`` to ``new`` (both at
+    the texels, ``(size, 3)``): scaled texel by texel (the lobe's own albedo is unchanged);
+    0 where the old albedo was."""
+    return np.where(old > 0.0, row * new / np.where(old > 0.0, old, 1.0), 0.0)
+
+
+_IMAGES = (("glossy", "lut", "LAYERED"), ("eevee_glossy", "eevee_lut", "EEVEE"))
+"""The fit's Glossy lobes, its image and their tier."""
+
+
+def at_thickness(fit: ClosureFit, tables: Tables, thickness_um: float) -> ClosureFit:
+    """``fit`` (of ``tables``, with the film as a slab) at another thickness, without fitting:
+    the lobes' shapes (roughnesses, distributions, the film gloss's rows, the coat) kept, and
+    what depends on the thickness read from the slab's axis (docs/model.md, "The tiers at a
+    thickness"): the mean transmittance, ``c``, the film body's albedo and row, the
+    transmittance row, the skin's gloss through the film (its Glossy rows and the Principled
+    specular level scaled by its albedo's change; ``gloss_to_diffuse`` where no lobe holds
+    it).  The errors are not measured again (dropped).  Milliseconds: what a Thickness slider
+    costs (``bench/slab_tiers.py``)."""
+    if fit.slab is None:
+        raise ValueError("a fit of the paper's film has no thickness")
+    size = next((getattr(fit, image).shape[1] for _, image, _ in _IMAGES
+                 if getattr(fit, image) is not None), DEFAULT_LUT_SIZE)
+    old = FitTargets(tables, size, fit.slab.thickness_um)
+    new = FitTargets(tables, size, thickness_um)
+    theta = old.albedo_theta("path3_gloss")
+    gloss_old, gloss_new = old.albedo("path3_gloss"), new.albedo("path3_gloss")
+    changes: dict[str, Any] = {**_film_parts(new), "errors": {}}
+    if fit.specular_film is not None and fit.specular_film.level:
+        ratio = (np.mean(cosine_mean(gloss_new, theta))
+                 / max(float(np.mean(cosine_mean(gloss_old, theta))), 1e-300))
+        changes["specular_film"] = replace(fit.specular_film,
+                                           level=float(fit.specular_film.level * ratio))
+    elif fit.gloss_to_diffuse is not None:
+        changes["gloss_to_diffuse"] = cosine_mean(gloss_new, theta)
+    for lobes_name, image_name, tier_name in _IMAGES:
+        lobes = getattr(fit, lobes_name)
+        if lobes is None:
+            continue
+        path3 = lobes["path3_gloss"]
+        lobes = {**lobes, "path3_gloss": replace(path3, lut=_scaled_row(
+            path3.lut, old.texel_rows(theta, gloss_old), new.texel_rows(theta, gloss_new)))}
+        image = tier(tier_name).image(fit)
+        if image is None:
+            raise AssertionError("a tier with Glossy lobes has an image")
+        lut = np.array(getattr(fit, image_name))
+        for name, row in (("path3_gloss", lobes["path3_gloss"].lut),
+                          ("film_transmittance", new.transmittance_rows()),
+                          ("film_body", new.body_rows())):
+            lut[image.rows.index(name)] = row
+        changes[lobes_name], changes[image_name] = lobes, lut
+    return replace(fit, **changes)

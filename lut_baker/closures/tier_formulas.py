@@ -20,6 +20,9 @@ made-up skin's parts goes through :func:`lut_baker.model.made_up_skin.coverage_w
 :func:`~lut_baker.model.made_up_skin.combine` (docs/model.md §4).
 
 - :class:`TierInputs` -- the group's inputs.
+- :func:`skin_through_film` -- the skin's diffuse light through the film (the paper's, or
+  the film as a slab with every return from its underside); :func:`under_film` -- the skin's
+  albedo under the film.
 - :func:`principled_sockets` -- one Principled BSDF's sockets; :func:`principled_shader` --
   that BSDF as a tier's shader.
 - :func:`view_weighted_closures` -- Glossy, Diffuse and Subsurface closures with view-angle
@@ -41,7 +44,7 @@ from .view_image import sample_lut
 __all__ = ["Algebra", "ShaderAlgebra", "NumpyAlgebra", "TierInputs", "Closure",
            "ViewWeightedClosures", "principled_sockets", "principled_shader",
            "view_weighted_closures", "view_weighted_shader", "assemble", "SPECULAR_IOR",
-           "ROW_SURFACE", "THROUGH_WEIGHT_FLOOR"]
+           "ROW_SURFACE", "THROUGH_WEIGHT_FLOOR", "skin_through_film", "under_film"]
 
 SPECULAR_IOR = 1.5
 """The Principled BSDF's IOR in the PRINCIPLED tier (its specular level carries the fit)."""
@@ -134,6 +137,37 @@ class TierInputs:
         return cls(scalar(coverage), colour(absorption), colour(skin_color), scalar(gloss))
 
 
+def _weights(fit: Any, x: TierInputs) -> Any:
+    """The coverage mix's weights: with the film as a slab its absorption is in the fit
+    (``once`` and ``twice`` 1), else the Foundation Absorption input's."""
+    return coverage_weights(x.coverage, 0.0 if _slab(fit) is not None else x.absorption)
+
+
+def _slab(fit: Any) -> Any:
+    return getattr(fit, "slab", None)
+
+
+def skin_through_film(fit: Any, x: TierInputs) -> Any:
+    """The skin's diffuse light through the film under uniform light, unabsorbed (``twice``
+    applies the paper film's absorption): ``S T_mean^2``; with the film as a slab every return
+    from the film's underside too, ``S t_mean^2 / (1 - S c)`` (docs/model.md "Made-up skin at
+    a thickness"), per pixel since ``S`` is the Skin Color input."""
+    slab = _slab(fit)
+    if slab is None:
+        return x.skin_color * fit.transmittance_mean**2
+    skin = under_film(fit, x)
+    return skin * fit.transmittance_mean**2 / (1.0 - skin * slab.below)
+
+
+def under_film(fit: Any, x: TierInputs) -> Any:
+    """The skin's albedo under the film: Skin Color, times the fit's ``slab.skin_under``
+    where Match Skin darkened it (the film at a thickness only)."""
+    slab = _slab(fit)
+    if slab is None or slab.skin_under is None:
+        return x.skin_color
+    return x.skin_color * slab.skin_under
+
+
 def principled_sockets(fit: Any, x: TierInputs, ops: Algebra) -> dict[str, Any]:
     """The PRINCIPLED tier's Principled BSDF sockets (by name) at inputs ``x``:
 
@@ -153,9 +187,9 @@ def principled_sockets(fit: Any, x: TierInputs, ops: Algebra) -> dict[str, Any]:
     CLOSURE_WEIGHT_CUTOFF`` and ``eta != 1`` guard them in ``svm_node_closure_bsdf``), and the
     base colour is the diffuse albedo alone.  Between 0 and 1 the layer attenuation is taken
     linear in ``g`` (exact at both ends)."""
-    weights = coverage_weights(x.coverage, x.absorption)
+    weights = _weights(fit, x)
     g = x.gloss
-    skin = combine(weights, **mix_slots(through_film=x.skin_color * fit.transmittance_mean**2,
+    skin = combine(weights, **mix_slots(through_film=skin_through_film(fit, x),
                                         skin=x.skin_color))
     total = skin + combine(weights, **mix_slots(film_diffuse=fit.film_albedo,
                                                 path3_gloss=g * fit.gloss_to_diffuse))
@@ -248,6 +282,11 @@ def view_weighted_closures(fit: Any, x: TierInputs, ops: Algebra, *,
       ``path3_gloss``), the skin through it (Subsurface, ``(1 - A)^2 T(theta_o) T_mean S``);
     - bare skin: its gloss (Glossy, ``g`` row ``skin_gloss``) and its subsurface (``S``).
 
+    With the film as a slab (``fit.slab``, docs/model.md "The tiers at a thickness") the
+    absorption is in the fit: the film's Diffuse is its body's row ``film_body`` (plus the
+    gloss's companion), ``path3_gloss`` is the skin's gloss through the film every order, and
+    the skin through the film ``t(theta_o) t_mean S / (1 - S c)``.
+
     ``g`` (the group's Gloss input) scales the Glossy colours: at 0 no Glossy closure is
     allocated.  ``tinted_subsurface``: the skin through the film keeps the skin's own
     (bright) colour, tinted by ``(1 - A)^2 T(theta_o) T_mean`` relative to its strongest
@@ -268,21 +307,24 @@ def view_weighted_closures(fit: Any, x: TierInputs, ops: Algebra, *,
     scatters below its surface, the rest a Diffuse closure of the same product (a skin whose
     shader has a Subsurface Weight, docs/addon.md "Over the artist's skin"); None: all of
     it."""
-    weights = coverage_weights(x.coverage, x.absorption)
+    weights = _weights(fit, x)
     g = x.gloss
+    slab = _slab(fit)
     transmitted = weights.twice * ops.row("film_transmittance") * fit.transmittance_mean
+    skin = under_film(fit, x)
+    if slab is not None:  # every return from the film's underside, per pixel
+        transmitted = transmitted / (1.0 - skin * slab.below)
     if tinted_subsurface:
         strongest = ops.channel_max(transmitted)
         through = Closure("subsurface", "skin through film",
-                          transmitted * x.skin_color / ops.maximum(strongest,
-                                                                   THROUGH_WEIGHT_FLOOR),
+                          transmitted * skin / ops.maximum(strongest, THROUGH_WEIGHT_FLOOR),
                           "skin", weight=strongest)
     else:
-        through = Closure("subsurface", "skin through film", transmitted * x.skin_color, "skin")
+        through = Closure("subsurface", "skin through film", transmitted * skin, "skin")
     diffuse_through: tuple[Closure, ...] = ()
     if subsurface_weight is not None:
         diffuse_through = (Closure("diffuse", "skin through film (diffuse)",
-                                   transmitted * x.skin_color, "skin",
+                                   transmitted * skin, "skin",
                                    weight=1.0 - subsurface_weight),)
         through = Closure(through.kind, through.name, through.colour, through.surface,
                           weight=subsurface_weight if through.weight is None
@@ -290,7 +332,8 @@ def view_weighted_closures(fit: Any, x: TierInputs, ops: Algebra, *,
     covered = (
         *(Closure("glossy", name, g * ops.row(name), "film") for name in film_lobes),
         Closure("diffuse", "film diffuse",
-                weights.once * fit.film_albedo + g * ops.row("film_gloss_diffuse"), "film"),
+                (weights.once * fit.film_albedo if slab is None else ops.row("film_body"))
+                + g * ops.row("film_gloss_diffuse"), "film"),
         Closure("glossy", "path3_gloss", g * ops.row("path3_gloss") * weights.twice, "skin"),
         through,
         *diffuse_through,

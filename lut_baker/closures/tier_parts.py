@@ -7,9 +7,11 @@ parameters are fitted to the tables, with weights that may depend on the view an
 1-D lookup images (:mod:`lut_baker.closures.view_image`).
 
 - :class:`FitTargets` -- what the lobes of one set of tables are fitted to, computed once.
+- :func:`cosine_mean` -- a directional table's mean under uniform light.
 - :func:`principled_parts` -- one Principled BSDF's coat and speculars.
 - :func:`layered_parts` -- Cycles' Glossy lobes and their view-angle image.
 - :func:`eevee_parts` -- EEVEE's GGX lobes (the film's gloss in two) and their image.
+- :func:`image_rows`, :data:`SLAB_ROWS` -- a tier's image rows, the film as a slab's included.
 """
 
 from __future__ import annotations
@@ -18,7 +20,9 @@ from dataclasses import replace
 
 import numpy as np
 
+from ..numerics.geometry import polar_angle_deg
 from ..numerics.quadrature import trapezoid_weights
+from ..tables.slab_tables import SlabParts, SlabTables
 from ..tables.table_set import Tables
 from . import cycles as cc
 from .lobes import (
@@ -34,10 +38,15 @@ from .tier_formulas import SPECULAR_IOR
 from .view_grid import FIT_VIEWS, lobe_widths_deg, view_grid
 from .view_image import EEVEE_LUT_ROWS, LUT_ROWS, lut_nodes
 
-__all__ = ["FitTargets", "principled_parts", "layered_parts", "eevee_parts"]
+__all__ = ["FitTargets", "cosine_mean", "principled_parts", "layered_parts", "eevee_parts",
+           "image_rows", "SLAB_ROWS"]
+
+SLAB_ROWS = ("film_body",)
+"""The view-angle rows a tier has beyond its own with the film as a slab: the film body's
+directional albedo (its Diffuse closure's weight)."""
 
 
-def _cosine_mean(values: np.ndarray, theta_deg: np.ndarray) -> np.ndarray:
+def cosine_mean(values: np.ndarray, theta_deg: np.ndarray) -> np.ndarray:
     """``2 Int v(mu) mu dmu`` of a directional table ``(n_theta[, C])`` (its hemispherical
     cosine-weighted mean), trapezoid in ``mu``, held at its last value beyond ``theta_max``."""
     mu = np.cos(np.radians(np.asarray(theta_deg, float)))[::-1]
@@ -72,11 +81,25 @@ class FitTargets:
     """What the lobes of one set of tables are fitted to, computed when first asked for: the
     grids sized by the film's and the skin's gloss (:func:`lobe_widths_deg`), the film's gloss,
     the skin's gloss and path 3 on them, the film's transmittance rows of the view-angle
-    image."""
+    image.
 
-    def __init__(self, tables: Tables, lut_size: int):
+    Tables with the film as a slab (``tables.slab``, docs/model.md "The tiers at a
+    thickness") are fitted at their baked thickness (``thickness_um``): ``path3_gloss`` is
+    then the slab's ``top`` less the film's body (Lambertian in the Layered and EEVEE tiers'
+    reading: ``alpha(theta_i) alpha(theta_o) / (pi alpha_mean)``, its directional albedo the
+    film's ``alpha``), the skin's gloss through the film every order; the transmittance rows
+    are the slab's ``t`` and the film's body has rows of its own (``film_body``).
+    ``thickness_um``: another thickness than the baked one."""
+
+    def __init__(self, tables: Tables, lut_size: int, thickness_um: float | None = None):
         self.tables, self.lut_size = tables, lut_size
         self.theta_deg = np.asarray(tables.theta_deg, float)
+        self.slab: SlabTables | None = getattr(tables, "slab", None)
+        if self.slab is None:
+            self.thickness_um = 0.0
+        else:
+            self.thickness_um = float(tables.parameters["film_thickness_um"]
+                                      if thickness_um is None else thickness_um)
         self._found: dict = {}
 
     def _once(self, name, compute):
@@ -89,29 +112,80 @@ class FitTargets:
         return self._once(("grid", surface), lambda: view_grid(
             lobe_widths_deg(self.tables)[surface], FIT_VIEWS))
 
+    def slab_tables(self) -> SlabTables:
+        """The tables' slab (``ValueError`` for the paper's film)."""
+        if self.slab is None:
+            raise ValueError("these tables hold the paper's film only")
+        return self.slab
+
+    def slab_parts(self, theta_deg) -> SlabParts:
+        """The slab's 1-D parts at the fit's thickness and polar angles ``theta_deg``."""
+        return self.slab_tables().at(self.thickness_um, theta_deg)
+
+    def film_body(self, wi, wo) -> np.ndarray:
+        """The film's body as the tiers draw it (class docstring), 1/sr ``(..., 3)``."""
+        def albedo(w):
+            return self.slab_parts(polar_angle_deg(w)).film_albedo
+        return albedo(wi) * albedo(wo) / (np.pi * np.maximum(self.film_mean(), 1e-12))
+
+    def film_mean(self) -> np.ndarray:
+        """The film body's albedo under uniform light (RGB): ``2 Int alpha mu dmu``."""
+        theta = self.slab_tables().theta_deg
+        return self._once("film_mean", lambda: cosine_mean(
+            self.slab_parts(theta).film_albedo, theta))
+
     def target(self, name: str):
         """``(grid, table)`` of a gloss part: ``film_gloss`` on the film's grid,
         ``path3_gloss`` and ``skin_gloss`` on the skin's."""
         def compute():
             if name == "path3_gloss":
                 grid = self.grid("skin_gloss")
+                if self.slab is not None:
+                    wi, wo = grid.directions
+                    return grid, (self.slab.top_at(self.thickness_um, wi, wo)
+                                  - self.film_body(wi, wo))
                 return grid, self.tables.angular(name, *grid.directions)
             grid = self.grid(name)
             return grid, self.tables.surface_gloss(name, *grid.directions)
         return self._once(("target", name), compute)
 
     def albedo(self, name: str) -> np.ndarray:
-        """A gloss part's directional albedo table ``(n_theta, 3)``."""
+        """A gloss part's directional albedo table ``(n_theta, 3)`` on
+        :meth:`albedo_theta`."""
+        if name == "path3_gloss" and self.slab is not None:
+            parts = self.slab_parts(self.slab.theta_deg)
+            return np.maximum(parts.top_albedo - parts.film_albedo, 0.0)
         return np.asarray(getattr(self.tables, name + "_albedo"))
 
+    def albedo_theta(self, name: str) -> np.ndarray:
+        """The polar angles (degrees) :meth:`albedo`'s table is on."""
+        if name == "path3_gloss" and self.slab is not None:
+            return np.asarray(self.slab.theta_deg, float)
+        return self.theta_deg
+
+    def texel_rows(self, theta_deg, values) -> np.ndarray:
+        """A directional table ``(n_theta, 3)`` on ``theta_deg`` at the image's texels."""
+        mu = lut_nodes(self.lut_size)
+        return np.stack([np.interp(np.degrees(np.arccos(mu)), theta_deg, values[:, c])
+                         for c in range(3)], -1)
+
     def transmittance_rows(self) -> np.ndarray:
-        """The film's transmittance at the view-angle image's texels, ``(size, 3)``."""
+        """The film's transmittance at the view-angle image's texels, ``(size, 3)`` (the
+        slab's ``t`` at its thickness)."""
         def compute():
-            transmittance = np.asarray(self.tables.film_transmittance, float)
-            mu = lut_nodes(self.lut_size)
-            return np.stack([np.interp(np.degrees(np.arccos(mu)), self.theta_deg,
-                                       transmittance[:, c]) for c in range(3)], -1)
+            if self.slab is not None:
+                theta = np.asarray(self.slab.theta_deg, float)
+                return self.texel_rows(theta, self.slab_parts(theta).through)
+            return self.texel_rows(self.theta_deg, np.asarray(self.tables.film_transmittance,
+                                                         float))
         return self._once("transmittance_rows", compute)
+
+    def body_rows(self) -> np.ndarray:
+        """The film body's directional albedo at the texels, ``(size, 3)`` (slab only)."""
+        def compute():
+            theta = np.asarray(self.slab_tables().theta_deg, dtype=np.float64)
+            return self.texel_rows(theta, self.slab_parts(theta).film_albedo)
+        return self._once("body_rows", compute)
 
 
 def _left_out_glossy(size: int) -> LobeFit:
@@ -123,7 +197,6 @@ def _left_out_glossy(size: int) -> LobeFit:
 def principled_parts(targets: FitTargets, over_shader: bool) -> dict:
     """The PRINCIPLED tier's parts of a :class:`ClosureFit`: the coat, the two speculars (over
     the artist's shader the bare one left out: level 0) and their mean layering albedos."""
-    tables, theta_deg = targets.tables, targets.theta_deg
     film_grid, film_gloss = targets.target("film_gloss")
     skin_grid, path3 = targets.target("path3_gloss")
     coat = fit_coat(film_grid, film_gloss)
@@ -156,16 +229,26 @@ def principled_parts(targets: FitTargets, over_shader: bool) -> dict:
         "specular_film": specular_film,
         "coat_albedo_mean": _coat_layering_mean(coat.roughness, coat_ior),
         "specular_albedo_mean": (specular_mean(specular_bare), specular_mean(specular_film)),
-        "gloss_to_diffuse": (_cosine_mean(np.asarray(tables.path3_gloss_albedo), theta_deg)
+        "gloss_to_diffuse": (cosine_mean(targets.albedo("path3_gloss"),
+                                          targets.albedo_theta("path3_gloss"))
                              if specular_film.level == 0.0 else np.zeros(3)),
     }
 
 
+def image_rows(rows: tuple, slab: bool) -> tuple:
+    """A tier's view-angle image rows: ``rows``, and with the film as a slab the film body's
+    (``film_body``)."""
+    return rows + (SLAB_ROWS if slab else ())
+
+
 def _image(targets: FitTargets, lobes: dict, rows: tuple) -> np.ndarray:
-    """The view-angle image of ``lobes``, rows named ``rows``."""
+    """The view-angle image of ``lobes``, rows named ``rows`` (:func:`image_rows`)."""
     found = {**{name: lobes[name].lut for name in lobes},
              "film_transmittance": targets.transmittance_rows(),
              "film_gloss_diffuse": lobes["film_gloss"].diffuse_lut}
+    rows = image_rows(rows, targets.slab is not None)
+    if targets.slab is not None:
+        found["film_body"] = targets.body_rows()
     if any(found.get(name) is None for name in rows):
         raise AssertionError("the lobes give every view-angle row")
     return np.stack([found[name] for name in rows])
@@ -174,7 +257,8 @@ def _image(targets: FitTargets, lobes: dict, rows: tuple) -> np.ndarray:
 def _glossy(targets: FitTargets, name: str, closures: tuple) -> LobeFit:
     """:func:`fit_glossy` of one gloss part (the film's with its Lambertian companion)."""
     grid, table = targets.target(name)
-    return fit_glossy(grid, table, targets.albedo(name), targets.theta_deg, targets.lut_size,
+    return fit_glossy(grid, table, targets.albedo(name), targets.albedo_theta(name),
+                      targets.lut_size,
                       companion=name == "film_gloss", closures=closures)
 
 

@@ -33,7 +33,7 @@ from . import cycles as cc
 from . import eevee
 from .lobes import LobeFit
 from .tier_formulas import TierInputs, principled_shader, view_weighted_shader
-from .tier_parts import FitTargets, eevee_parts, layered_parts, principled_parts
+from .tier_parts import FitTargets, eevee_parts, image_rows, layered_parts, principled_parts
 from .view_image import EEVEE_LUT_ROWS, LUT_ROWS
 
 __all__ = ["Tier", "ViewImage", "Costs", "register", "unregister", "tier", "held", "TIERS",
@@ -216,7 +216,8 @@ LAYERED = register(Tier(
     engines=("CYCLES",), fullness=0, fit_share=0.35,
     fit=layered_parts, holds=lambda fit: fit.glossy is not None,
     shader=partial(view_weighted_shader, tinted_subsurface=True, film_lobes=("film_gloss",)),
-    lobes=lambda fit: fit.glossy, image=lambda fit: ViewImage(LUT_ROWS, fit.lut)))
+    lobes=lambda fit: fit.glossy,
+    image=lambda fit: ViewImage(image_rows(LUT_ROWS, fit.slab is not None), fit.lut)))
 """Glossy (film gloss, path-3 gloss, skin gloss; weights read from a view-angle image),
 Diffuse and Subsurface closures mixed by coverage
 (:func:`~lut_baker.closures.tier_formulas.view_weighted_closures`); the skin through the film
@@ -228,8 +229,8 @@ EEVEE = register(Tier(
                 "image, Burley subsurface); closest to the tables in EEVEE",
     engines=("EEVEE",), fullness=0, fit_share=0.4,
     fit=eevee_parts, holds=lambda fit: fit.eevee_glossy is not None, shader=_eevee_shader,
-    lobes=lambda fit: fit.eevee_glossy, image=lambda fit: ViewImage(EEVEE_LUT_ROWS,
-                                                                     fit.eevee_lut),
+    lobes=lambda fit: fit.eevee_glossy, image=lambda fit: ViewImage(
+        image_rows(EEVEE_LUT_ROWS, fit.slab is not None), fit.eevee_lut),
     glossy=_eevee_glossy, subsurface_method="BURLEY"))
 """The Layered tier's closures and mix made for EEVEE: every Glossy lobe GGX fitted as EEVEE
 renders it under a lamp (a linearly transformed cosine, :mod:`lut_baker.closures.eevee`), the

@@ -14,6 +14,8 @@ view grid.
 - :func:`tier_replica` -- a tier's BRDF at a coverage, absorption and Gloss.
 - :func:`tier_reflection` -- a tier's BRDF as a made-up material renders it (over the
   artist's shader: the bare skin is theirs).
+- :func:`reference_reflection` -- what they are measured against (the tables' made-up skin,
+  or the film as a slab at the fit's thickness).
 - :func:`tier_errors` -- the tiers of a fit against the tables at one coverage and absorption.
 """
 
@@ -27,6 +29,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..model.made_up_skin import combine, coverage_weights
+from ..tables.slab_tables import slab_reflection
 from ..tables.table_set import Tables
 from . import cycles as cc
 from .closure_fit import ClosureFit
@@ -36,7 +39,7 @@ from .tier_registry import TIERS, Tier, held
 from .view_grid import ERROR_VIEWS, lobe_widths_deg, view_grid
 
 __all__ = ["TIERS", "TierError", "NumpyShaders", "principled_inputs", "tier_replica",
-           "tier_reflection", "tier_errors"]
+           "tier_reflection", "reference_reflection", "tier_errors"]
 
 Directions = tuple[NDArray[np.float64], NDArray[np.float64]]
 """``(wi, wo)``: light and view directions, local unit vectors ``(..., 3)``."""
@@ -162,6 +165,23 @@ def tier_reflection(fit: ClosureFit, tables: Tables, name: str, coverage: float,
     return combine(coverage_weights(coverage, 0.0), top=covered, bare=bare)
 
 
+def reference_reflection(fit: ClosureFit, tables: Tables, coverage: float,
+                         absorption: ArrayLike, directions: Directions) -> NDArray[np.float64]:
+    """What a fit's tiers are measured against, ``(..., 3)``: the tables' made-up skin at a
+    coverage and absorption, or with the film as a slab (``fit.slab``) the slab's at the fit's
+    thickness (its absorption baked, :func:`lut_baker.tables.slab_tables.slab_reflection`; the
+    skin under the film darkened by ``slab.skin_under`` where Match Skin set it)."""
+    if fit.slab is None:
+        return tables.made_up_reflection(*directions, coverage, absorption)
+    under = fit.slab.skin_under
+    if under is None:
+        return slab_reflection(tables, *directions, fit.slab.thickness_um, coverage=coverage)
+    covered = slab_reflection(tables, *directions, fit.slab.thickness_um,
+                              skin_albedo=fit.skin_albedo * np.asarray(under, float))
+    bare = slab_reflection(tables, *directions, fit.slab.thickness_um, coverage=0.0)
+    return combine(coverage_weights(coverage, 0.0), top=covered, bare=bare)
+
+
 def tier_errors(fit: ClosureFit, tables: Tables, coverage: float, absorption: ArrayLike,
                 gloss: float = 1.0, *, tiers: Iterable[str] | None = None,
                 over_shader: bool = False) -> dict[str, TierError]:
@@ -176,7 +196,8 @@ def tier_errors(fit: ClosureFit, tables: Tables, coverage: float, absorption: Ar
     grid = view_grid(min(lobe_widths_deg(tables).values()), ERROR_VIEWS)
     directions = grid.directions
     looked_up = tables.reflection_parts(*directions)  # one lookup for both coverages
-    reference = tables.mixed_reflection(looked_up, coverage, absorption)
+    reference = (tables.mixed_reflection(looked_up, coverage, absorption) if fit.slab is None
+                 else reference_reflection(fit, tables, coverage, absorption, directions))
     bare = tables.mixed_reflection(looked_up, 0.0, absorption) if over_shader else None
     out = {}
     for name in TIERS:

@@ -109,12 +109,16 @@ class SlabSkinParts(NamedTuple):
     ``top`` ``(C, orders, N, N)``: star form, what does not depend on the skin's albedo (the
     film's body through its surface, the skin's gloss through the film, every inter-reflection;
     the surface's own gloss left out).  ``through`` ``(C, N)``: ``t(theta)``, dimensionless.
-    ``below`` ``(C,)``: ``c``.  ``face`` ``(C, N)``: the surface's gloss albedo ``a_g``."""
+    ``below`` ``(C,)``: ``c``.  ``face`` ``(C, N)``: the surface's gloss albedo ``a_g``.
+    ``film`` ``(C, N)``: the film's own directional albedo from above (its body through its
+    surface, the surface's gloss left out): the part of ``top``'s albedo that is not the skin's
+    gloss (the tiers' film body, docs/model.md "The tiers at a thickness")."""
 
     top: np.ndarray
     through: np.ndarray
     below: np.ndarray
     face: np.ndarray
+    film: np.ndarray | None = None
 
 
 def _film_layer(film: FilmSlab, thickness: float, face: np.ndarray) -> Layer:
@@ -149,8 +153,10 @@ def slab_skin_parts(film: FilmSlab, thickness: float, skin: ReflectionLayer,
                          [..., None])[..., 0]  # G u, with G = (I - S_g R')^-1
     v = through_film[:, 0] @ u
     below = np.einsum("j,cjk,ck->c", u, r_up[:, 0], gu)
+    film_albedo = np.broadcast_to(star_albedo(layer.top[:, 0], s0), (channels, u.size))
     return SlabSkinParts(top=top, through=np.sqrt(np.pi) * v / s0, below=below,
-                         face=np.broadcast_to(face_a, (channels, face_a.shape[-1])))
+                         face=np.broadcast_to(face_a, (channels, face_a.shape[-1])),
+                         film=film_albedo)
 
 
 def _diffuse_weight(parts: SlabSkinParts, skin_albedo: ArrayLike) -> np.ndarray:
@@ -221,8 +227,14 @@ def matching_absorption(target: ArrayLike, film: ReflectionLayer,
     albedo = np.broadcast_to(np.asarray(skin_albedo, float), (3,))
     face = face_albedo(film, grid)
 
-    def colour(a: np.ndarray) -> np.ndarray:
-        return slab_colour(film, transmission, skin, albedo, thickness_um, grid, a, face)
+    known: dict[tuple[float, ...], np.ndarray] = {}
+
+    def colour(a: np.ndarray) -> np.ndarray:  # the ends, asked twice, evaluated once
+        key = tuple(np.broadcast_to(np.asarray(a, float), (3,)).tolist())
+        if key not in known:
+            known[key] = slab_colour(film, transmission, skin, albedo, thickness_um, grid, a,
+                                     face)
+        return known[key]
 
     absorption = increasing_root(lambda a: -colour(a), -goal, ROOT_STEPS)
     too_light = goal > colour(np.zeros(3))

@@ -12,8 +12,10 @@ texture, a socket) and the film's surface gloss ``film_gloss`` in closed form
 ``top`` (angular, 1/sr): the film's body through its surface and the skin's gloss through the
 film, every inter-reflection (what does not depend on ``a``); ``through`` ``t`` (directional,
 dimensionless): the film's transmittance into the skin's diffuse light; ``below`` ``c``: the
-film's reflectance seen from the skin (:mod:`lut_baker.model.slab_skin`).  The diffuse term is
-what spreads under the skin (the dipole's normalised profile).  Absorption is part of the bake
+film's reflectance seen from the skin (:mod:`lut_baker.model.slab_skin`); ``film_albedo``: the
+film's own directional albedo from above (its body through its surface: the part of ``top``'s
+albedo that is not the skin's gloss, the tiers' film Diffuse closure).  The diffuse term is what
+spreads under the skin (the dipole's normalised profile).  Absorption is part of the bake
 (the slab is not linear in it); coverage stays an areal mix with the bare skin.
 
 The thickness axis: ``thickness_um`` holds ``n - 1`` log-spaced thicknesses from
@@ -95,12 +97,14 @@ def thickness_index(thickness_um: ArrayLike, n: int = THICKNESS_NODES,
 class SlabParts(NamedTuple):
     """The 1-D parts at one thickness: ``top_albedo`` ``(..., 3)`` (``top``'s directional
     albedo, at the angles asked), ``through`` ``(..., 3)`` (``t``), ``through_mean`` ``(3,)``
-    (``t`` averaged over uniform light, ``2 Int t mu dmu``), ``below`` ``(3,)`` (``c``)."""
+    (``t`` averaged over uniform light, ``2 Int t mu dmu``), ``below`` ``(3,)`` (``c``),
+    ``film_albedo`` ``(..., 3)`` (the film's own directional albedo, at the angles asked)."""
 
     top_albedo: np.ndarray
     through: np.ndarray
     through_mean: np.ndarray
     below: np.ndarray
+    film_albedo: np.ndarray
 
 
 @dataclass(frozen=True, eq=False)
@@ -111,7 +115,8 @@ class SlabTables:
     ``theta_deg`` (n_theta,) and ``phi_deg`` (n_phi,), laid out as ``theta_spacing``,
     ``theta_offset`` and ``phi_spacing`` say (the closed forms of
     :mod:`lut_baker.tables.table_set`).  ``top`` (K, n_theta, n_theta, n_phi, 3) 1/sr;
-    ``top_albedo``, ``through`` (K, n_theta, 3); ``through_mean``, ``below`` (K, 3)."""
+    ``top_albedo``, ``through``, ``film_albedo`` (K, n_theta, 3); ``through_mean``, ``below``
+    (K, 3)."""
 
     thickness_um: np.ndarray
     theta_deg: np.ndarray
@@ -121,6 +126,7 @@ class SlabTables:
     through: np.ndarray
     through_mean: np.ndarray
     below: np.ndarray
+    film_albedo: np.ndarray
     absorption: np.ndarray
     theta_spacing: str = "grazing"
     theta_offset: float = THETA_OFFSET
@@ -129,7 +135,8 @@ class SlabTables:
     def __post_init__(self) -> None:
         k, n, p = self.thickness_um.size, self.theta_deg.size, self.phi_deg.size
         shapes = {"top": (k, n, n, p, 3), "top_albedo": (k, n, 3), "through": (k, n, 3),
-                  "through_mean": (k, 3), "below": (k, 3), "absorption": (3,)}
+                  "film_albedo": (k, n, 3), "through_mean": (k, 3), "below": (k, 3),
+                  "absorption": (3,)}
         for name, shape in shapes.items():
             if np.shape(getattr(self, name)) != shape:
                 raise ValueError(f"slab table {name!r} must have shape {shape}, "
@@ -159,7 +166,8 @@ class SlabTables:
         return SlabParts(top_albedo=_linear(self._along(self.top_albedo, thickness_um), x),
                          through=_linear(self._along(self.through, thickness_um), x),
                          through_mean=self._along(self.through_mean, thickness_um),
-                         below=self._along(self.below, thickness_um))
+                         below=self._along(self.below, thickness_um),
+                         film_albedo=_linear(self._along(self.film_albedo, thickness_um), x))
 
     def top_at(self, thickness_um: float, wi: ArrayLike, wo: ArrayLike) -> NDArray[np.float64]:
         """``top`` (1/sr, ``(..., 3)``) at one thickness and unit directions ``(..., 3)``."""

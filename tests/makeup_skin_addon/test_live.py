@@ -46,12 +46,14 @@ def test_choosing_a_foundation_updates_its_gloss_live(sphere):
 
 def test_roughness_moves_the_gloss_live_and_a_picked_colour_at_once(sphere):
     """Film and Skin Roughness re-fit the preview (the film's and the skin's lobe in the bake);
-    a colour picked sets the group's absorption at once, with no re-bake."""
+    with the paper's film a colour picked sets the group's absorption at once, with no
+    re-bake (a film at a thickness bakes its absorption:
+    test_a_thickness_moves_the_film_live_without_fitting)."""
     from support.addon_steps import counts
 
     from makeup_skin_addon import groups, live, nodes
 
-    material, _ = apply_pipeline(sphere, "LAYERED", resolution="preview")
+    material, _ = apply_pipeline(sphere, "LAYERED", resolution="preview", film_mode="PAPER")
     settings = material.makeup_skin
     before = nodes.read_meta(groups.group_of(material).node_tree)["parameters"]
     settings.film_roughness = 0.4
@@ -236,3 +238,34 @@ def test_unregister_leaves_no_worker_or_timer(addon, bpy_factory):
         assert live.pending() == set()
     finally:
         addon.register()
+
+
+def test_a_thickness_moves_the_film_live_without_fitting(sphere, monkeypatch):
+    """With the film at a thickness, a Thickness change re-reads the slab's tables baked for
+    another thickness (no bake) and moves the fit there (no fit: the lobes kept,
+    lut_baker.closures.fitting.at_thickness); the group's record keeps the new thickness.
+    A picked colour (the absorption, baked) marks a rebuild."""
+    from makeup_skin_addon import bakes, groups, live, nodes
+    from makeup_skin_addon.core import bake, fitting
+
+    material, _ = apply_pipeline(sphere, "LAYERED", resolution="preview")
+    settings = material.makeup_skin
+    assert settings.film_mode == "SLAB"
+    settings.live_update = True
+    calls = []
+    monkeypatch.setattr(bake, "bake", lambda *a, **k: calls.append("bake"))
+    monkeypatch.setattr(fitting, "fit_closures", lambda *a, **k: calls.append("fit"))
+    settings.thickness_um = 40.0
+    assert material.name in live.pending()
+    live.flush()
+    meta = nodes.read_meta(groups.group_of(material).node_tree)
+    assert calls == [] and meta["film_thickness_um"] == 40.0
+    assert meta["glossy"]["path3_gloss"]["roughness"] > 0.0
+    monkeypatch.undo()
+    settings.shade_colour = (0.5, 0.4, 0.3)
+    assert material.name in live.pending()
+    live.flush()
+    after = nodes.read_meta(groups.group_of(material).node_tree)
+    assert after["parameters"]["absorption"] == pytest.approx(list(settings.absorption),
+                                                              abs=1e-7)
+    bakes.clear()

@@ -86,11 +86,27 @@ def baked():
     return skin, tables, fit
 
 
+@pytest.fixture(scope="module")
+def baked_slab():
+    """``(skin, tables, fit)`` of the film as a slab (9.6 um, absorption baked in), the skin
+    under the film darkened per channel (``skin_under``): the factor ``1 / (1 - S c)`` and the
+    film body's row reach the probes."""
+    skin = presets.made_up_skin("paper_natural", "jensen_skin2", coverage=1.0,
+                                absorption=[0.1, 0.3, 0.5])
+    tables = bake(skin, "preview", film=9.6)
+    fit = cf.fit_closures(tables)
+    fit = dataclasses.replace(fit, slab=dataclasses.replace(
+        fit.slab, below=fit.slab.below * np.array([1.0, 1.2, 1.5]),
+        skin_under=np.array([1.0, 0.9, 0.7])))
+    return skin, tables, fit
+
+
 def _group(tier, baked):
     from makeup_skin_addon import bakes, nodes
 
     skin, tables, fit = baked
-    return nodes.build_group(tier, bakes.bake_record(skin, "preview"), fit)
+    film = "paper" if fit.slab is None else fit.slab.thickness_um
+    return nodes.build_group(tier, bakes.bake_record(skin, "preview", film), fit)
 
 
 def _source(target):
@@ -292,9 +308,13 @@ def _layered_expected(fit, case, eevee=False):
     return out
 
 
+@pytest.mark.parametrize("film", ["paper", "slab"])
 @pytest.mark.parametrize("tier", tiers.TIERS)
-def test_node_group_follows_the_tier_formulas(blank_scene, baked, tmp_path, tier):
-    """Every probe of ``tier`` in every case equals numpy's value to a relative 1e-5."""
+def test_node_group_follows_the_tier_formulas(blank_scene, baked, baked_slab, tmp_path, tier,
+                                              film):
+    """Every probe of ``tier`` in every case equals numpy's value to a relative 1e-5, with the
+    paper's film and with the film as a slab (docs/model.md, "The tiers at a thickness")."""
+    baked = baked if film == "paper" else baked_slab
     fit = baked[2]
     group = _group(tier, baked)
     probes, make_probe, expected_of = {

@@ -108,6 +108,34 @@ def test_a_file_without_a_made_up_material_is_left_alone(addon, blank_scene, tmp
     assert on_load.notice(bpy.data.materials["Someone's material"]) is None
 
 
+def test_a_file_made_before_the_film_setting_keeps_the_papers_film(sphere, tmp_path):
+    """A material of settings version 2 (made before the Film setting, so with the paper's
+    film; its file stores no Film): opened, it keeps the paper's film (its look, its group
+    untouched: Check Tables finds it intact, nothing pending), stamped version 3; a new
+    material's Film is the film at a thickness."""
+    import bpy
+
+    from makeup_skin_addon import apply, groups, live, on_load
+    from makeup_skin_addon.keys import SETTINGS_VERSION
+
+    material, _ = apply_pipeline(sphere, "LAYERED", film_mode="PAPER")
+    group_name = groups.group_of(material).node_tree.name
+    settings = material.makeup_skin
+    for name in ("film_mode", "thickness_um"):
+        settings.property_unset(name)
+    settings.settings_version = 2
+    path = tmp_path / "version2.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(path))
+    bpy.ops.wm.open_mainfile(filepath=str(path))
+    material = bpy.data.materials["Skin"]
+    settings = material.makeup_skin
+    assert settings.film_mode == "PAPER" and settings.settings_version == SETTINGS_VERSION == 3
+    assert groups.group_of(material).node_tree.name == group_name and not live.pending()
+    assert apply.check_material(bpy.context, material)[0]
+    assert on_load.upgrade_file() == []
+    assert bpy.data.materials.new("New").makeup_skin.film_mode == "SLAB"
+
+
 def test_settings_of_an_older_file_are_upgraded(sphere, tmp_path):
     """A file of the previous version (its settings as that version stored them: no settings
     version, Shade By Color meaning the colour the pigment passes, the film's width in degrees
@@ -120,7 +148,7 @@ def test_settings_of_an_older_file_are_upgraded(sphere, tmp_path):
     from lut_baker.model import roughness
     from makeup_skin_addon.keys import SETTINGS_VERSION
 
-    material, _ = apply_pipeline(sphere, "PRINCIPLED")
+    material, _ = apply_pipeline(sphere, "PRINCIPLED", film_mode="PAPER")
     settings = material.makeup_skin
     settings.live_update = False
     settings.absorption_mode = "COLOUR"
@@ -131,7 +159,7 @@ def test_settings_of_an_older_file_are_upgraded(sphere, tmp_path):
     node.inputs["Coverage"].default_value = 1.0
     node.inputs["Foundation Absorption"].default_value = (0.1, 0.2, 0.3, 1.0)
     for name in ("settings_version", "coverage", "film_roughness", "skin_roughness",
-                 "shade_colour"):
+                 "shade_colour", "film_mode", "thickness_um"):
         settings.property_unset(name)
     path = tmp_path / "old.blend"
     bpy.ops.wm.save_as_mainfile(filepath=str(path))
@@ -140,6 +168,7 @@ def test_settings_of_an_older_file_are_upgraded(sphere, tmp_path):
     settings = material.makeup_skin
     assert settings.settings_version == SETTINGS_VERSION
     assert settings.is_property_set("settings_version")
+    assert settings.film_mode == "PAPER"
     assert settings.coverage == 1.0
     assert tuple(settings.absorption) == pytest.approx((0.1, 0.2, 0.3), abs=1e-6)
     assert settings.film_roughness == pytest.approx(float(roughness.roughness_for_width(20.0)),

@@ -169,7 +169,10 @@ def test_fit_to_scene_operator(addon):
     # A film of index 1.01 (its gloss 0.9% of the image, under the noise): Gloss 0 on the
     # material and its group node, the value before kept; the change re-bakes first (the
     # panel's live update, which the operator flushes).  The paper's film again: Gloss 1.
+    # (The paper's film as published: a film at a thickness lets the skin's own gloss
+    # through, 4.9% of the image, and keeps its Gloss.)
     settings = material.makeup_skin
+    settings.film_mode = "PAPER"
     settings.override_film, settings.film_ior = True, 1.01
     assert bpy.ops.makeup_skin.fit_to_scene() == {"FINISHED"}
     matte = json.loads(material[tier_choice.CHOICE_KEY])

@@ -75,9 +75,10 @@ def test_panel_says_when_the_file_was_repaired_on_opening(head, tmp_path):
 
 
 def test_panel_shows_the_shade_buttons_and_what_is_out_of_reach(head):
-    """Match Skin, Lighter and Darker beside the shade; after the first Apply matched a fair
-    head (whose red the film cannot reach) the panel says so in words, read from what Apply
-    stored; a matte product's Film Roughness says it has no gloss to roughen."""
+    """Match Skin, Lighter and Darker beside the shade, Film and Thickness beside the
+    foundation; after the first Apply matched a fair head with the paper's film (whose red it
+    cannot reach) the panel says so in words, read from what Apply stored; a matte product's
+    Film Roughness says it has no gloss to roughen."""
     import bpy
     from support import character
 
@@ -85,7 +86,7 @@ def test_panel_shows_the_shade_buttons_and_what_is_out_of_reach(head):
 
     fair = character.skin_albedo_image(0, tone="lighter")
     head.active_material.node_tree.nodes["Albedo"].image = fair
-    material = apply_operator(head)
+    material = apply_operator(head, film_mode="PAPER")
     layout = RecordingLayout()
     ui.draw_settings(layout, bpy.context)
     assert ("operator", "makeup_skin.match_skin") in layout.drawn
@@ -94,6 +95,8 @@ def test_panel_shows_the_shade_buttons_and_what_is_out_of_reach(head):
     labels = [item[1] for item in layout.drawn if item[0] == "label"]
     assert "Shade: matched to the skin" in labels
     assert any(text.startswith("Red out of the film's reach") for text in labels), labels
+    props = [item[1] for item in layout.drawn if item[0] == "prop"]
+    assert "film_mode" in props and "thickness_um" in props
     material.makeup_skin.foundation = "clarins_103"
     layout = RecordingLayout()
     ui.draw_settings(layout, bpy.context)

@@ -83,3 +83,28 @@ def test_traits_of_a_fit_of_some_tiers(paper_tables, paper_fit):
     assert traits.profile_mismatch == 0.0 and set(traits.tier_errors) == {"LAYERED"}
     # Gloss 0 leaves the artist's bare skin as it is: what it changes is the covered part's.
     assert 0.0 < traits.gloss_error("LAYERED", 45.0) < full.gloss_error("LAYERED", 45.0)
+
+
+def test_a_slab_materials_traits_follow_its_thickness():
+    """With the film as a slab the traits are the slab's at the fit's thickness: the skin's
+    spreading light a large share of the image through a sheer film (2 um: 0.49-0.62) and a
+    small one through a thick film (150 um: 0.08-0.09, about the paper film's 0.05-0.06 with
+    every inter-reflection added), every share and gloss omission between 0 and 1."""
+    import dataclasses
+
+    from lut_baker import bake
+    from lut_baker.closures import fitting
+    from lut_baker.model import presets
+
+    tables = bake.bake(presets.made_up_skin("paper_natural", "jensen_skin1"), "preview",
+                       film=9.6)
+    skin_share = {}
+    for thickness in (2.0, 150.0):
+        at = dataclasses.replace(tables, parameters={**tables.parameters,
+                                                     "film_thickness_um": thickness})
+        traits = auto_tier.traits_from_tables(at, fitting.fit_closures(at), 1.0, 0.0)
+        skin_share[thickness] = min(traits.skin_share.values())
+        for values in (traits.skin_share, traits.gloss_share,
+                       *traits.gloss_omission.values()):
+            assert all(0.0 < v < 1.0 for v in values.values())
+    assert skin_share[2.0] > 0.4 and skin_share[150.0] < 0.12
