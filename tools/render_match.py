@@ -97,10 +97,12 @@ def measure_means(scene, settings, work: Path, tag: str) -> dict:
     return means
 
 
-def blotch_contrast(scene, material, settings, work: Path, tag: str) -> dict:
+def blotch_contrast(scene, material, settings, work: Path, tag: str,
+                    coverages: tuple[float, ...] = (0.0,) + COVERAGES) -> dict:
     """``{coverage: contrast}``: the standard deviation over the head's pixels of the
     luminance of the render divided by the render with the albedo at its mean (the artist's
-    Base Color and the group's Skin Color, the skin under the film, both set to their means)."""
+    Base Color and the group's Skin Color, the skin under the film, both set to their means),
+    at each of ``coverages``."""
     from makeup_skin_addon import artist_skin
 
     tree = material.node_tree
@@ -109,7 +111,7 @@ def blotch_contrast(scene, material, settings, work: Path, tag: str) -> dict:
                (reading.dominant.node.inputs["Base Color"], reading.leaves[0].base)]
     sources = [socket.links[0].from_socket for socket, _ in sockets]
     contrast = {}
-    for coverage in (0.0,) + COVERAGES:
+    for coverage in coverages:
         settings.coverage = coverage
         textured = _render_rgba(scene, work / f"{tag}_tex_{coverage}.exr")
         for socket, mean in sockets:
