@@ -222,7 +222,7 @@ class MakeupSkinSettings(bpy.types.PropertyGroup):
                                                       "150 micrometres, paths 1 + 3 as "
                                                       "published (files made before keep "
                                                       "it)")),
-        default=SLAB_FILM,
+        default=PAPER_FILM,
         description="How the foundation's film is modelled: at a thickness, or the paper's "
                     "free film as published", update=_update_film)
     thickness_um: bpy.props.FloatProperty(

@@ -248,7 +248,7 @@ def test_a_thickness_moves_the_film_live_without_fitting(sphere, monkeypatch):
     from makeup_skin_addon import bakes, groups, live, nodes
     from makeup_skin_addon.core import bake, fitting
 
-    material, _ = apply_pipeline(sphere, "LAYERED", resolution="preview")
+    material, _ = apply_pipeline(sphere, "LAYERED", resolution="preview", film_mode="SLAB")
     settings = material.makeup_skin
     assert settings.film_mode == "SLAB"
     settings.live_update = True

@@ -50,7 +50,7 @@ def test_the_first_apply_matches_the_skin(head):
     material = head.active_material
     settings = material.makeup_skin
     assert settings.shade_source == "DEFAULT" and settings.coverage == pytest.approx(0.6)
-    assert settings.film_mode == "SLAB" and settings.thickness_um == pytest.approx(9.6, abs=0.05)
+    assert settings.film_mode == "PAPER" and settings.thickness_um == pytest.approx(9.6, abs=0.05)
     bpy.context.view_layer.objects.active = head
     settings.resolution = "preview"
     settings.film_mode = "PAPER"
@@ -255,7 +255,7 @@ def test_match_skin_at_a_thickness(sphere):
 
     from makeup_skin_addon import matching, nodes
 
-    material, _ = apply_pipeline(sphere, "LAYERED", skin_colour=FAIR)
+    material, _ = apply_pipeline(sphere, "LAYERED", skin_colour=FAIR, film_mode="SLAB")
     settings = material.makeup_skin
     assert settings.film_mode == "SLAB"
     for thickness in (2.0, 9.6, 50.0):
@@ -298,6 +298,7 @@ def test_rendered_a_fair_skin_is_matched_at_every_thickness(addon, blank_scene, 
     obj.data.materials.append(material)
     artist_skins.uniform_white(blank_scene, obj, size=64, samples=64)
     before = artist_skins.face_mean(_render_rgba(tmp_path, "before"))
+    material.makeup_skin.film_mode = "SLAB"
     assert bpy.ops.makeup_skin.apply() == {"FINISHED"}
     settings = obj.active_material.makeup_skin
     assert settings.film_mode == "SLAB"

@@ -133,7 +133,7 @@ def test_a_file_made_before_the_film_setting_keeps_the_papers_film(sphere, tmp_p
     assert groups.group_of(material).node_tree.name == group_name and not live.pending()
     assert apply.check_material(bpy.context, material)[0]
     assert on_load.upgrade_file() == []
-    assert bpy.data.materials.new("New").makeup_skin.film_mode == "SLAB"
+    assert bpy.data.materials.new("New").makeup_skin.film_mode == "PAPER"  # the default
 
 
 def test_settings_of_an_older_file_are_upgraded(sphere, tmp_path):
