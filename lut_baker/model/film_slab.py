@@ -180,13 +180,26 @@ def face_albedo(film: ReflectionLayer, grid: HemisphereGrid) -> NDArray[np.float
     """``a_g``: the directional albedo of the film's surface gloss (eq. 2's specular term, its
     ``P_d`` left out) at the grid's polar nodes, ``(C, N)`` (C = 1 for a scalar film), computed
     through the half vector for narrow lobes (:func:`~lut_baker.model.albedo.reflection_albedo`);
-    zeros for a film without gloss (``P_s = 0``)."""
+    zeros for a film without gloss (``P_s = 0``).  Computed once per surface and grid (a
+    read-only array: Match Skin and the bake ask for it again and again)."""
     gloss = film.scaled(P_d=0.0)
     channels = 3 if film.channels else 1
-    if not np.any(gloss.P_s > 0.0):
-        return np.zeros((channels, grid.theta.size))
-    values = with_channel_axis(reflection_albedo(np.degrees(grid.theta), gloss), film)
-    return _channels_first(values)
+
+    def compute() -> NDArray[np.float64]:
+        if not np.any(gloss.P_s > 0.0):
+            values = np.zeros((channels, grid.theta.size))
+        else:
+            values = _channels_first(with_channel_axis(
+                reflection_albedo(np.degrees(grid.theta), gloss), film))
+        values.setflags(write=False)
+        return values
+
+    return _FACES.get_or_compute((repr(gloss.as_dict()), channels, *_grid_key(grid)), compute)
+
+
+def _grid_key(grid: HemisphereGrid) -> tuple[bytes, bytes, int]:
+    """What identifies a grid in this module's caches."""
+    return grid.theta.tobytes(), grid.weight.tobytes(), grid.n_phi
 
 
 def face_layer(albedo: ArrayLike, orders: int) -> Layer:
@@ -267,13 +280,13 @@ class FilmSlab:
 
 
 _MEASURED = LRUCache(MEASURED_CACHE_SIZE)
+_FACES = LRUCache(MEASURED_CACHE_SIZE)
 
 
 def _measured(film: ReflectionLayer, transmission: TransmissionLayer, grid: HemisphereGrid
               ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """:func:`measured_body_matrices` and :func:`face_albedo`, computed once per film and grid."""
-    key = (repr(film.as_dict()), repr(transmission.as_dict()), grid.theta.tobytes(),
-           grid.weight.tobytes(), grid.n_phi)
+    key = (repr(film.as_dict()), repr(transmission.as_dict()), *_grid_key(grid))
 
     def compute() -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
         arrays = (*measured_body_matrices(film, transmission, grid), face_albedo(film, grid))
@@ -442,7 +455,7 @@ _SKINS = LRUCache(MEASURED_CACHE_SIZE)
 
 def skin_star(skin: ReflectionLayer, grid: HemisphereGrid) -> NDArray[np.float64]:
     """The skin's eq. 2 kernel in the star form, ``(C, orders, N, N)``, once per skin and grid."""
-    key = (repr(skin.as_dict()), grid.theta.tobytes(), grid.weight.tobytes(), grid.n_phi)
+    key = (repr(skin.as_dict()), *_grid_key(grid))
 
     def compute() -> NDArray[np.float64]:
         kernel = layer_fourier_kernel(skin, grid.theta, grid.theta, grid.n_phi)
