@@ -10,8 +10,8 @@ Usage::
 One process, Cycles CPU, view transform Standard, no denoiser.  For each skin tone of
 tests/support/character.py it builds the textured head with its portrait camera and lights,
 renders ``<tone>_before.png`` (the artist's own material), presses Apply with the film at a
-thickness (every other setting at its default) and sets Covered Area to 1 (the film everywhere: what it hides is its thickness
-alone); then, at each thickness, presses Match Skin (the shade a makeup artist would pick for
+thickness (every other setting at its default) and sets Covered Area to 1 (the film
+everywhere: what it hides is its thickness alone); then, at each thickness, presses Match Skin (the shade a makeup artist would pick for
 that thickness) and renders ``<tone>_<thickness>um.png``.  It composes ``thickness_strip.png``
 (one row per tone: before, then each thickness).
 
