@@ -11,9 +11,10 @@ One process, Cycles CPU, view transform Standard, no denoiser.  For each skin to
 tests/support/character.py it builds the textured head with its portrait camera and lights,
 renders ``<tone>_before.png`` (the artist's own material), presses Apply with the film at a
 thickness (every other setting at its default) and sets Covered Area to 1 (the film
-everywhere: what it hides is its thickness alone); then, at each thickness, presses Match Skin (the shade a makeup artist would pick for
-that thickness) and renders ``<tone>_<thickness>um.png``.  It composes ``thickness_strip.png``
-(one row per tone: before, then each thickness).
+everywhere: what it hides is its thickness alone); then, at each thickness, presses Match
+Skin (the shade a makeup artist would pick for that thickness) and renders
+``<tone>_<thickness>um.png``.  It composes ``thickness_strip.png`` (one row per tone: before,
+then each thickness).
 
 Measured at each thickness under uniform white light (a white world, lamps off) and under the
 portrait lights: the head's mean colour against the artist's render, and the blotches'
