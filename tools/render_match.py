@@ -6,6 +6,7 @@ Usage::
     "$(tools/venv.sh)/bin/python" tools/render_match.py [--out docs/renders/match]
         [--size 200 --samples 64] [--measure-size 96 --measure-samples 128]
         [--tones medium darker lighter] [--no-pictures] [--json FILE]
+        [--film PAPER|SLAB] [--tier AUTO|PRINCIPLED|LAYERED|...]
 
 One process, Cycles CPU, view transform Standard, no denoiser.  For each skin tone of
 tests/support/character.py (``SKIN_TONES``: the head's own, a darker and a lighter skin) it
@@ -154,6 +155,8 @@ def run_tone(tone: str, args, out: Path, work: Path) -> dict:
         _save_png(pictures["before"], scene)
     settings = material.makeup_skin
     settings.live_update = False
+    settings.film_mode = args.film
+    settings.tier = args.tier
     start = time.perf_counter()
     result = bpy.ops.makeup_skin.apply()
     apply_s = time.perf_counter() - start
@@ -229,6 +232,8 @@ def main(argv=None) -> int:
                         choices=list(character.SKIN_TONES))
     parser.add_argument("--no-pictures", dest="pictures", action="store_false")
     parser.add_argument("--json", type=Path)
+    parser.add_argument("--film", default="PAPER", help="the Film setting (PAPER or SLAB)")
+    parser.add_argument("--tier", default="AUTO", help="the Tier setting")
     args = parser.parse_args(argv)
     import tempfile
 
