@@ -114,14 +114,14 @@ class SlabSkinParts(NamedTuple):
     surface, the surface's gloss left out): the part of ``top``'s albedo that is not the skin's
     gloss (the tiers' film body, docs/model.md "The tiers at a thickness")."""
 
-    top: np.ndarray
-    through: np.ndarray
-    below: np.ndarray
-    face: np.ndarray
-    film: np.ndarray | None = None
+    top: NDArray[np.float64]
+    through: NDArray[np.float64]
+    below: NDArray[np.float64]
+    face: NDArray[np.float64]
+    film: NDArray[np.float64] | None = None
 
 
-def _film_layer(film: FilmSlab, thickness: float, face: np.ndarray) -> Layer:
+def _film_layer(film: FilmSlab, thickness: float, face: NDArray[np.float64]) -> Layer:
     """The film on skin (its surface over its body at ``thickness``, paper-film units)."""
     r, t = body(film, thickness)
     return add_layers(face_layer(face, film.orders), Layer(top=r, bottom=r, down=t))
@@ -159,14 +159,14 @@ def slab_skin_parts(film: FilmSlab, thickness: float, skin: ReflectionLayer,
                          film=film_albedo)
 
 
-def _diffuse_weight(parts: SlabSkinParts, skin_albedo: ArrayLike) -> np.ndarray:
+def _diffuse_weight(parts: SlabSkinParts, skin_albedo: ArrayLike) -> NDArray[np.float64]:
     """``a / (1 - a c)`` per channel (``a`` and ``c`` broadcast: one channel or three)."""
     a = np.asarray(skin_albedo, float).reshape(-1)
     return a / (1.0 - a * parts.below)
 
 
 def parts_matrices(parts: SlabSkinParts, skin_albedo: ArrayLike,
-                   grid: HemisphereGrid) -> np.ndarray:
+                   grid: HemisphereGrid) -> NDArray[np.float64]:
     """Made-up skin without the surface's gloss (star form, ``(C, orders, N, N)``):
     ``top + a / (1 - a c) v v^T`` at order 0, ``v = t s / sqrt(pi)``."""
     s0 = star_scale(grid)[0]
@@ -227,9 +227,10 @@ def matching_absorption(target: ArrayLike, film: ReflectionLayer,
     albedo = np.broadcast_to(np.asarray(skin_albedo, float), (3,))
     face = face_albedo(film, grid)
 
-    known: dict[tuple[float, ...], np.ndarray] = {}
+    known: dict[tuple[float, ...], NDArray[np.float64]] = {}
 
-    def colour(a: np.ndarray) -> np.ndarray:  # the ends, asked twice, evaluated once
+    # the ends, asked twice, evaluated once
+    def colour(a: NDArray[np.float64]) -> NDArray[np.float64]:
         key = tuple(np.broadcast_to(np.asarray(a, float), (3,)).tolist())
         if key not in known:
             known[key] = slab_colour(film, transmission, skin, albedo, thickness_um, grid, a,
@@ -260,7 +261,8 @@ def matching_skin_albedo(parts: SlabSkinParts, target: ArrayLike,
 
 def matching_shade(target: ArrayLike, film: ReflectionLayer, transmission: TransmissionLayer,
                    skin: ReflectionLayer, skin_albedo: ArrayLike, thickness_um: float,
-                   grid: HemisphereGrid):
+                   grid: HemisphereGrid) -> tuple[NDArray[np.float64], NDArray[np.float64],
+                                                  NDArray[np.bool_]]:
     """Match Skin at a thickness: ``(A, a, clamped)`` per channel.  The foundation's
     absorption ``A`` first (:func:`matching_absorption`: the shade is the foundation's, the skin
     under the film is the artist's); where even ``A = 1`` leaves the made-up skin lighter than
