@@ -100,11 +100,11 @@ class SlabParts(NamedTuple):
     (``t`` averaged over uniform light, ``2 Int t mu dmu``), ``below`` ``(3,)`` (``c``),
     ``film_albedo`` ``(..., 3)`` (the film's own directional albedo, at the angles asked)."""
 
-    top_albedo: np.ndarray
-    through: np.ndarray
-    through_mean: np.ndarray
-    below: np.ndarray
-    film_albedo: np.ndarray
+    top_albedo: NDArray[np.float64]
+    through: NDArray[np.float64]
+    through_mean: NDArray[np.float64]
+    below: NDArray[np.float64]
+    film_albedo: NDArray[np.float64]
 
 
 @dataclass(frozen=True, eq=False)
@@ -118,16 +118,16 @@ class SlabTables:
     ``top_albedo``, ``through``, ``film_albedo`` (K, n_theta, 3); ``through_mean``, ``below``
     (K, 3)."""
 
-    thickness_um: np.ndarray
-    theta_deg: np.ndarray
-    phi_deg: np.ndarray
-    top: np.ndarray
-    top_albedo: np.ndarray
-    through: np.ndarray
-    through_mean: np.ndarray
-    below: np.ndarray
-    film_albedo: np.ndarray
-    absorption: np.ndarray
+    thickness_um: NDArray[np.float64]
+    theta_deg: NDArray[np.float64]
+    phi_deg: NDArray[np.float64]
+    top: NDArray[np.float64]
+    top_albedo: NDArray[np.float64]
+    through: NDArray[np.float64]
+    through_mean: NDArray[np.float64]
+    below: NDArray[np.float64]
+    film_albedo: NDArray[np.float64]
+    absorption: NDArray[np.float64]
     theta_spacing: str = "grazing"
     theta_offset: float = THETA_OFFSET
     phi_spacing: str = "half_vector"
@@ -156,7 +156,7 @@ class SlabTables:
         return theta_index(theta_deg, self.theta_deg.size, self.theta_spacing,
                            float(self.theta_deg[-1]), self.theta_offset)
 
-    def _along(self, table: np.ndarray, thickness_um: float) -> np.ndarray:
+    def _along(self, table: NDArray[np.float64], thickness_um: float) -> NDArray[np.float64]:
         """``table[k, ...]`` interpolated linearly at one thickness."""
         return _linear(np.asarray(table), np.asarray(self.thickness_index(thickness_um)))
 
