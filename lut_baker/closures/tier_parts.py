@@ -16,9 +16,12 @@ parameters are fitted to the tables, with weights that may depend on the view an
 
 from __future__ import annotations
 
+from collections.abc import Callable, Hashable
 from dataclasses import replace
+from typing import Any, TypeVar
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..numerics.geometry import polar_angle_deg
 from ..numerics.quadrature import trapezoid_weights
@@ -35,7 +38,7 @@ from .lobes import (
     fit_specular,
 )
 from .tier_formulas import SPECULAR_IOR
-from .view_grid import FIT_VIEWS, lobe_widths_deg, view_grid
+from .view_grid import FIT_VIEWS, ViewGrid, lobe_widths_deg, view_grid
 from .view_image import EEVEE_LUT_ROWS, LUT_ROWS, lut_nodes
 
 __all__ = ["FitTargets", "cosine_mean", "principled_parts", "layered_parts", "eevee_parts",
@@ -45,19 +48,21 @@ SLAB_ROWS = ("film_body",)
 """The view-angle rows a tier has beyond its own with the film as a slab: the film body's
 directional albedo (its Diffuse closure's weight)."""
 
+_T = TypeVar("_T")
 
-def cosine_mean(values: np.ndarray, theta_deg: np.ndarray) -> np.ndarray:
+
+def cosine_mean(values: ArrayLike, theta_deg: ArrayLike) -> NDArray[np.float64]:
     """``2 Int v(mu) mu dmu`` of a directional table ``(n_theta[, C])`` (its hemispherical
     cosine-weighted mean), trapezoid in ``mu``, held at its last value beyond ``theta_max``."""
     mu = np.cos(np.radians(np.asarray(theta_deg, float)))[::-1]
-    values = np.asarray(values, float)[::-1]
+    table = np.asarray(values, float)[::-1]
     mu = np.concatenate([[0.0], mu])
-    values = np.concatenate([values[:1], values])
+    table = np.concatenate([table[:1], table])
     w = trapezoid_weights(mu)
-    return 2.0 * np.tensordot(w * mu, values, axes=(0, 0))
+    return 2.0 * np.tensordot(w * mu, table, axes=(0, 0))
 
 
-def _view_mean(albedo_of) -> float:
+def _view_mean(albedo_of: Callable[[NDArray[np.float64]], NDArray[np.float64]]) -> float:
     """``2 Int a(mu) mu dmu``: the cosine-weighted mean over view angles of ``albedo_of(mu)``
     (trapezoid on 33 view cosines)."""
     mu = np.linspace(0.0, 1.0, 33)
@@ -70,7 +75,7 @@ def _coat_layering_mean(roughness: float, ior: float) -> float:
     return _view_mean(lambda mu: cc.coat_view_terms(mu, roughness, ior)[1])
 
 
-def _layering_mean(roughness: float, ior: float, f0=None) -> float:
+def _layering_mean(roughness: float, ior: float, f0: ArrayLike | None = None) -> float:
     """:func:`_view_mean` of :func:`lut_baker.closures.cycles.layering_albedo` (its largest
     channel)."""
     return _view_mean(lambda mu: np.max(
@@ -91,7 +96,8 @@ class FitTargets:
     are the slab's ``t`` and the film's body has rows of its own (``film_body``).
     ``thickness_um``: another thickness than the baked one."""
 
-    def __init__(self, tables: Tables, lut_size: int, thickness_um: float | None = None):
+    def __init__(self, tables: Tables, lut_size: int,
+                 thickness_um: float | None = None) -> None:
         self.tables, self.lut_size = tables, lut_size
         self.theta_deg = np.asarray(tables.theta_deg, float)
         self.slab: SlabTables | None = getattr(tables, "slab", None)
@@ -100,14 +106,14 @@ class FitTargets:
         else:
             self.thickness_um = float(tables.parameters["film_thickness_um"]
                                       if thickness_um is None else thickness_um)
-        self._found: dict = {}
+        self._found: dict[Hashable, Any] = {}
 
-    def _once(self, name, compute):
+    def _once(self, name: Hashable, compute: Callable[[], _T]) -> _T:
         if name not in self._found:
             self._found[name] = compute()
         return self._found[name]
 
-    def grid(self, surface: str):
+    def grid(self, surface: str) -> ViewGrid:
         """The view grid sized by ``surface``'s gloss (``film_gloss`` or ``skin_gloss``)."""
         return self._once(("grid", surface), lambda: view_grid(
             lobe_widths_deg(self.tables)[surface], FIT_VIEWS))
@@ -118,26 +124,27 @@ class FitTargets:
             raise ValueError("these tables hold the paper's film only")
         return self.slab
 
-    def slab_parts(self, theta_deg) -> SlabParts:
+    def slab_parts(self, theta_deg: ArrayLike) -> SlabParts:
         """The slab's 1-D parts at the fit's thickness and polar angles ``theta_deg``."""
         return self.slab_tables().at(self.thickness_um, theta_deg)
 
-    def film_body(self, wi, wo) -> np.ndarray:
+    def film_body(self, wi: NDArray[np.float64],
+                  wo: NDArray[np.float64]) -> NDArray[np.float64]:
         """The film's body as the tiers draw it (class docstring), 1/sr ``(..., 3)``."""
-        def albedo(w):
+        def albedo(w: NDArray[np.float64]) -> NDArray[np.float64]:
             return self.slab_parts(polar_angle_deg(w)).film_albedo
         return albedo(wi) * albedo(wo) / (np.pi * np.maximum(self.film_mean(), 1e-12))
 
-    def film_mean(self) -> np.ndarray:
+    def film_mean(self) -> NDArray[np.float64]:
         """The film body's albedo under uniform light (RGB): ``2 Int alpha mu dmu``."""
         theta = self.slab_tables().theta_deg
         return self._once("film_mean", lambda: cosine_mean(
             self.slab_parts(theta).film_albedo, theta))
 
-    def target(self, name: str):
+    def target(self, name: str) -> tuple[ViewGrid, NDArray[np.float64]]:
         """``(grid, table)`` of a gloss part: ``film_gloss`` on the film's grid,
         ``path3_gloss`` and ``skin_gloss`` on the skin's."""
-        def compute():
+        def compute() -> tuple[ViewGrid, NDArray[np.float64]]:
             if name == "path3_gloss":
                 grid = self.grid("skin_gloss")
                 if self.slab is not None:
@@ -149,7 +156,7 @@ class FitTargets:
             return grid, self.tables.surface_gloss(name, *grid.directions)
         return self._once(("target", name), compute)
 
-    def albedo(self, name: str) -> np.ndarray:
+    def albedo(self, name: str) -> NDArray[np.float64]:
         """A gloss part's directional albedo table ``(n_theta, 3)`` on
         :meth:`albedo_theta`."""
         if name == "path3_gloss" and self.slab is not None:
@@ -157,22 +164,23 @@ class FitTargets:
             return np.maximum(parts.top_albedo - parts.film_albedo, 0.0)
         return np.asarray(getattr(self.tables, name + "_albedo"))
 
-    def albedo_theta(self, name: str) -> np.ndarray:
+    def albedo_theta(self, name: str) -> NDArray[np.float64]:
         """The polar angles (degrees) :meth:`albedo`'s table is on."""
         if name == "path3_gloss" and self.slab is not None:
             return np.asarray(self.slab.theta_deg, float)
         return self.theta_deg
 
-    def texel_rows(self, theta_deg, values) -> np.ndarray:
+    def texel_rows(self, theta_deg: NDArray[np.float64],
+                   values: NDArray[np.float64]) -> NDArray[np.float64]:
         """A directional table ``(n_theta, 3)`` on ``theta_deg`` at the image's texels."""
         mu = lut_nodes(self.lut_size)
         return np.stack([np.interp(np.degrees(np.arccos(mu)), theta_deg, values[:, c])
                          for c in range(3)], -1)
 
-    def transmittance_rows(self) -> np.ndarray:
+    def transmittance_rows(self) -> NDArray[np.float64]:
         """The film's transmittance at the view-angle image's texels, ``(size, 3)`` (the
         slab's ``t`` at its thickness)."""
-        def compute():
+        def compute() -> NDArray[np.float64]:
             if self.slab is not None:
                 theta = np.asarray(self.slab.theta_deg, float)
                 return self.texel_rows(theta, self.slab_parts(theta).through)
@@ -180,9 +188,9 @@ class FitTargets:
                                                          float))
         return self._once("transmittance_rows", compute)
 
-    def body_rows(self) -> np.ndarray:
+    def body_rows(self) -> NDArray[np.float64]:
         """The film body's directional albedo at the texels, ``(size, 3)`` (slab only)."""
-        def compute():
+        def compute() -> NDArray[np.float64]:
             theta = np.asarray(self.slab_tables().theta_deg, dtype=np.float64)
             return self.texel_rows(theta, self.slab_parts(theta).film_albedo)
         return self._once("body_rows", compute)
@@ -194,7 +202,7 @@ def _left_out_glossy(size: int) -> LobeFit:
     return LobeFit(roughness=ROUGHNESS_RANGE[1], error=1.0, lut=np.zeros((size, 3)))
 
 
-def principled_parts(targets: FitTargets, over_shader: bool) -> dict:
+def principled_parts(targets: FitTargets, over_shader: bool) -> dict[str, Any]:
     """The PRINCIPLED tier's parts of a :class:`ClosureFit`: the coat, the two speculars (over
     the artist's shader the bare one left out: level 0) and their mean layering albedos."""
     film_grid, film_gloss = targets.target("film_gloss")
@@ -217,9 +225,11 @@ def principled_parts(targets: FitTargets, over_shader: bool) -> dict:
         elif specular_bare.level == 0.0:
             specular_bare = replace(specular_bare, roughness=specular_film.roughness)
 
-    def specular_mean(lobe):
+    def specular_mean(lobe: LobeFit) -> float:
         if lobe.level == 0.0:
             return 0.0
+        if lobe.level is None:
+            raise AssertionError("fit_specular gives a level")
         f0 = float(cc.f0_from_ior(SPECULAR_IOR)) * 2.0 * lobe.level
         return _layering_mean(lobe.roughness, float(cc.ior_from_f0(f0)), f0)
 
@@ -235,13 +245,14 @@ def principled_parts(targets: FitTargets, over_shader: bool) -> dict:
     }
 
 
-def image_rows(rows: tuple, slab: bool) -> tuple:
+def image_rows(rows: tuple[str, ...], slab: bool) -> tuple[str, ...]:
     """A tier's view-angle image rows: ``rows``, and with the film as a slab the film body's
     (``film_body``)."""
     return rows + (SLAB_ROWS if slab else ())
 
 
-def _image(targets: FitTargets, lobes: dict, rows: tuple) -> np.ndarray:
+def _image(targets: FitTargets, lobes: dict[str, LobeFit],
+           rows: tuple[str, ...]) -> NDArray[np.float64]:
     """The view-angle image of ``lobes``, rows named ``rows`` (:func:`image_rows`)."""
     found = {**{name: lobes[name].lut for name in lobes},
              "film_transmittance": targets.transmittance_rows(),
@@ -249,12 +260,13 @@ def _image(targets: FitTargets, lobes: dict, rows: tuple) -> np.ndarray:
     rows = image_rows(rows, targets.slab is not None)
     if targets.slab is not None:
         found["film_body"] = targets.body_rows()
-    if any(found.get(name) is None for name in rows):
+    stack = [row for name in rows if (row := found.get(name)) is not None]
+    if len(stack) != len(rows):
         raise AssertionError("the lobes give every view-angle row")
-    return np.stack([found[name] for name in rows])
+    return np.stack(stack)
 
 
-def _glossy(targets: FitTargets, name: str, closures: tuple) -> LobeFit:
+def _glossy(targets: FitTargets, name: str, closures: tuple[str, ...]) -> LobeFit:
     """:func:`fit_glossy` of one gloss part (the film's with its Lambertian companion)."""
     grid, table = targets.target(name)
     return fit_glossy(grid, table, targets.albedo(name), targets.albedo_theta(name),
@@ -262,21 +274,21 @@ def _glossy(targets: FitTargets, name: str, closures: tuple) -> LobeFit:
                       companion=name == "film_gloss", closures=closures)
 
 
-def _view_weighted_lobes(targets: FitTargets, names: tuple, closures: tuple,
-                         over_shader: bool) -> dict:
+def _view_weighted_lobes(targets: FitTargets, names: tuple[str, ...],
+                         closures: tuple[str, ...], over_shader: bool) -> dict[str, LobeFit]:
     """Glossy lobes of ``names`` (over the artist's shader ``skin_gloss`` left out)."""
     return {name: (_left_out_glossy(targets.lut_size) if over_shader and name == "skin_gloss"
                    else _glossy(targets, name, closures)) for name in names}
 
 
-def layered_parts(targets: FitTargets, over_shader: bool) -> dict:
+def layered_parts(targets: FitTargets, over_shader: bool) -> dict[str, Any]:
     """The LAYERED tier's parts: Cycles' Glossy lobes and their view-angle image."""
     glossy = _view_weighted_lobes(targets, ("film_gloss", "path3_gloss", "skin_gloss"),
                                   cc.GLOSSY_DISTRIBUTIONS, over_shader)
     return {"glossy": glossy, "lut": _image(targets, glossy, LUT_ROWS)}
 
 
-def eevee_parts(targets: FitTargets, over_shader: bool) -> dict:
+def eevee_parts(targets: FitTargets, over_shader: bool) -> dict[str, Any]:
     """The EEVEE tier's parts: EEVEE's GGX lobes (the film's gloss two of them and the
     companion, :func:`fit_glossy_pair`) and their view-angle image."""
     film_grid, film_gloss = targets.target("film_gloss")
