@@ -86,7 +86,7 @@ class NumpyAlgebra:
     leading shape, broadcast), rows read at ``cos_view`` (``(...,)``) from ``rows`` (name ->
     ``(size, 3)``) as Blender's Image Texture samples them."""
 
-    def __init__(self, rows: dict[str, Any] | None = None, cos_view: Any = None):
+    def __init__(self, rows: dict[str, Any] | None = None, cos_view: Any = None) -> None:
         self._rows = rows or {}
         self._cos = None if cos_view is None else np.asarray(cos_view, float)
 
