@@ -52,7 +52,7 @@ class TierError:
 
     tier: str
     coverage: float
-    absorption: tuple
+    absorption: tuple[float, ...]
     rms: float
     albedo: float
 
