@@ -5,10 +5,13 @@ made by :func:`lut_baker.closures.fitting.fit_closures`."""
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field
+from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from .lobes import LobeFit
+from .profiles import ProfileFit
 from .tier_registry import TIERS, tier
 
 __all__ = ["TIERS", "ClosureFit", "SlabFit"]
@@ -26,8 +29,8 @@ class SlabFit:
     docs/model.md "Made-up skin at a thickness")."""
 
     thickness_um: float
-    below: np.ndarray
-    skin_under: np.ndarray | None = None
+    below: NDArray[np.float64]
+    skin_under: NDArray[np.float64] | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -60,40 +63,40 @@ class ClosureFit:
     bare skin from the tables (:func:`lut_baker.closures.tiers.tier_reflection`).
     """
 
-    transmittance_mean: np.ndarray
-    film_albedo: np.ndarray
-    skin_albedo: np.ndarray
-    profiles: dict
+    transmittance_mean: NDArray[np.float64]
+    film_albedo: NDArray[np.float64]
+    skin_albedo: NDArray[np.float64]
+    profiles: dict[str, ProfileFit]
     subsurface_method: str
     subsurface_ior: float
     coat: LobeFit | None = None
     specular_bare: LobeFit | None = None
     specular_film: LobeFit | None = None
     coat_albedo_mean: float | None = None
-    specular_albedo_mean: tuple | None = None
-    gloss_to_diffuse: np.ndarray | None = None
-    glossy: dict | None = None
-    lut: np.ndarray | None = None
-    eevee_glossy: dict | None = None
-    eevee_lut: np.ndarray | None = None
-    errors: dict = field(default_factory=dict)
-    extra: dict = field(default_factory=dict)
+    specular_albedo_mean: tuple[float, float] | None = None
+    gloss_to_diffuse: NDArray[np.float64] | None = None
+    glossy: dict[str, LobeFit] | None = None
+    lut: NDArray[np.float64] | None = None
+    eevee_glossy: dict[str, LobeFit] | None = None
+    eevee_lut: NDArray[np.float64] | None = None
+    errors: dict[str, Any] = field(default_factory=dict)  # TierError by tier
+    extra: dict[str, Any] = field(default_factory=dict)
     slab: SlabFit | None = None
 
     @property
-    def tiers(self) -> tuple:
+    def tiers(self) -> tuple[str, ...]:
         """The tiers this fit holds the parts of, in :data:`TIERS` order."""
         return tuple(name for name in TIERS if tier(name).holds(self))
 
     @property
-    def subsurface_radius_mm(self) -> np.ndarray:
+    def subsurface_radius_mm(self) -> NDArray[np.float64]:
         """The chosen method's Subsurface Radius x Scale per channel, mm."""
         return self.profiles[self.subsurface_method].radius_mm
 
-    def summary(self) -> dict:
+    def summary(self) -> dict[str, Any]:
         """Plain data (floats and lists) for metadata, the panel and the docs: the fitted
         tiers' parts only."""
-        out: dict = {}
+        out: dict[str, Any] = {}
         if self.coat is not None:
             out["coat"] = {"roughness": self.coat.roughness, "ior": self.coat.ior,
                            "level": self.coat.level, "error": self.coat.error}
