@@ -28,6 +28,7 @@ from dataclasses import replace
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from ..tables.table_set import Tables
 from . import cycles as cc
@@ -41,7 +42,7 @@ from .view_image import DEFAULT_LUT_SIZE
 __all__ = ["fit_closures", "subsurface_ior", "at_thickness"]
 
 
-def subsurface_ior(parameters: dict) -> float:
+def subsurface_ior(parameters: dict[str, Any]) -> float:
     """The skin dipole's relative index (the Subsurface IOR) from tables' ``parameters``;
     1.4 (Blender's default) if they do not say.  Clamped to Cycles' [1.01, 3.8]."""
     dipole = parameters.get("dipole", {}) if isinstance(parameters, dict) else {}
@@ -51,7 +52,7 @@ def subsurface_ior(parameters: dict) -> float:
 
 
 
-def _subsurface(tables: Tables, method: str | None, over_shader: bool) -> dict:
+def _subsurface(tables: Tables, method: str | None, over_shader: bool) -> dict[str, Any]:
     """The subsurface parts of a fit: the profiles and the method (``method`` forced, else the
     one whose edge response, fitted error and replica error combined, is closest to the
     tables'), the Subsurface IOR.  Over the artist's shader with a forced method no profile is
@@ -67,7 +68,7 @@ def _subsurface(tables: Tables, method: str | None, over_shader: bool) -> dict:
     return {"profiles": profiles, "subsurface_method": method, "subsurface_ior": ior}
 
 
-def _film_parts(targets: FitTargets) -> dict:
+def _film_parts(targets: FitTargets) -> dict[str, Any]:
     """What every tier shares of the film: its mean transmittance and diffuse albedo (the
     paper's film: ``T_mean`` and ``pi P_d``; the film as a slab at the fit's thickness: ``t``
     averaged over uniform light, the film body's albedo under uniform light and the
@@ -92,7 +93,7 @@ def _checked_tiers(tiers: Iterable[str]) -> tuple[Tier, ...]:
     return tuple(tier(name) for name in TIERS if name in names)
 
 
-def _merged(parts: dict, more: dict) -> dict:
+def _merged(parts: dict[str, Any], more: dict[str, Any]) -> dict[str, Any]:
     """``parts`` updated with a tier's ``more``; the registered tiers' ``extra`` parts merged
     by tier."""
     extra = {**parts.get("extra", {}), **more.get("extra", {})}
@@ -122,7 +123,7 @@ def fit_closures(tables: Tables, *, tiers: Iterable[str] | None = None,
     asked = _checked_tiers(TIERS if tiers is None else tiers)
     wanted = asked if onto is None else tuple(t for t in asked if t.name not in onto.tiers)
     targets = FitTargets(tables, lut_size)
-    parts: dict = {}
+    parts: dict[str, Any] = {}
     total = sum(t.fit_share for t in wanted) or 1.0
     done = 0.0
     for each in wanted:
@@ -153,7 +154,8 @@ def fit_closures(tables: Tables, *, tiers: Iterable[str] | None = None,
 
 
 
-def _scaled_row(row: np.ndarray, old: np.ndarray, new: np.ndarray) -> np.ndarray:
+def _scaled_row(row: NDArray[np.float64], old: NDArray[np.float64],
+                new: NDArray[np.float64]) -> NDArray[np.float64]:
     """A Glossy lobe's weight row whose target albedo goes from ``old`` to ``new`` (both at
     the texels, ``(size, 3)``): scaled texel by texel (the lobe's own albedo is unchanged);
     0 where the old albedo was."""
