@@ -14,6 +14,8 @@ tier's choice, the skin's sampling):
   two_principled, mix_glossy, dark_value, pale_value; Cycles, a uniform white world, 128 px,
   64 samples), and ``defaults/sphere``: the sphere of tests/support/sphere_scene.py without a
   material (Apply makes one with the skin preset);
+- ``slab/KIND``, ``slab/sphere``: the same with the film at a thickness (Film: At a Thickness,
+  9.6 um) instead of the default, the paper's film;
 - ``OBJECT/FOUNDATION``: a foundation preset chosen in the panel before Apply (its own shade),
   on the sphere (a new material: the skin preset's made-up skin) and on the ``principled``
   head (over the artist's shader);
@@ -32,13 +34,13 @@ setting the worker off; ``poll``: each look at it, every :data:`POLL_S` s as the
 does; ``swap``: the look that builds the group and installs it), the longest being the worst
 block.
 
-With ``--live`` (default on) the ``full`` process of ``defaults/sphere`` and of
-``defaults/principled`` then moves the Thickness (2, 50, 9.6 um, where the film is at a
-thickness), picks every foundation in turn and sets each roughness to each
-end (Live Update on), each change measured like the refine: ``update`` (the property's
-assignment and its callbacks), ``start``, ``poll``, ``swap``, the worker's CPU and wall.  A
-checkout without the worker thread blocks for the whole rebuild in ``live.flush()`` (what
-its debounce timer ran): that is its ``flush`` step.
+With ``--live`` (default on) the ``full`` process of ``defaults/sphere``,
+``defaults/principled``, ``slab/sphere`` and ``slab/principled`` then moves the Thickness (2,
+50, 9.6 um, where the film is at a thickness), picks every foundation in turn and sets each
+roughness to each end (Live Update on), each change measured like the refine: ``update``
+(the property's assignment and its callbacks), ``start``, ``poll``, ``swap``, the worker's
+CPU and wall.  A checkout without the worker thread blocks for the whole rebuild in
+``live.flush()`` (what its debounce timer ran): that is its ``flush`` step.
 
 Every figure also times 3 (``x3``): a machine three times slower.  The measured processes run
 with one BLAS thread (``--blas-threads``): numpy's OpenBLAS threads spin between the bake's
@@ -98,6 +100,7 @@ def _foundations() -> list[str]:
 def cases(foundations) -> list[str]:
     """Every case name (module docstring)."""
     out = [f"defaults/{kind}" for kind in KINDS] + ["defaults/sphere"]
+    out += [f"slab/{kind}" for kind in KINDS] + ["slab/sphere"]
     for obj in ("sphere", "principled"):
         out += [f"{obj}/{name}" for name in foundations]
         out += [f"{obj}/{end}" for end in ROUGHNESS_ENDS
@@ -115,6 +118,9 @@ def _roughness(settings, end: str) -> tuple[str, float]:
 def _scene(bpy, artist_skins, sphere_scene, case: str):
     """The object of ``case`` in a fresh file, its settings set; returns it."""
     obj_name, what = case.split("/")
+    at_thickness = obj_name == "slab"
+    if at_thickness:
+        obj_name = "defaults"
     if obj_name == "sphere" or what == "sphere":
         obj = sphere_scene.build_scene(size=128, samples=64)
         if what != "sphere":  # a setting chosen before Apply needs a material to hold it
@@ -126,6 +132,10 @@ def _scene(bpy, artist_skins, sphere_scene, case: str):
     for other in bpy.context.view_layer.objects:
         other.select_set(other == obj)
     bpy.context.view_layer.objects.active = obj
+    if at_thickness:
+        if obj.active_material is None:  # the setting needs a material to hold it
+            obj.data.materials.append(bpy.data.materials.new("Skin"))
+        obj.active_material.makeup_skin.film_mode = "SLAB"
     if obj_name != "defaults":
         settings = obj.active_material.makeup_skin
         if what in ROUGHNESS_ENDS:
@@ -245,7 +255,7 @@ def worker(bpy, support, case: str, mode: str, with_live: bool) -> dict:
     return out
 
 
-LIVE_CASES = ("defaults/sphere", "defaults/principled")
+LIVE_CASES = ("defaults/sphere", "defaults/principled", "slab/sphere", "slab/principled")
 
 
 BLAS_VARIABLES = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
