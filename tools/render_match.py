@@ -52,7 +52,8 @@ for _path in (REPO_ROOT, REPO_ROOT / "tests"):
 
 from support import artist_skins, character, sphere_scene  # noqa: E402  (tests/support/)
 
-__all__ = ["main", "measure_means", "blotch_contrast", "uniform_light", "COVERAGES"]
+__all__ = ["main", "measure_means", "blotch_contrast", "uniform_light", "head_arguments",
+           "measure_tones", "COVERAGES"]
 
 COVERAGES = (0.3, 0.6, 1.0)
 GROUP_NODE = "Made-up Skin"
@@ -221,33 +222,43 @@ def first_apply_row(out: Path, tones) -> list[Path]:
     return [out / f"{tone}_{kind}.png" for tone in tones for kind in ("before", "0.6_pores")]
 
 
-def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--out", type=Path, default=REPO_ROOT / "docs" / "renders" / "match")
-    parser.add_argument("--size", type=int, default=200)
-    parser.add_argument("--samples", type=int, default=64)
-    parser.add_argument("--measure-size", type=int, default=96)
-    parser.add_argument("--measure-samples", type=int, default=128)
+def head_arguments(doc: str, out: str, size: int, samples: int, measure_size: int,
+                   measure_samples: int) -> argparse.ArgumentParser:
+    """The options every script rendering the textured head's skin tones takes, with its
+    defaults: ``--out`` (``docs/renders/<out>``), the pictures' and the measurements' size and
+    samples, ``--tones``, ``--json``."""
+    parser = argparse.ArgumentParser(description=doc.split("\n\n")[0])
+    parser.add_argument("--out", type=Path, default=REPO_ROOT / "docs" / "renders" / out)
+    parser.add_argument("--size", type=int, default=size)
+    parser.add_argument("--samples", type=int, default=samples)
+    parser.add_argument("--measure-size", type=int, default=measure_size)
+    parser.add_argument("--measure-samples", type=int, default=measure_samples)
     parser.add_argument("--tones", nargs="+", default=list(character.SKIN_TONES),
                         choices=list(character.SKIN_TONES))
-    parser.add_argument("--no-pictures", dest="pictures", action="store_false")
     parser.add_argument("--json", type=Path)
-    parser.add_argument("--film", default="PAPER", help="the Film setting (PAPER or SLAB)")
-    parser.add_argument("--tier", default="AUTO", help="the Tier setting")
-    args = parser.parse_args(argv)
+    return parser
+
+
+def measure_tones(run_tone, args) -> list[dict]:
+    """``run_tone(tone, args, out, work)`` for each of ``args.tones`` (``args.out`` made),
+    the add-on registered and a temporary folder ``work`` for the measurements' renders."""
     import tempfile
 
     import bpy  # noqa: F401  (Blender as a module)
 
-    import makeup_skin_addon
-
     args.out.mkdir(parents=True, exist_ok=True)
-    results = []
-    makeup_skin_addon.register()
+    with sphere_scene.addon_registered(), tempfile.TemporaryDirectory() as work:
+        return [run_tone(tone, args, args.out, Path(work)) for tone in args.tones]
+
+
+def main(argv=None) -> int:
+    parser = head_arguments(__doc__, "match", 200, 64, 96, 128)
+    parser.add_argument("--no-pictures", dest="pictures", action="store_false")
+    parser.add_argument("--film", default="PAPER", help="the Film setting (PAPER or SLAB)")
+    parser.add_argument("--tier", default="AUTO", help="the Tier setting")
+    args = parser.parse_args(argv)
     try:
-        with tempfile.TemporaryDirectory() as work:
-            for tone in args.tones:
-                results.append(run_tone(tone, args, args.out, Path(work)))
+        results = measure_tones(run_tone, args)
         if args.pictures:
             rows = []
             for figures in results:
@@ -260,8 +271,6 @@ def main(argv=None) -> int:
     except Exception:  # noqa: BLE001  (a tool: say what failed and exit non-zero)
         traceback.print_exc()
         return 1
-    finally:
-        makeup_skin_addon.unregister()
     table = _table(results)
     print(table)
     path = args.json or args.out / "match.json"

@@ -26,10 +26,8 @@ contrast (the luminance of the render over that of the same head with its albedo
 
 from __future__ import annotations
 
-import argparse
 import json
 import sys
-import tempfile
 import traceback
 from pathlib import Path
 
@@ -132,36 +130,17 @@ def _table(results, thicknesses) -> str:
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--out", type=Path, default=REPO_ROOT / "docs" / "renders" / "thickness")
-    parser.add_argument("--size", type=int, default=160)
-    parser.add_argument("--samples", type=int, default=48)
-    parser.add_argument("--measure-size", type=int, default=80)
-    parser.add_argument("--measure-samples", type=int, default=96)
-    parser.add_argument("--tones", nargs="+", default=list(character.SKIN_TONES),
-                        choices=list(character.SKIN_TONES))
+    parser = render_match.head_arguments(__doc__, "thickness", 160, 48, 80, 96)
     parser.add_argument("--thicknesses", nargs="+", type=float, default=list(THICKNESSES_UM))
-    parser.add_argument("--json", type=Path)
     args = parser.parse_args(argv)
-    import bpy  # noqa: F401  (Blender as a module)
-
-    import makeup_skin_addon
-
-    args.out.mkdir(parents=True, exist_ok=True)
-    results = []
-    makeup_skin_addon.register()
     try:
-        with tempfile.TemporaryDirectory() as work:
-            for tone in args.tones:
-                results.append(run_tone(tone, args, args.out, Path(work)))
+        results = render_match.measure_tones(run_tone, args)
         rows = [[Path(f["pictures"]["before"])] + [Path(f["pictures"][f"{t:g}"])
                                                    for t in args.thicknesses] for f in results]
         render_match._strip(rows, args.out / "thickness_strip.png")
     except Exception:  # noqa: BLE001  (a tool: say what failed and exit non-zero)
         traceback.print_exc()
         return 1
-    finally:
-        makeup_skin_addon.unregister()
     print(_table(results, args.thicknesses))
     path = args.json or args.out / "thickness.json"
     path.write_text(json.dumps(results, indent=1, default=str) + "\n")
