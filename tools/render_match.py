@@ -53,7 +53,7 @@ for _path in (REPO_ROOT, REPO_ROOT / "tests"):
 from support import artist_skins, character, sphere_scene  # noqa: E402  (tests/support/)
 
 __all__ = ["main", "measure_means", "blotch_contrast", "uniform_light", "head_arguments",
-           "measure_tones", "COVERAGES"]
+           "head_scene", "measure_tones", "COVERAGES"]
 
 COVERAGES = (0.3, 0.6, 1.0)
 GROUP_NODE = "Made-up Skin"
@@ -141,15 +141,23 @@ def _strip(rows, out_path: Path) -> None:
         [[sphere_scene.image_pixels(p) for p in row] for row in rows], GAP_PX), out_path)
 
 
-def run_tone(tone: str, args, out: Path, work: Path) -> dict:
-    """Build the head of one tone, render and measure it (see the module docstring)."""
+def head_scene(tone: str, args):
+    """``(scene, material)``: a fresh file holding the textured head of ``tone`` with its
+    portrait camera and lights, rendering ``args.size`` px at ``args.samples``."""
     import bpy
 
     bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
     scene = bpy.context.scene
     obj = character.build_character("Head", tone=tone)
     character.portrait_camera_and_lights(scene, obj, size=args.size, samples=args.samples)
-    material = obj.active_material
+    return scene, obj.active_material
+
+
+def run_tone(tone: str, args, out: Path, work: Path) -> dict:
+    """Build the head of one tone, render and measure it (see the module docstring)."""
+    import bpy
+
+    scene, material = head_scene(tone, args)
     pictures = {}
     if args.pictures:
         pictures["before"] = out / f"{tone}_before.png"

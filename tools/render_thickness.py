@@ -39,7 +39,7 @@ for _path in (REPO_ROOT, REPO_ROOT / "tests", REPO_ROOT / "tools"):
         sys.path.insert(0, str(_path))
 
 import render_match  # noqa: E402  (tools/render_match.py)
-from support import artist_skins, character  # noqa: E402  (tests/support/)
+from support import artist_skins  # noqa: E402  (tests/support/)
 
 __all__ = ["main", "THICKNESSES_UM"]
 
@@ -62,11 +62,7 @@ def run_tone(tone: str, args, out: Path, work: Path) -> dict:
 
     from makeup_skin_addon import live
 
-    bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
-    scene = bpy.context.scene
-    obj = character.build_character("Head", tone=tone)
-    character.portrait_camera_and_lights(scene, obj, size=args.size, samples=args.samples)
-    material = obj.active_material
+    scene, material = render_match.head_scene(tone, args)
     before = out / f"{tone}_before.png"
     scene.render.film_transparent = False
     render_match._save_png(before, scene)
