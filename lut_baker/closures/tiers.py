@@ -30,7 +30,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..model.made_up_skin import combine, coverage_weights
 from ..tables.slab_tables import slab_reflection
-from ..tables.table_set import Tables
+from ..tables.table_set import ReflectionParts, Tables
 from . import cycles as cc
 from .closure_fit import ClosureFit
 from .lobes import LobeFit
@@ -195,10 +195,17 @@ def tier_errors(fit: ClosureFit, tables: Tables, coverage: float, absorption: Ar
         return {}
     grid = view_grid(min(lobe_widths_deg(tables).values()), ERROR_VIEWS)
     directions = grid.directions
-    looked_up = tables.reflection_parts(*directions)  # one lookup for both coverages
-    reference = (tables.mixed_reflection(looked_up, coverage, absorption) if fit.slab is None
-                 else reference_reflection(fit, tables, coverage, absorption, directions))
-    bare = tables.mixed_reflection(looked_up, 0.0, absorption) if over_shader else None
+    # The tables looked up once for both coverages, and only where they are read: a fit of
+    # the film as a slab takes its reference from the slab, the bare skin from the tables.
+    looked_up: ReflectionParts | None
+    if fit.slab is None:
+        looked_up = tables.reflection_parts(*directions)
+        reference = tables.mixed_reflection(looked_up, coverage, absorption)
+    else:
+        reference = reference_reflection(fit, tables, coverage, absorption, directions)
+        looked_up = tables.reflection_parts(*directions) if over_shader else None
+    bare = (tables.mixed_reflection(looked_up, 0.0, absorption)
+            if over_shader and looked_up is not None else None)
     out = {}
     for name in TIERS:
         if name not in tiers:
