@@ -220,7 +220,7 @@ def matching_absorption(target: ArrayLike, film: ReflectionLayer,
     """``(A, clamped)`` per channel: the foundation's absorption whose made-up skin at
     ``thickness_um`` has the colour ``target`` (RGB, under uniform light) on the skin under the
     film (``skin``'s gloss, diffuse albedo ``skin_albedo``); :func:`slab_colour` falls as
-    ``A`` grows, and false position finds the root (:func:`~lut_baker.model.film_slab.
+    ``A`` grows, and a bracketed root finds it (:func:`~lut_baker.model.film_slab.
     increasing_root`).  A target out of the film's reach gets ``A = 0`` (too light) or 1 (too
     dark) and ``clamped``."""
     goal = np.broadcast_to(np.asarray(target, float), (3,))
