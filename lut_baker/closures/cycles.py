@@ -19,7 +19,8 @@ Functions
   :func:`microfacet_from_cosines` -- the Fresnel-free lobe from the four cosines it needs.
 - :func:`dielectric_fresnel`, :func:`schlick_ior_fresnel` -- the Fresnel terms Cycles uses.
 - :func:`directional_albedo` -- ``Int f cos(theta_i) dwi`` of any BRDF at view angles.
-- :func:`microfacet_albedo` -- the same for a microfacet lobe, by quadrature over normals.
+- :func:`microfacet_albedo` -- the same for a microfacet lobe, by quadrature over normals (views
+  in chunks of :data:`ALBEDO_CHUNK` nodes).
 - :func:`layering_albedo` -- Cycles' albedo estimate that attenuates the layers below a coat or
   a specular layer (``bsdf_microfacet_estimate_albedo``).
 - :func:`dielectric_fss`, :func:`ggx_energy_compensation` (:func:`ggx_energy_scale` from
@@ -76,6 +77,7 @@ __all__ = [
     "schlick_ior_fresnel",
     "directional_albedo",
     "microfacet_albedo",
+    "ALBEDO_CHUNK",
     "layering_albedo",
     "lambert_reflection",
     "view_table",
@@ -326,6 +328,26 @@ def microfacet_albedo(cos_view: ArrayLike, roughness: float, fresnel: OfCosine |
     the albedo is the mean of ``cos_i / max(cos_i, cos_o)``.
     """
     views = np.asarray(cos_view, float)
+    flat = views.ravel()
+    step = max(ALBEDO_CHUNK // (n_u * n_phi), 1)
+    parts = [_albedo_views(flat[k:k + step], roughness, fresnel, distribution, n_u, n_phi)
+             for k in range(0, flat.size, step)] or [
+        _albedo_views(flat, roughness, fresnel, distribution, n_u, n_phi)]
+    total = np.concatenate(parts, axis=0)
+    return total.reshape(views.shape + total.shape[1:])
+
+
+ALBEDO_CHUNK = 65536
+"""Quadrature nodes :func:`microfacet_albedo` works on at once: the views in chunks of about
+this many nodes, so that its arrays stay in the processor's cache (a Glossy lobe's final
+albedo at 64 texels, 393 216 nodes: 14 -> 5 ms); each view's sum is the same to the last bit
+whatever the chunk."""
+
+
+def _albedo_views(views: NDArray[np.float64], roughness: float, fresnel: OfCosine | None,
+                  distribution: str, n_u: int, n_phi: int) -> NDArray[np.float64]:
+    """:func:`microfacet_albedo` at 1-D ``views``: ``(V,)``, or ``(V, C)`` for an RGB
+    ``fresnel``."""
     alpha = np.square(max(float(roughness), ROUGHNESS_EPS))
     u, w_u = gauss_legendre(n_u)
     if distribution == "GGX":
@@ -341,7 +363,7 @@ def microfacet_albedo(cos_view: ArrayLike, roughness: float, fresnel: OfCosine |
     cos_h = 1.0 / np.sqrt(1.0 + tan2)
     sin_h = np.sqrt(tan2) * cos_h
     phi = midpoint_nodes(n_phi, 0.0, np.pi)
-    mu_o = np.clip(views.ravel(), 1e-6, 1.0)[:, None, None]
+    mu_o = np.clip(views, 1e-6, 1.0)[:, None, None]
     sin_o = np.sqrt(1.0 - mu_o * mu_o)
     hx = sin_h[None, :, None] * np.cos(phi)[None, None, :]
     hz = cos_h[None, :, None]
@@ -357,13 +379,11 @@ def microfacet_albedo(cos_view: ArrayLike, roughness: float, fresnel: OfCosine |
         value = np.where(valid, g2, 0.0)
     weights = w_u[None, :, None] / n_phi
     if fresnel is None:
-        total = np.sum(value * weights, axis=(1, 2))
-        return total.reshape(views.shape)
+        return np.sum(value * weights, axis=(1, 2))
     f = np.asarray(fresnel(np.clip(h_dot_o, 0.0, 1.0)))
     if f.ndim > value.ndim:
-        total = np.einsum("vup,vupc->vc", value * weights, f)
-        return total.reshape(views.shape + (f.shape[-1],))
-    return np.sum(value * weights * f, axis=(1, 2)).reshape(views.shape)
+        return np.einsum("vup,vupc->vc", value * weights, f)
+    return np.sum(value * weights * f, axis=(1, 2))
 
 
 def layering_albedo(cos_view: ArrayLike, roughness: float, eta: float,
