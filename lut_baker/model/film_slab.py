@@ -344,6 +344,8 @@ def increasing_root(function: Callable[[NDArray[np.float64]], NDArray[np.float64
     with np.errstate(divide="ignore", invalid="ignore"):
         t = np.where(done, 0.5, f_a / (f_a - f_b))  # false position
         for _ in range(steps):
+            if np.all(done):  # every target out of reach (or met): no step to take
+                break
             least = np.minimum(0.5 * ROOT_TOLERANCE / np.abs(b - a), 0.5)
             x = a + np.clip(np.where(np.isfinite(t), t, 0.5), least, 1.0 - least) * (b - a)
             f_x = function(x) - target
@@ -357,8 +359,6 @@ def increasing_root(function: Callable[[NDArray[np.float64]], NDArray[np.float64
             best = np.where(closer, a, b)
             done = done | (np.minimum(np.abs(f_a), np.abs(f_b)) <= ROOT_TOLERANCE) \
                 | (np.abs(b - a) <= ROOT_TOLERANCE)
-            if np.all(done):
-                break
             xi, phi = (a - b) / (c - b), (f_a - f_b) / (f_c - f_b)
             quadratic = (phi**2 < xi) & ((1.0 - phi)**2 < 1.0 - xi)
             t = np.where(quadratic, f_a / (f_b - f_a) * f_c / (f_b - f_c)
