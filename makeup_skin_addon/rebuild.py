@@ -51,7 +51,8 @@ class Rebuild:
         if work is None:
             record = bakes.bake_record(skin_model.skin_from_settings(self.skin),
                                        self.resolution, skin_model.film_of(self.skin),
-                                       skin_model.skin_under_of(self.skin))
+                                       skin_model.skin_under_of(self.skin),
+                                       skin_model.skin_albedo_of(self.skin))
             work = self.work = Bake(record, **self.bake)
         before = work.progress
         work.progress = self.progress if check is None else Checked(check)

@@ -9,6 +9,8 @@ parameters are fitted to the tables, with weights that may depend on the view an
 - :class:`FitTargets` -- what the lobes of one set of tables are fitted to, computed once.
 - :func:`cosine_mean` -- a directional table's mean under uniform light.
 - :func:`principled_parts` -- one Principled BSDF's coat and speculars.
+- :func:`held_gloss_to_diffuse` -- with the film as a slab, what its base colour carries so
+  that its colour under uniform light is the slab's on the skin the film covers.
 - :func:`layered_parts` -- Cycles' Glossy lobes and their view-angle image.
 - :func:`eevee_parts` -- EEVEE's GGX lobes (the film's gloss in two) and their image.
 - :func:`image_rows`, :data:`SLAB_ROWS` -- a tier's image rows, the film as a slab's included.
@@ -25,7 +27,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..numerics.geometry import polar_angle_deg
 from ..numerics.quadrature import trapezoid_weights
-from ..tables.slab_tables import SlabParts, SlabTables
+from ..tables.slab_tables import SlabParts, SlabTables, slab_colour
 from ..tables.table_set import Tables
 from . import cycles as cc
 from .lobes import (
@@ -41,8 +43,8 @@ from .tier_formulas import SPECULAR_IOR
 from .view_grid import FIT_VIEWS, ViewGrid, lobe_widths_deg, view_grid
 from .view_image import EEVEE_LUT_ROWS, LUT_ROWS, lut_nodes
 
-__all__ = ["FitTargets", "cosine_mean", "principled_parts", "layered_parts", "eevee_parts",
-           "image_rows", "SLAB_ROWS"]
+__all__ = ["FitTargets", "cosine_mean", "principled_parts", "held_gloss_to_diffuse",
+           "layered_parts", "eevee_parts", "image_rows", "SLAB_ROWS"]
 
 SLAB_ROWS = ("film_body",)
 """The view-angle rows a tier has beyond its own with the film as a slab: the film body's
@@ -94,12 +96,18 @@ class FitTargets:
     reading: ``alpha(theta_i) alpha(theta_o) / (pi alpha_mean)``, its directional albedo the
     film's ``alpha``), the skin's gloss through the film every order; the transmittance rows
     are the slab's ``t`` and the film's body has rows of its own (``film_body``).
-    ``thickness_um``: another thickness than the baked one."""
+    ``thickness_um``: another thickness than the baked one.  ``skin_albedo`` (RGB, diffuse
+    albedo ``a``): the skin the film covers, where a fit is judged and its colour held (the
+    artist's mean skin under the film; default the tables' skin, ``pi P_d``)."""
 
     def __init__(self, tables: Tables, lut_size: int,
-                 thickness_um: float | None = None) -> None:
+                 thickness_um: float | None = None,
+                 skin_albedo: ArrayLike | None = None) -> None:
         self.tables, self.lut_size = tables, lut_size
         self.theta_deg = np.asarray(tables.theta_deg, float)
+        self.skin_albedo: NDArray[np.float64] = np.array(np.broadcast_to(np.asarray(
+            np.pi * np.asarray(tables.skin_diffuse, float) if skin_albedo is None
+            else skin_albedo, float), (3,)))
         self.slab: SlabTables | None = getattr(tables, "slab", None)
         if self.slab is None:
             self.thickness_um = 0.0
@@ -233,7 +241,7 @@ def principled_parts(targets: FitTargets, over_shader: bool) -> dict[str, Any]:
         f0 = float(cc.f0_from_ior(SPECULAR_IOR)) * 2.0 * lobe.level
         return _layering_mean(lobe.roughness, float(cc.ior_from_f0(f0)), f0)
 
-    return {
+    parts = {
         "coat": coat,
         "specular_bare": specular_bare,
         "specular_film": specular_film,
@@ -243,6 +251,36 @@ def principled_parts(targets: FitTargets, over_shader: bool) -> dict[str, Any]:
                                           targets.albedo_theta("path3_gloss"))
                              if specular_film.level == 0.0 else np.zeros(3)),
     }
+    if targets.slab is not None:
+        parts["gloss_to_diffuse"] = held_gloss_to_diffuse(targets, parts)
+    return parts
+
+
+def held_gloss_to_diffuse(targets: FitTargets, parts: dict[str, Any]) -> NDArray[np.float64]:
+    """With the film as a slab, the PRINCIPLED tier's ``gloss_to_diffuse`` (RGB): what its
+    base colour carries so that, over the skin the film covers (``targets.skin_albedo``), its
+    colour under uniform light is the slab's (docs/model.md, "The tiers at a thickness").
+
+    Its specular and coat are white while the skin's gloss through the film is tinted by the
+    film's absorption (and the coat's albedo is not quite the film gloss's): they err by a
+    colour the same on any skin, so a relative error that grows as the skin darkens.  With
+    ``parts``' coat and film specular (coverage 1) the Principled BSDF's colour is ``G + W
+    base`` (:func:`lut_baker.closures.cycles.principled_uniform`); the base colour the node
+    group makes is ``(skin + film + x) / D`` (``D`` the mean attenuation it divides by,
+    :func:`~lut_baker.closures.tier_formulas.principled_sockets`), so ``x = (E - G) D / W -
+    skin - film``, ``E`` the slab's colour (:func:`lut_baker.tables.slab_tables.slab_colour`)."""
+    coat, specular = parts["coat"], parts["specular_film"]
+    gloss, passed = cc.principled_uniform(cc.PrincipledInputs(
+        roughness=specular.roughness, ior=SPECULAR_IOR,
+        specular_ior_level=float(specular.level), coat_weight=float(coat.level),
+        coat_roughness=coat.roughness, coat_ior=float(coat.ior)))
+    a = targets.skin_albedo
+    exact = slab_colour(targets.tables, targets.thickness_um, skin_albedo=a)
+    below = targets.slab_parts(0.0)
+    skin = a * np.square(below.through_mean) / (1.0 - a * below.below)
+    divided = ((1.0 - float(coat.level) * float(parts["coat_albedo_mean"]))
+               * (1.0 - float(parts["specular_albedo_mean"][1])))
+    return (exact - gloss) * divided / max(passed, 1e-12) - skin - targets.film_mean()
 
 
 def image_rows(rows: tuple[str, ...], slab: bool) -> tuple[str, ...]:
