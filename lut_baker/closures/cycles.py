@@ -529,13 +529,25 @@ def principled_uniform(inputs: PrincipledInputs, nodes: int = 24
         passed = 1.0 - np.max(np.atleast_2d(layering_albedo(
             mu, inputs.roughness, eta, f0).T).T, axis=-1)
     if inputs.coat_weight > 0.0:
-        scale, layered = coat_view_terms(mu, inputs.coat_roughness, inputs.coat_ior)
-        coat = inputs.coat_weight * scale * microfacet_albedo(
-            mu, inputs.coat_roughness, lambda c: dielectric_fresnel(c, inputs.coat_ior))
+        coat, layered = _coat_uniform(float(inputs.coat_roughness), float(inputs.coat_ior),
+                                      nodes)
         below = np.clip(1.0 - inputs.coat_weight * layered, 0.0, 1.0)
-        gloss = coat[:, None] + below[:, None] * gloss
+        gloss = inputs.coat_weight * coat[:, None] + below[:, None] * gloss
         passed = below * passed
     return mean @ gloss, float(mean @ passed)
+
+
+@lru_cache(maxsize=64)
+def _coat_uniform(roughness: float, ior: float, nodes: int
+                  ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """The coat's compensated albedo and its layering albedo at :func:`principled_uniform`'s
+    view nodes (cached: a fit moved to another thickness keeps its coat)."""
+    mu, _ = gauss_legendre(nodes)
+    scale, layered = coat_view_terms(mu, roughness, ior)
+    albedo = scale * microfacet_albedo(mu, roughness, lambda c: dielectric_fresnel(c, ior))
+    albedo.setflags(write=False)
+    layered.setflags(write=False)
+    return albedo, layered
 
 
 VIEW_TABLE_SIZE = 64
