@@ -143,7 +143,7 @@ def _update_thickness(self, context):
     if not shade.is_assigning():
         _reset_skin_under(self)
     _stamp(self)
-    live.tables_changed(self, live.THICKNESS_DEBOUNCE_S)
+    live.tables_changed(self, live.THICKNESS_DEBOUNCE_S, measure_later=True)
 
 
 def _update_absorption(self, context):
