@@ -37,7 +37,7 @@ from .profiles import REPLICA_EDGE_ERROR, fit_profiles
 from .tier_parts import FitTargets, cosine_mean, held_gloss_to_diffuse
 from .tier_registry import TIERS, Tier, tier
 from .tiers import tier_errors
-from .view_image import DEFAULT_LUT_SIZE
+from .view_image import DEFAULT_IMAGE_SIZE
 
 __all__ = ["fit_closures", "subsurface_ior", "at_thickness"]
 
@@ -102,7 +102,7 @@ def _merged(parts: dict[str, Any], more: dict[str, Any]) -> dict[str, Any]:
 
 def fit_closures(tables: Tables, *, tiers: Iterable[str] | None = None,
                  over_shader: bool = False, onto: ClosureFit | None = None,
-                 lut_size: int = DEFAULT_LUT_SIZE, subsurface_method: str | None = None,
+                 image_size: int = DEFAULT_IMAGE_SIZE, subsurface_method: str | None = None,
                  errors_at: tuple[float, Any] | None = None,
                  skin_albedo: Any = None,
                  progress: Callable[..., object] | None = None) -> ClosureFit:
@@ -127,7 +127,7 @@ def fit_closures(tables: Tables, *, tiers: Iterable[str] | None = None,
     report = progress or (lambda fraction, message="": None)
     asked = _checked_tiers(TIERS if tiers is None else tiers)
     wanted = asked if onto is None else tuple(t for t in asked if t.name not in onto.tiers)
-    targets = FitTargets(tables, lut_size,
+    targets = FitTargets(tables, image_size,
                          skin_albedo=onto.skin_albedo if onto is not None else skin_albedo)
     parts: dict[str, Any] = {}
     total = sum(t.fit_share for t in wanted) or 1.0
@@ -183,7 +183,7 @@ def at_thickness(fit: ClosureFit, tables: Tables, thickness_um: float) -> Closur
         raise ValueError("a fit of the paper's film has no thickness")
     imaged = [(each, image) for each in map(tier, fit.tiers)
               if (image := each.image(fit)) is not None]
-    size = imaged[0][1].lut.shape[1] if imaged else DEFAULT_LUT_SIZE
+    size = imaged[0][1].texels.shape[1] if imaged else DEFAULT_IMAGE_SIZE
     old = FitTargets(tables, size, fit.slab.thickness_um, fit.skin_albedo)
     new = FitTargets(tables, size, thickness_um, fit.skin_albedo)
     theta = old.albedo_theta("path3_gloss")
@@ -206,14 +206,14 @@ def at_thickness(fit: ClosureFit, tables: Tables, thickness_um: float) -> Closur
                              f"thickness (it names no fields: Tier.with_image)")
         lobes = each.lobes(fit)
         path3 = lobes["path3_gloss"]
-        if path3.lut is None:
+        if path3.weights is None:
             raise AssertionError("a tier's Glossy lobes with an image have their rows")
-        lobes = {**lobes, "path3_gloss": replace(path3, lut=_scaled_row(
-            path3.lut, old.texel_rows(theta, gloss_old), new.texel_rows(theta, gloss_new)))}
-        lut = np.array(image.lut)
-        for name, row in (("path3_gloss", lobes["path3_gloss"].lut),
+        lobes = {**lobes, "path3_gloss": replace(path3, weights=_scaled_row(
+            path3.weights, old.texel_rows(theta, gloss_old), new.texel_rows(theta, gloss_new)))}
+        texels = np.array(image.texels)
+        for name, row in (("path3_gloss", lobes["path3_gloss"].weights),
                           ("film_transmittance", new.transmittance_rows()),
                           ("film_body", new.body_rows())):
-            lut[image.rows.index(name)] = row
-        changes.update(each.with_image(lobes, lut))
+            texels[image.rows.index(name)] = row
+        changes.update(each.with_image(lobes, texels))
     return replace(fit, **changes)
