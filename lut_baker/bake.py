@@ -54,7 +54,7 @@ from numpy.typing import ArrayLike, NDArray
 from .evaluate.two_layer import inter_reflection_fourier_matrices, layered_fourier_matrices
 from .model.albedo import specular_albedo
 from .model.dipole import dipole_profile, dipole_total_reflectance
-from .model.film_slab import relative_thickness
+from .model.film_slab import relative_thickness, surface_share
 from .model.layers import Dipole, ReflectionLayer, TransmissionLayer
 from .model.made_up_skin import MadeUpSkin, film_reflection_layer, film_transmission_layer
 from .model.microfacet import (
@@ -595,7 +595,8 @@ def bake_slab(skin: MadeUpSkin, resolution_name: str | Resolution = "default", *
             else np.asarray(thicknesses_um, float))
     absorption = np.broadcast_to(np.asarray(skin.absorption, float), (3,))
     film = foundation_slab(skin.film, skin.film_transmission, grid, absorption)
-    face = gloss_albedos((skin.film,), np.degrees(grid.theta))[0].T  # (3, N), a_g
+    share = np.broadcast_to(surface_share(skin.film), (3,))  # k: the surface's share of the gloss
+    face = share[:, None] * gloss_albedos((skin.film,), np.degrees(grid.theta))[0].T  # a_g
     scale = star_scale(grid)
     top, top_albedo, through, through_mean, below, film_albedo = [], [], [], [], [], []
     for h in axis:
@@ -613,6 +614,6 @@ def bake_slab(skin: MadeUpSkin, resolution_name: str | Resolution = "default", *
                       top=np.stack(top), top_albedo=np.stack(top_albedo),
                       through=np.stack(through), through_mean=np.stack(through_mean),
                       below=np.stack(below), film_albedo=np.stack(film_albedo),
-                      absorption=absorption.copy(),
+                      absorption=absorption.copy(), surface_share=share.copy(),
                       theta_spacing=res.theta_spacing, theta_offset=res.theta_offset,
                       phi_spacing=res.phi_spacing)

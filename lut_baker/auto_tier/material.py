@@ -30,6 +30,7 @@ from ..model.made_up_skin import combine, coverage_weights, mix_slots
 from ..model.presets import made_up_skin
 from ..numerics.geometry import polar_angle_deg, sphere_directions
 from ..numerics.quadrature import trapezoid_weights
+from ..tables.slab_tables import surface_gloss
 from ..tables.table_set import ReflectionParts, Tables, radius_nodes
 from .measured import by_number, load
 
@@ -213,7 +214,7 @@ def _slab_shares(tables: Tables, fit: ClosureFit, sphere: _Sphere, w: float
     targets = FitTargets(tables, 2, h)
     weights = coverage_weights(w, 0.0)
     through_gloss = targets.slab_tables().top_at(h, wi, wo) - targets.film_body(wi, wo)
-    gloss = combine(weights, **mix_slots(film_gloss=tables.angular("film_gloss", wi, wo),
+    gloss = combine(weights, **mix_slots(film_gloss=surface_gloss(tables, wi, wo),
                                          path3_gloss=through_gloss,
                                          skin_gloss=tables.angular("skin_gloss", wi, wo))
                     ) * cos_i

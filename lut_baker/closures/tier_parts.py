@@ -26,6 +26,7 @@ from numpy.typing import ArrayLike, NDArray
 from ..numerics.geometry import polar_angle_deg
 from ..numerics.quadrature import trapezoid_weights
 from ..tables.slab_tables import SlabParts, SlabTables
+from ..tables.slab_tables import surface_gloss as slab_surface_gloss
 from ..tables.table_set import Tables
 from . import cycles as cc
 from .lobes import (
@@ -89,8 +90,9 @@ class FitTargets:
     image.
 
     Tables with the film as a slab (``tables.slab``, docs/model.md "The tiers at a
-    thickness") are fitted at their baked thickness (``thickness_um``): ``path3_gloss`` is
-    then the slab's ``top`` less the film's body (Lambertian in the Layered and EEVEE tiers'
+    thickness") are fitted at their baked thickness (``thickness_um``): ``film_gloss`` is then
+    the film surface's share of it (:func:`lut_baker.tables.slab_tables.surface_gloss`),
+    ``path3_gloss`` the slab's ``top`` less the film's body (Lambertian in the Layered and EEVEE tiers'
     reading: ``alpha(theta_i) alpha(theta_o) / (pi alpha_mean)``, its directional albedo the
     film's ``alpha``), the skin's gloss through the film every order; the transmittance rows
     are the slab's ``t`` and the film's body has rows of its own (``film_body``).
@@ -153,6 +155,8 @@ class FitTargets:
                                   - self.film_body(wi, wo))
                 return grid, self.tables.angular(name, *grid.directions)
             grid = self.grid(name)
+            if name == "film_gloss" and self.slab is not None:
+                return grid, slab_surface_gloss(self.tables, *grid.directions)
             return grid, self.tables.surface_gloss(name, *grid.directions)
         return self._once(("target", name), compute)
 
@@ -162,6 +166,8 @@ class FitTargets:
         if name == "path3_gloss" and self.slab is not None:
             parts = self.slab_parts(self.slab.theta_deg)
             return np.maximum(parts.top_albedo - parts.film_albedo, 0.0)
+        if name == "film_gloss" and self.slab is not None:
+            return self.slab.surface_share * np.asarray(self.tables.film_gloss_albedo, float)
         return np.asarray(getattr(self.tables, name + "_albedo"))
 
     def albedo_theta(self, name: str) -> NDArray[np.float64]:
