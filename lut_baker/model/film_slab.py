@@ -25,8 +25,8 @@ surface and its body (no air under it), over the skin with every inter-reflectio
 (:func:`made_up_matrices`).
 
 Absorption ``A`` (per channel, docs/model.md §4) keeps its meaning at the paper's thickness: the
-measured film's diffuse reflection and transmission are scaled by ``1 - A`` before the body is
-derived, so the free film of the paper's thickness reflects and transmits exactly what it did
+measured film's reflection below its surface (``P_d`` and the body's share of the gloss) and its
+transmission are scaled by ``1 - A`` before the body is derived, so the free film of the paper's thickness reflects and transmits exactly what it did
 (up to :func:`passive` below); the thickness then decides how much a film absorbs.
 
 Functions and types
@@ -456,8 +456,9 @@ def film_slab(film: ReflectionLayer, transmission: TransmissionLayer, grid: Hemi
     eq. 4; in albedo units) at every thickness, with absorption ``A`` (scalar or RGB in
     [0, 1]).
 
-    At the measured thickness the free film's diffuse reflection and transmission times
-    ``1 - A`` are the target; its faces (``film``'s gloss) are taken off
+    At the measured thickness the free film's reflection below its surface
+    (:func:`measured_body_matrices`) and transmission times ``1 - A`` are the target; its faces
+    (:func:`surface_layer` of ``film``) are taken off
     (:func:`remove_faces`) and the doubling relation inverted
     (:func:`~lut_baker.numerics.adding_doubling.slab_generator`, light the film extinguishes
     fading as ``exp(-optical_thickness x)``).  ``passive``: no direction may gain light

@@ -23,9 +23,11 @@ skin under any layer.  The diffuse part is what the dipole spreads (its amount `
 c)``, its spread the normalised profile): the light that scattered under the skin, with all its
 returns from the film's underside.
 
-The body is derived from the measured free film (:func:`measured_film`): the film's ``P_d`` and
-its transmission (eq. 4) under the paper film's surface, whatever the foundation's own gloss;
-on skin the foundation's own surface (``face``) lies on that body.
+The body is derived from the measured free film (:func:`measured_film`): the film's ``P_d``, the
+share of the paper film's gloss its surface does not reflect, and its transmission (eq. 4) under
+the paper film's surface, whatever the foundation's own gloss; on skin the foundation's own
+surface (``face``: its gloss times the share an interface of the vehicle reflects,
+:func:`~lut_baker.model.film_slab.face_albedo`) lies on that body.
 
 Functions and types
 -------------------
@@ -84,10 +86,11 @@ __all__ = [
 
 
 def measured_film(film: ReflectionLayer) -> ReflectionLayer:
-    """The free film a foundation's body is derived from: ``film``'s diffuse ``P_d`` under the
-    paper film's surface (the gloss it was measured with, paper 4.1.1).  The presets share the
-    paper film's ``P_d`` and transmission and differ in their surface only (docs/model.md §4),
-    so every foundation's body is the paper film's, absorbed by its shade."""
+    """The free film a foundation's body is derived from: ``film``'s diffuse ``P_d`` with the
+    paper film's gloss (the gloss it was measured with, paper 4.1.1; its surface's share on the
+    surface, the rest the body's).  The presets share the paper film's ``P_d`` and transmission
+    and differ in their surface only (docs/model.md §4), so every foundation's body is the paper
+    film's, absorbed by its shade."""
     from .presets import paper  # the paper's layers, in albedo units
 
     surface = paper().film
