@@ -92,8 +92,8 @@ class FitTargets:
     Tables with the film as a slab (``tables.slab``, docs/model.md "The tiers at a
     thickness") are fitted at their baked thickness (``thickness_um``): ``film_gloss`` is then
     the film surface's share of it (:func:`lut_baker.tables.slab_tables.surface_gloss`),
-    ``path3_gloss`` the slab's ``top`` less the film's body (Lambertian in the Layered and EEVEE tiers'
-    reading: ``alpha(theta_i) alpha(theta_o) / (pi alpha_mean)``, its directional albedo the
+    ``path3_gloss`` the slab's ``top`` less the film's body (Lambertian in the Layered and EEVEE
+    tiers' reading: ``alpha(theta_i) alpha(theta_o) / (pi alpha_mean)``, its directional albedo the
     film's ``alpha``), the skin's gloss through the film every order; the transmittance rows
     are the slab's ``t`` and the film's body has rows of its own (``film_body``).
     ``thickness_um``: another thickness than the baked one."""

@@ -26,8 +26,9 @@ surface and its body (no air under it), over the skin with every inter-reflectio
 
 Absorption ``A`` (per channel, docs/model.md §4) keeps its meaning at the paper's thickness: the
 measured film's reflection below its surface (``P_d`` and the body's share of the gloss) and its
-transmission are scaled by ``1 - A`` before the body is derived, so the free film of the paper's thickness reflects and transmits exactly what it did
-(up to :func:`passive` below); the thickness then decides how much a film absorbs.
+transmission are scaled by ``1 - A`` before the body is derived, so the free film of the paper's
+thickness reflects and transmits exactly what it did, the body's share of the gloss absorbed (up
+to :func:`passive` below); the thickness then decides how much a film absorbs.
 
 Functions and types
 -------------------

@@ -249,8 +249,8 @@ def test_match_skin_at_a_thickness(sphere):
     absorption on the slab's exact colour (every inter-reflection): the covered skin has the
     bare skin's colour under uniform light (the skin under the film darkened only where full
     absorption is not enough: not on this skin; at 9.6 and 50 um its red is 0.06% and 0.7%
-    beyond the film's reach, and the note says so); the group is rebuilt with the absorption baked in (its record
-    keeps the thickness); Lighter then Darker gives the shade back."""
+    beyond the film's reach, and the note says so); the group is rebuilt with the absorption
+    baked in (its record keeps the thickness); Lighter then Darker gives the shade back."""
     import bpy
 
     from makeup_skin_addon import matching, nodes
