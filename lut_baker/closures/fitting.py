@@ -33,6 +33,7 @@ from numpy.typing import NDArray
 from ..tables.table_set import Tables
 from . import cycles as cc
 from .closure_fit import ClosureFit, SlabFit
+from .lobes import LobeFit
 from .profiles import REPLICA_EDGE_ERROR, fit_profiles
 from .tier_parts import FitTargets, cosine_mean
 from .tier_registry import TIERS, Tier, tier
@@ -79,7 +80,7 @@ def _film_parts(targets: FitTargets) -> dict[str, Any]:
                 "film_albedo": np.pi * np.asarray(tables.film_diffuse, float)}
     parts = targets.slab_parts(0.0)
     return {"transmittance_mean": np.asarray(parts.through_mean, float),
-            "film_albedo": np.asarray(targets.film_mean(), float),
+            "film_albedo": np.asarray(targets.base_mean(), float),
             "slab": SlabFit(thickness_um=float(targets.thickness_um),
                             below=np.asarray(parts.below, float))}
 
@@ -162,6 +163,13 @@ def _scaled_row(row: NDArray[np.float64], old: NDArray[np.float64],
     return np.where(old > 0.0, row * new / np.where(old > 0.0, old, 1.0), 0.0)
 
 
+def _film_gloss_scaled(lobe: LobeFit, ratio: NDArray[np.float64]) -> LobeFit:
+    """The film's gloss lobe with its weight rows (and its Lambertian companion's) times
+    ``ratio`` (RGB): the body's share of the gloss at another thickness."""
+    return replace(lobe, lut=None if lobe.lut is None else lobe.lut * ratio,
+                   diffuse_lut=None if lobe.diffuse_lut is None else lobe.diffuse_lut * ratio)
+
+
 _IMAGES = (("glossy", "lut", "LAYERED"), ("eevee_glossy", "eevee_lut", "EEVEE"))
 """The fit's Glossy lobes, its image and their tier."""
 
@@ -173,8 +181,9 @@ def at_thickness(fit: ClosureFit, tables: Tables, thickness_um: float) -> Closur
     thickness"): the mean transmittance, ``c``, the film body's albedo and row, the
     transmittance row, the skin's gloss through the film (its Glossy rows and the Principled
     specular level scaled by its albedo's change; ``gloss_to_diffuse`` where no lobe holds
-    it).  The errors are not measured again (dropped).  Milliseconds: what a Thickness slider
-    costs (``bench/slab_tiers.py``)."""
+    it), the film's gloss rows scaled by its weight's change (the body's share of the gloss;
+    the Principled coat is kept).  The errors are not measured again (dropped).  Milliseconds:
+    what a Thickness slider costs (``bench/slab_tiers.py``)."""
     if fit.slab is None:
         raise ValueError("a fit of the paper's film has no thickness")
     size = next((getattr(fit, image).shape[1] for _, image, _ in _IMAGES
@@ -191,6 +200,7 @@ def at_thickness(fit: ClosureFit, tables: Tables, thickness_um: float) -> Closur
                                            level=float(fit.specular_film.level * ratio))
     elif fit.gloss_to_diffuse is not None:
         changes["gloss_to_diffuse"] = cosine_mean(gloss_new, theta)
+    film_ratio = new.gloss_weight() / np.maximum(old.gloss_weight(), 1e-300)
     for lobes_name, image_name, tier_name in _IMAGES:
         lobes = getattr(fit, lobes_name)
         if lobes is None:
@@ -198,13 +208,19 @@ def at_thickness(fit: ClosureFit, tables: Tables, thickness_um: float) -> Closur
         path3 = lobes["path3_gloss"]
         lobes = {**lobes, "path3_gloss": replace(path3, lut=_scaled_row(
             path3.lut, old.texel_rows(theta, gloss_old), new.texel_rows(theta, gloss_new)))}
+        lobes.update({name: _film_gloss_scaled(lobes[name], film_ratio)
+                      for name in ("film_gloss", "film_gloss_2") if name in lobes})
         image = tier(tier_name).image(fit)
         if image is None:
             raise AssertionError("a tier with Glossy lobes has an image")
         lut = np.array(getattr(fit, image_name))
-        for name, row in (("path3_gloss", lobes["path3_gloss"].lut),
-                          ("film_transmittance", new.transmittance_rows()),
-                          ("film_body", new.body_rows())):
+        rows = {"path3_gloss": lobes["path3_gloss"].lut,
+                "film_transmittance": new.transmittance_rows(), "film_body": new.body_rows(),
+                **{name: lobes[name].lut for name in ("film_gloss", "film_gloss_2")
+                   if name in lobes and name in image.rows}}
+        if lobes["film_gloss"].diffuse_lut is not None and "film_gloss_diffuse" in image.rows:
+            rows["film_gloss_diffuse"] = lobes["film_gloss"].diffuse_lut
+        for name, row in rows.items():
             lut[image.rows.index(name)] = row
         changes[lobes_name], changes[image_name] = lobes, lut
     return replace(fit, **changes)

@@ -35,6 +35,8 @@ Functions and types
 - :func:`foundation_slab` -- a foundation's body at every thickness, with its absorption.
 - :class:`SlabSkinParts`, :func:`slab_skin_parts` -- ``top``, ``t``, ``c`` and the surface's
   gloss albedo at one thickness.
+- :func:`body_gloss_weight` -- how much of eq. 2's gloss lobe the film's body returns at a
+  thickness (what the tiers draw as gloss).
 - :func:`parts_matrices` -- made-up skin (star form) from the parts and a skin albedo.
 - :func:`parts_albedo`, :func:`parts_colour` -- its directional albedo (gloss included) and its
   colour under uniform light.
@@ -75,6 +77,7 @@ __all__ = [
     "foundation_slab",
     "SlabSkinParts",
     "slab_skin_parts",
+    "body_gloss_weight",
     "parts_matrices",
     "parts_albedo",
     "parts_colour",
@@ -160,6 +163,19 @@ def slab_skin_parts(film: FilmSlab, thickness: float, skin: ReflectionLayer,
     return SlabSkinParts(top=top, through=np.sqrt(np.pi) * v / s0, below=below,
                          face=np.broadcast_to(face_a, (channels, face_a.shape[-1])),
                          film=film_albedo)
+
+
+def body_gloss_weight(film: FilmSlab, thickness: float, face: ArrayLike,
+                      lobe: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``(C,)``: the weight ``w`` of eq. 2's gloss lobe ``lobe`` (star form, ``(C', orders, N,
+    N)``, its whole ``P_s``) in the film's own reflection at ``thickness`` (its body through its
+    surface ``face``), least squares over the Fourier orders above 0, where a Lambertian body
+    has nothing: the body's share of the measured gloss, about ``1 - k`` at the paper's
+    thickness without absorption and fading with it as the film thins."""
+    top = _film_layer(film, float(thickness), np.asarray(face, float)).top[:, 1:]
+    shape = lobe[:, 1:top.shape[1] + 1]
+    return (np.einsum("cmij,cmij->c", top, np.broadcast_to(shape, top.shape))
+            / np.maximum(np.einsum("cmij,cmij->c", shape, shape), 1e-300))
 
 
 def _diffuse_weight(parts: SlabSkinParts, skin_albedo: ArrayLike) -> NDArray[np.float64]:

@@ -104,13 +104,15 @@ class SlabParts(NamedTuple):
     """The 1-D parts at one thickness: ``top_albedo`` ``(..., 3)`` (``top``'s directional
     albedo, at the angles asked), ``through`` ``(..., 3)`` (``t``), ``through_mean`` ``(3,)``
     (``t`` averaged over uniform light, ``2 Int t mu dmu``), ``below`` ``(3,)`` (``c``),
-    ``film_albedo`` ``(..., 3)`` (the film's own directional albedo, at the angles asked)."""
+    ``film_albedo`` ``(..., 3)`` (the film's own directional albedo, at the angles asked),
+    ``body_gloss`` ``(3,)`` (the weight of eq. 2's gloss lobe in it)."""
 
     top_albedo: NDArray[np.float64]
     through: NDArray[np.float64]
     through_mean: NDArray[np.float64]
     below: NDArray[np.float64]
     film_albedo: NDArray[np.float64]
+    body_gloss: NDArray[np.float64]
 
 
 @dataclass(frozen=True, eq=False)
@@ -122,8 +124,11 @@ class SlabTables:
     ``theta_offset`` and ``phi_spacing`` say (the closed forms of
     :mod:`lut_baker.tables.table_set`).  ``top`` (K, n_theta, n_theta, n_phi, 3) 1/sr;
     ``top_albedo``, ``through``, ``film_albedo`` (K, n_theta, 3); ``through_mean``, ``below``
-    (K, 3).  ``surface_share`` (3,): ``k``, the share of the tables' ``film_gloss`` the film's
-    surface reflects (:func:`lut_baker.model.film_slab.surface_share`)."""
+    (K, 3); ``body_gloss`` (K, 3): the weight of eq. 2's gloss lobe in the film's own
+    reflection (:func:`lut_baker.model.slab_skin.body_gloss_weight`, the body's share of the
+    gloss, what the tiers draw as gloss).  ``surface_share`` (3,): ``k``, the share of the
+    tables' ``film_gloss`` the film's surface reflects
+    (:func:`lut_baker.model.film_slab.surface_share`)."""
 
     thickness_um: NDArray[np.float64]
     theta_deg: NDArray[np.float64]
@@ -134,6 +139,7 @@ class SlabTables:
     through_mean: NDArray[np.float64]
     below: NDArray[np.float64]
     film_albedo: NDArray[np.float64]
+    body_gloss: NDArray[np.float64]
     absorption: NDArray[np.float64]
     surface_share: NDArray[np.float64]
     theta_spacing: str = "grazing"
@@ -144,7 +150,7 @@ class SlabTables:
         k, n, p = self.thickness_um.size, self.theta_deg.size, self.phi_deg.size
         shapes = {"top": (k, n, n, p, 3), "top_albedo": (k, n, 3), "through": (k, n, 3),
                   "film_albedo": (k, n, 3), "through_mean": (k, 3), "below": (k, 3),
-                  "absorption": (3,), "surface_share": (3,)}
+                  "body_gloss": (k, 3), "absorption": (3,), "surface_share": (3,)}
         for name, shape in shapes.items():
             if np.shape(getattr(self, name)) != shape:
                 raise ValueError(f"slab table {name!r} must have shape {shape}, "
@@ -175,7 +181,8 @@ class SlabTables:
                          through=_linear(self._along(self.through, thickness_um), x),
                          through_mean=self._along(self.through_mean, thickness_um),
                          below=self._along(self.below, thickness_um),
-                         film_albedo=_linear(self._along(self.film_albedo, thickness_um), x))
+                         film_albedo=_linear(self._along(self.film_albedo, thickness_um), x),
+                         body_gloss=self._along(self.body_gloss, thickness_um))
 
     def top_at(self, thickness_um: float, wi: ArrayLike, wo: ArrayLike) -> NDArray[np.float64]:
         """``top`` (1/sr, ``(..., 3)``) at one thickness and unit directions ``(..., 3)``."""
