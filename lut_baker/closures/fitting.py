@@ -214,10 +214,11 @@ def at_thickness(fit: ClosureFit, tables: Tables, thickness_um: float) -> Closur
         if image is None:
             raise AssertionError("a tier with Glossy lobes has an image")
         lut = np.array(getattr(fit, image_name))
-        rows = {"path3_gloss": lobes["path3_gloss"].lut,
-                "film_transmittance": new.transmittance_rows(), "film_body": new.body_rows(),
-                **{name: lobes[name].lut for name in ("film_gloss", "film_gloss_2")
-                   if name in lobes and name in image.rows}}
+        rows: dict[str, Any] = {"path3_gloss": lobes["path3_gloss"].lut,
+                                "film_transmittance": new.transmittance_rows(),
+                                "film_body": new.body_rows(),
+                                **{name: lobes[name].lut for name in ("film_gloss", "film_gloss_2")
+                                   if name in lobes and name in image.rows}}
         if lobes["film_gloss"].diffuse_lut is not None and "film_gloss_diffuse" in image.rows:
             rows["film_gloss_diffuse"] = lobes["film_gloss"].diffuse_lut
         for name, row in rows.items():
