@@ -9,7 +9,7 @@ does, or through the pipeline), render, and read node trees and images back.
 - :func:`render` -- render the scene to a float EXR and return its RGB pixels.
 - :func:`tree_state` -- a material's nodes and links, comparable.
 - :func:`group_node` -- a material's Made-up Skin group node.
-- :func:`lut_images` -- the add-on's view-angle images.
+- :func:`view_images` -- the add-on's view-angle images.
 - :func:`counts` -- how many node groups, images and materials the file holds.
 - :func:`session_caches` -- the add-on's session cache (re-baked tables and closure fits).
 - :func:`cold_caches` -- empty them: the next Apply bakes and fits.
@@ -23,7 +23,7 @@ from __future__ import annotations
 from support import sphere_scene
 
 __all__ = ["SPHERE_PX", "HEAD_PX", "apply_operator", "apply_pipeline", "render", "tree_state",
-           "group_node", "lut_images", "counts", "session_caches", "cold_caches",
+           "group_node", "view_images", "counts", "session_caches", "cold_caches",
            "registered_classes", "ui_texts"]
 
 SPHERE_PX = 64
@@ -84,7 +84,7 @@ def group_node(material):
     return material.node_tree.nodes["Made-up Skin"]
 
 
-def lut_images():
+def view_images():
     """The add-on's view-angle images in the file."""
     import bpy
 
