@@ -37,7 +37,7 @@ from .profiles import REPLICA_EDGE_ERROR, fit_profiles
 from .tier_parts import FitTargets, cosine_mean
 from .tier_registry import TIERS, Tier, tier
 from .tiers import tier_errors
-from .view_image import DEFAULT_LUT_SIZE
+from .view_image import DEFAULT_IMAGE_SIZE
 
 __all__ = ["fit_closures", "subsurface_ior", "at_thickness"]
 
@@ -102,7 +102,7 @@ def _merged(parts: dict[str, Any], more: dict[str, Any]) -> dict[str, Any]:
 
 def fit_closures(tables: Tables, *, tiers: Iterable[str] | None = None,
                  over_shader: bool = False, onto: ClosureFit | None = None,
-                 lut_size: int = DEFAULT_LUT_SIZE, subsurface_method: str | None = None,
+                 image_size: int = DEFAULT_IMAGE_SIZE, subsurface_method: str | None = None,
                  errors_at: tuple[float, Any] | None = None,
                  progress: Callable[..., object] | None = None) -> ClosureFit:
     """Fit the ``tiers`` (default: all of :data:`TIERS`) to ``tables`` and measure their
@@ -122,7 +122,7 @@ def fit_closures(tables: Tables, *, tiers: Iterable[str] | None = None,
     report = progress or (lambda fraction, message="": None)
     asked = _checked_tiers(TIERS if tiers is None else tiers)
     wanted = asked if onto is None else tuple(t for t in asked if t.name not in onto.tiers)
-    targets = FitTargets(tables, lut_size)
+    targets = FitTargets(tables, image_size)
     parts: dict[str, Any] = {}
     total = sum(t.fit_share for t in wanted) or 1.0
     done = 0.0
@@ -162,7 +162,7 @@ def _scaled_row(row: NDArray[np.float64], old: NDArray[np.float64],
     return np.where(old > 0.0, row * new / np.where(old > 0.0, old, 1.0), 0.0)
 
 
-_IMAGES = (("glossy", "lut", "LAYERED"), ("eevee_glossy", "eevee_lut", "EEVEE"))
+_IMAGES = (("glossy", "view_rows", "LAYERED"), ("eevee_glossy", "eevee_view_rows", "EEVEE"))
 """The fit's Glossy lobes, its image and their tier."""
 
 
@@ -178,7 +178,7 @@ def at_thickness(fit: ClosureFit, tables: Tables, thickness_um: float) -> Closur
     if fit.slab is None:
         raise ValueError("a fit of the paper's film has no thickness")
     size = next((getattr(fit, image).shape[1] for _, image, _ in _IMAGES
-                 if getattr(fit, image) is not None), DEFAULT_LUT_SIZE)
+                 if getattr(fit, image) is not None), DEFAULT_IMAGE_SIZE)
     old = FitTargets(tables, size, fit.slab.thickness_um)
     new = FitTargets(tables, size, thickness_um)
     theta = old.albedo_theta("path3_gloss")
@@ -196,15 +196,15 @@ def at_thickness(fit: ClosureFit, tables: Tables, thickness_um: float) -> Closur
         if lobes is None:
             continue
         path3 = lobes["path3_gloss"]
-        lobes = {**lobes, "path3_gloss": replace(path3, lut=_scaled_row(
-            path3.lut, old.texel_rows(theta, gloss_old), new.texel_rows(theta, gloss_new)))}
+        lobes = {**lobes, "path3_gloss": replace(path3, weights=_scaled_row(
+            path3.weights, old.texel_rows(theta, gloss_old), new.texel_rows(theta, gloss_new)))}
         image = tier(tier_name).image(fit)
         if image is None:
             raise AssertionError("a tier with Glossy lobes has an image")
-        lut = np.array(getattr(fit, image_name))
-        for name, row in (("path3_gloss", lobes["path3_gloss"].lut),
+        rows = np.array(getattr(fit, image_name))
+        for name, row in (("path3_gloss", lobes["path3_gloss"].weights),
                           ("film_transmittance", new.transmittance_rows()),
                           ("film_body", new.body_rows())):
-            lut[image.rows.index(name)] = row
-        changes[lobes_name], changes[image_name] = lobes, lut
+            rows[image.rows.index(name)] = row
+        changes[lobes_name], changes[image_name] = lobes, rows
     return replace(fit, **changes)

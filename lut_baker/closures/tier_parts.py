@@ -39,7 +39,7 @@ from .lobes import (
 )
 from .tier_formulas import SPECULAR_IOR
 from .view_grid import FIT_VIEWS, ViewGrid, lobe_widths_deg, view_grid
-from .view_image import EEVEE_LUT_ROWS, LUT_ROWS, lut_nodes
+from .view_image import EEVEE_IMAGE_ROWS, IMAGE_ROWS, texel_centres
 
 __all__ = ["FitTargets", "cosine_mean", "principled_parts", "layered_parts", "eevee_parts",
            "image_rows", "SLAB_ROWS"]
@@ -96,9 +96,9 @@ class FitTargets:
     are the slab's ``t`` and the film's body has rows of its own (``film_body``).
     ``thickness_um``: another thickness than the baked one."""
 
-    def __init__(self, tables: Tables, lut_size: int,
+    def __init__(self, tables: Tables, image_size: int,
                  thickness_um: float | None = None) -> None:
-        self.tables, self.lut_size = tables, lut_size
+        self.tables, self.image_size = tables, image_size
         self.theta_deg = np.asarray(tables.theta_deg, float)
         self.slab: SlabTables | None = getattr(tables, "slab", None)
         if self.slab is None:
@@ -173,7 +173,7 @@ class FitTargets:
     def texel_rows(self, theta_deg: NDArray[np.float64],
                    values: NDArray[np.float64]) -> NDArray[np.float64]:
         """A directional table ``(n_theta, 3)`` on ``theta_deg`` at the image's texels."""
-        mu = lut_nodes(self.lut_size)
+        mu = texel_centres(self.image_size)
         return np.stack([np.interp(np.degrees(np.arccos(mu)), theta_deg, values[:, c])
                          for c in range(3)], -1)
 
@@ -199,7 +199,7 @@ class FitTargets:
 def _left_out_glossy(size: int) -> LobeFit:
     """A Glossy lobe left out (a fit over the artist's shader has no bare skin of its own):
     weights 0, error 1 (what leaving a lobe out errs)."""
-    return LobeFit(roughness=ROUGHNESS_RANGE[1], error=1.0, lut=np.zeros((size, 3)))
+    return LobeFit(roughness=ROUGHNESS_RANGE[1], error=1.0, weights=np.zeros((size, 3)))
 
 
 def principled_parts(targets: FitTargets, over_shader: bool) -> dict[str, Any]:
@@ -254,9 +254,9 @@ def image_rows(rows: tuple[str, ...], slab: bool) -> tuple[str, ...]:
 def _image(targets: FitTargets, lobes: dict[str, LobeFit],
            rows: tuple[str, ...]) -> NDArray[np.float64]:
     """The view-angle image of ``lobes``, rows named ``rows`` (:func:`image_rows`)."""
-    found = {**{name: lobes[name].lut for name in lobes},
+    found = {**{name: lobes[name].weights for name in lobes},
              "film_transmittance": targets.transmittance_rows(),
-             "film_gloss_diffuse": lobes["film_gloss"].diffuse_lut}
+             "film_gloss_diffuse": lobes["film_gloss"].diffuse_weights}
     rows = image_rows(rows, targets.slab is not None)
     if targets.slab is not None:
         found["film_body"] = targets.body_rows()
@@ -270,14 +270,14 @@ def _glossy(targets: FitTargets, name: str, closures: tuple[str, ...]) -> LobeFi
     """:func:`fit_glossy` of one gloss part (the film's with its Lambertian companion)."""
     grid, table = targets.target(name)
     return fit_glossy(grid, table, targets.albedo(name), targets.albedo_theta(name),
-                      targets.lut_size,
+                      targets.image_size,
                       companion=name == "film_gloss", closures=closures)
 
 
 def _view_weighted_lobes(targets: FitTargets, names: tuple[str, ...],
                          closures: tuple[str, ...], over_shader: bool) -> dict[str, LobeFit]:
     """Glossy lobes of ``names`` (over the artist's shader ``skin_gloss`` left out)."""
-    return {name: (_left_out_glossy(targets.lut_size) if over_shader and name == "skin_gloss"
+    return {name: (_left_out_glossy(targets.image_size) if over_shader and name == "skin_gloss"
                    else _glossy(targets, name, closures)) for name in names}
 
 
@@ -285,7 +285,7 @@ def layered_parts(targets: FitTargets, over_shader: bool) -> dict[str, Any]:
     """The LAYERED tier's parts: Cycles' Glossy lobes and their view-angle image."""
     glossy = _view_weighted_lobes(targets, ("film_gloss", "path3_gloss", "skin_gloss"),
                                   cc.GLOSSY_DISTRIBUTIONS, over_shader)
-    return {"glossy": glossy, "lut": _image(targets, glossy, LUT_ROWS)}
+    return {"glossy": glossy, "view_rows": _image(targets, glossy, IMAGE_ROWS)}
 
 
 def eevee_parts(targets: FitTargets, over_shader: bool) -> dict[str, Any]:
@@ -293,9 +293,9 @@ def eevee_parts(targets: FitTargets, over_shader: bool) -> dict[str, Any]:
     companion, :func:`fit_glossy_pair`) and their view-angle image."""
     film_grid, film_gloss = targets.target("film_gloss")
     first, second = fit_glossy_pair(film_grid, film_gloss, targets.albedo("film_gloss"),
-                                    targets.theta_deg, targets.lut_size)
+                                    targets.theta_deg, targets.image_size)
     eevee_glossy = {"film_gloss": first, "film_gloss_2": second,
                     **_view_weighted_lobes(targets, ("path3_gloss", "skin_gloss"),
                                            (EEVEE_GLOSSY,), over_shader)}
     return {"eevee_glossy": eevee_glossy,
-            "eevee_lut": _image(targets, eevee_glossy, EEVEE_LUT_ROWS)}
+            "eevee_view_rows": _image(targets, eevee_glossy, EEVEE_IMAGE_ROWS)}

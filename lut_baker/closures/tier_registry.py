@@ -34,7 +34,7 @@ from . import eevee
 from .lobes import LobeFit
 from .tier_formulas import TierInputs, principled_shader, view_weighted_shader
 from .tier_parts import FitTargets, eevee_parts, image_rows, layered_parts, principled_parts
-from .view_image import EEVEE_LUT_ROWS, LUT_ROWS
+from .view_image import EEVEE_IMAGE_ROWS, IMAGE_ROWS
 
 __all__ = ["Tier", "ViewImage", "Costs", "register", "unregister", "tier", "held", "TIERS",
            "engine_tiers", "PRINCIPLED", "LAYERED", "EEVEE", "UNRECORDED"]
@@ -42,11 +42,11 @@ __all__ = ["Tier", "ViewImage", "Costs", "register", "unregister", "tier", "held
 
 @dataclass(frozen=True)
 class ViewImage:
-    """A tier's view-angle image: ``lut`` ``(len(rows), size, 3)``, its rows named ``rows``
+    """A tier's view-angle image: ``texels`` ``(len(rows), size, 3)``, its rows named ``rows``
     (:mod:`lut_baker.closures.view_image`)."""
 
     rows: tuple[str, ...]
-    lut: NDArray[np.float64]
+    texels: NDArray[np.float64]
 
 
 @dataclass(frozen=True)
@@ -188,7 +188,7 @@ def engine_tiers(engine: str) -> tuple[str, ...]:
 
 def _eevee_film_lobes(fit: Any) -> tuple[str, ...]:
     """The film gloss's second lobe is a closure only where its fit kept two."""
-    second = np.any(fit.eevee_glossy["film_gloss_2"].lut)
+    second = np.any(fit.eevee_glossy["film_gloss_2"].weights)
     return ("film_gloss", "film_gloss_2") if second else ("film_gloss",)
 
 
@@ -217,7 +217,7 @@ LAYERED = register(Tier(
     fit=layered_parts, holds=lambda fit: fit.glossy is not None,
     shader=partial(view_weighted_shader, tinted_subsurface=True, film_lobes=("film_gloss",)),
     lobes=lambda fit: fit.glossy,
-    image=lambda fit: ViewImage(image_rows(LUT_ROWS, fit.slab is not None), fit.lut)))
+    image=lambda fit: ViewImage(image_rows(IMAGE_ROWS, fit.slab is not None), fit.view_rows)))
 """Glossy (film gloss, path-3 gloss, skin gloss; weights read from a view-angle image),
 Diffuse and Subsurface closures mixed by coverage
 (:func:`~lut_baker.closures.tier_formulas.view_weighted_closures`); the skin through the film
@@ -230,7 +230,7 @@ EEVEE = register(Tier(
     engines=("EEVEE",), fullness=0, fit_share=0.4,
     fit=eevee_parts, holds=lambda fit: fit.eevee_glossy is not None, shader=_eevee_shader,
     lobes=lambda fit: fit.eevee_glossy, image=lambda fit: ViewImage(
-        image_rows(EEVEE_LUT_ROWS, fit.slab is not None), fit.eevee_lut),
+        image_rows(EEVEE_IMAGE_ROWS, fit.slab is not None), fit.eevee_view_rows),
     glossy=_eevee_glossy, subsurface_method="BURLEY"))
 """The Layered tier's closures and mix made for EEVEE: every Glossy lobe GGX fitted as EEVEE
 renders it under a lamp (a linearly transformed cosine, :mod:`lut_baker.closures.eevee`), the

@@ -139,7 +139,7 @@ def tier_replica(fit: ClosureFit, tables: Tables, name: str | Tier, coverage: fl
     found = name if isinstance(name, Tier) else held(fit, name)
     wi, wo = tables.node_directions() if directions is None else directions
     image = found.image(fit)
-    rows = {} if image is None else dict(zip(image.rows, image.lut, strict=True))
+    rows = {} if image is None else dict(zip(image.rows, image.texels, strict=True))
     ops = NumpyShaders(wi, wo, rows, found.lobes(fit), found.glossy)
     value = np.asarray(found.shader(fit, _inputs(fit, coverage, absorption, gloss), ops, None))
     shape = np.broadcast_shapes(wi.shape, wo.shape)[:-1] + (3,)

@@ -19,14 +19,15 @@ def test_paper_fit_parameters_are_in_blender_ranges(paper_fit):
     assert 1.0 < paper_fit.coat.ior <= lobes.COAT_IOR_RANGE[1]
     for lobe in paper_fit.glossy.values():
         assert lobe.distribution in cc.GLOSSY_DISTRIBUTIONS
-        assert np.all(np.isfinite(lobe.lut)) and np.all(lobe.lut >= 0.0)
-    assert paper_fit.lut.shape == (len(view_image.LUT_ROWS), view_image.DEFAULT_LUT_SIZE, 3)
-    assert paper_fit.eevee_lut.shape == (len(view_image.EEVEE_LUT_ROWS),
-                                         view_image.DEFAULT_LUT_SIZE, 3)
-    assert np.all(paper_fit.eevee_lut >= 0.0)
+        assert np.all(np.isfinite(lobe.weights)) and np.all(lobe.weights >= 0.0)
+    assert paper_fit.view_rows.shape == (len(view_image.IMAGE_ROWS),
+                                         view_image.DEFAULT_IMAGE_SIZE, 3)
+    assert paper_fit.eevee_view_rows.shape == (len(view_image.EEVEE_IMAGE_ROWS),
+                                         view_image.DEFAULT_IMAGE_SIZE, 3)
+    assert np.all(paper_fit.eevee_view_rows >= 0.0)
     # The paper film's broad gloss takes two EEVEE lobes.
     film = paper_fit.eevee_glossy["film_gloss"]
-    assert np.any(paper_fit.eevee_glossy["film_gloss_2"].lut)
+    assert np.any(paper_fit.eevee_glossy["film_gloss_2"].weights)
     for lobe in paper_fit.eevee_glossy.values():
         assert lobes.ROUGHNESS_RANGE[0] <= lobe.roughness <= lobes.ROUGHNESS_RANGE[1]
     assert film.searched[lobes.PAIR] < (1.0 - lobes.DISTRIBUTION_MARGIN) * film.searched["GGX"]
@@ -45,7 +46,7 @@ def test_fit_is_linear_in_the_skin_albedo(paper_tables, paper_fit):
                                                              P_d=colour / np.pi))
     fit = fitting.fit_closures(bake.bake(other, "preview"))
     np.testing.assert_allclose(fit.skin_albedo, colour, rtol=1e-12)
-    np.testing.assert_array_equal(fit.lut, paper_fit.lut)
+    np.testing.assert_array_equal(fit.view_rows, paper_fit.view_rows)
     same, reference = fit.summary(), paper_fit.summary()
     for summary in (same, reference):
         summary.pop("errors")  # measured against each skin's own tables
@@ -90,9 +91,9 @@ def _assert_same_parts(fit, reference, tiers):
             assert values.pop("distribution", None) == reference_values.pop("distribution",
                                                                             None)
             assert values == pytest.approx(reference_values, rel=1e-9), (name, lobe)
-    for lut in ("lut", "eevee_lut"):
-        if getattr(fit, lut) is not None:
-            np.testing.assert_allclose(getattr(fit, lut), getattr(reference, lut), rtol=1e-9,
+    for rows in ("view_rows", "eevee_view_rows"):
+        if getattr(fit, rows) is not None:
+            np.testing.assert_allclose(getattr(fit, rows), getattr(reference, rows), rtol=1e-9,
                                        atol=1e-12)
     for tier in tiers:
         assert fit.errors[tier].rms == pytest.approx(reference.errors[tier].rms, rel=1e-9)
@@ -106,7 +107,7 @@ def test_a_fit_holds_the_tiers_asked_for_and_takes_more_later(paper_tables, pape
 
     layered = fitting.fit_closures(paper_tables, tiers=("LAYERED",))
     assert layered.tiers == ("LAYERED",) and set(layered.errors) == {"LAYERED"}
-    assert layered.coat is None and layered.eevee_glossy is None and layered.eevee_lut is None
+    assert layered.coat is None and layered.eevee_glossy is None and layered.eevee_view_rows is None
     with pytest.raises(ValueError, match="no EEVEE tier"):
         tier_registry.held(layered, "EEVEE")
     _assert_same_parts(layered, paper_fit, ("LAYERED",))
@@ -126,10 +127,10 @@ def test_a_fit_over_the_artists_shader_leaves_out_the_bare_skin(paper_tables, pa
                                errors_at=(1.0, 0.0))
     assert fit.profiles == {} and fit.subsurface_method == "RANDOM_WALK"
     assert fit.specular_bare.level == 0.0 and fit.specular_albedo_mean[0] == 0.0
-    assert not np.any(fit.glossy["skin_gloss"].lut)
+    assert not np.any(fit.glossy["skin_gloss"].weights)
     assert fit.coat.roughness == pytest.approx(paper_fit.coat.roughness, rel=1e-12)
     for name in ("film_gloss", "path3_gloss"):
-        np.testing.assert_allclose(fit.glossy[name].lut, paper_fit.glossy[name].lut,
+        np.testing.assert_allclose(fit.glossy[name].weights, paper_fit.glossy[name].weights,
                                    rtol=1e-12)
     reference = fitting.fit_closures(paper_tables, tiers=("PRINCIPLED", "LAYERED"),
                                      errors_at=(1.0, 0.0))
@@ -160,9 +161,9 @@ def test_a_slab_fit_shades_the_film_at_its_thickness(slab_tables, slab_fit):
     parts = slab_tables.slab.at(9.6, 0.0)
     assert np.allclose(slab_fit.transmittance_mean, parts.through_mean, rtol=1e-12)
     assert np.allclose(slab_fit.slab.below, parts.below, rtol=1e-12)
-    rows = view_image.LUT_ROWS + tier_parts.SLAB_ROWS
-    assert slab_fit.lut.shape == (len(rows), view_image.DEFAULT_LUT_SIZE, 3)
-    body = slab_fit.lut[rows.index("film_body")]
+    rows = view_image.IMAGE_ROWS + tier_parts.SLAB_ROWS
+    assert slab_fit.view_rows.shape == (len(rows), view_image.DEFAULT_IMAGE_SIZE, 3)
+    body = slab_fit.view_rows[rows.index("film_body")]
     assert np.all(body > 0.0) and np.all(body < 1.0)
     errors = slab_fit.errors
     # The paper's film on this skin: Layered 6.6% / 2.5%, EEVEE 10.3% / 3.6%, Principled 10.5%
