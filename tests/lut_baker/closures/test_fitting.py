@@ -20,7 +20,8 @@ def test_paper_fit_parameters_are_in_blender_ranges(paper_fit):
     for lobe in paper_fit.glossy.values():
         assert lobe.distribution in cc.GLOSSY_DISTRIBUTIONS
         assert np.all(np.isfinite(lobe.weights)) and np.all(lobe.weights >= 0.0)
-    assert paper_fit.view_rows.shape == (len(view_image.IMAGE_ROWS), view_image.DEFAULT_IMAGE_SIZE, 3)
+    assert paper_fit.view_rows.shape == (len(view_image.IMAGE_ROWS),
+                                         view_image.DEFAULT_IMAGE_SIZE, 3)
     assert paper_fit.eevee_view_rows.shape == (len(view_image.EEVEE_IMAGE_ROWS),
                                          view_image.DEFAULT_IMAGE_SIZE, 3)
     assert np.all(paper_fit.eevee_view_rows >= 0.0)
