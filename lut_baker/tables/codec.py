@@ -20,13 +20,15 @@ as Blender's pixel rows are; pixel ``(x, y)`` has its centre at texture coordina
   its blocks on its own grids (``K`` thicknesses, ``n`` polar, ``p`` azimuth nodes):
   ``slab_top``, ``K n`` rows, pixel ``(theta_o p + phi, row + k n + theta_i)``; ``slab_top_albedo``,
   ``slab_through``, ``slab_film_albedo``, ``K`` rows each, pixel ``(theta, row + k)``;
-  ``slab_through_mean`` and ``slab_below``, one row each, pixel ``(k, row)``.  The tables of
-  the paper's film have none, and their atlas and hash are those of every earlier version.
+  ``slab_through_mean``, ``slab_below`` and ``slab_body_gloss``, one row each, pixel
+  ``(k, row)``.  The tables of the paper's film have none, and their atlas and hash are those
+  of every earlier version.
 
 The sidecar data hold the format version, the layout (first row and row count of each block),
 the grids and their closed forms (the slab's under ``"slab"``: its thickness axis as
-:func:`~lut_baker.tables.slab_tables.thickness_nodes`' closed form, its angular grid, and the
-absorption baked into it), units, the made-up skin's parameters (with K) and
+:func:`~lut_baker.tables.slab_tables.thickness_nodes`' closed form, its angular grid, the
+absorption baked into it and the surface's share of the gloss), units, the made-up skin's
+parameters (with K) and
 ``sha256``, the hash of the atlas's float32 pixels in the row order above (C order,
 little-endian).
 
@@ -69,7 +71,8 @@ UNITS = {
     "profile": "1/mm^2",
     "K": "counts per second per unit albedo",
     "slab_top": "1/sr",
-    "slab_top_albedo, slab_through, slab_through_mean, slab_below, slab_film_albedo":
+    "slab_top_albedo, slab_through, slab_through_mean, slab_below, slab_film_albedo, "
+    "slab_body_gloss, slab surface_share":
         "dimensionless",
     "slab thickness_um": "micrometres",
 }
@@ -94,7 +97,7 @@ SLAB_ANGULAR = ("top",)
 """The slab's tables ``(K, n, n, p, 3)`` (blocks ``slab_<name>``)."""
 SLAB_DIRECTIONAL = ("top_albedo", "through", "film_albedo")
 """The slab's tables ``(K, n, 3)``."""
-SLAB_PER_THICKNESS = ("through_mean", "below")
+SLAB_PER_THICKNESS = ("through_mean", "below", "body_gloss")
 """The slab's tables ``(K, 3)``."""
 
 
@@ -211,14 +214,16 @@ def sidecar_data(tables: Tables, layout: dict, digest: str, image_name: str) -> 
 
 def _slab_grids(slab: SlabTables) -> dict:
     """The slab's grids in the sidecar: the thickness axis by its closed form (it ends in
-    ``inf``, which JSON does not hold), the angular grid and its spacings, the absorption."""
+    ``inf``, which JSON does not hold), the angular grid and its spacings, the absorption, the
+    surface's share of the gloss."""
     return {"thickness_nodes": int(slab.thickness_um.size),
             "thickness_min_um": float(slab.thickness_um[0]),
             "thickness_max_um": float(slab.thickness_um[-2]),
             "theta_deg": slab.theta_deg.tolist(), "phi_deg": slab.phi_deg.tolist(),
             "theta_spacing": slab.theta_spacing, "theta_offset": slab.theta_offset,
             "phi_spacing": slab.phi_spacing,
-            "absorption": np.asarray(slab.absorption, float).tolist()}
+            "absorption": np.asarray(slab.absorption, float).tolist(),
+            "surface_share": np.asarray(slab.surface_share, float).tolist()}
 
 
 def _stored_slab_shape(meta: dict) -> tuple[int, int, int] | None:
@@ -315,5 +320,6 @@ def _slab_from_atlas(pixels: np.ndarray, meta: dict) -> SlabTables | None:
         **{name: block(name, k, n) for name in SLAB_DIRECTIONAL},
         **{name: block(name, k) for name in SLAB_PER_THICKNESS},
         absorption=np.asarray(grids["absorption"], float),
+        surface_share=np.asarray(grids["surface_share"], float),
         theta_spacing=grids["theta_spacing"], theta_offset=float(grids["theta_offset"]),
         phi_spacing=grids["phi_spacing"])

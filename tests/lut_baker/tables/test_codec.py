@@ -46,8 +46,8 @@ def test_the_slab_goes_through_the_atlas(slab_baked):
     for name in codec.SLAB_ANGULAR + codec.SLAB_DIRECTIONAL + codec.SLAB_PER_THICKNESS:
         np.testing.assert_array_equal(getattr(loaded, name),
                                       np.asarray(getattr(slab, name), np.float32), err_msg=name)
-    for name in ("theta_deg", "phi_deg", "absorption", "theta_spacing", "theta_offset",
-                 "phi_spacing"):
+    for name in ("theta_deg", "phi_deg", "absorption", "surface_share", "theta_spacing",
+                 "theta_offset", "phi_spacing"):
         np.testing.assert_array_equal(getattr(loaded, name), getattr(slab, name))
     assert codec.content_hash(codec.tables_from_atlas(pixels, meta)) \
         == codec.content_hash(slab_baked)
