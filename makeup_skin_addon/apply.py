@@ -286,7 +286,7 @@ def engine_note(material: Any, tier: str, scene: Any, measured: dict | None = No
     (:data:`lut_baker.auto_tier.ENGINE_TIERS`), naming the tier that is and its angular error
     at the material's coverage (``measured``: :func:`.bakes.measure`); None when it is.  The
     group renders in either engine: nothing is changed."""
-    engine = tier_choice.render_engine(scene)
+    engine = artist_skin.render_engine(scene)
     if tier in auto_tier.ENGINE_TIERS[engine]:
         return None
     suited = auto_tier.ENGINE_TIERS[engine][0]

@@ -154,7 +154,9 @@ GROUP_PREFIX = "Made-up Skin"
 METHOD_LABELS = {"BURLEY": "Burley", "RANDOM_WALK": "RW", "RANDOM_WALK_SKIN": "RW Skin"}
 """A forced subsurface method's part of a group name."""
 VIEW_IMAGE_PREFIX = "MakeupSkin LUT "
-"""Start of every view-angle image name (:func:`view_image_name`)."""
+"""Start of every view-angle image name (:func:`view_image_name`). Stored in files: it keeps
+the word the add-on used for these images from the start, so the images of files made before
+are still found (and reused, or removed with their group)."""
 
 
 OVER_LABEL = "over Shader"

@@ -33,6 +33,7 @@ from numpy.typing import NDArray
 from ..tables.table_set import Tables
 from . import cycles as cc
 from .closure_fit import ClosureFit, SlabFit
+from .lobes import LobeFit
 from .profiles import REPLICA_EDGE_ERROR, fit_profiles
 from .tier_parts import FitTargets, cosine_mean, held_gloss_to_diffuse
 from .tier_registry import TIERS, Tier, tier
@@ -79,7 +80,7 @@ def _film_parts(targets: FitTargets) -> dict[str, Any]:
                 "film_albedo": np.pi * np.asarray(tables.film_diffuse, float)}
     parts = targets.slab_parts(0.0)
     return {"transmittance_mean": np.asarray(parts.through_mean, float),
-            "film_albedo": np.asarray(targets.film_mean(), float),
+            "film_albedo": np.asarray(targets.base_mean(), float),
             "slab": SlabFit(thickness_um=float(targets.thickness_um),
                             below=np.asarray(parts.below, float))}
 
@@ -168,6 +169,14 @@ def _scaled_row(row: NDArray[np.float64], old: NDArray[np.float64],
     return np.where(old > 0.0, row * new / np.where(old > 0.0, old, 1.0), 0.0)
 
 
+def _film_gloss_scaled(lobe: LobeFit, ratio: NDArray[np.float64]) -> LobeFit:
+    """The film's gloss lobe with its weight rows (and its Lambertian companion's) times
+    ``ratio`` (RGB): the body's share of the gloss at another thickness."""
+    return replace(lobe, weights=None if lobe.weights is None else lobe.weights * ratio,
+                   diffuse_weights=(None if lobe.diffuse_weights is None
+                                    else lobe.diffuse_weights * ratio))
+
+
 def at_thickness(fit: ClosureFit, tables: Tables, thickness_um: float) -> ClosureFit:
     """``fit`` (of ``tables``, with the film as a slab) at another thickness, without fitting:
     the lobes' shapes (roughnesses, distributions, the film gloss's rows, the coat) kept, and
@@ -177,8 +186,9 @@ def at_thickness(fit: ClosureFit, tables: Tables, thickness_um: float) -> Closur
     a view-angle image, :attr:`~lut_baker.closures.tier_registry.Tier.image`, and the
     Principled specular level scaled by its albedo's change; the Principled base colour's
     share held on the fit's skin, :func:`~lut_baker.closures.tier_parts.
-    held_gloss_to_diffuse`).  The errors are not measured again (dropped).  Milliseconds:
-    what a Thickness slider costs (``bench/slab_tiers.py``)."""
+    held_gloss_to_diffuse`), the film's gloss rows scaled by its weight's change (the body's
+    share of the gloss; the Principled coat is kept).  The errors are not measured again
+    (dropped).  Milliseconds: what a Thickness slider costs (``bench/slab_tiers.py``)."""
     if fit.slab is None:
         raise ValueError("a fit of the paper's film has no thickness")
     imaged = [(each, image) for each in map(tier, fit.tiers)
@@ -200,6 +210,7 @@ def at_thickness(fit: ClosureFit, tables: Tables, thickness_um: float) -> Closur
             "coat": fit.coat, "specular_film": specular,
             "coat_albedo_mean": fit.coat_albedo_mean,
             "specular_albedo_mean": fit.specular_albedo_mean})
+    film_ratio = new.gloss_weight() / np.maximum(old.gloss_weight(), 1e-300)
     for each, image in imaged:
         if each.with_image is None:
             raise ValueError(f"the {each.label} tier's image cannot be moved to another "
@@ -210,10 +221,18 @@ def at_thickness(fit: ClosureFit, tables: Tables, thickness_um: float) -> Closur
             raise AssertionError("a tier's Glossy lobes with an image have their rows")
         lobes = {**lobes, "path3_gloss": replace(path3, weights=_scaled_row(
             path3.weights, old.texel_rows(theta, gloss_old), new.texel_rows(theta, gloss_new)))}
+        lobes.update({name: _film_gloss_scaled(lobes[name], film_ratio)
+                      for name in ("film_gloss", "film_gloss_2") if name in lobes})
         texels = np.array(image.texels)
-        for name, row in (("path3_gloss", lobes["path3_gloss"].weights),
-                          ("film_transmittance", new.transmittance_rows()),
-                          ("film_body", new.body_rows())):
+        rows: dict[str, Any] = {"path3_gloss": lobes["path3_gloss"].weights,
+                                "film_transmittance": new.transmittance_rows(),
+                                "film_body": new.body_rows(),
+                                **{name: lobes[name].weights
+                                   for name in ("film_gloss", "film_gloss_2")
+                                   if name in lobes and name in image.rows}}
+        if lobes["film_gloss"].diffuse_weights is not None and "film_gloss_diffuse" in image.rows:
+            rows["film_gloss_diffuse"] = lobes["film_gloss"].diffuse_weights
+        for name, row in rows.items():
             texels[image.rows.index(name)] = row
         changes.update(each.with_image(lobes, texels))
     return replace(fit, **changes)

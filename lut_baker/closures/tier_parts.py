@@ -91,9 +91,10 @@ class FitTargets:
     image.
 
     Tables with the film as a slab (``tables.slab``, docs/model.md "The tiers at a
-    thickness") are fitted at their baked thickness (``thickness_um``): ``path3_gloss`` is
-    then the slab's ``top`` less the film's body (Lambertian in the Layered and EEVEE tiers'
-    reading: ``alpha(theta_i) alpha(theta_o) / (pi alpha_mean)``, its directional albedo the
+    thickness") are fitted at their baked thickness (``thickness_um``): ``film_gloss`` is then
+    the film surface's share of it (:func:`lut_baker.tables.slab_tables.surface_gloss`),
+    ``path3_gloss`` the slab's ``top`` less the film's body (Lambertian in the Layered and EEVEE
+    tiers' reading: ``alpha(theta_i) alpha(theta_o) / (pi alpha_mean)``, its directional albedo the
     film's ``alpha``), the skin's gloss through the film every order; the transmittance rows
     are the slab's ``t`` and the film's body has rows of its own (``film_body``).
     ``thickness_um``: another thickness than the baked one.  ``skin_albedo`` (RGB, diffuse
@@ -136,18 +137,65 @@ class FitTargets:
         """The slab's 1-D parts at the fit's thickness and polar angles ``theta_deg``."""
         return self.slab_tables().at(self.thickness_um, theta_deg)
 
+    def gloss_weight(self) -> NDArray[np.float64]:
+        """The weight of eq. 2's gloss lobe (the tables' ``film_gloss``) the tiers draw as the
+        film's gloss, RGB: the surface's share and, with the film as a slab, the body's at the
+        fit's thickness (``SlabTables.body_gloss``)."""
+        if self.slab is None:
+            return np.ones(3)
+        return self.slab.surface_share + self.slab_parts(0.0).body_gloss
+
+    def body_albedo(self, theta_deg: ArrayLike) -> NDArray[np.float64]:
+        """The film body's directional albedo without its share of the gloss (what its Diffuse
+        closure draws), ``(..., 3)`` at ``theta_deg``: the film's own albedo less the body's
+        gloss lobe's (slab only)."""
+        parts = self.slab_parts(theta_deg)
+        lobe = self.tables.directional("film_gloss_albedo", theta_deg)
+        return np.maximum(parts.film_albedo - parts.body_gloss * lobe, 0.0)
+
     def film_body(self, wi: NDArray[np.float64],
                   wo: NDArray[np.float64]) -> NDArray[np.float64]:
-        """The film's body as the tiers draw it (class docstring), 1/sr ``(..., 3)``."""
+        """The film's body as the tiers draw it (class docstring), 1/sr ``(..., 3)``: its
+        share of the gloss (:meth:`gloss_weight`, the surface's left out) and the rest read
+        Lambertian."""
         def albedo(w: NDArray[np.float64]) -> NDArray[np.float64]:
-            return self.slab_parts(polar_angle_deg(w)).film_albedo
-        return albedo(wi) * albedo(wo) / (np.pi * np.maximum(self.film_mean(), 1e-12))
+            return self.body_albedo(polar_angle_deg(w))
+        body_gloss = self.slab_parts(0.0).body_gloss
+        return (albedo(wi) * albedo(wo) / (np.pi * np.maximum(self.film_mean(), 1e-12))
+                + body_gloss * self.tables.surface_gloss("film_gloss", wi, wo))
 
     def film_mean(self) -> NDArray[np.float64]:
-        """The film body's albedo under uniform light (RGB): ``2 Int alpha mu dmu``."""
+        """The film body's albedo under uniform light without its gloss (RGB): ``2 Int alpha
+        mu dmu``."""
         theta = self.slab_tables().theta_deg
-        return self._once("film_mean", lambda: cosine_mean(
-            self.slab_parts(theta).film_albedo, theta))
+        return self._once("film_mean", lambda: cosine_mean(self.body_albedo(theta), theta))
+
+    def coat_weight(self) -> NDArray[np.float64]:
+        """The weight of eq. 2's gloss lobe the Principled tier's coat (achromatic) draws, RGB:
+        the surface's share and, with the film as a slab, the body's share in its weakest
+        channel (what absorption leaves in every channel)."""
+        if self.slab is None:
+            return np.ones(3)
+        weight = self.slab.surface_share + np.min(self.slab_parts(0.0).body_gloss)
+        return np.broadcast_to(weight, (3,))
+
+    def base_mean(self) -> NDArray[np.float64]:
+        """The film's own albedo under uniform light less what the coat draws of the body's
+        gloss (RGB; slab only): what the Principled tier's base colour holds of the film."""
+        theta = self.slab_tables().theta_deg
+        lobe = self.tables.directional("film_gloss_albedo", theta)
+        extra = (self.coat_weight() - self.slab_tables().surface_share) * lobe
+        return cosine_mean(self.slab_parts(theta).film_albedo - extra, theta)
+
+    def coat_target(self) -> tuple[ViewGrid, NDArray[np.float64]]:
+        """``(grid, table)`` the Principled tier's coat is fitted to: the film's gloss at
+        :meth:`coat_weight` (the rest of the body's gloss, coloured by absorption, is in the
+        base colour, :meth:`base_mean`)."""
+        if self.slab is None:
+            return self.target("film_gloss")
+        grid = self.grid("film_gloss")
+        return grid, self.coat_weight() * self.tables.surface_gloss("film_gloss",
+                                                                    *grid.directions)
 
     def target(self, name: str) -> tuple[ViewGrid, NDArray[np.float64]]:
         """``(grid, table)`` of a gloss part: ``film_gloss`` on the film's grid,
@@ -161,6 +209,9 @@ class FitTargets:
                                   - self.film_body(wi, wo))
                 return grid, self.tables.angular(name, *grid.directions)
             grid = self.grid(name)
+            if name == "film_gloss" and self.slab is not None:
+                return grid, self.gloss_weight() * self.tables.surface_gloss(name,
+                                                                             *grid.directions)
             return grid, self.tables.surface_gloss(name, *grid.directions)
         return self._once(("target", name), compute)
 
@@ -170,6 +221,8 @@ class FitTargets:
         if name == "path3_gloss" and self.slab is not None:
             parts = self.slab_parts(self.slab.theta_deg)
             return np.maximum(parts.top_albedo - parts.film_albedo, 0.0)
+        if name == "film_gloss" and self.slab is not None:
+            return self.gloss_weight() * np.asarray(self.tables.film_gloss_albedo, float)
         return np.asarray(getattr(self.tables, name + "_albedo"))
 
     def albedo_theta(self, name: str) -> NDArray[np.float64]:
@@ -200,7 +253,7 @@ class FitTargets:
         """The film body's directional albedo at the texels, ``(size, 3)`` (slab only)."""
         def compute() -> NDArray[np.float64]:
             theta = np.asarray(self.slab_tables().theta_deg, dtype=np.float64)
-            return self.texel_rows(theta, self.slab_parts(theta).film_albedo)
+            return self.texel_rows(theta, self.body_albedo(theta))
         return self._once("body_rows", compute)
 
 
@@ -213,7 +266,7 @@ def _left_out_glossy(size: int) -> LobeFit:
 def principled_parts(targets: FitTargets, over_shader: bool) -> dict[str, Any]:
     """The PRINCIPLED tier's parts of a :class:`ClosureFit`: the coat, the two speculars (over
     the artist's shader the bare one left out: level 0) and their mean layering albedos."""
-    film_grid, film_gloss = targets.target("film_gloss")
+    film_grid, film_gloss = targets.coat_target()
     skin_grid, path3 = targets.target("path3_gloss")
     coat = fit_coat(film_grid, film_gloss)
     coat_ior = coat.ior

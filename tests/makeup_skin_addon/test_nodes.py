@@ -180,8 +180,8 @@ def test_view_angle_rows_read_in_eevee_as_in_cycles(addon, paper_tables):
     normals, mask = sphere_normals(size)
     expected = np.zeros((size, size, 3))
     row = "film_transmittance"  # non-zero at every view: the error is relative to it
-    expected[mask] = view_image.sample_row(fit.eevee_view_rows[view_image.EEVEE_IMAGE_ROWS.index(row)],
-                                           np.clip(normals[mask][:, 2], 0, 1))
+    texels = fit.eevee_view_rows[view_image.EEVEE_IMAGE_ROWS.index(row)]
+    expected[mask] = view_image.sample_row(texels, np.clip(normals[mask][:, 2], 0, 1))
     errors = {}
     for linear in (False, True):
         material = bpy.data.materials.new(f"row probe {linear}")

@@ -4,7 +4,7 @@ does, or through the pipeline), render, and read node trees and images back.
 - :data:`SPHERE_PX`, :data:`HEAD_PX` -- render sizes of the sphere and the head scenes
   (tests/makeup_skin_addon/conftest.py's ``sphere`` and ``head``).
 - :func:`apply_operator` -- ``bpy.ops.makeup_skin.apply()`` on an object with preview tables.
-- :func:`apply_pipeline` -- :func:`makeup_skin_addon.material.apply_to_object`; returns the
+- :func:`apply_pipeline` -- :func:`makeup_skin_addon.apply.apply_to_object`; returns the
   material and the warnings it reported.
 - :func:`render` -- render the scene to a float EXR and return its RGB pixels.
 - :func:`tree_state` -- a material's nodes and links, comparable.
@@ -47,7 +47,7 @@ def apply_operator(obj, tier="LAYERED", **settings):
 
 
 def apply_pipeline(obj, tier="PRINCIPLED", resolution="preview", **settings):
-    """Apply through :func:`makeup_skin_addon.material.apply_to_object` (a new material
+    """Apply through :func:`makeup_skin_addon.apply.apply_to_object` (a new material
     ``Skin`` if the object has none): ``(material, messages)``, the operator's reports
     (warnings only)."""
     import bpy
@@ -88,7 +88,9 @@ def view_images():
     """The add-on's view-angle images in the file."""
     import bpy
 
-    return [image for image in bpy.data.images if image.name.startswith("MakeupSkin LUT")]
+    from makeup_skin_addon.keys import VIEW_IMAGE_PREFIX
+
+    return [image for image in bpy.data.images if image.name.startswith(VIEW_IMAGE_PREFIX)]
 
 
 def counts():

@@ -152,4 +152,5 @@ def test_fit_glossy_pair_of_no_gloss_is_empty():
     theta = np.linspace(0.0, 90.0, 10)
     first, second = lobes.fit_glossy_pair(grid, np.zeros(grid.cos_i.shape), np.zeros((10, 3)),
                                           theta)
-    assert not np.any(first.weights) and not np.any(first.diffuse_weights) and not np.any(second.weights)
+    assert not np.any(first.weights) and not np.any(first.diffuse_weights)
+    assert not np.any(second.weights)
