@@ -319,7 +319,8 @@ def held_gloss_to_diffuse(targets: FitTargets, parts: dict[str, Any]) -> NDArray
     colour the same on any skin, so a relative error that grows as the skin darkens.  With
     ``parts``' coat and film specular (coverage 1) the Principled BSDF's colour is ``G + W
     base`` (:func:`lut_baker.closures.cycles.principled_uniform`); the base colour the node
-    group makes is ``(skin + film + x) / D`` (``D`` the mean attenuation it divides by,
+    group makes is ``(skin + film + x) / D`` (``film`` the film's own albedo less what the coat
+    draws, :meth:`FitTargets.base_mean`; ``D`` the mean attenuation it divides by,
     :func:`~lut_baker.closures.tier_formulas.principled_sockets`), so ``x = (E - G) D / W -
     skin - film``, ``E`` the slab's colour (:func:`lut_baker.tables.slab_tables.slab_colour`)."""
     coat, specular = parts["coat"], parts["specular_film"]
@@ -333,7 +334,7 @@ def held_gloss_to_diffuse(targets: FitTargets, parts: dict[str, Any]) -> NDArray
     skin = a * np.square(below.through_mean) / (1.0 - a * below.below)
     divided = ((1.0 - float(coat.level) * float(parts["coat_albedo_mean"]))
                * (1.0 - float(parts["specular_albedo_mean"][1])))
-    return (exact - gloss) * divided / max(passed, 1e-12) - skin - targets.film_mean()
+    return (exact - gloss) * divided / max(passed, 1e-12) - skin - targets.base_mean()
 
 
 def image_rows(rows: tuple[str, ...], slab: bool) -> tuple[str, ...]:
