@@ -23,6 +23,7 @@ evaluate) is a warning that says what the made-up skin uses instead.
 - :class:`SkinReading` -- all of it.
 - :func:`read_skin` -- read it from a shader tree at a surface's samples.
 - :func:`read_material` -- read it from a material (its surface sampled, the scene's engine).
+- :func:`render_engine` -- ``CYCLES`` or ``EEVEE``: the scene's engine as the model names it.
 """
 
 from __future__ import annotations
@@ -36,7 +37,7 @@ from . import artist_shader, convert, skin_sampling, surface_values
 from .artist_shader import Leaf, Source, source
 from .core import principled_albedo
 
-__all__ = ["SkinReading", "LeafReading", "read_skin", "read_material", "engine_of",
+__all__ = ["SkinReading", "LeafReading", "read_skin", "read_material", "render_engine",
            "PRINCIPLED_LEFT_OUT"]
 
 PRINCIPLED_LEFT_OUT = (
@@ -229,10 +230,14 @@ def read_skin(tree, samples, engine: str = "CYCLES") -> SkinReading:
     return reading
 
 
-def engine_of(scene) -> str:
-    """``"EEVEE"`` when ``scene`` renders with EEVEE, else ``"CYCLES"``."""
+def render_engine(scene) -> str:
+    """``"CYCLES"`` when ``scene`` renders with Cycles (or there is no scene), else ``"EEVEE"``
+    (``BLENDER_EEVEE`` in 5.0, ``BLENDER_EEVEE_NEXT`` in 4.2-4.5; Workbench counts as EEVEE: it
+    does not render the material, and its Material Preview is EEVEE). The name the Auto tier
+    and the tier registry give the engine, and the engine whose BSDFs the artist's shader is
+    read as."""
     engine = scene.render.engine if scene is not None else "CYCLES"
-    return "EEVEE" if engine.startswith("BLENDER_EEVEE") else "CYCLES"
+    return "CYCLES" if engine == "CYCLES" else "EEVEE"
 
 
 def read_material(material, scene=None, progress=None) -> SkinReading | None:
@@ -245,4 +250,4 @@ def read_material(material, scene=None, progress=None) -> SkinReading | None:
         return None
     scene = scene if scene is not None else bpy.context.scene
     samples = skin_sampling.surface_samples(material, progress=progress, scene=scene)
-    return read_skin(tree, samples, engine_of(scene))
+    return read_skin(tree, samples, render_engine(scene))

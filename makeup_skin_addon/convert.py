@@ -51,9 +51,9 @@ from .keys import (
     FRAME_LABEL,
     FRAME_NAME,
     GROUP_NODE,
-    LUT_PREFIX,
     OWNED_KEY,
     RECORD_KEY,
+    VIEW_IMAGE_PREFIX,
 )
 
 __all__ = ["Installed", "group_node", "linked_library", "material_output", "artist_tree",
@@ -261,7 +261,7 @@ def _remove_unused(group) -> list[str]:
     bpy.data.node_groups.remove(group)
     for name in images:
         image = bpy.data.images.get(name or "")
-        if image is not None and image.name.startswith(LUT_PREFIX) and image.users == 0:
+        if image is not None and image.name.startswith(VIEW_IMAGE_PREFIX) and image.users == 0:
             removed.append(image.name)
             bpy.data.images.remove(image)
     return removed

@@ -46,7 +46,7 @@ group"; Apply finds groups and images by name and reuses them):
   removes exactly these; :data:`SKIN_FRAME_NAME`, :data:`SKIN_FRAME_LABEL` -- their frame.
 - :func:`group_name` -- ``Made-up Skin <Tier> [<method>] <key>`` (:data:`GROUP_PREFIX`,
   the tier's label, :data:`METHOD_LABELS`).
-- :func:`lut_image_name` -- ``MakeupSkin LUT <Tier> <key>`` (:data:`LUT_PREFIX`).
+- :func:`view_image_name` -- ``MakeupSkin LUT <Tier> <key>`` (:data:`VIEW_IMAGE_PREFIX`).
 """
 
 from __future__ import annotations
@@ -77,9 +77,9 @@ __all__ = [
     "OVER_LABEL",
     "GROUP_PREFIX",
     "METHOD_LABELS",
-    "LUT_PREFIX",
+    "VIEW_IMAGE_PREFIX",
     "group_name",
-    "lut_image_name",
+    "view_image_name",
 ]
 
 # --- identifiers ---------------------------------------------------------------------------
@@ -153,8 +153,10 @@ GROUP_PREFIX = "Made-up Skin"
 """Start of every node group name (:func:`group_name`)."""
 METHOD_LABELS = {"BURLEY": "Burley", "RANDOM_WALK": "RW", "RANDOM_WALK_SKIN": "RW Skin"}
 """A forced subsurface method's part of a group name."""
-LUT_PREFIX = "MakeupSkin LUT "
-"""Start of every view-angle image name (:func:`lut_image_name`)."""
+VIEW_IMAGE_PREFIX = "MakeupSkin LUT "
+"""Start of every view-angle image name (:func:`view_image_name`). Stored in files: it keeps
+the word the add-on used for these images from the start, so the images of files made before
+are still found (and reused, or removed with their group)."""
 
 
 OVER_LABEL = "over Shader"
@@ -172,6 +174,6 @@ def group_name(tier_label: str, key: str, method: str | None = None,
     return f"{GROUP_PREFIX} {tier_label}{label}{over} {key[:8]}"
 
 
-def lut_image_name(key: str, tier_label: str) -> str:
+def view_image_name(key: str, tier_label: str) -> str:
     """``MakeupSkin LUT <Tier> <key>``: the name of a tier's view-angle image."""
-    return f"{LUT_PREFIX}{tier_label} {key[:16]}"
+    return f"{VIEW_IMAGE_PREFIX}{tier_label} {key[:16]}"

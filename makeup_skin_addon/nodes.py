@@ -27,7 +27,7 @@ allocated (a Glossy closure of colour 0, ``bsdf_alloc``; a Principled BSDF's coa
 painted coverage fades out without fringe or halo.
 
 A tier's view-angle rows (:attr:`~lut_baker.closures.tier_registry.Tier.image`) are read by
-:func:`_lut_rows` as :func:`lut_baker.closures.view_image.read_row` reads them: two Closest
+:func:`_read_rows` as :func:`lut_baker.closures.view_image.read_row` reads them: two Closest
 lookups at neighbouring texel centres mixed linearly, which is what a Linear lookup gives in
 Cycles; EEVEE samples a Linear image through mipmaps and anisotropic filtering, which mixes the
 image's rows wherever ``cos(theta_o)`` changes quickly across the screen (docs/addon.md, "Why
@@ -50,7 +50,7 @@ import numpy as np
 
 from . import keys, storage
 from .core import tier_formulas, tier_registry, view_image
-from .keys import FIT_KEY, LEGACY_TABLES_REF, lut_image_name
+from .keys import FIT_KEY, LEGACY_TABLES_REF, view_image_name
 from .node_algebra import Builder, Mismatch, NodeAlgebra, NodeShaders, NodeValue, socket
 
 __all__ = ["INPUTS", "OVER_SHADER_INPUTS", "NORMAL_INPUTS", "build_group", "group_name",
@@ -227,8 +227,8 @@ def _finish(build: Builder, inputs, output, shader, over: bool) -> None:
     build.link(shader, output.inputs["Shader"])
 
 
-def _lut_rows(build: Builder, lut, names: tuple, coordinates: dict, bounds) -> dict:
-    """Every row of the view-angle image ``lut`` (rows named ``names``), read at
+def _read_rows(build: Builder, datablock, names: tuple, coordinates: dict, bounds) -> dict:
+    """Every row of the view-angle image ``datablock`` (rows named ``names``), read at
     ``u = coordinates[name]`` (a socket per row name) as
     :func:`lut_baker.closures.view_image.read_row` reads it: two Closest lookups mixed, so
     that EEVEE reads what Cycles does (its Linear filter goes through mipmaps, which mix
@@ -236,7 +236,7 @@ def _lut_rows(build: Builder, lut, names: tuple, coordinates: dict, bounds) -> d
     range as baked (``bounds``): an image damaged in a file read where the add-on cannot
     repair it (a render farm) renders wrong, not blown out.  Colour :class:`NodeValue` by row
     name."""
-    size = lut.size[0]
+    size = datablock.size[0]
     algebra = NodeAlgebra(build)
     pairs: dict = {}
     rows = {}
@@ -251,7 +251,7 @@ def _lut_rows(build: Builder, lut, names: tuple, coordinates: dict, bounds) -> d
             coordinate = build.node("ShaderNodeCombineXYZ", f"row {name}, texel {k}")
             build.feed(coordinate.inputs["X"], at)
             build.feed(coordinate.inputs["Y"], (j + 0.5) / len(names))
-            texture = build.node("ShaderNodeTexImage", name, image=lut,
+            texture = build.node("ShaderNodeTexImage", name, image=datablock,
                                  interpolation="Closest", extension="EXTEND")
             build.link(coordinate.outputs[0], texture.inputs["Vector"])
             return NodeValue(build, texture.outputs["Color"], True)
@@ -263,11 +263,11 @@ def _lut_rows(build: Builder, lut, names: tuple, coordinates: dict, bounds) -> d
     return rows
 
 
-def _build(build: Builder, tier, fit, image, lut, method: str, radius_mm, ior: float,
+def _build(build: Builder, tier, fit, image, datablock, method: str, radius_mm, ior: float,
            over: bool) -> None:
     """``tier``'s shader (:attr:`lut_baker.closures.tier_registry.Tier.shader`) emitted as
     nodes (:class:`.node_algebra.NodeShaders`): its view-angle ``image`` (or None) read from
-    the image datablock ``lut`` at the view angle against the normal of the surface each row
+    the image datablock ``datablock`` at the view angle against the normal of the surface each row
     describes; over the artist's shader at full coverage, its subsurface the artist's radius
     and weight, mixed with the Skin Shader by Coverage (:func:`_finish`)."""
     inputs, output, x, (radius, scale) = _group_io(build, over)
@@ -277,9 +277,9 @@ def _build(build: Builder, tier, fit, image, lut, method: str, radius_mm, ior: f
         geometry = build.node("ShaderNodeNewGeometry")
         cosines = {surface: _cos_view(build, normal, geometry, f"cos theta_o ({surface})")
                    for surface, normal in normals.items()}
-        rows = _lut_rows(build, lut, image.rows, {
+        rows = _read_rows(build, datablock, image.rows, {
             name: cosines[tier_formulas.ROW_SURFACE.get(name, "film")] for name in image.rows},
-            np.max(np.asarray(image.lut, float), axis=1))
+            np.max(np.asarray(image.texels, float), axis=1))
     shaders = NodeShaders(build, rows, lobes=tier.lobes(fit), normals=normals, subsurface=(
         method, radius if over else tuple(map(float, radius_mm)), scale, ior))
     weight = NodeValue(build, inputs.outputs["Subsurface Weight"], False) if over else None
@@ -329,13 +329,13 @@ def build_group(tier: str, record: dict, fit, group=None, *, method=None, measur
     method = method or found.subsurface_method or fit.subsurface_method
     # Over the artist's shader the radius is theirs (a fit for it may have no profiles).
     radius = None if over else fit.profiles[method].radius_mm
-    image, lut, images = found.image(fit), None, []
+    image, datablock, images = found.image(fit), None, []
     if image is not None:
-        lut = storage.view_image(lut_image_name(key, found.label), image.lut)
-        images.append(storage.image_record(lut))
+        datablock = storage.view_image(view_image_name(key, found.label), image.texels)
+        images.append(storage.image_record(datablock))
 
     def emit(build):
-        _build(build, found, fit, image, lut, method, radius, fit.subsurface_ior, over)
+        _build(build, found, fit, image, datablock, method, radius, fit.subsurface_ior, over)
     _emit(group, emit, reuse)
     group[FIT_KEY] = json.dumps({**record, "tier": tier, "forced_method": forced,
                                  "over_shader": over,

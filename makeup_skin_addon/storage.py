@@ -5,7 +5,7 @@ The images a group reads (the Layered and EEVEE tiers' view-angle image) are pac
 group records the SHA-256 of their pixels and of their packed bytes (:func:`image_record`), so
 damage is found before Blender decodes the image (:func:`image_problem`).
 
-- :func:`view_image` -- a tier's view-angle image (named by :func:`.keys.lut_image_name`).
+- :func:`view_image` -- a tier's view-angle image (named by :func:`.keys.view_image_name`).
 - :func:`image_record`, :func:`image_problem` -- an image's hashes, and what is wrong with it;
   :func:`image_problems` for a group's images.
 - :func:`write_pixels` -- pixels into an image, packed.

@@ -12,7 +12,6 @@ coverage and absorption (kept in its group's record, :mod:`.bakes`).
   measurement); :func:`fitted_tiers` -- the tiers Apply fits: the scene engine's and the
   settings' own; :func:`forced_method` -- the subsurface method the settings force.
 - :func:`units_per_mm` -- scene units in one millimetre, from the scene's unit scale.
-- :func:`render_engine` -- ``CYCLES`` or ``EEVEE``, as the Auto tier names the scene's engine.
 - :func:`describe_scene` -- the scene as the model sees it (None without a camera or object).
 - :func:`material_traits` -- the material as the model sees it.
 - :func:`choose_with` -- the choice for a material of given traits in a scene (Apply's Auto
@@ -39,11 +38,12 @@ from dataclasses import dataclass
 from typing import Any
 
 from . import bakes, convert, nodes
+from .artist_skin import render_engine
 from .core import auto_tier, closure_fit, tiers
 from .keys import CHOICE_KEY, SAVED_GLOSS_KEY, SAVED_SCALE_KEY
 
 __all__ = ["ENVIRONMENT_LIGHT_DEG", "resolve_tier", "auto_choice", "fitted_tiers",
-           "forced_method", "units_per_mm", "render_engine", "describe_scene",
+           "forced_method", "units_per_mm", "describe_scene",
            "material_traits", "choose_with", "choose_for", "ChoiceScene", "choice_scene",
            "set_choice", "record_choice", "last_choice", "register", "unregister"]
 
@@ -95,12 +95,6 @@ def units_per_mm(scene) -> float:
     metres gives 0.001, one modelled in centimetres with scale 0.01 gives 0.1)."""
     scale = float(scene.unit_settings.scale_length) or 1.0
     return 0.001 / scale
-
-
-def render_engine(scene) -> str:
-    """``CYCLES`` for Cycles, else ``EEVEE`` (``BLENDER_EEVEE`` in 5.0, ``BLENDER_EEVEE_NEXT``
-    in 4.2-4.5; Workbench counts as EEVEE)."""
-    return "CYCLES" if scene.render.engine == "CYCLES" else "EEVEE"
 
 
 def _samples(scene) -> tuple[int, bool]:

@@ -23,7 +23,8 @@ class SlabFit:
     thickness"): ``thickness_um`` (the thickness it was fitted at) and ``below`` (RGB, ``c``:
     the film's reflectance seen from the skin, the skin's diffuse light ``a t t / (1 - a c)``).
     The fit's ``transmittance_mean`` is then the slab's ``t`` averaged over uniform light and
-    its ``film_albedo`` the film body's albedo under uniform light.  ``skin_under`` (RGB, or
+    its ``film_albedo`` the film body's albedo under uniform light (its share of the gloss
+    included: the Principled tier's base colour holds it).  ``skin_under`` (RGB, or
     None for 1): the skin's albedo under the film relative to Skin Color, where Match Skin
     darkens it (a sheer film whose gloss alone adds more than full absorption takes away,
     docs/model.md "Made-up skin at a thickness")."""
@@ -47,10 +48,10 @@ class ClosureFit:
     ``specular_albedo_mean`` (bare, film): the cosine-weighted mean layering albedos;
     ``gloss_to_diffuse`` (RGB): the path-3 gloss albedo the base colour carries when no
     specular lobe fits it (else 0).  LAYERED: ``glossy`` (film_gloss, path3_gloss, skin_gloss:
-    Glossy lobes with their weight rows) and ``lut`` (``(len(LUT_ROWS), size, 3)``: the
+    Glossy lobes with their weight rows) and ``view_rows`` (``(len(IMAGE_ROWS), size, 3)``: the
     view-angle image).  EEVEE: ``eevee_glossy`` (the same lobes, GGX as EEVEE renders it, the
-    film gloss in two: ``film_gloss`` and ``film_gloss_2``) and ``eevee_lut`` (their
-    view-angle image, rows :data:`lut_baker.closures.view_image.EEVEE_LUT_ROWS`); its
+    film gloss in two: ``film_gloss`` and ``film_gloss_2``) and ``eevee_view_rows`` (their
+    view-angle image, rows :data:`lut_baker.closures.view_image.EEVEE_IMAGE_ROWS`); its
     subsurface is Burley's.  ``extra``: the parts of tiers registered beyond these, by tier
     (:mod:`lut_baker.closures.tier_registry`).  ``slab``: a :class:`SlabFit` when the tables
     hold the film as a slab (the tiers then shade it at the fit's thickness, absorption baked
@@ -76,9 +77,9 @@ class ClosureFit:
     specular_albedo_mean: tuple[float, float] | None = None
     gloss_to_diffuse: NDArray[np.float64] | None = None
     glossy: dict[str, LobeFit] | None = None
-    lut: NDArray[np.float64] | None = None
+    view_rows: NDArray[np.float64] | None = None
     eevee_glossy: dict[str, LobeFit] | None = None
-    eevee_lut: NDArray[np.float64] | None = None
+    eevee_view_rows: NDArray[np.float64] | None = None
     errors: dict[str, Any] = field(default_factory=dict)  # TierError by tier
     extra: dict[str, Any] = field(default_factory=dict)
     slab: SlabFit | None = None

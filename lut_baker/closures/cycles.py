@@ -29,7 +29,8 @@ Functions
 - :func:`lambert_reflection` -- ``albedo / pi``.
 - :func:`view_table` -- a smooth function of the view cosine, tabulated and interpolated.
 - :func:`principled_reflection` -- the Principled BSDF's coat, specular and diffuse layers
-  (``svm_node_closure_bsdf``), for the inputs in :class:`PrincipledInputs`.
+  (``svm_node_closure_bsdf``), for the inputs in :class:`PrincipledInputs`;
+  :func:`principled_uniform` -- its colour under uniform light, split into gloss and base.
 - :func:`burley_profile` -- Christensen-Burley radial profile as Cycles scales it.
 - :func:`random_walk_scale` -- the measured radius factor that makes a Burley profile match a
   random walk's (Cycles' random walk is a Monte Carlo simulation with no closed form).
@@ -68,6 +69,7 @@ __all__ = [
     "microfacet_shadowing",
     "microfacet_reflection",
     "microfacet_from_cosines",
+    "principled_uniform",
     "dielectric_fss",
     "ggx_energy_compensation",
     "ggx_energy_scale",
@@ -527,6 +529,45 @@ def principled_reflection(wi: ArrayLike, wo: ArrayLike,
     a_c = np.clip(1.0 - inputs.coat_weight * terms[..., 1], 0.0, 1.0)
     return (inputs.coat_weight * (coat * terms[..., 0])[..., None]
             + a_c[..., None] * lower)
+
+
+def principled_uniform(inputs: PrincipledInputs, nodes: int = 24
+                       ) -> tuple[NDArray[np.float64], float]:
+    """``(gloss, W)`` of :func:`principled_reflection` under uniform white light: its colour
+    is ``gloss + W base_color`` (unclipped Base Color), ``gloss`` (RGB) its coat's and
+    specular's albedo, ``W`` what its layers leave the base, both ``2 Int (.) mu dmu`` over
+    the view (``nodes`` Gauss-Legendre nodes; each lobe's albedo by
+    :func:`microfacet_albedo`, so that a narrow lobe costs no finer grid)."""
+    mu, weight = gauss_legendre(nodes)
+    mean = 2.0 * weight * mu
+    eta, f0 = inputs.specular_eta_f0()
+    if eta == 1.0:
+        gloss, passed = np.zeros((mu.size, 3)), np.ones(mu.size)
+    else:
+        gloss = microfacet_albedo(mu, inputs.roughness,
+                                  lambda c: schlick_ior_fresnel(c, eta, f0)) * np.ones(3)
+        passed = 1.0 - np.max(np.atleast_2d(layering_albedo(
+            mu, inputs.roughness, eta, f0).T).T, axis=-1)
+    if inputs.coat_weight > 0.0:
+        coat, layered = _coat_uniform(float(inputs.coat_roughness), float(inputs.coat_ior),
+                                      nodes)
+        below = np.clip(1.0 - inputs.coat_weight * layered, 0.0, 1.0)
+        gloss = inputs.coat_weight * coat[:, None] + below[:, None] * gloss
+        passed = below * passed
+    return mean @ gloss, float(mean @ passed)
+
+
+@lru_cache(maxsize=64)
+def _coat_uniform(roughness: float, ior: float, nodes: int
+                  ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """The coat's compensated albedo and its layering albedo at :func:`principled_uniform`'s
+    view nodes (cached: a fit moved to another thickness keeps its coat)."""
+    mu, _ = gauss_legendre(nodes)
+    scale, layered = coat_view_terms(mu, roughness, ior)
+    albedo = scale * microfacet_albedo(mu, roughness, lambda c: dielectric_fresnel(c, ior))
+    albedo.setflags(write=False)
+    layered.setflags(write=False)
+    return albedo, layered
 
 
 VIEW_TABLE_SIZE = 64

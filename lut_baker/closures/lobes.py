@@ -31,7 +31,7 @@ from . import cycles as cc
 from . import eevee
 from .tier_formulas import SPECULAR_IOR
 from .view_grid import ViewGrid
-from .view_image import DEFAULT_LUT_SIZE, lut_nodes, sample_lut
+from .view_image import DEFAULT_IMAGE_SIZE, sample_row, texel_centres
 
 __all__ = ["LobeFit", "fit_coat", "fit_specular", "fit_glossy", "ROUGHNESS_RANGE",
            "FIT_XTOL", "DISTRIBUTION_MARGIN", "COAT_IOR_RANGE", "SPECULAR_LEVEL_RANGE",
@@ -71,9 +71,9 @@ class LobeFit:
 
     ``roughness``: Blender's Roughness; ``ior``: Coat IOR (coat) or the IOR whose F0 the
     Specular IOR Level sets (specular), None for a Glossy BSDF; ``level``: Specular IOR Level
-    (specular only; 0 when no lobe beats leaving the gloss out); ``lut``: the Glossy weight per
+    (specular only; 0 when no lobe beats leaving the gloss out); ``weights``: the Glossy weight per
     view-angle texel, ``(size, 3)`` (Glossy only); ``distribution``: ``GGX``, ``BECKMANN`` or
-    ``ASHIKHMIN_SHIRLEY`` (Glossy only; the Principled BSDF is GGX); ``diffuse_lut``: the
+    ``ASHIKHMIN_SHIRLEY`` (Glossy only; the Principled BSDF is GGX); ``diffuse_weights``: the
     weight of its Lambertian companion per texel, ``(size, 3)``, or None (:func:`fit_glossy`);
     ``error``: relative RMS of this lobe against its target (module docstring);
     ``searched``: each Glossy distribution's error in the search, by name (Glossy only: what
@@ -84,9 +84,9 @@ class LobeFit:
     error: float
     ior: float | None = None
     level: float | None = None
-    lut: np.ndarray | None = None
+    weights: np.ndarray | None = None
     distribution: str = "GGX"
-    diffuse_lut: np.ndarray | None = None
+    diffuse_weights: np.ndarray | None = None
     searched: dict | None = None
 
 
@@ -289,7 +289,7 @@ def _search_albedo(views: bytes, shape: tuple, roughness: float,
 
 
 def fit_glossy(grid: ViewGrid, target: ArrayLike, albedo_table: np.ndarray,
-               theta_deg: np.ndarray, size: int = DEFAULT_LUT_SIZE, *, companion: bool = False,
+               theta_deg: np.ndarray, size: int = DEFAULT_IMAGE_SIZE, *, companion: bool = False,
                closures: tuple[str, ...] = cc.GLOSSY_DISTRIBUTIONS) -> LobeFit:
     """Distribution (:data:`lut_baker.closures.cycles.GLOSSY_DISTRIBUTIONS`) and roughness of a
     Glossy BSDF whose view-dependent weight (table albedo / closure albedo, read from a
@@ -297,8 +297,8 @@ def fit_glossy(grid: ViewGrid, target: ArrayLike, albedo_table: np.ndarray,
     ``albedo_table`` ``(n_theta, 3)`` on ``theta_deg``.
 
     ``companion``: the albedo is shared with a Lambertian companion, in the proportion that
-    fits each view best (:func:`_companion_share`); the weights are then ``lut`` (Glossy) and
-    ``diffuse_lut`` (Diffuse), whose albedos still add up to the table's at every view.  A
+    fits each view best (:func:`_companion_share`); the weights are then ``weights`` (Glossy) and
+    ``diffuse_weights`` (Diffuse), whose albedos still add up to the table's at every view.  A
     broad lobe whose radiance keeps a ``cos(theta_i)`` factor (the paper's film gloss) is
     part Lambertian, which no Glossy closure alone reproduces.
 
@@ -313,23 +313,23 @@ def fit_glossy(grid: ViewGrid, target: ArrayLike, albedo_table: np.ndarray,
     grey = _grey(values)
     if not np.any(albedo_table):  # no gloss (a matte film): weights 0, nothing to fit
         zeros = np.zeros((size, 3))
-        return LobeFit(roughness=ROUGHNESS_RANGE[1], error=0.0, lut=zeros,
-                       diffuse_lut=zeros.copy() if companion else None)
-    texels = lut_nodes(size)
+        return LobeFit(roughness=ROUGHNESS_RANGE[1], error=0.0, weights=zeros,
+                       diffuse_weights=zeros.copy() if companion else None)
+    texels = texel_centres(size)
     tables = {False: _texel_albedo(albedo_table, theta_deg, grid.cos_view),
               True: _texel_albedo(albedo_table, theta_deg, texels)}
 
     def weights(roughness: float, distribution: str, final: bool
                 ) -> tuple[NDArray[np.float64], NDArray[np.float64] | None,
                            NDArray[np.float64]]:
-        """``(lut, diffuse_lut or None, value on the grid)`` for one lobe: while searching
+        """``(glossy, diffuse_weights or None, value on the grid)`` for one lobe: while searching
         (``final`` False) the weights sit at the grid's views, with a coarser closure albedo;
         the final ones at the image's texels, sampled as Blender samples them."""
         shape = glossy_lobe(grid, roughness, distribution)
         nodes = texels if final else grid.cos_view
         closure = glossy_albedo(nodes, roughness, distribution, final=final)
         table = tables[final]
-        lut = table / np.maximum(closure, 1e-6)[:, None]
+        glossy = table / np.maximum(closure, 1e-6)[:, None]
         diffuse = None
         if companion:
             e_views = np.interp(grid.cos_view, texels, closure) if final else closure
@@ -337,13 +337,13 @@ def fit_glossy(grid: ViewGrid, target: ArrayLike, albedo_table: np.ndarray,
                                      grey)
             share = np.interp(texels, grid.cos_view, share) if final else share
             diffuse = (1.0 - share)[:, None] * table
-            lut = share[:, None] * lut
-        rows = ((lambda row: sample_lut(row, grid.cos_o)) if final
+            glossy = share[:, None] * glossy
+        rows = ((lambda row: sample_row(row, grid.cos_o)) if final
                 else (lambda row: row[:, None, None, :]))
-        value = shape[..., None] * rows(lut)
+        value = shape[..., None] * rows(glossy)
         if diffuse is not None:
             value = value + rows(diffuse) / np.pi
-        return lut, diffuse, value
+        return glossy, diffuse, value
 
     def search(distribution: str) -> tuple[float, float]:
         return _minimise_roughness(
@@ -354,10 +354,10 @@ def fit_glossy(grid: ViewGrid, target: ArrayLike, albedo_table: np.ndarray,
     if searched[distribution][1] >= (1.0 - DISTRIBUTION_MARGIN) * searched[closures[0]][1]:
         distribution = closures[0]
     roughness = searched[distribution][0]
-    lut, diffuse, value = weights(roughness, distribution, True)
+    glossy, diffuse, value = weights(roughness, distribution, True)
     node = "GGX" if distribution == EEVEE_GLOSSY else distribution
-    return LobeFit(roughness=roughness, error=grid.error(value, values), lut=lut,
-                   distribution=node, diffuse_lut=diffuse,
+    return LobeFit(roughness=roughness, error=grid.error(value, values), weights=glossy,
+                   distribution=node, diffuse_weights=diffuse,
                    searched={("GGX" if name == EEVEE_GLOSSY else name): float(found[1])
                              for name, found in searched.items()})
 
@@ -449,7 +449,7 @@ def _albedo_shares(grid: ViewGrid, models: list, target: np.ndarray,
 
 def fit_glossy_pair(grid: ViewGrid, target: ArrayLike, albedo_table: np.ndarray,
                     theta_deg: np.ndarray,
-                    size: int = DEFAULT_LUT_SIZE, *,
+                    size: int = DEFAULT_IMAGE_SIZE, *,
                     slack: float = PAIR_ALBEDO_SLACK,
                     ratio: float = PAIR_RATIO) -> tuple[LobeFit, LobeFit]:
     """One or two of EEVEE's Glossy lobes (:data:`EEVEE_GLOSSY`) and a Lambertian companion
@@ -463,8 +463,8 @@ def fit_glossy_pair(grid: ViewGrid, target: ArrayLike, albedo_table: np.ndarray,
     :data:`DISTRIBUTION_MARGIN` (relative); else the second lobe has weight 0 and the first's
     roughness.
 
-    Returns ``(first, second)``: the first holds its row and the companion's (``lut``,
-    ``diffuse_lut``) and, in ``searched``, both errors (``GGX`` and :data:`PAIR`); the second
+    Returns ``(first, second)``: the first holds its row and the companion's (``weights``,
+    ``diffuse_weights``) and, in ``searched``, both errors (``GGX`` and :data:`PAIR`); the second
     its row.  EEVEE draws only GGX and drops a closure of negative colour, so no lobe can cut
     another's tail: a broad gloss whose radiance keeps ``cos(theta_i)`` (the paper film's) is
     followed closer by two lobes of different widths than by one, and a short-tailed narrow
@@ -472,12 +472,12 @@ def fit_glossy_pair(grid: ViewGrid, target: ArrayLike, albedo_table: np.ndarray,
     tier")."""
     if not np.any(albedo_table):  # no gloss (a matte film): weights 0, nothing to fit
         zeros = np.zeros((size, 3))
-        empty = LobeFit(roughness=ROUGHNESS_RANGE[1], error=0.0, lut=zeros)
-        return replace(empty, diffuse_lut=zeros.copy()), replace(empty, lut=zeros.copy())
+        empty = LobeFit(roughness=ROUGHNESS_RANGE[1], error=0.0, weights=zeros)
+        return replace(empty, diffuse_weights=zeros.copy()), replace(empty, weights=zeros.copy())
     values = np.asarray(target, float)
     values = (values if values.ndim == 4 else values[..., None]) * np.ones(3)
     grey = _grey(values)
-    texels = lut_nodes(size)
+    texels = texel_centres(size)
     at_views = np.mean(_texel_albedo(albedo_table, theta_deg, grid.cos_view), axis=-1)
     lambert = np.broadcast_to(1.0 / np.pi, grid.cos_i.shape) * at_views[:, None, None]
     root_weight = np.sqrt(grid.weight) * grid.cos_i
@@ -515,9 +515,9 @@ def fit_glossy_pair(grid: ViewGrid, target: ArrayLike, albedo_table: np.ndarray,
                 for k, r in enumerate(roughnesses)]
         companion = at_texels[:, -1, None] * table
         fitted = (sum(glossy_lobe(grid, r, EEVEE_GLOSSY)[..., None]
-                      * sample_lut(row, grid.cos_o)
+                      * sample_row(row, grid.cos_o)
                       for r, row in zip(roughnesses, rows, strict=True))
-                  + sample_lut(companion, grid.cos_o) / np.pi)
+                  + sample_row(companion, grid.cos_o) / np.pi)
         return grid.error(fitted, values), rows, companion
 
     def cost(roughnesses: Sequence[float]) -> float:  # np.sum, not BLAS: same everywhere
@@ -533,9 +533,9 @@ def fit_glossy_pair(grid: ViewGrid, target: ArrayLike, albedo_table: np.ndarray,
         result(one), result(two))
     searched = {"GGX": one_error, PAIR: two_error}
     if two_error >= (1.0 - DISTRIBUTION_MARGIN) * one_error:
-        first = LobeFit(roughness=one[0], error=one_error, lut=one_rows[0],
-                        diffuse_lut=one_companion, searched=searched)
-        return first, LobeFit(roughness=one[0], error=one_error, lut=np.zeros((size, 3)))
-    first = LobeFit(roughness=two[0], error=two_error, lut=two_rows[0],
-                    diffuse_lut=two_companion, searched=searched)
-    return first, LobeFit(roughness=two[1], error=two_error, lut=two_rows[1])
+        first = LobeFit(roughness=one[0], error=one_error, weights=one_rows[0],
+                        diffuse_weights=one_companion, searched=searched)
+        return first, LobeFit(roughness=one[0], error=one_error, weights=np.zeros((size, 3)))
+    first = LobeFit(roughness=two[0], error=two_error, weights=two_rows[0],
+                    diffuse_weights=two_companion, searched=searched)
+    return first, LobeFit(roughness=two[1], error=two_error, weights=two_rows[1])

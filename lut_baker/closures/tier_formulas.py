@@ -39,7 +39,7 @@ from typing import Any, Protocol
 import numpy as np
 
 from ..model.made_up_skin import combine, coverage_weights, mix_slots
-from .view_image import sample_lut
+from .view_image import sample_row
 
 __all__ = ["Algebra", "ShaderAlgebra", "NumpyAlgebra", "TierInputs", "Closure",
            "ViewWeightedClosures", "principled_sockets", "principled_shader",
@@ -109,7 +109,7 @@ class NumpyAlgebra:
     def row(self, name: str) -> Any:
         if self._cos is None:
             raise ValueError(f"row {name!r} asked of an algebra without view angles")
-        return sample_lut(self._rows[name], self._cos)
+        return sample_row(self._rows[name], self._cos)
 
 
 @dataclass(frozen=True)
@@ -273,7 +273,7 @@ def view_weighted_closures(fit: Any, x: TierInputs, ops: Algebra, *,
                            one_subsurface: bool = False,
                            subsurface_weight: Any = None) -> ViewWeightedClosures:
     """The LAYERED tier's closures at inputs ``x``, their view-dependent factors read from the
-    image rows (``ops.row``, :data:`lut_baker.closures.view_image.LUT_ROWS`):
+    image rows (``ops.row``, :data:`lut_baker.closures.view_image.IMAGE_ROWS`):
 
     - where the film is: its gloss (a Glossy per lobe of ``film_lobes``, ``g`` times the row
       of its name: ``film_gloss``, and ``film_gloss_2`` in the EEVEE tier), its diffuse and

@@ -34,7 +34,7 @@ from . import eevee
 from .lobes import LobeFit
 from .tier_formulas import TierInputs, principled_shader, view_weighted_shader
 from .tier_parts import FitTargets, eevee_parts, image_rows, layered_parts, principled_parts
-from .view_image import EEVEE_LUT_ROWS, LUT_ROWS
+from .view_image import EEVEE_IMAGE_ROWS, IMAGE_ROWS
 
 __all__ = ["Tier", "ViewImage", "Costs", "register", "unregister", "tier", "held", "TIERS",
            "engine_tiers", "PRINCIPLED", "LAYERED", "EEVEE", "UNRECORDED"]
@@ -42,11 +42,11 @@ __all__ = ["Tier", "ViewImage", "Costs", "register", "unregister", "tier", "held
 
 @dataclass(frozen=True)
 class ViewImage:
-    """A tier's view-angle image: ``lut`` ``(len(rows), size, 3)``, its rows named ``rows``
+    """A tier's view-angle image: ``texels`` ``(len(rows), size, 3)``, its rows named ``rows``
     (:mod:`lut_baker.closures.view_image`)."""
 
     rows: tuple[str, ...]
-    lut: NDArray[np.float64]
+    texels: NDArray[np.float64]
 
 
 @dataclass(frozen=True)
@@ -99,7 +99,10 @@ class Tier:
       :class:`~lut_baker.closures.tier_formulas.ShaderAlgebra` (``subsurface_weight``: the
       artist's, over their shader, else None); ``lobes(fit)``: its Glossy lobes by closure
       name; ``image(fit)``: its :class:`ViewImage` or None; ``glossy(wi, wo, lobe)``: a white
-      Glossy lobe as its renderer draws it (the replica's).
+      Glossy lobe as its renderer draws it (the replica's); ``with_image(lobes, texels)``: the
+      fit's fields that hold its lobes and image (a fit moved to another thickness,
+      :func:`lut_baker.closures.fitting.at_thickness`, writes them back; a tier with an
+      image has one).
     - ``subsurface_method``: the method its renderer always uses (None: the fit's choice).
     """
 
@@ -115,6 +118,8 @@ class Tier:
     image: Callable[[Any], ViewImage | None] = _no_image
     glossy: Callable[[NDArray[np.float64], NDArray[np.float64], LobeFit],
                      NDArray[np.float64]] = _cycles_glossy
+    with_image: Callable[[dict[str, LobeFit], NDArray[np.float64]],
+                         dict[str, Any]] | None = None
     subsurface_method: str | None = None
     fullness: int = 0
     fit_share: float = 0.3
@@ -188,7 +193,7 @@ def engine_tiers(engine: str) -> tuple[str, ...]:
 
 def _eevee_film_lobes(fit: Any) -> tuple[str, ...]:
     """The film gloss's second lobe is a closure only where its fit kept two."""
-    second = np.any(fit.eevee_glossy["film_gloss_2"].lut)
+    second = np.any(fit.eevee_glossy["film_gloss_2"].weights)
     return ("film_gloss", "film_gloss_2") if second else ("film_gloss",)
 
 
@@ -217,7 +222,8 @@ LAYERED = register(Tier(
     fit=layered_parts, holds=lambda fit: fit.glossy is not None,
     shader=partial(view_weighted_shader, tinted_subsurface=True, film_lobes=("film_gloss",)),
     lobes=lambda fit: fit.glossy,
-    image=lambda fit: ViewImage(image_rows(LUT_ROWS, fit.slab is not None), fit.lut)))
+    image=lambda fit: ViewImage(image_rows(IMAGE_ROWS, fit.slab is not None), fit.view_rows),
+    with_image=lambda lobes, texels: {"glossy": lobes, "view_rows": texels}))
 """Glossy (film gloss, path-3 gloss, skin gloss; weights read from a view-angle image),
 Diffuse and Subsurface closures mixed by coverage
 (:func:`~lut_baker.closures.tier_formulas.view_weighted_closures`); the skin through the film
@@ -230,7 +236,8 @@ EEVEE = register(Tier(
     engines=("EEVEE",), fullness=0, fit_share=0.4,
     fit=eevee_parts, holds=lambda fit: fit.eevee_glossy is not None, shader=_eevee_shader,
     lobes=lambda fit: fit.eevee_glossy, image=lambda fit: ViewImage(
-        image_rows(EEVEE_LUT_ROWS, fit.slab is not None), fit.eevee_lut),
+        image_rows(EEVEE_IMAGE_ROWS, fit.slab is not None), fit.eevee_view_rows),
+    with_image=lambda lobes, texels: {"eevee_glossy": lobes, "eevee_view_rows": texels},
     glossy=_eevee_glossy, subsurface_method="BURLEY"))
 """The Layered tier's closures and mix made for EEVEE: every Glossy lobe GGX fitted as EEVEE
 renders it under a lamp (a linearly transformed cosine, :mod:`lut_baker.closures.eevee`), the

@@ -2,11 +2,11 @@
 Blender's Image Texture samples it.
 
 A tier's view-dependent weights are 1-D functions of ``cos(theta_o)``, one per row of a small
-float image that the node group reads at ``u = cos(theta_o)``: :data:`LUT_ROWS` names the rows
-(:data:`EEVEE_LUT_ROWS` the EEVEE tier's), :func:`lut_nodes` gives the texel centres,
+float image that the node group reads at ``u = cos(theta_o)``: :data:`IMAGE_ROWS` names the rows
+(:data:`EEVEE_IMAGE_ROWS` the EEVEE tier's), :func:`texel_centres` gives the texel centres,
 :func:`texel_pair` and :func:`read_row` read a row at ``u`` as Blender's Linear, EXTEND lookup
 does, written once over an algebra (two Closest lookups at neighbouring texel centres mixed
-linearly: numpy arrays in :func:`sample_lut`, node sockets in the add-on's node group, where
+linearly: numpy arrays in :func:`sample_row`, node sockets in the add-on's node group, where
 EEVEE's Linear lookup would mix rows through mipmaps).
 """
 
@@ -18,22 +18,22 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-__all__ = ["LUT_ROWS", "EEVEE_LUT_ROWS", "DEFAULT_LUT_SIZE", "lut_nodes", "texel_pair",
-           "read_row", "sample_lut"]
+__all__ = ["IMAGE_ROWS", "EEVEE_IMAGE_ROWS", "DEFAULT_IMAGE_SIZE", "texel_centres", "texel_pair",
+           "read_row", "sample_row"]
 
-LUT_ROWS = ("film_gloss", "path3_gloss", "skin_gloss", "film_transmittance",
+IMAGE_ROWS = ("film_gloss", "path3_gloss", "skin_gloss", "film_transmittance",
             "film_gloss_diffuse")
 """Rows of the LAYERED tier's view-angle image: three Glossy weights, the film's
 transmittance ``T(theta_o)`` and the film gloss's Lambertian companion
 (:func:`lut_baker.closures.lobes.fit_glossy`)."""
-EEVEE_LUT_ROWS = LUT_ROWS + ("film_gloss_2",)
-"""Rows of the EEVEE tier's view-angle image: :data:`LUT_ROWS` and the weight of the film
+EEVEE_IMAGE_ROWS = IMAGE_ROWS + ("film_gloss_2",)
+"""Rows of the EEVEE tier's view-angle image: :data:`IMAGE_ROWS` and the weight of the film
 gloss's second lobe (:func:`lut_baker.closures.lobes.fit_glossy_pair`)."""
-DEFAULT_LUT_SIZE = 64
+DEFAULT_IMAGE_SIZE = 64
 """Texels per row of the view-angle image (linear filtering between texel centres)."""
 
 
-def lut_nodes(size: int = DEFAULT_LUT_SIZE) -> np.ndarray:
+def texel_centres(size: int = DEFAULT_IMAGE_SIZE) -> np.ndarray:
     """``cos(theta_o)`` at the texel centres ``(i + 0.5) / size`` of a view-angle image."""
     return (np.arange(size) + 0.5) / size
 
@@ -70,16 +70,16 @@ class _Numpy:
         return a + t * (b - a)
 
 
-def sample_lut(lut: ArrayLike, cos_view: ArrayLike) -> NDArray[np.float64]:
-    """What Blender's Image Texture (Linear, EXTEND) returns for a row ``lut`` ``(size[, C])``
+def sample_row(row: ArrayLike, cos_view: ArrayLike) -> NDArray[np.float64]:
+    """What Blender's Image Texture (Linear, EXTEND) returns for a row ``row`` ``(size[, C])``
     at ``u = cos_view``: :func:`read_row` on numpy arrays.
 
-    >>> print(np.round(lut_nodes(4), 3))  # the texel centres of a row of 4
+    >>> print(np.round(texel_centres(4), 3))  # the texel centres of a row of 4
     [0.125 0.375 0.625 0.875]
-    >>> print(sample_lut([0.0, 1.0, 2.0, 3.0], [0.0, 0.25, 0.5, 1.0]))  # held beyond them
+    >>> print(sample_row([0.0, 1.0, 2.0, 3.0], [0.0, 0.25, 0.5, 1.0]))  # held beyond them
     [0.  0.5 1.5 3. ]
     """
-    row = np.asarray(lut, float)
+    row = np.asarray(row, float)
     size = row.shape[0]
 
     def texel(u: NDArray[np.float64]) -> NDArray[np.float64]:

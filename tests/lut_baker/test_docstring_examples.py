@@ -25,7 +25,7 @@ FORMULAS_WITH_EXAMPLES = {
     "lut_baker.model.roughness": ["lobe_width_deg", "roughness_for_width"],
     "lut_baker.model.made_up_skin": ["coverage_weights", "combine"],
     "lut_baker.tables.uniform_light": ["made_up_colour", "matching_absorption"],
-    "lut_baker.closures.view_image": ["sample_lut"],
+    "lut_baker.closures.view_image": ["sample_row"],
     "lut_baker.closures.principled_albedo": ["base_color_for_body"],
     "lut_baker.numerics.adding_doubling": ["add_layers", "double_slab", "slab", "thick_slab"],
     "lut_baker.model.film_slab": ["thickness_from_mass", "body", "made_up_albedo",

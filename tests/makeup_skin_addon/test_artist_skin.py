@@ -141,3 +141,21 @@ def test_the_base_colour_read_is_an_images_mean_over_the_faces(addon, blank_scen
     assert reading.notes == []
 
 
+
+
+def test_the_engine_as_the_model_names_it(addon, blank_scene):
+    """One name per engine for the tiers fitted and the artist's shader read: Cycles is Cycles,
+    either EEVEE is EEVEE, and Workbench (which shows the material through EEVEE's Material
+    Preview) is EEVEE too; without a scene, Cycles."""
+    from makeup_skin_addon import artist_skin
+
+    names = {}
+    for engine in ("CYCLES", "BLENDER_EEVEE_NEXT", "BLENDER_EEVEE", "BLENDER_WORKBENCH"):
+        try:
+            blank_scene.render.engine = engine
+        except TypeError:  # BLENDER_EEVEE_NEXT in 4.2-4.5, BLENDER_EEVEE in 5.0
+            continue
+        names[engine] = artist_skin.render_engine(blank_scene)
+    assert names.pop("CYCLES") == "CYCLES" and names.pop("BLENDER_WORKBENCH") == "EEVEE"
+    assert list(names.values()) == ["EEVEE"]
+    assert artist_skin.render_engine(None) == "CYCLES"

@@ -285,7 +285,7 @@ def _numpy(fit, case, name="LAYERED"):
     coverage, absorption, gloss, skin_colour, view_deg = case
     x = tier_formulas.TierInputs.numpy(coverage, absorption, skin_colour, gloss)
     image = tier_registry.tier(name).image(fit)
-    rows = dict(zip(image.rows, image.lut, strict=True))
+    rows = dict(zip(image.rows, image.texels, strict=True))
     return x, _Recording(rows, np.cos(np.radians(view_deg)))
 
 

@@ -161,7 +161,7 @@ def test_view_angle_rows_read_in_eevee_as_in_cycles(addon, paper_tables):
     view-angle image's rows wherever cos(theta_o) changes quickly across the screen (the
     Layered tier's bright patches in EEVEE, docs/addon.md).  The groups read each row from two
     Closest texels mixed: in EEVEE, a sphere of a row (the film's transmittance) equals
-    :func:`lut_baker.closures.view_image.sample_lut` at every pixel's cos(theta_o) within the
+    :func:`lut_baker.closures.view_image.sample_row` at every pixel's cos(theta_o) within the
     image's half-float precision (and the mesh's normals), where one Linear lookup errs by tens
     of per cent."""
     import bpy
@@ -180,8 +180,8 @@ def test_view_angle_rows_read_in_eevee_as_in_cycles(addon, paper_tables):
     normals, mask = sphere_normals(size)
     expected = np.zeros((size, size, 3))
     row = "film_transmittance"  # non-zero at every view: the error is relative to it
-    expected[mask] = view_image.sample_lut(fit.eevee_lut[view_image.EEVEE_LUT_ROWS.index(row)],
-                                           np.clip(normals[mask][:, 2], 0, 1))
+    texels = fit.eevee_view_rows[view_image.EEVEE_IMAGE_ROWS.index(row)]
+    expected[mask] = view_image.sample_row(texels, np.clip(normals[mask][:, 2], 0, 1))
     errors = {}
     for linear in (False, True):
         material = bpy.data.materials.new(f"row probe {linear}")
@@ -207,11 +207,11 @@ def test_a_damaged_lookup_image_renders_wrong_but_bounded(sphere, tmp_path, tier
     sphere renders no brighter than the brightest the rows allow, and finite (unbounded, it
     rendered values up to 6e23)."""
     import bpy
-    from support.addon_steps import lut_images
+    from support.addon_steps import view_images
 
     material, _ = apply_pipeline(sphere, tier)
     intact = render(tmp_path, "intact")
-    image = lut_images()[0]
+    image = view_images()[0]
     image.pixels.foreach_set(np.full(len(image.pixels), 1e20, np.float32))
     bpy.context.scene.cycles.samples = 4
     damaged = render(tmp_path, "damaged")

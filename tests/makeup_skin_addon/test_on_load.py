@@ -5,7 +5,7 @@ left as they are, nothing decoded."""
 
 import numpy as np
 import pytest
-from support.addon_steps import apply_pipeline, lut_images, render
+from support.addon_steps import apply_pipeline, render, view_images
 
 REPAIRED_LINE = "Made-up Skin: on opening the file: 'Skin': its lookup image "
 
@@ -37,7 +37,7 @@ def damaged_file(sphere, tmp_path):
 
     apply_pipeline(sphere, "LAYERED")
     before = render(tmp_path, "before")
-    packed = bytes(lut_images()[0].packed_file.data)
+    packed = bytes(view_images()[0].packed_file.data)
     path = tmp_path / "damaged.blend"
     bpy.ops.wm.save_as_mainfile(filepath=str(path), compress=False)
     damage(path, packed)
@@ -87,7 +87,7 @@ def test_an_intact_file_is_left_alone_and_nothing_is_decoded(sphere, tmp_path, c
     bpy.ops.wm.save_as_mainfile(filepath=str(path))
     capsys.readouterr()
     bpy.ops.wm.open_mainfile(filepath=str(path), load_ui=False)
-    (image,) = lut_images()
+    (image,) = view_images()
     assert not image.has_data  # checked by its packed bytes only: not decoded
     assert on_load.notice(bpy.data.materials["Skin"]) is None
     assert "Made-up Skin" not in capsys.readouterr().out

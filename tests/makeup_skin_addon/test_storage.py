@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from support import character
-from support.addon_steps import apply_operator, apply_pipeline, group_node, lut_images, render
+from support.addon_steps import apply_operator, apply_pipeline, group_node, render, view_images
 
 
 def test_save_reload_renders_the_same_and_keeps_only_what_the_render_reads(sphere, tmp_path):
@@ -23,11 +23,11 @@ def test_save_reload_renders_the_same_and_keeps_only_what_the_render_reads(spher
     path = tmp_path / "made_up.blend"
     bpy.ops.wm.save_as_mainfile(filepath=str(path))
     bpy.ops.wm.open_mainfile(filepath=str(path), load_ui=False)
-    luts = lut_images()
-    assert len(luts) == 1 and luts[0].packed_file is not None
+    images = view_images()
+    assert len(images) == 1 and images[0].packed_file is not None
     saved = [i.name for i in bpy.data.images if i.type != "RENDER_RESULT"]
-    assert saved == [luts[0].name]  # no tables travel in the file
-    assert luts[0].size[0] * luts[0].size[1] <= 64 * 8
+    assert saved == [images[0].name]  # no tables travel in the file
+    assert images[0].size[0] * images[0].size[1] <= 64 * 8
     material = bpy.data.materials[name]
     assert apply.check_material(bpy.context, material) == (
         True, f"{material.name!r}: intact.")  # re-bakes to the recorded hash
@@ -43,19 +43,19 @@ def test_altered_lookup_image_is_found_and_rebuilt(sphere, tmp_path):
 
     material, _ = apply_pipeline(sphere, "LAYERED")
     before = render(tmp_path, "before")
-    lut = lut_images()[0]
-    lut.pixels.foreach_set(np.zeros(len(lut.pixels), np.float32))  # what the render reads
+    image = view_images()[0]
+    image.pixels.foreach_set(np.zeros(len(image.pixels), np.float32))  # what the render reads
     intact, sentence = apply.check_material(bpy.context, material)
     assert not intact and "was altered" in sentence and "rebuilt it from a re-bake" in sentence
     assert apply.check_material(bpy.context, material)[0]
     np.testing.assert_array_equal(render(tmp_path, "after"), before)
     # Deleted: the operator reports it in one sentence and rebuilds it, never raises.
-    bpy.data.images.remove(lut_images()[0])
+    bpy.data.images.remove(view_images()[0])
     assert bpy.ops.makeup_skin.check_tables() == {"FINISHED"}
-    assert len(lut_images()) == 1 and apply.check_material(bpy.context, material)[0]
+    assert len(view_images()) == 1 and apply.check_material(bpy.context, material)[0]
     group = material.node_tree.nodes["Made-up Skin"].node_tree
     textures = [n for n in group.nodes if n.type == "TEX_IMAGE"]
-    assert textures and all(n.image == lut_images()[0] for n in textures)
+    assert textures and all(n.image == view_images()[0] for n in textures)
 
 
 @pytest.mark.slow  # renders compared, re-bakes
@@ -65,12 +65,12 @@ def test_apply_rebuilds_a_damaged_group_instead_of_reusing_it(sphere):
     from makeup_skin_addon import apply
 
     material, _ = apply_pipeline(sphere, "LAYERED")
-    lut = lut_images()[0]
-    lut.pixels.foreach_set(np.zeros(len(lut.pixels), np.float32))
+    image = view_images()[0]
+    image.pixels.foreach_set(np.zeros(len(image.pixels), np.float32))
     _, messages = apply_pipeline(sphere, "LAYERED")  # must not raise, nor reuse the zeroed image
     assert len(messages) == 1 and "was altered" in messages[0]
     assert apply.check_material(bpy.context, material)[0]
-    assert np.asarray(lut_images()[0].pixels[:]).max() > 0.0
+    assert np.asarray(view_images()[0].pixels[:]).max() > 0.0
 
 
 def test_check_tables_reports_one_sentence_per_material(sphere):
@@ -164,7 +164,7 @@ def test_damaged_packed_image_is_repaired_without_a_crash(head, tmp_path):
     import bpy
 
     apply_operator(head)
-    packed = bytes(lut_images()[0].packed_file.data)
+    packed = bytes(view_images()[0].packed_file.data)
     path = tmp_path / "damaged.blend"
     bpy.ops.wm.save_as_mainfile(filepath=str(path), compress=False)
     data = bytearray(path.read_bytes())

@@ -3,7 +3,7 @@ panels): Apply before, Revert after, and a linked Skin Color shown as linked."""
 
 from types import SimpleNamespace
 
-from support.addon_steps import apply_operator, lut_images
+from support.addon_steps import apply_operator, view_images
 from support.panel_layout import RecordingLayout
 
 
@@ -64,11 +64,11 @@ def test_panel_says_when_the_file_was_repaired_on_opening(head, tmp_path):
     layout = RecordingLayout()
     ui.draw_settings(layout, bpy.context)
     assert ("label", on_load.REPAIRED) not in layout.drawn
-    bpy.data.images.remove(lut_images()[0])
+    bpy.data.images.remove(view_images()[0])
     path = tmp_path / "missing_image.blend"
     bpy.ops.wm.save_as_mainfile(filepath=str(path))
     bpy.ops.wm.open_mainfile(filepath=str(path), load_ui=False)
-    assert len(lut_images()) == 1  # rebuilt on opening
+    assert len(view_images()) == 1  # rebuilt on opening
     layout = RecordingLayout()
     ui.draw_settings(layout, bpy.context)
     assert ("label", on_load.REPAIRED) in layout.drawn

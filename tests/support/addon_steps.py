@@ -4,12 +4,12 @@ does, or through the pipeline), render, and read node trees and images back.
 - :data:`SPHERE_PX`, :data:`HEAD_PX` -- render sizes of the sphere and the head scenes
   (tests/makeup_skin_addon/conftest.py's ``sphere`` and ``head``).
 - :func:`apply_operator` -- ``bpy.ops.makeup_skin.apply()`` on an object with preview tables.
-- :func:`apply_pipeline` -- :func:`makeup_skin_addon.material.apply_to_object`; returns the
+- :func:`apply_pipeline` -- :func:`makeup_skin_addon.apply.apply_to_object`; returns the
   material and the warnings it reported.
 - :func:`render` -- render the scene to a float EXR and return its RGB pixels.
 - :func:`tree_state` -- a material's nodes and links, comparable.
 - :func:`group_node` -- a material's Made-up Skin group node.
-- :func:`lut_images` -- the add-on's view-angle images.
+- :func:`view_images` -- the add-on's view-angle images.
 - :func:`counts` -- how many node groups, images and materials the file holds.
 - :func:`session_caches` -- the add-on's session cache (re-baked tables and closure fits).
 - :func:`cold_caches` -- empty them: the next Apply bakes and fits.
@@ -23,7 +23,7 @@ from __future__ import annotations
 from support import sphere_scene
 
 __all__ = ["SPHERE_PX", "HEAD_PX", "apply_operator", "apply_pipeline", "render", "tree_state",
-           "group_node", "lut_images", "counts", "session_caches", "cold_caches",
+           "group_node", "view_images", "counts", "session_caches", "cold_caches",
            "registered_classes", "ui_texts"]
 
 SPHERE_PX = 64
@@ -47,7 +47,7 @@ def apply_operator(obj, tier="LAYERED", **settings):
 
 
 def apply_pipeline(obj, tier="PRINCIPLED", resolution="preview", **settings):
-    """Apply through :func:`makeup_skin_addon.material.apply_to_object` (a new material
+    """Apply through :func:`makeup_skin_addon.apply.apply_to_object` (a new material
     ``Skin`` if the object has none): ``(material, messages)``, the operator's reports
     (warnings only)."""
     import bpy
@@ -84,11 +84,13 @@ def group_node(material):
     return material.node_tree.nodes["Made-up Skin"]
 
 
-def lut_images():
+def view_images():
     """The add-on's view-angle images in the file."""
     import bpy
 
-    return [image for image in bpy.data.images if image.name.startswith("MakeupSkin LUT")]
+    from makeup_skin_addon.keys import VIEW_IMAGE_PREFIX
+
+    return [image for image in bpy.data.images if image.name.startswith(VIEW_IMAGE_PREFIX)]
 
 
 def counts():

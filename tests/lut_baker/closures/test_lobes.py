@@ -23,15 +23,15 @@ def test_fit_glossy_companion_recovers_a_lobe_plus_lambert(paper_tables):
     target = (0.7 * lobe + 0.2 / np.pi)[..., None] * np.ones(3)
     plain = lobes.fit_glossy(grid, target, albedo, theta)
     fit = lobes.fit_glossy(grid, target, albedo, theta, companion=True)
-    assert plain.diffuse_lut is None and fit.error < 0.25 * plain.error
+    assert plain.diffuse_weights is None and fit.error < 0.25 * plain.error
     assert fit.distribution == "BECKMANN" and fit.roughness == pytest.approx(0.5, abs=0.02)
     inner = slice(4, -4)  # texels away from the ends, where interpolation holds them
-    np.testing.assert_allclose(fit.lut[inner], 0.7, atol=0.03)
-    np.testing.assert_allclose(fit.diffuse_lut[inner], 0.2, atol=0.02)
-    mu = view_image.lut_nodes(view_image.DEFAULT_LUT_SIZE)
+    np.testing.assert_allclose(fit.weights[inner], 0.7, atol=0.03)
+    np.testing.assert_allclose(fit.diffuse_weights[inner], 0.2, atol=0.02)
+    mu = view_image.texel_centres(view_image.DEFAULT_IMAGE_SIZE)
     texel_e = cc.microfacet_albedo(mu, fit.roughness, distribution=fit.distribution)
     texel_table = np.interp(np.degrees(np.arccos(mu)), theta, albedo[:, 0])
-    np.testing.assert_allclose(fit.lut[:, 0] * texel_e + fit.diffuse_lut[:, 0], texel_table,
+    np.testing.assert_allclose(fit.weights[:, 0] * texel_e + fit.diffuse_weights[:, 0], texel_table,
                                rtol=2e-3)
 
 @pytest.mark.parametrize("roughness, ior", [(0.45, 1.8), (0.12, 1.4)])
@@ -61,7 +61,7 @@ def test_fit_glossy_recovers_distribution_and_roughness(paper_tables):
     assert fit.roughness == pytest.approx(0.5, abs=0.01)
     assert fit.error < 0.02
     # The weight row is table albedo / closure albedo: 1 for the lobe itself.
-    np.testing.assert_allclose(fit.lut, 1.0, atol=0.02)
+    np.testing.assert_allclose(fit.weights, 1.0, atol=0.02)
 
 def test_fit_glossy_keeps_ggx_in_a_near_tie(paper_tables, monkeypatch):
     """Another distribution replaces GGX only when it errs DISTRIBUTION_MARGIN less: with a
@@ -93,10 +93,10 @@ def _eevee_target(grid, theta, parts):
 def _closure_albedo(first, second):
     """The closures' albedo per texel: both lobes' rows times their albedos, and the
     companion's row."""
-    mu = view_image.lut_nodes(view_image.DEFAULT_LUT_SIZE)
-    return (first.lut[:, 0] * lobes.glossy_albedo(mu, first.roughness, lobes.EEVEE_GLOSSY)
-            + second.lut[:, 0] * lobes.glossy_albedo(mu, second.roughness, lobes.EEVEE_GLOSSY)
-            + first.diffuse_lut[:, 0])
+    mu = view_image.texel_centres(view_image.DEFAULT_IMAGE_SIZE)
+    return (first.weights[:, 0] * lobes.glossy_albedo(mu, first.roughness, lobes.EEVEE_GLOSSY)
+            + second.weights[:, 0] * lobes.glossy_albedo(mu, second.roughness, lobes.EEVEE_GLOSSY)
+            + first.diffuse_weights[:, 0])
 
 
 def test_fit_glossy_pair_recovers_two_lobes(paper_tables):
@@ -114,9 +114,9 @@ def test_fit_glossy_pair_recovers_two_lobes(paper_tables):
     assert second.roughness == pytest.approx(high, rel=0.02)
     assert first.error < 0.02
     inner = slice(4, -4)
-    np.testing.assert_allclose(first.lut[inner, 0], 0.5, atol=0.05)
-    np.testing.assert_allclose(second.lut[inner, 0], 0.4, atol=0.05)
-    mu = view_image.lut_nodes(view_image.DEFAULT_LUT_SIZE)
+    np.testing.assert_allclose(first.weights[inner, 0], 0.5, atol=0.05)
+    np.testing.assert_allclose(second.weights[inner, 0], 0.4, atol=0.05)
+    mu = view_image.texel_centres(view_image.DEFAULT_IMAGE_SIZE)
     table = np.interp(np.degrees(np.arccos(mu)), theta, albedo[:, 0])
     ratio = _closure_albedo(first, second) / table
     assert np.all(np.abs(ratio - 1.0) <= lobes.PAIR_ALBEDO_SLACK + 1e-3)
@@ -129,7 +129,7 @@ def test_fit_glossy_pair_keeps_one_lobe_where_one_fits(paper_tables):
     theta = np.asarray(paper_tables.theta_deg)
     target, albedo = _eevee_target(grid, theta, [(0.6, 0.3)])
     first, second = lobes.fit_glossy_pair(grid, target, albedo, theta)
-    assert not np.any(second.lut) and second.roughness == first.roughness
+    assert not np.any(second.weights) and second.roughness == first.roughness
     assert first.roughness == pytest.approx(0.3, rel=0.01) and first.error < 0.01
     assert first.searched[lobes.PAIR] >= (1.0 - lobes.DISTRIBUTION_MARGIN) * first.searched["GGX"]
 
@@ -152,4 +152,5 @@ def test_fit_glossy_pair_of_no_gloss_is_empty():
     theta = np.linspace(0.0, 90.0, 10)
     first, second = lobes.fit_glossy_pair(grid, np.zeros(grid.cos_i.shape), np.zeros((10, 3)),
                                           theta)
-    assert not np.any(first.lut) and not np.any(first.diffuse_lut) and not np.any(second.lut)
+    assert not np.any(first.weights) and not np.any(first.diffuse_weights)
+    assert not np.any(second.weights)

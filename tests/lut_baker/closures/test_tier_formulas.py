@@ -11,7 +11,7 @@ from lut_baker.closures import view_image
 
 
 def _algebra(fit, cos_view):
-    return tf.NumpyAlgebra(dict(zip(view_image.LUT_ROWS, fit.lut, strict=True)), cos_view)
+    return tf.NumpyAlgebra(dict(zip(view_image.IMAGE_ROWS, fit.view_rows, strict=True)), cos_view)
 
 
 def test_bare_skin_is_the_skins_own_principled_lobe(paper_fit):

@@ -7,7 +7,7 @@ import pytest
 
 from lut_baker.bake import bake
 from lut_baker.closures import tier_parts
-from lut_baker.closures.view_image import EEVEE_LUT_ROWS, LUT_ROWS
+from lut_baker.closures.view_image import EEVEE_IMAGE_ROWS, IMAGE_ROWS
 from lut_baker.model import presets
 
 SIZE = 16
@@ -28,13 +28,13 @@ def test_view_weighted_parts_hold_their_images(targets):
     """Each image has one row per name of its tier, of ``SIZE`` texels; over the artist's
     shader the bare skin's Glossy lobe is left out (rows 0, error 1)."""
     layered = tier_parts.layered_parts(targets, False)
-    assert layered["lut"].shape == (len(LUT_ROWS), SIZE, 3)
+    assert layered["view_rows"].shape == (len(IMAGE_ROWS), SIZE, 3)
     assert set(layered["glossy"]) == {"film_gloss", "path3_gloss", "skin_gloss"}
     eevee = tier_parts.eevee_parts(targets, True)
-    assert eevee["eevee_lut"].shape == (len(EEVEE_LUT_ROWS), SIZE, 3)
+    assert eevee["eevee_view_rows"].shape == (len(EEVEE_IMAGE_ROWS), SIZE, 3)
     left_out = eevee["eevee_glossy"]["skin_gloss"]
-    assert left_out.error == 1.0 and not np.any(left_out.lut)
-    assert not np.any(eevee["eevee_lut"][EEVEE_LUT_ROWS.index("skin_gloss")])
+    assert left_out.error == 1.0 and not np.any(left_out.weights)
+    assert not np.any(eevee["eevee_view_rows"][EEVEE_IMAGE_ROWS.index("skin_gloss")])
 
 
 def test_principled_parts_over_the_artists_shader(targets):

@@ -58,7 +58,7 @@ def test_gloss_zero_leaves_only_the_diffuse_closures(paper_tables, paper_fit):
     matte = tiers.tier_replica(paper_fit, paper_tables, "PRINCIPLED", w, a, gloss=0.0)
     np.testing.assert_allclose(matte, np.broadcast_to(np.clip(total, 0, 1) / np.pi,
                                                       matte.shape), rtol=1e-12)
-    algebra = tier_formulas.NumpyAlgebra(dict(zip(view_image.LUT_ROWS, paper_fit.lut,
+    algebra = tier_formulas.NumpyAlgebra(dict(zip(view_image.IMAGE_ROWS, paper_fit.view_rows,
                                                   strict=True)),
                                          np.linspace(0.0, 1.0, 9))
     closures = tier_formulas.view_weighted_closures(
