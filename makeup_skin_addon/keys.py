@@ -14,6 +14,7 @@ Identifiers (``bl_idname``):
   (:class:`makeup_skin_addon.properties.MakeupSkinSettings`); its ID properties are stored
   under this name.
 - :data:`PRESET_SUBDIR` -- the folder under Blender's ``presets`` where parameter sets are saved.
+- :data:`PAPER_FILM`, :data:`SLAB_FILM` -- the Film setting's values.
 - :data:`SETTINGS_VERSION` -- what the settings mean, stamped on them (older files are
   upgraded when opened).
 
@@ -57,6 +58,8 @@ __all__ = [
     "SETTINGS_ATTRIBUTE",
     "PRESET_SUBDIR",
     "SETTINGS_VERSION",
+    "PAPER_FILM",
+    "SLAB_FILM",
     "RECORD_KEY",
     "ERRORS_KEY",
     "CHOICE_KEY",
@@ -92,6 +95,10 @@ SETTINGS_ATTRIBUTE = "makeup_skin"
 ``material.makeup_skin``)."""
 PRESET_SUBDIR = "makeup_skin"
 """Folder under Blender's ``presets`` where parameter sets are saved."""
+PAPER_FILM = "PAPER"
+"""The Film setting of the paper's model as published (its 150 um free film, paths 1 + 3)."""
+SLAB_FILM = "SLAB"
+"""The Film setting of the film as a slab at the Thickness setting."""
 SETTINGS_VERSION = 3
 """What the settings mean, stamped on every change (``settings_version``).  1 (never stamped):
 Shade By Colour was the colour the pigment passes (1 - absorption), Film Roughness a width in

@@ -245,7 +245,7 @@ def matched(material, foundation: str | None = None, skin: SkinTarget | None = N
         f"Matched the shade to the skin's color before Apply ({_rgb(skin.target)}: "
         f"{skin.source}; under the film the skin's body color is {_rgb(skin.body)}): "
         f"absorption {_rgb(result.absorption)}, in the bottle "
-        f"{_rgb(shade.colour_seen(result.absorption))}.")
+        f"{_rgb(shade.colour_seen(result.absorption, shade.slab_foundation(settings)))}.")
     result.sentences += _reach_sentences(result, light, float(settings.gloss))
     return result
 
@@ -302,7 +302,7 @@ def stepped(material, steps: int) -> Shade:
     result.sentences.append(
         f"One shade {word}: the covered skin {_rgb(current)} -> {_rgb(result.reached)}, "
         f"absorption {_rgb(result.absorption)}, in the bottle "
-        f"{_rgb(shade.colour_seen(result.absorption))}.")
+        f"{_rgb(shade.colour_seen(result.absorption, shade.slab_foundation(settings)))}.")
     result.sentences += _reach_sentences(result, light, gloss)
     return result
 
@@ -316,7 +316,8 @@ def assign(settings, result: Shade, source: str) -> None:
     where the shade came from (``source``: ``"MATCH"``) and the steps' count and base."""
     with shade.assigning():
         settings.absorption = [float(a) for a in result.absorption]
-        settings.shade_colour = [float(c) for c in shade.colour_seen(result.absorption)]
+        settings.shade_colour = [float(c) for c in shade.colour_seen(
+            result.absorption, shade.slab_foundation(settings))]
         settings.shade_note = result.note()
         settings.shade_source = source
         if result.base is not None:

@@ -132,10 +132,31 @@ def _reset_skin_under(settings) -> None:
 
 def _update_film(self, context):
     """Film changes the tables; the skin under the film Match Skin darkened for another film
-    is the skin's own again."""
+    is the skin's own again, and the shade keeps its colour in the bottle (:func:`_reshade`)."""
     if not shade.is_assigning():
         _reset_skin_under(self)
+        _reshade(self)
     _update_tables(self, context)
+
+
+def _reshade(settings) -> None:
+    """The shade in the Film now: a preset's is its own (its colour's absorption with the film
+    at a thickness, :func:`.shade.preset_absorption`); a colour picked or matched keeps its
+    colour in the bottle, its absorption solved for this film; an absorption typed by hand
+    (or never chosen) keeps its value, and its colour in the bottle is this film's."""
+    slab = shade.slab_foundation(settings)
+    with shade.assigning():
+        source = settings.shade_source
+        if source == "PRESET" and settings.foundation in presets.FOUNDATIONS:
+            settings.absorption = [float(a) for a in shade.preset_absorption(
+                settings.foundation, slab is not None)]
+        elif source == "MATCH" or (source == "USER" and settings.absorption_mode == "COLOUR"):
+            absorption, clamped = shade.absorption_for_colour(settings.shade_colour, slab)
+            settings.absorption = [float(a) for a in absorption]
+            settings.shade_note = shade.colour_note(settings.shade_colour, clamped, slab)
+        else:
+            settings.shade_colour = [float(c) for c in shade.colour_seen(settings.absorption,
+                                                                         slab)]
 
 
 def _update_thickness(self, context):
@@ -149,7 +170,8 @@ def _update_thickness(self, context):
 def _update_absorption(self, context):
     if not shade.is_assigning():
         with shade.assigning():
-            self.shade_colour = [float(c) for c in shade.colour_seen(self.absorption)]
+            self.shade_colour = [float(c) for c in shade.colour_seen(
+                self.absorption, shade.slab_foundation(self))]
             self.shade_note = ""
             self.shade_source = "USER"
     _update_shade(self, context)
@@ -158,10 +180,11 @@ def _update_absorption(self, context):
 def _update_shade_colour(self, context):
     if shade.is_assigning():
         return
-    absorption, clamped = shade.absorption_for_colour(self.shade_colour)
+    slab = shade.slab_foundation(self)
+    absorption, clamped = shade.absorption_for_colour(self.shade_colour, slab)
     with shade.assigning():
         self.absorption = [float(a) for a in absorption]
-        self.shade_note = shade.colour_note(self.shade_colour, clamped)
+        self.shade_note = shade.colour_note(self.shade_colour, clamped, slab)
         self.shade_source = "USER"
     _update_shade(self, context)
 
@@ -181,7 +204,8 @@ def _update_foundation(self, context):
         with shade.assigning():
             # The preset's shade reaches the material at once (its sockets), its colour seen
             # and its film's own roughness come with it.
-            self.absorption = presets.FOUNDATIONS[self.foundation]["absorption"]
+            self.absorption = [float(a) for a in shade.preset_absorption(
+                self.foundation, self.film_mode != PAPER_FILM)]
             self.shade_colour = [float(c) for c in shade.preset_colour(self.foundation)]
             self.film_roughness = shade.foundation_roughness(self.foundation)
             self.shade_note = ""

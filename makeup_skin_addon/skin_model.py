@@ -22,16 +22,12 @@ from dataclasses import dataclass
 from typing import Any
 
 from .core import cache, presets, roughness
+from .keys import PAPER_FILM, SLAB_FILM
 from .shade import ROUGHNESS_TOLERANCE, foundation_roughness, skin_roughness
 
 __all__ = ["SkinSettings", "skin_settings", "skin_from_settings", "film_of", "skin_under_of",
            "skin_albedo_of", "clear_cache",
            "PAPER_FILM", "SLAB_FILM"]
-
-PAPER_FILM = "PAPER"
-"""The Film setting of the paper's model as published (its 150 um free film, paths 1 + 3)."""
-SLAB_FILM = "SLAB"
-"""The Film setting of the film as a slab at the Thickness setting (new Applies' default)."""
 
 _ROUGHENED = cache.LRUCache(32)
 
