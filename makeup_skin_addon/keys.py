@@ -99,13 +99,14 @@ PAPER_FILM = "PAPER"
 """The Film setting of the paper's model as published (its 150 um free film, paths 1 + 3)."""
 SLAB_FILM = "SLAB"
 """The Film setting of the film as a slab at the Thickness setting."""
-SETTINGS_VERSION = 3
+SETTINGS_VERSION = 4
 """What the settings mean, stamped on every change (``settings_version``).  1 (never stamped):
 Shade By Colour was the colour the pigment passes (1 - absorption), Film Roughness a width in
 degrees under Override Film, Coverage 1 and Shade By Absorption the defaults; 2: Colour is the
 colour seen (the thick layer), Film and Skin Roughness are Blender roughness; 3: the Film
-setting (the film at a Thickness, the default, or the paper's film as published): every
-material of versions 1 and 2 had the paper's film."""
+setting (the paper's film as published, the default, or the film at a Thickness): every
+material of versions 1 and 2 had the paper's film; 4: the film at a Thickness is the default
+(a version-3 file that stores no Film had the paper's)."""
 
 # --- custom properties of a material ---------------------------------------------------------
 RECORD_KEY = "makeup_skin_previous_surface"

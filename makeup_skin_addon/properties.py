@@ -189,6 +189,14 @@ def _update_shade_colour(self, context):
     _update_shade(self, context)
 
 
+def _update_skin_colour(self, context):
+    """Skin Color reaches the sockets at once; with the film as a slab the fit is made on it
+    (:func:`.skin_model.skin_albedo_of`), so the group is rebuilt too."""
+    _update_sockets(self, context)
+    if self.film_mode != PAPER_FILM and not self.over_shader:
+        live.tables_changed(self)
+
+
 def _update_skin(self, context):
     if self.skin in presets.SKINS:
         with shade.assigning():
@@ -244,9 +252,10 @@ class MakeupSkinSettings(bpy.types.PropertyGroup):
                                           "a slab)"),
             (PAPER_FILM, "Paper Film (as Published)", "The paper's measured free film, about "
                                                       "150 micrometres, paths 1 + 3 as "
-                                                      "published (files made before keep "
-                                                      "it)")),
-        default=PAPER_FILM,
+                                                      "published (files made before the "
+                                                      "film at a thickness was the default "
+                                                      "keep it)")),
+        default=SLAB_FILM,
         description="How the foundation's film is modelled: at a thickness, or the paper's "
                     "free film as published", update=_update_film)
     thickness_um: bpy.props.FloatProperty(
@@ -329,7 +338,7 @@ class MakeupSkinSettings(bpy.types.PropertyGroup):
         description="The skin's diffuse albedo (the skin preset's by default, or the value of "
                     "the artist's Base Color); an albedo texture linked to the group's Skin "
                     "Color input replaces it",
-        update=_update_sockets)
+        update=_update_skin_colour)
     skin_roughness: bpy.props.FloatProperty(
         name="Skin Roughness", default=shade.skin_roughness(FIRST_SKIN),
         min=SKIN_ROUGHNESS_MIN, max=ROUGHNESS_MAX, subtype="FACTOR",

@@ -18,9 +18,9 @@ def _settings(obj):
 
 @pytest.mark.parametrize("name", PRODUCTS)
 def test_picking_a_products_colour_gives_its_preset(sphere, name):
-    """The measured product's own colour (its bottle) picked in Colour mode: the preset's
-    absorption, and the group node has it at once."""
-    material, _ = apply_pipeline(sphere, "PRINCIPLED")
+    """The measured product's own colour (its bottle) picked in Colour mode, the paper's film:
+    the preset's absorption, and the group node has it at once."""
+    material, _ = apply_pipeline(sphere, "PRINCIPLED", film_mode="PAPER")
     settings = material.makeup_skin
     settings.absorption_mode = "COLOUR"
     settings.shade_colour = presets.FOUNDATIONS[name]["colour"]
@@ -34,12 +34,13 @@ def test_picking_a_products_colour_gives_its_preset(sphere, name):
 
 
 def test_a_picked_colour_is_the_thick_layer_of_the_solved_film(addon, blank_scene):
-    """Reachable colours come back from the solved film's thick layer to 1e-6; a colour too
-    light in red is clamped and the note says so in words; choosing a foundation shows its
-    colour."""
+    """The paper's film: reachable colours come back from the solved film's thick layer to
+    1e-6; a colour too light in red is clamped and the note says so in words; choosing a
+    foundation shows its colour."""
     import bpy
 
     settings = bpy.data.materials.new("Skin").makeup_skin
+    settings.film_mode = "PAPER"
     rng = np.random.default_rng(3)
     exchange = thick_layer.preset_film_exchange()
     for colour in rng.uniform(exchange.r_gloss + 0.01, 0.8, size=(5, 3)):
