@@ -113,9 +113,11 @@ def test_lighter_then_darker_returns_exactly_clamped_or_not(sphere):
     np.testing.assert_allclose(settings.absorption, (0.1, 0.3, 0.5), atol=1e-6)
 
 
-def test_a_dark_skin_gets_the_matte_film(addon, blank_scene):
-    """Skin darker in blue than the paper film's own gloss: the first Apply takes the matte
-    film, and its match reaches every channel."""
+@pytest.mark.parametrize("film", ["PAPER", "SLAB"])
+def test_a_dark_skin_gets_the_matte_film(addon, blank_scene, film):
+    """Skin darker in blue than the paper film's own gloss reaches: the first Apply takes the
+    matte film, and its match reaches every channel (with the film at a thickness, without
+    darkening the skin under the film, which the paper film's surface gloss would need)."""
     import bpy
 
     from makeup_skin_addon import matching
@@ -123,9 +125,10 @@ def test_a_dark_skin_gets_the_matte_film(addon, blank_scene):
     bpy.ops.mesh.primitive_uv_sphere_add(radius=0.03)
     obj = bpy.context.active_object
     material, messages = apply_pipeline(obj, "PRINCIPLED", skin_colour=(0.25, 0.11, 0.06),
-                                        film_mode="PAPER")
+                                        film_mode=film)
     settings = material.makeup_skin
     assert settings.foundation == matching.MATTE_FILM and settings.shade_note == ""
+    assert tuple(settings.skin_under) == (1.0, 1.0, 1.0)
     assert any(m.startswith("Chose Clarins 103 (matte, measured)'s matte film") for m in messages)
 
 
