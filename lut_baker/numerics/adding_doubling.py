@@ -231,7 +231,8 @@ def slab_generator(reflection: NDArray[np.float64], transmission: NDArray[np.flo
     and ``B = Y^(1/2) U tanh(lambda)^(-1/2)``.  A mode the slab extinguishes completely
     (``theta`` at or beyond 1 within rounding, or measured slightly negative) is given the rate
     ``max_rate``: ``rates`` never exceed it (for light straight through an absorbing slab of
-    optical thickness ``tau``, ``max_rate = tau / 2``, the transmission ``exp(-2 lambda x)``).
+    optical thickness ``tau``, ``max_rate = tau / 2``, the transmission ``exp(-2 lambda x)``);
+    a capped mode keeps ``Y`` and ``Z`` in proportion, so it stays pure loss where ``Y = Z``.
 
     >>> generator = slab_generator(np.array([[0.2]]), np.array([[0.7]]))  # one node
     >>> r, t = slab(generator, 1.0)  # the reference thickness: the slab given back
@@ -244,12 +245,17 @@ def slab_generator(reflection: NDArray[np.float64], transmission: NDArray[np.flo
     z = _cayley(even)
     y = _symmetric(np.linalg.solve(eye - odd, eye + odd))
     y_half, _ = _sqrt_and_inverse(y)
-    theta, vectors = np.linalg.eigh(_symmetric(y_half @ z @ y_half))
+    measured, vectors = np.linalg.eigh(_symmetric(y_half @ z @ y_half))
     ceiling = np.tanh(min(float(max_rate), 18.0)) ** 2  # tanh(18)^2 = 1 - 1e-15
-    theta = np.clip(theta, np.finfo(float).tiny, ceiling)
+    theta = np.clip(measured, np.finfo(float).tiny, ceiling)
     root = np.sqrt(theta)
     rates = np.arctanh(root)
-    basis = (y_half @ vectors) / np.sqrt(root)[..., None, :]
+    # A mode capped at the ceiling keeps Y and Z in proportion (each scaled by root over the
+    # measured root): one extinguished alike over a mirror and an anti-mirror (Y = Z) stays pure
+    # loss (P = Q, no back-scattering).  Normalised by the capped root, Y would stay as measured
+    # and Z alone shrink, which puts back-scattering ``lambda (1/root - root) / 2`` on the
+    # identity of the capped modes: a retro-reflected delta.
+    basis = (y_half @ vectors) / np.sqrt(np.sqrt(np.maximum(measured, theta)))[..., None, :]
     return SlabGenerator(basis=basis, rates=rates)
 
 

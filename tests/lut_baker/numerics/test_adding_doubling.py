@@ -111,6 +111,29 @@ def test_the_inverted_doubling_relation_recovers_the_medium(scale):
     assert np.allclose(r2, r, atol=1e-12) and np.allclose(t2, t, atol=1e-12)
 
 
+def test_a_mode_extinguished_beyond_its_rate_stays_pure_loss(scale):
+    """A slab measured too thick to resolve (a pure absorber, and the medium 40 times over)
+    capped at ``max_rate`` stays as absorbing as it was scattering: no back-scattering is
+    created in the capped modes (P = Q there), which would reflect a delta at the
+    retro-reflection direction (the identity of the star form), weighted by 1 / (c_m w) and
+    so a spike near the normal in every order."""
+    n = GRID.theta.size
+    eye = np.broadcast_to(np.eye(n), (GRID.orders, n, n))
+    gen = AD.slab_generator(np.zeros_like(eye), 1e-30 * eye, max_rate=3.0)
+    p, q = AD.generator_matrices(gen)
+    assert np.allclose(p, q, atol=1e-12)
+    for x in (0.01, 0.1, 1.0):
+        r, t = AD.slab(gen, x)
+        assert np.abs(r).max() < 1e-12
+        assert np.allclose(t, np.exp(-6.0 * x) * eye, atol=1e-12)
+    # A scattering medium: the capped modes add no back-scattering at small thickness either
+    # (the thin slab reflects what the medium's first order reflects, not a retro delta).
+    thick_r, thick_t = AD.slab(medium_slab(0.95, scale), 40.0)
+    capped = AD.slab_generator(thick_r, thick_t, max_rate=3.0)
+    r, _ = AD.slab(capped, 1e-3)
+    assert np.abs(r[1:]).max() < 1e-9  # isotropic scattering: order 0 only
+
+
 def test_thin_and_thick_limits(scale):
     gen = medium_slab(0.7, scale)
     r, t = AD.slab(gen, 0.0)
