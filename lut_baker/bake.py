@@ -54,7 +54,7 @@ from numpy.typing import ArrayLike, NDArray
 from .evaluate.two_layer import inter_reflection_fourier_matrices, layered_fourier_matrices
 from .model.albedo import specular_albedo
 from .model.dipole import dipole_profile, dipole_total_reflectance
-from .model.film_slab import relative_thickness
+from .model.film_slab import relative_thickness, skin_star, surface_share
 from .model.layers import Dipole, ReflectionLayer, TransmissionLayer
 from .model.made_up_skin import MadeUpSkin, film_reflection_layer, film_transmission_layer
 from .model.microfacet import (
@@ -65,7 +65,7 @@ from .model.microfacet import (
     ts_transmission_from_cosines,
 )
 from .model.params_file import skin_to_dict
-from .model.slab_skin import foundation_slab, slab_skin_parts
+from .model.slab_skin import body_gloss_weight, foundation_slab, slab_skin_parts
 from .numerics import Real
 from .numerics.adding_doubling import from_star, star_albedo, star_scale
 from .numerics.cache import LRUCache
@@ -595,12 +595,15 @@ def bake_slab(skin: MadeUpSkin, resolution_name: str | Resolution = "default", *
             else np.asarray(thicknesses_um, float))
     absorption = np.broadcast_to(np.asarray(skin.absorption, float), (3,))
     film = foundation_slab(skin.film, skin.film_transmission, grid, absorption)
-    face = gloss_albedos((skin.film,), np.degrees(grid.theta))[0].T  # (3, N), a_g
+    share = np.broadcast_to(surface_share(skin.film), (3,))  # k: the surface's share of the gloss
+    face = share[:, None] * gloss_albedos((skin.film,), np.degrees(grid.theta))[0].T  # a_g
     scale = star_scale(grid)
-    top, top_albedo, through, through_mean, below, film_albedo = [], [], [], [], [], []
+    lobe = skin_star(gloss_layer(skin.film), grid)  # eq. 2's gloss, star form, every order
+    top, top_albedo, through, through_mean, below, film_albedo, body_gloss = ([] for _ in range(7))
     for h in axis:
-        parts = slab_skin_parts(film, np.inf if np.isinf(h) else relative_thickness(h),
-                                skin.skin_reflection, face)
+        x = np.inf if np.isinf(h) else relative_thickness(h)
+        parts = slab_skin_parts(film, x, skin.skin_reflection, face)
+        body_gloss.append(np.broadcast_to(body_gloss_weight(film, x, face, lobe), (3,)))
         kernel = from_star(parts.top, scale)  # (C, M, N, N) 1/sr
         on_table = np.moveaxis(lagrange @ kernel @ lagrange.T, 0, -1)  # (M, I, I, C)
         top.append(np.asarray(_cosine_series(on_table, pairs)))
@@ -613,6 +616,7 @@ def bake_slab(skin: MadeUpSkin, resolution_name: str | Resolution = "default", *
                       top=np.stack(top), top_albedo=np.stack(top_albedo),
                       through=np.stack(through), through_mean=np.stack(through_mean),
                       below=np.stack(below), film_albedo=np.stack(film_albedo),
-                      absorption=absorption.copy(),
+                      body_gloss=np.stack(body_gloss),
+                      absorption=absorption.copy(), surface_share=share.copy(),
                       theta_spacing=res.theta_spacing, theta_offset=res.theta_offset,
                       phi_spacing=res.phi_spacing)

@@ -120,9 +120,11 @@ def _material_for(obj: Any) -> tuple[Any, bool]:
 
 def _follow_shader(settings: Any, reading: Any, report: Report) -> None:
     """Take from the artist's shader (``reading``) what the bake needs of the skin under the
-    film: its roughness (within the panel's range), index and subsurface method."""
+    film: its roughness (within the panel's range), index and subsurface method, and its mean
+    body colour (the skin the film covers, where a slab's fit is made)."""
     with shade.assigning():
         settings.over_shader = True
+        settings.skin_body = [float(b) for b in reading.body]
         if reading.roughness is not None:
             value = min(max(reading.roughness, shade.SKIN_ROUGHNESS_MIN), shade.ROUGHNESS_MAX)
             if abs(value - reading.roughness) > 1e-6:
@@ -158,9 +160,10 @@ def _bake_record(settings: Any, target: str, quick: bool, over: bool, report: Re
     that bake) at preview resolution, the refinement to ``target`` noted in ``report``."""
     skin = skin_model.skin_from_settings(settings)
     film, under = skin_model.film_of(settings), skin_model.skin_under_of(settings)
-    record = bakes.bake_record(skin, target, film, under)
+    albedo = skin_model.skin_albedo_of(settings)
+    record = bakes.bake_record(skin, target, film, under, albedo)
     if quick and not groups.has_group(record, tier_choice.forced_method(settings), over):
-        record = bakes.bake_record(skin, PREVIEW, film, under)
+        record = bakes.bake_record(skin, PREVIEW, film, under, albedo)
         report.refine = target
         report.append(f"Baked at preview resolution first: the {target} tables follow in "
                       f"the background.")
@@ -341,7 +344,8 @@ def check_material(context: Any, material: Any) -> tuple[bool, str]:
                        f"version; re-baked it from the panel's settings.")
     try:
         key = bakes.bake_key(meta["parameters"], meta.get("resolution", "default"),
-                             meta.get("film_thickness_um"), meta.get("skin_under"))
+                             meta.get("film_thickness_um"), meta.get("skin_under"),
+                             meta.get("skin_albedo"))
     except (TypeError, ValueError):
         key = None
     if key != meta.get("key"):

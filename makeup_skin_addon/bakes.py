@@ -67,9 +67,10 @@ MEASURE_SHARE = 0.85
 """Where on Apply's progress bar the fit ends and its measurement begins."""
 SLAB_TABLES = "slab"
 """:func:`bake_key`'s thickness for the slab's tables, shared by every thickness."""
-RECORD_FIELDS = ("key", "parameters", "resolution", "film_thickness_um", "skin_under")
-"""A bake record's fields (the thickness and the skin under the film only with the film as a
-slab)."""
+RECORD_FIELDS = ("key", "parameters", "resolution", "film_thickness_um", "skin_under",
+                 "skin_albedo")
+"""A bake record's fields (the thickness, the skin under the film and the skin the fit is made
+at only with the film as a slab)."""
 
 
 class BakeRecordError(ValueError):
@@ -89,9 +90,9 @@ _BAKES = cache.LRUCache(CACHE_SIZE)
 _SLABS = cache.LRUCache(CACHE_SIZE)
 """The slab's tables by the key they share over thicknesses (:func:`_tables_key`)."""
 _SLAB_FITS = cache.LRUCache(4 * CACHE_SIZE)
-"""The last fit of the slab's tables per ``(shared key, forced method, over the artist's
-shader)``: a fit at another thickness moves from it (:func:`lut_baker.closures.fitting.
-at_thickness`) instead of fitting again."""
+"""The last fit of the slab's tables per ``(shared key, skin albedo, forced method, over the
+artist's shader)``: a fit at another thickness on the same skin moves from it
+(:func:`lut_baker.closures.fitting.at_thickness`) instead of fitting again."""
 
 
 def _entry(key: str) -> _Entry:
@@ -104,14 +105,15 @@ def _entry(key: str) -> _Entry:
 
 
 def bake_key(parameters: dict, resolution: str, thickness_um: Any = None,
-             skin_under: Any = None) -> str:
+             skin_under: Any = None, skin_albedo: Any = None) -> str:
     """The key of a bake: SHA-256 (first :data:`KEY_LENGTH` hex digits) of the made-up skin's
     ``parameters`` (:func:`lut_baker.model.params_file.skin_to_dict`), the resolution name,
     the film's thickness (micrometres; None: the paper's film, whose keys are those of every
     earlier version; ``"slab"``: the slab's tables, whatever the thickness), the skin's albedo
     under the film relative to Skin Color where Match Skin darkened it (``skin_under``, RGB, or
-    None) and the tables' format version, as canonical JSON (floats by ``repr``: the same on
-    every machine)."""
+    None), the skin the film covers where the fit is made at it (``skin_albedo``, RGB, or None:
+    the skin preset's) and the tables' format version, as canonical JSON (floats by ``repr``:
+    the same on every machine)."""
     version = table_set.FORMAT_VERSION
     data: dict[str, Any] = {"parameters": parameters, "resolution": str(resolution),
                             "format": version}
@@ -120,35 +122,45 @@ def bake_key(parameters: dict, resolution: str, thickness_um: Any = None,
                                      else float(thickness_um))
     if skin_under is not None:
         data["skin_under"] = [float(u) for u in skin_under]
+    if skin_albedo is not None:
+        data["skin_albedo"] = [float(a) for a in skin_albedo]
     text = json.dumps(data, sort_keys=True, separators=(",", ":"))
     return hashlib.sha256(text.encode("utf-8")).hexdigest()[:KEY_LENGTH]
 
 
 def bake_record(skin: Any, resolution: str, film: Any = "paper",
-                skin_under: Any = None) -> dict:
+                skin_under: Any = None, skin_albedo: Any = None) -> dict:
     """What identifies a bake: ``{"key", "parameters", "resolution"}`` and, for the film as a
     slab (``film`` a thickness in micrometres, :func:`.skin_model.film_of`),
-    ``"film_thickness_um"`` and, where Match Skin darkened the skin under it, ``"skin_under"``
-    (:func:`.skin_model.skin_under_of`) (plain data, no bake needed).  A slab's skin carries
-    its absorption (the slab is baked at it)."""
+    ``"film_thickness_um"``, where Match Skin darkened the skin under it ``"skin_under"``
+    (:func:`.skin_model.skin_under_of`) and, where the skin the film covers is known (the
+    artist's, :func:`.skin_model.skin_albedo_of`), ``"skin_albedo"``: the fit is made and
+    judged there (plain data, no bake needed).  A slab's skin carries its absorption (the slab
+    is baked at it)."""
     parameters = params_file.skin_to_dict(skin)
     thickness = None if film == "paper" else float(film)
     under = None if thickness is None or skin_under is None else [float(u)
                                                                   for u in skin_under]
-    record: dict[str, Any] = {"key": bake_key(parameters, resolution, thickness, under),
+    albedo = None if thickness is None or skin_albedo is None else [float(a)
+                                                                    for a in skin_albedo]
+    record: dict[str, Any] = {"key": bake_key(parameters, resolution, thickness, under,
+                                              albedo),
                               "parameters": parameters, "resolution": str(resolution)}
     if thickness is not None:
         record["film_thickness_um"] = thickness
     if under is not None:
         record["skin_under"] = under
+    if albedo is not None:
+        record["skin_albedo"] = albedo
     return record
 
 
 def record_key(record: dict) -> str:
-    """The key a record's parameters, resolution, thickness and skin under the film give
-    (:func:`bake_key`)."""
+    """The key a record's parameters, resolution, thickness, skin under the film and skin
+    albedo give (:func:`bake_key`)."""
     return bake_key(record["parameters"], record["resolution"],
-                    record.get("film_thickness_um"), record.get("skin_under"))
+                    record.get("film_thickness_um"), record.get("skin_under"),
+                    record.get("skin_albedo"))
 
 
 def _tables_key(record: dict) -> str | None:
@@ -239,8 +251,10 @@ def baked(record: dict, *, method: str | None = None,
     fit = fits.get(which)
     tiers = tuple(tiers)
     shared = _tables_key(record)
+    skin = record.get("skin_albedo")
+    skin_key = None if skin is None else tuple(float(a) for a in skin)
     if fit is None and shared is not None:
-        other = _SLAB_FITS.get((shared, *which))
+        other = _SLAB_FITS.get((shared, skin_key, *which))
         if other is not None and set(tiers) <= set(other.tiers):
             fit = _under(fitting.at_thickness(other, tables,
                                               float(record["film_thickness_um"])), record)
@@ -249,10 +263,10 @@ def baked(record: dict, *, method: str | None = None,
     if fit is None or not set(tiers) <= set(fit.tiers):
         fit = _under(fitting.fit_closures(
             tables, tiers=tiers, over_shader=over_shader, onto=fit, subsurface_method=method,
-            errors_at=errors_at, progress=fit_progress), record)
+            errors_at=errors_at, skin_albedo=skin, progress=fit_progress), record)
         fits[which] = fit
         if shared is not None:
-            _SLAB_FITS.put((shared, *which), fit)
+            _SLAB_FITS.put((shared, skin_key, *which), fit)
     return tables, fit
 
 

@@ -82,12 +82,13 @@ def _stored_measurement(work: Bake) -> dict | None:
     return None
 
 
-def build(work: Bake, tier: str, group: Any = None) -> Any:
+def build(work: Bake, tier: str, group: Any = None, *, measured: bool = True) -> Any:
     """The group of ``tier`` built from the bake (rebuilt in place when ``group`` is given),
-    its record keeping the measurement; over the artist's shader if ``work.over``."""
+    its record keeping the measurement (none if not ``measured``: a Thickness move's, measured
+    after it is swapped in, :mod:`.live`); over the artist's shader if ``work.over``."""
     _, fit = work.fitted(tier)
     return nodes.build_group(tier, work.record, fit, group, method=work.method,
-                             measured=work.measured(), over=work.over)
+                             measured=work.measured() if measured else None, over=work.over)
 
 
 def group_for(material: Any, settings: Any, scene: Any, work: Bake, messages: list,

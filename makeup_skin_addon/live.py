@@ -13,6 +13,11 @@ main thread only reads the settings, polls and builds the group.  A newer change
 rebuild in flight: the worker stops at its next step and its result is dropped, as is one
 whose material was removed, reverted or re-applied (:func:`cancel`) meanwhile.
 
+A Thickness move measures nothing (the slab's tables are shared, its fit moves in
+milliseconds: :attr:`.rebuild.Rebuild.unmeasured`): the group of the tier the material has is
+swapped in at once, and a rebuild that measures (the tiers' errors, Tier Auto's choice) follows
+it once the slider rests (:data:`DEBOUNCE_S`), superseded by the next move.
+
 An Apply at preview resolution is refined the same way (:func:`refine`: the settings'
 resolution computed on a worker, swapped in when ready).
 
@@ -60,6 +65,8 @@ PREVIEW = apply.PREVIEW
 
 _dirty: dict[str, str] = {}
 """Materials marked for a rebuild, by name: the resolution to rebuild at."""
+_unmeasured: set[str] = set()
+"""Marked materials whose rebuild measures nothing (a Thickness move), by name."""
 _jobs: dict[str, _Job] = {}
 """The rebuild in flight of each material, by name."""
 _stopped: list[_Job] = []
@@ -127,15 +134,27 @@ def _supersede(name: str) -> None:
         _stopped.append(job)
 
 
-def tables_changed(settings, debounce_s: float = DEBOUNCE_S) -> None:
+def tables_changed(settings, debounce_s: float = DEBOUNCE_S, *,
+                   measure_later: bool = False) -> None:
     """A setting the tables depend on moved: supersede the material's rebuild in flight and
     schedule a preview rebuild (debounced by ``debounce_s``: :data:`THICKNESS_DEBOUNCE_S` for
-    a Thickness change, whose rebuild bakes and fits nothing)."""
+    a Thickness change, whose rebuild bakes and fits nothing; ``measure_later``: and measures
+    nothing, a measuring rebuild following it)."""
     material = _material_of(settings)
     if material is None or not settings.is_made_up or not settings.live_update:
         return
     _supersede(material.name)
-    _dirty[material.name] = PREVIEW
+    _mark(material.name, PREVIEW, measure_later, debounce_s)
+
+
+def _mark(name: str, resolution: str, measure_later: bool, debounce_s: float) -> None:
+    """Mark material ``name`` for a rebuild at ``resolution`` and (with an event loop) set the
+    debounce timer off anew."""
+    _dirty[name] = resolution
+    if measure_later and resolution == PREVIEW:
+        _unmeasured.add(name)
+    else:
+        _unmeasured.discard(name)
     if bpy.app.background:
         return  # no event loop: flush() runs the rebuild when asked
     if bpy.app.timers.is_registered(rebake_timer):
@@ -163,12 +182,14 @@ def in_flight() -> set[str]:
 def cancel(material) -> None:
     """Drop what is pending for ``material`` (an Apply or a Revert makes it stale)."""
     _dirty.pop(material.name, None)
+    _unmeasured.discard(material.name)
     _supersede(material.name)
 
 
 def forget() -> None:
     """Drop everything pending (another file was opened: its materials are not these)."""
     _dirty.clear()
+    _unmeasured.clear()
     for name in list(_jobs):
         _supersede(name)
 
@@ -185,14 +206,17 @@ def _usable(material) -> str | None:
 
 
 def _prepared(context, name: str, resolution: str) -> _Job | str | None:
-    """A job for material ``name``'s rebuild at ``resolution`` (its settings read now), or
-    the sentence saying why not, or None (the material is gone or no longer made up)."""
+    """A job for material ``name``'s rebuild at ``resolution`` (its settings read now;
+    measuring nothing if it was so marked), or the sentence saying why not, or None (the
+    material is gone or no longer made up)."""
+    measure = name not in _unmeasured
+    _unmeasured.discard(name)
     material = bpy.data.materials.get(name)
     reason = _usable(material)
     if reason is not None:
         return None if reason == "gone" else reason
     try:
-        return _Job(prepare_rebuild(context, material, resolution))
+        return _Job(prepare_rebuild(context, material, resolution, measure=measure))
     except (ValueError, RuntimeError) as error:
         return f"Made-up Skin: the preview of {name!r} failed: {error}."
 
@@ -222,6 +246,7 @@ def refine(context, material, resolution: str) -> None:
     preview resolution): swapped in by the poll timer, or by :func:`flush`."""
     _supersede(material.name)
     _dirty[material.name] = resolution
+    _unmeasured.discard(material.name)
     start(context)
 
 
@@ -247,6 +272,8 @@ def _swap(context, job: _Job) -> list[str]:
         finish_rebuild(context, material, group, rebuild)
     except (ValueError, RuntimeError) as error:
         return [f"Made-up Skin: the preview of {rebuild.material!r} failed: {error}."]
+    if rebuild.unmeasured is not None and material.name not in _dirty:
+        _mark(material.name, rebuild.resolution, False, DEBOUNCE_S)  # now measure it
     return []
 
 
@@ -310,6 +337,7 @@ def flush(context=None) -> list[str]:
 
 def register():
     _dirty.clear()
+    _unmeasured.clear()
 
 
 def unregister():
@@ -322,5 +350,6 @@ def unregister():
         job.thread.join(JOIN_TIMEOUT_S)
     _stopped.clear()
     _dirty.clear()
+    _unmeasured.clear()
     _messages.clear()
     apply.clear_cache()

@@ -143,7 +143,7 @@ def _update_thickness(self, context):
     if not shade.is_assigning():
         _reset_skin_under(self)
     _stamp(self)
-    live.tables_changed(self, live.THICKNESS_DEBOUNCE_S)
+    live.tables_changed(self, live.THICKNESS_DEBOUNCE_S, measure_later=True)
 
 
 def _update_absorption(self, context):
@@ -237,6 +237,11 @@ class MakeupSkinSettings(bpy.types.PropertyGroup):
                     "where a sheer film's gloss adds more than full absorption takes away, "
                     "Match Skin darkens the skin under it (1: the skin's own; internal, reset "
                     "by a shade or film set by hand)")
+    skin_body: bpy.props.FloatVectorProperty(
+        name="Skin Body Color", size=3, default=(0.0, 0.0, 0.0), min=0.0, max=1.0,
+        description="The mean body color of the skin under the film as Apply last read it "
+                    "from the artist's shader: the film at a thickness is fitted on it (0: "
+                    "not read; internal)")
     coverage: bpy.props.FloatProperty(
         name="Covered Area", default=0.6, min=0.0, max=1.0, subtype="FACTOR",
         description="Fraction of the surface the film lies on, as an areal mix of made-up "

@@ -3,7 +3,8 @@ one runs on a worker thread (the live preview's, :mod:`.live`): read the setting
 thread (:func:`prepare_rebuild`), make the skin, bake, fit and measure anywhere
 (:meth:`Rebuild.compute`, no bpy), build the group on the main thread (:func:`finish_rebuild`).
 
-- :class:`Rebuild` -- a rebuild and what it computed.
+- :class:`Rebuild` -- a rebuild and what it computed (measured, or not yet: a Thickness
+  move's group swapped in first and measured by the rebuild that follows it).
 - :func:`prepare_rebuild`, :func:`finish_rebuild` -- its first and last steps.
 - :func:`rebuild_from_settings` -- the three at once (Check Tables' repair, the live preview
   without an event loop).
@@ -14,8 +15,9 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from . import bakes, convert, groups, skin_model, tier_choice
+from . import bakes, convert, groups, nodes, skin_model, tier_choice
 from .bakes import Bake
+from .core import tier_registry
 from .progress import Checked, Progress, Stages
 
 __all__ = ["Rebuild", "prepare_rebuild", "finish_rebuild", "rebuild_from_settings"]
@@ -28,12 +30,17 @@ class Rebuild:
     makes the Auto tier's choice once, which leaves its costly part cached), touching no bpy,
     and :func:`finish_rebuild` builds the group from what was computed.  ``material``: the
     name, ``uid``: the material's ``session_uid`` (another file's material of the same name
-    is not it); ``work``: the :class:`.bakes.Bake` (made by :meth:`compute`)."""
+    is not it); ``work``: the :class:`.bakes.Bake` (made by :meth:`compute`).
+    ``unmeasured``: the tier of a rebuild that measures nothing (None: it measures, and Tier
+    Auto chooses): the group of the material's tier now, swapped in at once (a Thickness
+    move: its fit moved in milliseconds), then measured by a rebuild that follows it."""
 
     def __init__(self, material: Any, skin: skin_model.SkinSettings, resolution: str,
-                 bake: dict, where: tier_choice.ChoiceScene | None):
+                 bake: dict, where: tier_choice.ChoiceScene | None,
+                 unmeasured: str | None = None):
         self.material, self.uid = material.name, material.session_uid
         self.skin, self.resolution, self.bake, self.where = skin, resolution, bake, where
+        self.unmeasured = unmeasured
         self.work: Bake | None = None
         self.progress: Stages | None = None
 
@@ -51,12 +58,15 @@ class Rebuild:
         if work is None:
             record = bakes.bake_record(skin_model.skin_from_settings(self.skin),
                                        self.resolution, skin_model.film_of(self.skin),
-                                       skin_model.skin_under_of(self.skin))
+                                       skin_model.skin_under_of(self.skin),
+                                       skin_model.skin_albedo_of(self.skin))
             work = self.work = Bake(record, **self.bake)
         before = work.progress
         work.progress = self.progress if check is None else Checked(check)
         try:
-            work.fitted()
+            work.fitted(self.unmeasured)
+            if self.unmeasured is not None:
+                return work
             measured = work.measured(with_traits=self.where is not None)
             if self.where is not None:
                 traits = bakes.traits(measured)
@@ -67,12 +77,28 @@ class Rebuild:
         return work
 
 
-def prepare_rebuild(context: Any, material: Any, resolution: str) -> Rebuild:
+def _tier_now(material: Any) -> str | None:
+    """The tier of the material's group now (Tier Auto's last choice), or None."""
+    node = groups.group_of(material)
+    tier = nodes.read_meta(node.node_tree).get("tier") if node is not None else None
+    return tier if tier in tier_registry.TIERS else None
+
+
+def prepare_rebuild(context: Any, material: Any, resolution: str, *,
+                    measure: bool = True) -> Rebuild:
     """What the rebuild of ``material``'s group at ``resolution`` needs of Blender (main
     thread, a few milliseconds): its settings (:func:`.skin_model.skin_settings`), the tiers
     to fit (:func:`.tier_choice.fitted_tiers`), whether it goes over the artist's shader, and
-    with Tier Auto the scene the choice judges in."""
+    with Tier Auto the scene the choice judges in.  Not ``measure``: a rebuild of the tier the
+    material has now that measures nothing (:attr:`Rebuild.unmeasured`; measured all the same
+    if it has no group of a tier yet)."""
     settings = material.makeup_skin
+    if not measure:
+        tier = settings.tier if settings.tier != "AUTO" else _tier_now(material)
+        if tier is not None:
+            rebuild = prepare_rebuild(context, material, resolution)
+            rebuild.where, rebuild.unmeasured = None, tier
+            return rebuild
     over = settings.over_shader and convert.artist_tree(material) is not None
     bake = {"method": tier_choice.forced_method(settings), "coverage": settings.coverage,
             "absorption": list(settings.absorption),
@@ -87,6 +113,10 @@ def finish_rebuild(context: Any, material: Any, group: Any, rebuild: Rebuild) ->
     (computed: nothing is baked or fitted again) and make it the material's surface."""
     settings = material.makeup_skin
     work = rebuild.work if rebuild.work is not None else rebuild.compute()
+    if rebuild.unmeasured is not None:
+        group = groups.build(work, rebuild.unmeasured, group, measured=False)
+        groups.setup_material(material, group, context.scene)
+        return
     group, measured, _, auto = groups.group_for(material, settings, context.scene, work, [],
                                                 group=group)
     groups.record_measurement(material, measured, rebuild.key, auto)

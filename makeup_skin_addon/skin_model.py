@@ -11,7 +11,8 @@ so the skin carries it, and the bake's film is the thickness (:func:`film_of`).
 - :func:`skin_from_settings` -- the made-up skin of the settings, or of their plain values
   (:class:`SkinSettings`, read by :func:`skin_settings` on the main thread, for a worker).
 - :func:`film_of` -- the bake's film: the paper's (``"paper"``) or a thickness;
-  :func:`skin_under_of` -- the skin under the film where Match Skin darkened it.
+  :func:`skin_under_of` -- the skin under the film where Match Skin darkened it;
+  :func:`skin_albedo_of` -- the skin the film covers, at which a slab's fit is made.
 - :func:`clear_cache` -- forget the session's roughened layers.
 """
 
@@ -24,7 +25,7 @@ from .core import cache, presets, roughness
 from .shade import ROUGHNESS_TOLERANCE, foundation_roughness, skin_roughness
 
 __all__ = ["SkinSettings", "skin_settings", "skin_from_settings", "film_of", "skin_under_of",
-           "clear_cache",
+           "skin_albedo_of", "clear_cache",
            "PAPER_FILM", "SLAB_FILM"]
 
 PAPER_FILM = "PAPER"
@@ -61,12 +62,13 @@ class SkinSettings:
     thickness_um: float = 9.6
     absorption: tuple = (0.0, 0.0, 0.0)
     skin_under: tuple = (1.0, 1.0, 1.0)
+    skin_body: tuple = (0.0, 0.0, 0.0)
 
 
 def skin_settings(settings: Any) -> SkinSettings:
     """The :class:`SkinSettings` of a material's settings now."""
     values = {name: getattr(settings, name) for name in SkinSettings.__dataclass_fields__}
-    for name in ("absorption", "skin_under"):
+    for name in ("absorption", "skin_under", "skin_body"):
         values[name] = tuple(float(a) for a in values[name])
     return SkinSettings(**values)
 
@@ -78,6 +80,18 @@ def skin_under_of(settings: Any) -> tuple | None:
         return None
     under = tuple(float(u) for u in getattr(settings, "skin_under", (1.0, 1.0, 1.0)))
     return None if all(u == 1.0 for u in under) else under
+
+
+def skin_albedo_of(settings: Any) -> tuple | None:
+    """The skin the film covers, at which the film as a slab's closure fit is made and its
+    tiers judged (:func:`lut_baker.closures.fitting.fit_closures`' ``skin_albedo``): over the
+    artist's shader the mean body colour of the skin under the film as Apply last read it
+    (``skin_body``, :func:`.artist_skin.read_material`); None (the skin preset's albedo) for
+    the paper's film, without the artist's shader, or before it was read."""
+    if film_of(settings) == "paper" or not getattr(settings, "over_shader", False):
+        return None
+    body = tuple(float(b) for b in getattr(settings, "skin_body", (0.0, 0.0, 0.0)))
+    return body if max(body) > 0.0 else None
 
 
 def film_of(settings: Any) -> Any:

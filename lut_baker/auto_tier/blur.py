@@ -2,6 +2,7 @@
 image, from the profile's blur of a sphere's shading averaged over each pixel.
 
 - :func:`blur_kernel` -- the profile as a convolution kernel on a grid of cells.
+- :func:`fft_size` -- a fast FFT length.
 - :func:`subsurface_omission_error` -- the relative change of a sphere's image without the
   spread, at a pixel footprint and object size.
 """
@@ -15,7 +16,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..numerics.geometry import sphere_normals
 
-__all__ = ["blur_kernel", "subsurface_omission_error", "SUPERSAMPLE", "MAX_CELLS",
+__all__ = ["blur_kernel", "fft_size", "subsurface_omission_error", "SUPERSAMPLE", "MAX_CELLS",
            "KERNEL_SUBSAMPLES"]
 
 
@@ -54,15 +55,38 @@ def blur_kernel(cell_mm: float, radius_mm: ArrayLike, profile: ArrayLike
     return cells
 
 
-def _convolve(image: NDArray[np.float64], kernel: NDArray[np.float64]
-              ) -> NDArray[np.float64]:
-    """``image`` (m, m) convolved with ``kernel`` (k, k), same size, zero outside (FFT)."""
-    m, k = image.shape[0], kernel.shape[0]
-    size = m + k - 1
-    spectrum = np.fft.rfft2(image, (size, size)) * np.fft.rfft2(kernel, (size, size))
-    full = np.fft.irfft2(spectrum, (size, size))
+def fft_size(length: int) -> int:
+    """The smallest ``n >= length`` whose prime factors are 2, 3 and 5 (a fast FFT length).
+
+    >>> fft_size(769), fft_size(1152)
+    (800, 1152)
+    """
+    best = 1 << max(int(length) - 1, 0).bit_length()  # the next power of two
+    power5 = 1
+    while power5 < best:
+        odd = power5
+        while odd < best:
+            n = odd
+            while n < length:
+                n *= 2
+            best = min(best, n)
+            odd *= 3
+        power5 *= 5
+    return best
+
+
+def _convolved(images: list[NDArray[np.float64]], kernels: NDArray[np.float64]
+               ) -> NDArray[np.float64]:
+    """Each of ``images`` (m, m) convolved with each of ``kernels`` (k, k, C), same size,
+    zero outside: ``(len(images), C, m, m)``.  One FFT per image and per kernel, on a fast
+    length of at least ``m + k // 2``: the circular wrap then misses the kept window."""
+    m, k = images[0].shape[0], kernels.shape[0]
     h = k // 2
-    return full[h:h + m, h:h + m]
+    size = fft_size(m + h)
+    image_spectra = np.fft.rfft2(np.stack(images), (size, size))  # (I, s, s')
+    kernel_spectra = np.fft.rfft2(np.moveaxis(kernels, -1, 0), (size, size))  # (C, s, s')
+    full = np.fft.irfft2(image_spectra[:, None] * kernel_spectra[None], (size, size))
+    return full[..., h:h + m, h:h + m]
 
 
 def subsurface_omission_error(footprint_mm: float, object_size_mm: float, light_deg: float,
@@ -97,11 +121,10 @@ def subsurface_omission_error(footprint_mm: float, object_size_mm: float, light_
 
     seen = pixel_mean(disk) > 0.0
     sharp = pixel_mean(shading)
+    spread, reach = _convolved([shading, disk], kernel)
     errors = []
     for c in range(kernel.shape[-1]):
-        spread = _convolve(shading, kernel[..., c])
-        reach = _convolve(disk, kernel[..., c])
-        blurred = np.where(disk > 0, spread / np.maximum(reach, 1e-12), 0.0)
+        blurred = np.where(disk > 0, spread[c] / np.maximum(reach[c], 1e-12), 0.0)
         errors.append(pixel_mean(blurred)[seen] - sharp[seen])
     difference = np.stack(errors)
     return float(skin_share * np.sqrt(np.mean(difference**2)) / np.sqrt(np.mean(sharp[seen]**2)))

@@ -202,8 +202,9 @@ def _shares(tables: Tables, sphere: _Sphere, w: float, a: ArrayLike) -> tuple[fl
 def _slab_shares(tables: Tables, fit: ClosureFit, sphere: _Sphere, w: float
                  ) -> tuple[float, float]:
     """:func:`_shares` with the film as a slab at the fit's thickness (docs/model.md, "The
-    tiers at a thickness"): the gloss is the film's surface gloss, the skin's gloss through
-    the film (``top`` less the film's body) and the bare skin's; what spreads is the skin's
+    tiers at a thickness"): the gloss is the film's (its surface's and its body's share of
+    eq. 2's lobe), the skin's gloss through the film (``top`` less the film's body) and the bare
+    skin's; what spreads is the skin's
     diffuse light ``a t t / (pi (1 - a c))`` and the bare skin's."""
     wi, wo, cos_i = sphere.wi, sphere.wo, sphere.cos_i
     slab = fit.slab
@@ -213,7 +214,8 @@ def _slab_shares(tables: Tables, fit: ClosureFit, sphere: _Sphere, w: float
     targets = FitTargets(tables, 2, h)
     weights = coverage_weights(w, 0.0)
     through_gloss = targets.slab_tables().top_at(h, wi, wo) - targets.film_body(wi, wo)
-    gloss = combine(weights, **mix_slots(film_gloss=tables.angular("film_gloss", wi, wo),
+    film_gloss = targets.gloss_weight() * tables.surface_gloss("film_gloss", wi, wo)
+    gloss = combine(weights, **mix_slots(film_gloss=film_gloss,
                                          path3_gloss=through_gloss,
                                          skin_gloss=tables.angular("skin_gloss", wi, wo))
                     ) * cos_i

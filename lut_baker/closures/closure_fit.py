@@ -23,7 +23,8 @@ class SlabFit:
     thickness"): ``thickness_um`` (the thickness it was fitted at) and ``below`` (RGB, ``c``:
     the film's reflectance seen from the skin, the skin's diffuse light ``a t t / (1 - a c)``).
     The fit's ``transmittance_mean`` is then the slab's ``t`` averaged over uniform light and
-    its ``film_albedo`` the film body's albedo under uniform light.  ``skin_under`` (RGB, or
+    its ``film_albedo`` the film body's albedo under uniform light (its share of the gloss
+    included: the Principled tier's base colour holds it).  ``skin_under`` (RGB, or
     None for 1): the skin's albedo under the film relative to Skin Color, where Match Skin
     darkens it (a sheer film whose gloss alone adds more than full absorption takes away,
     docs/model.md "Made-up skin at a thickness")."""

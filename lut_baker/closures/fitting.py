@@ -33,8 +33,9 @@ from numpy.typing import NDArray
 from ..tables.table_set import Tables
 from . import cycles as cc
 from .closure_fit import ClosureFit, SlabFit
+from .lobes import LobeFit
 from .profiles import REPLICA_EDGE_ERROR, fit_profiles
-from .tier_parts import FitTargets, cosine_mean
+from .tier_parts import FitTargets, cosine_mean, held_gloss_to_diffuse
 from .tier_registry import TIERS, Tier, tier
 from .tiers import tier_errors
 from .view_image import DEFAULT_IMAGE_SIZE
@@ -79,7 +80,7 @@ def _film_parts(targets: FitTargets) -> dict[str, Any]:
                 "film_albedo": np.pi * np.asarray(tables.film_diffuse, float)}
     parts = targets.slab_parts(0.0)
     return {"transmittance_mean": np.asarray(parts.through_mean, float),
-            "film_albedo": np.asarray(targets.film_mean(), float),
+            "film_albedo": np.asarray(targets.base_mean(), float),
             "slab": SlabFit(thickness_um=float(targets.thickness_um),
                             below=np.asarray(parts.below, float))}
 
@@ -104,6 +105,7 @@ def fit_closures(tables: Tables, *, tiers: Iterable[str] | None = None,
                  over_shader: bool = False, onto: ClosureFit | None = None,
                  image_size: int = DEFAULT_IMAGE_SIZE, subsurface_method: str | None = None,
                  errors_at: tuple[float, Any] | None = None,
+                 skin_albedo: Any = None,
                  progress: Callable[..., object] | None = None) -> ClosureFit:
     """Fit the ``tiers`` (default: all of :data:`TIERS`) to ``tables`` and measure their
     errors at ``errors_at`` = ``(coverage, absorption)`` (default: those the tables were baked
@@ -113,7 +115,11 @@ def fit_closures(tables: Tables, *, tiers: Iterable[str] | None = None,
     skin there: the bare skin's gloss lobes are not fitted nor, with a forced method, the
     subsurface profiles (:class:`ClosureFit`), and the errors take the bare skin from the
     tables.  ``onto``: a fit of the same tables, method and ``over_shader`` whose tiers are
-    kept: only the others are fitted, and measured where its errors were.
+    kept: only the others are fitted, and measured where its errors were.  ``skin_albedo``
+    (RGB): the skin the film covers (the artist's mean skin under the film), at which the
+    tiers are judged (the fit's Skin Color) and, with the film as a slab, the PRINCIPLED
+    tier's colour held (:func:`~lut_baker.closures.tier_parts.held_gloss_to_diffuse`);
+    default the tables' skin, ``pi P_d`` (a fit ``onto`` keeps its own).
     ``progress(fraction, message)``: called as the fit advances (fraction 0..1).
 
     The film's gloss is fitted on a grid sized by its own lobe, the skin's gloss and path 3 on
@@ -122,7 +128,8 @@ def fit_closures(tables: Tables, *, tiers: Iterable[str] | None = None,
     report = progress or (lambda fraction, message="": None)
     asked = _checked_tiers(TIERS if tiers is None else tiers)
     wanted = asked if onto is None else tuple(t for t in asked if t.name not in onto.tiers)
-    targets = FitTargets(tables, image_size)
+    targets = FitTargets(tables, image_size,
+                         skin_albedo=onto.skin_albedo if onto is not None else skin_albedo)
     parts: dict[str, Any] = {}
     total = sum(t.fit_share for t in wanted) or 1.0
     done = 0.0
@@ -139,7 +146,7 @@ def fit_closures(tables: Tables, *, tiers: Iterable[str] | None = None,
         report(0.75, "fitting the subsurface profile")
         fit = ClosureFit(
             **_film_parts(targets),
-            skin_albedo=np.pi * np.asarray(tables.skin_diffuse, float),
+            skin_albedo=targets.skin_albedo,
             **_subsurface(tables, subsurface_method, over_shader), **parts)
     if errors_at is None:
         errors_at = (float(tables.parameters.get("coverage", 1.0)),
@@ -162,8 +169,12 @@ def _scaled_row(row: NDArray[np.float64], old: NDArray[np.float64],
     return np.where(old > 0.0, row * new / np.where(old > 0.0, old, 1.0), 0.0)
 
 
-_IMAGES = (("glossy", "view_rows", "LAYERED"), ("eevee_glossy", "eevee_view_rows", "EEVEE"))
-"""The fit's Glossy lobes, its image and their tier."""
+def _film_gloss_scaled(lobe: LobeFit, ratio: NDArray[np.float64]) -> LobeFit:
+    """The film's gloss lobe with its weight rows (and its Lambertian companion's) times
+    ``ratio`` (RGB): the body's share of the gloss at another thickness."""
+    return replace(lobe, weights=None if lobe.weights is None else lobe.weights * ratio,
+                   diffuse_weights=(None if lobe.diffuse_weights is None
+                                    else lobe.diffuse_weights * ratio))
 
 
 def at_thickness(fit: ClosureFit, tables: Tables, thickness_um: float) -> ClosureFit:
@@ -171,40 +182,57 @@ def at_thickness(fit: ClosureFit, tables: Tables, thickness_um: float) -> Closur
     the lobes' shapes (roughnesses, distributions, the film gloss's rows, the coat) kept, and
     what depends on the thickness read from the slab's axis (docs/model.md, "The tiers at a
     thickness"): the mean transmittance, ``c``, the film body's albedo and row, the
-    transmittance row, the skin's gloss through the film (its Glossy rows and the Principled
-    specular level scaled by its albedo's change; ``gloss_to_diffuse`` where no lobe holds
-    it).  The errors are not measured again (dropped).  Milliseconds: what a Thickness slider
-    costs (``bench/slab_tiers.py``)."""
+    transmittance row, the skin's gloss through the film (the Glossy rows of every tier with
+    a view-angle image, :attr:`~lut_baker.closures.tier_registry.Tier.image`, and the
+    Principled specular level scaled by its albedo's change; the Principled base colour's
+    share held on the fit's skin, :func:`~lut_baker.closures.tier_parts.
+    held_gloss_to_diffuse`), the film's gloss rows scaled by its weight's change (the body's
+    share of the gloss; the Principled coat is kept).  The errors are not measured again
+    (dropped).  Milliseconds: what a Thickness slider costs (``bench/slab_tiers.py``)."""
     if fit.slab is None:
         raise ValueError("a fit of the paper's film has no thickness")
-    size = next((getattr(fit, image).shape[1] for _, image, _ in _IMAGES
-                 if getattr(fit, image) is not None), DEFAULT_IMAGE_SIZE)
-    old = FitTargets(tables, size, fit.slab.thickness_um)
-    new = FitTargets(tables, size, thickness_um)
+    imaged = [(each, image) for each in map(tier, fit.tiers)
+              if (image := each.image(fit)) is not None]
+    size = imaged[0][1].texels.shape[1] if imaged else DEFAULT_IMAGE_SIZE
+    old = FitTargets(tables, size, fit.slab.thickness_um, fit.skin_albedo)
+    new = FitTargets(tables, size, thickness_um, fit.skin_albedo)
     theta = old.albedo_theta("path3_gloss")
     gloss_old, gloss_new = old.albedo("path3_gloss"), new.albedo("path3_gloss")
     changes: dict[str, Any] = {**_film_parts(new), "errors": {}}
-    if fit.specular_film is not None and fit.specular_film.level:
-        ratio = (np.mean(cosine_mean(gloss_new, theta))
-                 / max(float(np.mean(cosine_mean(gloss_old, theta))), 1e-300))
-        changes["specular_film"] = replace(fit.specular_film,
-                                           level=float(fit.specular_film.level * ratio))
-    elif fit.gloss_to_diffuse is not None:
-        changes["gloss_to_diffuse"] = cosine_mean(gloss_new, theta)
-    for lobes_name, image_name, tier_name in _IMAGES:
-        lobes = getattr(fit, lobes_name)
-        if lobes is None:
-            continue
+    if fit.specular_film is not None and fit.coat is not None:
+        specular = fit.specular_film
+        if specular.level:
+            ratio = (np.mean(cosine_mean(gloss_new, theta))
+                     / max(float(np.mean(cosine_mean(gloss_old, theta))), 1e-300))
+            specular = replace(specular, level=float(specular.level * ratio))
+        changes["specular_film"] = specular
+        changes["gloss_to_diffuse"] = held_gloss_to_diffuse(new, {
+            "coat": fit.coat, "specular_film": specular,
+            "coat_albedo_mean": fit.coat_albedo_mean,
+            "specular_albedo_mean": fit.specular_albedo_mean})
+    film_ratio = new.gloss_weight() / np.maximum(old.gloss_weight(), 1e-300)
+    for each, image in imaged:
+        if each.with_image is None:
+            raise ValueError(f"the {each.label} tier's image cannot be moved to another "
+                             f"thickness (it names no fields: Tier.with_image)")
+        lobes = each.lobes(fit)
         path3 = lobes["path3_gloss"]
+        if path3.weights is None:
+            raise AssertionError("a tier's Glossy lobes with an image have their rows")
         lobes = {**lobes, "path3_gloss": replace(path3, weights=_scaled_row(
             path3.weights, old.texel_rows(theta, gloss_old), new.texel_rows(theta, gloss_new)))}
-        image = tier(tier_name).image(fit)
-        if image is None:
-            raise AssertionError("a tier with Glossy lobes has an image")
-        rows = np.array(getattr(fit, image_name))
-        for name, row in (("path3_gloss", lobes["path3_gloss"].weights),
-                          ("film_transmittance", new.transmittance_rows()),
-                          ("film_body", new.body_rows())):
-            rows[image.rows.index(name)] = row
-        changes[lobes_name], changes[image_name] = lobes, rows
+        lobes.update({name: _film_gloss_scaled(lobes[name], film_ratio)
+                      for name in ("film_gloss", "film_gloss_2") if name in lobes})
+        texels = np.array(image.texels)
+        rows: dict[str, Any] = {"path3_gloss": lobes["path3_gloss"].weights,
+                                "film_transmittance": new.transmittance_rows(),
+                                "film_body": new.body_rows(),
+                                **{name: lobes[name].weights
+                                   for name in ("film_gloss", "film_gloss_2")
+                                   if name in lobes and name in image.rows}}
+        if lobes["film_gloss"].diffuse_weights is not None and "film_gloss_diffuse" in image.rows:
+            rows["film_gloss_diffuse"] = lobes["film_gloss"].diffuse_weights
+        for name, row in rows.items():
+            texels[image.rows.index(name)] = row
+        changes.update(each.with_image(lobes, texels))
     return replace(fit, **changes)

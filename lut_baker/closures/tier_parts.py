@@ -9,6 +9,8 @@ parameters are fitted to the tables, with weights that may depend on the view an
 - :class:`FitTargets` -- what the lobes of one set of tables are fitted to, computed once.
 - :func:`cosine_mean` -- a directional table's mean under uniform light.
 - :func:`principled_parts` -- one Principled BSDF's coat and speculars.
+- :func:`held_gloss_to_diffuse` -- with the film as a slab, what its base colour carries so
+  that its colour under uniform light is the slab's on the skin the film covers.
 - :func:`layered_parts` -- Cycles' Glossy lobes and their view-angle image.
 - :func:`eevee_parts` -- EEVEE's GGX lobes (the film's gloss in two) and their image.
 - :func:`image_rows`, :data:`SLAB_ROWS` -- a tier's image rows, the film as a slab's included.
@@ -25,7 +27,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..numerics.geometry import polar_angle_deg
 from ..numerics.quadrature import trapezoid_weights
-from ..tables.slab_tables import SlabParts, SlabTables
+from ..tables.slab_tables import SlabParts, SlabTables, slab_colour
 from ..tables.table_set import Tables
 from . import cycles as cc
 from .lobes import (
@@ -41,8 +43,8 @@ from .tier_formulas import SPECULAR_IOR
 from .view_grid import FIT_VIEWS, ViewGrid, lobe_widths_deg, view_grid
 from .view_image import EEVEE_IMAGE_ROWS, IMAGE_ROWS, texel_centres
 
-__all__ = ["FitTargets", "cosine_mean", "principled_parts", "layered_parts", "eevee_parts",
-           "image_rows", "SLAB_ROWS"]
+__all__ = ["FitTargets", "cosine_mean", "principled_parts", "held_gloss_to_diffuse",
+           "layered_parts", "eevee_parts", "image_rows", "SLAB_ROWS"]
 
 SLAB_ROWS = ("film_body",)
 """The view-angle rows a tier has beyond its own with the film as a slab: the film body's
@@ -89,17 +91,24 @@ class FitTargets:
     image.
 
     Tables with the film as a slab (``tables.slab``, docs/model.md "The tiers at a
-    thickness") are fitted at their baked thickness (``thickness_um``): ``path3_gloss`` is
-    then the slab's ``top`` less the film's body (Lambertian in the Layered and EEVEE tiers'
-    reading: ``alpha(theta_i) alpha(theta_o) / (pi alpha_mean)``, its directional albedo the
+    thickness") are fitted at their baked thickness (``thickness_um``): ``film_gloss`` is then
+    the film surface's share of it (:func:`lut_baker.tables.slab_tables.surface_gloss`),
+    ``path3_gloss`` the slab's ``top`` less the film's body (Lambertian in the Layered and EEVEE
+    tiers' reading: ``alpha(theta_i) alpha(theta_o) / (pi alpha_mean)``, its directional albedo the
     film's ``alpha``), the skin's gloss through the film every order; the transmittance rows
     are the slab's ``t`` and the film's body has rows of its own (``film_body``).
-    ``thickness_um``: another thickness than the baked one."""
+    ``thickness_um``: another thickness than the baked one.  ``skin_albedo`` (RGB, diffuse
+    albedo ``a``): the skin the film covers, where a fit is judged and its colour held (the
+    artist's mean skin under the film; default the tables' skin, ``pi P_d``)."""
 
     def __init__(self, tables: Tables, image_size: int,
-                 thickness_um: float | None = None) -> None:
+                 thickness_um: float | None = None,
+                 skin_albedo: ArrayLike | None = None) -> None:
         self.tables, self.image_size = tables, image_size
         self.theta_deg = np.asarray(tables.theta_deg, float)
+        self.skin_albedo: NDArray[np.float64] = np.array(np.broadcast_to(np.asarray(
+            np.pi * np.asarray(tables.skin_diffuse, float) if skin_albedo is None
+            else skin_albedo, float), (3,)))
         self.slab: SlabTables | None = getattr(tables, "slab", None)
         if self.slab is None:
             self.thickness_um = 0.0
@@ -128,18 +137,65 @@ class FitTargets:
         """The slab's 1-D parts at the fit's thickness and polar angles ``theta_deg``."""
         return self.slab_tables().at(self.thickness_um, theta_deg)
 
+    def gloss_weight(self) -> NDArray[np.float64]:
+        """The weight of eq. 2's gloss lobe (the tables' ``film_gloss``) the tiers draw as the
+        film's gloss, RGB: the surface's share and, with the film as a slab, the body's at the
+        fit's thickness (``SlabTables.body_gloss``)."""
+        if self.slab is None:
+            return np.ones(3)
+        return self.slab.surface_share + self.slab_parts(0.0).body_gloss
+
+    def body_albedo(self, theta_deg: ArrayLike) -> NDArray[np.float64]:
+        """The film body's directional albedo without its share of the gloss (what its Diffuse
+        closure draws), ``(..., 3)`` at ``theta_deg``: the film's own albedo less the body's
+        gloss lobe's (slab only)."""
+        parts = self.slab_parts(theta_deg)
+        lobe = self.tables.directional("film_gloss_albedo", theta_deg)
+        return np.maximum(parts.film_albedo - parts.body_gloss * lobe, 0.0)
+
     def film_body(self, wi: NDArray[np.float64],
                   wo: NDArray[np.float64]) -> NDArray[np.float64]:
-        """The film's body as the tiers draw it (class docstring), 1/sr ``(..., 3)``."""
+        """The film's body as the tiers draw it (class docstring), 1/sr ``(..., 3)``: its
+        share of the gloss (:meth:`gloss_weight`, the surface's left out) and the rest read
+        Lambertian."""
         def albedo(w: NDArray[np.float64]) -> NDArray[np.float64]:
-            return self.slab_parts(polar_angle_deg(w)).film_albedo
-        return albedo(wi) * albedo(wo) / (np.pi * np.maximum(self.film_mean(), 1e-12))
+            return self.body_albedo(polar_angle_deg(w))
+        body_gloss = self.slab_parts(0.0).body_gloss
+        return (albedo(wi) * albedo(wo) / (np.pi * np.maximum(self.film_mean(), 1e-12))
+                + body_gloss * self.tables.surface_gloss("film_gloss", wi, wo))
 
     def film_mean(self) -> NDArray[np.float64]:
-        """The film body's albedo under uniform light (RGB): ``2 Int alpha mu dmu``."""
+        """The film body's albedo under uniform light without its gloss (RGB): ``2 Int alpha
+        mu dmu``."""
         theta = self.slab_tables().theta_deg
-        return self._once("film_mean", lambda: cosine_mean(
-            self.slab_parts(theta).film_albedo, theta))
+        return self._once("film_mean", lambda: cosine_mean(self.body_albedo(theta), theta))
+
+    def coat_weight(self) -> NDArray[np.float64]:
+        """The weight of eq. 2's gloss lobe the Principled tier's coat (achromatic) draws, RGB:
+        the surface's share and, with the film as a slab, the body's share in its weakest
+        channel (what absorption leaves in every channel)."""
+        if self.slab is None:
+            return np.ones(3)
+        weight = self.slab.surface_share + np.min(self.slab_parts(0.0).body_gloss)
+        return np.broadcast_to(weight, (3,))
+
+    def base_mean(self) -> NDArray[np.float64]:
+        """The film's own albedo under uniform light less what the coat draws of the body's
+        gloss (RGB; slab only): what the Principled tier's base colour holds of the film."""
+        theta = self.slab_tables().theta_deg
+        lobe = self.tables.directional("film_gloss_albedo", theta)
+        extra = (self.coat_weight() - self.slab_tables().surface_share) * lobe
+        return cosine_mean(self.slab_parts(theta).film_albedo - extra, theta)
+
+    def coat_target(self) -> tuple[ViewGrid, NDArray[np.float64]]:
+        """``(grid, table)`` the Principled tier's coat is fitted to: the film's gloss at
+        :meth:`coat_weight` (the rest of the body's gloss, coloured by absorption, is in the
+        base colour, :meth:`base_mean`)."""
+        if self.slab is None:
+            return self.target("film_gloss")
+        grid = self.grid("film_gloss")
+        return grid, self.coat_weight() * self.tables.surface_gloss("film_gloss",
+                                                                    *grid.directions)
 
     def target(self, name: str) -> tuple[ViewGrid, NDArray[np.float64]]:
         """``(grid, table)`` of a gloss part: ``film_gloss`` on the film's grid,
@@ -153,6 +209,9 @@ class FitTargets:
                                   - self.film_body(wi, wo))
                 return grid, self.tables.angular(name, *grid.directions)
             grid = self.grid(name)
+            if name == "film_gloss" and self.slab is not None:
+                return grid, self.gloss_weight() * self.tables.surface_gloss(name,
+                                                                             *grid.directions)
             return grid, self.tables.surface_gloss(name, *grid.directions)
         return self._once(("target", name), compute)
 
@@ -162,6 +221,8 @@ class FitTargets:
         if name == "path3_gloss" and self.slab is not None:
             parts = self.slab_parts(self.slab.theta_deg)
             return np.maximum(parts.top_albedo - parts.film_albedo, 0.0)
+        if name == "film_gloss" and self.slab is not None:
+            return self.gloss_weight() * np.asarray(self.tables.film_gloss_albedo, float)
         return np.asarray(getattr(self.tables, name + "_albedo"))
 
     def albedo_theta(self, name: str) -> NDArray[np.float64]:
@@ -192,7 +253,7 @@ class FitTargets:
         """The film body's directional albedo at the texels, ``(size, 3)`` (slab only)."""
         def compute() -> NDArray[np.float64]:
             theta = np.asarray(self.slab_tables().theta_deg, dtype=np.float64)
-            return self.texel_rows(theta, self.slab_parts(theta).film_albedo)
+            return self.texel_rows(theta, self.body_albedo(theta))
         return self._once("body_rows", compute)
 
 
@@ -205,7 +266,7 @@ def _left_out_glossy(size: int) -> LobeFit:
 def principled_parts(targets: FitTargets, over_shader: bool) -> dict[str, Any]:
     """The PRINCIPLED tier's parts of a :class:`ClosureFit`: the coat, the two speculars (over
     the artist's shader the bare one left out: level 0) and their mean layering albedos."""
-    film_grid, film_gloss = targets.target("film_gloss")
+    film_grid, film_gloss = targets.coat_target()
     skin_grid, path3 = targets.target("path3_gloss")
     coat = fit_coat(film_grid, film_gloss)
     coat_ior = coat.ior
@@ -233,7 +294,7 @@ def principled_parts(targets: FitTargets, over_shader: bool) -> dict[str, Any]:
         f0 = float(cc.f0_from_ior(SPECULAR_IOR)) * 2.0 * lobe.level
         return _layering_mean(lobe.roughness, float(cc.ior_from_f0(f0)), f0)
 
-    return {
+    parts = {
         "coat": coat,
         "specular_bare": specular_bare,
         "specular_film": specular_film,
@@ -243,6 +304,37 @@ def principled_parts(targets: FitTargets, over_shader: bool) -> dict[str, Any]:
                                           targets.albedo_theta("path3_gloss"))
                              if specular_film.level == 0.0 else np.zeros(3)),
     }
+    if targets.slab is not None:
+        parts["gloss_to_diffuse"] = held_gloss_to_diffuse(targets, parts)
+    return parts
+
+
+def held_gloss_to_diffuse(targets: FitTargets, parts: dict[str, Any]) -> NDArray[np.float64]:
+    """With the film as a slab, the PRINCIPLED tier's ``gloss_to_diffuse`` (RGB): what its
+    base colour carries so that, over the skin the film covers (``targets.skin_albedo``), its
+    colour under uniform light is the slab's (docs/model.md, "The tiers at a thickness").
+
+    Its specular and coat are white while the skin's gloss through the film is tinted by the
+    film's absorption (and the coat's albedo is not quite the film gloss's): they err by a
+    colour the same on any skin, so a relative error that grows as the skin darkens.  With
+    ``parts``' coat and film specular (coverage 1) the Principled BSDF's colour is ``G + W
+    base`` (:func:`lut_baker.closures.cycles.principled_uniform`); the base colour the node
+    group makes is ``(skin + film + x) / D`` (``film`` the film's own albedo less what the coat
+    draws, :meth:`FitTargets.base_mean`; ``D`` the mean attenuation it divides by,
+    :func:`~lut_baker.closures.tier_formulas.principled_sockets`), so ``x = (E - G) D / W -
+    skin - film``, ``E`` the slab's colour (:func:`lut_baker.tables.slab_tables.slab_colour`)."""
+    coat, specular = parts["coat"], parts["specular_film"]
+    gloss, passed = cc.principled_uniform(cc.PrincipledInputs(
+        roughness=specular.roughness, ior=SPECULAR_IOR,
+        specular_ior_level=float(specular.level), coat_weight=float(coat.level),
+        coat_roughness=coat.roughness, coat_ior=float(coat.ior)))
+    a = targets.skin_albedo
+    exact = slab_colour(targets.tables, targets.thickness_um, skin_albedo=a)
+    below = targets.slab_parts(0.0)
+    skin = a * np.square(below.through_mean) / (1.0 - a * below.below)
+    divided = ((1.0 - float(coat.level) * float(parts["coat_albedo_mean"]))
+               * (1.0 - float(parts["specular_albedo_mean"][1])))
+    return (exact - gloss) * divided / max(passed, 1e-12) - skin - targets.base_mean()
 
 
 def image_rows(rows: tuple[str, ...], slab: bool) -> tuple[str, ...]:

@@ -99,7 +99,10 @@ class Tier:
       :class:`~lut_baker.closures.tier_formulas.ShaderAlgebra` (``subsurface_weight``: the
       artist's, over their shader, else None); ``lobes(fit)``: its Glossy lobes by closure
       name; ``image(fit)``: its :class:`ViewImage` or None; ``glossy(wi, wo, lobe)``: a white
-      Glossy lobe as its renderer draws it (the replica's).
+      Glossy lobe as its renderer draws it (the replica's); ``with_image(lobes, texels)``: the
+      fit's fields that hold its lobes and image (a fit moved to another thickness,
+      :func:`lut_baker.closures.fitting.at_thickness`, writes them back; a tier with an
+      image has one).
     - ``subsurface_method``: the method its renderer always uses (None: the fit's choice).
     """
 
@@ -115,6 +118,8 @@ class Tier:
     image: Callable[[Any], ViewImage | None] = _no_image
     glossy: Callable[[NDArray[np.float64], NDArray[np.float64], LobeFit],
                      NDArray[np.float64]] = _cycles_glossy
+    with_image: Callable[[dict[str, LobeFit], NDArray[np.float64]],
+                         dict[str, Any]] | None = None
     subsurface_method: str | None = None
     fullness: int = 0
     fit_share: float = 0.3
@@ -217,7 +222,8 @@ LAYERED = register(Tier(
     fit=layered_parts, holds=lambda fit: fit.glossy is not None,
     shader=partial(view_weighted_shader, tinted_subsurface=True, film_lobes=("film_gloss",)),
     lobes=lambda fit: fit.glossy,
-    image=lambda fit: ViewImage(image_rows(IMAGE_ROWS, fit.slab is not None), fit.view_rows)))
+    image=lambda fit: ViewImage(image_rows(IMAGE_ROWS, fit.slab is not None), fit.view_rows),
+    with_image=lambda lobes, texels: {"glossy": lobes, "view_rows": texels}))
 """Glossy (film gloss, path-3 gloss, skin gloss; weights read from a view-angle image),
 Diffuse and Subsurface closures mixed by coverage
 (:func:`~lut_baker.closures.tier_formulas.view_weighted_closures`); the skin through the film
@@ -231,6 +237,7 @@ EEVEE = register(Tier(
     fit=eevee_parts, holds=lambda fit: fit.eevee_glossy is not None, shader=_eevee_shader,
     lobes=lambda fit: fit.eevee_glossy, image=lambda fit: ViewImage(
         image_rows(EEVEE_IMAGE_ROWS, fit.slab is not None), fit.eevee_view_rows),
+    with_image=lambda lobes, texels: {"eevee_glossy": lobes, "eevee_view_rows": texels},
     glossy=_eevee_glossy, subsurface_method="BURLEY"))
 """The Layered tier's closures and mix made for EEVEE: every Glossy lobe GGX fitted as EEVEE
 renders it under a lamp (a linearly transformed cosine, :mod:`lut_baker.closures.eevee`), the

@@ -152,16 +152,17 @@ def tier_reflection(fit: ClosureFit, tables: Tables, name: str, coverage: float,
                     bare: NDArray[np.float64] | None = None) -> NDArray[np.float64]:
     """Tier ``name``'s BRDF ``(..., 3)`` (:func:`tier_replica`) at the angular nodes or at
     ``directions``.  ``over_shader``: the group goes over the artist's shader, which is the
-    bare skin (the tables' bare skin stands for it, the Gloss input leaves it alone): the
-    tier's covered skin (its replica at coverage 1) and the tables' bare skin (``bare``, if
-    already computed at these directions: ``made_up_reflection`` at coverage 0), mixed by
-    coverage as areas."""
+    bare skin (the tables' bare skin stands for it, with the film as a slab on the fit's skin;
+    the Gloss input leaves it alone): the tier's covered skin (its replica at coverage 1) and
+    that bare skin (``bare``, if already computed at these directions), mixed by coverage as
+    areas."""
     if not over_shader:
         return tier_replica(fit, tables, name, coverage, absorption, gloss, directions)
     wi, wo = tables.node_directions() if directions is None else directions
     covered = tier_replica(fit, tables, name, 1.0, absorption, gloss, (wi, wo))
     if bare is None:
-        bare = tables.made_up_reflection(wi, wo, 0.0, absorption)
+        bare = (tables.made_up_reflection(wi, wo, 0.0, absorption) if fit.slab is None
+                else _slab_bare(fit, tables, (wi, wo)))
     return combine(coverage_weights(coverage, 0.0), top=covered, bare=bare)
 
 
@@ -169,17 +170,28 @@ def reference_reflection(fit: ClosureFit, tables: Tables, coverage: float,
                          absorption: ArrayLike, directions: Directions) -> NDArray[np.float64]:
     """What a fit's tiers are measured against, ``(..., 3)``: the tables' made-up skin at a
     coverage and absorption, or with the film as a slab (``fit.slab``) the slab's at the fit's
-    thickness (its absorption baked, :func:`lut_baker.tables.slab_tables.slab_reflection`; the
-    skin under the film darkened by ``slab.skin_under`` where Match Skin set it)."""
+    thickness on the fit's skin (``fit.skin_albedo``, the skin the film covers; its absorption
+    baked, :func:`lut_baker.tables.slab_tables.slab_reflection`; the skin under the film
+    darkened by ``slab.skin_under`` where Match Skin set it)."""
     if fit.slab is None:
         return tables.made_up_reflection(*directions, coverage, absorption)
     under = fit.slab.skin_under
     if under is None:
-        return slab_reflection(tables, *directions, fit.slab.thickness_um, coverage=coverage)
+        return slab_reflection(tables, *directions, fit.slab.thickness_um,
+                               skin_albedo=fit.skin_albedo, coverage=coverage)
     covered = slab_reflection(tables, *directions, fit.slab.thickness_um,
                               skin_albedo=fit.skin_albedo * np.asarray(under, float))
-    bare = slab_reflection(tables, *directions, fit.slab.thickness_um, coverage=0.0)
-    return combine(coverage_weights(coverage, 0.0), top=covered, bare=bare)
+    return combine(coverage_weights(coverage, 0.0), top=covered,
+                   bare=_slab_bare(fit, tables, directions))
+
+
+def _slab_bare(fit: ClosureFit, tables: Tables, directions: Directions) -> NDArray[np.float64]:
+    """The bare skin of a fit of the film as a slab: the skin's gloss and the fit's skin
+    (:func:`lut_baker.tables.slab_tables.slab_reflection` at coverage 0)."""
+    if fit.slab is None:
+        raise ValueError("a fit of the paper's film takes its bare skin from the tables")
+    return slab_reflection(tables, *directions, fit.slab.thickness_um,
+                           skin_albedo=fit.skin_albedo, coverage=0.0)
 
 
 def tier_errors(fit: ClosureFit, tables: Tables, coverage: float, absorption: ArrayLike,
@@ -196,16 +208,17 @@ def tier_errors(fit: ClosureFit, tables: Tables, coverage: float, absorption: Ar
     grid = view_grid(min(lobe_widths_deg(tables).values()), ERROR_VIEWS)
     directions = grid.directions
     # The tables looked up once for both coverages, and only where they are read: a fit of
-    # the film as a slab takes its reference from the slab, the bare skin from the tables.
-    looked_up: ReflectionParts | None
+    # the film as a slab takes its reference and its bare skin from the slab on its skin.
+    bare: NDArray[np.float64] | None = None
     if fit.slab is None:
-        looked_up = tables.reflection_parts(*directions)
+        looked_up: ReflectionParts = tables.reflection_parts(*directions)
         reference = tables.mixed_reflection(looked_up, coverage, absorption)
+        if over_shader:
+            bare = tables.mixed_reflection(looked_up, 0.0, absorption)
     else:
         reference = reference_reflection(fit, tables, coverage, absorption, directions)
-        looked_up = tables.reflection_parts(*directions) if over_shader else None
-    bare = (tables.mixed_reflection(looked_up, 0.0, absorption)
-            if over_shader and looked_up is not None else None)
+        if over_shader:
+            bare = _slab_bare(fit, tables, directions)
     out = {}
     for name in TIERS:
         if name not in tiers:

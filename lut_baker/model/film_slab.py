@@ -3,26 +3,32 @@
 
 The film is made of
 
-- its **surface**: eq. 2's specular lobe of the film (its gloss, path 1) reflects the fraction
-  ``a_g(theta)`` of the light falling on it (:func:`face_albedo`); the rest, ``1 - a_g``,
-  crosses it straight (the film does not refract, docs/model.md §2.2); light reaching it from
-  inside is reflected back by the same fraction, specularly, and crosses it by ``1 - a_g``.
-  It is lossless and reciprocal;
+- its **surface**: an interface of the film's vehicle (:data:`VEHICLE_INDEX`).  It reflects
+  eq. 2's specular lobe of the film (its gloss, path 1) scaled by the share ``k`` an interface
+  of the vehicle reflects under uniform light (:func:`surface_share`, :func:`surface_layer`):
+  the fraction ``a_g(theta)`` of the light falling on it (:func:`face_albedo`); the rest,
+  ``1 - a_g``, crosses it straight (the film does not refract, docs/model.md §2.2); light
+  reaching it from inside is reflected back by the same fraction, specularly, and crosses it by
+  ``1 - a_g``.  It is lossless and reciprocal;
 - its **body**: a homogeneous symmetric slab (the pigment), whose reflection and transmission
   per Fourier order come from :mod:`lut_baker.numerics.adding_doubling`.
 
 The free film the paper measured (foundation filling a hole in a 0.15 mm cover glass, paper
-4.1) is surface, body, surface (air on both sides): its diffuse reflection is eq. 2's ``P_d``
-and its transmission eq. 4.  The body at that thickness is what remains when the two faces are
-taken off those measurements (:func:`remove_faces`, exact), and the body at any other thickness
+4.1) is surface, body, surface (air on both sides): its reflection is eq. 2 (the gloss and
+``P_d``) and its transmission eq. 4.  The share of the gloss the surface does not reflect,
+``1 - k``, is the body's: the free film's reflection below its surface's is ``P_d`` and ``1 - k``
+of the gloss lobe (:func:`measured_body_matrices`).  The body at that thickness is what remains
+when the two faces are taken off those measurements (:func:`remove_faces`, exact), and the body
+at any other thickness
 follows from the doubling relation inverted (:func:`body_generator`).  On skin the film is its
 surface and its body (no air under it), over the skin with every inter-reflection summed
 (:func:`made_up_matrices`).
 
 Absorption ``A`` (per channel, docs/model.md §4) keeps its meaning at the paper's thickness: the
-measured film's diffuse reflection and transmission are scaled by ``1 - A`` before the body is
-derived, so the free film of the paper's thickness reflects and transmits exactly what it did
-(up to :func:`passive` below); the thickness then decides how much a film absorbs.
+measured film's reflection below its surface (``P_d`` and the body's share of the gloss) and its
+transmission are scaled by ``1 - A`` before the body is derived, so the free film of the paper's
+thickness reflects and transmits exactly what it did, the body's share of the gloss absorbed (up
+to :func:`passive` below); the thickness then decides how much a film absorbs.
 
 Functions and types
 -------------------
@@ -31,10 +37,14 @@ Functions and types
   :data:`PAPER_FILM_OPTICAL_THICKNESS` -- the thicknesses and their sources.
 - :func:`thickness_from_mass` -- micrometres of film from mass per area and density.
 - :func:`relative_thickness` -- a thickness in units of the paper's film.
+- :data:`VEHICLE_INDEX` -- the refractive index of the film's vehicle, its source.
+- :func:`interface_albedo` -- a smooth dielectric interface's reflectance under uniform light.
+- :func:`surface_share`, :func:`surface_layer` -- the share ``k`` of eq. 2's gloss the film's
+  surface reflects, and the surface as a layer (eq. 2's gloss times ``k``).
 - :func:`face_albedo` -- ``a_g`` of a film's surface at the grid's nodes.
 - :func:`face_layer` -- the surface as a layer (star form, its gloss left out).
-- :func:`measured_body_matrices` -- the free film's diffuse reflection and transmission (eq. 2's
-  ``P_d``, eq. 4) in the star form.
+- :func:`measured_body_matrices` -- the free film's reflection below its surface's and its
+  transmission (eq. 2's ``P_d`` and ``1 - k`` of its gloss, eq. 4) in the star form.
 - :func:`remove_faces` -- the body inside a symmetric free film, its two faces taken off.
 - :class:`FilmSlab`, :func:`film_slab` -- the body at every thickness, with absorption.
 - :func:`body` -- the body's ``(R, T)`` at a thickness.
@@ -48,7 +58,7 @@ Functions and types
 - :func:`solve_thick_absorption` -- the absorption whose thick film has a target colour.
 - :func:`skin_star` -- a skin's eq. 2 kernel in the star form (cached per skin and grid).
 - :func:`increasing_root` -- per entry, where an increasing function of [0, 1] meets a target
-  (false position, vectorised).
+  (Chandrupatla's method, vectorised).
 """
 
 from __future__ import annotations
@@ -74,8 +84,9 @@ from ..numerics.adding_doubling import (
 )
 from ..numerics.cache import LRUCache
 from ..numerics.quadrature import HemisphereGrid
-from .albedo import layer_fourier_kernel, reflection_albedo, with_channel_axis
+from .albedo import bihemispherical, layer_fourier_kernel, reflection_albedo, with_channel_axis
 from .layers import ReflectionLayer, TransmissionLayer
+from .microfacet import fresnel_reflectance
 
 __all__ = [
     "PAPER_FILM_THICKNESS_UM",
@@ -86,6 +97,10 @@ __all__ = [
     "PAPER_FILM_OPTICAL_THICKNESS",
     "thickness_from_mass",
     "relative_thickness",
+    "VEHICLE_INDEX",
+    "interface_albedo",
+    "surface_share",
+    "surface_layer",
     "face_albedo",
     "face_layer",
     "measured_body_matrices",
@@ -149,8 +164,9 @@ extinguishes entirely (below what eq. 4 resolves) fades with thickness, the unsc
 ``exp(-tau x)`` (:func:`lut_baker.numerics.adding_doubling.slab_generator`'s ``max_rate``)."""
 
 ROOT_STEPS = 30
-"""Steps of the root finder (false position, Illinois) of :func:`solve_thick_absorption` and
-of the passive slab's relief: it reaches rounding within some 10-15 steps."""
+"""Steps of the root finder (:func:`increasing_root`) of :func:`solve_thick_absorption`, of the
+passive slab's relief and of Match Skin at a thickness: it reaches rounding within some 3-12
+steps."""
 RELIEF_STEPS = ROOT_STEPS
 ROOT_TOLERANCE = 1e-13
 """The root finder stops when every entry is within this of its target, or its bracket is
@@ -176,13 +192,70 @@ def _channels_first(values: NDArray[np.float64]) -> NDArray[np.float64]:
     return np.moveaxis(values, -1, 0)
 
 
-def face_albedo(film: ReflectionLayer, grid: HemisphereGrid) -> NDArray[np.float64]:
-    """``a_g``: the directional albedo of the film's surface gloss (eq. 2's specular term, its
-    ``P_d`` left out) at the grid's polar nodes, ``(C, N)`` (C = 1 for a scalar film), computed
-    through the half vector for narrow lobes (:func:`~lut_baker.model.albedo.reflection_albedo`);
-    zeros for a film without gloss (``P_s = 0``).  Computed once per surface and grid (a
-    read-only array: Match Skin and the bake ask for it again and again)."""
+VEHICLE_INDEX = 1.40
+"""Refractive index of a liquid foundation's vehicle, the medium its surface is an interface
+of: the silicones that carry most liquid foundations' pigment, cyclopentasiloxane (1.397 at
+25 C, Dow's XIAMETER PMX-0245 data sheet) and dimethicone (about 1.40, Dow's PMX-200 fluids);
+emollient oils lie near 1.45.  An interface of 1.40 reflects 2.8% at normal incidence and
+7.7% under uniform light (:func:`interface_albedo`)."""
+
+
+def interface_albedo(eta: float) -> float:
+    """A smooth dielectric interface's reflectance under uniform light from outside, ``2 Int
+    F_r(mu, eta) mu dmu`` (its bihemispherical albedo; the unpolarised Fresnel reflectance).
+
+    >>> round(interface_albedo(VEHICLE_INDEX), 4)  # the vehicle's interface
+    0.0768
+    >>> round(interface_albedo(1.5), 4)  # glass
+    0.0918
+    """
+    return float(bihemispherical(lambda theta_deg: fresnel_reflectance(
+        np.cos(np.radians(theta_deg)), float(eta))))
+
+
+def surface_share(film: ReflectionLayer, vehicle_index: float = VEHICLE_INDEX
+                  ) -> NDArray[np.float64]:
+    """``k``: the share of eq. 2's gloss (the specular term of ``film``) that the film's surface
+    reflects, ``min(1, F / a_g)`` with ``F`` the vehicle's :func:`interface_albedo` and ``a_g``
+    the gloss's albedo under uniform light (docs/model.md, "The film as a slab"); 1 for a film
+    without gloss.  Shaped as ``film.P_s`` (a scalar or per channel).  Computed once per
+    gloss.
+
+    >>> paper_film = ReflectionLayer(P_d=0.155, P_s=10.7, n=0.033, eta=1.19)  # albedo units
+    >>> print(np.round(surface_share(paper_film), 3))  # a_g 0.14: the interface reflects 55%
+    0.549
+    >>> dewy = ReflectionLayer(P_d=0.155, P_s=0.5, n=0.17, eta=1.09)  # a_g 0.013 < F
+    >>> print(surface_share(dewy))
+    1.0
+    """
     gloss = film.scaled(P_d=0.0)
+
+    def compute() -> NDArray[np.float64]:
+        albedo = np.asarray(bihemispherical(lambda theta: reflection_albedo(theta, gloss)),
+                            float)
+        interface = interface_albedo(vehicle_index)
+        share = np.where(albedo > interface, interface / np.where(albedo > 0.0, albedo, 1.0),
+                         1.0)
+        share.setflags(write=False)
+        return share
+
+    return _SHARES.get_or_compute((repr(gloss.as_dict()), float(vehicle_index)), compute)
+
+
+def surface_layer(film: ReflectionLayer) -> ReflectionLayer:
+    """The film's surface as eq. 2's layer: ``film``'s specular term times
+    :func:`surface_share` (its ``P_s`` scaled; its ``P_d`` 0, the body's)."""
+    return film.scaled(P_d=0.0, P_s=surface_share(film))
+
+
+def face_albedo(film: ReflectionLayer, grid: HemisphereGrid) -> NDArray[np.float64]:
+    """``a_g``: the directional albedo of the film's surface (:func:`surface_layer`: eq. 2's
+    specular term times :func:`surface_share`) at the grid's polar nodes, ``(C, N)`` (C = 1 for
+    a scalar film), computed through the half vector for narrow lobes
+    (:func:`~lut_baker.model.albedo.reflection_albedo`); zeros for a film without gloss
+    (``P_s = 0``).  Computed once per surface and grid (a read-only array: Match Skin and the
+    bake ask for it again and again)."""
+    gloss = surface_layer(film)
     channels = 3 if film.channels else 1
 
     def compute() -> NDArray[np.float64]:
@@ -215,16 +288,30 @@ def face_layer(albedo: ArrayLike, orders: int) -> Layer:
 
 def measured_body_matrices(film: ReflectionLayer, transmission: TransmissionLayer,
                            grid: HemisphereGrid) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """The measured free film's diffuse reflection (eq. 2's ``P_d``, Lambertian) and
-    transmission (eq. 4) in the star form, each ``(C, orders, N, N)``."""
+    """The measured free film's reflection below its surface's and its transmission (eq. 4) in
+    the star form, each ``(C, orders, N, N)``: eq. 2's ``P_d`` (Lambertian) and the share of
+    its gloss lobe the surface does not reflect (:func:`_body_gloss`), the light the body
+    returns."""
     scale = star_scale(grid)
     t = _channels_first(layer_fourier_kernel(transmission, grid.theta, grid.theta, grid.n_phi))
+    gloss = _body_gloss(film, grid)
     p_d = np.asarray(film.P_d, float).reshape(-1)
-    channels = max(t.shape[0], p_d.size)
-    t = np.broadcast_to(t, (channels,) + t.shape[1:])
-    r = np.zeros(t.shape)
-    r[:, 0] = np.broadcast_to(p_d, (channels,))[:, None, None]
-    return to_star(r, scale), to_star(t, scale)
+    channels = max(t.shape[0], p_d.size, gloss.shape[0])
+    r = np.array(np.broadcast_to(gloss, (channels,) + t.shape[1:]))
+    r[:, 0] += np.broadcast_to(p_d, (channels,))[:, None, None] * scale[0][:, None] * scale[0]
+    return r, to_star(np.broadcast_to(t, (channels,) + t.shape[1:]), scale)
+
+
+def _body_gloss(film: ReflectionLayer, grid: HemisphereGrid) -> NDArray[np.float64]:
+    """The share of eq. 2's gloss lobe the surface does not reflect, ``1 - k``
+    (:func:`surface_share`), in the star form, ``(C, orders, N, N)`` (every order; zeros, one
+    channel, where the surface reflects it all): the measured film's gloss the body returns."""
+    rest = 1.0 - surface_share(film)
+    if not np.any(rest > 0.0):
+        return np.zeros((1, grid.orders, grid.theta.size, grid.theta.size))
+    lobe = film.scaled(P_d=0.0, P_s=rest)
+    kernel = layer_fourier_kernel(lobe, grid.theta, grid.theta, grid.n_phi)
+    return to_star(_channels_first(kernel), star_scale(grid))
 
 
 def remove_faces(reflection: NDArray[np.float64], transmission: NDArray[np.float64],
@@ -281,6 +368,7 @@ class FilmSlab:
 
 _MEASURED = LRUCache(MEASURED_CACHE_SIZE)
 _FACES = LRUCache(MEASURED_CACHE_SIZE)
+_SHARES = LRUCache(MEASURED_CACHE_SIZE)
 
 
 def _measured(film: ReflectionLayer, transmission: TransmissionLayer, grid: HemisphereGrid
@@ -311,9 +399,9 @@ def _free_film_albedo(generator: SlabGenerator, face: NDArray[np.float64],
 def _passive(generator: SlabGenerator, target: ArrayLike, face: NDArray[np.float64],
              grid: HemisphereGrid) -> SlabGenerator:
     """:func:`~lut_baker.numerics.adding_doubling.passive_generator` with the ``relief`` per
-    channel (false position on [0, 1]) at which the free film of unit thickness keeps, under uniform
-    light, the measured film's ``R + T`` (``target``): passive, and absorbing what the measured
-    film absorbs."""
+    channel (a root on [0, 1], :func:`increasing_root`) at which the free film of unit
+    thickness keeps, under uniform light, the measured film's ``R + T`` (``target``): passive,
+    and absorbing what the measured film absorbs."""
     scale0 = star_scale(grid)[0]
     order0 = SlabGenerator(basis=generator.basis[..., :1, :, :], rates=generator.rates[..., :1, :])
     relief = increasing_root(
@@ -325,41 +413,44 @@ def _passive(generator: SlabGenerator, target: ArrayLike, face: NDArray[np.float
 def increasing_root(function: Callable[[NDArray[np.float64]], NDArray[np.float64]],
                     target: NDArray[np.float64], steps: int) -> NDArray[np.float64]:
     """Per entry, ``x`` in [0, 1] with ``function(x) = target`` for an increasing ``function``
-    (vectorised over the entries), by the Illinois variant of false position (the bracket
-    always holds the root; it shrinks superlinearly) until :data:`ROOT_TOLERANCE`; 0 or 1
-    when the target lies outside ``[function(0), function(1)]``.
+    (vectorised over the entries), by Chandrupatla's method (false position first, then inverse
+    quadratic interpolation where the last three points allow it, else bisection: the bracket
+    always holds the root, and it shrinks superlinearly, in about half the steps of the
+    Illinois variant of false position) until :data:`ROOT_TOLERANCE` (the value, or the
+    bracket); 0 or 1 when the target lies outside ``[function(0), function(1)]``.
 
     >>> print(increasing_root(lambda x: x**2, np.array([0.25, 0.5, 2.0]), ROOT_STEPS))
     [0.5        0.70710678 1.        ]
     """
-    low = np.zeros(target.shape)
-    high = np.ones(target.shape)
-    f_low = function(low) - target
-    f_high = function(high) - target
-    below = f_low >= 0.0
-    above = f_high <= 0.0
-    side = np.zeros(target.shape, int)
-    for _ in range(steps):
-        span = f_high - f_low
-        x = np.where(span > 0.0, low - f_low * (high - low) / np.where(span > 0.0, span, 1.0),
-                     0.5 * (low + high))
-        x = np.clip(x, low, high)
-        f_x = function(x) - target
-        left = f_x < 0.0  # the root is above x
-        low = np.where(left, x, low)
-        f_low = np.where(left, f_x, f_low)
-        high = np.where(left, high, x)
-        f_high = np.where(left, f_high, f_x)
-        # Illinois: an end kept twice in a row has its value halved.
-        f_high = np.where(left & (side == 1), 0.5 * f_high, f_high)
-        f_low = np.where(~left & (side == -1), 0.5 * f_low, f_low)
-        side = np.where(left, 1, -1)
-        if np.all((np.abs(f_x) <= ROOT_TOLERANCE) | (high - low <= ROOT_TOLERANCE)):
-            return np.where(below, 0.0, np.where(above, 1.0, x))
-    span = f_high - f_low
-    x = np.where(span > 0.0, low - f_low * (high - low) / np.where(span > 0.0, span, 1.0),
-                 0.5 * (low + high))
-    return np.where(below, 0.0, np.where(above, 1.0, np.clip(x, low, high)))
+    a, b = np.zeros(target.shape), np.ones(target.shape)  # a: the newest point, b: the other end
+    f_a, f_b = function(a) - target, function(b) - target
+    below, above = f_a >= 0.0, f_b <= 0.0
+    done = below | above
+    c, f_c = b, f_b  # the point before (unused by the first step)
+    best = a
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = np.where(done, 0.5, f_a / (f_a - f_b))  # false position
+        for _ in range(steps):
+            if np.all(done):  # every target out of reach (or met): no step to take
+                break
+            least = np.minimum(0.5 * ROOT_TOLERANCE / np.abs(b - a), 0.5)
+            x = a + np.clip(np.where(np.isfinite(t), t, 0.5), least, 1.0 - least) * (b - a)
+            f_x = function(x) - target
+            same = np.sign(f_x) == np.sign(f_a)
+            moving = ~done
+            c, f_c = (np.where(moving, np.where(same, a, b), c),
+                      np.where(moving, np.where(same, f_a, f_b), f_c))
+            b, f_b = np.where(moving & ~same, a, b), np.where(moving & ~same, f_a, f_b)
+            a, f_a = np.where(moving, x, a), np.where(moving, f_x, f_a)
+            closer = np.abs(f_a) < np.abs(f_b)
+            best = np.where(closer, a, b)
+            done = done | (np.minimum(np.abs(f_a), np.abs(f_b)) <= ROOT_TOLERANCE) \
+                | (np.abs(b - a) <= ROOT_TOLERANCE)
+            xi, phi = (a - b) / (c - b), (f_a - f_b) / (f_c - f_b)
+            quadratic = (phi**2 < xi) & ((1.0 - phi)**2 < 1.0 - xi)
+            t = np.where(quadratic, f_a / (f_b - f_a) * f_c / (f_b - f_c)
+                         + (c - a) / (b - a) * f_a / (f_c - f_a) * f_b / (f_c - f_b), 0.5)
+    return np.where(below, 0.0, np.where(above, 1.0, best))
 
 
 def film_slab(film: ReflectionLayer, transmission: TransmissionLayer, grid: HemisphereGrid, *,
@@ -370,8 +461,9 @@ def film_slab(film: ReflectionLayer, transmission: TransmissionLayer, grid: Hemi
     eq. 4; in albedo units) at every thickness, with absorption ``A`` (scalar or RGB in
     [0, 1]).
 
-    At the measured thickness the free film's diffuse reflection and transmission times
-    ``1 - A`` are the target; its faces (``film``'s gloss) are taken off
+    At the measured thickness the free film's reflection below its surface
+    (:func:`measured_body_matrices`) and transmission times ``1 - A`` are the target; its faces
+    (:func:`surface_layer` of ``film``) are taken off
     (:func:`remove_faces`) and the doubling relation inverted
     (:func:`~lut_baker.numerics.adding_doubling.slab_generator`, light the film extinguishes
     fading as ``exp(-optical_thickness x)``).  ``passive``: no direction may gain light
@@ -404,6 +496,8 @@ def film_slab(film: ReflectionLayer, transmission: TransmissionLayer, grid: Hemi
         r, t = r[:, :orders], t[:, :orders]
     channels = max(r.shape[0], face.shape[0], a.size)
     once = (1.0 - a)[:, None, None, None]
+    # The pigment absorbs all the body returns: P_d and the body's share of the gloss
+    # (docs/model.md, "The film as a slab").
     r = np.broadcast_to(r, (channels,) + r.shape[1:]) * once
     t = np.broadcast_to(t, (channels,) + t.shape[1:]) * once
     face = np.broadcast_to(face, (channels, face.shape[-1]))
@@ -499,12 +593,12 @@ def made_up_albedo(film: FilmSlab, thickness: float, skin: ReflectionLayer,
     >>> for micrometres in (0.0, DEFAULT_THICKNESS_UM, 150.0, 1500.0):  # under uniform light
     ...     albedo = made_up_albedo(slab_of, relative_thickness(micrometres), skin)
     ...     print(np.round(bihemispherical_on_grid(albedo, grid), 4))
-    [0.3826]
-    [0.415]
-    [0.6583]
-    [0.8267]
+    [0.351]
+    [0.3877]
+    [0.6451]
+    [0.7804]
     >>> print(np.round(bihemispherical_on_grid(thick_limit_albedo(slab_of), grid), 4))
-    [0.8274]
+    [0.7805]
     """
     face = film.measured_face if face is None else np.asarray(face, float)
     top = made_up_matrices(film, thickness, skin, face)
@@ -541,7 +635,7 @@ def solve_thick_absorption(target: ArrayLike, film: ReflectionLayer,
                            passive: bool = True) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
     """``(A, clamped)`` per channel of ``target`` (a colour under uniform light, RGB): the
     absorption whose film, infinitely thick under its surface (``face``: ``a_g`` ``(C, N)``,
-    default the measured film's), has that bihemispherical albedo, by false position on [0, 1]
+    default the measured film's), has that bihemispherical albedo, by a root on [0, 1]
     (order 0 only; the thick film darkens as ``A`` grows).  Out of reach: ``A = 0`` or 1 and
     ``clamped``.
 
@@ -551,7 +645,7 @@ def solve_thick_absorption(target: ArrayLike, film: ReflectionLayer,
     >>> through = TransmissionLayer(P_d=0.095, P_t=0.039, n=0.035, eta=1.19)  # eq. 4
     >>> a, clamped = solve_thick_absorption([0.6, 0.5, 0.4], film, through, grid)
     >>> print(np.round(a, 4), clamped)
-    [0.1802 0.3165 0.483 ] [False False False]
+    [0.1468 0.2698 0.4182] [False False False]
     >>> thick = film_slab(film, through, grid, absorption=a, orders=1)
     >>> print(np.round(bihemispherical_on_grid(thick_limit_albedo(thick), grid), 4))
     [0.6 0.5 0.4]

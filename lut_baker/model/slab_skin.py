@@ -23,9 +23,11 @@ skin under any layer.  The diffuse part is what the dipole spreads (its amount `
 c)``, its spread the normalised profile): the light that scattered under the skin, with all its
 returns from the film's underside.
 
-The body is derived from the measured free film (:func:`measured_film`): the film's ``P_d`` and
-its transmission (eq. 4) under the paper film's surface, whatever the foundation's own gloss;
-on skin the foundation's own surface (``face``) lies on that body.
+The body is derived from the measured free film (:func:`measured_film`): the film's ``P_d``, the
+share of the paper film's gloss its surface does not reflect, and its transmission (eq. 4) under
+the paper film's surface, whatever the foundation's own gloss; on skin the foundation's own
+surface (``face``: its gloss times the share an interface of the vehicle reflects,
+:func:`~lut_baker.model.film_slab.face_albedo`) lies on that body.
 
 Functions and types
 -------------------
@@ -33,6 +35,8 @@ Functions and types
 - :func:`foundation_slab` -- a foundation's body at every thickness, with its absorption.
 - :class:`SlabSkinParts`, :func:`slab_skin_parts` -- ``top``, ``t``, ``c`` and the surface's
   gloss albedo at one thickness.
+- :func:`body_gloss_weight` -- how much of eq. 2's gloss lobe the film's body returns at a
+  thickness (what the tiers draw as gloss).
 - :func:`parts_matrices` -- made-up skin (star form) from the parts and a skin albedo.
 - :func:`parts_albedo`, :func:`parts_colour` -- its directional albedo (gloss included) and its
   colour under uniform light.
@@ -73,6 +77,7 @@ __all__ = [
     "foundation_slab",
     "SlabSkinParts",
     "slab_skin_parts",
+    "body_gloss_weight",
     "parts_matrices",
     "parts_albedo",
     "parts_colour",
@@ -84,10 +89,11 @@ __all__ = [
 
 
 def measured_film(film: ReflectionLayer) -> ReflectionLayer:
-    """The free film a foundation's body is derived from: ``film``'s diffuse ``P_d`` under the
-    paper film's surface (the gloss it was measured with, paper 4.1.1).  The presets share the
-    paper film's ``P_d`` and transmission and differ in their surface only (docs/model.md §4),
-    so every foundation's body is the paper film's, absorbed by its shade."""
+    """The free film a foundation's body is derived from: ``film``'s diffuse ``P_d`` with the
+    paper film's gloss (the gloss it was measured with, paper 4.1.1; its surface's share on the
+    surface, the rest the body's).  The presets share the paper film's ``P_d`` and transmission
+    and differ in their surface only (docs/model.md §4), so every foundation's body is the paper
+    film's, absorbed by its shade."""
     from .presets import paper  # the paper's layers, in albedo units
 
     surface = paper().film
@@ -159,6 +165,19 @@ def slab_skin_parts(film: FilmSlab, thickness: float, skin: ReflectionLayer,
                          film=film_albedo)
 
 
+def body_gloss_weight(film: FilmSlab, thickness: float, face: ArrayLike,
+                      lobe: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``(C,)``: the weight ``w`` of eq. 2's gloss lobe ``lobe`` (star form, ``(C', orders, N,
+    N)``, its whole ``P_s``) in the film's own reflection at ``thickness`` (its body through its
+    surface ``face``), least squares over the Fourier orders above 0, where a Lambertian body
+    has nothing: the body's share of the measured gloss, about ``1 - k`` at the paper's
+    thickness without absorption and fading with it as the film thins."""
+    top = _film_layer(film, float(thickness), np.asarray(face, float)).top[:, 1:]
+    shape = lobe[:, 1:top.shape[1] + 1]
+    return (np.einsum("cmij,cmij->c", top, np.broadcast_to(shape, top.shape))
+            / np.maximum(np.einsum("cmij,cmij->c", shape, shape), 1e-300))
+
+
 def _diffuse_weight(parts: SlabSkinParts, skin_albedo: ArrayLike) -> NDArray[np.float64]:
     """``a / (1 - a c)`` per channel (``a`` and ``c`` broadcast: one channel or three)."""
     a = np.asarray(skin_albedo, float).reshape(-1)
@@ -220,7 +239,7 @@ def matching_absorption(target: ArrayLike, film: ReflectionLayer,
     """``(A, clamped)`` per channel: the foundation's absorption whose made-up skin at
     ``thickness_um`` has the colour ``target`` (RGB, under uniform light) on the skin under the
     film (``skin``'s gloss, diffuse albedo ``skin_albedo``); :func:`slab_colour` falls as
-    ``A`` grows, and false position finds the root (:func:`~lut_baker.model.film_slab.
+    ``A`` grows, and a bracketed root finds it (:func:`~lut_baker.model.film_slab.
     increasing_root`).  A target out of the film's reach gets ``A = 0`` (too light) or 1 (too
     dark) and ``clamped``."""
     goal = np.broadcast_to(np.asarray(target, float), (3,))

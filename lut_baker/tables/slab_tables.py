@@ -4,10 +4,12 @@ painted thickness map) is a lookup, not a bake (docs/baking.md, "The film as a s
 tables"; docs/model.md, "Made-up skin at a thickness").
 
 Per thickness ``h`` (micrometres) and channel, with ``a`` the skin's diffuse albedo (free: a
-texture, a socket) and the film's surface gloss ``film_gloss`` in closed form
-(:meth:`lut_baker.tables.table_set.Tables.surface_gloss`)::
+texture, a socket) and the film's surface gloss in closed form, ``k`` times eq. 2's gloss
+``film_gloss`` (:meth:`lut_baker.tables.table_set.Tables.surface_gloss`; ``k`` the share an
+interface of the film's vehicle reflects, :func:`lut_baker.model.film_slab.surface_share`, the
+rest the body's)::
 
-    f = film_gloss + top(h) + a t_h(theta_i) t_h(theta_o) / (pi (1 - a c_h))
+    f = k film_gloss + top(h) + a t_h(theta_i) t_h(theta_o) / (pi (1 - a c_h))
 
 ``top`` (angular, 1/sr): the film's body through its surface and the skin's gloss through the
 film, every inter-reflection (what does not depend on ``a``); ``through`` ``t`` (directional,
@@ -34,6 +36,8 @@ Functions and types
 - :func:`thickness_nodes`, :func:`thickness_index` -- its nodes and the closed-form index.
 - :class:`SlabTables` -- the tables, with ``at`` (the 1-D parts at a thickness).
 - :class:`SlabParts` -- the 1-D parts at one thickness.
+- :func:`surface_gloss`, :func:`surface_gloss_albedo` -- the film surface's gloss (``k``
+  times the tables' ``film_gloss``) and its directional albedo.
 - :func:`slab_reflection` -- made-up skin's BRDF at a thickness from the tables (optionally
   without its diffuse term, the part that spreads under the skin).
 - :class:`SlabDiffuse`, :func:`slab_diffuse` -- that diffuse term's factors at one thickness
@@ -62,6 +66,8 @@ __all__ = [
     "thickness_index",
     "SlabTables",
     "SlabParts",
+    "surface_gloss",
+    "surface_gloss_albedo",
     "slab_reflection",
     "SlabDiffuse",
     "slab_diffuse",
@@ -103,13 +109,15 @@ class SlabParts(NamedTuple):
     """The 1-D parts at one thickness: ``top_albedo`` ``(..., 3)`` (``top``'s directional
     albedo, at the angles asked), ``through`` ``(..., 3)`` (``t``), ``through_mean`` ``(3,)``
     (``t`` averaged over uniform light, ``2 Int t mu dmu``), ``below`` ``(3,)`` (``c``),
-    ``film_albedo`` ``(..., 3)`` (the film's own directional albedo, at the angles asked)."""
+    ``film_albedo`` ``(..., 3)`` (the film's own directional albedo, at the angles asked),
+    ``body_gloss`` ``(3,)`` (the weight of eq. 2's gloss lobe in it)."""
 
     top_albedo: NDArray[np.float64]
     through: NDArray[np.float64]
     through_mean: NDArray[np.float64]
     below: NDArray[np.float64]
     film_albedo: NDArray[np.float64]
+    body_gloss: NDArray[np.float64]
 
 
 @dataclass(frozen=True, eq=False)
@@ -121,7 +129,11 @@ class SlabTables:
     ``theta_offset`` and ``phi_spacing`` say (the closed forms of
     :mod:`lut_baker.tables.table_set`).  ``top`` (K, n_theta, n_theta, n_phi, 3) 1/sr;
     ``top_albedo``, ``through``, ``film_albedo`` (K, n_theta, 3); ``through_mean``, ``below``
-    (K, 3)."""
+    (K, 3); ``body_gloss`` (K, 3): the weight of eq. 2's gloss lobe in the film's own
+    reflection (:func:`lut_baker.model.slab_skin.body_gloss_weight`, the body's share of the
+    gloss, what the tiers draw as gloss).  ``surface_share`` (3,): ``k``, the share of the
+    tables' ``film_gloss`` the film's surface reflects
+    (:func:`lut_baker.model.film_slab.surface_share`)."""
 
     thickness_um: NDArray[np.float64]
     theta_deg: NDArray[np.float64]
@@ -132,7 +144,9 @@ class SlabTables:
     through_mean: NDArray[np.float64]
     below: NDArray[np.float64]
     film_albedo: NDArray[np.float64]
+    body_gloss: NDArray[np.float64]
     absorption: NDArray[np.float64]
+    surface_share: NDArray[np.float64]
     theta_spacing: str = "grazing"
     theta_offset: float = THETA_OFFSET
     phi_spacing: str = "half_vector"
@@ -141,7 +155,7 @@ class SlabTables:
         k, n, p = self.thickness_um.size, self.theta_deg.size, self.phi_deg.size
         shapes = {"top": (k, n, n, p, 3), "top_albedo": (k, n, 3), "through": (k, n, 3),
                   "film_albedo": (k, n, 3), "through_mean": (k, 3), "below": (k, 3),
-                  "absorption": (3,)}
+                  "body_gloss": (k, 3), "absorption": (3,), "surface_share": (3,)}
         for name, shape in shapes.items():
             if np.shape(getattr(self, name)) != shape:
                 raise ValueError(f"slab table {name!r} must have shape {shape}, "
@@ -172,7 +186,8 @@ class SlabTables:
                          through=_linear(self._along(self.through, thickness_um), x),
                          through_mean=self._along(self.through_mean, thickness_um),
                          below=self._along(self.below, thickness_um),
-                         film_albedo=_linear(self._along(self.film_albedo, thickness_um), x))
+                         film_albedo=_linear(self._along(self.film_albedo, thickness_um), x),
+                         body_gloss=self._along(self.body_gloss, thickness_um))
 
     def through_at(self, thickness_um: float, w: ArrayLike) -> NDArray[np.float64]:
         """``t`` (dimensionless, ``(..., 3)``) at one thickness for unit directions ``(..., 3)``
@@ -210,6 +225,18 @@ def _albedo(tables: Tables, skin_albedo: ArrayLike | None) -> NDArray[np.float64
     if skin_albedo is None:
         return np.pi * np.asarray(tables.skin_diffuse, float)
     return np.broadcast_to(np.asarray(skin_albedo, float), (3,))
+
+
+def surface_gloss(tables: Tables, wi: ArrayLike, wo: ArrayLike) -> NDArray[np.float64]:
+    """The film surface's gloss (1/sr, ``(..., 3)``) at unit directions: the slab's
+    ``surface_share`` times the tables' ``film_gloss`` (closed form); 0 below the surface."""
+    to_light, to_view = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
+    return _slab(tables).surface_share * tables.surface_gloss("film_gloss", to_light, to_view)
+
+
+def surface_gloss_albedo(tables: Tables, theta_deg: ArrayLike) -> NDArray[np.float64]:
+    """:func:`surface_gloss`'s directional albedo at incidences ``theta_deg``, ``(..., 3)``."""
+    return _slab(tables).surface_share * tables.directional("film_gloss_albedo", theta_deg)
 
 
 class SlabDiffuse(NamedTuple):
@@ -251,7 +278,7 @@ def slab_reflection(tables: Tables, wi: ArrayLike, wo: ArrayLike,
     slab = _slab(tables)
     h = _thickness(tables, thickness_um)
     to_light, to_view = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
-    covered = (tables.surface_gloss("film_gloss", to_light, to_view)
+    covered = (surface_gloss(tables, to_light, to_view)
                + slab.top_at(h, to_light, to_view))
     bare = tables.surface_gloss("skin_gloss", to_light, to_view)
     if diffuse:
@@ -268,13 +295,13 @@ def slab_directional_albedo(tables: Tables, theta_deg: ArrayLike,
                             skin_albedo: ArrayLike | None = None,
                             coverage: float = 1.0) -> NDArray[np.float64]:
     """``Int f cos(theta_o) dwo`` at incidences ``theta_deg`` from the tables' 1-D parts,
-    ``(..., 3)``: the film's gloss albedo, ``top``'s, ``a t(theta) t_mean / (1 - a c)``; the
+    ``(..., 3)``: the film surface's gloss albedo, ``top``'s, ``a t(theta) t_mean / (1 - a c)``; the
     bare skin's by ``1 - coverage``."""
     slab = _slab(tables)
     h = _thickness(tables, thickness_um)
     a = _albedo(tables, skin_albedo)
     parts = slab.at(h, theta_deg)
-    covered = (tables.directional("film_gloss_albedo", theta_deg) + parts.top_albedo
+    covered = (surface_gloss_albedo(tables, theta_deg) + parts.top_albedo
                + a * parts.through * parts.through_mean / (1.0 - a * parts.below))
     bare = tables.directional("skin_gloss_albedo", theta_deg) + a
     return coverage * covered + (1.0 - coverage) * bare

@@ -106,3 +106,35 @@ def test_the_tiers_asked_for_are_fitted_and_others_when_asked(record, monkeypatc
     assert bakes.measured_at(meta, 0.6, (0.1, 0.2, 0.3), tiers=("EEVEE",)) is None
     assert bakes.measured_at(meta, 0.6, (0.1, 0.2, 0.3), with_traits=True,
                             tiers=("LAYERED",)) is measured
+
+
+def test_a_slab_fit_is_made_on_the_records_skin(bpy_factory, monkeypatch):
+    """The film at a thickness: the skin the film covers (``skin_albedo``) is in the record's
+    key (another colour is another fit, the same colour reuses it; the paper's film ignores
+    it), every skin shares the slab's tables, and each fit's Skin Color is its record's; a
+    fit at another thickness on the same skin moves from it (no fit)."""
+    from lut_baker.closures import fitting
+    from makeup_skin_addon import bakes
+
+    bakes.clear()
+    skin = presets.made_up_skin("light_ivory", "jensen_skin1", absorption=[0.2, 0.4, 0.6])
+    tan, pale = [0.55, 0.27, 0.16], [0.7, 0.55, 0.45]
+    records = [bakes.bake_record(skin, "preview", 9.6, None, albedo) for albedo in (tan, pale)]
+    assert records[0]["key"] != records[1]["key"] and records[0]["skin_albedo"] == tan
+    assert bakes.bake_record(skin, "preview", 9.6, None, list(tan))["key"] == records[0]["key"]
+    assert bakes.record_key(records[0]) == records[0]["key"]
+    paper = bakes.bake_record(skin, "preview", "paper", None, tan)
+    assert "skin_albedo" not in paper and paper == bakes.bake_record(skin, "preview")
+    fits = [bakes.baked(record, tiers=("PRINCIPLED",)) for record in records]
+    assert fits[0][0].slab is fits[1][0].slab  # one bake of the slab
+    for (_, fit), albedo in zip(fits, (tan, pale), strict=True):
+        np.testing.assert_array_equal(fit.skin_albedo, albedo)
+    calls = []
+    original = fitting.fit_closures
+    monkeypatch.setattr(fitting, "fit_closures",
+                        lambda *a, **k: (calls.append(1), original(*a, **k))[1])
+    moved = bakes.baked(bakes.bake_record(skin, "preview", 30.0, None, tan),
+                        tiers=("PRINCIPLED",))[1]
+    assert calls == [] and moved.slab.thickness_um == 30.0
+    np.testing.assert_array_equal(moved.skin_albedo, tan)
+    bakes.clear()

@@ -269,3 +269,35 @@ def test_a_thickness_moves_the_film_live_without_fitting(sphere, monkeypatch):
     assert after["parameters"]["absorption"] == pytest.approx(list(settings.absorption),
                                                               abs=1e-7)
     bakes.clear()
+
+
+def test_a_thickness_move_is_swapped_in_first_and_measured_after(sphere, monkeypatch):
+    """Tier Auto, the film at a thickness: a Thickness move's rebuild measures nothing (the
+    group of the tier chosen last, its fit moved, swapped in at once; no tier errors), and a
+    rebuild that measures follows it once swapped in: the group's record and the material's
+    tier errors then hold the new thickness's measurement."""
+    from makeup_skin_addon import bakes, groups, live, nodes
+    from makeup_skin_addon.keys import ERRORS_KEY
+
+    material, _ = apply_pipeline(sphere, "AUTO", resolution="preview", film_mode="SLAB")
+    settings = material.makeup_skin
+    settings.live_update = True
+    tier = nodes.read_meta(groups.group_of(material).node_tree)["tier"]
+    measured = []
+    original = bakes.measure
+    monkeypatch.setattr(bakes, "measure", lambda *a, **k: measured.append(1) or original(
+        *a, **k))
+    settings.thickness_um = 40.0
+    live.start()
+    live.wait()
+    live.poll()
+    meta = nodes.read_meta(groups.group_of(material).node_tree)
+    assert measured == [] and meta["film_thickness_um"] == 40.0 and meta["tier"] == tier
+    assert meta["measured"] is None and material.name in live.pending()
+    live.flush()
+    meta = nodes.read_meta(groups.group_of(material).node_tree)
+    assert measured and meta["film_thickness_um"] == 40.0 and meta["measured"]["errors"]
+    errors = json.loads(material[ERRORS_KEY])
+    assert {e["key"] for e in errors.values()} == {meta["key"]}
+    assert live.pending() == set()
+    bakes.clear()

@@ -140,3 +140,43 @@ def test_in_eevee_coverage_0_is_the_artists_render(artist_head, tmp_path):
     np.testing.assert_allclose(artist_skins.face_mean(zero), mean_before, rtol=COVERAGE_0_MEAN)
     np.testing.assert_allclose(artist_skins.face_mean(first), mean_before,
                                rtol=0.03)  # measured 0.9-1.6%
+
+
+SLAB_SKIN = (0.55, 0.27, 0.16)
+"""A tanned artist's skin, far darker in blue than the skin preset (grey 0.756)."""
+SLAB_COLOUR_TOLERANCE = 0.02
+"""The forced Principled tier's colour against the slab's exact one, per channel: 2% (measured
+-0.6% to 0%; fitted and judged on the skin preset it rendered +0.8/+4.8/+14%)."""
+
+
+def test_principled_tier_holds_the_slabs_colour_on_the_artists_skin(addon):
+    """The film at a thickness over an artist's Principled skin unlike the skin preset, the
+    Principled tier forced, at coverage 1 on a large sphere under a white sky
+    (:mod:`support.furnace_albedo`, whose mean is the colour under uniform light): its colour
+    is the slab's exact one on the skin under the film
+    (:func:`lut_baker.tables.slab_tables.slab_colour`) within 2% per channel."""
+    import bpy
+    from support import furnace_albedo
+
+    from lut_baker.tables.slab_tables import slab_colour
+    from makeup_skin_addon import bakes, convert, nodes
+
+    principled = furnace_albedo.build_scene(size=64, samples=32)
+    furnace_albedo.set_principled(principled, SLAB_SKIN, 0.45, 1.4, subsurface_weight=1.0,
+                                  method="RANDOM_WALK_SKIN")
+    sphere = next(o for o in bpy.context.scene.objects if o.type == "MESH")
+    bpy.context.view_layer.objects.active = sphere
+    material = sphere.active_material
+    settings = material.makeup_skin
+    settings.live_update = False
+    settings.film_mode, settings.tier = "SLAB", "PRINCIPLED"
+    assert bpy.ops.makeup_skin.apply() == {"FINISHED"}
+    settings.coverage = 1.0
+    meta = nodes.read_meta(convert.group_node(material).node_tree)
+    tables = bakes.rebake({k: meta[k] for k in bakes.RECORD_FIELDS if k in meta})
+    under = np.asarray(settings.skin_body, float) * np.asarray(settings.skin_under, float)
+    exact = slab_colour(tables, meta["film_thickness_um"], skin_albedo=under)
+    rendered, noise, _ = furnace_albedo.render_albedo()
+    assert meta["tier"] == "PRINCIPLED"
+    np.testing.assert_array_less(np.abs(rendered / exact - 1.0),
+                                 SLAB_COLOUR_TOLERANCE + 3.0 * noise / exact)

@@ -259,3 +259,18 @@ def test_only_exr_paths_are_written(baked, tmp_path):
 def test_load_accepts_the_sidecar_path(baked, saved):
     loaded = exr_files.load_tables(saved.with_suffix(".json"))
     assert codec.content_hash(loaded) == codec.content_hash(baked)
+
+
+def test_the_slab_round_trips_through_the_file(tmp_path):
+    """Tables baked with the film at a thickness keep their slab on disk: the same made-up
+    skin read back from the file (float32) at every thickness of the axis."""
+    from lut_baker.model import film_slab
+    from lut_baker.tables import slab_tables
+
+    skin = presets.made_up_skin("paper_natural", "jensen_skin1", absorption=[0.1, 0.3, 0.5])
+    tables = bake.bake(skin, "preview", film=film_slab.DEFAULT_THICKNESS_UM)
+    loaded = exr_files.load_tables(exr_files.save_tables(tables, tmp_path / "slab.exr"))
+    assert loaded.parameters["film_thickness_um"] == film_slab.DEFAULT_THICKNESS_UM
+    for um in (1.0, film_slab.DEFAULT_THICKNESS_UM, 150.0, np.inf):
+        np.testing.assert_allclose(slab_tables.slab_colour(loaded, um),
+                                   slab_tables.slab_colour(tables, um), rtol=1e-6)

@@ -45,6 +45,18 @@ def test_cli_bake_writes_the_same_tables_as_the_function(tmp_path):
     assert codec.content_hash(exr_files.load_tables(tmp_path / "paper.exr")) == meta["sha256"]
 
 
+def test_cli_bakes_the_film_at_a_thickness(tmp_path):
+    """--thickness: the tables hold the slab, as the function bakes them, read back from the
+    file."""
+    args = ("--foundation", "clarins_103", "--thickness", "9.6", "--resolution", "preview")
+    assert main.main(["bake", *args, "--out", str(tmp_path), "--name", "sheer"]) == 0
+    meta = json.loads((tmp_path / "sheer.json").read_text())
+    assert meta["parameters"]["film_thickness_um"] == 9.6 and "slab_top" in meta["layout"]
+    skin = bake_command.skin_from_args(parse(*args))
+    assert meta["sha256"] == codec.content_hash(bake.bake(skin, "preview", film=9.6))
+    assert exr_files.load_tables(tmp_path / "sheer.exr").slab is not None
+
+
 @pytest.mark.slow  # a fresh Python bakes (~0.8 s)
 def test_cli_options_override_in_order(tmp_path):
     result = run_cli("--params", EXAMPLE, "--coverage", "0.25", "--absorption", "0", "0.5", "1",
@@ -118,6 +130,9 @@ def test_bad_argument_exits_2_with_one_line_from_the_shell(tmp_path):
     (["--foundation", "purple"], "--foundation"),
     (["--skin", "green"], "--skin"),
     (["--params", "missing.toml"], "--params"),
+    (["--thickness", "0"], "--thickness"),
+    (["--thickness", "thin"], "--thickness"),
+    (["--thickness", "inf"], "--thickness"),
 ])
 def test_bad_arguments_exit_2_with_one_line(capsys, args, named, tmp_path):
     code, err = main_exit(capsys, *args, "--out", tmp_path)
@@ -156,9 +171,10 @@ def test_help_explains_every_option_with_units():
     assert result.returncode == 0
     text = " ".join(result.stdout.split())
     for option in ("--preset", "--foundation", "--skin", "--params", "--coverage",
-                   "--absorption", "--resolution", "--inter-reflection", "--out", "--name"):
+                   "--absorption", "--resolution", "--thickness", "--inter-reflection", "--out",
+                   "--name"):
         assert option in text
-    for unit in ("[0, 1]", "1/sr", "per RGB channel", "docs/baking.md"):
+    for unit in ("[0, 1]", "1/sr", "per RGB channel", "docs/baking.md", "micrometres"):
         assert unit in text
     # Every foundation preset is listed, the measured products included.
     for name in presets.FOUNDATIONS:
