@@ -456,13 +456,10 @@ def coat_view_terms(cos_view: ArrayLike, roughness: float, ior: float
 
 
 @lru_cache(maxsize=64)
-def ggx_average_albedo(roughness: float, n_u: int = 48, n_phi: int = 32) -> float:
-    """``2 Int E(mu) mu dmu`` of the Fresnel-free GGX albedo (Cycles' ``ggx_Eavg``), ``E`` by
-    :func:`microfacet_albedo`'s quadrature of ``n_u`` by ``n_phi`` nodes (a search may take a
-    coarser one)."""
+def ggx_average_albedo(roughness: float) -> float:
+    """``2 Int E(mu) mu dmu`` of the Fresnel-free GGX albedo (Cycles' ``ggx_Eavg``)."""
     mu, w = gauss_legendre(32)
-    return float(2.0 * np.sum(w * mu * microfacet_albedo(mu, roughness, n_u=n_u,
-                                                          n_phi=n_phi)))
+    return float(2.0 * np.sum(w * mu * microfacet_albedo(mu, roughness)))
 
 
 # --------------------------------------------------------------------------------------------
