@@ -29,6 +29,7 @@ if INSTALLED:
         params_file,
         presets,
         roughness,
+        slab_shade,
         slab_skin,
         thick_layer,
     )
@@ -52,6 +53,7 @@ else:
         params_file,
         presets,
         roughness,
+        slab_shade,
         slab_skin,
         thick_layer,
     )
@@ -60,5 +62,5 @@ else:
 
 __all__ = ["albedo", "auto_tier", "bake", "cache", "closure_fit", "codec", "film_slab",
            "fitting", "params_file", "presets", "principled_albedo", "profiles", "quadrature",
-           "roughness", "slab_skin", "slab_tables", "table_set", "thick_layer", "tier_formulas",
-           "tier_registry", "tiers", "uniform_light", "view_image"]
+           "roughness", "slab_shade", "slab_skin", "slab_tables", "table_set", "thick_layer",
+           "tier_formulas", "tier_registry", "tiers", "uniform_light", "view_image"]

@@ -263,29 +263,34 @@ def matched(material, foundation: str | None = None, skin: SkinTarget | None = N
         f"Matched the shade to the skin's color before Apply ({_rgb(skin.target)}: "
         f"{skin.source}; under the film the skin's body color is {_rgb(skin.body)}): "
         f"absorption {_rgb(result.absorption)}, in the bottle "
-        f"{_rgb(shade.colour_seen(result.absorption))}.")
+        f"{_rgb(shade.colour_seen(result.absorption, shade.slab_foundation(settings)))}.")
     result.sentences += _reach_sentences(result, light, float(settings.gloss))
     return result
 
 
 def _shortfall(result: Shade) -> float:
-    """How far a shade's covered colour misses its target, relative, summed over channels."""
+    """How far a shade misses the skin, relative, summed over channels: its covered colour
+    against its target, and with the film at a thickness how far it darkened the skin under
+    the film to get there (a sheer film's gloss that full absorption cannot take away)."""
     return float(np.sum(np.abs(result.reached - result.target)
-                        / np.maximum(result.target, 1e-6)))
+                        / np.maximum(result.target, 1e-6))
+                 + np.sum(1.0 - result.skin_under()))
 
 
 def first_shade(material, reading=None, resolution: str | None = None
                 ) -> tuple[str | None, Shade]:
     """The first Apply's shade (docs/addon.md, "A first Apply"): :func:`matched` on the
     settings' film; when the skin is darker than that film's own gloss in some channel
-    (clamped at full absorption) and the matte film (:data:`MATTE_FILM`) reaches it better,
+    (clamped at full absorption, or with the film at a thickness the skin under the film
+    darkened to reach it) and the matte film (:data:`MATTE_FILM`) reaches it better,
     matched on that instead, and its name returned (else None).  ``reading``: the artist's
     skin (:class:`.artist_skin.SkinReading`), if read; ``resolution``: of the tables (default
     the settings': Apply's own, so that the match's bake is Apply's)."""
     settings = material.makeup_skin
     skin = skin_target(material, reading, resolution=resolution)
     result = matched(material, skin=skin, resolution=resolution)
-    too_dark = np.any(result.clamped & (result.absorption == 1.0))
+    too_dark = np.any(result.clamped & (result.absorption == 1.0)) or np.any(
+        result.skin_under() < 1.0)
     if not too_dark or settings.foundation == MATTE_FILM:
         return None, result
     matte = matched(material, MATTE_FILM, skin, resolution)
@@ -320,7 +325,7 @@ def stepped(material, steps: int) -> Shade:
     result.sentences.append(
         f"One shade {word}: the covered skin {_rgb(current)} -> {_rgb(result.reached)}, "
         f"absorption {_rgb(result.absorption)}, in the bottle "
-        f"{_rgb(shade.colour_seen(result.absorption))}.")
+        f"{_rgb(shade.colour_seen(result.absorption, shade.slab_foundation(settings)))}.")
     result.sentences += _reach_sentences(result, light, gloss)
     return result
 
@@ -334,7 +339,8 @@ def assign(settings, result: Shade, source: str) -> None:
     where the shade came from (``source``: ``"MATCH"``) and the steps' count and base."""
     with shade.assigning():
         settings.absorption = [float(a) for a in result.absorption]
-        settings.shade_colour = [float(c) for c in shade.colour_seen(result.absorption)]
+        settings.shade_colour = [float(c) for c in shade.colour_seen(
+            result.absorption, shade.slab_foundation(settings))]
         settings.shade_note = result.note()
         settings.shade_source = source
         if result.base is not None:
