@@ -14,6 +14,7 @@ Identifiers (``bl_idname``):
   (:class:`makeup_skin_addon.properties.MakeupSkinSettings`); its ID properties are stored
   under this name.
 - :data:`PRESET_SUBDIR` -- the folder under Blender's ``presets`` where parameter sets are saved.
+- :data:`PAPER_FILM`, :data:`SLAB_FILM` -- the Film setting's values.
 - :data:`SETTINGS_VERSION` -- what the settings mean, stamped on them (older files are
   upgraded when opened).
 
@@ -57,6 +58,8 @@ __all__ = [
     "SETTINGS_ATTRIBUTE",
     "PRESET_SUBDIR",
     "SETTINGS_VERSION",
+    "PAPER_FILM",
+    "SLAB_FILM",
     "RECORD_KEY",
     "ERRORS_KEY",
     "CHOICE_KEY",
@@ -92,13 +95,18 @@ SETTINGS_ATTRIBUTE = "makeup_skin"
 ``material.makeup_skin``)."""
 PRESET_SUBDIR = "makeup_skin"
 """Folder under Blender's ``presets`` where parameter sets are saved."""
-SETTINGS_VERSION = 3
+PAPER_FILM = "PAPER"
+"""The Film setting of the paper's model as published (its 150 um free film, paths 1 + 3)."""
+SLAB_FILM = "SLAB"
+"""The Film setting of the film as a slab at the Thickness setting."""
+SETTINGS_VERSION = 4
 """What the settings mean, stamped on every change (``settings_version``).  1 (never stamped):
 Shade By Colour was the colour the pigment passes (1 - absorption), Film Roughness a width in
 degrees under Override Film, Coverage 1 and Shade By Absorption the defaults; 2: Colour is the
 colour seen (the thick layer), Film and Skin Roughness are Blender roughness; 3: the Film
-setting (the film at a Thickness, the default, or the paper's film as published): every
-material of versions 1 and 2 had the paper's film."""
+setting (the paper's film as published, the default, or the film at a Thickness): every
+material of versions 1 and 2 had the paper's film; 4: the film at a Thickness is the default
+(a version-3 file that stores no Film had the paper's)."""
 
 # --- custom properties of a material ---------------------------------------------------------
 RECORD_KEY = "makeup_skin_previous_surface"

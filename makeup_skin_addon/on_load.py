@@ -16,8 +16,9 @@ The same handler first upgrades the settings of files saved by an earlier add-on
 (:func:`upgrade_settings`, :data:`.keys.SETTINGS_VERSION`): their Shade By Color meant the
 colour the pigment passes (now the colour seen), their film width was in degrees under Override
 Film (now Film Roughness, always on), and their Coverage and Shade By defaulted to 1 and
-Absorption; every value they meant is kept, and every material made before the Film setting
-(versions 1 and 2) keeps the paper's film.
+Absorption; every value they meant is kept, and every material made before the film at a
+thickness became the default (versions 1-3) keeps the Film it had: the paper's, unless a
+version-3 file chose another.
 
 - :func:`upgrade_settings` -- one material's settings of an older file, upgraded.
 - :func:`damaged_groups` -- the add-on's groups whose images are missing or damaged (no decode).
@@ -67,14 +68,16 @@ def upgrade_settings(settings) -> bool:
     """Upgrade one material's settings written by an earlier add-on to
     :data:`.keys.SETTINGS_VERSION`, keeping what they meant; returns whether it did.  Version 1
     (no ``settings_version``, some setting stored): the colour passed, the film width, the old
-    defaults; versions 1 and 2: the paper's film (the Film setting came with version 3, its
-    default the film at a thickness).  Settings of this version, or never touched, are left
-    alone."""
+    defaults; versions 1 and 2: the paper's film (the Film setting came with version 3);
+    version 3: the paper's film unless the file stores another Film (it was the default
+    until version 4, whose default is the film at a thickness: a file stores only what was
+    set).  Settings of this version, or never touched, are left alone."""
     if settings.is_property_set("settings_version"):
-        if settings.settings_version >= 3:
+        if settings.settings_version >= SETTINGS_VERSION:
             return False
         with shade.assigning():
-            _paper_film(settings)
+            if settings.settings_version < 3 or not settings.is_property_set("film_mode"):
+                _paper_film(settings)
             settings.settings_version = SETTINGS_VERSION
         return True
     if not any(settings.is_property_set(name) for name in OLD_PROPERTIES):

@@ -132,10 +132,31 @@ def _reset_skin_under(settings) -> None:
 
 def _update_film(self, context):
     """Film changes the tables; the skin under the film Match Skin darkened for another film
-    is the skin's own again."""
+    is the skin's own again, and the shade keeps its colour in the bottle (:func:`_reshade`)."""
     if not shade.is_assigning():
         _reset_skin_under(self)
+        _reshade(self)
     _update_tables(self, context)
+
+
+def _reshade(settings) -> None:
+    """The shade in the Film now: a preset's is its own (its colour's absorption with the film
+    at a thickness, :func:`.shade.preset_absorption`); a colour picked or matched keeps its
+    colour in the bottle, its absorption solved for this film; an absorption typed by hand
+    (or never chosen) keeps its value, and its colour in the bottle is this film's."""
+    slab = shade.slab_foundation(settings)
+    with shade.assigning():
+        source = settings.shade_source
+        if source == "PRESET" and settings.foundation in presets.FOUNDATIONS:
+            settings.absorption = [float(a) for a in shade.preset_absorption(
+                settings.foundation, slab is not None)]
+        elif source == "MATCH" or (source == "USER" and settings.absorption_mode == "COLOUR"):
+            absorption, clamped = shade.absorption_for_colour(settings.shade_colour, slab)
+            settings.absorption = [float(a) for a in absorption]
+            settings.shade_note = shade.colour_note(settings.shade_colour, clamped, slab)
+        else:
+            settings.shade_colour = [float(c) for c in shade.colour_seen(settings.absorption,
+                                                                         slab)]
 
 
 def _update_thickness(self, context):
@@ -149,7 +170,8 @@ def _update_thickness(self, context):
 def _update_absorption(self, context):
     if not shade.is_assigning():
         with shade.assigning():
-            self.shade_colour = [float(c) for c in shade.colour_seen(self.absorption)]
+            self.shade_colour = [float(c) for c in shade.colour_seen(
+                self.absorption, shade.slab_foundation(self))]
             self.shade_note = ""
             self.shade_source = "USER"
     _update_shade(self, context)
@@ -158,12 +180,21 @@ def _update_absorption(self, context):
 def _update_shade_colour(self, context):
     if shade.is_assigning():
         return
-    absorption, clamped = shade.absorption_for_colour(self.shade_colour)
+    slab = shade.slab_foundation(self)
+    absorption, clamped = shade.absorption_for_colour(self.shade_colour, slab)
     with shade.assigning():
         self.absorption = [float(a) for a in absorption]
-        self.shade_note = shade.colour_note(self.shade_colour, clamped)
+        self.shade_note = shade.colour_note(self.shade_colour, clamped, slab)
         self.shade_source = "USER"
     _update_shade(self, context)
+
+
+def _update_skin_colour(self, context):
+    """Skin Color reaches the sockets at once; with the film as a slab the fit is made on it
+    (:func:`.skin_model.skin_albedo_of`), so the group is rebuilt too."""
+    _update_sockets(self, context)
+    if self.film_mode != PAPER_FILM and not self.over_shader:
+        live.tables_changed(self)
 
 
 def _update_skin(self, context):
@@ -181,7 +212,8 @@ def _update_foundation(self, context):
         with shade.assigning():
             # The preset's shade reaches the material at once (its sockets), its colour seen
             # and its film's own roughness come with it.
-            self.absorption = presets.FOUNDATIONS[self.foundation]["absorption"]
+            self.absorption = [float(a) for a in shade.preset_absorption(
+                self.foundation, self.film_mode != PAPER_FILM)]
             self.shade_colour = [float(c) for c in shade.preset_colour(self.foundation)]
             self.film_roughness = shade.foundation_roughness(self.foundation)
             self.shade_note = ""
@@ -220,9 +252,10 @@ class MakeupSkinSettings(bpy.types.PropertyGroup):
                                           "a slab)"),
             (PAPER_FILM, "Paper Film (as Published)", "The paper's measured free film, about "
                                                       "150 micrometres, paths 1 + 3 as "
-                                                      "published (files made before keep "
-                                                      "it)")),
-        default=PAPER_FILM,
+                                                      "published (files made before the "
+                                                      "film at a thickness was the default "
+                                                      "keep it)")),
+        default=SLAB_FILM,
         description="How the foundation's film is modelled: at a thickness, or the paper's "
                     "free film as published", update=_update_film)
     thickness_um: bpy.props.FloatProperty(
@@ -305,7 +338,7 @@ class MakeupSkinSettings(bpy.types.PropertyGroup):
         description="The skin's diffuse albedo (the skin preset's by default, or the value of "
                     "the artist's Base Color); an albedo texture linked to the group's Skin "
                     "Color input replaces it",
-        update=_update_sockets)
+        update=_update_skin_colour)
     skin_roughness: bpy.props.FloatProperty(
         name="Skin Roughness", default=shade.skin_roughness(FIRST_SKIN),
         min=SKIN_ROUGHNESS_MIN, max=ROUGHNESS_MAX, subtype="FACTOR",

@@ -22,16 +22,12 @@ from dataclasses import dataclass
 from typing import Any
 
 from .core import cache, presets, roughness
+from .keys import PAPER_FILM, SLAB_FILM
 from .shade import ROUGHNESS_TOLERANCE, foundation_roughness, skin_roughness
 
 __all__ = ["SkinSettings", "skin_settings", "skin_from_settings", "film_of", "skin_under_of",
            "skin_albedo_of", "clear_cache",
            "PAPER_FILM", "SLAB_FILM"]
-
-PAPER_FILM = "PAPER"
-"""The Film setting of the paper's model as published (its 150 um free film, paths 1 + 3)."""
-SLAB_FILM = "SLAB"
-"""The Film setting of the film as a slab at the Thickness setting (new Applies' default)."""
 
 _ROUGHENED = cache.LRUCache(32)
 
@@ -63,12 +59,13 @@ class SkinSettings:
     absorption: tuple = (0.0, 0.0, 0.0)
     skin_under: tuple = (1.0, 1.0, 1.0)
     skin_body: tuple = (0.0, 0.0, 0.0)
+    skin_colour: tuple = (0.0, 0.0, 0.0)
 
 
 def skin_settings(settings: Any) -> SkinSettings:
     """The :class:`SkinSettings` of a material's settings now."""
     values = {name: getattr(settings, name) for name in SkinSettings.__dataclass_fields__}
-    for name in ("absorption", "skin_under", "skin_body"):
+    for name in ("absorption", "skin_under", "skin_body", "skin_colour"):
         values[name] = tuple(float(a) for a in values[name])
     return SkinSettings(**values)
 
@@ -86,10 +83,16 @@ def skin_albedo_of(settings: Any) -> tuple | None:
     """The skin the film covers, at which the film as a slab's closure fit is made and its
     tiers judged (:func:`lut_baker.closures.fitting.fit_closures`' ``skin_albedo``): over the
     artist's shader the mean body colour of the skin under the film as Apply last read it
-    (``skin_body``, :func:`.artist_skin.read_material`); None (the skin preset's albedo) for
-    the paper's film, without the artist's shader, or before it was read."""
-    if film_of(settings) == "paper" or not getattr(settings, "over_shader", False):
+    (``skin_body``, :func:`.artist_skin.read_material`), without it the Skin Color value;
+    None (the skin preset's albedo) for the paper's film, for a Skin Color that is the
+    preset's, or before the artist's shader was read."""
+    if film_of(settings) == "paper":
         return None
+    if not getattr(settings, "over_shader", False):
+        colour = tuple(float(c) for c in getattr(settings, "skin_colour", (0.0, 0.0, 0.0)))
+        own = tuple(float(c) for c in presets.skin_albedo(settings.skin))
+        return None if max(abs(a - b) for a, b in zip(colour, own, strict=True)) < 1e-6 \
+            or max(colour) <= 0.0 else colour
     body = tuple(float(b) for b in getattr(settings, "skin_body", (0.0, 0.0, 0.0)))
     return body if max(body) > 0.0 else None
 

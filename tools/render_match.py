@@ -6,7 +6,7 @@ Usage::
     "$(tools/venv.sh)/bin/python" tools/render_match.py [--out docs/renders/match]
         [--size 200 --samples 64] [--measure-size 96 --measure-samples 128]
         [--tones medium darker lighter] [--no-pictures] [--json FILE]
-        [--film PAPER|SLAB] [--tier AUTO|PRINCIPLED|LAYERED|...]
+        [--film SLAB|PAPER] [--tier AUTO|PRINCIPLED|LAYERED|...]
 
 One process, Cycles CPU, view transform Standard, no denoiser.  For each skin tone of
 tests/support/character.py (``SKIN_TONES``: the head's own, a darker and a lighter skin) it
@@ -262,7 +262,8 @@ def measure_tones(run_tone, args) -> list[dict]:
 def main(argv=None) -> int:
     parser = head_arguments(__doc__, "match", 200, 64, 96, 128)
     parser.add_argument("--no-pictures", dest="pictures", action="store_false")
-    parser.add_argument("--film", default="PAPER", help="the Film setting (PAPER or SLAB)")
+    parser.add_argument("--film", default="SLAB",
+                        help="the Film setting (SLAB, the default: at a thickness; PAPER)")
     parser.add_argument("--tier", default="AUTO", help="the Tier setting")
     args = parser.parse_args(argv)
     try:

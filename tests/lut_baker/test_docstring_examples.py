@@ -30,6 +30,7 @@ FORMULAS_WITH_EXAMPLES = {
     "lut_baker.numerics.adding_doubling": ["add_layers", "double_slab", "slab", "thick_slab"],
     "lut_baker.model.film_slab": ["thickness_from_mass", "body", "made_up_albedo",
                                   "solve_thick_absorption"],
+    "lut_baker.model.slab_shade": ["thick_limit_curve"],
 }
 """The formulas whose docstrings must show an example (docs/model.md's equations)."""
 

@@ -27,11 +27,12 @@ def test_live_update_rebakes_at_preview_resolution(sphere):
 
 
 def test_choosing_a_foundation_updates_its_gloss_live(sphere):
-    """The Foundation dropdown sets everything the product is: its absorption at once, its
-    gloss (the film's lobe: roughness, index) by the debounced preview re-fit."""
+    """The Foundation dropdown sets everything the product is: its absorption at once (the
+    paper's film: its own), its gloss (the film's lobe: roughness, index) by the debounced
+    preview re-fit."""
     from makeup_skin_addon import groups, live, nodes
 
-    material, _ = apply_pipeline(sphere, "LAYERED", foundation="clarins_103")
+    material, _ = apply_pipeline(sphere, "LAYERED", foundation="clarins_103", film_mode="PAPER")
     matte = nodes.read_meta(groups.group_of(material).node_tree)
     material.makeup_skin.foundation = "clarins_112"
     assert material.name in live.pending()

@@ -39,10 +39,34 @@ def test_match_skin_and_the_steps(sphere):
     np.testing.assert_allclose(settings.absorption, absorption, atol=1e-5)
 
 
+def test_the_bare_skins_gloss_needs_no_bake(addon):
+    """With the film at a thickness the bare skin's gloss comes from its own layer
+    (``bare_light``, no tables baked): within 2e-4 of what the paper film's tables give at each
+    resolution (their directional table interpolated), at either end of Skin Roughness, and
+    its film parts weigh nothing at coverage 0."""
+    import bpy
+
+    from makeup_skin_addon import matching
+
+    settings = bpy.data.materials.new("Skin").makeup_skin
+    skin = np.array([0.45, 0.25, 0.15])
+    prop = settings.bl_rna.properties["skin_roughness"]
+    for roughness in (prop.hard_min, prop.hard_max):
+        settings.skin_roughness = roughness
+        bare = matching.bare_light(settings)
+        assert not np.any(bare.film_gloss) and not np.any(bare.through_film)
+        for resolution in ("preview", "default"):
+            baked = matching.light_for(settings, resolution=resolution)
+            np.testing.assert_allclose(bare.skin_gloss, baked.skin_gloss, rtol=2e-4)
+            np.testing.assert_allclose(uniform_light.bare_colour(bare, skin, 0.7),
+                                       uniform_light.bare_colour(baked, skin, 0.7), rtol=1e-5)
+
+
 def test_the_first_apply_matches_the_skin(head):
-    """Every setting at its default (the paper's film): the first Apply matches the shade to
-    the colour the artist's shader has under uniform light (the covered skin reaches it),
-    coverage 0.6, the film's normal a weaker copy of the skin's."""
+    """Every setting at its default but Film (the paper's film here; the default film at a
+    thickness: the tests below): the first Apply matches the shade to the colour the artist's
+    shader has under uniform light (the covered skin reaches it), coverage 0.6, the film's
+    normal a weaker copy of the skin's."""
     import bpy
 
     from makeup_skin_addon import artist_skin, matching
@@ -50,7 +74,7 @@ def test_the_first_apply_matches_the_skin(head):
     material = head.active_material
     settings = material.makeup_skin
     assert settings.shade_source == "DEFAULT" and settings.coverage == pytest.approx(0.6)
-    assert settings.film_mode == "PAPER" and settings.thickness_um == pytest.approx(9.6, abs=0.05)
+    assert settings.film_mode == "SLAB" and settings.thickness_um == pytest.approx(9.6, abs=0.05)
     bpy.context.view_layer.objects.active = head
     settings.resolution = "preview"
     settings.film_mode = "PAPER"
@@ -62,6 +86,29 @@ def test_the_first_apply_matches_the_skin(head):
     np.testing.assert_allclose(uniform_light.covered_colour(
         light, np.asarray(settings.absorption), reading.body), reading.target, rtol=1e-5)
     assert group_node(material).inputs["Film Normal"].is_linked
+
+
+def test_the_first_apply_at_every_default_matches_at_the_default_thickness(head):
+    """Every setting at its default, the film at a thickness (9.6 um): the first Apply matches
+    the shade on the slab's exact colour (the covered skin reaches the artist's colour under
+    uniform light) and bakes it in."""
+    import bpy
+
+    from makeup_skin_addon import artist_skin, matching, nodes
+
+    material = head.active_material
+    settings = material.makeup_skin
+    assert settings.film_mode == "SLAB" and settings.shade_source == "DEFAULT"
+    bpy.context.view_layer.objects.active = head
+    settings.resolution = "preview"
+    assert bpy.ops.makeup_skin.apply() == {"FINISHED"}
+    assert settings.shade_source == "MATCH" and settings.foundation == "paper_natural"
+    reading = artist_skin.read_material(material)
+    reached = matching.SlabLight(settings).covered(np.asarray(settings.absorption),
+                                                   reading.body, settings.skin_under)
+    np.testing.assert_allclose(reached, reading.target, rtol=1e-4)
+    record = nodes.read_meta(group_node(material).node_tree)
+    assert record["film_thickness_um"] == pytest.approx(settings.thickness_um)
 
 
 def test_lighter_then_darker_returns_exactly_clamped_or_not(sphere):
@@ -89,9 +136,11 @@ def test_lighter_then_darker_returns_exactly_clamped_or_not(sphere):
     np.testing.assert_allclose(settings.absorption, (0.1, 0.3, 0.5), atol=1e-6)
 
 
-def test_a_dark_skin_gets_the_matte_film(addon, blank_scene):
-    """Skin darker in blue than the paper film's own gloss: the first Apply takes the matte
-    film, and its match reaches every channel."""
+@pytest.mark.parametrize("film", ["PAPER", "SLAB"])
+def test_a_dark_skin_gets_the_matte_film(addon, blank_scene, film):
+    """Skin darker in blue than the paper film's own gloss reaches: the first Apply takes the
+    matte film, and its match reaches every channel (with the film at a thickness, without
+    darkening the skin under the film, which the paper film's surface gloss would need)."""
     import bpy
 
     from makeup_skin_addon import matching
@@ -99,9 +148,10 @@ def test_a_dark_skin_gets_the_matte_film(addon, blank_scene):
     bpy.ops.mesh.primitive_uv_sphere_add(radius=0.03)
     obj = bpy.context.active_object
     material, messages = apply_pipeline(obj, "PRINCIPLED", skin_colour=(0.25, 0.11, 0.06),
-                                        film_mode="PAPER")
+                                        film_mode=film)
     settings = material.makeup_skin
     assert settings.foundation == matching.MATTE_FILM and settings.shade_note == ""
+    assert tuple(settings.skin_under) == (1.0, 1.0, 1.0)
     assert any(m.startswith("Chose Clarins 103 (matte, measured)'s matte film") for m in messages)
 
 
@@ -139,17 +189,25 @@ the head (measured up to 5.5% at full coverage, in blue)."""
 
 
 @pytest.mark.slow  # eight renders
-def test_rendered_the_match_keeps_the_sphere_colour(sphere, tmp_path):
-    """A sphere of one skin colour under uniform white light, matched: the made-up skin's mean
-    colour is within 3% of the bare skin's (coverage 0) in every channel at coverage 0.3, 0.6
-    and 1 (Cycles; Layered and Principled tiers)."""
+@pytest.mark.parametrize("film, tiers", [("PAPER", ("LAYERED", "PRINCIPLED")),
+                                         ("SLAB", ("LAYERED",))])
+def test_rendered_the_match_keeps_the_sphere_colour(sphere, tmp_path, film, tiers):
+    """A sphere of one skin colour (the skin preset's closures, no artist's shader) under
+    uniform white light, matched: the made-up skin's mean colour is within 3% of the bare
+    skin's (coverage 0) in every channel at coverage 0.3, 0.6 and 1 (Cycles).  With the film
+    at a thickness the Principled tier is left out here: its covered skin is the exact model's
+    (its replica within 0.01%, test_fitting), but its bare skin's specular renders 0.010 above
+    the model's bare skin in every channel (measured: covered 0.491 / 0.291 / 0.191 against
+    bare 0.501 / 0.301 / 0.201), an error of the tier's bare lobe that the paper's film hides
+    in its own match (docs/addon.md, "Not done")."""
     import bpy
 
     scene = bpy.context.scene
     _uniform_white(scene)
     scene.cycles.samples = 64
-    for tier in ("LAYERED", "PRINCIPLED"):
-        material, _ = apply_pipeline(sphere, tier, skin_colour=(0.45, 0.25, 0.15))
+    for tier in tiers:
+        material, _ = apply_pipeline(sphere, tier, skin_colour=(0.45, 0.25, 0.15),
+                                     film_mode=film)
         settings = material.makeup_skin
         settings.live_update = False
         assert bpy.ops.makeup_skin.match_skin() == {"FINISHED"}

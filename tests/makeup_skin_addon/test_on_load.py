@@ -108,11 +108,13 @@ def test_a_file_without_a_made_up_material_is_left_alone(addon, blank_scene, tmp
     assert on_load.notice(bpy.data.materials["Someone's material"]) is None
 
 
-def test_a_file_made_before_the_film_setting_keeps_the_papers_film(sphere, tmp_path):
-    """A material of settings version 2 (made before the Film setting, so with the paper's
-    film; its file stores no Film): opened, it keeps the paper's film (its look, its group
-    untouched: Check Tables finds it intact, nothing pending), stamped version 3; a new
-    material's Film is the film at a thickness."""
+@pytest.mark.parametrize("version", [2, 3])
+def test_a_file_made_before_the_film_at_a_thickness_was_the_default_keeps_its_film(
+        sphere, tmp_path, version):
+    """A material of settings version 2 (made before the Film setting) or 3 (the paper's film
+    the default), its file storing no Film: opened, it keeps the paper's film (its look, its
+    group untouched: Check Tables finds it intact, nothing pending), stamped this version; a
+    new material's Film is the film at a thickness."""
     import bpy
 
     from makeup_skin_addon import apply, groups, live, on_load
@@ -123,17 +125,17 @@ def test_a_file_made_before_the_film_setting_keeps_the_papers_film(sphere, tmp_p
     settings = material.makeup_skin
     for name in ("film_mode", "thickness_um"):
         settings.property_unset(name)
-    settings.settings_version = 2
-    path = tmp_path / "version2.blend"
+    settings.settings_version = version
+    path = tmp_path / f"version{version}.blend"
     bpy.ops.wm.save_as_mainfile(filepath=str(path))
     bpy.ops.wm.open_mainfile(filepath=str(path))
     material = bpy.data.materials["Skin"]
     settings = material.makeup_skin
-    assert settings.film_mode == "PAPER" and settings.settings_version == SETTINGS_VERSION == 3
+    assert settings.film_mode == "PAPER" and settings.settings_version == SETTINGS_VERSION == 4
     assert groups.group_of(material).node_tree.name == group_name and not live.pending()
     assert apply.check_material(bpy.context, material)[0]
     assert on_load.upgrade_file() == []
-    assert bpy.data.materials.new("New").makeup_skin.film_mode == "PAPER"  # the default
+    assert bpy.data.materials.new("New").makeup_skin.film_mode == "SLAB"  # the default
 
 
 def test_settings_of_an_older_file_are_upgraded(sphere, tmp_path):
@@ -181,3 +183,22 @@ def test_settings_of_an_older_file_are_upgraded(sphere, tmp_path):
     from makeup_skin_addon import on_load
 
     assert on_load.upgrade_file() == []
+
+
+def test_a_version_3_file_that_chose_the_film_at_a_thickness_keeps_it(addon, blank_scene,
+                                                                      tmp_path):
+    """Version 3 stored a Film chosen by hand: opened, it is kept (only an unset Film meant
+    the old default)."""
+    import bpy
+
+    from makeup_skin_addon import on_load
+
+    settings = bpy.data.materials.new("Chosen").makeup_skin
+    with_paper = bpy.data.materials.new("Unset").makeup_skin
+    settings.film_mode = "SLAB"  # chosen (its update stamps this version: set 3 after)
+    with_paper.property_unset("film_mode")
+    for one in (settings, with_paper):
+        one.is_made_up = True
+        one.settings_version = 3
+    assert on_load.upgrade_settings(settings) and on_load.upgrade_settings(with_paper)
+    assert settings.film_mode == "SLAB" and with_paper.film_mode == "PAPER"
