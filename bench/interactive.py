@@ -14,8 +14,11 @@ tier's choice, the skin's sampling):
   two_principled, mix_glossy, dark_value, pale_value; Cycles, a uniform white world, 128 px,
   64 samples), and ``defaults/sphere``: the sphere of tests/support/sphere_scene.py without a
   material (Apply makes one with the skin preset);
-- ``slab/KIND``, ``slab/sphere``: the same with the film at a thickness (Film: At a Thickness,
-  9.6 um) instead of the default, the paper's film;
+- ``slab/KIND``, ``slab/sphere``: the same with the film at a thickness chosen (Film: At a
+  Thickness, 9.6 um: the default, so these are ``defaults/`` by another name, kept for
+  comparing with earlier runs);
+- ``paper/KIND``, ``paper/sphere``: the same with the paper's film as published (Film: Paper
+  Film; the default before the film at a thickness);
 - ``OBJECT/FOUNDATION``: a foundation preset chosen in the panel before Apply (its own shade),
   on the sphere (a new material: the skin preset's made-up skin) and on the ``principled``
   head (over the artist's shader);
@@ -102,6 +105,7 @@ def cases(foundations) -> list[str]:
     """Every case name (module docstring)."""
     out = [f"defaults/{kind}" for kind in KINDS] + ["defaults/sphere"]
     out += [f"slab/{kind}" for kind in KINDS] + ["slab/sphere"]
+    out += [f"paper/{kind}" for kind in KINDS] + ["paper/sphere"]
     for obj in ("sphere", "principled"):
         out += [f"{obj}/{name}" for name in foundations]
         out += [f"{obj}/{end}" for end in ROUGHNESS_ENDS
@@ -119,8 +123,8 @@ def _roughness(settings, end: str) -> tuple[str, float]:
 def _scene(bpy, artist_skins, sphere_scene, case: str):
     """The object of ``case`` in a fresh file, its settings set; returns it."""
     obj_name, what = case.split("/")
-    at_thickness = obj_name == "slab"
-    if at_thickness:
+    film = {"slab": "SLAB", "paper": "PAPER"}.get(obj_name)
+    if film is not None:
         obj_name = "defaults"
     if obj_name == "sphere" or what == "sphere":
         obj = sphere_scene.build_scene(size=128, samples=64)
@@ -133,10 +137,10 @@ def _scene(bpy, artist_skins, sphere_scene, case: str):
     for other in bpy.context.view_layer.objects:
         other.select_set(other == obj)
     bpy.context.view_layer.objects.active = obj
-    if at_thickness:
+    if film is not None:
         if obj.active_material is None:  # the setting needs a material to hold it
             obj.data.materials.append(bpy.data.materials.new("Skin"))
-        obj.active_material.makeup_skin.film_mode = "SLAB"
+        obj.active_material.makeup_skin.film_mode = film
     if obj_name != "defaults":
         settings = obj.active_material.makeup_skin
         if what in ROUGHNESS_ENDS:

@@ -24,6 +24,7 @@ if INSTALLED:
         view_image,
     )
     from ..lut_baker.model import (
+        albedo,
         film_slab,
         params_file,
         presets,
@@ -47,6 +48,7 @@ else:
         view_image,
     )
     from lut_baker.model import (
+        albedo,
         film_slab,
         params_file,
         presets,
@@ -58,7 +60,7 @@ else:
     from lut_baker.numerics import cache, quadrature
     from lut_baker.tables import codec, slab_tables, table_set, uniform_light
 
-__all__ = ["auto_tier", "bake", "cache", "closure_fit", "codec", "film_slab", "fitting",
-           "params_file", "presets", "principled_albedo", "profiles", "quadrature", "roughness",
-           "slab_shade", "slab_skin", "slab_tables", "table_set", "thick_layer", "tier_formulas",
-           "tier_registry", "tiers", "uniform_light", "view_image"]
+__all__ = ["albedo", "auto_tier", "bake", "cache", "closure_fit", "codec", "film_slab",
+           "fitting", "params_file", "presets", "principled_albedo", "profiles", "quadrature",
+           "roughness", "slab_shade", "slab_skin", "slab_tables", "table_set", "thick_layer",
+           "tier_formulas", "tier_registry", "tiers", "uniform_light", "view_image"]

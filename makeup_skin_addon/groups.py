@@ -119,7 +119,9 @@ def group_for_tables(tables: table_set.Tables, tier: str, *, resolution: str = "
                      group: Any = None, errors_at: tuple[float, Any] | None = None,
                      method: str | None = None, messages: list | None = None) -> tuple:
     """``(group, fit or None)`` of ``tier`` for baked ``tables`` baked at ``resolution`` (tests
-    and tools that bake themselves; Apply goes through the settings).
+    and tools that bake themselves; Apply goes through the settings).  Tables baked with a film
+    thickness get the record of the film as a slab at it, as Apply's would
+    (:func:`.bakes.bake_record`): their own key, the slab's tiers.
 
     A group already built from the same bake, tier and ``method`` (a forced subsurface method,
     or None for the fit's choice) whose images are intact is reused (no fit) unless ``group``
@@ -128,7 +130,8 @@ def group_for_tables(tables: table_set.Tables, tier: str, *, resolution: str = "
     each damaged image found (then rebuilt)."""
     messages = [] if messages is None else messages
     skin = params_file.skin_from_dict(tables.parameters)
-    record = bakes.bake_record(skin, resolution)
+    thickness = tables.parameters.get("film_thickness_um")  # the film as a slab, if baked so
+    record = bakes.bake_record(skin, resolution, "paper" if thickness is None else thickness)
     bakes.remember(record, tables)
     coverage, absorption = errors_at if errors_at is not None else \
         tables.coverage_and_absorption()

@@ -28,7 +28,8 @@ Darker returns to exactly the same shade, clamped or not.
 - :func:`matched` -- Match Skin; :func:`first_shade` -- the first Apply's;
   :func:`stepped` -- Lighter / Darker; :func:`assign` -- store a shade on the settings.
 - :func:`light_for` -- the settings' made-up skin under uniform light (cached per bake);
-  :class:`SlabLight` -- with the film at a thickness (the exact closed form).
+  :class:`SlabLight` -- with the film at a thickness (the exact closed form);
+  :func:`bare_light` -- the bare skin alone (its gloss), without a bake.
 """
 
 from __future__ import annotations
@@ -38,10 +39,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import artist_skin, bakes, shade, skin_colour, skin_model
-from .core import bake, cache, film_slab, presets, quadrature, slab_skin, uniform_light
+from .core import albedo, bake, cache, film_slab, presets, quadrature, slab_skin, uniform_light
 
 __all__ = ["SHADE_STEP", "MATTE_FILM", "SkinTarget", "Shade", "SlabLight", "skin_target",
-           "light_for",
+           "light_for", "bare_light",
            "matched", "first_shade", "stepped", "assign", "clear_cache"]
 
 SHADE_STEP = 1.1
@@ -77,6 +78,21 @@ def light_for(settings, foundation: str | None = None, resolution: str | None = 
                                  lambda: uniform_light.uniform_light(bakes.rebake(record)))
 
 
+def bare_light(settings) -> uniform_light.UniformLight:
+    """The settings' bare skin under uniform light: its gloss layer's directional albedo
+    averaged over incidence (:func:`lut_baker.model.albedo.bihemispherical` of
+    :func:`lut_baker.bake.gloss_albedos`, without the tables: what :func:`skin_target` needs
+    with the film at a thickness, where the shade is solved on :class:`SlabLight`), the
+    film's parts 0 (they weigh nothing at coverage 0).  Within 1e-4 of the gloss
+    :func:`light_for`'s tables give (their directional table interpolated)."""
+    layer = skin_model.skin_from_settings(settings).skin_reflection
+    gloss = np.asarray(albedo.bihemispherical(
+        lambda theta_deg: bake.gloss_albedos((layer,), theta_deg)[0]), float)
+    zeros = np.zeros(3)
+    return uniform_light.UniformLight(film_gloss=zeros, film_diffuse=zeros,
+                                      path3_gloss=zeros, through_film=zeros, skin_gloss=gloss)
+
+
 def skin_target(material, reading=None, light=None, resolution: str | None = None
                 ) -> SkinTarget:
     """What the material's shade matches: over the artist's shader its colour under uniform
@@ -93,7 +109,9 @@ def skin_target(material, reading=None, light=None, resolution: str | None = Non
         return SkinTarget(np.asarray(reading.target, float), np.asarray(reading.body, float),
                           f"the artist's shader under uniform light{where}{notes}")
     skin = skin_colour.skin_colour(material)
-    light = light_for(settings, resolution=resolution) if light is None else light
+    if light is None:
+        light = (light_for(settings, resolution=resolution)
+                 if skin_model.film_of(settings) == "paper" else bare_light(settings))
     bare = uniform_light.bare_colour(light, skin.rgb, float(settings.gloss))
     return SkinTarget(np.asarray(bare, float), np.asarray(skin.rgb, float),
                       f"its diffuse albedo {_rgb(skin.rgb)} with the skin preset's gloss; the "

@@ -154,6 +154,14 @@ def _fit_roughness_and(grid: ViewGrid, target: ArrayLike, lobe_times: LobeTimes,
     return float(np.exp(x[0])), float(x[1]), float(np.sqrt(cost))
 
 
+def _search_average_albedo(grid: ViewGrid, albedo: NDArray[np.float64]) -> float:
+    """The coat search's ``E_avg = 2 Int E(mu) mu dmu`` (Cycles' ``ggx_Eavg``,
+    :func:`lut_baker.closures.cycles.ggx_average_albedo`) from the albedo ``E`` it has at
+    ``grid``'s views, the midpoints of ``cos(theta_o)`` in [0, 1]: the midpoint rule, within
+    1.5e-3 of the 32-node one (the search's ``E`` is within 2%)."""
+    return float(2.0 * np.mean(albedo * grid.cos_view))
+
+
 def fit_coat(grid: ViewGrid, target: ArrayLike) -> LobeFit:
     """Coat Roughness and Coat IOR of a GGX coat (weight 1, dielectric Fresnel, Cycles'
     energy compensation) fitted to ``target`` (the film's gloss on ``grid``, ``(V, A, P[, 3])``,
@@ -167,7 +175,7 @@ def fit_coat(grid: ViewGrid, target: ArrayLike) -> LobeFit:
 
     def lobe_times(roughness: float) -> Callable[[float], NDArray[np.float64]]:
         albedo = glossy_albedo(grid.cos_view, roughness, "GGX", final=False)
-        average = cc.ggx_average_albedo(roughness)
+        average = _search_average_albedo(grid, albedo)
 
         def factor(ior: float) -> NDArray[np.float64]:
             scale = cc.ggx_energy_scale(albedo, average, float(cc.dielectric_fss(ior)))[0]
@@ -218,8 +226,10 @@ class AlbedoQuadrature(TypedDict):
 
 
 SEARCH_QUADRATURE: AlbedoQuadrature = {"n_u": 24, "n_phi": 12}
-"""Closure-albedo quadrature while searching, at the grid's views (within 2%); the final
-weights use :data:`FINAL_QUADRATURE` (within 0.1%) at every texel."""
+"""Closure-albedo quadrature of the coat's search, at the grid's views (within 2%; its
+energy compensation's mean albedo from them, :func:`_search_average_albedo`); the Glossy
+weights use :data:`FINAL_QUADRATURE` (within 0.1%) at every texel (while searching, the
+grid's own integral: :func:`_search_glossy_albedo`)."""
 FINAL_QUADRATURE: AlbedoQuadrature = {"n_u": 96, "n_phi": 64}
 
 
@@ -274,8 +284,8 @@ def glossy_albedo(cos_view: ArrayLike, roughness: float, closure: str, *,
 
 SEARCH_ALBEDOS = 256
 """Closure albedos at :data:`SEARCH_QUADRATURE` kept for the session (0.1 kB each): every
-search starts on the same roughnesses at the same views (:data:`ROUGHNESS_SCAN`,
-:data:`lut_baker.closures.view_grid.FIT_VIEWS`), the film's, path 3's and the coat's alike."""
+coat search starts on the same roughnesses at the same views (:data:`ROUGHNESS_SCAN`,
+:data:`lut_baker.closures.view_grid.FIT_VIEWS`)."""
 
 
 @lru_cache(maxsize=SEARCH_ALBEDOS)
@@ -286,6 +296,19 @@ def _search_albedo(views: bytes, shape: tuple, roughness: float,
                                   distribution=closure, **SEARCH_QUADRATURE)
     albedo.setflags(write=False)
     return albedo
+
+
+def _search_glossy_albedo(grid: ViewGrid, lobe: NDArray[np.float64], roughness: float,
+                          closure: str) -> NDArray[np.float64]:
+    """A Glossy closure's albedo at ``grid``'s views while :func:`fit_glossy` searches: the
+    grid's own integral of its ``lobe`` (:meth:`ViewGrid.view_albedo`, a sum over pairs the
+    search has at hand) for Cycles' distributions, so that each weighted lobe carries the
+    table's albedo on the grid that measures it; EEVEE's closed form
+    (:func:`glossy_albedo`).  A lobe narrower than the grid resolves gets an albedo far off,
+    and so errs far more than the lobes the grid is sized for: the search never ends there."""
+    if closure == EEVEE_GLOSSY:
+        return glossy_albedo(grid.cos_view, roughness, closure)
+    return grid.view_albedo(lobe)
 
 
 def fit_glossy(grid: ViewGrid, target: ArrayLike, albedo_table: np.ndarray,
@@ -323,11 +346,12 @@ def fit_glossy(grid: ViewGrid, target: ArrayLike, albedo_table: np.ndarray,
                 ) -> tuple[NDArray[np.float64], NDArray[np.float64] | None,
                            NDArray[np.float64]]:
         """``(glossy, diffuse_weights or None, value on the grid)`` for one lobe: while searching
-        (``final`` False) the weights sit at the grid's views, with a coarser closure albedo;
-        the final ones at the image's texels, sampled as Blender samples them."""
+        (``final`` False) the weights sit at the grid's views, the closure's albedo the grid's
+        own integral of the lobe (:func:`_search_glossy_albedo`); the final ones at the
+        image's texels, sampled as Blender samples them."""
         shape = glossy_lobe(grid, roughness, distribution)
-        nodes = texels if final else grid.cos_view
-        closure = glossy_albedo(nodes, roughness, distribution, final=final)
+        closure = (glossy_albedo(texels, roughness, distribution) if final
+                   else _search_glossy_albedo(grid, shape, roughness, distribution))
         table = tables[final]
         glossy = table / np.maximum(closure, 1e-6)[:, None]
         diffuse = None

@@ -38,7 +38,10 @@ Functions and types
 - :class:`SlabParts` -- the 1-D parts at one thickness.
 - :func:`surface_gloss`, :func:`surface_gloss_albedo` -- the film surface's gloss (``k``
   times the tables' ``film_gloss``) and its directional albedo.
-- :func:`slab_reflection` -- made-up skin's BRDF at a thickness from the tables.
+- :func:`slab_reflection` -- made-up skin's BRDF at a thickness from the tables (optionally
+  without its diffuse term, the part that spreads under the skin).
+- :class:`SlabDiffuse`, :func:`slab_diffuse` -- that diffuse term's factors at one thickness
+  (what a reference image spreads by the dipole's profile).
 - :func:`slab_directional_albedo`, :func:`slab_colour` -- its directional albedo and its colour
   under uniform light.
 """
@@ -66,6 +69,8 @@ __all__ = [
     "surface_gloss",
     "surface_gloss_albedo",
     "slab_reflection",
+    "SlabDiffuse",
+    "slab_diffuse",
     "slab_directional_albedo",
     "slab_colour",
 ]
@@ -184,6 +189,12 @@ class SlabTables:
                          film_albedo=_linear(self._along(self.film_albedo, thickness_um), x),
                          body_gloss=self._along(self.body_gloss, thickness_um))
 
+    def through_at(self, thickness_um: float, w: ArrayLike) -> NDArray[np.float64]:
+        """``t`` (dimensionless, ``(..., 3)``) at one thickness for unit directions ``(..., 3)``
+        (their polar angles; clamped to the grid)."""
+        return _linear(self._along(self.through, thickness_um),
+                       self.theta_index(polar_angle_deg(np.asarray(w, float))))
+
     def top_at(self, thickness_um: float, wi: ArrayLike, wo: ArrayLike) -> NDArray[np.float64]:
         """``top`` (1/sr, ``(..., 3)``) at one thickness and unit directions ``(..., 3)``."""
         to_light, to_view = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
@@ -228,21 +239,52 @@ def surface_gloss_albedo(tables: Tables, theta_deg: ArrayLike) -> NDArray[np.flo
     return _slab(tables).surface_share * tables.directional("film_gloss_albedo", theta_deg)
 
 
-def slab_reflection(tables: Tables, wi: ArrayLike, wo: ArrayLike,
-                    thickness_um: float | None = None, skin_albedo: ArrayLike | None = None,
-                    coverage: float = 1.0) -> NDArray[np.float64]:
-    """Made-up skin's BRDF (1/sr, ``(..., 3)``) from the tables at ``thickness_um`` (default
-    the baked one) on skin of diffuse albedo ``skin_albedo`` (default the baked skin's
-    ``pi P_d``), mixed by area with the bare skin at ``coverage``; 0 below the surface."""
+class SlabDiffuse(NamedTuple):
+    """The diffuse term of :func:`slab_reflection` at one thickness: under the film
+    ``covered t(theta_i) t(theta_o)`` with ``covered = a / (pi (1 - a c))``, on bare skin
+    ``bare = a / pi`` (1/sr, ``(3,)`` each), mixed by area at the coverage; ``through(w)`` is
+    ``t`` for unit directions ``(..., 3)`` (the light's way in and out of the skin)."""
+
+    covered: NDArray[np.float64]
+    bare: NDArray[np.float64]
+    slab: SlabTables
+    thickness_um: float
+
+    def through(self, w: ArrayLike) -> NDArray[np.float64]:
+        """``t`` at directions ``w`` (``(..., 3)``)."""
+        return self.slab.through_at(self.thickness_um, w)
+
+
+def slab_diffuse(tables: Tables, thickness_um: float | None = None,
+                 skin_albedo: ArrayLike | None = None) -> SlabDiffuse:
+    """:class:`SlabDiffuse` of the tables at ``thickness_um`` (default the baked one) on skin
+    of diffuse albedo ``skin_albedo`` (default the baked skin's ``pi P_d``)."""
     slab = _slab(tables)
     h = _thickness(tables, thickness_um)
     a = _albedo(tables, skin_albedo)
+    below = slab._along(slab.below, h)
+    return SlabDiffuse(covered=a / (np.pi * (1.0 - a * below)), bare=a / np.pi, slab=slab,
+                       thickness_um=h)
+
+
+def slab_reflection(tables: Tables, wi: ArrayLike, wo: ArrayLike,
+                    thickness_um: float | None = None, skin_albedo: ArrayLike | None = None,
+                    coverage: float = 1.0, *, diffuse: bool = True) -> NDArray[np.float64]:
+    """Made-up skin's BRDF (1/sr, ``(..., 3)``) from the tables at ``thickness_um`` (default
+    the baked one) on skin of diffuse albedo ``skin_albedo`` (default the baked skin's
+    ``pi P_d``), mixed by area with the bare skin at ``coverage``; 0 below the surface.
+    ``diffuse=False``: without the diffuse term (:func:`slab_diffuse`), what returns where it
+    entered."""
+    slab = _slab(tables)
+    h = _thickness(tables, thickness_um)
     to_light, to_view = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
-    parts_i = slab.at(h, polar_angle_deg(to_light))
-    t_o = _linear(slab._along(slab.through, h), slab.theta_index(polar_angle_deg(to_view)))
-    diffuse = a / (np.pi * (1.0 - a * parts_i.below)) * parts_i.through * t_o
-    covered = surface_gloss(tables, to_light, to_view) + slab.top_at(h, to_light, to_view) + diffuse
-    bare = tables.surface_gloss("skin_gloss", to_light, to_view) + a / np.pi
+    covered = (surface_gloss(tables, to_light, to_view)
+               + slab.top_at(h, to_light, to_view))
+    bare = tables.surface_gloss("skin_gloss", to_light, to_view)
+    if diffuse:
+        terms = slab_diffuse(tables, h, skin_albedo)
+        covered = covered + terms.covered * terms.through(to_light) * terms.through(to_view)
+        bare = bare + terms.bare
     value = coverage * covered + (1.0 - coverage) * bare
     upper = (to_light[..., 2] >= 0.0) & (to_view[..., 2] >= 0.0)
     return np.where(upper[..., None], value, 0.0)

@@ -39,6 +39,29 @@ def test_match_skin_and_the_steps(sphere):
     np.testing.assert_allclose(settings.absorption, absorption, atol=1e-5)
 
 
+def test_the_bare_skins_gloss_needs_no_bake(addon):
+    """With the film at a thickness the bare skin's gloss comes from its own layer
+    (``bare_light``, no tables baked): within 2e-4 of what the paper film's tables give at each
+    resolution (their directional table interpolated), at either end of Skin Roughness, and
+    its film parts weigh nothing at coverage 0."""
+    import bpy
+
+    from makeup_skin_addon import matching
+
+    settings = bpy.data.materials.new("Skin").makeup_skin
+    skin = np.array([0.45, 0.25, 0.15])
+    prop = settings.bl_rna.properties["skin_roughness"]
+    for roughness in (prop.hard_min, prop.hard_max):
+        settings.skin_roughness = roughness
+        bare = matching.bare_light(settings)
+        assert not np.any(bare.film_gloss) and not np.any(bare.through_film)
+        for resolution in ("preview", "default"):
+            baked = matching.light_for(settings, resolution=resolution)
+            np.testing.assert_allclose(bare.skin_gloss, baked.skin_gloss, rtol=2e-4)
+            np.testing.assert_allclose(uniform_light.bare_colour(bare, skin, 0.7),
+                                       uniform_light.bare_colour(baked, skin, 0.7), rtol=1e-5)
+
+
 def test_the_first_apply_matches_the_skin(head):
     """Every setting at its default but Film (the paper's film here; the default film at a
     thickness: the tests below): the first Apply matches the shade to the colour the artist's

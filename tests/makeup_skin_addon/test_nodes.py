@@ -129,6 +129,25 @@ def test_forced_subsurface_method_gets_its_own_group(sphere):
                  .default_value) == pytest.approx(radius)
 
 
+
+def test_tables_with_the_film_as_a_slab_get_the_slabs_group(addon, blank_scene):
+    """Tables baked with a film thickness give a group of the film as a slab at it (the record
+    Apply's Film "At a Thickness" makes, its own key, the slab's fit), never the paper film's
+    group of the same skin."""
+    from lut_baker import bake
+    from lut_baker.model import presets
+    from makeup_skin_addon import bakes, groups, nodes
+
+    skin = presets.paper()
+    slab = bake.bake(skin, "preview", film=9.6)
+    group, fit = groups.group_for_tables(slab, "LAYERED", resolution="preview")
+    meta = nodes.read_meta(group)
+    assert meta["film_thickness_um"] == pytest.approx(9.6)
+    assert meta["key"] == bakes.bake_record(skin, "preview", 9.6)["key"]
+    assert meta["key"] != bakes.bake_record(skin, "preview")["key"]
+    assert fit is not None and fit.slab is not None
+    assert fit.slab.thickness_um == pytest.approx(9.6)
+
 def _row_probe(group, row: str, linear: bool):
     """A copy of ``group`` whose output is an Emission of its view-angle row ``row``: read as
     the group reads it (two Closest texels mixed) or, ``linear``, by one Linear lookup at

@@ -131,7 +131,8 @@ def addon_registered():
 
 def made_up_material(obj, tables, tier="LAYERED", *, coverage=None, absorption=None):
     """Give ``obj`` a material with the Made-up Skin group for ``tables`` (the add-on must be
-    registered: :func:`addon_registered`).  Coverage and absorption default to the tables'."""
+    registered: :func:`addon_registered`).  Coverage and absorption default to the tables';
+    tables baked with a film thickness give the slab's tiers at it (Film: at a thickness)."""
     import bpy
 
     from makeup_skin_addon import groups, keys
@@ -142,6 +143,10 @@ def made_up_material(obj, tables, tier="LAYERED", *, coverage=None, absorption=N
     settings.is_made_up = True
     settings.live_update = False
     settings.tier = tier
+    thickness = tables.parameters.get("film_thickness_um")
+    if thickness is not None:  # the film as a slab: the panel says so, as Apply's would
+        settings.film_mode = "SLAB"
+        settings.thickness_um = thickness
     settings.coverage = tables.parameters.get("coverage", 1.0) if coverage is None else coverage
     absorption = tables.parameters.get("absorption", 0.0) if absorption is None else absorption
     settings.absorption = [absorption] * 3 if isinstance(absorption, float) else absorption

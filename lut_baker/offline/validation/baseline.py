@@ -7,7 +7,8 @@ least squares on the images that matter, the sphere under one distant light at 0
 from the view, each pixel ``E f cos(theta_i)`` of the Principled BSDF's replica
 (:func:`lut_baker.closures.cycles.principled_reflection`) against paths 1 + 3 read from the
 baked tables (:func:`lut_baker.offline.validation.compare.local_image`, no spread on either side:
-the subsurface radius is fitted separately, to the profile, as for the tiers).
+the subsurface radius is fitted separately, to the profile, as for the tiers); tables holding the
+film as a slab give the slab's made-up skin instead, as they do to the tiers.
 
 Free sockets: Base Color (RGB), Roughness, Specular IOR Level, Coat Weight, Coat Roughness and
 Coat IOR, within the ranges Blender's sockets allow; IOR stays at the tiers' 1.5 (Specular IOR
@@ -115,7 +116,9 @@ def fit_baseline(skin: MadeUpSkin, tables: Tables, fit: ClosureFit | None = None
                  max_evaluations: int = MAX_EVALUATIONS) -> Baseline:
     """Fit a stock Principled BSDF to ``tables`` (baked from ``skin``) at the skin's coverage
     and absorption: least squares over the lit pixels of every light's image, each image's
-    residual relative to its own RMS (so each light counts alike).  ``fit``: the tables'
+    residual relative to its own RMS (so each light counts alike).  The images are those the
+    tiers are measured against (:func:`lut_baker.closures.tiers.reference_reflection`): with
+    the film as a slab, the slab's made-up skin at the fit's thickness.  ``fit``: the tables'
     :class:`~lut_baker.closures.closure_fit.ClosureFit` (fitted here if not given).  A light whose
     image is black (e.g. from behind the sphere) raises ValueError naming it."""
     fit = fit or fitting.fit_closures(tables)
@@ -123,7 +126,8 @@ def fit_baseline(skin: MadeUpSkin, tables: Tables, fit: ClosureFit | None = None
     views = [sphere_directions(resolution, light) for light in lights_deg]
     wi = np.concatenate([v[1] for v in views])
     wo = np.concatenate([v[2] for v in views])
-    ref = wi[:, 2:3] * tables.made_up_reflection(wi, wo, skin.coverage, skin.absorption)
+    ref = wi[:, 2:3] * tiers.reference_reflection(fit, tables, skin.coverage, skin.absorption,
+                                                  (wi, wo))
     # Each light's residuals divided by its RMS and the root of its count: each image counts
     # as its relative mean square error.
     bounds = np.cumsum([0] + [len(v[1]) for v in views])

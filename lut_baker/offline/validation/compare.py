@@ -21,7 +21,10 @@ Functions
 - :func:`lambert_image` -- the analytic image of a Lambertian sphere, ``E a / pi max(0, N.L)``.
 - :func:`reference_image` -- the made-up sphere's reference, exact or with paths 1 + 3 read
   from baked tables (same geometry and spread as
-  :func:`lut_baker.offline.validation.reference.sphere_image`).
+  :func:`lut_baker.offline.validation.reference.sphere_image`); from tables holding the film as
+  a slab, :func:`slab_reference_image`.
+- :func:`slab_reference_image` -- the reference of made-up skin at a thickness (docs/model.md,
+  "Made-up skin at a thickness"): the slab's BRDF from the tables, its diffuse term spread.
 - :func:`local_image` -- the image of any local reflection function (no spread), at the
   pixels' local light and view directions
   (:func:`lut_baker.numerics.geometry.sphere_directions`).
@@ -32,8 +35,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...model.made_up_skin import MadeUpSkin
+from ...model.made_up_skin import MadeUpSkin, combine, coverage_weights
 from ...numerics.geometry import light_direction, sphere_directions, sphere_normals
+from ...tables.slab_tables import slab_diffuse, slab_reflection
 from ..validation import reference
 
 __all__ = [
@@ -44,6 +48,7 @@ __all__ = [
     "bias",
     "lambert_image",
     "reference_image",
+    "slab_reference_image",
     "local_image",
     "pareto_front",
 ]
@@ -127,7 +132,12 @@ def reference_image(skin: MadeUpSkin, *, tables=None, resolution: int = 64,
     "default" and "high" resolutions, docs/baking.md), everything else the same: the
     skin-diffuse part is spread by :func:`lut_baker.offline.validation.reference.spread_diffuse`
     when ``spread``.  ``tests/makeup_skin_addon/test_render_compare.py`` checks that the two
-    agree."""
+    agree.  ``tables`` holding the film as a slab (``tables.slab``, as the tiers fitted to them
+    shade it): :func:`slab_reference_image` at their baked thickness."""
+    if getattr(tables, "slab", None) is not None:
+        return slab_reference_image(skin, tables, resolution=resolution, radius_mm=radius_mm,
+                                    light_angle_deg=light_angle_deg, irradiance=irradiance,
+                                    spread=spread, samples=samples)
     if tables is None:
         return reference.sphere_image(skin, resolution=resolution, radius_mm=radius_mm,
                                       light_angle_deg=light_angle_deg, irradiance=irradiance,
@@ -143,6 +153,44 @@ def reference_image(skin: MadeUpSkin, *, tables=None, resolution: int = 64,
         image[mask] += (reference.spread_diffuse(points, light, skin, radius_mm=radius_mm,
                                                  samples=samples, irradiance=irradiance)
                         - reference.local_diffuse(points, light, skin, irradiance))
+    return image
+
+
+def slab_reference_image(skin: MadeUpSkin, tables, *, thickness_um: float | None = None,
+                         resolution: int = 64, radius_mm: float = 10.0,
+                         light_angle_deg: float = 45.0, irradiance: float = 1.0,
+                         spread: bool = True, samples: int | None = None) -> np.ndarray:
+    """The reference image ``(n, n, 3)`` of made-up skin with the film as a slab at
+    ``thickness_um`` (default the tables' baked one), from ``tables`` baked from ``skin`` with
+    a film thickness, at the skin's coverage (the slab's absorption is baked).
+
+    ``spread=False``: :func:`lut_baker.tables.slab_tables.slab_reflection` ``E cos(theta_i)``
+    per pixel.  ``spread=True``: its diffuse term (:func:`lut_baker.tables.slab_tables.
+    slab_diffuse`) is what scattered under the skin, so it leaves spread by the dipole's
+    normalised profile (:func:`lut_baker.offline.validation.reference.spread_sums`, ``samples``
+    entry points, default :func:`lut_baker.offline.validation.reference.default_samples`)::
+
+        L = E f_local cos(theta_i) + w a/(pi (1 - a c)) t(wo) sum_i E cos(theta_i) t(wi) R(d)/Rd dA
+            + (1 - w) a/pi sum_i E cos(theta_i) R(d)/Rd dA
+
+    (``f_local``: ``slab_reflection`` without its diffuse term)."""
+    def local(diffuse: bool) -> np.ndarray:
+        return local_image(lambda wi, wo: slab_reflection(tables, wi, wo, thickness_um,
+                                                          coverage=skin.coverage,
+                                                          diffuse=diffuse),
+                           resolution, light_angle_deg, irradiance)
+
+    if not spread:
+        return local(True)
+    image = local(False)
+    _, normals, mask = reference.sphere_points(resolution, radius_mm)
+    terms = slab_diffuse(tables, thickness_um)
+    through, bare = reference.spread_sums(
+        normals[mask], light_direction(light_angle_deg), skin, terms.through,
+        radius_mm=radius_mm, samples=samples or reference.default_samples(skin, radius_mm),
+        irradiance=irradiance)
+    image[mask] += combine(coverage_weights(skin.coverage, 0.0), top=terms.covered * through,
+                           bare=terms.bare * bare)
     return image
 
 

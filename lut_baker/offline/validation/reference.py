@@ -16,7 +16,9 @@ Functions
 - :func:`fibonacci_sphere` -- near-uniform surface samples with equal areas (mm^2).
 - :func:`local_radiance` -- radiance of paths 1 + 3 at each point (nothing spread).
 - :func:`local_diffuse` -- the skin-diffuse part of paths 1 + 3 where it entered.
-- :func:`spread_diffuse` -- the same part spread by the dipole profile (k-d tree over samples).
+- :func:`spread_sums` -- the dipole profile's spread of the light entering the lit sphere, through
+  a film's transmittance given and through bare skin (k-d tree over samples).
+- :func:`spread_diffuse` -- the skin-diffuse part spread by the dipole profile (the paper's film).
 - :func:`default_samples` -- entry samples fine enough for the profile's depth scale.
 - :func:`sphere_image` -- the whole image, ``(n, n, 3)``.
 - :func:`spread_convergence` -- relative change of the spread image when samples double.
@@ -50,6 +52,7 @@ __all__ = [
     "local_radiance",
     "local_diffuse",
     "default_samples",
+    "spread_sums",
     "spread_diffuse",
     "sphere_image",
     "spread_convergence",
@@ -146,25 +149,31 @@ def local_diffuse(normals: np.ndarray, light: np.ndarray, skin: MadeUpSkin,
                     * wi[:, 2:3], 0.0)
 
 
-def spread_diffuse(exit_normals: np.ndarray, light: np.ndarray, skin: MadeUpSkin, *,
-                   radius_mm: float, samples: int, irradiance: float = 1.0) -> np.ndarray:
-    """The skin-diffuse part after spreading under the surface (docs/model.md §4), radiance (P, 3)::
+def spread_sums(exit_normals: np.ndarray, light: np.ndarray, skin: MadeUpSkin,
+                transmittance, *, radius_mm: float, samples: int,
+                irradiance: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+    """The spread under the skin (docs/model.md §4) at exit points with ``exit_normals``
+    (P, 3), before the skin's albedo: ``(through, bare)``, each (P, 3)::
 
-        L(x_o) = P_d,s sum_i E cos(theta_i) [w T_A(wi) T_A(wo) + (1 - w)] R(|x_i - x_o|)/Rd dA
+        through(x_o) = t(wo) sum_i E cos(theta_i) t(wi) R(|x_i - x_o|)/Rd dA
+        bare(x_o)    =       sum_i E cos(theta_i)       R(|x_i - x_o|)/Rd dA
 
     over ``samples`` Fibonacci entry points on the lit sphere within the profile's cutoff,
-    found with a k-d tree (chord distances, mm).  Entry and exit through the film and through
-    bare skin are summed apart, so the coverage mix is the one of :func:`local_diffuse`.
-    """
+    found with a k-d tree (chord distances, mm); ``transmittance(local (N, 3)) -> (N, 3)`` is
+    the film's on the way in and out (the same function both ways: reciprocity), at the
+    entry's local light direction and the exit's local view direction.  0 where the exit
+    faces away from the view.  The paper's film (:func:`spread_diffuse`) and the film as a
+    slab (:func:`lut_baker.offline.validation.compare.slab_reference_image`) weight the two
+    sums by their coverage and albedo terms."""
     entry_pos, entry_normals, area = fibonacci_sphere(samples, radius_mm)
     cos_i = entry_normals @ light
     lit = cos_i > 0.0
     entry_pos, entry_normals, cos_i = entry_pos[lit], entry_normals[lit], cos_i[lit]
     power = (irradiance * cos_i * area)[:, None]  # (I, 1)
-    entry_film = _film_transmittance_rgb(
-        local_directions(np.broadcast_to(light, entry_normals.shape), entry_normals), skin)
+    entry_film = transmittance(
+        local_directions(np.broadcast_to(light, entry_normals.shape), entry_normals))
     exit_local = local_directions(np.broadcast_to(VIEW, exit_normals.shape), exit_normals)
-    exit_film = _film_transmittance_rgb(exit_local, skin)
+    exit_film = transmittance(exit_local)
     rd = np.atleast_1d(dipole_total_reflectance(skin.dipole)) * np.ones(3)
     from scipy.spatial import cKDTree  # here: importing scipy.spatial takes ~0.3 s
 
@@ -186,10 +195,26 @@ def spread_diffuse(exit_normals: np.ndarray, light: np.ndarray, skin: MadeUpSkin
             k = kernel[:, c % kernel.shape[1]]
             bare[chunk, c] = np.bincount(owner, k, rows)
             through[chunk, c] = np.bincount(owner, k * entry_film[neighbours, c], rows)
+    facing = exit_local[:, 2:3] > 0.0
+    return np.where(facing, exit_film * through, 0.0), np.where(facing, bare, 0.0)
+
+
+def spread_diffuse(exit_normals: np.ndarray, light: np.ndarray, skin: MadeUpSkin, *,
+                   radius_mm: float, samples: int, irradiance: float = 1.0) -> np.ndarray:
+    """The skin-diffuse part after spreading under the surface (docs/model.md §4), radiance (P, 3)::
+
+        L(x_o) = P_d,s sum_i E cos(theta_i) [w T_A(wi) T_A(wo) + (1 - w)] R(|x_i - x_o|)/Rd dA
+
+    (:func:`spread_sums` with ``T_A = (1 - A) T``).  Entry and exit through the film and
+    through bare skin are summed apart, so the coverage mix is the one of
+    :func:`local_diffuse`.
+    """
+    through, bare = spread_sums(exit_normals, light, skin,
+                                lambda local: _film_transmittance_rgb(local, skin),
+                                radius_mm=radius_mm, samples=samples, irradiance=irradiance)
     weights = coverage_weights(skin.coverage, skin.absorption)
     p_d = np.asarray(skin.skin_reflection.P_d) * np.ones(3)
-    out = combine(weights, top=p_d * exit_film * through, bare=p_d * bare)
-    return np.where(exit_local[:, 2:3] > 0.0, out, 0.0)
+    return combine(weights, top=p_d * through, bare=p_d * bare)
 
 
 def _pairs_within(tree: cKDTree, entry_pos: np.ndarray, exit_pos: np.ndarray, cutoff: float):

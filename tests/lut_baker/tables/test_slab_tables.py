@@ -124,3 +124,21 @@ def test_the_film_surface_and_the_bodys_gloss_in_the_tables(skin, tables):
     weights = tables.slab.body_gloss
     assert np.all(np.diff(weights[:-1], axis=0) > 0.0)
     assert np.allclose(weights[-1], (1.0 - np.array(ABSORPTION)) * (1.0 - share), rtol=0.02)
+
+
+def test_the_diffuse_term_is_what_the_brdf_holds_beyond_its_local_part(skin, tables):
+    """``slab_reflection`` = its part without the diffuse term + ``slab_diffuse``'s
+    ``w covered t(theta_i) t(theta_o) + (1 - w) bare``, at another thickness, albedo and
+    coverage too; the diffuse part is what a skin of albedo 0 lacks."""
+    rng = np.random.default_rng(3)
+    wi, wo = (v / np.linalg.norm(v, axis=-1, keepdims=True)
+              for v in np.abs(rng.normal(size=(2, 50, 3))))
+    for h, albedo, w in ((None, None, 1.0), (30.0, [0.3, 0.5, 0.7], 0.4)):
+        full = ST.slab_reflection(tables, wi, wo, h, albedo, w)
+        local = ST.slab_reflection(tables, wi, wo, h, albedo, w, diffuse=False)
+        terms = ST.slab_diffuse(tables, h, albedo)
+        diffuse = w * terms.covered * terms.through(wi) * terms.through(wo) + (1 - w) * terms.bare
+        np.testing.assert_allclose(local + diffuse, full, rtol=1e-12, atol=1e-15)
+        assert np.all(diffuse > 0.05 * full)  # the split moves a real share
+        np.testing.assert_allclose(ST.slab_reflection(tables, wi, wo, h, [0.0] * 3, w), local,
+                                   rtol=1e-12, atol=1e-15)
