@@ -55,6 +55,7 @@ Functions and types
   the bottle), directional.
 - :func:`bihemispherical_on_grid` -- a directional albedo at the nodes averaged over uniform
   light.
+- :func:`thick_limit_colour` -- that film's colour under uniform light at an absorption.
 - :func:`solve_thick_absorption` -- the absorption whose thick film has a target colour.
 - :func:`skin_star` -- a skin's eq. 2 kernel in the star form (cached per skin and grid).
 - :func:`increasing_root` -- per entry, where an increasing function of [0, 1] meets a target
@@ -113,6 +114,7 @@ __all__ = [
     "made_up_albedo",
     "thick_limit_albedo",
     "bihemispherical_on_grid",
+    "thick_limit_colour",
     "solve_thick_absorption",
     "skin_star",
     "increasing_root",
@@ -628,6 +630,20 @@ def bihemispherical_on_grid(albedo: ArrayLike, grid: HemisphereGrid) -> NDArray[
     return np.asarray(albedo, float) @ (2.0 * grid.weight)
 
 
+def thick_limit_colour(film: ReflectionLayer, transmission: TransmissionLayer,
+                       grid: HemisphereGrid, absorption: ArrayLike, *,
+                       face: ArrayLike | None = None,
+                       optical_thickness: float = PAPER_FILM_OPTICAL_THICKNESS,
+                       passive: bool = True) -> NDArray[np.float64]:
+    """The bihemispherical albedo ``(C,)`` of the film of ``film`` and ``transmission`` at
+    ``absorption`` (scalar or RGB), infinitely thick under its surface (``face``: ``a_g``
+    ``(C, N)``, default the measured film's): :func:`thick_limit_albedo` of the body's order 0
+    under uniform light."""
+    slab_a = film_slab(film, transmission, grid, absorption=absorption,
+                       optical_thickness=optical_thickness, passive=passive, orders=1)
+    return bihemispherical_on_grid(thick_limit_albedo(slab_a, face), grid)
+
+
 def solve_thick_absorption(target: ArrayLike, film: ReflectionLayer,
                            transmission: TransmissionLayer, grid: HemisphereGrid, *,
                            face: ArrayLike | None = None,
@@ -653,9 +669,8 @@ def solve_thick_absorption(target: ArrayLike, film: ReflectionLayer,
     wanted = np.atleast_1d(np.asarray(target, float))
 
     def limit(a: NDArray[np.float64]) -> NDArray[np.float64]:
-        slab_a = film_slab(film, transmission, grid, absorption=a,
-                           optical_thickness=optical_thickness, passive=passive, orders=1)
-        return bihemispherical_on_grid(thick_limit_albedo(slab_a, face), grid)
+        return thick_limit_colour(film, transmission, grid, a, face=face,
+                                  optical_thickness=optical_thickness, passive=passive)
 
     absorption = increasing_root(lambda a: -limit(a), -wanted, ROOT_STEPS)
     too_light = wanted > limit(np.zeros_like(wanted))

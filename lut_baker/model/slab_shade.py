@@ -33,10 +33,10 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..numerics.cache import LRUCache
 from ..numerics.quadrature import HemisphereGrid, hemisphere_panels
-from .film_slab import bihemispherical_on_grid, face_albedo, thick_limit_albedo
+from .film_slab import face_albedo, thick_limit_colour
 from .layers import ReflectionLayer, TransmissionLayer
 from .presets import FOUNDATIONS, foundation_film, paper
-from .slab_skin import foundation_slab
+from .slab_skin import measured_film
 
 __all__ = ["CURVE_NODES", "CURVE_GRID", "ThickLimitCurve", "thick_limit_colours",
            "thick_limit_curve", "SHADES_FILE", "preset_curves", "curves_data", "read_curves",
@@ -84,7 +84,7 @@ def thick_limit_colours(film: ReflectionLayer, transmission: TransmissionLayer,
                         grid: HemisphereGrid, absorptions: ArrayLike) -> NDArray[np.float64]:
     """The colour under uniform light ``(N, 3)`` of the foundation (``film``: its top
     reflection, whose surface it keeps; its body the paper film's,
-    :func:`~lut_baker.model.slab_skin.foundation_slab`) infinitely thick, at each of
+    :func:`~lut_baker.model.slab_skin.measured_film`) infinitely thick, at each of
     ``absorptions`` ``(N,)`` (the same in every channel), order 0 only.  A grey film's channels
     differ only by their absorption, so three absorptions are evaluated at once."""
     a = np.atleast_1d(np.asarray(absorptions, float))
@@ -95,9 +95,8 @@ def thick_limit_colours(film: ReflectionLayer, transmission: TransmissionLayer,
     for start in range(0, a.size, step):
         chunk = a[start:start + step]
         shades = np.resize(chunk, 3) if grey else np.full(3, chunk[0])
-        slab = foundation_slab(film, transmission, grid, shades, orders=1)
-        limit = np.broadcast_to(bihemispherical_on_grid(thick_limit_albedo(slab, face), grid),
-                                (3,))
+        limit = np.broadcast_to(thick_limit_colour(measured_film(film), transmission, grid,
+                                                   shades, face=face), (3,))
         out[start:start + chunk.size] = (limit[:chunk.size, None] * np.ones(3) if grey
                                          else limit)
     return out

@@ -14,16 +14,12 @@ GRID = hemisphere_panels(*SS.CURVE_GRID)
 
 
 def exact_absorption(film, target):
-    """The exact root: the absorption whose foundation slab, infinitely thick under its own
-    surface, has ``target`` under uniform light."""
-    transmission = presets.paper().film_transmission
-    face = FS.face_albedo(film, GRID)
-
-    def limit(a):
-        slab = slab_skin.foundation_slab(film, transmission, GRID, a, orders=1)
-        return FS.bihemispherical_on_grid(FS.thick_limit_albedo(slab, face), GRID)
-
-    return FS.increasing_root(lambda a: -limit(a), -np.asarray(target, float), FS.ROOT_STEPS)
+    """The exact root: the absorption whose foundation slab (the paper film's body), infinitely
+    thick under its own surface, has ``target`` under uniform light."""
+    absorption, _ = FS.solve_thick_absorption(
+        target, slab_skin.measured_film(film), presets.paper().film_transmission, GRID,
+        face=FS.face_albedo(film, GRID))
+    return absorption
 
 
 @pytest.mark.parametrize("name", ["paper_natural", "clarins_105"])
