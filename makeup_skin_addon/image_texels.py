@@ -10,7 +10,7 @@ time).
 - :func:`reduced_image` -- an image box-filtered to at most :data:`IMAGE_SIZE`, linear
   (cached, :class:`ReducedImage`); :func:`is_cached` -- whether it is.
 - :func:`box_factor`, :func:`box_reduce` -- the filter in numpy; :func:`srgb_to_linear` -- the
-  sRGB curve.
+  sRGB curve; :func:`srgb_codes_to_linear` -- the same on a byte image's codes, by table.
 - :func:`read_texels` -- a reduced image at UVs, wrapped as the texture's extension says.
 - :func:`clear_cache` -- forget the reduced images.
 """
@@ -29,7 +29,8 @@ from .core import cache
 from .progress import report
 
 __all__ = ["IMAGE_SIZE", "ReducedImage", "reduced_image", "is_cached", "box_factor",
-           "box_reduce", "srgb_to_linear", "read_texels", "clear_cache"]
+           "box_reduce", "srgb_to_linear", "srgb_codes_to_linear", "read_texels",
+           "clear_cache"]
 
 IMAGE_SIZE = 512
 """The longest side, in texels, the image is box-filtered down to before it is read."""
@@ -60,6 +61,20 @@ def srgb_to_linear(values: np.ndarray) -> np.ndarray:
     return np.where(values <= 0.04045, values / 12.92, ((values + 0.055) / 1.055) ** 2.4)
 
 
+_SRGB_CODES = None
+
+
+def srgb_codes_to_linear(values: np.ndarray) -> np.ndarray:
+    """:func:`srgb_to_linear` of a byte buffer's values (each ``code / 255``, as Blender
+    gives a byte image's pixels) by a table of the 256 codes: the same values, a third of the
+    time of the curve on a 4096 px image, float32."""
+    global _SRGB_CODES
+    if _SRGB_CODES is None:
+        _SRGB_CODES = srgb_to_linear(np.arange(256, dtype=np.float32) / np.float32(255.0))
+    codes = (np.asarray(values, np.float32) * np.float32(255.0) + np.float32(0.5))
+    return _SRGB_CODES[codes.astype(np.uint8)]
+
+
 def box_factor(width: int, height: int, size: int) -> int:
     """The smallest whole factor that brings both sides to at most ``size``."""
     return max(1, -(-max(width, height) // size))
@@ -71,6 +86,10 @@ def box_reduce(pixels: np.ndarray, factor: int) -> np.ndarray:
     if factor == 1:
         return np.asarray(pixels, np.float32)
     height, width = pixels.shape[:2]
+    if height % factor == 0 and width % factor == 0:  # whole boxes: two reshaped sums
+        rows = pixels.reshape(height // factor, factor, width, -1).sum(axis=1, dtype=float)
+        return (rows.reshape(height // factor, width // factor, factor, -1).sum(axis=2)
+                / factor**2).astype(np.float32)
     rows = np.arange(0, height, factor)
     columns = np.arange(0, width, factor)
     summed = np.add.reduceat(np.add.reduceat(pixels, rows, axis=0, dtype=float), columns,
@@ -87,14 +106,15 @@ def _rgb(values: np.ndarray, width: int, height: int) -> np.ndarray:
 
 def _linearised(rgb: np.ndarray, is_float: bool, settings) -> tuple[np.ndarray, str]:
     """``(linear values, note)``: as a texture node reads pixels of this colour space.  Float
-    buffers are scene linear once loaded; byte buffers keep their colour space's encoding."""
+    buffers are scene linear once loaded; byte buffers keep their colour space's encoding
+    (their values are byte codes: linearised by :func:`srgb_codes_to_linear`)."""
     space = settings.name
     if is_float or settings.is_data or space in LINEAR_SPACES:
         return rgb, ""
     if space.startswith("Linear") or space in {"ACEScg", "ACES2065-1"}:
         return rgb, f"its colour space {space!r} was read as Linear Rec.709"
     note = "" if space == "sRGB" else f"its colour space {space!r} was read as sRGB"
-    return srgb_to_linear(rgb), note
+    return srgb_codes_to_linear(rgb), note
 
 
 def _whole(image, size: int) -> ReducedImage:

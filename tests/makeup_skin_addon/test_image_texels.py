@@ -78,3 +78,31 @@ def test_the_srgb_curve_of_rgba_pixels_read_as_rgb(addon):
     read = image_texels.srgb_to_linear(rgba[:, :3])
     assert read.dtype == np.float32 and read.shape == (2000, 3)
     np.testing.assert_allclose(read, linear(rgba[:, :3].astype(float)), rtol=1e-6, atol=1e-9)
+
+
+def test_a_byte_images_codes_linearised_by_table_as_by_the_curve(addon):
+    """A byte image's values (each code times 1/255, as Blender gives them, or code / 255)
+    linearised through the 256-code table equal the curve's, within float32 rounding."""
+    from makeup_skin_addon import image_texels
+
+    codes = np.random.default_rng(4).integers(0, 256, (500, 3))
+    for values in (codes.astype(np.float32) * np.float32(1.0 / 255.0),
+                   (codes / 255.0).astype(np.float32)):
+        read = image_texels.srgb_codes_to_linear(values)
+        assert read.dtype == np.float32 and read.shape == (500, 3)
+        np.testing.assert_allclose(read, linear(codes / 255.0), rtol=1e-6, atol=1e-9)
+
+
+def test_the_box_filter_averages_whole_and_partial_boxes(addon):
+    """Boxes that tile the image (the reshaped sums) and boxes cut at the far edges (the
+    reduceat path) both average exactly the texels they cover."""
+    from makeup_skin_addon import image_texels
+
+    pixels = np.random.default_rng(5).random((12, 8, 3)).astype(np.float32)
+    whole = image_texels.box_reduce(pixels, 4)
+    assert whole.shape == (3, 2, 3)
+    np.testing.assert_allclose(whole[1, 1], pixels[4:8, 4:8].mean(axis=(0, 1)), rtol=1e-6)
+    cut = image_texels.box_reduce(pixels[:10, :7], 4)
+    assert cut.shape == (3, 2, 3)
+    np.testing.assert_allclose(cut[2, 1], pixels[8:10, 4:7].mean(axis=(0, 1)), rtol=1e-6)
+    np.testing.assert_allclose(cut[0, 0], whole[0, 0], rtol=1e-6)
