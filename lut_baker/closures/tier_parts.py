@@ -344,25 +344,25 @@ def held_gloss_to_diffuse(targets: FitTargets, parts: dict[str, Any]) -> NDArray
 
 def held_bare_to_diffuse(targets: FitTargets, parts: dict[str, Any]) -> NDArray[np.float64]:
     """The PRINCIPLED tier's ``bare_to_diffuse`` (RGB): what its base colour carries on bare
-    skin so that, over the skin the fit is made on (``targets.skin_albedo``), its bare skin's
-    colour under uniform light is the tables' (the skin's gloss and its diffuse albedo: what
-    Match Skin matches, docs/model.md "The tiers at a thickness").
+    skin so that its bare skin's colour under uniform light is the tables' (the skin's gloss
+    and its diffuse albedo: what Match Skin matches, docs/model.md "The tiers at a
+    thickness").
 
     The bare specular is fitted to the skin gloss's shape (:func:`fit_specular`), not to its
-    albedo: the preset skin's lobe came 0.009 above its gloss under uniform light, in every
-    channel (a white lobe), whatever the skin or the film.  With ``parts``' bare specular the
-    Principled BSDF's colour is ``G + W base``
+    albedo: the preset skins' lobes came 0.009-0.010 above their gloss under uniform light, in
+    every channel (a white lobe), whatever the skin's albedo or the film.  With ``parts``' bare
+    specular the Principled BSDF's colour is ``G + W base``
     (:func:`lut_baker.closures.cycles.principled_uniform`), the base colour the node group
-    makes at coverage 0 is ``(skin + x) / (1 - E)`` (``E`` the lobe's mean layering albedo),
-    so ``x = (gloss + skin - G) (1 - E) / W - skin``: exact on the fit's skin, on another
-    within ``(1 - E) / W - 1`` of the skin's part (1e-5)."""
+    makes at coverage 0 is ``(skin + x) / (1 - E)`` (``E`` the lobe's mean layering albedo,
+    within 1e-4 of ``1 - W``), so ``x = (gloss - G) (1 - E) / W``: the same on any skin (the
+    fit stays linear in the skin's albedo), which it leaves within ``W / (1 - E) - 1`` (2e-5)
+    of its part."""
     lobe = parts["specular_bare"]
     gloss, passed = cc.principled_uniform(cc.PrincipledInputs(
         roughness=lobe.roughness, ior=SPECULAR_IOR, specular_ior_level=float(lobe.level)))
-    a = targets.skin_albedo
     wanted = cosine_mean(targets.albedo("skin_gloss"), targets.albedo_theta("skin_gloss"))
     divided = 1.0 - float(parts["specular_albedo_mean"][0])
-    return (wanted + a - gloss) * divided / max(passed, 1e-12) - a
+    return (wanted - gloss) * divided / max(passed, 1e-12)
 
 
 def image_rows(rows: tuple[str, ...], slab: bool) -> tuple[str, ...]:

@@ -60,6 +60,7 @@ def test_fit_is_linear_in_the_skin_albedo(paper_tables, paper_fit):
     np.testing.assert_allclose(burley["error"], reference_burley["error"], rtol=1e-6)
     np.testing.assert_array_equal(fit.film_albedo, paper_fit.film_albedo)
     np.testing.assert_array_equal(fit.transmittance_mean, paper_fit.transmittance_mean)
+    np.testing.assert_array_equal(fit.bare_to_diffuse, paper_fit.bare_to_diffuse)
 
 def test_fits_of_a_narrow_gloss_cost_what_a_broad_one_does():
     """The film's gloss is fitted on a grid sized by its own lobe, never on the tables' grid:
