@@ -22,6 +22,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Hashable
 from dataclasses import replace
+from functools import lru_cache
 from typing import Any, TypeVar
 
 import numpy as np
@@ -358,11 +359,20 @@ def held_bare_to_diffuse(targets: FitTargets, parts: dict[str, Any]) -> NDArray[
     fit stays linear in the skin's albedo), which it leaves within ``W / (1 - E) - 1`` (2e-5)
     of its part."""
     lobe = parts["specular_bare"]
-    gloss, passed = cc.principled_uniform(cc.PrincipledInputs(
-        roughness=lobe.roughness, ior=SPECULAR_IOR, specular_ior_level=float(lobe.level)))
+    gloss, passed = _specular_uniform(float(lobe.roughness), float(lobe.level))
     wanted = cosine_mean(targets.albedo("skin_gloss"), targets.albedo_theta("skin_gloss"))
     divided = 1.0 - float(parts["specular_albedo_mean"][0])
     return (wanted - gloss) * divided / max(passed, 1e-12)
+
+
+@lru_cache(maxsize=16)
+def _specular_uniform(roughness: float, level: float) -> tuple[NDArray[np.float64], float]:
+    """:func:`lut_baker.closures.cycles.principled_uniform` of a specular alone (cached: a
+    skin's bare lobe is the same under every foundation, some 20 ms each)."""
+    gloss, passed = cc.principled_uniform(cc.PrincipledInputs(
+        roughness=roughness, ior=SPECULAR_IOR, specular_ior_level=level))
+    gloss.setflags(write=False)
+    return gloss, passed
 
 
 def image_rows(rows: tuple[str, ...], slab: bool) -> tuple[str, ...]:
