@@ -47,7 +47,10 @@ class ClosureFit:
     ``specular_film`` (path-3 gloss under the coat), ``coat_albedo_mean``,
     ``specular_albedo_mean`` (bare, film): the cosine-weighted mean layering albedos;
     ``gloss_to_diffuse`` (RGB): the path-3 gloss albedo the base colour carries when no
-    specular lobe fits it (else 0).  LAYERED: ``glossy`` (film_gloss, path3_gloss, skin_gloss:
+    specular lobe fits it (else 0; with the film as a slab, what holds the covered skin's
+    colour); ``bare_to_diffuse`` (RGB): what the base colour carries on bare skin so that its
+    colour under uniform light is the tables' (None over the artist's shader, whose bare skin
+    is theirs).  LAYERED: ``glossy`` (film_gloss, path3_gloss, skin_gloss:
     Glossy lobes with their weight rows) and ``view_rows`` (``(len(IMAGE_ROWS), size, 3)``: the
     view-angle image).  EEVEE: ``eevee_glossy`` (the same lobes, GGX as EEVEE renders it, the
     film gloss in two: ``film_gloss`` and ``film_gloss_2``) and ``eevee_view_rows`` (their
@@ -76,6 +79,7 @@ class ClosureFit:
     coat_albedo_mean: float | None = None
     specular_albedo_mean: tuple[float, float] | None = None
     gloss_to_diffuse: NDArray[np.float64] | None = None
+    bare_to_diffuse: NDArray[np.float64] | None = None
     glossy: dict[str, LobeFit] | None = None
     view_rows: NDArray[np.float64] | None = None
     eevee_glossy: dict[str, LobeFit] | None = None

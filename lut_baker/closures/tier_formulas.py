@@ -176,11 +176,13 @@ def principled_sockets(fit: Any, x: TierInputs, ops: Algebra) -> dict[str, Any]:
     - Roughness ``mix(r_bare, r_film, w)``, Specular IOR Level
       ``g [(1 - w) l_bare + w l_film mean((1 - A)^2)]``;
     - Base Color: the diffuse albedo ``combine(once: pi P_d,f, twice: S T_mean^2 + g
-      gloss_to_diffuse, bare: S)`` divided by the mean attenuation of the layers above it,
+      gloss_to_diffuse, bare: S + g bare_to_diffuse)`` divided by the mean attenuation of the
+      layers above it,
       ``(1 - g w c E_coat) (1 - g E_spec(w))``, ``E_spec(w) = mix(E_bare, E_film, w)``, and
       clipped to [0, 1] (Cycles clamps the colour its subsurface closure takes to 1, not its
       diffuse one: clipped, both take the same);
-    - Subsurface Weight: the skin's share of the diffuse albedo (channel mean).
+    - Subsurface Weight: the skin's share of the diffuse albedo (channel mean; the bare
+      skin's, ``bare_to_diffuse`` included, is all of it).
 
     ``g`` (the group's Gloss input, 0..1) scales the gloss lobes: at 0 the coat weight and the
     specular level are 0, so Cycles allocates neither closure (``coat_weight >
@@ -189,8 +191,9 @@ def principled_sockets(fit: Any, x: TierInputs, ops: Algebra) -> dict[str, Any]:
     linear in ``g`` (exact at both ends)."""
     weights = _weights(fit, x)
     g = x.gloss
+    bare_gloss = None if fit.bare_to_diffuse is None else g * fit.bare_to_diffuse
     skin = combine(weights, **mix_slots(through_film=skin_through_film(fit, x),
-                                        skin=x.skin_color))
+                                        skin_gloss=bare_gloss, skin=x.skin_color))
     total = skin + combine(weights, **mix_slots(film_diffuse=fit.film_albedo,
                                                 path3_gloss=g * fit.gloss_to_diffuse))
     e_spec = combine(weights, top=fit.specular_albedo_mean[1], bare=fit.specular_albedo_mean[0])

@@ -11,6 +11,8 @@ parameters are fitted to the tables, with weights that may depend on the view an
 - :func:`principled_parts` -- one Principled BSDF's coat and speculars.
 - :func:`held_gloss_to_diffuse` -- with the film as a slab, what its base colour carries so
   that its colour under uniform light is the slab's on the skin the film covers.
+- :func:`held_bare_to_diffuse` -- what its base colour carries on bare skin so that its bare
+  skin's colour under uniform light is the tables' (the skin's gloss and diffuse albedo).
 - :func:`layered_parts` -- Cycles' Glossy lobes and their view-angle image.
 - :func:`eevee_parts` -- EEVEE's GGX lobes (the film's gloss in two) and their image.
 - :func:`image_rows`, :data:`SLAB_ROWS` -- a tier's image rows, the film as a slab's included.
@@ -20,6 +22,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Hashable
 from dataclasses import replace
+from functools import lru_cache
 from typing import Any, TypeVar
 
 import numpy as np
@@ -44,7 +47,7 @@ from .view_grid import FIT_VIEWS, ViewGrid, lobe_widths_deg, view_grid
 from .view_image import EEVEE_IMAGE_ROWS, IMAGE_ROWS, texel_centres
 
 __all__ = ["FitTargets", "cosine_mean", "principled_parts", "held_gloss_to_diffuse",
-           "layered_parts", "eevee_parts", "image_rows", "SLAB_ROWS"]
+           "held_bare_to_diffuse", "layered_parts", "eevee_parts", "image_rows", "SLAB_ROWS"]
 
 SLAB_ROWS = ("film_body",)
 """The view-angle rows a tier has beyond its own with the film as a slab: the film body's
@@ -265,7 +268,8 @@ def _left_out_glossy(size: int) -> LobeFit:
 
 def principled_parts(targets: FitTargets, over_shader: bool) -> dict[str, Any]:
     """The PRINCIPLED tier's parts of a :class:`ClosureFit`: the coat, the two speculars (over
-    the artist's shader the bare one left out: level 0) and their mean layering albedos."""
+    the artist's shader the bare one left out: level 0, and no ``bare_to_diffuse``), their
+    mean layering albedos and what the base colour carries of the gloss the lobes miss."""
     film_grid, film_gloss = targets.coat_target()
     skin_grid, path3 = targets.target("path3_gloss")
     coat = fit_coat(film_grid, film_gloss)
@@ -306,6 +310,8 @@ def principled_parts(targets: FitTargets, over_shader: bool) -> dict[str, Any]:
     }
     if targets.slab is not None:
         parts["gloss_to_diffuse"] = held_gloss_to_diffuse(targets, parts)
+    if not over_shader:
+        parts["bare_to_diffuse"] = held_bare_to_diffuse(targets, parts)
     return parts
 
 
@@ -335,6 +341,38 @@ def held_gloss_to_diffuse(targets: FitTargets, parts: dict[str, Any]) -> NDArray
     divided = ((1.0 - float(coat.level) * float(parts["coat_albedo_mean"]))
                * (1.0 - float(parts["specular_albedo_mean"][1])))
     return (exact - gloss) * divided / max(passed, 1e-12) - skin - targets.base_mean()
+
+
+def held_bare_to_diffuse(targets: FitTargets, parts: dict[str, Any]) -> NDArray[np.float64]:
+    """The PRINCIPLED tier's ``bare_to_diffuse`` (RGB): what its base colour carries on bare
+    skin so that its bare skin's colour under uniform light is the tables' (the skin's gloss
+    and its diffuse albedo: what Match Skin matches, docs/model.md "The tiers at a
+    thickness").
+
+    The bare specular is fitted to the skin gloss's shape (:func:`fit_specular`), not to its
+    albedo: the preset skins' lobes came 0.009-0.010 above their gloss under uniform light, in
+    every channel (a white lobe), whatever the skin's albedo or the film.  With ``parts``' bare
+    specular the Principled BSDF's colour is ``G + W base``
+    (:func:`lut_baker.closures.cycles.principled_uniform`), the base colour the node group
+    makes at coverage 0 is ``(skin + x) / (1 - E)`` (``E`` the lobe's mean layering albedo,
+    within 1e-4 of ``1 - W``), so ``x = (gloss - G) (1 - E) / W``: the same on any skin (the
+    fit stays linear in the skin's albedo), which it leaves within ``W / (1 - E) - 1`` (2e-5)
+    of its part."""
+    lobe = parts["specular_bare"]
+    gloss, passed = _specular_uniform(float(lobe.roughness), float(lobe.level))
+    wanted = cosine_mean(targets.albedo("skin_gloss"), targets.albedo_theta("skin_gloss"))
+    divided = 1.0 - float(parts["specular_albedo_mean"][0])
+    return (wanted - gloss) * divided / max(passed, 1e-12)
+
+
+@lru_cache(maxsize=16)
+def _specular_uniform(roughness: float, level: float) -> tuple[NDArray[np.float64], float]:
+    """:func:`lut_baker.closures.cycles.principled_uniform` of a specular alone (cached: a
+    skin's bare lobe is the same under every foundation, some 20 ms each)."""
+    gloss, passed = cc.principled_uniform(cc.PrincipledInputs(
+        roughness=roughness, ior=SPECULAR_IOR, specular_ior_level=level))
+    gloss.setflags(write=False)
+    return gloss, passed
 
 
 def image_rows(rows: tuple[str, ...], slab: bool) -> tuple[str, ...]:

@@ -21,8 +21,11 @@ def test_bare_skin_is_the_skins_own_principled_lobe(paper_fit):
     assert sockets["Coat Weight"].item() == 0.0
     assert sockets["Roughness"].item() == paper_fit.specular_bare.roughness
     assert sockets["Specular IOR Level"].item() == paper_fit.specular_bare.level
+    # The base colour carries what the bare specular errs under uniform light (a white lobe).
+    assert np.ptp(paper_fit.bare_to_diffuse) < 1e-12
     np.testing.assert_allclose(sockets["Base Color"],
-                               skin / (1.0 - paper_fit.specular_albedo_mean[0]), rtol=1e-12)
+                               (skin + paper_fit.bare_to_diffuse)
+                               / (1.0 - paper_fit.specular_albedo_mean[0]), rtol=1e-12)
     assert sockets["Subsurface Weight"].item() == pytest.approx(1.0)  # all of it is the skin's
 
 
