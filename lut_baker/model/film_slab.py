@@ -74,6 +74,7 @@ from numpy.typing import ArrayLike, NDArray
 from ..numerics.adding_doubling import (
     Layer,
     SlabGenerator,
+    absorption_per_direction,
     add_layers,
     mirror,
     passive_generator,
@@ -429,6 +430,9 @@ def _passive(generator: SlabGenerator, target: ArrayLike, face: NDArray[np.float
     thickness keeps, under uniform light, the measured film's ``R + T`` (``target``): passive,
     and absorbing what the measured film absorbs."""
     scale0 = star_scale(grid)[0]
+    first = SlabGenerator(basis=generator.basis[..., 0, :, :], rates=generator.rates[..., 0, :])
+    if not np.any(absorption_per_direction(first, scale0) < 0.0):
+        return generator  # passive already: any relief leaves it as it is
     order0 = SlabGenerator(basis=generator.basis[..., :1, :, :], rates=generator.rates[..., :1, :])
     relief = increasing_root(
         lambda r: _free_film_albedo(passive_generator(order0, scale0, r), face, scale0, grid),
