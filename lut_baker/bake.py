@@ -54,7 +54,7 @@ from numpy.typing import ArrayLike, NDArray
 from .evaluate.two_layer import inter_reflection_fourier_matrices, layered_fourier_matrices
 from .model.albedo import specular_albedo
 from .model.dipole import dipole_profile, dipole_total_reflectance
-from .model.film_slab import relative_thickness, skin_star, surface_share
+from .model.film_slab import face_albedo, relative_thickness, skin_star, surface_share
 from .model.layers import Dipole, ReflectionLayer, TransmissionLayer
 from .model.made_up_skin import MadeUpSkin, film_reflection_layer, film_transmission_layer
 from .model.microfacet import (
@@ -596,7 +596,7 @@ def bake_slab(skin: MadeUpSkin, resolution_name: str | Resolution = "default", *
     absorption = np.broadcast_to(np.asarray(skin.absorption, float), (3,))
     film = foundation_slab(skin.film, skin.film_transmission, grid, absorption)
     share = np.broadcast_to(surface_share(skin.film), (3,))  # k: the surface's share of the gloss
-    face = share[:, None] * gloss_albedos((skin.film,), np.degrees(grid.theta))[0].T  # a_g
+    face = np.broadcast_to(face_albedo(skin.film, grid), (3, grid.theta.size))  # a_g
     scale = star_scale(grid)
     lobe = skin_star(gloss_layer(skin.film), grid)  # eq. 2's gloss, star form, every order
     top, top_albedo, through, through_mean, below, film_albedo, body_gloss = ([] for _ in range(7))

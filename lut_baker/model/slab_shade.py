@@ -113,7 +113,7 @@ def thick_limit_curve(film: ReflectionLayer, transmission: TransmissionLayer,
     [0.828 0.828 0.828]
     >>> a, clamped = curve.absorption([0.7, 0.55, 0.45])
     >>> print(np.round(a, 3), clamped)
-    [0.077 0.23  0.364] [False False False]
+    [0.077 0.23  0.365] [False False False]
     """
     key = (repr(film.as_dict()), repr(transmission.as_dict()), int(nodes))
 
