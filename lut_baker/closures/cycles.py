@@ -389,7 +389,8 @@ def _albedo_views(views: NDArray[np.float64], roughness: float, fresnel: OfCosin
 
 
 def layering_albedo(cos_view: ArrayLike, roughness: float, eta: float,
-                    f0: ArrayLike | None = None) -> NDArray[np.float64]:
+                    f0: ArrayLike | None = None, *,
+                    plain: NDArray[np.float64] | None = None) -> NDArray[np.float64]:
     """The albedo Cycles attributes to a dielectric GGX layer seen at ``cos_view`` when it
     attenuates the layers below (``bsdf_microfacet_estimate_albedo``): ``mix(f0, 1, s)``.
 
@@ -397,11 +398,12 @@ def layering_albedo(cos_view: ArrayLike, roughness: float, eta: float,
     (its comment: the table "assumes energy preservation"); this replica computes the same
     ratio ``E_F / E_1`` by quadrature (:func:`microfacet_albedo`), with ``E_F`` the albedo under the
     real Fresnel at ``eta``.  ``f0`` (default ``F0(eta)``, RGB allowed) rescales the start as
-    Specular IOR Level and Specular Tint do.
+    Specular IOR Level and Specular Tint do.  ``plain``: the Fresnel-free albedo at these
+    views if already computed (:func:`coat_view_terms` has it).
     """
     views = np.asarray(cos_view, float)
     e_f = microfacet_albedo(views, roughness, lambda c: dielectric_fresnel(c, eta))
-    e_1 = microfacet_albedo(views, roughness)
+    e_1 = microfacet_albedo(views, roughness) if plain is None else plain
     real0 = f0_from_ior(eta)
     s = np.clip((e_f / np.maximum(e_1, 1e-12) - real0) / (1.0 - real0), 0.0, 1.0)
     start = real0 if f0 is None else np.asarray(f0, float)
@@ -449,10 +451,12 @@ def coat_view_terms(cos_view: ArrayLike, roughness: float, ior: float
     """``(scale, layering albedo)`` of the Principled coat at view cosines ``cos_view``: the
     factor :func:`ggx_energy_compensation` puts on its lobe, and the albedo by which it
     attenuates the layers below, ``darkening * layering_albedo`` (Cycles' ``bsdf_albedo``
-    reads the closure's weight, which holds the darkening)."""
-    scale, darkening = ggx_energy_compensation(cos_view, roughness,
-                                               float(dielectric_fss(ior)))
-    return scale, darkening * layering_albedo(cos_view, roughness, ior)
+    reads the closure's weight, which holds the darkening).  The Fresnel-free albedo both
+    need is computed once."""
+    plain = microfacet_albedo(np.asarray(cos_view, float), roughness)
+    scale, darkening = ggx_energy_scale(plain, ggx_average_albedo(float(roughness)),
+                                        float(dielectric_fss(ior)))
+    return scale, darkening * layering_albedo(cos_view, roughness, ior, plain=plain)
 
 
 @lru_cache(maxsize=64)
