@@ -390,7 +390,8 @@ def _albedo_views(views: NDArray[np.float64], roughness: float, fresnel: OfCosin
 
 def layering_albedo(cos_view: ArrayLike, roughness: float, eta: float,
                     f0: ArrayLike | None = None, *,
-                    plain: NDArray[np.float64] | None = None) -> NDArray[np.float64]:
+                    plain: NDArray[np.float64] | None = None,
+                    weighted: NDArray[np.float64] | None = None) -> NDArray[np.float64]:
     """The albedo Cycles attributes to a dielectric GGX layer seen at ``cos_view`` when it
     attenuates the layers below (``bsdf_microfacet_estimate_albedo``): ``mix(f0, 1, s)``.
 
@@ -398,11 +399,13 @@ def layering_albedo(cos_view: ArrayLike, roughness: float, eta: float,
     (its comment: the table "assumes energy preservation"); this replica computes the same
     ratio ``E_F / E_1`` by quadrature (:func:`microfacet_albedo`), with ``E_F`` the albedo under the
     real Fresnel at ``eta``.  ``f0`` (default ``F0(eta)``, RGB allowed) rescales the start as
-    Specular IOR Level and Specular Tint do.  ``plain``: the Fresnel-free albedo at these
-    views if already computed (:func:`coat_view_terms` has it).
+    Specular IOR Level and Specular Tint do.  ``plain``, ``weighted``: ``E_1`` and ``E_F`` at
+    these views if already computed (:func:`coat_view_terms` has the first, a caller that
+    needs the lobe's own albedo the second).
     """
     views = np.asarray(cos_view, float)
-    e_f = microfacet_albedo(views, roughness, lambda c: dielectric_fresnel(c, eta))
+    e_f = (microfacet_albedo(views, roughness, lambda c: dielectric_fresnel(c, eta))
+           if weighted is None else weighted)
     e_1 = microfacet_albedo(views, roughness) if plain is None else plain
     real0 = f0_from_ior(eta)
     s = np.clip((e_f / np.maximum(e_1, 1e-12) - real0) / (1.0 - real0), 0.0, 1.0)
@@ -446,17 +449,20 @@ def ggx_energy_scale(albedo: ArrayLike, average_albedo: float, fss: Real
     return scale, scale / (1.0 + missing)
 
 
-def coat_view_terms(cos_view: ArrayLike, roughness: float, ior: float
+def coat_view_terms(cos_view: ArrayLike, roughness: float, ior: float, *,
+                    weighted: NDArray[np.float64] | None = None
                     ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """``(scale, layering albedo)`` of the Principled coat at view cosines ``cos_view``: the
     factor :func:`ggx_energy_compensation` puts on its lobe, and the albedo by which it
     attenuates the layers below, ``darkening * layering_albedo`` (Cycles' ``bsdf_albedo``
     reads the closure's weight, which holds the darkening).  The Fresnel-free albedo both
-    need is computed once."""
+    need is computed once; ``weighted``: the lobe's albedo with its Fresnel at these views,
+    if the caller has it (:func:`layering_albedo`)."""
     plain = microfacet_albedo(np.asarray(cos_view, float), roughness)
     scale, darkening = ggx_energy_scale(plain, ggx_average_albedo(float(roughness)),
                                         float(dielectric_fss(ior)))
-    return scale, darkening * layering_albedo(cos_view, roughness, ior, plain=plain)
+    return scale, darkening * layering_albedo(cos_view, roughness, ior, plain=plain,
+                                              weighted=weighted)
 
 
 @lru_cache(maxsize=64)
