@@ -198,7 +198,7 @@ def microfacet_from_cosines(cos_h: NDArray[np.float64], cos_hi: NDArray[np.float
     - ``ASHIKHMIN_SHIRLEY``: ``(e + 1) / (8 pi) (n.h)^e / ((h.wi) max(cos_i, cos_o))``
       (``bsdf_ashikhmin_shirley_eval``).
     """
-    cos_i, cos_o = np.broadcast_arrays(np.asarray(cos_i, float), np.asarray(cos_o, float))
+    cos_i, cos_o = np.asarray(cos_i, float), np.asarray(cos_o, float)
     upper = (cos_i > 0.0) & (cos_o > 0.0)
     if distribution == "ASHIKHMIN_SHIRLEY":
         e = ashikhmin_shirley_exponent(roughness)
@@ -210,8 +210,12 @@ def microfacet_from_cosines(cos_h: NDArray[np.float64], cos_hi: NDArray[np.float
         raise ValueError(f"distribution must be one of {GLOSSY_DISTRIBUTIONS}, got "
                          f"{distribution!r}")
     alpha = np.square(max(float(roughness), ROUGHNESS_EPS))
-    safe_i = np.where(upper, cos_i, 1.0)
-    safe_o = np.where(upper, cos_o, 1.0)
+    # Each cosine kept at its own shape (a view's Lambda once per view, not per pair); where
+    # the other one is below the surface the value is dropped anyway.
+    safe_i = np.where(upper, cos_i, 1.0) if cos_i.size >= cos_o.size else \
+        np.where(cos_i > 0.0, cos_i, 1.0)
+    safe_o = np.where(upper, cos_o, 1.0) if cos_o.size > cos_i.size else \
+        np.where(cos_o > 0.0, cos_o, 1.0)
     value = (DISTRIBUTIONS[distribution][0](cos_h, alpha)
              * microfacet_shadowing(safe_i, safe_o, alpha, distribution)
              / (4.0 * safe_i * safe_o))
