@@ -92,10 +92,8 @@ def face_points(face_area, loop_start, loop_total, corner_vert, positions, corne
         loops = start[pick, None] + np.arange(k)
         second = np.ones(len(pick), np.int64)
         if k > 3:
-            p = positions[corner_vert[loops]]
-            fan = 0.5 * np.linalg.norm(np.cross(p[:, 1:-1] - p[:, :1], p[:, 2:] - p[:, :1]),
-                                       axis=-1)
-            partial = np.cumsum(fan, axis=1)
+            partial = _fan_partial(face[pick], loops, loop_start, loop_total, corner_vert,
+                                   positions, k)
             below = partial < draws[1, pick, None] * partial[:, -1:]
             second += np.minimum(below.sum(axis=1), k - 3)
         rows = np.arange(len(pick))
@@ -106,6 +104,28 @@ def face_points(face_area, loop_start, loop_total, corner_vert, positions, corne
         if xyz is not None:
             xyz[pick] = _interpolated(weights, positions[corner_vert[triangle]])
     return (uv, xyz, face) if with_positions else uv
+
+
+def _fan_areas(loops: np.ndarray, corner_vert, positions) -> np.ndarray:
+    """The cumulative areas of the fan triangles from the first corner of faces of ``k``
+    corners (their corners ``loops``, ``(n, k)``): ``(n, k - 2)``."""
+    p = positions[corner_vert[loops]]
+    fan = 0.5 * np.linalg.norm(np.cross(p[:, 1:-1] - p[:, :1], p[:, 2:] - p[:, :1]), axis=-1)
+    return np.cumsum(fan, axis=1)
+
+
+def _fan_partial(faces: np.ndarray, loops: np.ndarray, loop_start, loop_total, corner_vert,
+                 positions, k: int) -> np.ndarray:
+    """:func:`_fan_areas` of the faces ``faces`` of ``k`` corners that points fell in (their
+    corners ``loops``), one row a point: computed once per face of ``k`` corners when the mesh
+    has fewer of them than there are points (the same numbers, row by row), else per point."""
+    with_k = np.flatnonzero(np.asarray(loop_total) == k)
+    if len(with_k) >= len(faces):
+        return _fan_areas(loops, corner_vert, positions)
+    row = np.zeros(len(loop_total), np.int64)
+    row[with_k] = np.arange(len(with_k))
+    own = np.asarray(loop_start)[with_k].astype(np.int64)[:, None] + np.arange(k)
+    return _fan_areas(own, corner_vert, positions)[row[faces]]
 
 
 def _interpolated(weights: np.ndarray, corners: np.ndarray) -> np.ndarray:

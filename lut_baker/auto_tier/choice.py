@@ -52,18 +52,19 @@ _OMISSIONS = LRUCache(OMISSION_CACHE_SIZE)
 
 def _omission(scene: SceneDescription, traits: MaterialTraits) -> float:
     """The largest :func:`subsurface_omission_error` over the scene's lights, remembered by
-    everything it depends on (the same material read again from a file is the same)."""
+    everything it depends on but the skin's share, which it is proportional to (the same
+    scene and skin under another foundation, or read again from a file, is the same)."""
     scale = traits.subsurface_scale
     radius = np.asarray(traits.radius_mm, float)
     profile = np.asarray(traits.profile, float)
 
     def at(light_deg: float) -> float:
-        share = traits.share("skin_share", light_deg)
-        key = (scene.footprint_mm, scene.object_size_mm, light_deg, scale, share,
+        key = (scene.footprint_mm, scene.object_size_mm, light_deg, scale,
                radius.tobytes(), profile.tobytes())
-        return _OMISSIONS.get_or_compute(key, lambda: subsurface_omission_error(
+        whole = _OMISSIONS.get_or_compute(key, lambda: subsurface_omission_error(
             scene.footprint_mm, scene.object_size_mm, light_deg, scale * radius,
-            profile / scale**2, share))
+            profile / scale**2))
+        return traits.share("skin_share", light_deg) * whole
 
     return max(at(float(light)) for light in scene.lights_deg)
 

@@ -198,7 +198,7 @@ def microfacet_from_cosines(cos_h: NDArray[np.float64], cos_hi: NDArray[np.float
     - ``ASHIKHMIN_SHIRLEY``: ``(e + 1) / (8 pi) (n.h)^e / ((h.wi) max(cos_i, cos_o))``
       (``bsdf_ashikhmin_shirley_eval``).
     """
-    cos_i, cos_o = np.broadcast_arrays(np.asarray(cos_i, float), np.asarray(cos_o, float))
+    cos_i, cos_o = np.asarray(cos_i, float), np.asarray(cos_o, float)
     upper = (cos_i > 0.0) & (cos_o > 0.0)
     if distribution == "ASHIKHMIN_SHIRLEY":
         e = ashikhmin_shirley_exponent(roughness)
@@ -210,8 +210,12 @@ def microfacet_from_cosines(cos_h: NDArray[np.float64], cos_hi: NDArray[np.float
         raise ValueError(f"distribution must be one of {GLOSSY_DISTRIBUTIONS}, got "
                          f"{distribution!r}")
     alpha = np.square(max(float(roughness), ROUGHNESS_EPS))
-    safe_i = np.where(upper, cos_i, 1.0)
-    safe_o = np.where(upper, cos_o, 1.0)
+    # Each cosine kept at its own shape (a view's Lambda once per view, not per pair); where
+    # the other one is below the surface the value is dropped anyway.
+    safe_i = np.where(upper, cos_i, 1.0) if cos_i.size >= cos_o.size else \
+        np.where(cos_i > 0.0, cos_i, 1.0)
+    safe_o = np.where(upper, cos_o, 1.0) if cos_o.size > cos_i.size else \
+        np.where(cos_o > 0.0, cos_o, 1.0)
     value = (DISTRIBUTIONS[distribution][0](cos_h, alpha)
              * microfacet_shadowing(safe_i, safe_o, alpha, distribution)
              / (4.0 * safe_i * safe_o))
@@ -389,7 +393,9 @@ def _albedo_views(views: NDArray[np.float64], roughness: float, fresnel: OfCosin
 
 
 def layering_albedo(cos_view: ArrayLike, roughness: float, eta: float,
-                    f0: ArrayLike | None = None) -> NDArray[np.float64]:
+                    f0: ArrayLike | None = None, *,
+                    plain: NDArray[np.float64] | None = None,
+                    weighted: NDArray[np.float64] | None = None) -> NDArray[np.float64]:
     """The albedo Cycles attributes to a dielectric GGX layer seen at ``cos_view`` when it
     attenuates the layers below (``bsdf_microfacet_estimate_albedo``): ``mix(f0, 1, s)``.
 
@@ -397,11 +403,14 @@ def layering_albedo(cos_view: ArrayLike, roughness: float, eta: float,
     (its comment: the table "assumes energy preservation"); this replica computes the same
     ratio ``E_F / E_1`` by quadrature (:func:`microfacet_albedo`), with ``E_F`` the albedo under the
     real Fresnel at ``eta``.  ``f0`` (default ``F0(eta)``, RGB allowed) rescales the start as
-    Specular IOR Level and Specular Tint do.
+    Specular IOR Level and Specular Tint do.  ``plain``, ``weighted``: ``E_1`` and ``E_F`` at
+    these views if already computed (:func:`coat_view_terms` has the first, a caller that
+    needs the lobe's own albedo the second).
     """
     views = np.asarray(cos_view, float)
-    e_f = microfacet_albedo(views, roughness, lambda c: dielectric_fresnel(c, eta))
-    e_1 = microfacet_albedo(views, roughness)
+    e_f = (microfacet_albedo(views, roughness, lambda c: dielectric_fresnel(c, eta))
+           if weighted is None else weighted)
+    e_1 = microfacet_albedo(views, roughness) if plain is None else plain
     real0 = f0_from_ior(eta)
     s = np.clip((e_f / np.maximum(e_1, 1e-12) - real0) / (1.0 - real0), 0.0, 1.0)
     start = real0 if f0 is None else np.asarray(f0, float)
@@ -444,15 +453,20 @@ def ggx_energy_scale(albedo: ArrayLike, average_albedo: float, fss: Real
     return scale, scale / (1.0 + missing)
 
 
-def coat_view_terms(cos_view: ArrayLike, roughness: float, ior: float
+def coat_view_terms(cos_view: ArrayLike, roughness: float, ior: float, *,
+                    weighted: NDArray[np.float64] | None = None
                     ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """``(scale, layering albedo)`` of the Principled coat at view cosines ``cos_view``: the
     factor :func:`ggx_energy_compensation` puts on its lobe, and the albedo by which it
     attenuates the layers below, ``darkening * layering_albedo`` (Cycles' ``bsdf_albedo``
-    reads the closure's weight, which holds the darkening)."""
-    scale, darkening = ggx_energy_compensation(cos_view, roughness,
-                                               float(dielectric_fss(ior)))
-    return scale, darkening * layering_albedo(cos_view, roughness, ior)
+    reads the closure's weight, which holds the darkening).  The Fresnel-free albedo both
+    need is computed once; ``weighted``: the lobe's albedo with its Fresnel at these views,
+    if the caller has it (:func:`layering_albedo`)."""
+    plain = microfacet_albedo(np.asarray(cos_view, float), roughness)
+    scale, darkening = ggx_energy_scale(plain, ggx_average_albedo(float(roughness)),
+                                        float(dielectric_fss(ior)))
+    return scale, darkening * layering_albedo(cos_view, roughness, ior, plain=plain,
+                                              weighted=weighted)
 
 
 @lru_cache(maxsize=64)

@@ -108,10 +108,10 @@ def _specular_layer(roughness: float, ior: float, distribution: str) -> tuple[fl
     if distribution == "MULTI_GGX":
         # Specular IOR Level 0.5 and a white tint make the generalised Schlick Fresnel the
         # real one, so its compensation and darkening are the coat's at the same IOR.
-        scale, layered = cc.coat_view_terms(mu, roughness, ior)
+        scale, layered = cc.coat_view_terms(mu, roughness, ior, weighted=lobe)
         lobe = scale * lobe
     else:
-        layered = cc.layering_albedo(mu, roughness, ior)
+        layered = cc.layering_albedo(mu, roughness, ior, weighted=lobe)
     gloss = float(np.sum(weight * 2.0 * mu * lobe))
     passed = float(np.sum(weight * 2.0 * mu * np.clip(1.0 - layered, 0.0, 1.0)))
     return gloss, passed

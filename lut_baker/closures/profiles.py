@@ -7,7 +7,8 @@ straight shadow edge, which is what a render shows of subsurface scattering (doc
 "Subsurface: which Blender method fits the skin").
 
 - :class:`ProfileFit` -- a method's radius and its error.
-- :func:`edge_response` -- a radial profile's response to a straight shadow edge.
+- :func:`edge_response` -- a radial profile's response to a straight shadow edge;
+  :func:`edge_kernel` -- its integral as a matrix, for many profiles on the same radii.
 - :func:`fit_profile`, :func:`fit_profiles` -- one method's radius, or every method's (cached).
 """
 
@@ -25,8 +26,8 @@ from ..tables.table_set import Tables
 from . import cycles as cc
 from .lobes import FIT_XTOL
 
-__all__ = ["ProfileFit", "edge_response", "profile_grid", "fit_profile", "fit_profiles",
-           "REPLICA_EDGE_ERROR"]
+__all__ = ["ProfileFit", "edge_response", "edge_kernel", "profile_grid", "fit_profile",
+           "fit_profiles", "REPLICA_EDGE_ERROR"]
 
 REPLICA_EDGE_ERROR = {"BURLEY": 0.0035, "RANDOM_WALK": 0.0068, "RANDOM_WALK_SKIN": 0.0067}
 """RMS difference (fraction of the lit level) between a rendered edge response and the
@@ -60,10 +61,17 @@ def edge_response(r_mm: ArrayLike, profile: ArrayLike, s_mm: ArrayLike) -> NDArr
     1/mm^2) sampled at ``r_mm``: ``ESF(s) = Int_s^inf P(r) 2 r arccos(s / r) dr`` (0.5 at the
     edge).  What a subsurface profile looks like in a render: the blur of a shadow edge.
     ``profile``: ``(n_r)`` or ``(n_r, C)``; the result ``(n_s)`` or ``(n_s, C)``."""
+    return edge_kernel(r_mm, s_mm) @ np.asarray(profile, float)
+
+
+def edge_kernel(r_mm: ArrayLike, s_mm: ArrayLike) -> NDArray[np.float64]:
+    """:func:`edge_response`'s integral as a matrix ``(n_s, n_r)``: ``2 r arccos(s / r)`` times
+    the trapezoid weights in ``r`` (0 where ``r <= s``), so that a fit trying many profiles on
+    the same radii builds it once."""
     r = np.asarray(r_mm, float)
     s = np.asarray(s_mm, float)[:, None]
     arc = np.where(r > s, 2.0 * np.arccos(np.clip(s / np.maximum(r, 1e-300), -1.0, 1.0)), 0.0)
-    return (arc * (r * trapezoid_weights(r))) @ np.asarray(profile, float)
+    return arc * (r * trapezoid_weights(r))
 
 
 PROFILE_RADII = 600
@@ -87,7 +95,8 @@ def fit_profile(tables: Tables, method: str, *, albedo: ArrayLike | None = None)
     r_max = float(tables.radius_mm[-1])
     r = profile_grid(r_max)
     s = np.linspace(0.0, r_max, 48)
-    reference = edge_response(r, tables.radial(r), s)  # (48, 3)
+    kernel = edge_kernel(r, s)
+    reference = kernel @ np.asarray(tables.radial(r), float)  # (48, 3): edge_response
     radii: list[float] = []
     errors: list[float] = []
     worst: list[float] = []
@@ -102,7 +111,7 @@ def fit_profile(tables: Tables, method: str, *, albedo: ArrayLike | None = None)
 
         def difference(log_radius: float, c: int = c) -> NDArray[np.float64]:
             model = cc.subsurface_profile(r, float(np.exp(log_radius)), colour[c], method)
-            return edge_response(r, model, s) - reference[:, c]
+            return kernel @ np.asarray(model, float) - reference[:, c]
 
         def rms(log_radius: float) -> float:
             return float(np.sqrt(np.mean(np.square(difference(log_radius)))))

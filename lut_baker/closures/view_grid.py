@@ -24,7 +24,7 @@ Functions and types
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import lru_cache
+from functools import cached_property, lru_cache
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -70,6 +70,17 @@ class ViewGrid:
         """``(wi, wo)`` broadcast to ``(V, A, P, 3)``, for the replicas."""
         return self.wi, np.broadcast_to(self.wo, self.wi.shape)
 
+    @cached_property
+    def _radiance_weight(self) -> np.ndarray:
+        """:meth:`error`'s weight, ``weight cos(theta_i)^2`` (once per grid: the fits'
+        searches measure many lobes on one grid)."""
+        return self.weight * np.square(self.cos_i)
+
+    @cached_property
+    def _albedo_weight(self) -> np.ndarray:
+        """:meth:`view_albedo`'s weight, ``light_weight cos(theta_i)`` (once per grid)."""
+        return self.light_weight * self.cos_i
+
     def lobe(self, roughness: float, distribution: str = "GGX") -> np.ndarray:
         """A Glossy lobe without Fresnel (1/sr) at the pairs, ``(V, A, P)``."""
         return cc.microfacet_from_cosines(self.cos_h, self.cos_hi, self.cos_i, self.cos_o,
@@ -79,7 +90,7 @@ class ViewGrid:
         """Relative RMS of the radiance ``f cos(theta_i)``, channels pooled (``f``:
         ``(V, A, P)`` or ``(V, A, P, C)``)."""
         fit, ref = np.asarray(f_fit, float), np.asarray(f_ref, float)
-        weight = self.weight * np.square(self.cos_i)
+        weight = self._radiance_weight
         if ref.ndim == 4 or fit.ndim == 4:
             weight = weight[..., None]
         num = np.sum(weight * np.square(fit - ref))
@@ -89,7 +100,7 @@ class ViewGrid:
     def view_albedo(self, f: ArrayLike) -> NDArray[np.float64]:
         """``Int f cos(theta_i) dw_i`` per view, ``(V,)`` or ``(V, C)``."""
         values = np.asarray(f, float)
-        weight = self.light_weight * self.cos_i
+        weight = self._albedo_weight
         if values.ndim == 4:
             return np.einsum("vapc,vap->vc", values, weight)
         return np.sum(values * weight, axis=(1, 2))
