@@ -31,10 +31,10 @@ own reflection in closed form).  Physical bounds: |g| <= 0.95, 1.01 <= eta <= 2,
 narrower cone is finer than the default grid resolves).  It prints the relative error
 (model/measured - 1) on every incidence and, fitted on alternate incidences, on the others
 (as lut_baker/offline/foundations.py does for eq. 2); then the check that the fit is
-determined by its data: refitted from its optimum to the measurements moved by 1e-9 (relative, random signs), the largest change of a
-parameter to first order (< 1e-6 passes; :func:`data_response`) and whether a parameter sits at
-its bound (then it is not determined either).  About 2-5 minutes per product and form on
-one core at the default grid.
+determined by its data: refitted from its optimum to the measurements moved by 1e-9
+(relative, random signs), the largest change of a parameter to first order (< 1e-6 passes;
+:func:`data_response`) and whether a parameter sits at its bound (then it is not determined
+either).  About 1-6 minutes per product and form on one core at the default grid.
 """
 
 from __future__ import annotations
