@@ -14,17 +14,27 @@ infinitely thick medium with a single-scattering albedo per channel in one of th
 - ``surface``: spheres with one HG lobe under a rough dielectric surface (GGX, index eta,
   roughness alpha; 6 parameters);
 - ``flakes_surface``: the same medium with specular flakes (GGX normals, a fraction of the
-  extinction and a roughness) mixed in, under the surface (8 parameters),
+  extinction and a roughness) mixed in, under the surface (8 parameters);
+- ``cone``: spheres with one HG lobe and specular flakes whose normals lie on a cone
+  (lut_baker.offline.matte_slab.cone_distribution: a Gaussian in the polar angle about the
+  cone angle, uniform in azimuth; Lanza et al. 2024's tilted platelets), no surface (7
+  parameters: albedo RGB, g, flakes, cone, spread);
+- ``cone_flakes``: flakes on a cone alone, no spheres and no surface (5 parameters: albedo
+  RGB, cone, spread);
+- ``cone_tinted``: ``cone`` with the flakes' own albedo RGB (10 parameters), as Lanza et al.
+  give their flakes and their spheres each an albedo;
+- ``cone_slab``: spheres with two HG lobes and the flakes on a cone (9 parameters),
 
 read in the plane of incidence by a bicubic spline over the grid's polar nodes (the surface's
 own reflection in closed form).  Physical bounds: |g| <= 0.95, 1.01 <= eta <= 2, 0.05 <= alpha
-<= 1, 0.2 <= flake alpha <= 1.  It prints the relative error (model/measured - 1) on every
-incidence and, fitted on alternate incidences, on the others (as lut_baker/offline/foundations.py
-does for eq. 2); then the check that the fit is determined by its data: refitted from its
-optimum to the measurements moved by 1e-9 (relative, random signs), the largest change of a
-parameter to first order (< 1e-6 passes; :func:`data_response`) and whether a parameter sits at
-its bound (then it is not determined either).  About 2-5 minutes per product and form on
-one core at the default grid.
+<= 1, 0.2 <= flake alpha <= 1, 0 <= cone <= 90 degrees, 5 <= spread <= 60 degrees (a
+narrower cone is finer than the default grid resolves).  It prints the relative error
+(model/measured - 1) on every incidence and, fitted on alternate incidences, on the others
+(as lut_baker/offline/foundations.py does for eq. 2); then the check that the fit is
+determined by its data: refitted from its optimum to the measurements moved by 1e-9
+(relative, random signs), the largest change of a parameter to first order (< 1e-6 passes;
+:func:`data_response`) and whether a parameter sits at its bound (then it is not determined
+either).  About 1-6 minutes per product and form on one core at the default grid.
 """
 
 from __future__ import annotations
@@ -61,6 +71,11 @@ DETERMINED = 1e-6
 LOG_ETA = (np.log(0.01), np.log(1.0))
 LOG_ALPHA = (np.log(0.05), 0.0)
 LOG_FLAKE_ALPHA = (np.log(0.2), 0.0)
+SPREAD_DEG = (5.0, 60.0)
+"""The cone's spread (degrees): at 5 the default grid departs from one of 8 x 8 nodes and 257
+azimuths by 1.8% at most on the measured geometries (flakes at 67 degrees), and more below."""
+LOG_SPREAD = (np.log(SPREAD_DEG[0]), np.log(SPREAD_DEG[1]))
+LOGIT = (-8.0, 8.0)
 FORMS = {
     "slab": (("g1", "g2", "weight"), ((-4.0, 4.0), (-4.0, 4.0), (-8.0, 8.0)),
              ((-0.3, 1.2, 0.0), (0.5, -0.5, 0.0))),
@@ -70,7 +85,20 @@ FORMS = {
                        ((-4.0, 4.0), (-8.0, 8.0), LOG_FLAKE_ALPHA, LOG_ETA, LOG_ALPHA),
                        ((-0.3, 0.0, np.log(0.4), np.log(0.4), np.log(0.3)),
                         (0.3, 1.0, np.log(0.25), np.log(0.2), np.log(0.6)))),
+    "cone": (("g", "flakes", "cone", "spread"), ((-4.0, 4.0), LOGIT, LOGIT, LOG_SPREAD),
+             ((-0.2, 1.0, 0.3, np.log(20.0)), (0.3, 0.0, -1.0, np.log(30.0)))),
+    "cone_flakes": (("cone", "spread"), (LOGIT, LOG_SPREAD),
+                    ((0.3, np.log(20.0)), (-1.0, np.log(30.0)))),
+    "cone_tinted": (("g", "flakes", "cone", "spread", "flake_r", "flake_g", "flake_b"),
+                    ((-4.0, 4.0), LOGIT, LOGIT, LOG_SPREAD) + ((-12.0, 12.0),) * 3,
+                    ((-0.2, 1.0, 0.3, np.log(20.0), 3.0, 2.0, 1.0),
+                     (0.3, 0.0, -1.0, np.log(30.0), 3.0, 2.0, 1.0))),
+    "cone_slab": (("g1", "g2", "weight", "flakes", "cone", "spread"),
+                  ((-4.0, 4.0), (-4.0, 4.0), LOGIT, LOGIT, LOGIT, LOG_SPREAD),
+                  ((-0.3, 1.2, 0.0, 1.0, 0.3, np.log(20.0)),
+                   (0.5, -0.5, 0.0, 0.0, -1.0, np.log(30.0)))),
 }
+CONE_FORMS = ("cone", "cone_flakes", "cone_tinted", "cone_slab")
 
 
 def _sigmoid(x):
@@ -79,22 +107,36 @@ def _sigmoid(x):
 
 def unpack(form: str, p) -> MatteSlab:
     """The model of the fitted coordinates ``p`` (albedos as logits, g as ``0.95 tanh``,
-    weights as logits, eta - 1 and roughnesses as logarithms)."""
+    weights as logits, the cone angle as ``90`` times a logistic, eta - 1, roughnesses and the
+    cone's spread as logarithms)."""
     kw: dict = {"albedo": _sigmoid(p[:3])}
-    if form == "slab":
+    if form in ("slab", "cone_slab"):
         kw.update(g1=G_MAX * np.tanh(p[3]), g2=G_MAX * np.tanh(p[4]), weight=_sigmoid(p[5]))
-    else:
-        kw.update(g1=G_MAX * np.tanh(p[3]), eta=1.0 + np.exp(p[-2]), alpha=np.exp(p[-1]))
+    elif form != "cone_flakes":
+        kw.update(g1=G_MAX * np.tanh(p[3]))
+    if form in ("surface", "flakes_surface"):
+        kw.update(eta=1.0 + np.exp(p[-2]), alpha=np.exp(p[-1]))
     if form == "flakes_surface":
         kw.update(flakes=_sigmoid(p[4]), flake_alpha=np.exp(p[5]))
+    if form == "cone_flakes":
+        kw.update(flakes=1.0, cone_deg=90.0 * _sigmoid(p[3]), cone_spread_deg=np.exp(p[4]))
+    elif form in CONE_FORMS:
+        first = 6 if form == "cone_slab" else 4
+        kw.update(flakes=_sigmoid(p[first]), cone_deg=90.0 * _sigmoid(p[first + 1]),
+                  cone_spread_deg=np.exp(p[first + 2]))
+    if form == "cone_tinted":
+        kw.update(flake_albedo=_sigmoid(p[7:10]))
     return MatteSlab(**kw)
 
 
 def physical(form: str, p) -> np.ndarray:
     """The fitted model's parameters as numbers (albedo RGB, then the form's own)."""
     m = unpack(form, p)
+    tint = m.flake_albedo if m.flake_albedo is not None else np.full(3, np.nan)
     values = {"g1": m.g1, "g2": m.g2, "weight": m.weight, "g": m.g1, "eta": m.eta,
-              "alpha": m.alpha, "flakes": m.flakes, "flake_alpha": m.flake_alpha}
+              "alpha": m.alpha, "flakes": m.flakes, "flake_alpha": m.flake_alpha,
+              "cone": m.cone_deg, "spread": m.cone_spread_deg, "flake_r": tint[0],
+              "flake_g": tint[1], "flake_b": tint[2]}
     return np.array([*m.albedo, *(values[k] for k in FORMS[form][0])])
 
 

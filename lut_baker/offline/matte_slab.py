@@ -35,13 +35,19 @@ Functions
 - :func:`refracted_grid` -- the inside polar nodes and weights.
 - :func:`henyey_greenstein` -- the Henyey-Greenstein phase function (1/sr).
 - :func:`phase_orders` -- a two-lobe HG phase function's cosine coefficients between nodes.
+- :func:`transport_generator` -- a medium's slab generator (its transport matrices).
 - :func:`thick_medium` -- the infinitely thick medium's reflection (star form).
 - :func:`under_surface` -- the medium's reflection seen through the surface (star form, outside
   grid).
 - :func:`flake_extinction`, :func:`flake_orders` -- specular flakes (platelets) with GGX
   normals: their projected area and scattering kernel.
+- :func:`cone_distribution` -- flake normals on a cone about the vertical (a Gaussian in the
+  polar angle, Lanza et al. 2024's tilted platelets made azimuthally isotropic).
+- :func:`projected_area` -- any such distribution's projected area (azimuth in closed form).
+- :func:`kernel_orders` -- any such distribution's specular kernel ``D(h) / 4`` per order.
 - :class:`MatteSlab` -- the parameters.
-- :func:`medium_reflection` -- the thick medium of spheres and flakes.
+- :func:`medium_generator`, :func:`medium_reflection` -- the medium of spheres and flakes:
+  its generator (any thickness) and its thick limit.
 - :func:`matte_slab_kernel` -- the model on one grid: parameters to the reflection kernel per
   channel and order.
 """
@@ -66,15 +72,23 @@ __all__ = [
     "phase_orders",
     "flake_extinction",
     "flake_orders",
+    "cone_distribution",
+    "projected_area",
+    "kernel_orders",
+    "transport_generator",
     "thick_medium",
     "under_surface",
     "MatteSlab",
+    "medium_generator",
     "medium_reflection",
     "matte_slab_kernel",
 ]
 
 ALBEDO_POINTS = 48
 """Gauss-Legendre points per axis of :func:`ggx_albedo`'s half-vector quadrature."""
+CONE_POINTS = 256
+"""Gauss-Legendre points in the normal's polar angle of :func:`cone_distribution`'s
+normalisation and of :func:`projected_area`."""
 
 
 def ggx_distribution(cos_h, alpha):
@@ -192,11 +206,20 @@ def flake_extinction(mu, alpha):
 
 def flake_orders(grid: HemisphereGrid, alpha: float):
     """``(forward, back)``: cosine coefficients per order ``(orders, N, N)`` (1/sr per unit
-    flake density) of the scattering kernel of specular two-sided flakes, ``D(h) / 4`` with
-    ``h`` the flake normal that reflects one direction into the other (Heitz et al. 2015, eq. 9:
-    ``sigma(w) p(w -> w') = D(h) / 4``, symmetric), between two downgoing nodes (straight on at
-    relative azimuth 0) and between a downgoing and an upgoing one; it integrates to
-    :func:`flake_extinction` over the sphere."""
+    flake density) of the scattering kernel of specular two-sided flakes with GGX normals of
+    roughness ``alpha`` about the vertical (:func:`kernel_orders` of :func:`ggx_distribution`);
+    it integrates to :func:`flake_extinction` over the sphere."""
+    return kernel_orders(grid, lambda cos_h: ggx_distribution(cos_h, alpha))
+
+
+def kernel_orders(grid: HemisphereGrid, distribution):
+    """``(forward, back)``: cosine coefficients per order ``(orders, N, N)`` (1/sr per unit
+    flake density) of the scattering kernel of specular two-sided flakes whose normals follow
+    ``distribution`` (a function of the normal's ``|cos|`` with the vertical, 1/sr, normalised
+    as GGX is: ``Int_H D cos dm = 1``), ``D(h) / 4`` with ``h`` the flake normal that reflects
+    one direction into the other (Heitz et al. 2015, eq. 9: ``sigma(w) p(w -> w') = D(h) / 4``,
+    symmetric), between two downgoing nodes (straight on at relative azimuth 0) and between a
+    downgoing and an upgoing one; it integrates to :func:`projected_area` over the sphere."""
     mu = np.cos(grid.theta)
     sin = np.sin(grid.theta)
     dot = (mu[:, None, None] * mu[None, :, None]
@@ -209,7 +232,7 @@ def flake_orders(grid: HemisphereGrid, alpha: float):
                        / np.sqrt(np.maximum(gap, 1e-300)), 0.0)
 
     def orders(cos_h):
-        values = 0.25 * ggx_distribution(np.clip(cos_h, 0.0, 1.0), alpha)
+        values = 0.25 * distribution(np.clip(cos_h, 0.0, 1.0))
         spectrum = np.fft.rfft(values, axis=-1).real / grid.n_phi
         spectrum[..., 1:] *= 2.0
         return np.moveaxis(spectrum, -1, 0)
@@ -217,13 +240,64 @@ def flake_orders(grid: HemisphereGrid, alpha: float):
     return orders(forward), orders(back)
 
 
-def thick_medium(grid: HemisphereGrid, albedo, forward, back, extinction=None) -> np.ndarray:
-    """Reflection (star form on ``grid``, ``(C, orders, N, N)``) of an infinitely thick medium of
-    single-scattering albedo ``albedo`` ``(C,)``, extinction ``extinction`` per node (relative,
-    default 1: isotropic) and scattering coefficients ``forward``, ``back`` per unit of it
-    (:func:`phase_orders`, :func:`flake_orders`): its transport matrices, loss ``e / mu - a
-    p_forward`` and back-scattering ``a p_back`` in the star form, and the slab's
-    infinite-thickness limit (:func:`~lut_baker.numerics.adding_doubling.thick_slab`)."""
+def _cone_weight(theta, cone, spread):
+    """Unnormalised density (per solid angle) of flake normals at polar angle ``theta``
+    (radians, in [0, pi/2]): the Gaussian ``exp(-(theta - cone)^2 / (2 spread^2))`` wrapped
+    modulo pi and mirrored about the pole, so that it is even about the pole and about the
+    horizon (a flake's axis at ``theta`` and at ``pi - theta`` is the same flake)."""
+    theta = np.asarray(theta, float)
+    total = np.zeros_like(theta)
+    for k in range(-2, 3):
+        for centre in (cone, -cone):
+            total = total + np.exp(-0.5 * ((theta - centre + np.pi * k) / spread) ** 2)
+    return total
+
+
+def cone_distribution(cos_h, cone_deg: float, spread_deg: float, points: int = CONE_POINTS):
+    """Flake normals on a cone about the vertical, 1/sr, at the normal's ``|cos|``
+    ``cos_h``: density per solid angle ``exp(-(theta - cone)^2 / (2 spread^2))`` in the
+    normal's polar angle ``theta`` (wrapped and mirrored, :func:`_cone_weight`), uniform in
+    azimuth, normalised as :func:`ggx_distribution` is (``Int_H D cos dm = 1``: the flakes'
+    projected area seen from straight above is 1).  Lanza et al. 2024 (their pbrt-v4 plugin,
+    ``media.h``, ``SGGXPhaseFunctionMixedRefl::SampleMicroflakeOrientation``) tilt each flake
+    by a Gaussian angle (``means_or``, ``stds_or``, degrees) about one fixed horizontal axis;
+    here the tilt's azimuth is uniform (a film has no preferred direction), and the spread is
+    the whole of the normals' spread (their flakes add an SGGX roughness of their own)."""
+    cone = np.radians(cone_deg)
+    spread = np.radians(spread_deg)
+    theta, weight = gauss_legendre(points, 0.0, 0.5 * np.pi)
+    norm = 2.0 * np.pi * np.sum(weight * _cone_weight(theta, cone, spread)
+                                * np.cos(theta) * np.sin(theta))
+    polar = np.arccos(np.clip(np.abs(np.asarray(cos_h, float)), 0.0, 1.0))
+    return _cone_weight(polar, cone, spread) / norm
+
+
+def projected_area(mu, distribution, points: int = CONE_POINTS):
+    """Projected area ``Int_H |w.m| D(m) dm`` of two-sided flakes whose normals follow the
+    azimuthally uniform ``distribution`` (a function of the normal's cosine, 1/sr, normalised
+    as :func:`kernel_orders` takes it) seen along directions at cosines ``mu``: Gauss-Legendre
+    in the normal's polar angle, the azimuth in closed form (``Int_0^2pi |a + b cos phi| dphi
+    = 2 pi a - 4 a (pi - phi_0) + 4 b sin phi_0``, ``cos phi_0 = -a / b``, for ``0 <= a < b``;
+    ``2 pi a`` for ``a >= b``).  For GGX it is :func:`flake_extinction`."""
+    mu = np.asarray(mu, float)[..., None]
+    theta, weight = gauss_legendre(points, 0.0, 0.5 * np.pi)
+    a = mu * np.cos(theta)
+    b = np.sqrt(np.maximum(1.0 - mu * mu, 0.0)) * np.sin(theta)
+    ratio = np.where(b > a, a / np.maximum(b, 1e-300), 1.0)
+    phi0 = np.arccos(-ratio)
+    ring = (2.0 * np.pi * a - 4.0 * a * (np.pi - phi0)
+            + 4.0 * b * np.sqrt(np.maximum(1.0 - ratio * ratio, 0.0)))
+    return np.sum(weight * np.sin(theta) * distribution(np.cos(theta)) * ring, axis=-1)
+
+
+def transport_generator(grid: HemisphereGrid, albedo, forward, back, extinction=None):
+    """The slab generator (:func:`~lut_baker.numerics.adding_doubling.generator_from_matrices`,
+    thickness in units of the spheres' extinction) of a medium of single-scattering albedo
+    ``albedo`` ``(C,)``, extinction ``extinction`` per node (relative, default 1: isotropic)
+    and scattering coefficients ``forward``, ``back`` per unit of it (:func:`phase_orders`,
+    :func:`flake_orders`; ``(orders, N, N)``, or per channel with the albedo in them and
+    ``albedo`` ones): its transport matrices, loss ``e / mu - a p_forward`` and
+    back-scattering ``a p_back`` in the star form."""
     mu = np.cos(grid.theta)
     e = np.ones(mu.size) if extinction is None else np.asarray(extinction, float)
     s = AD.star_scale(grid)
@@ -231,8 +305,14 @@ def thick_medium(grid: HemisphereGrid, albedo, forward, back, extinction=None) -
     single = np.asarray(albedo, float)[:, None, None, None]
     loss = np.diag(e / mu) - single * forward * k
     scatter = single * back * k
-    generator = AD.generator_from_matrices(0.5 * (loss + scatter), 0.5 * (loss - scatter))
-    return AD.thick_slab(generator)
+    return AD.generator_from_matrices(0.5 * (loss + scatter), 0.5 * (loss - scatter))
+
+
+def thick_medium(grid: HemisphereGrid, albedo, forward, back, extinction=None) -> np.ndarray:
+    """Reflection (star form on ``grid``, ``(C, orders, N, N)``) of the infinitely thick medium
+    of :func:`transport_generator` (the slab's limit,
+    :func:`~lut_baker.numerics.adding_doubling.thick_slab`)."""
+    return AD.thick_slab(transport_generator(grid, albedo, forward, back, extinction))
 
 
 def under_surface(body: np.ndarray, surface_albedo: np.ndarray) -> np.ndarray:
@@ -257,8 +337,10 @@ class MatteSlab:
     """The model's parameters: ``albedo`` (single scattering, RGB, shared by the two kinds of
     particle), the spheres' phase function ``g1``, ``g2`` and the weight of ``g1``
     (``weight``), the fraction of the extinction seen from above that is due to flakes
-    (``flakes``) and their GGX roughness (``flake_alpha``), the surface's index ``eta`` (1: no
-    surface) and GGX roughness ``alpha``."""
+    (``flakes``) and their GGX roughness (``flake_alpha``) or, if ``cone_spread_deg > 0``,
+    their normals on a cone (:func:`cone_distribution`: ``cone_deg`` from the vertical, spread
+    ``cone_spread_deg``), the flakes' own single-scattering albedo (``flake_albedo``; None:
+    ``albedo``), the surface's index ``eta`` (1: no surface) and GGX roughness ``alpha``."""
 
     albedo: np.ndarray
     g1: float = 0.0
@@ -266,23 +348,51 @@ class MatteSlab:
     weight: float = 1.0
     flakes: float = 0.0
     flake_alpha: float = 0.5
+    cone_deg: float = 0.0
+    cone_spread_deg: float = 0.0
+    flake_albedo: np.ndarray | None = None
     eta: float = 1.0
     alpha: float = 0.3
 
 
-def medium_reflection(grid: HemisphereGrid, model: MatteSlab) -> np.ndarray:
-    """The thick medium's reflection (star form on ``grid``): spheres (two-lobe HG, extinction
-    the same every way) and flakes (:func:`flake_orders`, :func:`flake_extinction`) mixed, the
-    flakes ``model.flakes`` of the extinction seen from above."""
+def medium_generator(grid: HemisphereGrid, model: MatteSlab):
+    """The medium's slab generator (:func:`transport_generator`): spheres (two-lobe HG,
+    extinction the same every way) and flakes (GGX or on a cone: :func:`kernel_orders`,
+    :func:`projected_area`) mixed, the flakes ``model.flakes`` of the extinction seen from
+    above, each kind with its single-scattering albedo."""
     forward, back = phase_orders(grid, model.g1, model.g2, model.weight)
     f = float(model.flakes)
     extinction = np.ones(grid.theta.size)
+    albedo = np.asarray(model.albedo, float)
     if f > 0.0:
-        flake_forward, flake_back = flake_orders(grid, model.flake_alpha)
-        forward = (1.0 - f) * forward + f * flake_forward
-        back = (1.0 - f) * back + f * flake_back
-        extinction = (1.0 - f) + f * flake_extinction(np.cos(grid.theta), model.flake_alpha)
-    return thick_medium(grid, model.albedo, forward, back, extinction)
+        mu = np.cos(grid.theta)
+        if model.cone_spread_deg > 0.0:
+            def distribution(cos_h):
+                return cone_distribution(cos_h, model.cone_deg, model.cone_spread_deg)
+
+            flake_forward, flake_back = kernel_orders(grid, distribution)
+            flake_area = projected_area(mu, distribution)
+        else:
+            flake_forward, flake_back = flake_orders(grid, model.flake_alpha)
+            flake_area = flake_extinction(mu, model.flake_alpha)
+        extinction = (1.0 - f) + f * flake_area
+        if model.flake_albedo is None:
+            forward = (1.0 - f) * forward + f * flake_forward
+            back = (1.0 - f) * back + f * flake_back
+        else:
+            # Each kind scatters with its own albedo: the albedo goes into the kernels.
+            spheres = albedo[:, None, None, None] * (1.0 - f)
+            flakes = np.asarray(model.flake_albedo, float)[:, None, None, None] * f
+            forward = spheres * forward + flakes * flake_forward
+            back = spheres * back + flakes * flake_back
+            albedo = np.ones(albedo.size)
+    return transport_generator(grid, albedo, forward, back, extinction)
+
+
+def medium_reflection(grid: HemisphereGrid, model: MatteSlab) -> np.ndarray:
+    """The thick medium's reflection (star form on ``grid``): :func:`medium_generator`'s
+    infinite-thickness limit."""
+    return AD.thick_slab(medium_generator(grid, model))
 
 
 def matte_slab_kernel(grid: HemisphereGrid, model: MatteSlab, tir_points: int = 8):
