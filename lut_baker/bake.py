@@ -603,7 +603,8 @@ def bake_slab(skin: MadeUpSkin, resolution_name: str | Resolution = "default", *
     for h in axis:
         x = np.inf if np.isinf(h) else relative_thickness(h)
         parts = slab_skin_parts(film, x, skin.skin_reflection, face)
-        body_gloss.append(np.broadcast_to(body_gloss_weight(film, x, face, lobe), (3,)))
+        body_gloss.append(np.broadcast_to(
+            body_gloss_weight(film, x, face, lobe, film_top=parts.film_top), (3,)))
         kernel = from_star(parts.top, scale)  # (C, M, N, N) 1/sr
         on_table = np.moveaxis(lagrange @ kernel @ lagrange.T, 0, -1)  # (M, I, I, C)
         top.append(np.asarray(_cosine_series(on_table, pairs)))

@@ -118,13 +118,16 @@ class SlabSkinParts(NamedTuple):
     ``below`` ``(C,)``: ``c``.  ``face`` ``(C, N)``: the surface's gloss albedo ``a_g``.
     ``film`` ``(C, N)``: the film's own directional albedo from above (its body through its
     surface, the surface's gloss left out): the part of ``top``'s albedo that is not the skin's
-    gloss (the tiers' film body, docs/model.md "The tiers at a thickness")."""
+    gloss (the tiers' film body, docs/model.md "The tiers at a thickness").  ``film_top``
+    ``(C, orders, N, N)``: the film's own reflection from above, star form (what
+    :func:`body_gloss_weight` weighs)."""
 
     top: NDArray[np.float64]
     through: NDArray[np.float64]
     below: NDArray[np.float64]
     face: NDArray[np.float64]
     film: NDArray[np.float64] | None = None
+    film_top: NDArray[np.float64] | None = None
 
 
 def _film_layer(film: FilmSlab, thickness: float, face: NDArray[np.float64]) -> Layer:
@@ -162,17 +165,22 @@ def slab_skin_parts(film: FilmSlab, thickness: float, skin: ReflectionLayer,
     film_albedo = np.broadcast_to(star_albedo(layer.top[:, 0], s0), (channels, u.size))
     return SlabSkinParts(top=top, through=np.sqrt(np.pi) * v / s0, below=below,
                          face=np.broadcast_to(face_a, (channels, face_a.shape[-1])),
-                         film=film_albedo)
+                         film=film_albedo, film_top=layer.top)
 
 
 def body_gloss_weight(film: FilmSlab, thickness: float, face: ArrayLike,
-                      lobe: NDArray[np.float64]) -> NDArray[np.float64]:
+                      lobe: NDArray[np.float64], *,
+                      film_top: NDArray[np.float64] | None = None) -> NDArray[np.float64]:
     """``(C,)``: the weight ``w`` of eq. 2's gloss lobe ``lobe`` (star form, ``(C', orders, N,
     N)``, its whole ``P_s``) in the film's own reflection at ``thickness`` (its body through its
     surface ``face``), least squares over the Fourier orders above 0, where a Lambertian body
     has nothing: the body's share of the measured gloss, about ``1 - k`` at the paper's
-    thickness without absorption and fading with it as the film thins."""
-    top = _film_layer(film, float(thickness), np.asarray(face, float)).top[:, 1:]
+    thickness without absorption and fading with it as the film thins.  ``film_top``: that
+    reflection if already computed (:attr:`SlabSkinParts.film_top` of the same film, thickness
+    and face), else computed here."""
+    if film_top is None:
+        film_top = _film_layer(film, float(thickness), np.asarray(face, float)).top
+    top = film_top[:, 1:]
     shape = lobe[:, 1:top.shape[1] + 1]
     return (np.einsum("cmij,cmij->c", top, np.broadcast_to(shape, top.shape))
             / np.maximum(np.einsum("cmij,cmij->c", shape, shape), 1e-300))
