@@ -11,6 +11,9 @@ bench/apply.py, bench/tier_accuracy.py).
 - :func:`write_figures` -- a benchmark's results as JSON (``--json FILE``).
 - :class:`Memory` -- the memory a step adds: its peak resident set (VmHWM, reset before it)
   and what it keeps, in :data:`MB`.
+- :class:`Clock`, :func:`timed` -- CPU and wall seconds of a stretch, of a call;
+  :func:`swapped_in` -- a rebuild on the add-on's worker thread polled until its group is
+  swapped in, as the add-on's timers would (each main-thread step timed).
 """
 
 from __future__ import annotations
@@ -21,13 +24,15 @@ import json
 import os
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 OWN_ROOT = Path(__file__).resolve().parents[1]
 OWN_TESTS = OWN_ROOT / "tests"
 
 __all__ = ["OWN_ROOT", "OWN_TESTS", "MB", "use_checkout", "commit", "packages_commit",
-           "addon_attribute", "machine_load", "write_figures", "Memory"]
+           "addon_attribute", "machine_load", "write_figures", "Memory", "Clock", "timed",
+           "swapped_in", "POLL_S"]
 
 MB = 1e6
 
@@ -156,3 +161,58 @@ class Memory:
     @property
     def kept_mb(self) -> float:
         return (self.after - self.before) / MB
+
+
+POLL_S = 0.05
+"""Seconds between two looks at a rebuild in flight (the add-on's poll timer's)."""
+
+
+class Clock:
+    """CPU (every thread) and wall seconds of a stretch, and the main thread's CPU."""
+
+    def __enter__(self):
+        self.cpu, self.wall, self.main = time.process_time(), time.perf_counter(), \
+            time.thread_time()
+        return self
+
+    def __exit__(self, *exc):
+        self.cpu = time.process_time() - self.cpu
+        self.wall = time.perf_counter() - self.wall
+        self.main = time.thread_time() - self.main
+        return False
+
+
+def timed(function, *args, **kwargs) -> tuple[float, object]:
+    """``(wall seconds, result)`` of ``function(*args, **kwargs)``."""
+    start = time.perf_counter()
+    result = function(*args, **kwargs)
+    return time.perf_counter() - start, result
+
+
+def swapped_in(bpy, live, name: str, start, poll_s: float = POLL_S, watch=None) -> dict:
+    """Set a worker off with ``start()`` (or nothing: ``lambda: None`` when it is already off)
+    and poll it until material ``name``'s group is swapped in (and any rebuild a swap sets
+    off after it), as the add-on's timers would: each main-thread step's wall seconds, the
+    worker's CPU and wall; with ``watch`` (a function of nothing), the wall seconds at which
+    its value changed, and the values (``changes``: when a preview showed, when its
+    refinement did)."""
+    seen = watch() if watch is not None else None
+    changes = []
+    with Clock() as clock:
+        start_s, _ = timed(start)
+        polls = []
+        while name in live.in_flight():
+            time.sleep(poll_s)
+            seconds, messages = timed(live.poll, bpy.context)
+            polls.append(seconds)
+            if messages:
+                raise SystemExit(f"bench: {messages}")
+            if watch is not None and (now := watch()) != seen:
+                seen = now
+                changes.append((time.perf_counter() - clock.wall, now))
+    swap = polls[-1] if polls else 0.0
+    waits = polls[:-1]
+    return {"start_s": start_s, "poll_max_s": max(waits, default=0.0), "polls": len(polls),
+            "swap_s": swap, "worker_wall_s": clock.wall, "worker_cpu_s": clock.cpu - clock.main,
+            "main_cpu_s": clock.main, "worst_block_s": max([start_s, swap, *waits]),
+            "changes": changes}

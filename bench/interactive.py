@@ -33,7 +33,7 @@ preview_first=True)`` then ``live.refine``): the bake and fit at preview resolut
 settings' resolution on a worker thread.  For ``preview``: Apply's CPU (``time.process_time``:
 every thread) and wall seconds, and the refine's: the worker's wall and CPU seconds (process
 CPU minus the main thread's, ``time.thread_time``) and every main-thread step (``start``:
-setting the worker off; ``poll``: each look at it, every :data:`POLL_S` s as the poll timer
+setting the worker off; ``poll``: each look at it, every ``checkout.POLL_S`` s as the poll timer
 does; ``swap``: the look that builds the group and installs it), the longest being the worst
 block.
 
@@ -63,13 +63,15 @@ import statistics
 import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 from checkout import (  # bench/checkout.py
+    Clock,
     addon_attribute,
     commit,
     machine_load,
+    swapped_in,
+    timed,
     use_checkout,
     write_figures,
 )
@@ -77,7 +79,6 @@ from checkout import (  # bench/checkout.py
 HERE = Path(__file__).resolve()
 KINDS = ("principled", "in_group", "two_principled", "mix_glossy", "dark_value", "pale_value")
 ROUGHNESS_ENDS = ("film_min", "film_max", "skin_min", "skin_max")
-POLL_S = 0.05
 """Seconds between two polls (the add-on's poll timer's interval)."""
 SLOWER = 3.0
 """How much slower the machine of the ``x3`` figures is."""
@@ -151,46 +152,6 @@ def _scene(bpy, artist_skins, sphere_scene, case: str):
     return obj
 
 
-class _Clock:
-    """CPU (every thread) and wall seconds of a stretch, and the main thread's CPU."""
-
-    def __enter__(self):
-        self.cpu, self.wall, self.main = time.process_time(), time.perf_counter(), \
-            time.thread_time()
-        return self
-
-    def __exit__(self, *exc):
-        self.cpu = time.process_time() - self.cpu
-        self.wall = time.perf_counter() - self.wall
-        self.main = time.thread_time() - self.main
-        return False
-
-
-def _timed(function, *args, **kwargs) -> tuple[float, object]:
-    start = time.perf_counter()
-    result = function(*args, **kwargs)
-    return time.perf_counter() - start, result
-
-
-def _background(bpy, live, name: str, start) -> dict:
-    """Set a worker off with ``start()`` and poll it until its group is swapped in, as the
-    add-on's timers would: each main-thread step's wall seconds, the worker's CPU and wall."""
-    with _Clock() as clock:
-        start_s, _ = _timed(start)
-        polls = []
-        while name in live.in_flight():
-            time.sleep(POLL_S)
-            seconds, messages = _timed(live.poll, bpy.context)
-            polls.append(seconds)
-            if messages:
-                raise SystemExit(f"interactive: {messages}")
-    swap = polls[-1] if polls else 0.0
-    waits = polls[:-1]
-    return {"start_s": start_s, "poll_max_s": max(waits, default=0.0), "polls": len(polls),
-            "swap_s": swap, "worker_wall_s": clock.wall, "worker_cpu_s": clock.cpu - clock.main,
-            "main_cpu_s": clock.main, "worst_block_s": max([start_s, swap, *waits])}
-
-
 def first_apply(bpy, support, case: str, mode: str) -> dict:
     """One case's first Apply in this (fresh) process, ``full`` or ``preview``."""
     from makeup_skin_addon import live
@@ -202,14 +163,14 @@ def first_apply(bpy, support, case: str, mode: str) -> dict:
     if mode == "preview":
         if not hasattr(live, "refine"):
             return {**out, "unavailable": "no worker thread in this checkout"}
-        with _Clock() as clock:
+        with Clock() as clock:
             material, report = apply_to_object(bpy.context, obj, preview_first=True)
         out.update(apply_cpu_s=clock.cpu, apply_wall_s=clock.wall, refined=report.refine)
         if report.refine is not None:
-            out["refine"] = _background(bpy, live, material.name, lambda: live.refine(
+            out["refine"] = swapped_in(bpy, live, material.name, lambda: live.refine(
                 bpy.context, material, report.refine))
     else:
-        with _Clock() as clock:
+        with Clock() as clock:
             material, _ = apply_to_object(bpy.context, obj)
         out.update(apply_cpu_s=clock.cpu, apply_wall_s=clock.wall)
     meta = json.loads(group_of(material).node_tree["makeup_skin_fit"])
@@ -236,17 +197,17 @@ def live_changes(bpy, material) -> list[dict]:
                                                               for end in ROUGHNESS_ENDS]
     out = []
     for name, value in changes:
-        with _Clock() as clock:
-            update_s, _ = _timed(setattr, settings, name, value)
+        with Clock() as clock:
+            update_s, _ = timed(setattr, settings, name, value)
         row = {"change": f"{name}={value}", "update_s": update_s, "update_cpu_s": clock.cpu}
         if hasattr(live, "start"):
-            row.update(_background(bpy, live, material.name, lambda: live.start(bpy.context)))
+            row.update(swapped_in(bpy, live, material.name, lambda: live.start(bpy.context)))
             row["worst_block_s"] = max(row["worst_block_s"], update_s)
             if material.name in live.pending():  # a rebuild that measures follows the swap
-                then = _background(bpy, live, material.name, lambda: live.start(bpy.context))
+                then = swapped_in(bpy, live, material.name, lambda: live.start(bpy.context))
                 row["then"] = then
         else:  # the old add-on's debounce timer ran the whole rebuild on the main thread
-            with _Clock() as clock:
+            with Clock() as clock:
                 live.flush(bpy.context)
             row.update(flush_s=clock.wall, flush_cpu_s=clock.cpu,
                        worst_block_s=max(clock.wall, update_s))

@@ -20,6 +20,8 @@ Apply (:func:`apply_to_object`) takes these steps, each a call into the module t
 
 - :func:`apply_to_object` -- the Apply operator's work; :class:`Report` its sentences.
 - :func:`revert_material` -- Revert's.
+- :func:`preview_first` -- whether a rebuild goes at preview resolution first (no group of
+  the settings' bake yet).
 - :func:`engine_note` -- the report's sentence when a tier is not made for the scene's engine.
 - :func:`refuse_linked` -- :class:`LinkedDataError` for data linked from a library.
 - :func:`check_material` -- verify a made-up material against its bake record, repair it
@@ -58,6 +60,7 @@ __all__ = [
     "refuse_linked",
     "Report",
     "apply_to_object",
+    "preview_first",
     "engine_note",
     "revert_material",
     "check_material",
@@ -155,15 +158,33 @@ def _first_match(context: Any, material: Any, reading: Any, resolution: str,
     report += result.sentences
 
 
+def _record(settings: Any, resolution: str) -> dict:
+    """The settings' bake record at ``resolution`` (:func:`.bakes.bake_record`)."""
+    return bakes.bake_record(skin_model.skin_from_settings(settings), resolution,
+                             skin_model.film_of(settings), skin_model.skin_under_of(settings),
+                             skin_model.skin_albedo_of(settings))
+
+
+def _has_group(settings: Any, record: dict, over: bool) -> bool:
+    return groups.has_group(record, tier_choice.forced_method(settings), over)
+
+
+def preview_first(material: Any) -> bool:
+    """Whether a rebuild of ``material``'s settings goes at preview resolution first: the
+    settings' resolution is finer and the file has no group of that bake yet (one it has is
+    swapped in at once)."""
+    settings = material.makeup_skin
+    over = settings.over_shader and convert.artist_tree(material) is not None
+    return (settings.resolution != PREVIEW
+            and not _has_group(settings, _record(settings, settings.resolution), over))
+
+
 def _bake_record(settings: Any, target: str, quick: bool, over: bool, report: Report) -> dict:
     """The settings' bake record at ``target``, or (``quick``, and the file has no group of
     that bake) at preview resolution, the refinement to ``target`` noted in ``report``."""
-    skin = skin_model.skin_from_settings(settings)
-    film, under = skin_model.film_of(settings), skin_model.skin_under_of(settings)
-    albedo = skin_model.skin_albedo_of(settings)
-    record = bakes.bake_record(skin, target, film, under, albedo)
-    if quick and not groups.has_group(record, tier_choice.forced_method(settings), over):
-        record = bakes.bake_record(skin, PREVIEW, film, under, albedo)
+    record = _record(settings, target)
+    if quick and not _has_group(settings, record, over):
+        record = _record(settings, PREVIEW)
         report.refine = target
         report.append(f"Baked at preview resolution first: the {target} tables follow in "
                       f"the background.")

@@ -67,6 +67,9 @@ _dirty: dict[str, str] = {}
 """Materials marked for a rebuild, by name: the resolution to rebuild at."""
 _unmeasured: set[str] = set()
 """Marked materials whose rebuild measures nothing (a Thickness move), by name."""
+_then: dict[str, str] = {}
+"""Materials whose rebuild in flight is refined once swapped in, by name: the resolution to
+rebuild at then (:func:`refine`'s ``then``)."""
 _jobs: dict[str, _Job] = {}
 """The rebuild in flight of each material, by name."""
 _stopped: list[_Job] = []
@@ -144,6 +147,7 @@ def tables_changed(settings, debounce_s: float = DEBOUNCE_S, *,
     if material is None or not settings.is_made_up or not settings.live_update:
         return
     _supersede(material.name)
+    _then.pop(material.name, None)
     _mark(material.name, PREVIEW, measure_later, debounce_s)
 
 
@@ -183,6 +187,7 @@ def cancel(material) -> None:
     """Drop what is pending for ``material`` (an Apply or a Revert makes it stale)."""
     _dirty.pop(material.name, None)
     _unmeasured.discard(material.name)
+    _then.pop(material.name, None)
     _supersede(material.name)
 
 
@@ -190,6 +195,7 @@ def forget() -> None:
     """Drop everything pending (another file was opened: its materials are not these)."""
     _dirty.clear()
     _unmeasured.clear()
+    _then.clear()
     for name in list(_jobs):
         _supersede(name)
 
@@ -241,12 +247,17 @@ def start(context=None) -> list[str]:
     return messages
 
 
-def refine(context, material, resolution: str) -> None:
+def refine(context, material, resolution: str, *, then: str | None = None) -> None:
     """Set off the rebuild of ``material``'s group at ``resolution`` now (after an Apply at
-    preview resolution): swapped in by the poll timer, or by :func:`flush`."""
+    preview resolution): swapped in by the poll timer, or by :func:`flush`.  ``then``: once
+    swapped in, rebuild at that resolution too (a shade change with the film at a thickness:
+    shown at preview resolution first)."""
     _supersede(material.name)
     _dirty[material.name] = resolution
     _unmeasured.discard(material.name)
+    _then.pop(material.name, None)
+    if then is not None and then != resolution:
+        _then[material.name] = then
     start(context)
 
 
@@ -254,6 +265,7 @@ def _swap(context, job: _Job) -> list[str]:
     """Build the group of a computed rebuild and make it its material's surface (main
     thread), unless the rebuild was superseded or its material changed meanwhile."""
     rebuild = job.rebuild
+    then = _then.pop(rebuild.material, None)
     material = bpy.data.materials.get(rebuild.material)
     if material is None or material.session_uid != rebuild.uid:  # renamed meanwhile?
         material = next((m for m in bpy.data.materials if m.session_uid == rebuild.uid), None)
@@ -274,6 +286,8 @@ def _swap(context, job: _Job) -> list[str]:
         return [f"Made-up Skin: the preview of {rebuild.material!r} failed: {error}."]
     if rebuild.unmeasured is not None and material.name not in _dirty:
         _mark(material.name, rebuild.resolution, False, DEBOUNCE_S)  # now measure it
+    if then is not None and material.name not in _dirty:
+        refine(context, material, then)
     return []
 
 
@@ -323,7 +337,11 @@ def flush(context=None) -> list[str]:
     context = context or bpy.context
     wait()
     messages = poll(context)
-    while _dirty:
+    while _dirty or _jobs:
+        if not _dirty:  # a refinement a swap set off (``then``)
+            wait()
+            messages += poll(context)
+            continue
         name, resolution = _dirty.popitem()
         job = _prepared(context, name, resolution)
         if isinstance(job, _Job):
@@ -351,5 +369,6 @@ def unregister():
     _stopped.clear()
     _dirty.clear()
     _unmeasured.clear()
+    _then.clear()
     _messages.clear()
     apply.clear_cache()

@@ -271,8 +271,13 @@ def _set_shade(operator, context, solve) -> set:
     groups.update_sockets(material)
     if skin_model.film_of(material.makeup_skin) != "paper":
         # The film at a thickness has its absorption baked: its group is rebuilt (on a
-        # worker, swapped in when ready; at once without an event loop).
-        live.refine(context, material, material.makeup_skin.resolution)
+        # worker, swapped in when ready, at preview resolution first when the bake is new;
+        # at once without an event loop).
+        target = material.makeup_skin.resolution
+        if live.can_refine() and apply.preview_first(material):
+            live.refine(context, material, apply.PREVIEW, then=target)
+        else:
+            live.refine(context, material, target)
         if not live.can_refine():
             live.flush(context)
     for sentence in result.sentences:

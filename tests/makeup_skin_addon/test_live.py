@@ -302,3 +302,38 @@ def test_a_thickness_move_is_swapped_in_first_and_measured_after(sphere, monkeyp
     assert {e["key"] for e in errors.values()} == {meta["key"]}
     assert live.pending() == set()
     bakes.clear()
+
+
+def test_a_shade_step_at_a_thickness_shows_at_preview_first_then_refines(sphere, monkeypatch):
+    """With the film at a thickness a shade change rebuilds the group (its absorption is
+    baked): with an event loop, a bake the file has not seen goes at preview resolution first
+    and the settings' resolution follows once it is swapped in; a shade whose bake the file
+    has goes straight to it."""
+    import bpy
+
+    from makeup_skin_addon import apply, groups, live, nodes
+
+    material, _ = apply_pipeline(sphere, "LAYERED", resolution="default", film_mode="SLAB",
+                                 skin_colour=(0.45, 0.25, 0.15))
+    material.makeup_skin.live_update = False
+    assert bpy.ops.makeup_skin.match_skin() == {"FINISHED"}  # headless: rebuilt at once
+    before = nodes.read_meta(groups.group_of(material).node_tree)["key"]
+    shade = list(material.makeup_skin.absorption)
+    monkeypatch.setattr(live, "can_refine", lambda: True)  # as with a window
+    assert bpy.ops.makeup_skin.shade_step(direction="LIGHTER") == {"FINISHED"}
+    assert material.name in live.in_flight()
+    assert live.wait(60.0) and live.poll(bpy.context) == []
+    shown = nodes.read_meta(groups.group_of(material).node_tree)
+    assert shown["resolution"] == "preview" and shown["key"] != before
+    assert material.name in live.in_flight()  # the refinement, set off by the swap
+    assert live.wait(60.0) and live.poll(bpy.context) == []
+    refined = nodes.read_meta(groups.group_of(material).node_tree)
+    assert refined["resolution"] == "default" and not live.pending()
+    assert not apply.preview_first(material)
+    assert bpy.ops.makeup_skin.shade_step(direction="DARKER") == {"FINISHED"}
+    assert apply.preview_first(material)  # the group was rebuilt in place: no first bake
+    live.flush(bpy.context)  # flush follows the refinement too
+    assert not live.pending()
+    back = nodes.read_meta(groups.group_of(material).node_tree)
+    assert back["resolution"] == "default" and back["key"] != refined["key"]
+    assert list(material.makeup_skin.absorption) == pytest.approx(shade, abs=1e-6)
