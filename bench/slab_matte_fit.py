@@ -23,7 +23,9 @@ infinitely thick medium with a single-scattering albedo per channel in one of th
   RGB, cone, spread);
 - ``cone_tinted``: ``cone`` with the flakes' own albedo RGB (10 parameters), as Lanza et al.
   give their flakes and their spheres each an albedo;
-- ``cone_slab``: spheres with two HG lobes and the flakes on a cone (9 parameters),
+- ``cone_slab``: spheres with two HG lobes and the flakes on a cone (9 parameters);
+- ``cone_surface``: ``cone`` under the rough dielectric surface (9 parameters: eta, alpha
+  added),
 
 read in the plane of incidence by a bicubic spline over the grid's polar nodes (the surface's
 own reflection in closed form).  Physical bounds: |g| <= 0.95, 1.01 <= eta <= 2, 0.05 <= alpha
@@ -97,8 +99,15 @@ FORMS = {
                   ((-4.0, 4.0), (-4.0, 4.0), LOGIT, LOGIT, LOGIT, LOG_SPREAD),
                   ((-0.3, 1.2, 0.0, 1.0, 0.3, np.log(20.0)),
                    (0.5, -0.5, 0.0, 0.0, -1.0, np.log(30.0)))),
+    "cone_surface": (("g", "flakes", "cone", "spread", "eta", "alpha"),
+                     ((-4.0, 4.0), LOGIT, LOGIT, LOG_SPREAD, LOG_ETA, LOG_ALPHA),
+                     ((-0.2, 1.0, 0.3, np.log(20.0), np.log(0.4), np.log(0.3)),
+                      (0.3, 0.0, -1.0, np.log(30.0), np.log(0.2), np.log(0.6)))),
 }
-CONE_FORMS = ("cone", "cone_flakes", "cone_tinted", "cone_slab")
+CONE_FORMS = ("cone", "cone_flakes", "cone_tinted", "cone_slab", "cone_surface")
+ALBEDO_LOGIT_MAX = {"cone_tinted": float(np.log(0.995 / 0.005))}
+"""The spheres' albedo stays below 0.995 where the flakes carry their own: the kernels gain
+energy above about 0.997 (docs/model.md)."""
 
 
 def _sigmoid(x):
@@ -114,7 +123,7 @@ def unpack(form: str, p) -> MatteSlab:
         kw.update(g1=G_MAX * np.tanh(p[3]), g2=G_MAX * np.tanh(p[4]), weight=_sigmoid(p[5]))
     elif form != "cone_flakes":
         kw.update(g1=G_MAX * np.tanh(p[3]))
-    if form in ("surface", "flakes_surface"):
+    if form in ("surface", "flakes_surface", "cone_surface"):
         kw.update(eta=1.0 + np.exp(p[-2]), alpha=np.exp(p[-1]))
     if form == "flakes_surface":
         kw.update(flakes=_sigmoid(p[4]), flake_alpha=np.exp(p[5]))
@@ -164,7 +173,7 @@ def in_plane(grid, model: MatteSlab, theta_i, theta_o) -> np.ndarray:
 def fit(grid, form, theta_i, theta_o, rgb, start, *, tight=False):
     """Least squares of the relative residuals from ``start``, within the form's bounds."""
     lower = np.array([-12.0] * 3 + [b[0] for b in FORMS[form][1]])
-    upper = np.array([12.0] * 3 + [b[1] for b in FORMS[form][1]])
+    upper = np.array([ALBEDO_LOGIT_MAX.get(form, 12.0)] * 3 + [b[1] for b in FORMS[form][1]])
 
     def residual(p):
         return (in_plane(grid, unpack(form, p), theta_i, theta_o) / rgb - 1.0).ravel()
