@@ -25,7 +25,7 @@ infinitely thick medium with a single-scattering albedo per channel in one of th
   give their flakes and their spheres each an albedo;
 - ``cone_slab``: spheres with two HG lobes and the flakes on a cone (9 parameters);
 - ``cone_surface``: ``cone`` under the rough dielectric surface (9 parameters: eta, alpha
-  added),
+  added); ``cone_surface_15`` the same with eta held at a binder's 1.5 (8 parameters),
 
 read in the plane of incidence by a bicubic spline over the grid's polar nodes (the surface's
 own reflection in closed form).  Physical bounds: |g| <= 0.95, 1.01 <= eta <= 2, 0.05 <= alpha
@@ -103,8 +103,15 @@ FORMS = {
                      ((-4.0, 4.0), LOGIT, LOGIT, LOG_SPREAD, LOG_ETA, LOG_ALPHA),
                      ((-0.2, 1.0, 0.3, np.log(20.0), np.log(0.4), np.log(0.3)),
                       (0.3, 0.0, -1.0, np.log(30.0), np.log(0.2), np.log(0.6)))),
+    "cone_surface_15": (("g", "flakes", "cone", "spread", "alpha"),
+                        ((-4.0, 4.0), LOGIT, LOGIT, LOG_SPREAD, LOG_ALPHA),
+                        ((-0.2, 1.0, 0.3, np.log(20.0), np.log(0.3)),
+                         (0.3, 0.0, -1.0, np.log(30.0), np.log(0.6)))),
 }
-CONE_FORMS = ("cone", "cone_flakes", "cone_tinted", "cone_slab", "cone_surface")
+CONE_FORMS = ("cone", "cone_flakes", "cone_tinted", "cone_slab", "cone_surface",
+              "cone_surface_15")
+BINDER_ETA = 1.5
+"""The surface's index in ``cone_surface_15``: a binder's (oils, silicones: about 1.4-1.5)."""
 ALBEDO_LOGIT_MAX = {"cone_tinted": float(np.log(0.995 / 0.005))}
 """The spheres' albedo stays below 0.995 where the flakes carry their own: the kernels gain
 energy above about 0.997 (docs/model.md)."""
@@ -125,6 +132,8 @@ def unpack(form: str, p) -> MatteSlab:
         kw.update(g1=G_MAX * np.tanh(p[3]))
     if form in ("surface", "flakes_surface", "cone_surface"):
         kw.update(eta=1.0 + np.exp(p[-2]), alpha=np.exp(p[-1]))
+    elif form == "cone_surface_15":
+        kw.update(eta=BINDER_ETA, alpha=np.exp(p[-1]))
     if form == "flakes_surface":
         kw.update(flakes=_sigmoid(p[4]), flake_alpha=np.exp(p[5]))
     if form == "cone_flakes":
