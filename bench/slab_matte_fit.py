@@ -22,7 +22,7 @@ infinitely thick medium with a single-scattering albedo per channel in one of th
 - ``cone_flakes``: flakes on a cone alone, no spheres and no surface (5 parameters: albedo
   RGB, cone, spread);
 - ``cone_tinted``: ``cone`` with the flakes' own albedo RGB (10 parameters), as Lanza et al.
-  give their flakes and their spheres each an albedo;
+  give their flakes and their spheres each an albedo (the spheres' at most 0.995);
 - ``cone_slab``: spheres with two HG lobes and the flakes on a cone (9 parameters);
 - ``cone_surface``: ``cone`` under the rough dielectric surface (9 parameters: eta, alpha
   added); ``cone_surface_15`` the same with eta held at a binder's 1.5 (8 parameters),
