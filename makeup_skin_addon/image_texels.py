@@ -61,16 +61,14 @@ def srgb_to_linear(values: np.ndarray) -> np.ndarray:
     return np.where(values <= 0.04045, values / 12.92, ((values + 0.055) / 1.055) ** 2.4)
 
 
-_SRGB_CODES = None
+_SRGB_CODES = srgb_to_linear(np.arange(256, dtype=np.float32) / np.float32(255.0))
+""":func:`srgb_to_linear` of the 256 byte codes (float32)."""
 
 
 def srgb_codes_to_linear(values: np.ndarray) -> np.ndarray:
     """:func:`srgb_to_linear` of a byte buffer's values (each ``code / 255``, as Blender
     gives a byte image's pixels) by a table of the 256 codes: the same values, a third of the
     time of the curve on a 4096 px image, float32."""
-    global _SRGB_CODES
-    if _SRGB_CODES is None:
-        _SRGB_CODES = srgb_to_linear(np.arange(256, dtype=np.float32) / np.float32(255.0))
     codes = (np.asarray(values, np.float32) * np.float32(255.0) + np.float32(0.5))
     return _SRGB_CODES[codes.astype(np.uint8)]
 

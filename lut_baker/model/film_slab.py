@@ -289,8 +289,8 @@ def face_albedo(film: ReflectionLayer, grid: HemisphereGrid) -> NDArray[np.float
         if not np.any(np.asarray(gloss.P_s) > 0.0):
             values = np.zeros((channels, grid.theta.size))
         else:
-            share = np.reshape(surface_share(film), (-1, 1))
-            values = share * _channels_first(specular_albedo(np.degrees(grid.theta), gloss))
+            values = _channels_first(specular_albedo(np.degrees(grid.theta),
+                                                     surface_layer(film)))
         values.setflags(write=False)
         return values
 
