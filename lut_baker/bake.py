@@ -357,15 +357,15 @@ class _NodePairs:
     def tables(self, function: Callable[[slice], list[NDArray[np.float64]]],
                channels: Sequence[int]) -> list[np.ndarray]:
         """``function(chunk)`` -> a list of ``(len(chunk), n_phi, C_k)`` arrays for slices of
-        the pairs; returns the full ``(n_theta, n_theta, n_phi, 3)`` tables (read-only
-        broadcasts where ``C_k`` = 1).  ``channels``: the ``C_k``."""
+        the pairs; returns the full ``(n_theta, n_theta, n_phi, C_k)`` tables.  ``channels``:
+        the ``C_k``."""
         out = [np.empty((self.n, self.n, self.n_phi, c)) for c in channels]
         for chunk in self.chunks:
             i, j = self.upper[0][chunk], self.upper[1][chunk]
             for table, values in zip(out, function(chunk), strict=True):
                 table[i, j] = values
                 table[j, i] = values
-        return [rgb_view(table) for table in out]
+        return out
 
 
 def gloss_albedos(layers: Sequence[ReflectionLayer], theta_deg: ArrayLike) -> list[np.ndarray]:
@@ -389,7 +389,14 @@ def path3_width_deg(skin: MadeUpSkin) -> float:
 
 def _cosine_series(matrices: np.ndarray, pairs: _NodePairs) -> np.ndarray:
     """``sum_m F_m(theta_i, theta_o) cos(m phi)`` at the nodes: ``(M, I, I, C)`` ->
-    ``(I, I, P, 3)``, clipped at 0 (cos(m phi) by Chebyshev's recurrence)."""
+    ``(I, I, P, 3)`` (C = 1 or 3), clipped at 0 (:func:`_series_table`)."""
+    return rgb_view(_series_table(matrices, pairs))
+
+
+def _series_table(matrices: np.ndarray, pairs: _NodePairs) -> np.ndarray:
+    """``sum_m F_m(theta_i, theta_o) cos(m phi)`` at the nodes: ``(M, I, I, C)`` ->
+    ``(I, I, P, C)`` for any number of channels ``C`` (several tables at once share the
+    recurrence), clipped at 0 (cos(m phi) by Chebyshev's recurrence)."""
     f = matrices[:, pairs.upper[0], pairs.upper[1], None, :]  # (M, P, 1, C)
 
     def values(chunk: slice) -> list[NDArray[np.float64]]:
@@ -599,25 +606,37 @@ def bake_slab(skin: MadeUpSkin, resolution_name: str | Resolution = "default", *
     face = np.broadcast_to(face_albedo(skin.film, grid), (3, grid.theta.size))  # a_g
     scale = star_scale(grid)
     lobe = skin_star(gloss_layer(skin.film), grid)  # eq. 2's gloss, star form, every order
-    top, top_albedo, through, through_mean, below, film_albedo, body_gloss = ([] for _ in range(7))
+    on_table, top_albedo, through, through_mean, below, film_albedo, body_gloss = (
+        [] for _ in range(7))
     for h in axis:
         x = np.inf if np.isinf(h) else relative_thickness(h)
         parts = slab_skin_parts(film, x, skin.skin_reflection, face)
         body_gloss.append(np.broadcast_to(
             body_gloss_weight(film, x, face, lobe, film_top=parts.film_top), (3,)))
         kernel = from_star(parts.top, scale)  # (C, M, N, N) 1/sr
-        on_table = np.moveaxis(lagrange @ kernel @ lagrange.T, 0, -1)  # (M, I, I, C)
-        top.append(np.asarray(_cosine_series(on_table, pairs)))
+        on_table.append(lagrange @ kernel @ lagrange.T)  # (C, M, I, I)
         top_albedo.append(rgb_view(lagrange @ star_albedo(parts.top[:, 0], scale[0]).T))
         through.append(rgb_view(lagrange @ parts.through.T))
         through_mean.append(np.broadcast_to(parts.through @ (2.0 * grid.weight), (3,)))
         below.append(np.broadcast_to(parts.below, (3,)))
         film_albedo.append(rgb_view(lagrange @ np.asarray(parts.film).T))
     return SlabTables(thickness_um=axis, theta_deg=theta_deg, phi_deg=phi_deg,
-                      top=np.stack(top), top_albedo=np.stack(top_albedo),
+                      top=_thickness_series(np.stack(on_table), pairs),
+                      top_albedo=np.stack(top_albedo),
                       through=np.stack(through), through_mean=np.stack(through_mean),
                       below=np.stack(below), film_albedo=np.stack(film_albedo),
                       body_gloss=np.stack(body_gloss),
                       absorption=absorption.copy(), surface_share=share.copy(),
                       theta_spacing=res.theta_spacing, theta_offset=res.theta_offset,
                       phi_spacing=res.phi_spacing)
+
+
+def _thickness_series(on_table: NDArray[np.float64], pairs: _NodePairs) -> NDArray[np.float64]:
+    """The slab's ``top`` at the tables' nodes, ``(H, I, I, P, 3)``, from its cosine
+    coefficients at every thickness ``(H, C, M, I, I)`` (C = 1 or 3): one
+    :func:`_series_table` for all thicknesses, the channels and thicknesses side by side."""
+    h, c, m, i = on_table.shape[:4]
+    stacked = np.moveaxis(on_table, 2, 0).reshape(m, h * c, i, i)  # (M, H C, I, I)
+    table = _series_table(np.moveaxis(stacked, 1, -1), pairs)  # (I, I, P, H C)
+    per_thickness = np.moveaxis(table.reshape(table.shape[:3] + (h, c)), 3, 0)
+    return np.array(np.broadcast_to(per_thickness, per_thickness.shape[:-1] + (3,)))

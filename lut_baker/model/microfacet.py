@@ -126,9 +126,15 @@ def fresnel_reflectance(cos_theta: Real, eta: Real, *, check: bool = False
     # g^2 = (eta^2 - 1) + c^2, with eta^2 - 1 = (eta - 1)(eta + 1): no cancellation near
     # eta = 1 (where g -> c and F -> 0), and no underflow of c^2 for eta >= 1 (hypot).
     excess = (index - 1.0) * (index + 1.0)
-    g2 = excess + c * c
-    g = np.where(excess >= 0.0, np.hypot(np.sqrt(np.maximum(excess, 0.0)), c),
-                 np.sqrt(np.maximum(g2, 0.0)))
+    # eta >= 1 everywhere (the usual case): no total internal reflection, g from hypot alone
+    # (the same numbers as the general branch, without evaluating its other side).
+    outside = bool(np.all(np.asarray(excess) >= 0.0))
+    if outside:
+        g = np.hypot(np.sqrt(excess), c)
+    else:
+        g2 = excess + c * c
+        g = np.where(excess >= 0.0, np.hypot(np.sqrt(np.maximum(excess, 0.0)), c),
+                     np.sqrt(np.maximum(g2, 0.0)))
     gpc = g + c
     gmc = g - c
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -137,7 +143,9 @@ def fresnel_reflectance(cos_theta: Real, eta: Real, *, check: bool = False
         f = first * second
     # g2 < 0 is total internal reflection.  Otherwise g + c = 0 only at eta = 1 and grazing,
     # where the formula is 0/0: with no interface nothing is reflected.
-    f = np.where(g2 < 0.0, 1.0, np.where(gpc > 0.0, f, 0.0))
+    f = np.where(gpc > 0.0, f, 0.0)
+    if not outside:
+        f = np.where(g2 < 0.0, 1.0, f)
     return np.clip(f, 0.0, 1.0)
 
 
