@@ -30,7 +30,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
-from functools import lru_cache
+from functools import cached_property, lru_cache
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -262,25 +262,36 @@ class MirrorQuadrature:
     over the upper hemisphere through its half vector ``h = normalize(d + e)``, at polar
     angles ``alpha`` from the normal and azimuths ``phi`` in [0, 180] degrees (the other half
     by symmetry):  ``Int g(d, e) dw_e ~ sum weight * g`` with ``dw_e = 4 (d.h) dw_h``.
-    ``cos_h`` is ``n.h`` and ``cos_dh`` is ``d.h = e.h``, each ``(N, A, P)``.
+    ``cos_h`` is ``n.h``, ``cos_dh`` is ``d.h = e.h`` and ``cos_other`` is ``n.e``, each
+    ``(N, A, P)``; ``sin_h`` and ``phi`` (``(P,)``) the half vector's polar sine and azimuth,
+    from which ``other`` is built when asked (an integral over ``n.e`` alone, such as
+    :func:`lut_baker.model.albedo.specular_albedo`, never needs it).
     """
 
     theta: np.ndarray
     fixed: np.ndarray
-    other: np.ndarray
     weight: np.ndarray
     cos_h: np.ndarray
     cos_dh: np.ndarray
+    cos_other: np.ndarray
+    sin_h: np.ndarray
+    phi: np.ndarray
 
     @property
     def cos_fixed(self) -> np.ndarray:
         """``n.d`` broadcast to the nodes, ``(N, A, P)``."""
         return np.broadcast_to(np.cos(self.theta)[:, None, None], self.weight.shape)
 
-    @property
-    def cos_other(self) -> np.ndarray:
-        """``n.e``, ``(N, A, P)`` (>= 0)."""
-        return self.other[..., 2]
+    @cached_property
+    def other(self) -> np.ndarray:
+        """``e = 2 (d.h) h - d``, ``(N, A, P, 3)`` (its z-component is ``cos_other``)."""
+        twice = 2.0 * self.cos_dh
+        out = np.empty(self.weight.shape + (3,))
+        np.subtract(twice * (self.sin_h * np.cos(self.phi)), self.fixed[:, 0, None, None],
+                    out=out[..., 0])
+        np.subtract(twice * (self.sin_h * np.sin(self.phi)), 0.0, out=out[..., 1])
+        out[..., 2] = self.cos_other
+        return out
 
 
 def mirror_alpha_edges(width_deg: float) -> np.ndarray:
@@ -318,18 +329,15 @@ def mirror_quadrature(theta: ArrayLike, width_deg: float, *,
     alpha = alpha.reshape(angles.size, -1, phi.size)
     d_alpha = (length[:, :, None] * wx[None, None, :, None]).reshape(alpha.shape)
     sin_a, cos_a = np.sin(alpha), np.cos(alpha)
-    hx, hy = sin_a * np.cos(phi), sin_a * np.sin(phi)  # h = (hx, hy, cos_a)
+    hx = sin_a * np.cos(phi)  # h = (hx, hy, cos_a); hy only for ``other``, when asked
     fixed = np.stack([sin_t[:, 0], np.zeros_like(angles), cos_t[:, 0]], axis=-1)
     sin_d, cos_d = sin_t[:, :, None], cos_t[:, :, None]
     cos_dh = np.clip(sin_d * hx + cos_d * cos_a, 0.0, 1.0)  # d.h, d = (sin_t, 0, cos_t)
-    twice = 2.0 * cos_dh
-    other = np.empty(alpha.shape + (3,))  # e = 2 (d.h) h - d, component by component
-    np.subtract(twice * hx, sin_d, out=other[..., 0])
-    np.subtract(twice * hy, 0.0, out=other[..., 1])
-    np.maximum(twice * cos_a - cos_d, 0.0, out=other[..., 2])  # rounding at the horizon
+    # n.e of e = 2 (d.h) h - d, held at 0 against rounding at the horizon
+    cos_other = np.maximum(2.0 * cos_dh * cos_a - cos_d, 0.0)
     weight = 2.0 * 4.0 * cos_dh * sin_a * d_alpha * wphi
-    return MirrorQuadrature(theta=angles, fixed=fixed, other=other, weight=weight,
-                            cos_h=cos_a, cos_dh=cos_dh)
+    return MirrorQuadrature(theta=angles, fixed=fixed, weight=weight, cos_h=cos_a,
+                            cos_dh=cos_dh, cos_other=cos_other, sin_h=sin_a, phi=phi)
 
 
 def order0_integral(matrix0: np.ndarray, grid: HemisphereGrid,
