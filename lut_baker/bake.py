@@ -346,13 +346,18 @@ class _NodePairs:
         a, b = np.radians(theta_deg[self.upper[0]]), np.radians(theta_deg[self.upper[1]])
         self.cos_a, self.sin_a = np.cos(a)[:, None], np.sin(a)[:, None]
         self.cos_b, self.sin_b = np.cos(b)[:, None], np.sin(b)[:, None]
-        self.chunks = [slice(start, start + max(1, CHUNK_ELEMENTS // self.n_phi))
-                       for start in range(0, a.size, max(1, CHUNK_ELEMENTS // self.n_phi))]
+        self.chunks = self.chunked(1)
         self.cos_phi = np.empty((a.size, self.n_phi))
         for chunk in self.chunks:
             self.cos_phi[chunk] = node_cos_azimuths(theta_deg[self.upper[0][chunk]],
                                                     theta_deg[self.upper[1][chunk]],
                                                     phi_deg, phi_spacing)
+
+    def chunked(self, channels: int) -> list[slice]:
+        """Slices of the pairs holding about :data:`CHUNK_ELEMENTS` values of ``channels``
+        channels each."""
+        step = max(1, CHUNK_ELEMENTS // (self.n_phi * channels))
+        return [slice(start, start + step) for start in range(0, self.upper[0].size, step)]
 
     def tables(self, function: Callable[[slice], list[NDArray[np.float64]]],
                channels: Sequence[int]) -> list[np.ndarray]:
@@ -360,7 +365,7 @@ class _NodePairs:
         the pairs; returns the full ``(n_theta, n_theta, n_phi, C_k)`` tables.  ``channels``:
         the ``C_k``."""
         out = [np.empty((self.n, self.n, self.n_phi, c)) for c in channels]
-        for chunk in self.chunks:
+        for chunk in self.chunked(max(channels)):
             i, j = self.upper[0][chunk], self.upper[1][chunk]
             for table, values in zip(out, function(chunk), strict=True):
                 table[i, j] = values
