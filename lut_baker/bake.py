@@ -218,17 +218,25 @@ def fresnel_tabulation(eta: float) -> np.ndarray | None:
     return nodes if error.max() <= FRESNEL_TOLERANCE else None
 
 
+@lru_cache(maxsize=16)
+def _fresnel_steps(eta: float) -> tuple[np.ndarray, np.ndarray] | None:
+    """:func:`fresnel_tabulation` and its differences between neighbouring nodes (what
+    :func:`fresnel_interpolated` gathers: one look-up per value, not two)."""
+    table = fresnel_tabulation(eta)
+    return None if table is None else (table, table[1:] - table[:-1])
+
+
 def fresnel_interpolated(cosine: NDArray[np.float64], eta: Real) -> NDArray[np.float64]:
     """:func:`lut_baker.model.microfacet.fresnel_reflectance` of cosines in [0, 1] with a
     trailing channel axis of 1, interpolated from :func:`fresnel_tabulation` (5x faster,
     within 1e-8 relative) when eta is one number; the formula itself otherwise."""
-    table = fresnel_tabulation(float(eta)) if np.ndim(eta) == 0 else None
-    if table is None:
+    steps = _fresnel_steps(float(eta)) if np.ndim(eta) == 0 else None
+    if steps is None:
         return fresnel_reflectance(cosine, eta)
+    table, step = steps
     x = cosine * FRESNEL_NODES
     low = np.minimum(x.astype(np.intp), FRESNEL_NODES - 1)
-    below = table[low]
-    return below + (x - low) * (table[low + 1] - below)
+    return np.take(table, low) + (x - low) * np.take(step, low)
 
 
 def _reflection_values(layer: ReflectionLayer, cos_a: NDArray[np.float64],
