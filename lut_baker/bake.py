@@ -444,12 +444,37 @@ def profile_radius(dipole: Dipole, floor: float = PROFILE_FLOOR) -> float:
         last = int(np.max(np.nonzero(above(grid))[0], initial=0))
         low, high = grid[last], grid[min(last + 1, grid.size - 1)]
     while high > low * (1.0 + RADIUS_PRECISION):
-        middle = np.sqrt(low * high)
-        if above(np.array([middle]))[0]:
-            low = middle
-        else:
-            high = middle
+        low, high = _bisected(low, high, above)
     return float(high)
+
+
+BISECTION_DEPTH = 6
+"""Steps of :func:`profile_radius`'s bisection whose midpoints are evaluated together."""
+
+
+def _bisected(low: float, high: float,
+              above: Callable[[NDArray[np.float64]], NDArray[np.bool_]]) -> tuple[float, float]:
+    """Up to :data:`BISECTION_DEPTH` steps of the bisection in ``log d`` of ``[low, high]``
+    (``above`` true at the low end), stopping at :data:`RADIUS_PRECISION` as one step at a
+    time would: the midpoints every path could reach, ``sqrt(low high)`` as each step takes it,
+    are evaluated in one call of ``above`` (the same points, the same bracket)."""
+    tree: list[float] = []  # midpoints in breadth-first order: node k's halves are 2k+1, 2k+2
+    brackets = [(low, high)]
+    for _ in range(BISECTION_DEPTH):
+        halves = []
+        for a, b in brackets:
+            middle = np.sqrt(a * b)
+            tree.append(middle)
+            halves += [(a, middle), (middle, b)]
+        brackets = halves
+    known = above(np.array(tree))
+    node = 0
+    while node < len(tree) and high > low * (1.0 + RADIUS_PRECISION):
+        if known[node]:
+            low, node = tree[node], 2 * node + 2
+        else:
+            high, node = tree[node], 2 * node + 1
+    return low, high
 
 
 Progress = Callable[[float, str], object]

@@ -205,6 +205,30 @@ def test_profile_radius_moves_continuously_with_the_dipole(paper):
     assert profile[1] == pytest.approx(bake.PROFILE_FLOOR * profile[0], rel=1e-9)
 
 
+def test_profile_radius_bisects_as_one_step_at_a_time(paper, monkeypatch):
+    """The midpoints evaluated together (``BISECTION_DEPTH`` steps a call) end the bisection
+    where one step a call ends it."""
+    together = [bake.profile_radius(paper.dipole.scaled(sigma_a=s)) for s in (0.5, 1.0, 3.0)]
+    monkeypatch.setattr(bake, "BISECTION_DEPTH", 1)
+    alone = [bake.profile_radius(paper.dipole.scaled(sigma_a=s)) for s in (0.5, 1.0, 3.0)]
+    np.testing.assert_allclose(together, alone, rtol=bake.RADIUS_PRECISION)
+
+
+def test_slab_top_series_of_every_thickness_at_once_is_each_thickness_alone(monkeypatch):
+    """The slab's ``top`` summed for all thicknesses at once, in chunks of any size, is each
+    thickness's cosine series on its own."""
+    theta_deg = np.linspace(0.0, 89.0, 9)
+    pairs = bake._NodePairs(theta_deg, np.linspace(0.0, 180.0, 7), "uniform")
+    coefficients = np.random.default_rng(3).normal(size=(4, 3, 5, 9, 9))  # (H, C, M, I, I)
+    coefficients = coefficients + np.swapaxes(coefficients, -1, -2)
+    alone = [np.asarray(bake._cosine_series(np.moveaxis(c, 0, -1), pairs)) for c in coefficients]
+    for chunk in (bake.CHUNK_ELEMENTS, 40):  # one chunk, and many
+        monkeypatch.setattr(bake, "CHUNK_ELEMENTS", chunk)
+        together = bake._thickness_series(coefficients, pairs)
+        assert together.shape == (4, 9, 9, 7, 3)
+        np.testing.assert_allclose(together, np.stack(alone), rtol=1e-15, atol=1e-300)
+
+
 def test_narrow_lobes_in_path3_scale_the_grids_and_the_film_gloss_does_not(paper):
     """The grids follow what path 3 goes through (the film's transmission, the skin's gloss);
     the film's own gloss is a closed form and leaves them as they are."""

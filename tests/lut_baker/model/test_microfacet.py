@@ -44,6 +44,19 @@ def test_fresnel_grazing_is_one(eta):
     assert microfacet.fresnel_reflectance(0.0, eta, check=True) == pytest.approx(1.0, abs=1e-12)
 
 
+def test_fresnel_mixed_indices_per_channel_match_each_index_alone():
+    """Indices below 1 (total internal reflection) beside indices above it, and above it
+    alone (where the formula skips the total-internal-reflection branch): each channel is
+    what its index gives on its own."""
+    c = np.linspace(0.0, 1.0, 41)[:, None]
+    for eta in (np.array([0.7, 1.0, 1.5]), np.array([1.0, 1.19, 2.4]), np.array([0.5, 0.9, 0.95])):
+        together = microfacet.fresnel_reflectance(c, eta)
+        alone = np.stack([microfacet.fresnel_reflectance(c[:, 0], float(e)) for e in eta], -1)
+        np.testing.assert_allclose(together, alone, rtol=1e-15, atol=1e-300)
+    assert microfacet.fresnel_reflectance(np.array([np.nan]), 1.5)[0] == 0.0  # as for eta < 1
+    assert microfacet.fresnel_reflectance(np.array([np.nan]), 0.7)[0] == 0.0
+
+
 def test_fresnel_index_matched_is_zero():
     """eta = 1: no interface, no reflection at any incidence, grazing included, and the
     values next to eta = 1 approach it continuously."""

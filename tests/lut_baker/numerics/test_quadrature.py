@@ -50,3 +50,21 @@ def test_order0_integral_of_a_constant_kernel():
     grid = quadrature.hemisphere_panels(2, 6, 17)
     kernel = np.full((1, grid.theta.size, 1), 1.0 / np.pi)  # a Lambertian BRDF's K_0
     assert quadrature.order0_integral(kernel, grid)[0, 0] == pytest.approx(1.0, rel=1e-12)
+
+
+def test_mirror_quadrature_builds_the_other_direction_on_demand():
+    """``other`` (built when asked) is the unit mirror of the fixed direction through the
+    half vector: its z-component is ``cos_other``, ``e.h = d.h = cos_dh`` and ``n.h``
+    of ``normalize(d + e)`` is ``cos_h``."""
+    quad = quadrature.mirror_quadrature(np.radians([0.0, 30.0, 75.0, 89.0]), 12.0)
+    e = quad.other
+    assert e.shape == quad.weight.shape + (3,)
+    np.testing.assert_array_equal(e[..., 2], quad.cos_other)
+    live = quad.weight > 0.0  # panels beyond the horizon have no length
+    np.testing.assert_allclose(np.linalg.norm(e, axis=-1)[live], 1.0, atol=1e-12)
+    d = np.broadcast_to(quad.fixed[:, None, None, :], e.shape)
+    h = d + e
+    h /= np.linalg.norm(h, axis=-1, keepdims=True)
+    np.testing.assert_allclose(h[..., 2][live], quad.cos_h[live], atol=1e-12)
+    np.testing.assert_allclose(np.sum(e * h, axis=-1)[live], quad.cos_dh[live], atol=1e-12)
+    assert quad.other is e  # built once
