@@ -156,16 +156,19 @@ class FitTargets:
         lobe = self.tables.directional("film_gloss_albedo", theta_deg)
         return np.maximum(parts.film_albedo - parts.body_gloss * lobe, 0.0)
 
-    def film_body(self, wi: NDArray[np.float64],
-                  wo: NDArray[np.float64]) -> NDArray[np.float64]:
+    def film_body(self, wi: NDArray[np.float64], wo: NDArray[np.float64],
+                  film_gloss: NDArray[np.float64] | None = None) -> NDArray[np.float64]:
         """The film's body as the tiers draw it (class docstring), 1/sr ``(..., 3)``: its
         share of the gloss (:meth:`gloss_weight`, the surface's left out) and the rest read
-        Lambertian."""
+        Lambertian.  ``film_gloss``: the tables' ``film_gloss`` at ``(wi, wo)``, if already
+        looked up."""
         def albedo(w: NDArray[np.float64]) -> NDArray[np.float64]:
             return self.body_albedo(polar_angle_deg(w))
         body_gloss = self.slab_parts(0.0).body_gloss
+        gloss = (self.tables.surface_gloss("film_gloss", wi, wo) if film_gloss is None
+                 else film_gloss)
         return (albedo(wi) * albedo(wo) / (np.pi * np.maximum(self.film_mean(), 1e-12))
-                + body_gloss * self.tables.surface_gloss("film_gloss", wi, wo))
+                + body_gloss * gloss)
 
     def film_mean(self) -> NDArray[np.float64]:
         """The film body's albedo under uniform light without its gloss (RGB): ``2 Int alpha

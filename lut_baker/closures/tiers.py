@@ -15,7 +15,8 @@ view grid.
 - :func:`tier_reflection` -- a tier's BRDF as a made-up material renders it (over the
   artist's shader: the bare skin is theirs).
 - :func:`reference_reflection` -- what they are measured against (the tables' made-up skin,
-  or the film as a slab at the fit's thickness).
+  or the film as a slab at the fit's thickness); :func:`slab_bare` -- a slab fit's bare skin;
+  :func:`slab_lookup_of` -- the slab's lookups they share.
 - :func:`tier_errors` -- the tiers of a fit against the tables at one coverage and absorption.
 """
 
@@ -29,7 +30,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..model.made_up_skin import combine, coverage_weights
-from ..tables.slab_tables import slab_reflection
+from ..tables.slab_tables import SlabLookup, slab_lookup, slab_mixed
 from ..tables.table_set import ReflectionParts, Tables
 from . import cycles as cc
 from .closure_fit import ClosureFit
@@ -39,7 +40,7 @@ from .tier_registry import TIERS, Tier, held
 from .view_grid import ERROR_VIEWS, lobe_widths_deg, view_grid
 
 __all__ = ["TIERS", "TierError", "NumpyShaders", "principled_inputs", "tier_replica",
-           "tier_reflection", "reference_reflection", "tier_errors"]
+           "tier_reflection", "reference_reflection", "slab_lookup_of", "slab_bare", "tier_errors"]
 
 Directions = tuple[NDArray[np.float64], NDArray[np.float64]]
 """``(wi, wo)``: light and view directions, local unit vectors ``(..., 3)``."""
@@ -162,36 +163,49 @@ def tier_reflection(fit: ClosureFit, tables: Tables, name: str, coverage: float,
     covered = tier_replica(fit, tables, name, 1.0, absorption, gloss, (wi, wo))
     if bare is None:
         bare = (tables.made_up_reflection(wi, wo, 0.0, absorption) if fit.slab is None
-                else _slab_bare(fit, tables, (wi, wo)))
+                else slab_bare(fit, tables, (wi, wo)))
     return combine(coverage_weights(coverage, 0.0), top=covered, bare=bare)
 
 
 def reference_reflection(fit: ClosureFit, tables: Tables, coverage: float,
-                         absorption: ArrayLike, directions: Directions) -> NDArray[np.float64]:
+                         absorption: ArrayLike, directions: Directions,
+                         lookup: SlabLookup | None = None) -> NDArray[np.float64]:
     """What a fit's tiers are measured against, ``(..., 3)``: the tables' made-up skin at a
     coverage and absorption, or with the film as a slab (``fit.slab``) the slab's at the fit's
     thickness on the fit's skin (``fit.skin_albedo``, the skin the film covers; its absorption
     baked, :func:`lut_baker.tables.slab_tables.slab_reflection`; the skin under the film
-    darkened by ``slab.skin_under`` where Match Skin set it)."""
+    darkened by ``slab.skin_under`` where Match Skin set it).  ``lookup``: the slab's
+    :func:`~lut_baker.tables.slab_tables.slab_lookup` at ``directions`` and the fit's
+    thickness, if already made (:func:`slab_lookup_of`)."""
     if fit.slab is None:
         return tables.made_up_reflection(*directions, coverage, absorption)
+    found = slab_lookup_of(fit, tables, directions) if lookup is None else lookup
     under = fit.slab.skin_under
     if under is None:
-        return slab_reflection(tables, *directions, fit.slab.thickness_um,
-                               skin_albedo=fit.skin_albedo, coverage=coverage)
-    covered = slab_reflection(tables, *directions, fit.slab.thickness_um,
-                              skin_albedo=fit.skin_albedo * np.asarray(under, float))
+        return slab_mixed(tables, found, skin_albedo=fit.skin_albedo, coverage=coverage)
+    covered = slab_mixed(tables, found, skin_albedo=fit.skin_albedo * np.asarray(under, float))
     return combine(coverage_weights(coverage, 0.0), top=covered,
-                   bare=_slab_bare(fit, tables, directions))
+                   bare=slab_bare(fit, tables, directions, found))
 
 
-def _slab_bare(fit: ClosureFit, tables: Tables, directions: Directions) -> NDArray[np.float64]:
+def slab_lookup_of(fit: ClosureFit, tables: Tables, directions: Directions) -> SlabLookup:
+    """The slab's lookups at ``directions`` and a slab fit's thickness
+    (:func:`lut_baker.tables.slab_tables.slab_lookup`): what its reference and bare skin
+    share."""
+    if fit.slab is None:
+        raise ValueError("a fit of the paper's film has no slab")
+    return slab_lookup(tables, *directions, fit.slab.thickness_um)
+
+
+def slab_bare(fit: ClosureFit, tables: Tables, directions: Directions,
+               lookup: SlabLookup | None = None) -> NDArray[np.float64]:
     """The bare skin of a fit of the film as a slab: the skin's gloss and the fit's skin
-    (:func:`lut_baker.tables.slab_tables.slab_reflection` at coverage 0)."""
+    (:func:`lut_baker.tables.slab_tables.slab_reflection` at coverage 0; ``lookup``: its
+    lookups at ``directions``, if already made)."""
     if fit.slab is None:
         raise ValueError("a fit of the paper's film takes its bare skin from the tables")
-    return slab_reflection(tables, *directions, fit.slab.thickness_um,
-                           skin_albedo=fit.skin_albedo, coverage=0.0)
+    found = slab_lookup_of(fit, tables, directions) if lookup is None else lookup
+    return slab_mixed(tables, found, skin_albedo=fit.skin_albedo, coverage=0.0)
 
 
 def tier_errors(fit: ClosureFit, tables: Tables, coverage: float, absorption: ArrayLike,
@@ -216,9 +230,10 @@ def tier_errors(fit: ClosureFit, tables: Tables, coverage: float, absorption: Ar
         if over_shader:
             bare = tables.mixed_reflection(looked_up, 0.0, absorption)
     else:
-        reference = reference_reflection(fit, tables, coverage, absorption, directions)
+        lookup = slab_lookup_of(fit, tables, directions)
+        reference = reference_reflection(fit, tables, coverage, absorption, directions, lookup)
         if over_shader:
-            bare = _slab_bare(fit, tables, directions)
+            bare = slab_bare(fit, tables, directions, lookup)
     out = {}
     for name in TIERS:
         if name not in tiers:
