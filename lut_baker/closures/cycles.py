@@ -20,7 +20,8 @@ Functions
 - :func:`dielectric_fresnel`, :func:`schlick_ior_fresnel` -- the Fresnel terms Cycles uses.
 - :func:`directional_albedo` -- ``Int f cos(theta_i) dwi`` of any BRDF at view angles.
 - :func:`microfacet_albedo` -- the same for a microfacet lobe, by quadrature over normals (views
-  in chunks of :data:`ALBEDO_CHUNK` nodes).
+  in chunks of :data:`ALBEDO_CHUNK` nodes); :func:`microfacet_albedos` -- without and with a
+  Fresnel term from one pass.
 - :func:`layering_albedo` -- Cycles' albedo estimate that attenuates the layers below a coat or
   a specular layer (``bsdf_microfacet_estimate_albedo``).
 - :func:`dielectric_fss`, :func:`ggx_energy_compensation` (:func:`ggx_energy_scale` from
@@ -79,6 +80,7 @@ __all__ = [
     "schlick_ior_fresnel",
     "directional_albedo",
     "microfacet_albedo",
+    "microfacet_albedos",
     "ALBEDO_CHUNK",
     "layering_albedo",
     "lambert_reflection",
@@ -333,14 +335,34 @@ def microfacet_albedo(cos_view: ArrayLike, roughness: float, fresnel: OfCosine |
     Ashikhmin-Shirley: ``h`` has density ``(e + 1) / (2 pi) cos^e`` (``cos = u^(1/(e+1))``) and
     the albedo is the mean of ``cos_i / max(cos_i, cos_o)``.
     """
+    return _chunked(cos_view, roughness, fresnel, distribution, n_u, n_phi, False)[0]
+
+
+def microfacet_albedos(cos_view: ArrayLike, roughness: float, fresnel: OfCosine,
+                       distribution: str = "GGX", *, n_u: int = 48, n_phi: int = 32
+                       ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """``(plain, weighted)``: :func:`microfacet_albedo` without Fresnel and with ``fresnel``
+    from one pass over the nodes (a layering albedo needs both; the same numbers as two
+    calls)."""
+    plain, weighted = _chunked(cos_view, roughness, fresnel, distribution, n_u, n_phi, True)
+    return plain, weighted
+
+
+def _chunked(cos_view: ArrayLike, roughness: float, fresnel: OfCosine | None,
+             distribution: str, n_u: int, n_phi: int,
+             both: bool) -> tuple[NDArray[np.float64], ...]:
+    """:func:`_albedo_views` over the views in chunks (:data:`ALBEDO_CHUNK`), reshaped."""
     views = np.asarray(cos_view, float)
     flat = views.ravel()
     step = max(ALBEDO_CHUNK // (n_u * n_phi), 1)
-    parts = [_albedo_views(flat[k:k + step], roughness, fresnel, distribution, n_u, n_phi)
-             for k in range(0, flat.size, step)] or [
-        _albedo_views(flat, roughness, fresnel, distribution, n_u, n_phi)]
-    total = np.concatenate(parts, axis=0)
-    return total.reshape(views.shape + total.shape[1:])
+    parts = [_albedo_views(flat[k:k + step], roughness, fresnel, distribution, n_u, n_phi,
+                           both) for k in range(0, flat.size, step)] or [
+        _albedo_views(flat, roughness, fresnel, distribution, n_u, n_phi, both)]
+    out = []
+    for index in range(len(parts[0])):
+        total = np.concatenate([part[index] for part in parts], axis=0)
+        out.append(total.reshape(views.shape + total.shape[1:]))
+    return tuple(out)
 
 
 ALBEDO_CHUNK = 65536
@@ -351,9 +373,10 @@ whatever the chunk."""
 
 
 def _albedo_views(views: NDArray[np.float64], roughness: float, fresnel: OfCosine | None,
-                  distribution: str, n_u: int, n_phi: int) -> NDArray[np.float64]:
-    """:func:`microfacet_albedo` at 1-D ``views``: ``(V,)``, or ``(V, C)`` for an RGB
-    ``fresnel``."""
+                  distribution: str, n_u: int, n_phi: int,
+                  both: bool = False) -> tuple[NDArray[np.float64], ...]:
+    """:func:`microfacet_albedo` at 1-D ``views``: ``((V,),)``, or ``((V, C),)`` for an RGB
+    ``fresnel``; ``both``: the Fresnel-free albedo first, then the one with ``fresnel``."""
     alpha = np.square(max(float(roughness), ROUGHNESS_EPS))
     u, w_u = gauss_legendre(n_u)
     if distribution == "GGX":
@@ -385,11 +408,14 @@ def _albedo_views(views: NDArray[np.float64], roughness: float, fresnel: OfCosin
         value = np.where(valid, g2, 0.0)
     weights = w_u[None, :, None] / n_phi
     if fresnel is None:
-        return np.sum(value * weights, axis=(1, 2))
+        return (np.sum(value * weights, axis=(1, 2)),)
+    weighted = value * weights
     f = np.asarray(fresnel(np.clip(h_dot_o, 0.0, 1.0)))
     if f.ndim > value.ndim:
-        return np.einsum("vup,vupc->vc", value * weights, f)
-    return np.sum(value * weights * f, axis=(1, 2))
+        with_fresnel = np.einsum("vup,vupc->vc", weighted, f)
+    else:
+        with_fresnel = np.sum(weighted * f, axis=(1, 2))
+    return (np.sum(weighted, axis=(1, 2)), with_fresnel) if both else (with_fresnel,)
 
 
 def layering_albedo(cos_view: ArrayLike, roughness: float, eta: float,
@@ -408,9 +434,12 @@ def layering_albedo(cos_view: ArrayLike, roughness: float, eta: float,
     needs the lobe's own albedo the second).
     """
     views = np.asarray(cos_view, float)
-    e_f = (microfacet_albedo(views, roughness, lambda c: dielectric_fresnel(c, eta))
-           if weighted is None else weighted)
-    e_1 = microfacet_albedo(views, roughness) if plain is None else plain
+    if weighted is None and plain is None:
+        e_1, e_f = microfacet_albedos(views, roughness, lambda c: dielectric_fresnel(c, eta))
+    else:
+        e_f = (microfacet_albedo(views, roughness, lambda c: dielectric_fresnel(c, eta))
+               if weighted is None else weighted)
+        e_1 = microfacet_albedo(views, roughness) if plain is None else plain
     real0 = f0_from_ior(eta)
     s = np.clip((e_f / np.maximum(e_1, 1e-12) - real0) / (1.0 - real0), 0.0, 1.0)
     start = real0 if f0 is None else np.asarray(f0, float)
@@ -454,15 +483,22 @@ def ggx_energy_scale(albedo: ArrayLike, average_albedo: float, fss: Real
 
 
 def coat_view_terms(cos_view: ArrayLike, roughness: float, ior: float, *,
-                    weighted: NDArray[np.float64] | None = None
+                    weighted: NDArray[np.float64] | None = None,
+                    plain: NDArray[np.float64] | None = None
                     ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """``(scale, layering albedo)`` of the Principled coat at view cosines ``cos_view``: the
     factor :func:`ggx_energy_compensation` puts on its lobe, and the albedo by which it
     attenuates the layers below, ``darkening * layering_albedo`` (Cycles' ``bsdf_albedo``
     reads the closure's weight, which holds the darkening).  The Fresnel-free albedo both
-    need is computed once; ``weighted``: the lobe's albedo with its Fresnel at these views,
-    if the caller has it (:func:`layering_albedo`)."""
-    plain = microfacet_albedo(np.asarray(cos_view, float), roughness)
+    need is computed once, with the lobe's albedo with its Fresnel
+    (:func:`microfacet_albedos`); ``weighted``, ``plain``: these at these views, if the caller
+    has them (:func:`layering_albedo`)."""
+    views = np.asarray(cos_view, float)
+    if plain is None and weighted is None:
+        plain, weighted = microfacet_albedos(views, roughness,
+                                             lambda c: dielectric_fresnel(c, ior))
+    elif plain is None:
+        plain = microfacet_albedo(views, roughness)
     scale, darkening = ggx_energy_scale(plain, ggx_average_albedo(float(roughness)),
                                         float(dielectric_fss(ior)))
     return scale, darkening * layering_albedo(cos_view, roughness, ior, plain=plain,
@@ -577,8 +613,9 @@ def _coat_uniform(roughness: float, ior: float, nodes: int
     """The coat's compensated albedo and its layering albedo at :func:`principled_uniform`'s
     view nodes (cached: a fit moved to another thickness keeps its coat)."""
     mu, _ = gauss_legendre(nodes)
-    scale, layered = coat_view_terms(mu, roughness, ior)
-    albedo = scale * microfacet_albedo(mu, roughness, lambda c: dielectric_fresnel(c, ior))
+    plain, weighted = microfacet_albedos(mu, roughness, lambda c: dielectric_fresnel(c, ior))
+    scale, layered = coat_view_terms(mu, roughness, ior, weighted=weighted, plain=plain)
+    albedo = scale * weighted
     albedo.setflags(write=False)
     layered.setflags(write=False)
     return albedo, layered
