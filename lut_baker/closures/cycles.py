@@ -16,7 +16,8 @@ Functions
 - :func:`microfacet_shadowing` -- height-correlated ``G2 = 1 / (1 + Lambda_i + Lambda_o)``.
 - :func:`microfacet_reflection` -- microfacet BRDF ``D G2 F / (4 cos_i cos_o)`` with a Fresnel
   callable (Glossy BSDF: none; coat: dielectric; Principled specular: generalised Schlick);
-  :func:`microfacet_from_cosines` -- the Fresnel-free lobe from the four cosines it needs.
+  :func:`microfacet_from_cosines` -- the Fresnel-free lobe from the four cosines it needs
+  (:class:`LobeCosines`, :func:`lobe_from_cosines`: what depends on them alone made once).
 - :func:`dielectric_fresnel`, :func:`schlick_ior_fresnel` -- the Fresnel terms Cycles uses.
 - :func:`directional_albedo` -- ``Int f cos(theta_i) dwi`` of any BRDF at view angles.
 - :func:`microfacet_albedo` -- the same for a microfacet lobe, by quadrature over normals (views
@@ -48,7 +49,8 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from functools import lru_cache
+from functools import cached_property, lru_cache
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -70,6 +72,8 @@ __all__ = [
     "microfacet_shadowing",
     "microfacet_reflection",
     "microfacet_from_cosines",
+    "LobeCosines",
+    "lobe_from_cosines",
     "principled_uniform",
     "dielectric_fss",
     "ggx_energy_compensation",
@@ -115,16 +119,24 @@ OfCosine = Callable[[NDArray[np.float64]], ArrayLike]
 def ggx_distribution(cos_h: ArrayLike, alpha: Real) -> NDArray[np.float64]:
     """GGX ``D = alpha^2 / (pi ((1 - c^2) + alpha^2 c^2)^2)`` at ``c = N.H`` (Walter 2007)."""
     c2 = np.minimum(np.square(np.asarray(cos_h, float)), 1.0)
-    a2 = np.square(alpha)
-    return a2 / (np.pi * np.square((1.0 - c2) + a2 * c2))
+    return _ggx_d(c2, 1.0 - c2, np.square(alpha))
+
+
+def _ggx_d(c2: Any, one_minus: Any, a2: Any) -> NDArray[np.float64]:
+    """:func:`ggx_distribution` from ``c^2``, ``1 - c^2`` and ``alpha^2``."""
+    return a2 / (np.pi * np.square(one_minus + a2 * c2))
 
 
 def beckmann_distribution(cos_h: ArrayLike, alpha: Real) -> NDArray[np.float64]:
     """Beckmann ``D = exp(-tan^2 / alpha^2) / (pi alpha^2 c^4)`` at ``c = N.H``."""
     c2 = np.clip(np.square(np.asarray(cos_h, float)), 1e-300, 1.0)
-    a2 = np.square(alpha)
+    return _beckmann_d(c2, 1.0 - c2, np.square(alpha))
+
+
+def _beckmann_d(c2: Any, one_minus: Any, a2: Any) -> NDArray[np.float64]:
+    """:func:`beckmann_distribution` from ``c^2``, ``1 - c^2`` and ``alpha^2``."""
     with np.errstate(over="ignore"):
-        return np.exp(-(1.0 - c2) / (c2 * a2)) / (np.pi * a2 * c2 * c2)
+        return np.exp(-one_minus / (c2 * a2)) / (np.pi * a2 * c2 * c2)
 
 
 def _in_place(values: object) -> bool:
@@ -134,22 +146,34 @@ def _in_place(values: object) -> bool:
     return isinstance(values, np.ndarray) and values.ndim > 0
 
 
-def _alpha_tan2(cos_theta: ArrayLike, alpha: Real) -> NDArray[np.float64]:
-    """``alpha^2 tan^2(theta)`` at ``cos(theta)`` (0 for a cosine of 1 or more)."""
+def _tan2(cos_theta: ArrayLike) -> NDArray[np.float64]:
+    """``tan^2(theta)`` at ``cos(theta)`` (0 for a cosine of 1 or more)."""
     t2 = np.square(np.asarray(cos_theta, float))
     if not _in_place(t2):
-        return np.square(alpha) * np.maximum(1.0 / np.maximum(t2, 1e-300) - 1.0, 0.0)
+        return np.maximum(1.0 / np.maximum(t2, 1e-300) - 1.0, 0.0)
     np.maximum(t2, 1e-300, out=t2)
     np.divide(1.0, t2, out=t2)
     t2 -= 1.0
     np.maximum(t2, 0.0, out=t2)
+    return t2
+
+
+def _alpha_tan2(cos_theta: ArrayLike, alpha: Real) -> NDArray[np.float64]:
+    """``alpha^2 tan^2(theta)`` at ``cos(theta)`` (0 for a cosine of 1 or more)."""
+    t2 = _tan2(cos_theta)
+    if not _in_place(t2):
+        return np.square(alpha) * t2
     t2 *= np.square(alpha)
     return t2
 
 
 def ggx_lambda(cos_theta: ArrayLike, alpha: Real) -> NDArray[np.float64]:
     """Smith ``Lambda = (sqrt(1 + alpha^2 tan^2) - 1) / 2`` of GGX (Heitz 2014, eq. 72)."""
-    value = _alpha_tan2(cos_theta, alpha)
+    return _ggx_lambda_of(_alpha_tan2(cos_theta, alpha))
+
+
+def _ggx_lambda_of(value: Any) -> NDArray[np.float64]:
+    """:func:`ggx_lambda` from ``alpha^2 tan^2`` (an array is worked on in place)."""
     if not _in_place(value):
         return 0.5 * (np.sqrt(1.0 + value) - 1.0)
     value += 1.0
@@ -162,7 +186,11 @@ def ggx_lambda(cos_theta: ArrayLike, alpha: Real) -> NDArray[np.float64]:
 def beckmann_lambda(cos_theta: ArrayLike, alpha: Real) -> NDArray[np.float64]:
     """Smith ``Lambda`` of Beckmann, the rational approximation Cycles uses (0 where
     ``alpha^2 tan^2 < 0.39``)."""
-    t2 = _alpha_tan2(cos_theta, alpha)
+    return _beckmann_lambda_of(_alpha_tan2(cos_theta, alpha))
+
+
+def _beckmann_lambda_of(t2: Any) -> NDArray[np.float64]:
+    """:func:`beckmann_lambda` from ``alpha^2 tan^2``."""
     a = 1.0 / np.sqrt(np.maximum(t2, 1e-300))
     value = ((0.396 * a - 1.259) * a + 1.0) / ((2.181 * a + 3.535) * a)
     return np.where(t2 < 0.39, 0.0, value)
@@ -171,6 +199,7 @@ def beckmann_lambda(cos_theta: ArrayLike, alpha: Real) -> NDArray[np.float64]:
 DISTRIBUTIONS = {"GGX": (ggx_distribution, ggx_lambda),
                  "BECKMANN": (beckmann_distribution, beckmann_lambda)}
 """Blender's microfacet distributions replicated: ``(D, Lambda)`` by identifier."""
+_LAMBDA_OF_TAN2 = {"GGX": _ggx_lambda_of, "BECKMANN": _beckmann_lambda_of}
 GLOSSY_DISTRIBUTIONS = ("GGX", "BECKMANN", "ASHIKHMIN_SHIRLEY")
 """The Glossy BSDF's distributions the replicas cover (Multiscatter GGX is left out)."""
 
@@ -189,6 +218,57 @@ def ashikhmin_shirley_reflection(wi: ArrayLike, wo: ArrayLike,
     return microfacet_reflection(wi, wo, roughness, distribution="ASHIKHMIN_SHIRLEY")
 
 
+class LobeCosines:
+    """What :func:`microfacet_from_cosines` computes of its cosines alone, whatever the
+    roughness: made once where many lobes are evaluated on the same pairs (a fit's view grid,
+    :meth:`lut_baker.closures.view_grid.ViewGrid.lobe`), each part when first needed.
+    ``cos_h`` (``n.h``), ``cos_hi`` (``h.wi``), ``cos_i``, ``cos_o``, broadcasting."""
+
+    def __init__(self, cos_h: NDArray[np.float64], cos_hi: NDArray[np.float64],
+                 cos_i: ArrayLike, cos_o: ArrayLike) -> None:
+        self.cos_h, self.cos_hi = cos_h, cos_hi
+        self.cos_i, self.cos_o = np.asarray(cos_i, float), np.asarray(cos_o, float)
+        self.upper = (self.cos_i > 0.0) & (self.cos_o > 0.0)
+
+    @cached_property
+    def safe_i(self) -> NDArray[np.float64]:
+        """``cos_i``, 1 where a direction is below the surface (each cosine kept at its own
+        shape: a view's Lambda once per view, not per pair; where the other one is below the
+        surface the value is dropped anyway)."""
+        cos_i, cos_o = self.cos_i, self.cos_o
+        return (np.where(self.upper, cos_i, 1.0) if cos_i.size >= cos_o.size
+                else np.where(cos_i > 0.0, cos_i, 1.0))
+
+    @cached_property
+    def safe_o(self) -> NDArray[np.float64]:
+        """``cos_o``, 1 where it is below the surface (as :attr:`safe_i`)."""
+        cos_i, cos_o = self.cos_i, self.cos_o
+        return (np.where(self.upper, cos_o, 1.0) if cos_o.size > cos_i.size
+                else np.where(cos_o > 0.0, cos_o, 1.0))
+
+    @cached_property
+    def tan2(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """``tan^2`` of :attr:`safe_i` and :attr:`safe_o`."""
+        return _tan2(self.safe_i), _tan2(self.safe_o)
+
+    @cached_property
+    def denominator(self) -> NDArray[np.float64]:
+        """``4 cos_i cos_o`` (safe)."""
+        return 4.0 * self.safe_i * self.safe_o
+
+    @cached_property
+    def ggx_c2(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """``(c^2, 1 - c^2)`` of ``n.h`` as :func:`ggx_distribution` clamps it."""
+        c2 = np.minimum(np.square(np.asarray(self.cos_h, float)), 1.0)
+        return c2, 1.0 - c2
+
+    @cached_property
+    def beckmann_c2(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """``(c^2, 1 - c^2)`` of ``n.h`` as :func:`beckmann_distribution` clamps it."""
+        c2 = np.clip(np.square(np.asarray(self.cos_h, float)), 1e-300, 1.0)
+        return c2, 1.0 - c2
+
+
 def microfacet_from_cosines(cos_h: NDArray[np.float64], cos_hi: NDArray[np.float64],
                             cos_i: ArrayLike, cos_o: ArrayLike, roughness: float,
                             distribution: str = "GGX") -> NDArray[np.float64]:
@@ -200,27 +280,34 @@ def microfacet_from_cosines(cos_h: NDArray[np.float64], cos_hi: NDArray[np.float
     - ``ASHIKHMIN_SHIRLEY``: ``(e + 1) / (8 pi) (n.h)^e / ((h.wi) max(cos_i, cos_o))``
       (``bsdf_ashikhmin_shirley_eval``).
     """
-    cos_i, cos_o = np.asarray(cos_i, float), np.asarray(cos_o, float)
-    upper = (cos_i > 0.0) & (cos_o > 0.0)
+    return lobe_from_cosines(LobeCosines(cos_h, cos_hi, cos_i, cos_o), roughness,
+                             distribution)
+
+
+def lobe_from_cosines(cosines: LobeCosines, roughness: float,
+                      distribution: str = "GGX") -> NDArray[np.float64]:
+    """:func:`microfacet_from_cosines` from its cosines' :class:`LobeCosines` (the same
+    numbers; what depends on the cosines alone computed once for many lobes)."""
+    cos_i, cos_o, upper = cosines.cos_i, cosines.cos_o, cosines.upper
     if distribution == "ASHIKHMIN_SHIRLEY":
         e = ashikhmin_shirley_exponent(roughness)
-        h_dot_i = np.maximum(np.abs(cos_hi), 1e-6)
-        h_dot_n = np.maximum(cos_h, 1e-6)
+        h_dot_i = np.maximum(np.abs(cosines.cos_hi), 1e-6)
+        h_dot_n = np.maximum(cosines.cos_h, 1e-6)
         pump = 1.0 / np.maximum(1e-6, h_dot_i * np.maximum(np.maximum(cos_i, cos_o), 1e-6))
         return np.where(upper, (e + 1.0) / (8.0 * np.pi) * h_dot_n**e * pump, 0.0)
     if distribution not in DISTRIBUTIONS:
         raise ValueError(f"distribution must be one of {GLOSSY_DISTRIBUTIONS}, got "
                          f"{distribution!r}")
     alpha = np.square(max(float(roughness), ROUGHNESS_EPS))
-    # Each cosine kept at its own shape (a view's Lambda once per view, not per pair); where
-    # the other one is below the surface the value is dropped anyway.
-    safe_i = np.where(upper, cos_i, 1.0) if cos_i.size >= cos_o.size else \
-        np.where(cos_i > 0.0, cos_i, 1.0)
-    safe_o = np.where(upper, cos_o, 1.0) if cos_o.size > cos_i.size else \
-        np.where(cos_o > 0.0, cos_o, 1.0)
-    value = (DISTRIBUTIONS[distribution][0](cos_h, alpha)
-             * microfacet_shadowing(safe_i, safe_o, alpha, distribution)
-             / (4.0 * safe_i * safe_o))
+    a2 = np.square(alpha)
+    if distribution == "GGX":
+        d = _ggx_d(*cosines.ggx_c2, a2)
+    else:
+        d = _beckmann_d(*cosines.beckmann_c2, a2)
+    lambda_of = _LAMBDA_OF_TAN2[distribution]
+    tan2_i, tan2_o = cosines.tan2
+    shadowing = _shadowing_of(lambda_of(tan2_i * a2), lambda_of(tan2_o * a2))
+    value = d * shadowing / cosines.denominator
     return np.where(upper, value, 0.0)
 
 
@@ -229,7 +316,12 @@ def microfacet_shadowing(cos_i: ArrayLike, cos_o: ArrayLike, alpha: Real,
     """Height-correlated masking-shadowing ``G2 = 1 / (1 + Lambda_i + Lambda_o)``
     (Cycles ``bsdf_G``)."""
     lam = DISTRIBUTIONS[distribution][1]
-    lam_i, lam_o = lam(cos_i, alpha), lam(cos_o, alpha)
+    return _shadowing_of(lam(cos_i, alpha), lam(cos_o, alpha))
+
+
+def _shadowing_of(lam_i: Any, lam_o: Any) -> NDArray[np.float64]:
+    """:func:`microfacet_shadowing` from the two Lambdas (the first worked on in place when
+    it is an array of the result's shape)."""
     if not (_in_place(lam_i) and lam_i.shape == np.broadcast_shapes(lam_i.shape,
                                                                     np.shape(lam_o))):
         return 1.0 / (1.0 + lam_i + lam_o)

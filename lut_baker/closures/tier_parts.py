@@ -199,9 +199,13 @@ class FitTargets:
         base colour, :meth:`base_mean`)."""
         if self.slab is None:
             return self.target("film_gloss")
-        grid = self.grid("film_gloss")
-        return grid, self.coat_weight() * self.tables.surface_gloss("film_gloss",
-                                                                    *grid.directions)
+        return self.grid("film_gloss"), self.coat_weight() * self.surface_on_grid("film_gloss")
+
+    def surface_on_grid(self, name: str) -> NDArray[np.float64]:
+        """The tables' surface gloss ``name`` (closed form) on :meth:`grid` of ``name``
+        (once: the coat's target and the film gloss's share it)."""
+        return self._once(("surface", name), lambda: self.tables.surface_gloss(
+            name, *self.grid(name).directions))
 
     def target(self, name: str) -> tuple[ViewGrid, NDArray[np.float64]]:
         """``(grid, table)`` of a gloss part: ``film_gloss`` on the film's grid,
@@ -216,9 +220,8 @@ class FitTargets:
                 return grid, self.tables.angular(name, *grid.directions)
             grid = self.grid(name)
             if name == "film_gloss" and self.slab is not None:
-                return grid, self.gloss_weight() * self.tables.surface_gloss(name,
-                                                                             *grid.directions)
-            return grid, self.tables.surface_gloss(name, *grid.directions)
+                return grid, self.gloss_weight() * self.surface_on_grid(name)
+            return grid, self.surface_on_grid(name)
         return self._once(("target", name), compute)
 
     def albedo(self, name: str) -> NDArray[np.float64]:

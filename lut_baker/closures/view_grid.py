@@ -81,10 +81,16 @@ class ViewGrid:
         """:meth:`view_albedo`'s weight, ``light_weight cos(theta_i)`` (once per grid)."""
         return self.light_weight * self.cos_i
 
+    @cached_property
+    def _cosines(self) -> cc.LobeCosines:
+        """What every lobe on the pairs shares (once per grid: the fits' searches evaluate
+        many lobes on one grid)."""
+        return cc.LobeCosines(self.cos_h, self.cos_hi, self.cos_i, self.cos_o)
+
     def lobe(self, roughness: float, distribution: str = "GGX") -> np.ndarray:
-        """A Glossy lobe without Fresnel (1/sr) at the pairs, ``(V, A, P)``."""
-        return cc.microfacet_from_cosines(self.cos_h, self.cos_hi, self.cos_i, self.cos_o,
-                                          roughness, distribution)
+        """A Glossy lobe without Fresnel (1/sr) at the pairs, ``(V, A, P)``
+        (:func:`lut_baker.closures.cycles.microfacet_from_cosines`)."""
+        return cc.lobe_from_cosines(self._cosines, roughness, distribution)
 
     def error(self, f_fit: ArrayLike, f_ref: ArrayLike) -> float:
         """Relative RMS of the radiance ``f cos(theta_i)``, channels pooled (``f``:
