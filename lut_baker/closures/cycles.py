@@ -16,6 +16,7 @@ Functions
 - :func:`microfacet_shadowing` -- height-correlated ``G2 = 1 / (1 + Lambda_i + Lambda_o)``.
 - :func:`microfacet_reflection` -- microfacet BRDF ``D G2 F / (4 cos_i cos_o)`` with a Fresnel
   callable (Glossy BSDF: none; coat: dielectric; Principled specular: generalised Schlick);
+  :class:`DirectionPairs`, :func:`pair_reflection` -- the same for lobes sharing their pairs;
   :func:`microfacet_from_cosines` -- the Fresnel-free lobe from the four cosines it needs
   (:class:`LobeCosines`, :func:`lobe_from_cosines`: what depends on them alone made once).
 - :func:`dielectric_fresnel`, :func:`schlick_ior_fresnel` -- the Fresnel terms Cycles uses.
@@ -71,6 +72,8 @@ __all__ = [
     "ashikhmin_shirley_reflection",
     "microfacet_shadowing",
     "microfacet_reflection",
+    "DirectionPairs",
+    "pair_reflection",
     "microfacet_from_cosines",
     "LobeCosines",
     "lobe_from_cosines",
@@ -362,6 +365,22 @@ def schlick_ior_fresnel(cos_theta: ArrayLike, eta: ArrayLike,
     return start + (1.0 - start) * s
 
 
+class DirectionPairs:
+    """Light and view directions (unit vectors ``(..., 3)``, broadcast) and, made when first
+    asked for, the :class:`LobeCosines` of their half vectors: what every microfacet lobe at
+    these pairs shares (:func:`pair_reflection`)."""
+
+    def __init__(self, wi: ArrayLike, wo: ArrayLike) -> None:
+        self.wi, self.wo = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
+
+    @cached_property
+    def cosines(self) -> LobeCosines:
+        """``n.h``, ``h.wi``, ``n.wi``, ``n.wo`` of the pairs' half vectors."""
+        h = half_vector(self.wi, self.wo)
+        cos_hi = np.sum(h * self.wi, axis=-1)
+        return LobeCosines(h[..., 2], cos_hi, self.wi[..., 2], self.wo[..., 2])
+
+
 def microfacet_reflection(wi: ArrayLike, wo: ArrayLike, roughness: float,
                           fresnel: OfCosine | None = None,
                           distribution: str = "GGX") -> NDArray[np.float64]:
@@ -374,16 +393,20 @@ def microfacet_reflection(wi: ArrayLike, wo: ArrayLike, roughness: float,
     ``distribution``: ``GGX``, ``BECKMANN`` or ``ASHIKHMIN_SHIRLEY`` (which takes no Fresnel).
     0 where either direction is below the surface.
     """
+    return pair_reflection(DirectionPairs(wi, wo), roughness, fresnel, distribution)
+
+
+def pair_reflection(pairs: DirectionPairs, roughness: float, fresnel: OfCosine | None = None,
+                    distribution: str = "GGX") -> NDArray[np.float64]:
+    """:func:`microfacet_reflection` at :class:`DirectionPairs` (their cosines shared by every
+    lobe drawn there)."""
     if distribution == "ASHIKHMIN_SHIRLEY" and fresnel is not None:
         raise ValueError("the Ashikhmin-Shirley lobe takes no Fresnel in Cycles")
-    to_light, to_view = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
-    h = half_vector(to_light, to_view)
-    cos_hi = np.sum(h * to_light, axis=-1)
-    value = microfacet_from_cosines(h[..., 2], cos_hi, to_light[..., 2], to_view[..., 2],
-                                    roughness, distribution)
+    cosines = pairs.cosines
+    value = lobe_from_cosines(cosines, roughness, distribution)
     if fresnel is None:
         return value
-    f = np.asarray(fresnel(np.clip(cos_hi, 0.0, 1.0)))
+    f = np.asarray(fresnel(np.clip(cosines.cos_hi, 0.0, 1.0)))
     return (value[..., None] if f.ndim > value.ndim else value) * f
 
 
@@ -650,22 +673,22 @@ def principled_reflection(wi: ArrayLike, wo: ArrayLike,
     only, so the model is not reciprocal, like Cycles.  Subsurface counts as its albedo in
     ``base_color`` leaving Lambertian-like (its spread is separate, see the profiles).
     """
-    to_light, to_view = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
-    cos_o = np.clip(to_view[..., 2], 0.0, 1.0)
+    pairs = DirectionPairs(wi, wo)
+    cos_o = np.clip(pairs.wo[..., 2], 0.0, 1.0)
     eta, f0 = inputs.specular_eta_f0()
     base = lambert_reflection(np.minimum(np.maximum(inputs.base_color, 0.0), 1.0))
     if eta == 1.0:  # Specular IOR Level 0: Cycles allocates no specular closure
         lower = base * np.ones(cos_o.shape + (1,))
     else:
-        spec = microfacet_reflection(to_light, to_view, inputs.roughness,
-                                     lambda c: schlick_ior_fresnel(c, eta, f0))
+        spec = pair_reflection(pairs, inputs.roughness,
+                               lambda c: schlick_ior_fresnel(c, eta, f0))
         a_s = 1.0 - np.max(view_table(cos_o, _layering_nodes(
             float(inputs.roughness), float(eta), tuple(np.atleast_1d(f0).tolist()))), axis=-1)
         lower = spec + a_s[..., None] * base
     if inputs.coat_weight <= 0.0:
         return lower
-    coat = microfacet_reflection(to_light, to_view, inputs.coat_roughness,
-                                 lambda c: dielectric_fresnel(c, inputs.coat_ior))
+    coat = pair_reflection(pairs, inputs.coat_roughness,
+                           lambda c: dielectric_fresnel(c, inputs.coat_ior))
     terms = view_table(cos_o, _coat_nodes(float(inputs.coat_roughness),
                                           float(inputs.coat_ior)))
     a_c = np.clip(1.0 - inputs.coat_weight * terms[..., 1], 0.0, 1.0)

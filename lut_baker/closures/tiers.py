@@ -94,24 +94,25 @@ def principled_inputs(fit: ClosureFit, coverage: float, absorption: ArrayLike,
 class NumpyShaders(NumpyAlgebra):
     """The shader algebra (:class:`lut_baker.closures.tier_formulas.ShaderAlgebra`) on numpy:
     a shader is its BRDF ``(..., 3)`` at ``(wi, wo)``; rows read at ``wo``'s view angles; a
-    Glossy closure is its white lobe (``lobes`` by name, drawn by ``glossy(wi, wo, lobe)``)
-    times its colour, Diffuse and Subsurface closures Lambertian, a closure of colour 0 none
-    (it is never allocated); a Principled BSDF Cycles'
-    (:func:`lut_baker.closures.cycles.principled_reflection`)."""
+    Glossy closure is its white lobe (``lobes`` by name, drawn by ``glossy(pairs, lobe)``,
+    :class:`lut_baker.closures.cycles.DirectionPairs` shared by the lobes) times its colour,
+    Diffuse and Subsurface closures Lambertian, a closure of colour 0 none (it is never
+    allocated); a Principled BSDF Cycles' (:func:`lut_baker.closures.cycles.
+    principled_reflection`)."""
 
     def __init__(self, wi: NDArray[np.float64], wo: NDArray[np.float64],
                  rows: dict[str, Any], lobes: dict[str, LobeFit],
-                 glossy: Callable[[NDArray[np.float64], NDArray[np.float64], LobeFit],
-                                  NDArray[np.float64]]):
+                 glossy: Callable[[cc.DirectionPairs, LobeFit], NDArray[np.float64]]):
         super().__init__(rows, wo[..., 2])
         self.wi, self.wo, self._lobes, self._glossy = wi, wo, lobes, glossy
+        self._pairs = cc.DirectionPairs(wi, wo)
 
     def closure(self, closure: Closure) -> Any:
         colour = closure.product
         if not np.any(colour):
             return 0.0
         if closure.kind == "glossy":
-            return self._glossy(self.wi, self.wo, self._lobes[closure.name])[..., None] * colour
+            return self._glossy(self._pairs, self._lobes[closure.name])[..., None] * colour
         return cc.lambert_reflection(colour)
 
     def principled(self, sockets: dict[str, Any]) -> Any:
