@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, replace
-from functools import lru_cache
+from functools import cached_property, lru_cache
 from typing import Any
 
 import numpy as np
@@ -22,6 +22,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..bake import RESOLUTIONS, profile_radius
 from ..closures.closure_fit import ClosureFit
+from ..closures.cycles import DirectionPairs
 from ..closures.profiles import edge_response, profile_grid
 from ..closures.tier_parts import FitTargets
 from ..closures.tiers import (
@@ -172,6 +173,12 @@ class _Sphere:
     _parts: ReflectionParts | None = None
     _bare: NDArray[np.float64] | None = None
 
+    @cached_property
+    def pairs(self) -> DirectionPairs:
+        """The pixels' :class:`lut_baker.closures.cycles.DirectionPairs` (the replicas' lobes
+        share their cosines)."""
+        return DirectionPairs(self.wi, self.wo)
+
     def parts(self, tables: Tables) -> ReflectionParts:
         """The tables' lookups at the pixels (made once)."""
         if self._parts is None:
@@ -283,7 +290,7 @@ def _omission(tables: Tables, fit: ClosureFit, tier: str, sphere: _Sphere, w: fl
         return 0.0
     bare = sphere.bare(tables, a, fit) if over_shader else None
     kept, left_out = (tier_reflection(fit, tables, tier, w, a, gloss, (sphere.wi, sphere.wo),
-                                      over_shader=over_shader, bare=bare)
+                                      over_shader=over_shader, bare=bare, pairs=sphere.pairs)
                       for gloss in (1.0, 0.0))
     return float(np.sqrt(np.mean(((kept - left_out) * sphere.cos_i) ** 2)) / norm)
 

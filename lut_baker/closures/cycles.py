@@ -660,8 +660,8 @@ class PrincipledInputs:
         return eta, f0 * np.asarray(self.specular_tint, float)
 
 
-def principled_reflection(wi: ArrayLike, wo: ArrayLike,
-                          inputs: PrincipledInputs) -> NDArray[np.float64]:
+def principled_reflection(wi: ArrayLike, wo: ArrayLike, inputs: PrincipledInputs, *,
+                          pairs: DirectionPairs | None = None) -> NDArray[np.float64]:
     """The Principled BSDF's reflection (no cosine), RGB ``(..., 3)``, as Cycles layers it:
 
     ``w_c k(wo) coat(wi, wo) + a_c(wo) [spec(wi, wo) + a_s(wo) base / pi]``
@@ -672,8 +672,9 @@ def principled_reflection(wi: ArrayLike, wo: ArrayLike,
     :func:`layering_albedo` (``closure_layering_weight``): the attenuation depends on the view
     only, so the model is not reciprocal, like Cycles.  Subsurface counts as its albedo in
     ``base_color`` leaving Lambertian-like (its spread is separate, see the profiles).
+    ``pairs``: :class:`DirectionPairs` of ``(wi, wo)``, if made (shared with other lobes).
     """
-    pairs = DirectionPairs(wi, wo)
+    pairs = DirectionPairs(wi, wo) if pairs is None else pairs
     cos_o = np.clip(pairs.wo[..., 2], 0.0, 1.0)
     eta, f0 = inputs.specular_eta_f0()
     base = lambert_reflection(np.minimum(np.maximum(inputs.base_color, 0.0), 1.0))

@@ -102,10 +102,11 @@ class NumpyShaders(NumpyAlgebra):
 
     def __init__(self, wi: NDArray[np.float64], wo: NDArray[np.float64],
                  rows: dict[str, Any], lobes: dict[str, LobeFit],
-                 glossy: Callable[[cc.DirectionPairs, LobeFit], NDArray[np.float64]]):
+                 glossy: Callable[[cc.DirectionPairs, LobeFit], NDArray[np.float64]],
+                 pairs: cc.DirectionPairs | None = None):
         super().__init__(rows, wo[..., 2])
         self.wi, self.wo, self._lobes, self._glossy = wi, wo, lobes, glossy
-        self._pairs = cc.DirectionPairs(wi, wo)
+        self._pairs = cc.DirectionPairs(wi, wo) if pairs is None else pairs
 
     def closure(self, closure: Closure) -> Any:
         colour = closure.product
@@ -116,7 +117,8 @@ class NumpyShaders(NumpyAlgebra):
         return cc.lambert_reflection(colour)
 
     def principled(self, sockets: dict[str, Any]) -> Any:
-        return cc.principled_reflection(self.wi, self.wo, _principled_inputs(sockets)[0])
+        return cc.principled_reflection(self.wi, self.wo, _principled_inputs(sockets)[0],
+                                        pairs=self._pairs)
 
     @staticmethod
     def add(*shaders: Any) -> Any:
@@ -132,17 +134,20 @@ class NumpyShaders(NumpyAlgebra):
 
 def tier_replica(fit: ClosureFit, tables: Tables, name: str | Tier, coverage: float,
                  absorption: ArrayLike, gloss: float = 1.0,
-                 directions: Directions | None = None) -> NDArray[np.float64]:
+                 directions: Directions | None = None, *,
+                 pairs: cc.DirectionPairs | None = None) -> NDArray[np.float64]:
     """Tier ``name``'s (or a :class:`~lut_baker.closures.tier_registry.Tier`'s) BRDF
     ``(..., 3)`` at the angular nodes or at ``directions``
     ``(wi, wo)``: its shader (:attr:`~lut_baker.closures.tier_registry.Tier.shader`) at a
     coverage, absorption and Gloss evaluated by :class:`NumpyShaders`, its image's rows read
-    as Blender reads them (linear between texel centres)."""
+    as Blender reads them (linear between texel centres).  ``pairs``: the
+    :class:`lut_baker.closures.cycles.DirectionPairs` of ``directions``, if made (their
+    cosines shared by the replicas there)."""
     found = name if isinstance(name, Tier) else held(fit, name)
     wi, wo = tables.node_directions() if directions is None else directions
     image = found.image(fit)
     rows = {} if image is None else dict(zip(image.rows, image.texels, strict=True))
-    ops = NumpyShaders(wi, wo, rows, found.lobes(fit), found.glossy)
+    ops = NumpyShaders(wi, wo, rows, found.lobes(fit), found.glossy, pairs)
     value = np.asarray(found.shader(fit, _inputs(fit, coverage, absorption, gloss), ops, None))
     shape = np.broadcast_shapes(wi.shape, wo.shape)[:-1] + (3,)
     return value if value.shape == shape else np.broadcast_to(value, shape).copy()
@@ -151,17 +156,19 @@ def tier_replica(fit: ClosureFit, tables: Tables, name: str | Tier, coverage: fl
 def tier_reflection(fit: ClosureFit, tables: Tables, name: str, coverage: float,
                     absorption: ArrayLike, gloss: float = 1.0,
                     directions: Directions | None = None, *, over_shader: bool = False,
-                    bare: NDArray[np.float64] | None = None) -> NDArray[np.float64]:
+                    bare: NDArray[np.float64] | None = None,
+                    pairs: cc.DirectionPairs | None = None) -> NDArray[np.float64]:
     """Tier ``name``'s BRDF ``(..., 3)`` (:func:`tier_replica`) at the angular nodes or at
     ``directions``.  ``over_shader``: the group goes over the artist's shader, which is the
     bare skin (the tables' bare skin stands for it, with the film as a slab on the fit's skin;
     the Gloss input leaves it alone): the tier's covered skin (its replica at coverage 1) and
     that bare skin (``bare``, if already computed at these directions), mixed by coverage as
-    areas."""
+    areas.  ``pairs``: as :func:`tier_replica`'s."""
     if not over_shader:
-        return tier_replica(fit, tables, name, coverage, absorption, gloss, directions)
+        return tier_replica(fit, tables, name, coverage, absorption, gloss, directions,
+                            pairs=pairs)
     wi, wo = tables.node_directions() if directions is None else directions
-    covered = tier_replica(fit, tables, name, 1.0, absorption, gloss, (wi, wo))
+    covered = tier_replica(fit, tables, name, 1.0, absorption, gloss, (wi, wo), pairs=pairs)
     if bare is None:
         bare = (tables.made_up_reflection(wi, wo, 0.0, absorption) if fit.slab is None
                 else slab_bare(fit, tables, (wi, wo)))
@@ -236,11 +243,12 @@ def tier_errors(fit: ClosureFit, tables: Tables, coverage: float, absorption: Ar
         if over_shader:
             bare = slab_bare(fit, tables, directions, lookup)
     out = {}
+    pairs = cc.DirectionPairs(*directions)  # the tiers' lobes share their cosines
     for name in TIERS:
         if name not in tiers:
             continue
         f = tier_reflection(fit, tables, name, coverage, absorption, gloss, directions,
-                            over_shader=over_shader, bare=bare)
+                            over_shader=over_shader, bare=bare, pairs=pairs)
         out[name] = TierError(tier=name, coverage=float(coverage),
                               absorption=tuple(_absorption(absorption).tolist()),
                               rms=grid.error(f, reference),
