@@ -138,7 +138,8 @@ class FitTargets:
 
     def slab_parts(self, theta_deg: ArrayLike) -> SlabParts:
         """The slab's 1-D parts at the fit's thickness and polar angles ``theta_deg``."""
-        return self.slab_tables().at(self.thickness_um, theta_deg)
+        return self._once("slice", lambda: self.slab_tables().sliced(
+            self.thickness_um)).at(theta_deg)
 
     def gloss_weight(self) -> NDArray[np.float64]:
         """The weight of eq. 2's gloss lobe (the tables' ``film_gloss``) the tiers draw as the

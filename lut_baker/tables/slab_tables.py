@@ -35,7 +35,8 @@ Functions and types
 - :data:`THICKNESS_MIN_UM`, :data:`THICKNESS_MAX_UM`, :data:`THICKNESS_NODES` -- the axis.
 - :func:`thickness_nodes`, :func:`thickness_index` -- its nodes and the closed-form index.
 - :class:`SlabTables` -- the tables, with ``at`` (the 1-D parts at a thickness).
-- :class:`SlabParts` -- the 1-D parts at one thickness.
+- :class:`SlabParts` -- the 1-D parts at one thickness; :class:`SlabSlice` -- the 1-D tables
+  at one thickness (``SlabTables.sliced``), read at any angles.
 - :func:`surface_gloss`, :func:`surface_gloss_albedo` -- the film surface's gloss (``k``
   times the tables' ``film_gloss``) and its directional albedo.
 - :func:`slab_reflection` -- made-up skin's BRDF at a thickness from the tables (optionally
@@ -68,6 +69,7 @@ __all__ = [
     "thickness_index",
     "SlabTables",
     "SlabParts",
+    "SlabSlice",
     "surface_gloss",
     "surface_gloss_albedo",
     "slab_reflection",
@@ -123,6 +125,31 @@ class SlabParts(NamedTuple):
     below: NDArray[np.float64]
     film_albedo: NDArray[np.float64]
     body_gloss: NDArray[np.float64]
+
+
+class SlabSlice(NamedTuple):
+    """The 1-D tables of ``slab`` at one thickness (:meth:`SlabTables.sliced`):
+    ``top_albedo``, ``through``, ``film_albedo`` ``(n_theta, 3)`` on its angular grid,
+    ``through_mean``, ``below``, ``body_gloss`` ``(3,)``; :meth:`at` reads them at polar
+    angles."""
+
+    slab: SlabTables
+    thickness_um: float
+    top_albedo: NDArray[np.float64]
+    through: NDArray[np.float64]
+    through_mean: NDArray[np.float64]
+    below: NDArray[np.float64]
+    film_albedo: NDArray[np.float64]
+    body_gloss: NDArray[np.float64]
+
+    def at(self, theta_deg: ArrayLike) -> SlabParts:
+        """The 1-D parts at polar angles ``theta_deg`` (degrees)."""
+        x = self.slab.theta_index(theta_deg)
+        return SlabParts(top_albedo=_linear(self.top_albedo, x),
+                         through=_linear(self.through, x),
+                         through_mean=self.through_mean, below=self.below,
+                         film_albedo=_linear(self.film_albedo, x),
+                         body_gloss=self.body_gloss)
 
 
 @dataclass(frozen=True, eq=False)
@@ -186,13 +213,17 @@ class SlabTables:
 
     def at(self, thickness_um: float, theta_deg: ArrayLike) -> SlabParts:
         """The 1-D parts at ``thickness_um`` and polar angles ``theta_deg`` (degrees)."""
-        x = self.theta_index(theta_deg)
-        return SlabParts(top_albedo=_linear(self._along(self.top_albedo, thickness_um), x),
-                         through=_linear(self._along(self.through, thickness_um), x),
-                         through_mean=self._along(self.through_mean, thickness_um),
-                         below=self._along(self.below, thickness_um),
-                         film_albedo=_linear(self._along(self.film_albedo, thickness_um), x),
-                         body_gloss=self._along(self.body_gloss, thickness_um))
+        return self.sliced(thickness_um).at(theta_deg)
+
+    def sliced(self, thickness_um: float) -> SlabSlice:
+        """The 1-D tables at one thickness (:class:`SlabSlice`, read-only: read at many
+        angles, they are interpolated along the thickness once)."""
+        tables = {name: self._along(getattr(self, name), thickness_um)
+                  for name in ("top_albedo", "through", "through_mean", "below",
+                               "film_albedo", "body_gloss")}
+        for table in tables.values():
+            table.setflags(write=False)
+        return SlabSlice(self, float(thickness_um), **tables)
 
     def through_at(self, thickness_um: float, w: ArrayLike) -> NDArray[np.float64]:
         """``t`` (dimensionless, ``(..., 3)``) at one thickness for unit directions ``(..., 3)``
