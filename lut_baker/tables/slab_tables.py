@@ -128,28 +128,23 @@ class SlabParts(NamedTuple):
 
 
 class SlabSlice(NamedTuple):
-    """The 1-D tables of ``slab`` at one thickness (:meth:`SlabTables.sliced`):
-    ``top_albedo``, ``through``, ``film_albedo`` ``(n_theta, 3)`` on its angular grid,
-    ``through_mean``, ``below``, ``body_gloss`` ``(3,)``; :meth:`at` reads them at polar
+    """The 1-D tables of ``slab`` at one thickness (:meth:`SlabTables.sliced`): ``tables``,
+    :class:`SlabParts` on the slab's own angular grid; :meth:`at` reads them at polar
     angles."""
 
     slab: SlabTables
     thickness_um: float
-    top_albedo: NDArray[np.float64]
-    through: NDArray[np.float64]
-    through_mean: NDArray[np.float64]
-    below: NDArray[np.float64]
-    film_albedo: NDArray[np.float64]
-    body_gloss: NDArray[np.float64]
+    tables: SlabParts
 
     def at(self, theta_deg: ArrayLike) -> SlabParts:
         """The 1-D parts at polar angles ``theta_deg`` (degrees)."""
         x = self.slab.theta_index(theta_deg)
-        return SlabParts(top_albedo=_linear(self.top_albedo, x),
-                         through=_linear(self.through, x),
-                         through_mean=self.through_mean, below=self.below,
-                         film_albedo=_linear(self.film_albedo, x),
-                         body_gloss=self.body_gloss)
+        tables = self.tables
+        return SlabParts(top_albedo=_linear(tables.top_albedo, x),
+                         through=_linear(tables.through, x),
+                         through_mean=tables.through_mean, below=tables.below,
+                         film_albedo=_linear(tables.film_albedo, x),
+                         body_gloss=tables.body_gloss)
 
 
 @dataclass(frozen=True, eq=False)
@@ -219,11 +214,10 @@ class SlabTables:
         """The 1-D tables at one thickness (:class:`SlabSlice`, read-only: read at many
         angles, they are interpolated along the thickness once)."""
         tables = {name: self._along(getattr(self, name), thickness_um)
-                  for name in ("top_albedo", "through", "through_mean", "below",
-                               "film_albedo", "body_gloss")}
+                  for name in SlabParts._fields}
         for table in tables.values():
             table.setflags(write=False)
-        return SlabSlice(self, float(thickness_um), **tables)
+        return SlabSlice(self, float(thickness_um), SlabParts(**tables))
 
     def through_at(self, thickness_um: float, w: ArrayLike) -> NDArray[np.float64]:
         """``t`` (dimensionless, ``(..., 3)``) at one thickness for unit directions ``(..., 3)``
