@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, replace
-from functools import lru_cache
+from functools import cached_property, lru_cache
 from typing import Any
 
 import numpy as np
@@ -22,14 +22,23 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..bake import RESOLUTIONS, profile_radius
 from ..closures.closure_fit import ClosureFit
+from ..closures.cycles import DirectionPairs
 from ..closures.profiles import edge_response, profile_grid
 from ..closures.tier_parts import FitTargets
-from ..closures.tiers import TierError, reference_reflection, tier_errors, tier_reflection
+from ..closures.tiers import (
+    TierError,
+    reference_reflection,
+    slab_bare,
+    slab_lookup_of,
+    tier_errors,
+    tier_reflection,
+)
 from ..model.dipole import dipole_profile, dipole_total_reflectance
 from ..model.made_up_skin import combine, coverage_weights, mix_slots
 from ..model.presets import made_up_skin
-from ..numerics.geometry import polar_angle_deg, sphere_directions
+from ..numerics.geometry import sphere_directions
 from ..numerics.quadrature import trapezoid_weights
+from ..tables.slab_tables import SlabLookup
 from ..tables.table_set import ReflectionParts, Tables, radius_nodes
 from .measured import by_number, load
 
@@ -149,23 +158,43 @@ def profile_mean_radius_mm(radius_mm: ArrayLike, profile: ArrayLike) -> float:
 @dataclass
 class _Sphere:
     """A sphere's lit pixels under one distant light (orthographic, the reference's
-    framing): their directions, ``cos(theta_i)`` ``(N, 1)``, the tables' lookups there
-    (:meth:`lut_baker.tables.table_set.Tables.reflection_parts`, made once for the total, the
-    bare skin and the shares) and the tables' radiance ``f cos(theta_i)`` at a coverage and
-    absorption, with its RMS ``norm``."""
+    framing): their directions, ``cos(theta_i)`` ``(N, 1)``, the tables' lookups there (made
+    once for the total, the bare skin and the shares: with the film as a slab the slab's,
+    ``lookup``, :func:`lut_baker.closures.tiers.slab_lookup_of`, and the paper's tables',
+    :meth:`lut_baker.tables.table_set.Tables.reflection_parts`, only when asked for) and the
+    tables' radiance ``f cos(theta_i)`` at a coverage and absorption, with its RMS ``norm``."""
 
     wi: NDArray[np.float64]
     wo: NDArray[np.float64]
     cos_i: NDArray[np.float64]
-    parts: ReflectionParts
     total: NDArray[np.float64]
     norm: float
+    lookup: SlabLookup | None = None
+    _parts: ReflectionParts | None = None
     _bare: NDArray[np.float64] | None = None
 
-    def bare(self, tables: Tables, absorption: ArrayLike) -> NDArray[np.float64]:
-        """The tables' bare skin's BRDF at the pixels (computed once)."""
+    @cached_property
+    def pairs(self) -> DirectionPairs:
+        """The pixels' :class:`lut_baker.closures.cycles.DirectionPairs` (the replicas' lobes
+        share their cosines)."""
+        return DirectionPairs(self.wi, self.wo)
+
+    def parts(self, tables: Tables) -> ReflectionParts:
+        """The tables' lookups at the pixels (made once)."""
+        if self._parts is None:
+            self._parts = tables.reflection_parts(self.wi, self.wo)
+        return self._parts
+
+    def bare(self, tables: Tables, absorption: ArrayLike,
+             fit: ClosureFit | None = None) -> NDArray[np.float64]:
+        """The bare skin's BRDF at the pixels (computed once): with the film as a slab the
+        slab fit's (:func:`lut_baker.closures.tiers.slab_bare`, from the sphere's lookups),
+        else the tables'."""
         if self._bare is None:
-            self._bare = tables.mixed_reflection(self.parts, 0.0, absorption)
+            if self.lookup is not None and fit is not None and fit.slab is not None:
+                self._bare = slab_bare(fit, tables, (self.wi, self.wo), self.lookup)
+            else:
+                self._bare = tables.mixed_reflection(self.parts(tables), 0.0, absorption)
         return self._bare
 
 
@@ -176,21 +205,27 @@ def _sphere(tables: Tables, light_deg: float, w: float, a: ArrayLike, resolution
     (:func:`lut_baker.closures.tiers.reference_reflection`)."""
     _, wi, wo = sphere_directions(resolution, light_deg)
     cos_i = wi[:, 2:3]
-    parts = tables.reflection_parts(wi, wo)
-    reflection = (tables.mixed_reflection(parts, w, a) if fit is None or fit.slab is None
-                  else reference_reflection(fit, tables, w, a, (wi, wo)))
-    total = reflection * cos_i
-    return _Sphere(wi, wo, cos_i, parts, total, float(np.sqrt(np.mean(total**2))))
+    if fit is None or fit.slab is None:
+        sphere = _Sphere(wi, wo, cos_i, np.zeros(0), 0.0)
+        reflection = tables.mixed_reflection(sphere.parts(tables), w, a)
+    else:
+        sphere = _Sphere(wi, wo, cos_i, np.zeros(0), 0.0,
+                         lookup=slab_lookup_of(fit, tables, (wi, wo)))
+        reflection = reference_reflection(fit, tables, w, a, (wi, wo), sphere.lookup)
+    sphere.total = reflection * cos_i
+    sphere.norm = float(np.sqrt(np.mean(sphere.total**2)))
+    return sphere
 
 
 def _shares(tables: Tables, sphere: _Sphere, w: float, a: ArrayLike) -> tuple[float, float]:
     """:func:`gloss_and_skin_shares` on a sphere's pixels (its lookups reused)."""
-    cos_i, looked_up = sphere.cos_i, sphere.parts.angular
+    cos_i, parts = sphere.cos_i, sphere.parts(tables)
+    looked_up = parts.angular
     weights = coverage_weights(w, a)
     gloss = combine(weights, **mix_slots(film_gloss=looked_up["film_gloss"],
                                          path3_gloss=looked_up["path3_gloss"],
                                          skin_gloss=looked_up["skin_gloss"])) * cos_i
-    t_i, t_o = sphere.parts.t_i, sphere.parts.t_o
+    t_i, t_o = parts.t_i, parts.t_o
     skin = combine(weights, **mix_slots(through_film=tables.skin_diffuse * t_i * t_o,
                                         skin=tables.skin_diffuse)) * cos_i
     norm = sphere.norm
@@ -199,32 +234,35 @@ def _shares(tables: Tables, sphere: _Sphere, w: float, a: ArrayLike) -> tuple[fl
     return float(np.sqrt(np.mean(gloss**2)) / norm), float(np.sqrt(np.mean(skin**2)) / norm)
 
 
-def _slab_shares(tables: Tables, fit: ClosureFit, sphere: _Sphere, w: float
-                 ) -> tuple[float, float]:
+def _slab_shares(tables: Tables, fit: ClosureFit, sphere: _Sphere, w: float,
+                 targets: FitTargets | None = None) -> tuple[float, float]:
     """:func:`_shares` with the film as a slab at the fit's thickness (docs/model.md, "The
     tiers at a thickness"): the gloss is the film's (its surface's and its body's share of
     eq. 2's lobe), the skin's gloss through the film (``top`` less the film's body) and the bare
     skin's; what spreads is the skin's
-    diffuse light ``a t t / (pi (1 - a c))`` and the bare skin's."""
+    diffuse light ``a t t / (pi (1 - a c))`` and the bare skin's.  The sphere's slab lookups
+    are reused; ``targets``: the slab's :class:`FitTargets` at the fit's thickness, if
+    made (shared by the spheres)."""
     wi, wo, cos_i = sphere.wi, sphere.wo, sphere.cos_i
     slab = fit.slab
     if slab is None:
         raise ValueError("the fit holds no slab: use the paper film's shares")
     h = slab.thickness_um
-    targets = FitTargets(tables, 2, h)
+    targets = FitTargets(tables, 2, h) if targets is None else targets
+    found = sphere.lookup if sphere.lookup is not None else \
+        slab_lookup_of(fit, tables, (wi, wo))
     weights = coverage_weights(w, 0.0)
-    through_gloss = targets.slab_tables().top_at(h, wi, wo) - targets.film_body(wi, wo)
-    film_gloss = targets.gloss_weight() * tables.surface_gloss("film_gloss", wi, wo)
+    through_gloss = found.top - targets.film_body(wi, wo, found.film_gloss)
+    film_gloss = targets.gloss_weight() * found.film_gloss
     gloss = combine(weights, **mix_slots(film_gloss=film_gloss,
                                          path3_gloss=through_gloss,
-                                         skin_gloss=tables.angular("skin_gloss", wi, wo))
+                                         skin_gloss=found.skin_gloss)
                     ) * cos_i
     albedo = np.asarray(fit.skin_albedo, float)
     under = albedo * (1.0 if slab.skin_under is None else np.asarray(slab.skin_under, float))
-    t_i = targets.slab_parts(polar_angle_deg(wi)).through
-    t_o = targets.slab_parts(polar_angle_deg(wo)).through
     skin = combine(weights, **mix_slots(
-        through_film=under * t_i * t_o / (np.pi * (1.0 - under * slab.below)),
+        through_film=under * found.through_i * found.through_o
+        / (np.pi * (1.0 - under * slab.below)),
         skin=albedo / np.pi)) * cos_i
     norm = sphere.norm
     if not norm > 0:
@@ -250,9 +288,9 @@ def _omission(tables: Tables, fit: ClosureFit, tier: str, sphere: _Sphere, w: fl
     norm = sphere.norm
     if not norm > 0:
         return 0.0
-    bare = sphere.bare(tables, a) if over_shader else None
+    bare = sphere.bare(tables, a, fit) if over_shader else None
     kept, left_out = (tier_reflection(fit, tables, tier, w, a, gloss, (sphere.wi, sphere.wo),
-                                      over_shader=over_shader, bare=bare)
+                                      over_shader=over_shader, bare=bare, pairs=sphere.pairs)
                       for gloss in (1.0, 0.0))
     return float(np.sqrt(np.mean(((kept - left_out) * sphere.cos_i) ** 2)) / norm)
 
@@ -332,7 +370,8 @@ def traits_from_tables(tables: Tables, fit: ClosureFit, coverage: float | None =
     if fit.slab is not None:  # the film as a slab: its own made-up skin and parts
         spheres = {float(angle): _sphere(tables, angle, w, a, 48, fit)
                    for angle in lights_deg}
-        shares = {angle: _slab_shares(tables, fit, sphere, w)
+        targets = FitTargets(tables, 2, fit.slab.thickness_um)
+        shares = {angle: _slab_shares(tables, fit, sphere, w, targets)
                   for angle, sphere in spheres.items()}
     else:
         spheres = {float(angle): _sphere(tables, angle, w, a, 48) for angle in lights_deg}

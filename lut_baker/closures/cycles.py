@@ -16,11 +16,14 @@ Functions
 - :func:`microfacet_shadowing` -- height-correlated ``G2 = 1 / (1 + Lambda_i + Lambda_o)``.
 - :func:`microfacet_reflection` -- microfacet BRDF ``D G2 F / (4 cos_i cos_o)`` with a Fresnel
   callable (Glossy BSDF: none; coat: dielectric; Principled specular: generalised Schlick);
-  :func:`microfacet_from_cosines` -- the Fresnel-free lobe from the four cosines it needs.
+  :class:`DirectionPairs`, :func:`pair_reflection` -- the same for lobes sharing their pairs;
+  :func:`microfacet_from_cosines` -- the Fresnel-free lobe from the four cosines it needs
+  (:class:`LobeCosines`, :func:`lobe_from_cosines`: what depends on them alone made once).
 - :func:`dielectric_fresnel`, :func:`schlick_ior_fresnel` -- the Fresnel terms Cycles uses.
 - :func:`directional_albedo` -- ``Int f cos(theta_i) dwi`` of any BRDF at view angles.
 - :func:`microfacet_albedo` -- the same for a microfacet lobe, by quadrature over normals (views
-  in chunks of :data:`ALBEDO_CHUNK` nodes).
+  in chunks of :data:`ALBEDO_CHUNK` nodes); :func:`microfacet_albedos` -- without and with a
+  Fresnel term from one pass.
 - :func:`layering_albedo` -- Cycles' albedo estimate that attenuates the layers below a coat or
   a specular layer (``bsdf_microfacet_estimate_albedo``).
 - :func:`dielectric_fss`, :func:`ggx_energy_compensation` (:func:`ggx_energy_scale` from
@@ -47,7 +50,8 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from functools import lru_cache
+from functools import cached_property, lru_cache
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -68,7 +72,11 @@ __all__ = [
     "ashikhmin_shirley_reflection",
     "microfacet_shadowing",
     "microfacet_reflection",
+    "DirectionPairs",
+    "pair_reflection",
     "microfacet_from_cosines",
+    "LobeCosines",
+    "lobe_from_cosines",
     "principled_uniform",
     "dielectric_fss",
     "ggx_energy_compensation",
@@ -79,6 +87,7 @@ __all__ = [
     "schlick_ior_fresnel",
     "directional_albedo",
     "microfacet_albedo",
+    "microfacet_albedos",
     "ALBEDO_CHUNK",
     "layering_albedo",
     "lambert_reflection",
@@ -113,16 +122,24 @@ OfCosine = Callable[[NDArray[np.float64]], ArrayLike]
 def ggx_distribution(cos_h: ArrayLike, alpha: Real) -> NDArray[np.float64]:
     """GGX ``D = alpha^2 / (pi ((1 - c^2) + alpha^2 c^2)^2)`` at ``c = N.H`` (Walter 2007)."""
     c2 = np.minimum(np.square(np.asarray(cos_h, float)), 1.0)
-    a2 = np.square(alpha)
-    return a2 / (np.pi * np.square((1.0 - c2) + a2 * c2))
+    return _ggx_d(c2, 1.0 - c2, np.square(alpha))
+
+
+def _ggx_d(c2: Any, one_minus: Any, a2: Any) -> NDArray[np.float64]:
+    """:func:`ggx_distribution` from ``c^2``, ``1 - c^2`` and ``alpha^2``."""
+    return a2 / (np.pi * np.square(one_minus + a2 * c2))
 
 
 def beckmann_distribution(cos_h: ArrayLike, alpha: Real) -> NDArray[np.float64]:
     """Beckmann ``D = exp(-tan^2 / alpha^2) / (pi alpha^2 c^4)`` at ``c = N.H``."""
     c2 = np.clip(np.square(np.asarray(cos_h, float)), 1e-300, 1.0)
-    a2 = np.square(alpha)
+    return _beckmann_d(c2, 1.0 - c2, np.square(alpha))
+
+
+def _beckmann_d(c2: Any, one_minus: Any, a2: Any) -> NDArray[np.float64]:
+    """:func:`beckmann_distribution` from ``c^2``, ``1 - c^2`` and ``alpha^2``."""
     with np.errstate(over="ignore"):
-        return np.exp(-(1.0 - c2) / (c2 * a2)) / (np.pi * a2 * c2 * c2)
+        return np.exp(-one_minus / (c2 * a2)) / (np.pi * a2 * c2 * c2)
 
 
 def _in_place(values: object) -> bool:
@@ -132,22 +149,34 @@ def _in_place(values: object) -> bool:
     return isinstance(values, np.ndarray) and values.ndim > 0
 
 
-def _alpha_tan2(cos_theta: ArrayLike, alpha: Real) -> NDArray[np.float64]:
-    """``alpha^2 tan^2(theta)`` at ``cos(theta)`` (0 for a cosine of 1 or more)."""
+def _tan2(cos_theta: ArrayLike) -> NDArray[np.float64]:
+    """``tan^2(theta)`` at ``cos(theta)`` (0 for a cosine of 1 or more)."""
     t2 = np.square(np.asarray(cos_theta, float))
     if not _in_place(t2):
-        return np.square(alpha) * np.maximum(1.0 / np.maximum(t2, 1e-300) - 1.0, 0.0)
+        return np.maximum(1.0 / np.maximum(t2, 1e-300) - 1.0, 0.0)
     np.maximum(t2, 1e-300, out=t2)
     np.divide(1.0, t2, out=t2)
     t2 -= 1.0
     np.maximum(t2, 0.0, out=t2)
+    return t2
+
+
+def _alpha_tan2(cos_theta: ArrayLike, alpha: Real) -> NDArray[np.float64]:
+    """``alpha^2 tan^2(theta)`` at ``cos(theta)`` (0 for a cosine of 1 or more)."""
+    t2 = _tan2(cos_theta)
+    if not _in_place(t2):
+        return np.square(alpha) * t2
     t2 *= np.square(alpha)
     return t2
 
 
 def ggx_lambda(cos_theta: ArrayLike, alpha: Real) -> NDArray[np.float64]:
     """Smith ``Lambda = (sqrt(1 + alpha^2 tan^2) - 1) / 2`` of GGX (Heitz 2014, eq. 72)."""
-    value = _alpha_tan2(cos_theta, alpha)
+    return _ggx_lambda_of(_alpha_tan2(cos_theta, alpha))
+
+
+def _ggx_lambda_of(value: Any) -> NDArray[np.float64]:
+    """:func:`ggx_lambda` from ``alpha^2 tan^2`` (an array is worked on in place)."""
     if not _in_place(value):
         return 0.5 * (np.sqrt(1.0 + value) - 1.0)
     value += 1.0
@@ -160,7 +189,11 @@ def ggx_lambda(cos_theta: ArrayLike, alpha: Real) -> NDArray[np.float64]:
 def beckmann_lambda(cos_theta: ArrayLike, alpha: Real) -> NDArray[np.float64]:
     """Smith ``Lambda`` of Beckmann, the rational approximation Cycles uses (0 where
     ``alpha^2 tan^2 < 0.39``)."""
-    t2 = _alpha_tan2(cos_theta, alpha)
+    return _beckmann_lambda_of(_alpha_tan2(cos_theta, alpha))
+
+
+def _beckmann_lambda_of(t2: Any) -> NDArray[np.float64]:
+    """:func:`beckmann_lambda` from ``alpha^2 tan^2``."""
     a = 1.0 / np.sqrt(np.maximum(t2, 1e-300))
     value = ((0.396 * a - 1.259) * a + 1.0) / ((2.181 * a + 3.535) * a)
     return np.where(t2 < 0.39, 0.0, value)
@@ -169,6 +202,7 @@ def beckmann_lambda(cos_theta: ArrayLike, alpha: Real) -> NDArray[np.float64]:
 DISTRIBUTIONS = {"GGX": (ggx_distribution, ggx_lambda),
                  "BECKMANN": (beckmann_distribution, beckmann_lambda)}
 """Blender's microfacet distributions replicated: ``(D, Lambda)`` by identifier."""
+_LAMBDA_OF_TAN2 = {"GGX": _ggx_lambda_of, "BECKMANN": _beckmann_lambda_of}
 GLOSSY_DISTRIBUTIONS = ("GGX", "BECKMANN", "ASHIKHMIN_SHIRLEY")
 """The Glossy BSDF's distributions the replicas cover (Multiscatter GGX is left out)."""
 
@@ -187,6 +221,57 @@ def ashikhmin_shirley_reflection(wi: ArrayLike, wo: ArrayLike,
     return microfacet_reflection(wi, wo, roughness, distribution="ASHIKHMIN_SHIRLEY")
 
 
+class LobeCosines:
+    """What :func:`microfacet_from_cosines` computes of its cosines alone, whatever the
+    roughness: made once where many lobes are evaluated on the same pairs (a fit's view grid,
+    :meth:`lut_baker.closures.view_grid.ViewGrid.lobe`), each part when first needed.
+    ``cos_h`` (``n.h``), ``cos_hi`` (``h.wi``), ``cos_i``, ``cos_o``, broadcasting."""
+
+    def __init__(self, cos_h: NDArray[np.float64], cos_hi: NDArray[np.float64],
+                 cos_i: ArrayLike, cos_o: ArrayLike) -> None:
+        self.cos_h, self.cos_hi = cos_h, cos_hi
+        self.cos_i, self.cos_o = np.asarray(cos_i, float), np.asarray(cos_o, float)
+        self.upper = (self.cos_i > 0.0) & (self.cos_o > 0.0)
+
+    @cached_property
+    def safe_i(self) -> NDArray[np.float64]:
+        """``cos_i``, 1 where a direction is below the surface (each cosine kept at its own
+        shape: a view's Lambda once per view, not per pair; where the other one is below the
+        surface the value is dropped anyway)."""
+        cos_i, cos_o = self.cos_i, self.cos_o
+        return (np.where(self.upper, cos_i, 1.0) if cos_i.size >= cos_o.size
+                else np.where(cos_i > 0.0, cos_i, 1.0))
+
+    @cached_property
+    def safe_o(self) -> NDArray[np.float64]:
+        """``cos_o``, 1 where it is below the surface (as :attr:`safe_i`)."""
+        cos_i, cos_o = self.cos_i, self.cos_o
+        return (np.where(self.upper, cos_o, 1.0) if cos_o.size > cos_i.size
+                else np.where(cos_o > 0.0, cos_o, 1.0))
+
+    @cached_property
+    def tan2(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """``tan^2`` of :attr:`safe_i` and :attr:`safe_o`."""
+        return _tan2(self.safe_i), _tan2(self.safe_o)
+
+    @cached_property
+    def denominator(self) -> NDArray[np.float64]:
+        """``4 cos_i cos_o`` (safe)."""
+        return 4.0 * self.safe_i * self.safe_o
+
+    @cached_property
+    def ggx_c2(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """``(c^2, 1 - c^2)`` of ``n.h`` as :func:`ggx_distribution` clamps it."""
+        c2 = np.minimum(np.square(np.asarray(self.cos_h, float)), 1.0)
+        return c2, 1.0 - c2
+
+    @cached_property
+    def beckmann_c2(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """``(c^2, 1 - c^2)`` of ``n.h`` as :func:`beckmann_distribution` clamps it."""
+        c2 = np.clip(np.square(np.asarray(self.cos_h, float)), 1e-300, 1.0)
+        return c2, 1.0 - c2
+
+
 def microfacet_from_cosines(cos_h: NDArray[np.float64], cos_hi: NDArray[np.float64],
                             cos_i: ArrayLike, cos_o: ArrayLike, roughness: float,
                             distribution: str = "GGX") -> NDArray[np.float64]:
@@ -198,27 +283,34 @@ def microfacet_from_cosines(cos_h: NDArray[np.float64], cos_hi: NDArray[np.float
     - ``ASHIKHMIN_SHIRLEY``: ``(e + 1) / (8 pi) (n.h)^e / ((h.wi) max(cos_i, cos_o))``
       (``bsdf_ashikhmin_shirley_eval``).
     """
-    cos_i, cos_o = np.asarray(cos_i, float), np.asarray(cos_o, float)
-    upper = (cos_i > 0.0) & (cos_o > 0.0)
+    return lobe_from_cosines(LobeCosines(cos_h, cos_hi, cos_i, cos_o), roughness,
+                             distribution)
+
+
+def lobe_from_cosines(cosines: LobeCosines, roughness: float,
+                      distribution: str = "GGX") -> NDArray[np.float64]:
+    """:func:`microfacet_from_cosines` from its cosines' :class:`LobeCosines` (the same
+    numbers; what depends on the cosines alone computed once for many lobes)."""
+    cos_i, cos_o, upper = cosines.cos_i, cosines.cos_o, cosines.upper
     if distribution == "ASHIKHMIN_SHIRLEY":
         e = ashikhmin_shirley_exponent(roughness)
-        h_dot_i = np.maximum(np.abs(cos_hi), 1e-6)
-        h_dot_n = np.maximum(cos_h, 1e-6)
+        h_dot_i = np.maximum(np.abs(cosines.cos_hi), 1e-6)
+        h_dot_n = np.maximum(cosines.cos_h, 1e-6)
         pump = 1.0 / np.maximum(1e-6, h_dot_i * np.maximum(np.maximum(cos_i, cos_o), 1e-6))
         return np.where(upper, (e + 1.0) / (8.0 * np.pi) * h_dot_n**e * pump, 0.0)
     if distribution not in DISTRIBUTIONS:
         raise ValueError(f"distribution must be one of {GLOSSY_DISTRIBUTIONS}, got "
                          f"{distribution!r}")
     alpha = np.square(max(float(roughness), ROUGHNESS_EPS))
-    # Each cosine kept at its own shape (a view's Lambda once per view, not per pair); where
-    # the other one is below the surface the value is dropped anyway.
-    safe_i = np.where(upper, cos_i, 1.0) if cos_i.size >= cos_o.size else \
-        np.where(cos_i > 0.0, cos_i, 1.0)
-    safe_o = np.where(upper, cos_o, 1.0) if cos_o.size > cos_i.size else \
-        np.where(cos_o > 0.0, cos_o, 1.0)
-    value = (DISTRIBUTIONS[distribution][0](cos_h, alpha)
-             * microfacet_shadowing(safe_i, safe_o, alpha, distribution)
-             / (4.0 * safe_i * safe_o))
+    a2 = np.square(alpha)
+    if distribution == "GGX":
+        d = _ggx_d(*cosines.ggx_c2, a2)
+    else:
+        d = _beckmann_d(*cosines.beckmann_c2, a2)
+    lambda_of = _LAMBDA_OF_TAN2[distribution]
+    tan2_i, tan2_o = cosines.tan2
+    shadowing = _shadowing_of(lambda_of(tan2_i * a2), lambda_of(tan2_o * a2))
+    value = d * shadowing / cosines.denominator
     return np.where(upper, value, 0.0)
 
 
@@ -227,7 +319,12 @@ def microfacet_shadowing(cos_i: ArrayLike, cos_o: ArrayLike, alpha: Real,
     """Height-correlated masking-shadowing ``G2 = 1 / (1 + Lambda_i + Lambda_o)``
     (Cycles ``bsdf_G``)."""
     lam = DISTRIBUTIONS[distribution][1]
-    lam_i, lam_o = lam(cos_i, alpha), lam(cos_o, alpha)
+    return _shadowing_of(lam(cos_i, alpha), lam(cos_o, alpha))
+
+
+def _shadowing_of(lam_i: Any, lam_o: Any) -> NDArray[np.float64]:
+    """:func:`microfacet_shadowing` from the two Lambdas (the first worked on in place when
+    it is an array of the result's shape)."""
     if not (_in_place(lam_i) and lam_i.shape == np.broadcast_shapes(lam_i.shape,
                                                                     np.shape(lam_o))):
         return 1.0 / (1.0 + lam_i + lam_o)
@@ -268,6 +365,22 @@ def schlick_ior_fresnel(cos_theta: ArrayLike, eta: ArrayLike,
     return start + (1.0 - start) * s
 
 
+class DirectionPairs:
+    """Light and view directions (unit vectors ``(..., 3)``, broadcast) and, made when first
+    asked for, the :class:`LobeCosines` of their half vectors: what every microfacet lobe at
+    these pairs shares (:func:`pair_reflection`)."""
+
+    def __init__(self, wi: ArrayLike, wo: ArrayLike) -> None:
+        self.wi, self.wo = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
+
+    @cached_property
+    def cosines(self) -> LobeCosines:
+        """``n.h``, ``h.wi``, ``n.wi``, ``n.wo`` of the pairs' half vectors."""
+        h = half_vector(self.wi, self.wo)
+        cos_hi = np.sum(h * self.wi, axis=-1)
+        return LobeCosines(h[..., 2], cos_hi, self.wi[..., 2], self.wo[..., 2])
+
+
 def microfacet_reflection(wi: ArrayLike, wo: ArrayLike, roughness: float,
                           fresnel: OfCosine | None = None,
                           distribution: str = "GGX") -> NDArray[np.float64]:
@@ -280,16 +393,20 @@ def microfacet_reflection(wi: ArrayLike, wo: ArrayLike, roughness: float,
     ``distribution``: ``GGX``, ``BECKMANN`` or ``ASHIKHMIN_SHIRLEY`` (which takes no Fresnel).
     0 where either direction is below the surface.
     """
+    return pair_reflection(DirectionPairs(wi, wo), roughness, fresnel, distribution)
+
+
+def pair_reflection(pairs: DirectionPairs, roughness: float, fresnel: OfCosine | None = None,
+                    distribution: str = "GGX") -> NDArray[np.float64]:
+    """:func:`microfacet_reflection` at :class:`DirectionPairs` (their cosines shared by every
+    lobe drawn there)."""
     if distribution == "ASHIKHMIN_SHIRLEY" and fresnel is not None:
         raise ValueError("the Ashikhmin-Shirley lobe takes no Fresnel in Cycles")
-    to_light, to_view = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
-    h = half_vector(to_light, to_view)
-    cos_hi = np.sum(h * to_light, axis=-1)
-    value = microfacet_from_cosines(h[..., 2], cos_hi, to_light[..., 2], to_view[..., 2],
-                                    roughness, distribution)
+    cosines = pairs.cosines
+    value = lobe_from_cosines(cosines, roughness, distribution)
     if fresnel is None:
         return value
-    f = np.asarray(fresnel(np.clip(cos_hi, 0.0, 1.0)))
+    f = np.asarray(fresnel(np.clip(cosines.cos_hi, 0.0, 1.0)))
     return (value[..., None] if f.ndim > value.ndim else value) * f
 
 
@@ -333,14 +450,34 @@ def microfacet_albedo(cos_view: ArrayLike, roughness: float, fresnel: OfCosine |
     Ashikhmin-Shirley: ``h`` has density ``(e + 1) / (2 pi) cos^e`` (``cos = u^(1/(e+1))``) and
     the albedo is the mean of ``cos_i / max(cos_i, cos_o)``.
     """
+    return _chunked(cos_view, roughness, fresnel, distribution, n_u, n_phi, False)[0]
+
+
+def microfacet_albedos(cos_view: ArrayLike, roughness: float, fresnel: OfCosine,
+                       distribution: str = "GGX", *, n_u: int = 48, n_phi: int = 32
+                       ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """``(plain, weighted)``: :func:`microfacet_albedo` without Fresnel and with ``fresnel``
+    from one pass over the nodes (a layering albedo needs both; the same numbers as two
+    calls)."""
+    plain, weighted = _chunked(cos_view, roughness, fresnel, distribution, n_u, n_phi, True)
+    return plain, weighted
+
+
+def _chunked(cos_view: ArrayLike, roughness: float, fresnel: OfCosine | None,
+             distribution: str, n_u: int, n_phi: int,
+             both: bool) -> tuple[NDArray[np.float64], ...]:
+    """:func:`_albedo_views` over the views in chunks (:data:`ALBEDO_CHUNK`), reshaped."""
     views = np.asarray(cos_view, float)
     flat = views.ravel()
     step = max(ALBEDO_CHUNK // (n_u * n_phi), 1)
-    parts = [_albedo_views(flat[k:k + step], roughness, fresnel, distribution, n_u, n_phi)
-             for k in range(0, flat.size, step)] or [
-        _albedo_views(flat, roughness, fresnel, distribution, n_u, n_phi)]
-    total = np.concatenate(parts, axis=0)
-    return total.reshape(views.shape + total.shape[1:])
+    parts = [_albedo_views(flat[k:k + step], roughness, fresnel, distribution, n_u, n_phi,
+                           both) for k in range(0, flat.size, step)] or [
+        _albedo_views(flat, roughness, fresnel, distribution, n_u, n_phi, both)]
+    out = []
+    for index in range(len(parts[0])):
+        total = np.concatenate([part[index] for part in parts], axis=0)
+        out.append(total.reshape(views.shape + total.shape[1:]))
+    return tuple(out)
 
 
 ALBEDO_CHUNK = 65536
@@ -351,9 +488,10 @@ whatever the chunk."""
 
 
 def _albedo_views(views: NDArray[np.float64], roughness: float, fresnel: OfCosine | None,
-                  distribution: str, n_u: int, n_phi: int) -> NDArray[np.float64]:
-    """:func:`microfacet_albedo` at 1-D ``views``: ``(V,)``, or ``(V, C)`` for an RGB
-    ``fresnel``."""
+                  distribution: str, n_u: int, n_phi: int,
+                  both: bool = False) -> tuple[NDArray[np.float64], ...]:
+    """:func:`microfacet_albedo` at 1-D ``views``: ``((V,),)``, or ``((V, C),)`` for an RGB
+    ``fresnel``; ``both``: the Fresnel-free albedo first, then the one with ``fresnel``."""
     alpha = np.square(max(float(roughness), ROUGHNESS_EPS))
     u, w_u = gauss_legendre(n_u)
     if distribution == "GGX":
@@ -385,11 +523,14 @@ def _albedo_views(views: NDArray[np.float64], roughness: float, fresnel: OfCosin
         value = np.where(valid, g2, 0.0)
     weights = w_u[None, :, None] / n_phi
     if fresnel is None:
-        return np.sum(value * weights, axis=(1, 2))
+        return (np.sum(value * weights, axis=(1, 2)),)
+    weighted = value * weights
     f = np.asarray(fresnel(np.clip(h_dot_o, 0.0, 1.0)))
     if f.ndim > value.ndim:
-        return np.einsum("vup,vupc->vc", value * weights, f)
-    return np.sum(value * weights * f, axis=(1, 2))
+        with_fresnel = np.einsum("vup,vupc->vc", weighted, f)
+    else:
+        with_fresnel = np.sum(weighted * f, axis=(1, 2))
+    return (np.sum(weighted, axis=(1, 2)), with_fresnel) if both else (with_fresnel,)
 
 
 def layering_albedo(cos_view: ArrayLike, roughness: float, eta: float,
@@ -408,9 +549,12 @@ def layering_albedo(cos_view: ArrayLike, roughness: float, eta: float,
     needs the lobe's own albedo the second).
     """
     views = np.asarray(cos_view, float)
-    e_f = (microfacet_albedo(views, roughness, lambda c: dielectric_fresnel(c, eta))
-           if weighted is None else weighted)
-    e_1 = microfacet_albedo(views, roughness) if plain is None else plain
+    if weighted is None and plain is None:
+        e_1, e_f = microfacet_albedos(views, roughness, lambda c: dielectric_fresnel(c, eta))
+    else:
+        e_f = (microfacet_albedo(views, roughness, lambda c: dielectric_fresnel(c, eta))
+               if weighted is None else weighted)
+        e_1 = microfacet_albedo(views, roughness) if plain is None else plain
     real0 = f0_from_ior(eta)
     s = np.clip((e_f / np.maximum(e_1, 1e-12) - real0) / (1.0 - real0), 0.0, 1.0)
     start = real0 if f0 is None else np.asarray(f0, float)
@@ -454,15 +598,22 @@ def ggx_energy_scale(albedo: ArrayLike, average_albedo: float, fss: Real
 
 
 def coat_view_terms(cos_view: ArrayLike, roughness: float, ior: float, *,
-                    weighted: NDArray[np.float64] | None = None
+                    weighted: NDArray[np.float64] | None = None,
+                    plain: NDArray[np.float64] | None = None
                     ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """``(scale, layering albedo)`` of the Principled coat at view cosines ``cos_view``: the
     factor :func:`ggx_energy_compensation` puts on its lobe, and the albedo by which it
     attenuates the layers below, ``darkening * layering_albedo`` (Cycles' ``bsdf_albedo``
     reads the closure's weight, which holds the darkening).  The Fresnel-free albedo both
-    need is computed once; ``weighted``: the lobe's albedo with its Fresnel at these views,
-    if the caller has it (:func:`layering_albedo`)."""
-    plain = microfacet_albedo(np.asarray(cos_view, float), roughness)
+    need is computed once, with the lobe's albedo with its Fresnel
+    (:func:`microfacet_albedos`); ``weighted``, ``plain``: these at these views, if the caller
+    has them (:func:`layering_albedo`)."""
+    views = np.asarray(cos_view, float)
+    if plain is None and weighted is None:
+        plain, weighted = microfacet_albedos(views, roughness,
+                                             lambda c: dielectric_fresnel(c, ior))
+    elif plain is None:
+        plain = microfacet_albedo(views, roughness)
     scale, darkening = ggx_energy_scale(plain, ggx_average_albedo(float(roughness)),
                                         float(dielectric_fss(ior)))
     return scale, darkening * layering_albedo(cos_view, roughness, ior, plain=plain,
@@ -509,8 +660,8 @@ class PrincipledInputs:
         return eta, f0 * np.asarray(self.specular_tint, float)
 
 
-def principled_reflection(wi: ArrayLike, wo: ArrayLike,
-                          inputs: PrincipledInputs) -> NDArray[np.float64]:
+def principled_reflection(wi: ArrayLike, wo: ArrayLike, inputs: PrincipledInputs, *,
+                          pairs: DirectionPairs | None = None) -> NDArray[np.float64]:
     """The Principled BSDF's reflection (no cosine), RGB ``(..., 3)``, as Cycles layers it:
 
     ``w_c k(wo) coat(wi, wo) + a_c(wo) [spec(wi, wo) + a_s(wo) base / pi]``
@@ -521,23 +672,24 @@ def principled_reflection(wi: ArrayLike, wo: ArrayLike,
     :func:`layering_albedo` (``closure_layering_weight``): the attenuation depends on the view
     only, so the model is not reciprocal, like Cycles.  Subsurface counts as its albedo in
     ``base_color`` leaving Lambertian-like (its spread is separate, see the profiles).
+    ``pairs``: :class:`DirectionPairs` of ``(wi, wo)``, if made (shared with other lobes).
     """
-    to_light, to_view = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
-    cos_o = np.clip(to_view[..., 2], 0.0, 1.0)
+    pairs = DirectionPairs(wi, wo) if pairs is None else pairs
+    cos_o = np.clip(pairs.wo[..., 2], 0.0, 1.0)
     eta, f0 = inputs.specular_eta_f0()
     base = lambert_reflection(np.minimum(np.maximum(inputs.base_color, 0.0), 1.0))
     if eta == 1.0:  # Specular IOR Level 0: Cycles allocates no specular closure
         lower = base * np.ones(cos_o.shape + (1,))
     else:
-        spec = microfacet_reflection(to_light, to_view, inputs.roughness,
-                                     lambda c: schlick_ior_fresnel(c, eta, f0))
+        spec = pair_reflection(pairs, inputs.roughness,
+                               lambda c: schlick_ior_fresnel(c, eta, f0))
         a_s = 1.0 - np.max(view_table(cos_o, _layering_nodes(
             float(inputs.roughness), float(eta), tuple(np.atleast_1d(f0).tolist()))), axis=-1)
         lower = spec + a_s[..., None] * base
     if inputs.coat_weight <= 0.0:
         return lower
-    coat = microfacet_reflection(to_light, to_view, inputs.coat_roughness,
-                                 lambda c: dielectric_fresnel(c, inputs.coat_ior))
+    coat = pair_reflection(pairs, inputs.coat_roughness,
+                           lambda c: dielectric_fresnel(c, inputs.coat_ior))
     terms = view_table(cos_o, _coat_nodes(float(inputs.coat_roughness),
                                           float(inputs.coat_ior)))
     a_c = np.clip(1.0 - inputs.coat_weight * terms[..., 1], 0.0, 1.0)
@@ -577,8 +729,9 @@ def _coat_uniform(roughness: float, ior: float, nodes: int
     """The coat's compensated albedo and its layering albedo at :func:`principled_uniform`'s
     view nodes (cached: a fit moved to another thickness keeps its coat)."""
     mu, _ = gauss_legendre(nodes)
-    scale, layered = coat_view_terms(mu, roughness, ior)
-    albedo = scale * microfacet_albedo(mu, roughness, lambda c: dielectric_fresnel(c, ior))
+    plain, weighted = microfacet_albedos(mu, roughness, lambda c: dielectric_fresnel(c, ior))
+    scale, layered = coat_view_terms(mu, roughness, ior, weighted=weighted, plain=plain)
+    albedo = scale * weighted
     albedo.setflags(write=False)
     layered.setflags(write=False)
     return albedo, layered

@@ -241,23 +241,28 @@ def _texel_albedo(albedo_table: np.ndarray, theta_deg: np.ndarray,
     return np.stack([np.interp(theta, theta_deg, albedo_table[:, c]) for c in range(3)], -1)
 
 
-def _companion_share(grid: ViewGrid, lobe: np.ndarray, closure_albedo: np.ndarray,
-                     table_albedo: np.ndarray, target: np.ndarray) -> np.ndarray:
-    """The share ``s`` (per view of ``grid``, in [0, 1]) of a table's albedo ``A`` that the
-    Glossy lobe carries when a Lambertian companion carries the rest: weights ``a = s A / E``
-    (Glossy, ``E`` its albedo) and ``b = (1 - s) A`` (Diffuse), so ``a E + b = A`` at every
-    view.  ``s`` minimises ``|a lobe cos_i + b cos_i / pi - target cos_i|`` over the lights
-    of each view (closed form).  ``lobe`` and ``target`` grey ``(V, A, P)``, the albedos at
-    the views ``(V,)``."""
-    e = closure_albedo[:, None, None]
+def _companion_share(grid: ViewGrid, table_albedo: np.ndarray, target: np.ndarray
+                     ) -> Callable[[np.ndarray, np.ndarray], np.ndarray]:
+    """``share(lobe, closure_albedo)``: the share ``s`` (per view of ``grid``, in [0, 1]) of
+    a table's albedo ``A`` that the Glossy lobe carries when a Lambertian companion carries
+    the rest: weights ``a = s A / E`` (Glossy, ``E`` its albedo) and ``b = (1 - s) A``
+    (Diffuse), so ``a E + b = A`` at every view.  ``s`` minimises ``|a lobe cos_i + b cos_i /
+    pi - target cos_i|`` over the lights of each view (closed form).  ``lobe`` and ``target``
+    grey ``(V, A, P)``, the albedos at the views ``(V,)``; what depends on the table alone is
+    computed once (a search tries many lobes)."""
     a = table_albedo[:, None, None]
     lam = grid.cos_i / np.pi
-    u = a / np.maximum(e, 1e-6) * (lobe * grid.cos_i - e * lam)
     v = target * grid.cos_i - a * lam
     w = grid.weight
-    num = np.sum(w * u * v, axis=(1, 2))
-    den = np.sum(w * u * u, axis=(1, 2))
-    return np.clip(np.where(den > 0.0, num / np.where(den > 0.0, den, 1.0), 1.0), 0.0, 1.0)
+
+    def share(lobe: np.ndarray, closure_albedo: np.ndarray) -> np.ndarray:
+        e = closure_albedo[:, None, None]
+        u = a / np.maximum(e, 1e-6) * (lobe * grid.cos_i - e * lam)
+        weighted = w * u
+        num = np.sum(weighted * v, axis=(1, 2))
+        den = np.sum(weighted * u, axis=(1, 2))
+        return np.clip(np.where(den > 0.0, num / np.where(den > 0.0, den, 1.0), 1.0), 0.0, 1.0)
+    return share
 
 
 def glossy_lobe(grid: ViewGrid, roughness: float, closure: str) -> np.ndarray:
@@ -341,6 +346,9 @@ def fit_glossy(grid: ViewGrid, target: ArrayLike, albedo_table: np.ndarray,
     texels = texel_centres(size)
     tables = {False: _texel_albedo(albedo_table, theta_deg, grid.cos_view),
               True: _texel_albedo(albedo_table, theta_deg, texels)}
+    shares = (_companion_share(grid, np.mean(tables[False], axis=-1), grey) if companion
+              else None)
+    error_of = grid.error_to(values)
 
     def weights(roughness: float, distribution: str, final: bool
                 ) -> tuple[NDArray[np.float64], NDArray[np.float64] | None,
@@ -355,10 +363,9 @@ def fit_glossy(grid: ViewGrid, target: ArrayLike, albedo_table: np.ndarray,
         table = tables[final]
         glossy = table / np.maximum(closure, 1e-6)[:, None]
         diffuse = None
-        if companion:
+        if shares is not None:
             e_views = np.interp(grid.cos_view, texels, closure) if final else closure
-            share = _companion_share(grid, shape, e_views, np.mean(tables[False], axis=-1),
-                                     grey)
+            share = shares(shape, e_views)
             share = np.interp(texels, grid.cos_view, share) if final else share
             diffuse = (1.0 - share)[:, None] * table
             glossy = share[:, None] * glossy
@@ -370,8 +377,7 @@ def fit_glossy(grid: ViewGrid, target: ArrayLike, albedo_table: np.ndarray,
         return glossy, diffuse, value
 
     def search(distribution: str) -> tuple[float, float]:
-        return _minimise_roughness(
-            lambda r: grid.error(weights(r, distribution, False)[2], values))
+        return _minimise_roughness(lambda r: error_of(weights(r, distribution, False)[2]))
 
     searched = {distribution: search(distribution) for distribution in closures}
     distribution = min(searched, key=lambda d: searched[d][1])
@@ -380,7 +386,7 @@ def fit_glossy(grid: ViewGrid, target: ArrayLike, albedo_table: np.ndarray,
     roughness = searched[distribution][0]
     glossy, diffuse, value = weights(roughness, distribution, True)
     node = "GGX" if distribution == EEVEE_GLOSSY else distribution
-    return LobeFit(roughness=roughness, error=grid.error(value, values), weights=glossy,
+    return LobeFit(roughness=roughness, error=error_of(value), weights=glossy,
                    distribution=node, diffuse_weights=diffuse,
                    searched={("GGX" if name == EEVEE_GLOSSY else name): float(found[1])
                              for name, found in searched.items()})

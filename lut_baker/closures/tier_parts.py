@@ -138,7 +138,8 @@ class FitTargets:
 
     def slab_parts(self, theta_deg: ArrayLike) -> SlabParts:
         """The slab's 1-D parts at the fit's thickness and polar angles ``theta_deg``."""
-        return self.slab_tables().at(self.thickness_um, theta_deg)
+        return self._once("slice", lambda: self.slab_tables().sliced(
+            self.thickness_um)).at(theta_deg)
 
     def gloss_weight(self) -> NDArray[np.float64]:
         """The weight of eq. 2's gloss lobe (the tables' ``film_gloss``) the tiers draw as the
@@ -156,16 +157,19 @@ class FitTargets:
         lobe = self.tables.directional("film_gloss_albedo", theta_deg)
         return np.maximum(parts.film_albedo - parts.body_gloss * lobe, 0.0)
 
-    def film_body(self, wi: NDArray[np.float64],
-                  wo: NDArray[np.float64]) -> NDArray[np.float64]:
+    def film_body(self, wi: NDArray[np.float64], wo: NDArray[np.float64],
+                  film_gloss: NDArray[np.float64] | None = None) -> NDArray[np.float64]:
         """The film's body as the tiers draw it (class docstring), 1/sr ``(..., 3)``: its
         share of the gloss (:meth:`gloss_weight`, the surface's left out) and the rest read
-        Lambertian."""
+        Lambertian.  ``film_gloss``: the tables' ``film_gloss`` at ``(wi, wo)``, if already
+        looked up."""
         def albedo(w: NDArray[np.float64]) -> NDArray[np.float64]:
             return self.body_albedo(polar_angle_deg(w))
         body_gloss = self.slab_parts(0.0).body_gloss
+        gloss = (self.tables.surface_gloss("film_gloss", wi, wo) if film_gloss is None
+                 else film_gloss)
         return (albedo(wi) * albedo(wo) / (np.pi * np.maximum(self.film_mean(), 1e-12))
-                + body_gloss * self.tables.surface_gloss("film_gloss", wi, wo))
+                + body_gloss * gloss)
 
     def film_mean(self) -> NDArray[np.float64]:
         """The film body's albedo under uniform light without its gloss (RGB): ``2 Int alpha
@@ -196,9 +200,13 @@ class FitTargets:
         base colour, :meth:`base_mean`)."""
         if self.slab is None:
             return self.target("film_gloss")
-        grid = self.grid("film_gloss")
-        return grid, self.coat_weight() * self.tables.surface_gloss("film_gloss",
-                                                                    *grid.directions)
+        return self.grid("film_gloss"), self.coat_weight() * self.surface_on_grid("film_gloss")
+
+    def surface_on_grid(self, name: str) -> NDArray[np.float64]:
+        """The tables' surface gloss ``name`` (closed form) on :meth:`grid` of ``name``
+        (once: the coat's target and the film gloss's share it)."""
+        return self._once(("surface", name), lambda: self.tables.surface_gloss(
+            name, *self.grid(name).directions))
 
     def target(self, name: str) -> tuple[ViewGrid, NDArray[np.float64]]:
         """``(grid, table)`` of a gloss part: ``film_gloss`` on the film's grid,
@@ -213,9 +221,8 @@ class FitTargets:
                 return grid, self.tables.angular(name, *grid.directions)
             grid = self.grid(name)
             if name == "film_gloss" and self.slab is not None:
-                return grid, self.gloss_weight() * self.tables.surface_gloss(name,
-                                                                             *grid.directions)
-            return grid, self.tables.surface_gloss(name, *grid.directions)
+                return grid, self.gloss_weight() * self.surface_on_grid(name)
+            return grid, self.surface_on_grid(name)
         return self._once(("target", name), compute)
 
     def albedo(self, name: str) -> NDArray[np.float64]:

@@ -67,18 +67,16 @@ def _no_image(fit: Any) -> ViewImage | None:
     return None
 
 
-def _cycles_glossy(wi: NDArray[np.float64], wo: NDArray[np.float64],
-                   lobe: LobeFit) -> NDArray[np.float64]:
+def _cycles_glossy(pairs: cc.DirectionPairs, lobe: LobeFit) -> NDArray[np.float64]:
     """Cycles' Glossy BSDF of a fitted lobe, white (:func:`lut_baker.closures.cycles.
     microfacet_reflection`)."""
-    return cc.microfacet_reflection(wi, wo, lobe.roughness, distribution=lobe.distribution)
+    return cc.pair_reflection(pairs, lobe.roughness, distribution=lobe.distribution)
 
 
-def _eevee_glossy(wi: NDArray[np.float64], wo: NDArray[np.float64],
-                  lobe: LobeFit) -> NDArray[np.float64]:
+def _eevee_glossy(pairs: cc.DirectionPairs, lobe: LobeFit) -> NDArray[np.float64]:
     """EEVEE's Glossy BSDF of a fitted lobe under a lamp, white
     (:func:`lut_baker.closures.eevee.glossy_reflection`)."""
-    return eevee.glossy_reflection(wi, wo, lobe.roughness)
+    return eevee.glossy_reflection(pairs.wi, pairs.wo, lobe.roughness)
 
 
 @dataclass(frozen=True)
@@ -98,9 +96,11 @@ class Tier:
     - ``shader(fit, inputs, ops, subsurface_weight)``: its shader over a
       :class:`~lut_baker.closures.tier_formulas.ShaderAlgebra` (``subsurface_weight``: the
       artist's, over their shader, else None); ``lobes(fit)``: its Glossy lobes by closure
-      name; ``image(fit)``: its :class:`ViewImage` or None; ``glossy(wi, wo, lobe)``: a white
-      Glossy lobe as its renderer draws it (the replica's); ``with_image(lobes, texels)``: the
-      fit's fields that hold its lobes and image (a fit moved to another thickness,
+      name; ``image(fit)``: its :class:`ViewImage` or None; ``glossy(pairs, lobe)``: a white
+      Glossy lobe as its renderer draws it at :class:`lut_baker.closures.cycles.
+      DirectionPairs` (the replica's; the pairs' cosines shared by its lobes);
+      ``with_image(lobes, texels)``: the fit's fields that hold its lobes and image (a fit
+      moved to another thickness,
       :func:`lut_baker.closures.fitting.at_thickness`, writes them back; a tier with an
       image has one).
     - ``subsurface_method``: the method its renderer always uses (None: the fit's choice).
@@ -116,8 +116,7 @@ class Tier:
     shader: Callable[[Any, TierInputs, Any, Any], Any]
     lobes: Callable[[Any], dict[str, LobeFit]] = _no_lobes
     image: Callable[[Any], ViewImage | None] = _no_image
-    glossy: Callable[[NDArray[np.float64], NDArray[np.float64], LobeFit],
-                     NDArray[np.float64]] = _cycles_glossy
+    glossy: Callable[[cc.DirectionPairs, LobeFit], NDArray[np.float64]] = _cycles_glossy
     with_image: Callable[[dict[str, LobeFit], NDArray[np.float64]],
                          dict[str, Any]] | None = None
     subsurface_method: str | None = None

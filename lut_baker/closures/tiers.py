@@ -15,7 +15,8 @@ view grid.
 - :func:`tier_reflection` -- a tier's BRDF as a made-up material renders it (over the
   artist's shader: the bare skin is theirs).
 - :func:`reference_reflection` -- what they are measured against (the tables' made-up skin,
-  or the film as a slab at the fit's thickness).
+  or the film as a slab at the fit's thickness); :func:`slab_bare` -- a slab fit's bare skin;
+  :func:`slab_lookup_of` -- the slab's lookups they share.
 - :func:`tier_errors` -- the tiers of a fit against the tables at one coverage and absorption.
 """
 
@@ -29,7 +30,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..model.made_up_skin import combine, coverage_weights
-from ..tables.slab_tables import slab_reflection
+from ..tables.slab_tables import SlabLookup, slab_lookup, slab_mixed
 from ..tables.table_set import ReflectionParts, Tables
 from . import cycles as cc
 from .closure_fit import ClosureFit
@@ -39,7 +40,7 @@ from .tier_registry import TIERS, Tier, held
 from .view_grid import ERROR_VIEWS, lobe_widths_deg, view_grid
 
 __all__ = ["TIERS", "TierError", "NumpyShaders", "principled_inputs", "tier_replica",
-           "tier_reflection", "reference_reflection", "tier_errors"]
+           "tier_reflection", "reference_reflection", "slab_lookup_of", "slab_bare", "tier_errors"]
 
 Directions = tuple[NDArray[np.float64], NDArray[np.float64]]
 """``(wi, wo)``: light and view directions, local unit vectors ``(..., 3)``."""
@@ -93,28 +94,31 @@ def principled_inputs(fit: ClosureFit, coverage: float, absorption: ArrayLike,
 class NumpyShaders(NumpyAlgebra):
     """The shader algebra (:class:`lut_baker.closures.tier_formulas.ShaderAlgebra`) on numpy:
     a shader is its BRDF ``(..., 3)`` at ``(wi, wo)``; rows read at ``wo``'s view angles; a
-    Glossy closure is its white lobe (``lobes`` by name, drawn by ``glossy(wi, wo, lobe)``)
-    times its colour, Diffuse and Subsurface closures Lambertian, a closure of colour 0 none
-    (it is never allocated); a Principled BSDF Cycles'
-    (:func:`lut_baker.closures.cycles.principled_reflection`)."""
+    Glossy closure is its white lobe (``lobes`` by name, drawn by ``glossy(pairs, lobe)``,
+    :class:`lut_baker.closures.cycles.DirectionPairs` shared by the lobes) times its colour,
+    Diffuse and Subsurface closures Lambertian, a closure of colour 0 none (it is never
+    allocated); a Principled BSDF Cycles' (:func:`lut_baker.closures.cycles.
+    principled_reflection`)."""
 
     def __init__(self, wi: NDArray[np.float64], wo: NDArray[np.float64],
                  rows: dict[str, Any], lobes: dict[str, LobeFit],
-                 glossy: Callable[[NDArray[np.float64], NDArray[np.float64], LobeFit],
-                                  NDArray[np.float64]]):
+                 glossy: Callable[[cc.DirectionPairs, LobeFit], NDArray[np.float64]],
+                 pairs: cc.DirectionPairs | None = None):
         super().__init__(rows, wo[..., 2])
         self.wi, self.wo, self._lobes, self._glossy = wi, wo, lobes, glossy
+        self._pairs = cc.DirectionPairs(wi, wo) if pairs is None else pairs
 
     def closure(self, closure: Closure) -> Any:
         colour = closure.product
         if not np.any(colour):
             return 0.0
         if closure.kind == "glossy":
-            return self._glossy(self.wi, self.wo, self._lobes[closure.name])[..., None] * colour
+            return self._glossy(self._pairs, self._lobes[closure.name])[..., None] * colour
         return cc.lambert_reflection(colour)
 
     def principled(self, sockets: dict[str, Any]) -> Any:
-        return cc.principled_reflection(self.wi, self.wo, _principled_inputs(sockets)[0])
+        return cc.principled_reflection(self.wi, self.wo, _principled_inputs(sockets)[0],
+                                        pairs=self._pairs)
 
     @staticmethod
     def add(*shaders: Any) -> Any:
@@ -130,17 +134,20 @@ class NumpyShaders(NumpyAlgebra):
 
 def tier_replica(fit: ClosureFit, tables: Tables, name: str | Tier, coverage: float,
                  absorption: ArrayLike, gloss: float = 1.0,
-                 directions: Directions | None = None) -> NDArray[np.float64]:
+                 directions: Directions | None = None, *,
+                 pairs: cc.DirectionPairs | None = None) -> NDArray[np.float64]:
     """Tier ``name``'s (or a :class:`~lut_baker.closures.tier_registry.Tier`'s) BRDF
     ``(..., 3)`` at the angular nodes or at ``directions``
     ``(wi, wo)``: its shader (:attr:`~lut_baker.closures.tier_registry.Tier.shader`) at a
     coverage, absorption and Gloss evaluated by :class:`NumpyShaders`, its image's rows read
-    as Blender reads them (linear between texel centres)."""
+    as Blender reads them (linear between texel centres).  ``pairs``: the
+    :class:`lut_baker.closures.cycles.DirectionPairs` of ``directions``, if made (their
+    cosines shared by the replicas there)."""
     found = name if isinstance(name, Tier) else held(fit, name)
     wi, wo = tables.node_directions() if directions is None else directions
     image = found.image(fit)
     rows = {} if image is None else dict(zip(image.rows, image.texels, strict=True))
-    ops = NumpyShaders(wi, wo, rows, found.lobes(fit), found.glossy)
+    ops = NumpyShaders(wi, wo, rows, found.lobes(fit), found.glossy, pairs)
     value = np.asarray(found.shader(fit, _inputs(fit, coverage, absorption, gloss), ops, None))
     shape = np.broadcast_shapes(wi.shape, wo.shape)[:-1] + (3,)
     return value if value.shape == shape else np.broadcast_to(value, shape).copy()
@@ -149,49 +156,64 @@ def tier_replica(fit: ClosureFit, tables: Tables, name: str | Tier, coverage: fl
 def tier_reflection(fit: ClosureFit, tables: Tables, name: str, coverage: float,
                     absorption: ArrayLike, gloss: float = 1.0,
                     directions: Directions | None = None, *, over_shader: bool = False,
-                    bare: NDArray[np.float64] | None = None) -> NDArray[np.float64]:
+                    bare: NDArray[np.float64] | None = None,
+                    pairs: cc.DirectionPairs | None = None) -> NDArray[np.float64]:
     """Tier ``name``'s BRDF ``(..., 3)`` (:func:`tier_replica`) at the angular nodes or at
     ``directions``.  ``over_shader``: the group goes over the artist's shader, which is the
     bare skin (the tables' bare skin stands for it, with the film as a slab on the fit's skin;
     the Gloss input leaves it alone): the tier's covered skin (its replica at coverage 1) and
     that bare skin (``bare``, if already computed at these directions), mixed by coverage as
-    areas."""
+    areas.  ``pairs``: as :func:`tier_replica`'s."""
     if not over_shader:
-        return tier_replica(fit, tables, name, coverage, absorption, gloss, directions)
+        return tier_replica(fit, tables, name, coverage, absorption, gloss, directions,
+                            pairs=pairs)
     wi, wo = tables.node_directions() if directions is None else directions
-    covered = tier_replica(fit, tables, name, 1.0, absorption, gloss, (wi, wo))
+    covered = tier_replica(fit, tables, name, 1.0, absorption, gloss, (wi, wo), pairs=pairs)
     if bare is None:
         bare = (tables.made_up_reflection(wi, wo, 0.0, absorption) if fit.slab is None
-                else _slab_bare(fit, tables, (wi, wo)))
+                else slab_bare(fit, tables, (wi, wo)))
     return combine(coverage_weights(coverage, 0.0), top=covered, bare=bare)
 
 
 def reference_reflection(fit: ClosureFit, tables: Tables, coverage: float,
-                         absorption: ArrayLike, directions: Directions) -> NDArray[np.float64]:
+                         absorption: ArrayLike, directions: Directions,
+                         lookup: SlabLookup | None = None) -> NDArray[np.float64]:
     """What a fit's tiers are measured against, ``(..., 3)``: the tables' made-up skin at a
     coverage and absorption, or with the film as a slab (``fit.slab``) the slab's at the fit's
     thickness on the fit's skin (``fit.skin_albedo``, the skin the film covers; its absorption
     baked, :func:`lut_baker.tables.slab_tables.slab_reflection`; the skin under the film
-    darkened by ``slab.skin_under`` where Match Skin set it)."""
+    darkened by ``slab.skin_under`` where Match Skin set it).  ``lookup``: the slab's
+    :func:`~lut_baker.tables.slab_tables.slab_lookup` at ``directions`` and the fit's
+    thickness, if already made (:func:`slab_lookup_of`)."""
     if fit.slab is None:
         return tables.made_up_reflection(*directions, coverage, absorption)
+    found = slab_lookup_of(fit, tables, directions) if lookup is None else lookup
     under = fit.slab.skin_under
     if under is None:
-        return slab_reflection(tables, *directions, fit.slab.thickness_um,
-                               skin_albedo=fit.skin_albedo, coverage=coverage)
-    covered = slab_reflection(tables, *directions, fit.slab.thickness_um,
-                              skin_albedo=fit.skin_albedo * np.asarray(under, float))
+        return slab_mixed(tables, found, skin_albedo=fit.skin_albedo, coverage=coverage)
+    covered = slab_mixed(tables, found, skin_albedo=fit.skin_albedo * np.asarray(under, float))
     return combine(coverage_weights(coverage, 0.0), top=covered,
-                   bare=_slab_bare(fit, tables, directions))
+                   bare=slab_bare(fit, tables, directions, found))
 
 
-def _slab_bare(fit: ClosureFit, tables: Tables, directions: Directions) -> NDArray[np.float64]:
+def slab_lookup_of(fit: ClosureFit, tables: Tables, directions: Directions) -> SlabLookup:
+    """The slab's lookups at ``directions`` and a slab fit's thickness
+    (:func:`lut_baker.tables.slab_tables.slab_lookup`): what its reference and bare skin
+    share."""
+    if fit.slab is None:
+        raise ValueError("a fit of the paper's film has no slab")
+    return slab_lookup(tables, *directions, fit.slab.thickness_um)
+
+
+def slab_bare(fit: ClosureFit, tables: Tables, directions: Directions,
+               lookup: SlabLookup | None = None) -> NDArray[np.float64]:
     """The bare skin of a fit of the film as a slab: the skin's gloss and the fit's skin
-    (:func:`lut_baker.tables.slab_tables.slab_reflection` at coverage 0)."""
+    (:func:`lut_baker.tables.slab_tables.slab_reflection` at coverage 0; ``lookup``: its
+    lookups at ``directions``, if already made)."""
     if fit.slab is None:
         raise ValueError("a fit of the paper's film takes its bare skin from the tables")
-    return slab_reflection(tables, *directions, fit.slab.thickness_um,
-                           skin_albedo=fit.skin_albedo, coverage=0.0)
+    found = slab_lookup_of(fit, tables, directions) if lookup is None else lookup
+    return slab_mixed(tables, found, skin_albedo=fit.skin_albedo, coverage=0.0)
 
 
 def tier_errors(fit: ClosureFit, tables: Tables, coverage: float, absorption: ArrayLike,
@@ -216,15 +238,17 @@ def tier_errors(fit: ClosureFit, tables: Tables, coverage: float, absorption: Ar
         if over_shader:
             bare = tables.mixed_reflection(looked_up, 0.0, absorption)
     else:
-        reference = reference_reflection(fit, tables, coverage, absorption, directions)
+        lookup = slab_lookup_of(fit, tables, directions)
+        reference = reference_reflection(fit, tables, coverage, absorption, directions, lookup)
         if over_shader:
-            bare = _slab_bare(fit, tables, directions)
+            bare = slab_bare(fit, tables, directions, lookup)
     out = {}
+    pairs = cc.DirectionPairs(*directions)  # the tiers' lobes share their cosines
     for name in TIERS:
         if name not in tiers:
             continue
         f = tier_reflection(fit, tables, name, coverage, absorption, gloss, directions,
-                            over_shader=over_shader, bare=bare)
+                            over_shader=over_shader, bare=bare, pairs=pairs)
         out[name] = TierError(tier=name, coverage=float(coverage),
                               absorption=tuple(_absorption(absorption).tolist()),
                               rms=grid.error(f, reference),

@@ -14,8 +14,8 @@ The measure is the one the fits have always used (docs/baking.md, "Errors"): the
 
 Functions and types
 -------------------
-- :class:`ViewGrid` -- the pairs, their cosines and weights; relative RMS, view albedos and
-  Glossy lobes on them.
+- :class:`ViewGrid` -- the pairs, their cosines and weights; relative RMS (against one
+  reference for many fits: ``error_to``), view albedos and Glossy lobes on them.
 - :func:`view_grid` -- the grid for a lobe width (cached).
 - :func:`lobe_widths_deg` -- the widths of the tables' two surface glosses, which size the
   grids.
@@ -23,6 +23,7 @@ Functions and types
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cached_property, lru_cache
 
@@ -81,21 +82,37 @@ class ViewGrid:
         """:meth:`view_albedo`'s weight, ``light_weight cos(theta_i)`` (once per grid)."""
         return self.light_weight * self.cos_i
 
+    @cached_property
+    def _cosines(self) -> cc.LobeCosines:
+        """What every lobe on the pairs shares (once per grid: the fits' searches evaluate
+        many lobes on one grid)."""
+        return cc.LobeCosines(self.cos_h, self.cos_hi, self.cos_i, self.cos_o)
+
     def lobe(self, roughness: float, distribution: str = "GGX") -> np.ndarray:
-        """A Glossy lobe without Fresnel (1/sr) at the pairs, ``(V, A, P)``."""
-        return cc.microfacet_from_cosines(self.cos_h, self.cos_hi, self.cos_i, self.cos_o,
-                                          roughness, distribution)
+        """A Glossy lobe without Fresnel (1/sr) at the pairs, ``(V, A, P)``
+        (:func:`lut_baker.closures.cycles.microfacet_from_cosines`)."""
+        return cc.lobe_from_cosines(self._cosines, roughness, distribution)
 
     def error(self, f_fit: ArrayLike, f_ref: ArrayLike) -> float:
         """Relative RMS of the radiance ``f cos(theta_i)``, channels pooled (``f``:
         ``(V, A, P)`` or ``(V, A, P, C)``)."""
         fit, ref = np.asarray(f_fit, float), np.asarray(f_ref, float)
+        return self.error_to(ref, channels=fit.ndim == 4)(fit)
+
+    def error_to(self, f_ref: ArrayLike, *,
+                 channels: bool = False) -> Callable[[ArrayLike], float]:
+        """:meth:`error` against one ``f_ref``, its norm computed once (a search measures
+        many fits against it); ``channels``: the fits have a channel axis."""
+        ref = np.asarray(f_ref, float)
         weight = self._radiance_weight
-        if ref.ndim == 4 or fit.ndim == 4:
+        if ref.ndim == 4 or channels:
             weight = weight[..., None]
-        num = np.sum(weight * np.square(fit - ref))
         den = np.sum(weight * np.square(ref))
-        return float(np.sqrt(num / den)) if den > 0 else float(np.sqrt(num))
+
+        def error(f_fit: ArrayLike) -> float:
+            num = np.sum(weight * np.square(np.asarray(f_fit, float) - ref))
+            return float(np.sqrt(num / den)) if den > 0 else float(np.sqrt(num))
+        return error
 
     def view_albedo(self, f: ArrayLike) -> NDArray[np.float64]:
         """``Int f cos(theta_i) dw_i`` per view, ``(V,)`` or ``(V, C)``."""

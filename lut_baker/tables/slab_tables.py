@@ -35,11 +35,14 @@ Functions and types
 - :data:`THICKNESS_MIN_UM`, :data:`THICKNESS_MAX_UM`, :data:`THICKNESS_NODES` -- the axis.
 - :func:`thickness_nodes`, :func:`thickness_index` -- its nodes and the closed-form index.
 - :class:`SlabTables` -- the tables, with ``at`` (the 1-D parts at a thickness).
-- :class:`SlabParts` -- the 1-D parts at one thickness.
+- :class:`SlabParts` -- the 1-D parts at one thickness; :class:`SlabSlice` -- the 1-D tables
+  at one thickness (``SlabTables.sliced``), read at any angles.
 - :func:`surface_gloss`, :func:`surface_gloss_albedo` -- the film surface's gloss (``k``
   times the tables' ``film_gloss``) and its directional albedo.
 - :func:`slab_reflection` -- made-up skin's BRDF at a thickness from the tables (optionally
-  without its diffuse term, the part that spreads under the skin).
+  without its diffuse term, the part that spreads under the skin); :class:`SlabLookup`,
+  :func:`slab_lookup`, :func:`slab_mixed` -- the same in two steps, its lookups once for
+  every skin and coverage at the same directions.
 - :class:`SlabDiffuse`, :func:`slab_diffuse` -- that diffuse term's factors at one thickness
   (what a reference image spreads by the dipole's profile).
 - :func:`slab_directional_albedo`, :func:`slab_colour` -- its directional albedo and its colour
@@ -66,9 +69,13 @@ __all__ = [
     "thickness_index",
     "SlabTables",
     "SlabParts",
+    "SlabSlice",
     "surface_gloss",
     "surface_gloss_albedo",
     "slab_reflection",
+    "SlabLookup",
+    "slab_lookup",
+    "slab_mixed",
     "SlabDiffuse",
     "slab_diffuse",
     "slab_directional_albedo",
@@ -118,6 +125,26 @@ class SlabParts(NamedTuple):
     below: NDArray[np.float64]
     film_albedo: NDArray[np.float64]
     body_gloss: NDArray[np.float64]
+
+
+class SlabSlice(NamedTuple):
+    """The 1-D tables of ``slab`` at one thickness (:meth:`SlabTables.sliced`): ``tables``,
+    :class:`SlabParts` on the slab's own angular grid; :meth:`at` reads them at polar
+    angles."""
+
+    slab: SlabTables
+    thickness_um: float
+    tables: SlabParts
+
+    def at(self, theta_deg: ArrayLike) -> SlabParts:
+        """The 1-D parts at polar angles ``theta_deg`` (degrees)."""
+        x = self.slab.theta_index(theta_deg)
+        tables = self.tables
+        return SlabParts(top_albedo=_linear(tables.top_albedo, x),
+                         through=_linear(tables.through, x),
+                         through_mean=tables.through_mean, below=tables.below,
+                         film_albedo=_linear(tables.film_albedo, x),
+                         body_gloss=tables.body_gloss)
 
 
 @dataclass(frozen=True, eq=False)
@@ -181,13 +208,16 @@ class SlabTables:
 
     def at(self, thickness_um: float, theta_deg: ArrayLike) -> SlabParts:
         """The 1-D parts at ``thickness_um`` and polar angles ``theta_deg`` (degrees)."""
-        x = self.theta_index(theta_deg)
-        return SlabParts(top_albedo=_linear(self._along(self.top_albedo, thickness_um), x),
-                         through=_linear(self._along(self.through, thickness_um), x),
-                         through_mean=self._along(self.through_mean, thickness_um),
-                         below=self._along(self.below, thickness_um),
-                         film_albedo=_linear(self._along(self.film_albedo, thickness_um), x),
-                         body_gloss=self._along(self.body_gloss, thickness_um))
+        return self.sliced(thickness_um).at(theta_deg)
+
+    def sliced(self, thickness_um: float) -> SlabSlice:
+        """The 1-D tables at one thickness (:class:`SlabSlice`, read-only: read at many
+        angles, they are interpolated along the thickness once)."""
+        tables = {name: self._along(getattr(self, name), thickness_um)
+                  for name in SlabParts._fields}
+        for table in tables.values():
+            table.setflags(write=False)
+        return SlabSlice(self, float(thickness_um), SlabParts(**tables))
 
     def through_at(self, thickness_um: float, w: ArrayLike) -> NDArray[np.float64]:
         """``t`` (dimensionless, ``(..., 3)``) at one thickness for unit directions ``(..., 3)``
@@ -267,6 +297,53 @@ def slab_diffuse(tables: Tables, thickness_um: float | None = None,
                        thickness_um=h)
 
 
+class SlabLookup(NamedTuple):
+    """What :func:`slab_reflection` looks up at unit directions before the skin's albedo and
+    the coverage mix it (:func:`slab_lookup`): one lookup serves every skin and coverage at the
+    same directions.  ``film_gloss``: the tables' ``film_gloss`` (closed form, before the
+    surface's share), ``top`` and ``skin_gloss`` (1/sr, ``(..., 3)``), ``through_i``,
+    ``through_o``: ``t`` at the light's and the view's polar angles, ``upper``: both directions
+    above the surface, at ``thickness_um``."""
+
+    film_gloss: NDArray[np.float64]
+    top: NDArray[np.float64]
+    skin_gloss: NDArray[np.float64]
+    through_i: NDArray[np.float64]
+    through_o: NDArray[np.float64]
+    upper: NDArray[np.bool_]
+    thickness_um: float
+
+
+def slab_lookup(tables: Tables, wi: ArrayLike, wo: ArrayLike,
+                thickness_um: float | None = None) -> SlabLookup:
+    """:class:`SlabLookup` of the tables at unit directions ``(..., 3)`` and ``thickness_um``
+    (default the baked one)."""
+    slab = _slab(tables)
+    h = _thickness(tables, thickness_um)
+    to_light, to_view = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
+    return SlabLookup(film_gloss=tables.surface_gloss("film_gloss", to_light, to_view),
+                      top=slab.top_at(h, to_light, to_view),
+                      skin_gloss=tables.surface_gloss("skin_gloss", to_light, to_view),
+                      through_i=slab.through_at(h, to_light),
+                      through_o=slab.through_at(h, to_view),
+                      upper=(to_light[..., 2] >= 0.0) & (to_view[..., 2] >= 0.0),
+                      thickness_um=h)
+
+
+def slab_mixed(tables: Tables, lookup: SlabLookup, skin_albedo: ArrayLike | None = None,
+               coverage: float = 1.0, *, diffuse: bool = True) -> NDArray[np.float64]:
+    """:func:`slab_reflection` from its looked-up ``lookup`` (:func:`slab_lookup`) on skin of
+    diffuse albedo ``skin_albedo`` (default the baked skin's ``pi P_d``) at ``coverage``."""
+    covered = _slab(tables).surface_share * lookup.film_gloss + lookup.top
+    bare = lookup.skin_gloss
+    if diffuse:
+        terms = slab_diffuse(tables, lookup.thickness_um, skin_albedo)
+        covered = covered + terms.covered * lookup.through_i * lookup.through_o
+        bare = bare + terms.bare
+    value = coverage * covered + (1.0 - coverage) * bare
+    return np.where(lookup.upper[..., None], value, 0.0)
+
+
 def slab_reflection(tables: Tables, wi: ArrayLike, wo: ArrayLike,
                     thickness_um: float | None = None, skin_albedo: ArrayLike | None = None,
                     coverage: float = 1.0, *, diffuse: bool = True) -> NDArray[np.float64]:
@@ -274,20 +351,9 @@ def slab_reflection(tables: Tables, wi: ArrayLike, wo: ArrayLike,
     the baked one) on skin of diffuse albedo ``skin_albedo`` (default the baked skin's
     ``pi P_d``), mixed by area with the bare skin at ``coverage``; 0 below the surface.
     ``diffuse=False``: without the diffuse term (:func:`slab_diffuse`), what returns where it
-    entered."""
-    slab = _slab(tables)
-    h = _thickness(tables, thickness_um)
-    to_light, to_view = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
-    covered = (surface_gloss(tables, to_light, to_view)
-               + slab.top_at(h, to_light, to_view))
-    bare = tables.surface_gloss("skin_gloss", to_light, to_view)
-    if diffuse:
-        terms = slab_diffuse(tables, h, skin_albedo)
-        covered = covered + terms.covered * terms.through(to_light) * terms.through(to_view)
-        bare = bare + terms.bare
-    value = coverage * covered + (1.0 - coverage) * bare
-    upper = (to_light[..., 2] >= 0.0) & (to_view[..., 2] >= 0.0)
-    return np.where(upper[..., None], value, 0.0)
+    entered.  (:func:`slab_mixed` of :func:`slab_lookup`.)"""
+    return slab_mixed(tables, slab_lookup(tables, wi, wo, thickness_um), skin_albedo,
+                      coverage, diffuse=diffuse)
 
 
 def slab_directional_albedo(tables: Tables, theta_deg: ArrayLike,
