@@ -101,11 +101,14 @@ def counts():
 
 
 def session_caches() -> dict:
-    """The add-on's session caches by name: ``bakes`` (re-baked tables and their closure fits,
-    keyed by bake key: :mod:`makeup_skin_addon.bakes`)."""
+    """The add-on's session caches by name (:mod:`makeup_skin_addon.bakes`): ``bakes``
+    (re-baked tables and their closure fits, keyed by bake key), ``slabs`` and ``slab_fits``
+    (the slab's tables and fits every thickness shares).  All of them or none: a session
+    never has a bake's fit without its slab's, and a test that carried one over without the
+    other would see what no session does (a Thickness move fitting again)."""
     from makeup_skin_addon import bakes
 
-    return {"bakes": bakes._BAKES}
+    return {"bakes": bakes._BAKES, "slabs": bakes._SLABS, "slab_fits": bakes._SLAB_FITS}
 
 
 def cold_caches():
