@@ -3,7 +3,9 @@
 Matching means the artist's render: the shade is solved so that the skin under the film, the
 film over it included, has under uniform white light the colour the artist's own shader has
 there (:class:`SkinTarget`, from :mod:`.artist_skin`: a Principled BSDF's layering and its
-random walk included), so that at any coverage the face keeps the tone it had before Apply.
+random walk included), so that at any coverage the face keeps the tone it had before Apply;
+on a mesh whose hollows hide part of the sky, each part of both colours weighed by what it
+keeps of it (:func:`seen_target`: the artist's gloss loses more there than the film).
 A material without a shader of the artist's (the skin preset's made-up skin) matches its own
 bare skin instead.  The covered colour is the model's
 (:func:`lut_baker.tables.uniform_light.covered_colour`), solved per channel in closed form
