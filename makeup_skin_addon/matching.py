@@ -267,7 +267,11 @@ def seen_target(skin: SkinTarget, film_gloss, film_roughness: float
         return np.asarray(skin.target, float), ""
     target = np.asarray(skin.target, float)
     film_gloss = np.asarray(film_gloss, float) * np.ones(3)
-    diffuse, skies = skin.sky.seen(*(r for _, r in skin.glosses), film_roughness)
+    glossy_film = bool(np.any(film_gloss > 0.0))  # a matte film: no lobe to measure
+    diffuse, skies = skin.sky.seen(*(r for _, r in skin.glosses),
+                                   *([film_roughness] if glossy_film else []))
+    if not glossy_film:
+        skies = [*skies, 1.0]
     kept = skin.sky.kept
     gloss = sum((np.asarray(g, float) for g, _ in skin.glosses), np.zeros(3))
     rendered = kept(diffuse, target) * (target - gloss) + sum(
@@ -277,10 +281,11 @@ def seen_target(skin: SkinTarget, film_gloss, film_roughness: float
         / kept(diffuse, target)
     lobes = ", ".join(f"a gloss at roughness {r:.2g} {sky:.0%}" for (_, r), sky in zip(
         skin.glosses, skies[:-1], strict=True))
+    film = f", the film's gloss {skies[-1]:.0%}" if glossy_film else ""
     return seen, (f"On this mesh a diffuse surface sees {diffuse:.0%} of a uniform sky"
-                  f"{', ' + lobes if lobes else ''}, the film's gloss {skies[-1]:.0%} (its "
-                  f"hollows, as the camera sees them): matched to {_rgb(seen)} under uniform "
-                  f"light, which renders here as the artist's shader does.")
+                  f"{', ' + lobes if lobes else ''}{film} (its hollows, as the camera sees "
+                  f"them): matched to {_rgb(seen)} under uniform light, which renders here as "
+                  f"the artist's shader does.")
 
 
 def _film_gloss(settings, light, foundation: str | None) -> tuple[np.ndarray, float]:

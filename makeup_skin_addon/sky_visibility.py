@@ -191,32 +191,37 @@ class SkyVisibility:
         self.positions, self.normals, self.views = positions, normals, views
         self.grid, self.origin, self.size = occupancy(all_positions)
         self.distance = clearance(self.grid)
+        self._shown: np.ndarray | None = None
         self._seen: dict = {}
 
     def seen(self, *roughnesses: float) -> tuple[float, list[float]]:
         """``(diffuse, glosses)``: the share of the sky a diffuse (cosine-weighted) lobe sees,
         and the share of a GGX gloss lobe's reflectance (per Blender roughness) that comes
-        from the sky, over the points the camera sees (one march for all: a point hidden from
-        the camera is left out, as the points' weights do not look)."""
-        key = tuple(round(float(r), 4) for r in roughnesses)
-        if key not in self._seen:
-            lobes = [diffuse_rays(self.normals)] + [gloss_rays(self.normals, self.views, r)
-                                                    for r in key]
-            directions = np.concatenate([self.views[:, None]] + [d for d, _ in lobes], axis=1)
+        from the sky, over the points the camera sees (a point hidden from the camera is left
+        out: the points' weights do not look).  Each lobe is marched once, those not yet
+        measured together."""
+        key = [round(float(r), 4) for r in roughnesses]
+        missing = sorted({r for r in key if r not in self._seen})
+        if self._shown is None or missing:
+            lobes = ([] if "diffuse" in self._seen else [("diffuse", diffuse_rays(self.normals))]
+                     ) + [(r, gloss_rays(self.normals, self.views, r)) for r in missing]
+            first = self._shown is None
+            directions = np.concatenate(([self.views[:, None]] if first else [])
+                                        + [d for _, (d, _) in lobes], axis=1)
             starts = np.broadcast_to((self.positions + OFFSET_CELLS * self.size
                                       * self.normals)[:, None], directions.shape)
             free = unhidden(self.grid, self.origin, self.size, starts.reshape(-1, 3),
                             directions.reshape(-1, 3), self.distance
                             ).reshape(directions.shape[:2])
-            shown = free[:, 0] if np.any(free[:, 0]) else np.ones(len(free), bool)
-            fractions, at = [], 1
-            for _, weights in lobes:
-                part, weights = free[shown, at:at + weights.shape[1]], weights[shown]
+            if first:
+                self._shown = free[:, 0] if np.any(free[:, 0]) else np.ones(len(free), bool)
+            at = 1 if first else 0
+            for name, (_, weights) in lobes:
+                part, weights = free[self._shown, at:at + weights.shape[1]], weights[self._shown]
                 total = float(weights.sum())
-                fractions.append(float(np.sum(weights * part) / total) if total > 0.0 else 1.0)
+                self._seen[name] = float(np.sum(weights * part) / total) if total > 0.0 else 1.0
                 at += weights.shape[1]
-            self._seen[key] = (fractions[0], fractions[1:])
-        return self._seen[key]
+        return self._seen["diffuse"], [self._seen[r] for r in key]
 
     @staticmethod
     def kept(sky: float, colour) -> np.ndarray:
