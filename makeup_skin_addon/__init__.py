@@ -15,7 +15,8 @@ its own, and only at module level (no import inside a function, no cycle):
 4. The session's bakes: ``storage`` (the images the .blend keeps, their hashes), ``bakes`` (a
    bake's key and record, one cache of tables and closure fits, :class:`.bakes.Bake`).
 5. The skin: ``surface_points``, ``image_texels`` and ``skin_sampling`` (an image's mean over a
-   material's faces), ``skin_colour`` (the skin preset's own colour), ``artist_skin`` (the
+   material's faces), ``sky_visibility`` (what the mesh hides of a uniform sky from its
+   skin), ``skin_colour`` (the skin preset's own colour), ``artist_skin`` (the
    skin the artist's shader describes), ``shade`` and ``skin_model`` (the settings as the
    model), ``matching`` (Match Skin, Lighter / Darker).
 6. The group: ``node_algebra`` and ``nodes`` (built from closure fits), ``tier_choice`` (the

@@ -15,7 +15,9 @@ needs a skin: :func:`read_skin` reads it from that shader's leaves, weighted by 
   skin leaf with the largest share, a Principled BSDF first among equals);
 - the colour to match (``target``): the whole shader's colour under uniform white light, its
   gloss included, the mean over the surface (:mod:`.surface_values` evaluates what feeds each
-  input at points of the surface).
+  input at points of the surface), each leaf's gloss apart with its roughness, and what a
+  uniform sky leaves to the surface as the camera sees it (:mod:`.sky_visibility`: the match
+  weighs the gloss by it).
 
 What cannot be followed (an emission, a metallic or coated Principled BSDF, a node it cannot
 evaluate) is a warning that says what the made-up skin uses instead.
@@ -33,7 +35,7 @@ from dataclasses import dataclass, field
 import bpy
 import numpy as np
 
-from . import artist_shader, convert, skin_sampling, surface_values
+from . import artist_shader, convert, skin_sampling, sky_visibility, surface_values
 from .artist_shader import Leaf, Source, source
 from .core import principled_albedo
 
@@ -78,7 +80,9 @@ class SkinReading:
     by share); ``roughness``, ``ior``, ``method``, ``subsurface_weight``: the dominant leaf's
     (for the bake and the group); ``where``: the surface it was read over (the end of a
     sentence); ``warnings``: sentences saying what could not be followed and what is used
-    instead; ``notes``: what evaluating the inputs assumed."""
+    instead; ``notes``: what evaluating the inputs assumed; ``glosses``: each leaf's gloss
+    under uniform light (RGB, by its share) and its roughness; ``sky``: what a uniform sky
+    leaves to the surface (:class:`.sky_visibility.SkyVisibility`, or None)."""
 
     leaves: list
     dominant: Leaf | None
@@ -91,6 +95,8 @@ class SkinReading:
     subsurface_weight: float = 1.0
     warnings: list = field(default_factory=list)
     notes: list = field(default_factory=list)
+    glosses: list = field(default_factory=list)
+    sky: sky_visibility.SkyVisibility | None = None
 
     def factor_of(self, leaf: Leaf) -> np.ndarray | None:
         """The body factor of ``leaf`` (RGB; the same node reached through the same groups,
@@ -193,13 +199,17 @@ def read_skin(tree, samples, engine: str = "CYCLES") -> SkinReading:
     def factor_mean(where: Source) -> float:
         return surface_values.mean(where, samples, notes, "VALUE")
 
-    readings, values_of = [], {}
+    readings, values_of, glosses = [], {}, []
     for leaf, share in artist_shader.leaves(tree, factor_mean):
         reading, values = _leaf_reading(leaf, share, samples, notes, warnings, engine)
         if reading is not None:
             readings.append(reading)
             if values is not None:
                 values_of[id(leaf)] = values
+            roughness = values[0] if values is not None else _mean(
+                leaf.node, "Roughness", leaf.groups, samples, notes)
+            if roughness is not None and np.any(reading.total > reading.body):
+                glosses.append((share * (reading.total - reading.body), float(roughness)))
     target = sum((r.share * r.total for r in readings), np.zeros(3))
     body = sum((r.share * r.body for r in readings), np.zeros(3))
     skins = [r for r in readings if r.leaf.role == "skin"]
@@ -214,7 +224,7 @@ def read_skin(tree, samples, engine: str = "CYCLES") -> SkinReading:
     where = (f"over the {faces} faces that use it" if faces else "") + (
         f", as the camera {seen_by!r} sees them" if faces and seen_by else "")
     reading = SkinReading(readings, dominant.leaf if dominant else None, target, body, where,
-                          warnings=warnings, notes=notes)
+                          warnings=warnings, notes=notes, glosses=glosses)
     if dominant is None:
         warnings.append("no skin BSDF (Principled, Diffuse or Subsurface Scattering) behind "
                         "the surface: the skin under the film is the skin preset's")
@@ -250,4 +260,6 @@ def read_material(material, scene=None, progress=None) -> SkinReading | None:
         return None
     scene = scene if scene is not None else bpy.context.scene
     samples = skin_sampling.surface_samples(material, progress=progress, scene=scene)
-    return read_skin(tree, samples, render_engine(scene))
+    reading = read_skin(tree, samples, render_engine(scene))
+    reading.sky = sky_visibility.sky_visibility(samples)
+    return reading

@@ -3,7 +3,9 @@
 Matching means the artist's render: the shade is solved so that the skin under the film, the
 film over it included, has under uniform white light the colour the artist's own shader has
 there (:class:`SkinTarget`, from :mod:`.artist_skin`: a Principled BSDF's layering and its
-random walk included), so that at any coverage the face keeps the tone it had before Apply.
+random walk included), so that at any coverage the face keeps the tone it had before Apply;
+on a mesh whose hollows hide part of the sky, each part of both colours weighed by what it
+keeps of it (:func:`seen_target`: the artist's gloss loses more there than the film).
 A material without a shader of the artist's (the skin preset's made-up skin) matches its own
 bare skin instead.  The covered colour is the model's
 (:func:`lut_baker.tables.uniform_light.covered_colour`), solved per channel in closed form
@@ -26,6 +28,7 @@ Darker returns to exactly the same shade, clamped or not.
 - :func:`skin_target` -- both for a material, with where they came from.
 - :class:`Shade` -- a solved shade.
 - :func:`matched` -- Match Skin; :func:`first_shade` -- the first Apply's;
+  :func:`seen_target` -- the colour to match as the mesh's hollows render it;
   :func:`stepped` -- Lighter / Darker; :func:`assign` -- store a shade on the settings.
 - :func:`light_for` -- the settings' made-up skin under uniform light (cached per bake);
   :class:`SlabLight` -- with the film at a thickness (the exact closed form);
@@ -38,11 +41,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import artist_skin, bakes, shade, skin_colour, skin_model
+from . import artist_skin, bakes, shade, skin_colour, skin_model, sky_visibility
 from .core import albedo, bake, cache, film_slab, presets, quadrature, slab_skin, uniform_light
 
 __all__ = ["SHADE_STEP", "MATTE_FILM", "SkinTarget", "Shade", "SlabLight", "skin_target",
-           "light_for", "bare_light",
+           "light_for", "bare_light", "seen_target",
            "matched", "first_shade", "stepped", "assign", "clear_cache"]
 
 SHADE_STEP = 1.1
@@ -60,11 +63,15 @@ class SkinTarget:
     """What a shade is matched to: ``target``, the colour the skin has before Apply under
     uniform light (RGB, its gloss included), ``body``, the body colour of the skin under the
     film (RGB, the model's skin diffuse albedo ``a``), and ``source``, the end of a sentence
-    saying where they came from."""
+    saying where they came from; over the artist's shader ``glosses`` and ``sky``."""
 
     target: np.ndarray
     body: np.ndarray
     source: str
+    glosses: list = field(default_factory=list)
+    sky: sky_visibility.SkyVisibility | None = None
+    """Over the artist's shader: its gloss parts (RGB, roughness) and what a uniform sky
+    leaves to the surface (:func:`seen_target` weighs them)."""
 
 
 def light_for(settings, foundation: str | None = None, resolution: str | None = None):
@@ -107,7 +114,8 @@ def skin_target(material, reading=None, light=None, resolution: str | None = Non
         notes = "".join(f"; {note}" for note in reading.notes)
         where = f" {reading.where}" if reading.where else ""
         return SkinTarget(np.asarray(reading.target, float), np.asarray(reading.body, float),
-                          f"the artist's shader under uniform light{where}{notes}")
+                          f"the artist's shader under uniform light{where}{notes}",
+                          list(reading.glosses), reading.sky)
     skin = skin_colour.skin_colour(material)
     if light is None:
         light = (light_for(settings, resolution=resolution)
@@ -246,6 +254,49 @@ def _reach_sentences(shade_: Shade, light, gloss: float) -> list[str]:
     return sentences
 
 
+def seen_target(skin: SkinTarget, film_gloss, film_roughness: float
+                ) -> tuple[np.ndarray, str]:
+    """``(target, sentence)``: the covered colour under uniform light that renders on this
+    mesh as the artist's shader does, and what the sentence says of it (or ``skin.target``
+    and "" without ``skin.sky``).  Under a uniform sky each part of a colour keeps what the
+    mesh leaves it (:meth:`.sky_visibility.SkyVisibility.kept`): the artist's glosses their
+    lobes', the rest a diffuse surface's; so does the film's own gloss (``film_gloss``, RGB,
+    at Blender ``film_roughness``), and what the film lets through of the skin is counted as
+    diffuse."""
+    if skin.sky is None:
+        return np.asarray(skin.target, float), ""
+    target = np.asarray(skin.target, float)
+    film_gloss = np.asarray(film_gloss, float) * np.ones(3)
+    glossy_film = bool(np.any(film_gloss > 0.0))  # a matte film: no lobe to measure
+    diffuse, skies = skin.sky.seen(*(r for _, r in skin.glosses),
+                                   *([film_roughness] if glossy_film else []))
+    if not glossy_film:
+        skies = [*skies, 1.0]
+    kept = skin.sky.kept
+    gloss = sum((np.asarray(g, float) for g, _ in skin.glosses), np.zeros(3))
+    rendered = kept(diffuse, target) * (target - gloss) + sum(
+        (kept(sky, target) * np.asarray(g, float)
+         for (g, _), sky in zip(skin.glosses, skies[:-1], strict=True)), np.zeros(3))
+    seen = film_gloss + (rendered - kept(skies[-1], target) * film_gloss) \
+        / kept(diffuse, target)
+    lobes = ", ".join(f"a gloss at roughness {r:.2g} {sky:.0%}" for (_, r), sky in zip(
+        skin.glosses, skies[:-1], strict=True))
+    film = f", the film's gloss {skies[-1]:.0%}" if glossy_film else ""
+    return seen, (f"On this mesh a diffuse surface sees {diffuse:.0%} of a uniform sky"
+                  f"{', ' + lobes if lobes else ''}{film} (its hollows, as the camera sees "
+                  f"them): matched to {_rgb(seen)} under uniform light, which renders here as "
+                  f"the artist's shader does.")
+
+
+def _film_gloss(settings, light, foundation: str | None) -> tuple[np.ndarray, float]:
+    """The film surface's own gloss under uniform light (RGB) and its Blender roughness."""
+    roughness = (float(settings.film_roughness) if foundation is None
+                 else shade.foundation_roughness(foundation))
+    if isinstance(light, SlabLight):
+        return light.film_gloss, roughness
+    return float(settings.gloss) * np.asarray(light.film_gloss, float), roughness
+
+
 def matched(material, foundation: str | None = None, skin: SkinTarget | None = None,
             resolution: str | None = None) -> Shade:
     """The shade whose covered skin has the skin's colour before Apply under uniform light
@@ -257,13 +308,16 @@ def matched(material, foundation: str | None = None, skin: SkinTarget | None = N
     if skin is None:
         skin = skin_target(material, resolution=resolution, light=None if isinstance(
             light, SlabLight) else light)
-    result = _solve(settings, light, skin.target, skin)
+    target, seen = seen_target(skin, *_film_gloss(settings, light, foundation))
+    result = _solve(settings, light, target, skin)
     result.base = result.target
     result.sentences.append(
         f"Matched the shade to the skin's color before Apply ({_rgb(skin.target)}: "
         f"{skin.source}; under the film the skin's body color is {_rgb(skin.body)}): "
         f"absorption {_rgb(result.absorption)}, in the bottle "
         f"{_rgb(shade.colour_seen(result.absorption, shade.slab_foundation(settings)))}.")
+    if seen:
+        result.sentences.append(seen)
     result.sentences += _reach_sentences(result, light, float(settings.gloss))
     return result
 
@@ -350,6 +404,8 @@ def assign(settings, result: Shade, source: str) -> None:
 
 
 def clear_cache() -> None:
-    """Forget the session's uniform-light parts (the add-on's unregister calls it)."""
+    """Forget the session's uniform-light parts and the surfaces' sky (the add-on's
+    unregister calls it)."""
     _LIGHT.clear()
+    sky_visibility.clear_cache()
 

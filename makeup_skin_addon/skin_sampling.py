@@ -122,7 +122,8 @@ class SurfaceSamples:
     """The points of a material's surface as :mod:`.surface_values` evaluates the artist's
     shader at them (:class:`.surface_values.Samples`): the same points (faces and places in
     them: the seed and the areas fix them) at every UV map, ``weights`` (each point's share of
-    the area), image values read from the reduced image (:func:`.image_texels.reduced_image`).
+    the area), ``picked`` (the objects and their points, in the weights' order), image values
+    read from the reduced image (:func:`.image_texels.reduced_image`).
 
     An object without a UV map a texture reads is left out for that map (said in ``notes``);
     with no face to read (``problem`` says why: no object, no face of the material, no UV
@@ -143,6 +144,7 @@ class SurfaceSamples:
         self.notes: list[str] = []
         self.faces = 0
         self.seen_by = ""
+        self.picked: list = []
         self.problem = "" if self.objects else f"no mesh object uses {material.name!r}"
 
     def _note(self, sentence: str) -> None:
@@ -178,13 +180,14 @@ class SurfaceSamples:
         uv = np.concatenate([points.uv for points, _ in picked]).astype(float)
         weights = np.concatenate([np.full(len(points.uv), points.area / n)
                                   for points, n in picked])
+        used = [(surface.obj, points) for surface, (points, _) in zip(
+            [s for s, n in zip(surfaces, counts, strict=True) if n > 0], picked, strict=True)]
         if self.weights is None:
             self.faces = sum(points.faces for points, _ in picked)
+            self.picked = used
         if self.camera is not None and self.weights is None:
-            seen = np.concatenate([_seen(surface.obj, points, self.camera, self.scene)
-                                   for surface, (points, _) in zip(
-                                       [s for s, n in zip(surfaces, counts, strict=True)
-                                        if n > 0], picked, strict=True)])
+            seen = np.concatenate([_seen(obj, points, self.camera, self.scene)
+                                   for obj, points in used])
             if np.any(seen > 0.0):
                 weights = weights * seen
                 self.seen_by = self.camera.name

@@ -64,6 +64,7 @@ LAYERS: dict[str, list[tuple[str, ...]]] = {
         ("makeup_skin_addon.surface_points",),
         ("makeup_skin_addon.image_texels",),
         ("makeup_skin_addon.skin_sampling",),
+        ("makeup_skin_addon.sky_visibility",),
         ("makeup_skin_addon.skin_colour",),
         ("makeup_skin_addon.artist_skin",),
         ("makeup_skin_addon.shade",),

@@ -6,11 +6,10 @@ light under which a shader shows its colour, and the one the match is defined fo
 - at Coverage 0 the made-up material renders as the material did before Apply (the face's
   mean within 1% per channel, its blurred pixels within the noise of two seeds);
 - the first Apply, every setting at its default, keeps the face's colour within 3% per
-  channel of the render before Apply (the skin matched as the camera sees it; measured
-  0.0-1.2%, and 2.7% in red where the film cannot reach the glossy mix), but for the dark skin
-  in blue: 3.3%, where the artist's gloss is a large part of the colour and loses more light in
-  the head's hollows than the matte film's broader scattering (docs/addon.md, "A first Apply";
-  the goal is not met there);
+  channel of the render before Apply (the skin matched as the camera sees it, each part of
+  its colour weighed by what the head's hollows leave it of the sky: docs/addon.md, "A first
+  Apply"; measured within 0.7% for every kind, the dark skin's blue 3.6% off before the
+  hollows were weighed);
 - the same in EEVEE for the Principled head (slow: software OpenGL);
 - Revert gives back the tree as it was and removes the group and images nothing else uses.
 
@@ -30,9 +29,9 @@ EEVEE_SIZE = 48
 EEVEE_SAMPLES = 16
 COVERAGE_0_MEAN = 0.01
 """Coverage 0 against the render before Apply, the face's mean per channel."""
-FIRST_APPLY_MEAN = {"dark_value": 0.04}
-"""The first Apply against the render before Apply, the face's mean per channel: 3% (the
-goal), the dark skin 4% (measured 3.3% in blue)."""
+FIRST_APPLY_MEAN = 0.03
+"""The first Apply against the render before Apply, the face's mean per channel (measured
+within 0.7% for every kind)."""
 BLUR_NOISE_MARGIN = 1.5
 """Coverage 0's blurred pixels may differ from before Apply's by this times the difference
 between two seeds of the render before Apply (noise alone)."""
@@ -97,7 +96,7 @@ def test_coverage_0_is_the_artists_render_and_the_first_apply_keeps_its_colour(
     np.testing.assert_allclose(artist_skins.face_mean(zero), mean_before, rtol=COVERAGE_0_MEAN)
     assert _blurred_rms(zero, before) <= BLUR_NOISE_MARGIN * noise + 1e-4
     np.testing.assert_allclose(artist_skins.face_mean(first), mean_before,
-                               rtol=FIRST_APPLY_MEAN.get(kind, 0.03))
+                               rtol=FIRST_APPLY_MEAN)
 
 
 @pytest.mark.parametrize("kind", ["principled", "in_group"])
