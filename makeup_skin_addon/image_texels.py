@@ -69,8 +69,10 @@ def srgb_codes_to_linear(values: np.ndarray) -> np.ndarray:
     """:func:`srgb_to_linear` of a byte buffer's values (each ``code / 255``, as Blender
     gives a byte image's pixels) by a table of the 256 codes: the same values, a third of the
     time of the curve on a 4096 px image, float32."""
-    codes = (np.asarray(values, np.float32) * np.float32(255.0) + np.float32(0.5))
-    return np.take(_SRGB_CODES, codes.astype(np.uint8))
+    codes = np.multiply(values, np.float32(255.0), dtype=np.float32)
+    codes += np.float32(0.5)
+    # Written over the codes (one buffer the image's size, not three); every index is a byte.
+    return np.take(_SRGB_CODES, codes.astype(np.uint8), out=codes, mode="clip")
 
 
 def box_factor(width: int, height: int, size: int) -> int:
