@@ -88,8 +88,8 @@ def face_points(face_area, loop_start, loop_total, corner_vert, positions, corne
     second = first + 1  # the fan triangle's second corner (the first triangle's)
     for k in np.flatnonzero(np.bincount(corners)[4:]) + 4:  # faces of more than 3 corners
         pick = np.flatnonzero(corners == k)
-        partial = _fan_partial(face[pick], first[pick, None] + np.arange(k), loop_start,
-                               loop_total, corner_vert, positions, k)
+        partial = _fan_partial(face[pick], first[pick], loop_start, loop_total, corner_vert,
+                               positions, k)
         # The triangles whose cumulative area lies below the point's share of the face (the
         # last, the whole face, never does).
         below = partial[:, :-1] < draws[1, pick, None] * partial[:, -1:]
@@ -113,14 +113,15 @@ def _fan_areas(loops: np.ndarray, corner_vert, positions) -> np.ndarray:
     return np.cumsum(fan, axis=1)
 
 
-def _fan_partial(faces: np.ndarray, loops: np.ndarray, loop_start, loop_total, corner_vert,
+def _fan_partial(faces: np.ndarray, first: np.ndarray, loop_start, loop_total, corner_vert,
                  positions, k: int) -> np.ndarray:
     """:func:`_fan_areas` of the faces ``faces`` of ``k`` corners that points fell in (their
-    corners ``loops``), one row a point: computed once per face of ``k`` corners when the mesh
-    has fewer of them than there are points (the same numbers, row by row), else per point."""
+    first corners ``first``), one row a point: computed once per face of ``k`` corners when
+    the mesh has fewer of them than there are points (the same numbers, row by row), else per
+    point."""
     with_k = np.flatnonzero(np.asarray(loop_total) == k)
     if len(with_k) >= len(faces):
-        return _fan_areas(loops, corner_vert, positions)
+        return _fan_areas(first[:, None] + np.arange(k), corner_vert, positions)
     row = np.zeros(len(loop_total), np.int64)
     row[with_k] = np.arange(len(with_k))
     own = np.asarray(loop_start)[with_k].astype(np.int64)[:, None] + np.arange(k)
