@@ -214,8 +214,10 @@ def _read(image, size: int) -> ReducedImage:
 def _loaded_small(image, size: int) -> bool:
     """Whether ``image`` is a file image loaded already (its size known without decoding it)
     and at most ``size`` across (nothing to scale)."""
-    return (image.source == "FILE" and image.has_data
-            and box_factor(*image.size, size) == 1)
+    if image.source != "FILE" or not image.has_data:
+        return False
+    width, height = image.size
+    return box_factor(width, height, size) == 1
 
 
 def _read_pixels(image, size: int) -> ReducedImage:
