@@ -69,8 +69,11 @@ def srgb_codes_to_linear(values: np.ndarray) -> np.ndarray:
     """:func:`srgb_to_linear` of a byte buffer's values (each ``code / 255``, as Blender
     gives a byte image's pixels) by a table of the 256 codes: the same values, a third of the
     time of the curve on a 4096 px image, float32."""
-    codes = (np.asarray(values, np.float32) * np.float32(255.0) + np.float32(0.5))
-    return _SRGB_CODES[codes.astype(np.uint8)]
+    codes = np.multiply(values, np.float32(255.0), dtype=np.float32)
+    codes += np.float32(0.5)  # in place: one float buffer the image's size at a time
+    index = codes.astype(np.uint8)
+    del codes
+    return _SRGB_CODES[index]  # a byte index (``np.take`` would copy it as 8-byte integers)
 
 
 def box_factor(width: int, height: int, size: int) -> int:
@@ -96,42 +99,45 @@ def box_reduce(pixels: np.ndarray, factor: int) -> np.ndarray:
     return (summed / counts[..., None]).astype(np.float32)
 
 
-def _rgb(values: np.ndarray, width: int, height: int) -> np.ndarray:
-    """Flat pixels of any channel count as (height, width, 3): grey repeated."""
-    pixels = values.reshape(height, width, -1)
+def _rgb(pixels: np.ndarray) -> np.ndarray:
+    """Pixels ``(height, width, channels)`` of any channel count as (height, width, 3): grey
+    repeated."""
     return pixels[..., :3] if pixels.shape[-1] >= 3 else np.repeat(pixels[..., :1], 3, axis=-1)
 
 
-def _linearised(rgb: np.ndarray, is_float: bool, settings) -> tuple[np.ndarray, str]:
-    """``(linear values, note)``: as a texture node reads pixels of this colour space.  Float
-    buffers are scene linear once loaded; byte buffers keep their colour space's encoding
-    (their values are byte codes: linearised by :func:`srgb_codes_to_linear`)."""
+def _linearised(pixels: np.ndarray, is_float: bool, settings) -> tuple[np.ndarray, str]:
+    """``(linear values, note)``: as a texture node reads pixels of this colour space (every
+    channel, before :func:`_rgb` picks them: the whole pixel is contiguous, its RGB view is
+    not, and the codes are computed several times faster on it).  Float buffers are scene
+    linear once loaded; byte buffers keep their colour space's encoding (their values are byte
+    codes: linearised by :func:`srgb_codes_to_linear`)."""
     space = settings.name
     if is_float or settings.is_data or space in LINEAR_SPACES:
-        return rgb, ""
+        return pixels, ""
     if space.startswith("Linear") or space in {"ACEScg", "ACES2065-1"}:
-        return rgb, f"its colour space {space!r} was read as Linear Rec.709"
+        return pixels, f"its colour space {space!r} was read as Linear Rec.709"
     note = "" if space == "sRGB" else f"its colour space {space!r} was read as sRGB"
-    return srgb_codes_to_linear(rgb), note
+    return srgb_codes_to_linear(pixels), note
 
 
 def _whole(image, size: int) -> ReducedImage:
     """An image whose pixels live only in memory (generated, or with unsaved changes), which a
-    copy would not have: read whole (16 bytes a texel), linearised and box-filtered a band of
-    rows at a time."""
+    copy would not have, or one loaded already at most ``size`` across (a copy would decode
+    its file again, for the same pixels): read whole (16 bytes a texel), linearised and
+    box-filtered a band of rows at a time."""
     width, height = image.size
     if width * height == 0:
         return ReducedImage(None, problem=f"image {image.name!r} has no pixels")
     values = np.empty(width * height * image.channels, np.float32)
     image.pixels.foreach_get(values)
-    rgb = _rgb(values, width, height)
+    pixels = values.reshape(height, width, -1)
     factor = box_factor(width, height, size)
     band = factor * max(1, (1 << 20) // (factor * width))
     parts, note = [], ""
     for start in range(0, height, band):
-        linear, note = _linearised(rgb[start:start + band], image.is_float,
+        linear, note = _linearised(pixels[start:start + band], image.is_float,
                                    image.colorspace_settings)
-        parts.append(box_reduce(linear, factor))
+        parts.append(_rgb(box_reduce(linear, factor)))  # every channel: no strided copy
     return ReducedImage(np.concatenate(parts), note)
 
 
@@ -153,8 +159,9 @@ def _scaled_copy(image, size: int) -> ReducedImage | None:
         is_float = copy.is_float
     finally:
         bpy.data.images.remove(copy)
-    linear, note = _linearised(_rgb(values, width, height), is_float, image.colorspace_settings)
-    return ReducedImage(np.ascontiguousarray(linear, np.float32), note)
+    linear, note = _linearised(values.reshape(height, width, -1), is_float,
+                               image.colorspace_settings)
+    return ReducedImage(np.ascontiguousarray(_rgb(linear), np.float32), note)
 
 
 def _image_fingerprint(image) -> tuple:
@@ -205,10 +212,19 @@ def _read(image, size: int) -> ReducedImage:
     return reduced
 
 
+def _loaded_small(image, size: int) -> bool:
+    """Whether ``image`` is a file image loaded already (its size known without decoding it)
+    and at most ``size`` across (nothing to scale)."""
+    if image.source != "FILE" or not image.has_data:
+        return False
+    width, height = image.size
+    return box_factor(width, height, size) == 1
+
+
 def _read_pixels(image, size: int) -> ReducedImage:
     if image.source == "VIEWER":
         return ReducedImage(None, problem=f"image {image.name!r} is a render result")
-    if image.is_dirty or image.source == "GENERATED":
+    if image.is_dirty or image.source == "GENERATED" or _loaded_small(image, size):
         return _whole(image, size)
     reduced = _scaled_copy(image, size)
     if reduced is not None:

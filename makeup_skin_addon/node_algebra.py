@@ -44,6 +44,11 @@ class Builder:
     """Adds nodes to a tree and links them; values may be sockets, :class:`NodeValue` or
     constants.
 
+    Every setting, value and link set through the Python API updates the whole tree (about
+    half a microsecond a node, the tree's nodes at the time), so only what differs from a
+    new node's own is set, and the new nodes are laid out in one call by :meth:`finish`
+    (their places matter to no render).
+
     ``reuse``: the tree holds what an earlier build of the same structure added, in the same
     order (a group rebuilt from a new fit of the same tier): its nodes are taken in turn
     instead of added, and only the settings, values and links that differ are set, which
@@ -66,12 +71,10 @@ class Builder:
         if self._old is not None:
             return self._reused(kind, label, props)
         node = self.tree.nodes.new(kind)
-        node.location = (200 * (self.count // 10) - 400, -160 * (self.count % 10))
         self.count += 1
         if label:
             node.label = label
-        for name, value in props.items():
-            setattr(node, name, value)
+        _set(node, props)
         return node
 
     def _reused(self, kind: str, label: str, props: dict):
@@ -83,9 +86,7 @@ class Builder:
         self.count += 1
         if node.bl_idname != SAME_NODE.get(kind, kind) or node.label != label:
             raise Mismatch(f"{node.bl_idname} {node.label!r} where {kind} {label!r} goes")
-        for name, value in props.items():
-            if getattr(node, name) != value:
-                setattr(node, name, value)
+        _set(node, props)
         return node
 
     def link(self, source, target) -> None:
@@ -101,14 +102,16 @@ class Builder:
         self._into[key] = self.tree.links.new(source, target)
 
     def finish(self) -> None:
-        """Reusing: :class:`Mismatch` unless every node and link of the tree was taken."""
-        if self._old is not None and (self.count != len(self._old)
-                                      or self._links != len(self.tree.links)):
+        """Adding: lay the new nodes out (columns of ten, in the order they were added).
+        Reusing: :class:`Mismatch` unless every node and link of the tree was taken."""
+        if self._old is None:
+            _lay_out(self.tree.nodes, self.count)
+        elif self.count != len(self._old) or self._links != len(self.tree.links):
             raise Mismatch("the tree holds nodes or links this build does not add")
 
     def feed(self, target, value):
-        """Link a socket into ``target`` or set its default value (reusing: only if it
-        differs, and a link where a value goes removed)."""
+        """Link a socket into ``target`` or set its default value (only if it differs;
+        reusing, a link where a value goes removed)."""
         value = value_of(value)
         if isinstance(value, bpy.types.NodeSocket):
             self.link(value, target)
@@ -127,10 +130,9 @@ class Builder:
             link = self._into.pop(target.as_pointer(), None)
             if link is not None:
                 self.tree.links.remove(link)
-            old = target.default_value
-            if (tuple(old) if isinstance(new, tuple) else old) == new:
-                return
-        target.default_value = new
+        old = target.default_value
+        if (tuple(old) if isinstance(new, tuple) else old) != new:
+            target.default_value = new
 
     def math(self, operation: str, a, b=0.0, label: str = ""):
         node = self.node("ShaderNodeMath", label, operation=operation)
@@ -151,6 +153,25 @@ class Builder:
         self.feed(socket(node.inputs, "A_Vector"), a)
         self.feed(socket(node.inputs, "B_Vector"), b)
         return socket(node.outputs, "Result_Vector")
+
+
+def _set(node, props: dict) -> None:
+    """Set the settings ``props`` of ``node`` that differ (each set updates the tree)."""
+    for name, value in props.items():
+        if getattr(node, name) != value:
+            setattr(node, name, value)
+
+
+def _lay_out(nodes, count: int) -> None:
+    """Place the last ``count`` of ``nodes`` (the tree's collection) in columns of ten, in one
+    call (``foreach_set`` updates nothing; a node's ``location`` set alone updates the
+    tree)."""
+    places = np.empty(2 * len(nodes), np.float32)
+    nodes.foreach_get("location", places)
+    index = np.arange(count)
+    places[len(places) - 2 * count:] = np.column_stack(
+        [200 * (index // 10) - 400, -160 * (index % 10)]).ravel()
+    nodes.foreach_set("location", places)
 
 
 def _constant(value):

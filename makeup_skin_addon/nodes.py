@@ -299,7 +299,9 @@ def _emit(group, emit, reuse: bool) -> None:
         except Mismatch:
             pass
     group.nodes.clear()
-    emit(Builder(group))
+    build = Builder(group)
+    emit(build)
+    build.finish()
 
 
 def build_group(tier: str, record: dict, fit, group=None, *, method=None, measured=None,

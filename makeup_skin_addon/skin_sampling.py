@@ -224,7 +224,7 @@ def _seen(obj, points: surface_points.Points, camera, scene) -> np.ndarray:
     matrix = np.array(obj.matrix_world, float)
     position = points.position @ matrix[:3, :3].T + matrix[:3, 3]
     normal = points.normal @ np.linalg.inv(matrix[:3, :3])  # the inverse transpose, by rows
-    normal /= np.maximum(np.linalg.norm(normal, axis=1, keepdims=True), 1e-30)
+    normal /= np.maximum(np.sqrt(_rows_dot(normal, normal)), 1e-30)[:, None]
     view = np.array(camera.matrix_world, float)
     local = (position - view[:3, 3]) @ view[:3, :3]  # in the camera's frame (looks down -z)
     frame = np.array([tuple(corner) for corner in camera.data.view_frame(scene=scene)])
@@ -234,14 +234,21 @@ def _seen(obj, points: surface_points.Points, camera, scene) -> np.ndarray:
         inside = np.ones(len(local), bool)
     else:
         towards = view[:3, 3] - position
-        towards = towards / np.maximum(np.linalg.norm(towards, axis=1, keepdims=True), 1e-30)
+        towards = towards / np.maximum(np.sqrt(_rows_dot(towards, towards)), 1e-30)[:, None]
         depth = -local[:, 2]
         inside = depth > 0.0
         scale = -frame[0, 2] / np.where(inside, depth, 1.0)
         x, y = local[:, 0] * scale, local[:, 1] * scale
     inside &= ((x >= frame[:, 0].min()) & (x <= frame[:, 0].max())
                & (y >= frame[:, 1].min()) & (y <= frame[:, 1].max()))
-    return np.where(inside, np.maximum(np.sum(normal * towards, axis=1), 0.0), 0.0)
+    return np.where(inside, np.maximum(_rows_dot(normal, towards), 0.0), 0.0)
+
+
+def _rows_dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The dot product of each row of ``a`` and ``b`` (``(n, 3)``), summed in the order
+    ``np.sum(a * b, axis=1)`` sums them, a column at a time (several times faster than that
+    reduction over rows of three)."""
+    return (a[:, 0] * b[:, 0] + a[:, 1] * b[:, 1]) + a[:, 2] * b[:, 2]
 
 
 def surface_samples(material, progress: Report | None = None, scene=None) -> SurfaceSamples:

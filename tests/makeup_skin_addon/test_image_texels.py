@@ -106,3 +106,31 @@ def test_the_box_filter_averages_whole_and_partial_boxes(addon):
     assert cut.shape == (3, 2, 3)
     np.testing.assert_allclose(cut[2, 1], pixels[8:10, 4:7].mean(axis=(0, 1)), rtol=1e-6)
     np.testing.assert_allclose(cut[0, 0], whole[0, 0], rtol=1e-6)
+
+
+def test_a_small_image_loaded_already_reads_as_its_file_does(addon, tmp_path):
+    """An image file at most 512 px across that Blender has loaded is read from memory (no
+    copy decoding its file again): the same reduced pixels as the same file not yet loaded,
+    read through a copy, and as the pixels written to it, linearised."""
+    import bpy
+
+    from makeup_skin_addon import image_texels
+
+    rng = np.random.default_rng(11)
+    codes = rng.integers(0, 256, (24, 40, 4))
+    source = bpy.data.images.new("Codes", 40, 24, alpha=True)
+    source.pixels.foreach_set((codes / 255).astype(np.float32).ravel())
+    path = str(tmp_path / "codes.png")
+    source.filepath_raw = path
+    source.file_format = "PNG"
+    source.save()
+    read = {}
+    for loaded in (False, True):
+        image = bpy.data.images.load(path, check_existing=False)
+        image.colorspace_settings.name = "sRGB"
+        if loaded:
+            assert image.size[0] == 40  # loads it
+        assert image.has_data == loaded
+        read[loaded] = image_texels.reduced_image(image).pixels
+    assert np.array_equal(read[True], read[False])
+    np.testing.assert_allclose(read[True], linear(codes[..., :3] / 255), rtol=1e-6, atol=1e-9)

@@ -70,3 +70,19 @@ def test_channel_functions(tree):
     assert algebra.channel_max(np.array([0.1, 0.5, 0.2])) == 0.5
     assert algebra.maximum(0.2, np.array([0.1, 0.3, 0.0])).tolist() == [0.2, 0.3, 0.2]
     assert algebra.minimum(colour, 1.0).socket.node.operation == "MINIMUM"
+
+
+def test_a_finished_build_lays_its_nodes_out_in_columns_of_ten(tree):
+    """The nodes a build added, in the order it added them, ten to a column (the tree's
+    nodes before it stay where they were)."""
+    from makeup_skin_addon.node_algebra import Builder
+
+    before = tree.nodes.new("ShaderNodeValue")
+    before.location = (5.0, 7.0)
+    build = Builder(tree)
+    added = [build.node("ShaderNodeMath", operation="MULTIPLY") for _ in range(23)]
+    build.finish()
+    assert tuple(before.location) == (5.0, 7.0)
+    for i, node in enumerate(added):
+        assert tuple(node.location) == (200 * (i // 10) - 400, -160 * (i % 10))
+        assert node.operation == "MULTIPLY"
