@@ -325,17 +325,32 @@ def mirror_quadrature(theta: ArrayLike, width_deg: float, *,
     alpha_max = 0.5 * np.arctan2(sin_t * np.cos(phi), cos_t) + 0.25 * np.pi  # (N, P)
     low = np.minimum(edges[None, :-1, None], alpha_max[:, None, :])  # (N, K, P)
     length = np.minimum(edges[None, 1:, None], alpha_max[:, None, :]) - low
-    alpha = (low[:, :, None] + length[:, :, None] * x[None, None, :, None])
+    # The nodes' arrays (N, K * A, P) are the cost: each is worked on in place, in the same
+    # operations and order as written in the comments (products and sums commute exactly).
+    alpha = length[:, :, None] * x[None, None, :, None]
+    alpha += low[:, :, None]  # low + length x
     alpha = alpha.reshape(angles.size, -1, phi.size)
     d_alpha = (length[:, :, None] * wx[None, None, :, None]).reshape(alpha.shape)
-    sin_a, cos_a = np.sin(alpha), np.cos(alpha)
-    hx = sin_a * np.cos(phi)  # h = (hx, hy, cos_a); hy only for ``other``, when asked
+    sin_a = np.sin(alpha)
+    cos_a = np.cos(alpha, out=alpha)
     fixed = np.stack([sin_t[:, 0], np.zeros_like(angles), cos_t[:, 0]], axis=-1)
     sin_d, cos_d = sin_t[:, :, None], cos_t[:, :, None]
-    cos_dh = np.clip(sin_d * hx + cos_d * cos_a, 0.0, 1.0)  # d.h, d = (sin_t, 0, cos_t)
+    # d.h with h = (sin_a cos(phi), hy, cos_a) and d = (sin_t, 0, cos_t); hy only for
+    # ``other``, when asked
+    cos_dh = sin_a * np.cos(phi)
+    cos_dh *= sin_d
+    scratch = np.multiply(cos_d, cos_a)
+    cos_dh += scratch
+    np.clip(cos_dh, 0.0, 1.0, out=cos_dh)
     # n.e of e = 2 (d.h) h - d, held at 0 against rounding at the horizon
-    cos_other = np.maximum(2.0 * cos_dh * cos_a - cos_d, 0.0)
-    weight = 2.0 * 4.0 * cos_dh * sin_a * d_alpha * wphi
+    cos_other = np.multiply(2.0, cos_dh, out=scratch)
+    cos_other *= cos_a
+    cos_other -= cos_d
+    np.maximum(cos_other, 0.0, out=cos_other)
+    weight = 8.0 * cos_dh  # 2 (the other half) 4 (d.h) sin_a d_alpha wphi
+    weight *= sin_a
+    weight *= d_alpha
+    weight *= wphi
     return MirrorQuadrature(theta=angles, fixed=fixed, weight=weight, cos_h=cos_a,
                             cos_dh=cos_dh, cos_other=cos_other, sin_h=sin_a, phi=phi)
 
