@@ -74,13 +74,23 @@ def _read_only(*arrays: np.ndarray) -> tuple[np.ndarray, ...]:
     return arrays
 
 
+@lru_cache(maxsize=16)
+def _legendre_rule(points: int) -> tuple[np.ndarray, np.ndarray]:
+    """numpy's ``leggauss(points)`` on [-1, 1] (read-only arrays), once per process and
+    count: it costs 0.2 ms at 5 nodes to 3 ms at 96, and every interval and panel count of
+    :func:`gauss_legendre` shares it."""
+    x, w = np.polynomial.legendre.leggauss(points)
+    _read_only(x, w)
+    return x, w
+
+
 @lru_cache(maxsize=32)
 def gauss_legendre(points: int, start: float = 0.0, stop: float = 1.0,
                    panels: int = 1) -> tuple[np.ndarray, np.ndarray]:
     """``(nodes, weights)`` of the composite Gauss-Legendre rule: ``panels`` equal panels of
     ``points`` nodes on [``start``, ``stop``], ``Int f dx ~ sum_k weights_k f(nodes_k)``
     (read-only arrays, in the units of ``start`` and ``stop``)."""
-    x, w = np.polynomial.legendre.leggauss(points)
+    x, w = _legendre_rule(points)
     half = (stop - start) / 2.0 / panels
     mid = start + half * (2.0 * np.arange(panels) + 1.0)
     nodes = (mid[:, None] + half * x[None, :]).ravel()
