@@ -37,6 +37,21 @@ def test_gauss_legendre_shares_numpys_rule_per_point_count():
         rule[0] = 0.0  # shared: read-only
 
 
+def test_stored_legendre_rules_are_numpys():
+    """The rules read from the file (every stored count) are numpy's ``leggauss`` (within
+    what moves between machines), and a count not stored is computed."""
+    stored = quadrature._stored_legendre_rules()
+    assert sorted(stored) == sorted(quadrature.STORED_LEGENDRE_POINTS)
+    quadrature._legendre_rule.cache_clear()
+    for count in (*quadrature.STORED_LEGENDRE_POINTS, 7):
+        x, w = np.polynomial.legendre.leggauss(count)
+        nodes, weights = quadrature._legendre_rule(count)
+        assert (nodes is stored[count][0]) if count in stored else nodes.size == 7
+        np.testing.assert_allclose(nodes, x, rtol=0.0, atol=4e-16)
+        np.testing.assert_allclose(weights, w, rtol=1e-14)
+        assert np.sum(weights * nodes**2) == pytest.approx(2.0 / 3.0, rel=1e-14)
+
+
 def test_hemisphere_rules_integrate_the_projected_solid_angle():
     """``Int cos(theta) dw = pi`` over the hemisphere, by both grids."""
     for grid in (quadrature.hemisphere_panels(3, 10, 33), quadrature.hemisphere_grid(20.0)):
