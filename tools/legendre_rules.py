@@ -13,35 +13,30 @@ Run it after changing ``STORED_LEGENDRE_POINTS`` or numpy.
 
 from __future__ import annotations
 
-import argparse
 import json
 import sys
 from pathlib import Path
 
-REPO = Path(__file__).resolve().parent.parent
-if str(REPO) not in sys.path:
-    sys.path.insert(0, str(REPO))
-
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the repository's lut_baker
 from lut_baker.numerics import quadrature  # noqa: E402
 
 
-def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--check", action="store_true", help="compare only")
-    args = parser.parse_args(argv)
+def main(arguments: list[str]) -> int:
+    if arguments not in ([], ["--check"]):
+        print(__doc__)
+        return 2
     fresh = quadrature.legendre_rules_data()
-    if args.check:
-        stored = json.loads(quadrature.LEGENDRE_RULES_FILE.read_text())
-        differ = [count for count, rule in fresh["rules"].items()
-                  if stored["rules"].get(count) != rule]
-        print(f"{len(fresh['rules'])} rules, "
-              + (f"differ at {', '.join(differ)} points" if differ else "all identical"))
+    target = quadrature.LEGENDRE_RULES_FILE
+    if arguments:
+        stored = json.loads(target.read_text())["rules"]
+        differ = [count for count, rule in fresh["rules"].items() if stored.get(count) != rule]
+        print(f"{len(fresh['rules'])} rules against numpy's: "
+              + (f"{', '.join(differ)} points differ" if differ else "all identical"))
         return 1 if differ else 0
-    quadrature.LEGENDRE_RULES_FILE.write_text(json.dumps(fresh, indent=1) + "\n")
-    print(f"wrote {quadrature.LEGENDRE_RULES_FILE.relative_to(REPO)} "
-          f"({len(fresh['rules'])} rules)")
+    target.write_text(json.dumps(fresh, indent=1) + "\n")
+    print(f"wrote {target.name} ({len(fresh['rules'])} rules)")
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(main(sys.argv[1:]))
