@@ -49,6 +49,8 @@ Functions and types
 - :func:`remove_faces` -- the body inside a symmetric free film, its two faces taken off.
 - :class:`FilmSlab`, :func:`film_slab` -- the body at every thickness, with absorption.
 - :func:`body` -- the body's ``(R, T)`` at a thickness.
+- :func:`surface_on_body` -- the surface over the body (the adding equations, their two
+  systems solved as one).
 - :func:`free_film_matrices` -- the free film (face, body, face) at a thickness.
 - :func:`made_up_matrices`, :func:`made_up_albedo` -- the film on skin (surface, body, skin,
   every inter-reflection), its directional albedo with the surface's gloss.
@@ -113,6 +115,7 @@ __all__ = [
     "FilmSlab",
     "film_slab",
     "body",
+    "surface_on_body",
     "free_film_matrices",
     "made_up_matrices",
     "made_up_albedo",
@@ -557,6 +560,14 @@ def body(film: FilmSlab, thickness: float) -> tuple[NDArray[np.float64], NDArray
     return slab(film.generator, thickness)
 
 
+def surface_on_body(surface: Layer, body_layer: Layer) -> Layer:
+    """The surface (:func:`face_layer`) over the body (:func:`body` or :func:`thick_slab
+    <lut_baker.numerics.adding_doubling.thick_slab>`): the surface's reflection from below is a
+    mirror (diagonal) and the body's from above a slab's (symmetric by construction), so the
+    adding equations solve their two systems as one (``add_layers(..., symmetric=True)``)."""
+    return add_layers(surface, body_layer, symmetric=True)
+
+
 def _body_layer(film: FilmSlab, thickness: float) -> Layer:
     r, t = body(film, thickness)
     return Layer(top=r, bottom=r, down=t)
@@ -570,7 +581,7 @@ def free_film_matrices(film: FilmSlab, thickness: float, face: ArrayLike | None 
     face = film.measured_face if face is None else np.asarray(face, float)
     upper = face_layer(face, film.orders)
     lower = Layer(top=upper.bottom, bottom=upper.top, down=upper.down)
-    stack = add_layers(add_layers(upper, _body_layer(film, thickness)), lower)
+    stack = add_layers(surface_on_body(upper, _body_layer(film, thickness)), lower)
     return stack.top, stack.down
 
 
@@ -604,8 +615,8 @@ def made_up_matrices(film: FilmSlab, thickness: float, skin: ReflectionLayer,
     the whole BRDF."""
     face = film.measured_face if face is None else np.asarray(face, float)
     skin_matrix = skin_star(skin, film.grid)[:, :film.orders]
-    stack = add_layers(add_layers(face_layer(face, film.orders), _body_layer(film, thickness)),
-                       _skin_layer(skin_matrix))
+    stack = add_layers(surface_on_body(face_layer(face, film.orders),
+                                        _body_layer(film, thickness)), _skin_layer(skin_matrix))
     return stack.top
 
 
@@ -642,7 +653,8 @@ def thick_limit_albedo(film: FilmSlab, face: ArrayLike | None = None) -> NDArray
     face = film.measured_face if face is None else np.asarray(face, float)
     r_inf = thick_slab(film.generator)
     zeros = np.zeros_like(r_inf)
-    stack = add_layers(face_layer(face, film.orders), Layer(top=r_inf, bottom=r_inf, down=zeros))
+    stack = surface_on_body(face_layer(face, film.orders),
+                             Layer(top=r_inf, bottom=r_inf, down=zeros))
     return face + star_albedo(stack.top[:, 0], film.scale[0])
 
 

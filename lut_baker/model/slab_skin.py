@@ -56,7 +56,7 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..numerics.adding_doubling import Layer, add_layers, star_albedo, star_scale
+from ..numerics.adding_doubling import Layer, star_albedo, star_scale
 from ..numerics.quadrature import HemisphereGrid
 from .film_slab import (
     ROOT_STEPS,
@@ -69,6 +69,7 @@ from .film_slab import (
     increasing_root,
     relative_thickness,
     skin_star,
+    surface_on_body,
 )
 from .layers import ReflectionLayer, TransmissionLayer
 
@@ -133,7 +134,7 @@ class SlabSkinParts(NamedTuple):
 def _film_layer(film: FilmSlab, thickness: float, face: NDArray[np.float64]) -> Layer:
     """The film on skin (its surface over its body at ``thickness``, paper-film units)."""
     r, t = body(film, thickness)
-    return add_layers(face_layer(face, film.orders), Layer(top=r, bottom=r, down=t))
+    return surface_on_body(face_layer(face, film.orders), Layer(top=r, bottom=r, down=t))
 
 
 def slab_skin_parts(film: FilmSlab, thickness: float, skin: ReflectionLayer,

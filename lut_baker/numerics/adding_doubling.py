@@ -138,7 +138,7 @@ def _t(a: NDArray[np.float64]) -> NDArray[np.float64]:
     return np.swapaxes(a, -1, -2)
 
 
-def add_layers(upper: Layer, lower: Layer) -> Layer:
+def add_layers(upper: Layer, lower: Layer, *, symmetric: bool = False) -> Layer:
     """``upper`` lying on ``lower``: the adding equations (van de Hulst 1980, eq. 4.15; Prahl
     1995, eqs. 26-29), every inter-reflection between the two summed::
 
@@ -148,22 +148,37 @@ def add_layers(upper: Layer, lower: Layer) -> Layer:
 
     with ``R1 = upper.top``, ``R1' = upper.bottom``, ``R2 = lower.top``, ``R2' =
     lower.bottom``, ``T1``, ``T2`` their transmissions downward (row vectors: light enters on
-    the left).
+    the left).  ``symmetric=True`` is the caller's guarantee that ``R1'`` and ``R2`` are
+    symmetric (exactly, as a slab's reflections and a mirror are): then ``(I - R2 R1')^T =
+    I - R1' R2`` and the two systems are solved as one, with both right-hand sides.
 
     >>> generator = slab_generator(np.array([[0.2]]), np.array([[0.7]]))  # one node
     >>> r, t = slab(generator, 0.5)
     >>> half = Layer(top=r, bottom=r, down=t)  # half the slab on the other half: the slab
-    >>> whole = add_layers(half, half)
+    >>> whole = add_layers(half, half, symmetric=True)
     >>> print(np.round(whole.top, 6), np.round(whole.down, 6))
     [[0.2]] [[0.7]]
     """
     eye = np.eye(upper.top.shape[-1])
-    # (I - R2 R1')^-1 applied from the right, as a solve of the transposed system.
-    inner = np.linalg.solve(_t(eye - lower.top @ upper.bottom), _t(upper.down))
+    reflected = upper.bottom @ lower.down  # R1' T2
+    if symmetric:
+        # One factorisation of I - R1' R2 for (I - R2 R1')^-1 from the right (the transposed
+        # system) and (I - R1' R2)^-1 R1' T2.
+        matrix = eye - upper.bottom @ lower.top
+        first = _t(upper.down)
+        lead = np.broadcast_shapes(matrix.shape[:-2], first.shape[:-2], reflected.shape[:-2])
+        both = np.linalg.solve(matrix, np.concatenate(
+            [np.broadcast_to(first, lead + first.shape[-2:]),
+             np.broadcast_to(reflected, lead + reflected.shape[-2:])], axis=-1))
+        inner = np.ascontiguousarray(both[..., :first.shape[-1]])
+        back = np.ascontiguousarray(both[..., first.shape[-1]:])
+    else:
+        # (I - R2 R1')^-1 applied from the right, as a solve of the transposed system.
+        inner = np.linalg.solve(_t(eye - lower.top @ upper.bottom), _t(upper.down))
+        back = np.linalg.solve(eye - upper.bottom @ lower.top, reflected)
     through = _t(inner)  # T1 (I - R2 R1')^-1
     top = upper.top + through @ lower.top @ _t(upper.down)
     down = through @ lower.down
-    back = np.linalg.solve(eye - upper.bottom @ lower.top, upper.bottom @ lower.down)
     bottom = lower.bottom + _t(lower.down) @ back
     return Layer(top=top, bottom=bottom, down=down)
 

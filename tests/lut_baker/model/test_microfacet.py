@@ -57,6 +57,21 @@ def test_fresnel_mixed_indices_per_channel_match_each_index_alone():
     assert microfacet.fresnel_reflectance(np.array([np.nan]), 0.7)[0] == 0.0
 
 
+def test_fresnel_arrays_agree_with_single_cosines_and_keep_their_input():
+    """An array of cosines (worked on in place where no total internal reflection can occur)
+    gives what each cosine gives alone (the formula on scalars), NaN and index-matched
+    grazing included, and leaves the caller's array as it was."""
+    c = np.array([0.0, 5e-324, 1e-8, 0.2, 0.5, 0.99, 1.0, np.nan])
+    kept = c.copy()
+    for eta in (1.0, 1.0 + 1e-12, 1.19, 1.5, 2.42, np.float64(1.33), np.array(1.45)):
+        together = microfacet.fresnel_reflectance(c, eta)
+        alone = [float(microfacet.fresnel_reflectance(float(value), eta)) for value in c]
+        np.testing.assert_allclose(together, alone, rtol=1e-15, atol=1e-300)
+        assert together[-1] == 0.0 and together.shape == c.shape
+        np.testing.assert_array_equal(c, kept)
+    assert microfacet.fresnel_reflectance(c[:1], 1.0)[0] == 0.0  # no interface, grazing
+
+
 def test_fresnel_index_matched_is_zero():
     """eta = 1: no interface, no reflection at any incidence, grazing included, and the
     values next to eta = 1 approach it continuously."""

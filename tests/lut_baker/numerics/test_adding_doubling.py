@@ -79,6 +79,31 @@ def test_adding_a_clear_layer_changes_nothing_and_doubling_is_adding(scale):
     assert np.allclose(both.bottom, r2, atol=1e-14)
 
 
+def test_symmetric_layers_solve_both_systems_as_one(scale):
+    """``symmetric=True`` (a mirror over a slab, each reflection symmetric) gives what the
+    general adding equations give, with layers of different leading shapes broadcast; the
+    general form still handles a non-symmetric pair (where the flag would not apply)."""
+    gen = medium_slab(0.8, scale)
+    r, t = AD.slab(gen, 0.7)
+    surface = AD.Layer(top=np.zeros((3,) + r.shape), bottom=AD.mirror(
+        np.array([[0.1], [0.3], [0.5]]) * np.ones(r.shape[-1]), GRID.orders),
+        down=np.broadcast_to(0.8 * np.eye(r.shape[-1]), (3,) + r.shape))
+    body = AD.Layer(top=r, bottom=r, down=t)
+    per_channel = AD.Layer(*(np.broadcast_to(part, (3,) + r.shape) for part in body))
+    for upper, lower in ((surface, body), (body, body), (per_channel, surface)):
+        general = AD.add_layers(upper, lower)
+        together = AD.add_layers(upper, lower, symmetric=True)
+        for got, expected in zip(together, general, strict=True):
+            assert got.shape == expected.shape
+            np.testing.assert_allclose(got, expected, rtol=1e-13, atol=1e-15)
+    skewed = AD.Layer(top=r, bottom=r + 0.01 * np.triu(np.ones_like(r)), down=t)
+    general = AD.add_layers(skewed, body)
+    assert not np.allclose(AD.add_layers(skewed, body, symmetric=True).top, general.top,
+                           rtol=1e-6)  # the flag is a promise the caller must keep
+    r2, t2 = AD.double_slab(r, t)
+    np.testing.assert_allclose(AD.add_layers(body, body).top, r2, atol=1e-14)
+
+
 def test_the_slab_doubles_into_itself_at_every_thickness(scale):
     gen = medium_slab(0.9, scale)
     for x in (0.01, 0.3, 1.0, 4.0):

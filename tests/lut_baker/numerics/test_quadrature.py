@@ -18,6 +18,40 @@ def test_gauss_legendre_integrates_polynomials_exactly(panels):
         nodes[0] = 0.0  # cached: every caller shares the arrays
 
 
+def test_gauss_legendre_shares_numpys_rule_per_point_count():
+    """The rule on [-1, 1] is computed once per point count (numpy's ``leggauss``) and every
+    interval and panel count maps it; another count gets its own."""
+    quadrature.gauss_legendre.cache_clear()
+    quadrature._legendre_rule.cache_clear()
+    x, w = np.polynomial.legendre.leggauss(7)
+    nodes, weights = quadrature.gauss_legendre(7, 0.0, 2.0)
+    np.testing.assert_allclose(nodes, x + 1.0, rtol=0.0, atol=1e-15)
+    np.testing.assert_allclose(weights, w, rtol=1e-15)
+    quadrature.gauss_legendre(7, -3.0, 5.0, 4)
+    assert quadrature._legendre_rule.cache_info().misses == 1  # one rule for both intervals
+    assert quadrature._legendre_rule.cache_info().hits == 1
+    other, _ = quadrature.gauss_legendre(9, 0.0, 2.0)
+    assert other.size == 9 and quadrature._legendre_rule.cache_info().misses == 2
+    rule, _ = quadrature._legendre_rule(7)
+    with pytest.raises(ValueError):
+        rule[0] = 0.0  # shared: read-only
+
+
+def test_stored_legendre_rules_are_numpys():
+    """The rules read from the file (every stored count) are numpy's ``leggauss`` (within
+    what moves between machines), and a count not stored is computed."""
+    stored = quadrature._stored_legendre_rules()
+    assert sorted(stored) == sorted(quadrature.STORED_LEGENDRE_POINTS)
+    quadrature._legendre_rule.cache_clear()
+    for count in (*quadrature.STORED_LEGENDRE_POINTS, 7):
+        x, w = np.polynomial.legendre.leggauss(count)
+        nodes, weights = quadrature._legendre_rule(count)
+        assert (nodes is stored[count][0]) if count in stored else nodes.size == 7
+        np.testing.assert_allclose(nodes, x, rtol=0.0, atol=4e-16)
+        np.testing.assert_allclose(weights, w, rtol=1e-14)
+        assert np.sum(weights * nodes**2) == pytest.approx(2.0 / 3.0, rel=1e-14)
+
+
 def test_hemisphere_rules_integrate_the_projected_solid_angle():
     """``Int cos(theta) dw = pi`` over the hemisphere, by both grids."""
     for grid in (quadrature.hemisphere_panels(3, 10, 33), quadrature.hemisphere_grid(20.0)):
@@ -68,3 +102,14 @@ def test_mirror_quadrature_builds_the_other_direction_on_demand():
     np.testing.assert_allclose(h[..., 2][live], quad.cos_h[live], atol=1e-12)
     np.testing.assert_allclose(np.sum(e * h, axis=-1)[live], quad.cos_dh[live], atol=1e-12)
     assert quad.other is e  # built once
+
+
+def test_mirror_quadrature_arrays_are_separate():
+    """Built in place, the node arrays still share no memory: a caller may change one."""
+    quad = quadrature.mirror_quadrature(np.radians([10.0, 60.0, 85.0]), 8.0)
+    arrays = [quad.weight, quad.cos_h, quad.cos_dh, quad.cos_other, quad.sin_h]
+    for i, first in enumerate(arrays):
+        assert first.shape == quad.weight.shape
+        assert not any(np.shares_memory(first, second) for second in arrays[i + 1:])
+    lambert = np.sum(quad.weight * quad.cos_other, axis=(1, 2)) / np.pi
+    np.testing.assert_allclose(lambert, 1.0, atol=1e-7)
