@@ -129,7 +129,7 @@ def test_eevee_renders_the_tier_as_its_replica(renders, made_up, light):
 
     in_cycles = dataclasses.replace(
         tier_registry.EEVEE,
-        glossy=lambda wi, wo, lobe: cc.microfacet_reflection(wi, wo, lobe.roughness))
+        glossy=lambda pairs, lobe: cc.pair_reflection(pairs, lobe.roughness))
 
     def as_cycles(fit_, tables_, coverage, absorption, gloss, directions):
         return tiers.tier_replica(fit_, tables_, in_cycles, coverage, absorption, gloss,
