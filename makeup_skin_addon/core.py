@@ -15,6 +15,7 @@ if INSTALLED:
     from ..lut_baker import auto_tier, bake
     from ..lut_baker.closures import (
         closure_fit,
+        cycles,
         fitting,
         principled_albedo,
         profiles,
@@ -39,6 +40,7 @@ else:
     from lut_baker import auto_tier, bake
     from lut_baker.closures import (
         closure_fit,
+        cycles,
         fitting,
         principled_albedo,
         profiles,
@@ -60,7 +62,7 @@ else:
     from lut_baker.numerics import cache, quadrature
     from lut_baker.tables import codec, slab_tables, table_set, uniform_light
 
-__all__ = ["albedo", "auto_tier", "bake", "cache", "closure_fit", "codec", "film_slab",
+__all__ = ["albedo", "auto_tier", "bake", "cache", "closure_fit", "codec", "cycles", "film_slab",
            "fitting", "params_file", "presets", "principled_albedo", "profiles", "quadrature",
            "roughness", "slab_shade", "slab_skin", "slab_tables", "table_set", "thick_layer",
            "tier_formulas", "tier_registry", "tiers", "uniform_light", "view_image"]

@@ -32,7 +32,7 @@ import zlib
 
 import numpy as np
 
-from .core import cache
+from .core import cache, cycles
 
 __all__ = ["GRID", "POINTS", "RAYS", "SkyVisibility", "sky_visibility", "occupancy",
            "clearance", "unhidden", "diffuse_rays", "gloss_rays", "clear_cache"]
@@ -157,9 +157,10 @@ def diffuse_rays(normals: np.ndarray, rays: int = RAYS) -> tuple[np.ndarray, np.
     return _along(normals, first, second, np.sqrt(1.0 - u), phi), np.ones(u.shape)
 
 
-def _smith_g1(cos_theta, alpha2):
-    tan2 = np.maximum(1.0 - cos_theta ** 2, 0.0) / np.maximum(cos_theta ** 2, 1e-12)
-    return 2.0 / (1.0 + np.sqrt(1.0 + alpha2 * tan2))
+def _smith_g1(cos_theta, alpha: float):
+    """Smith's masking of GGX, ``1 / (1 + Lambda)`` (:func:`lut_baker.closures.cycles.
+    ggx_lambda`, the lobe the closures fit)."""
+    return 1.0 / (1.0 + cycles.ggx_lambda(cos_theta, alpha))
 
 
 def gloss_rays(normals: np.ndarray, views: np.ndarray, roughness: float, rays: int = RAYS
@@ -168,7 +169,8 @@ def gloss_rays(normals: np.ndarray, views: np.ndarray, roughness: float, rays: i
     (alpha its square) about the mirror of the unit ``views`` (towards the camera), the
     microfacet normals sampled by their distribution; a ray's weight is its share of the
     lobe's reflectance (Smith's shadowing, Schlick's Fresnel; 0 below the surface)."""
-    alpha2 = max(float(roughness) ** 2, 1e-3) ** 2
+    alpha = max(float(roughness) ** 2, 1e-3)
+    alpha2 = alpha ** 2
     first, second = _frames(normals)
     u, phi = _pattern(len(normals), rays)
     cos_h = 1.0 / np.sqrt(1.0 + alpha2 * u / np.maximum(1.0 - u, 1e-12))
@@ -178,8 +180,8 @@ def gloss_rays(normals: np.ndarray, views: np.ndarray, roughness: float, rays: i
     n_v = np.maximum(np.sum(normals * views, axis=1), 1e-3)[:, None]
     n_l = np.sum(directions * normals[:, None], axis=2)
     fresnel = FRESNEL_F0 + (1.0 - FRESNEL_F0) * (1.0 - np.clip(v_h, 0.0, 1.0)) ** 5
-    weights = np.where((n_l > 0.0) & (v_h > 0.0), fresnel * _smith_g1(n_v, alpha2)
-                       * _smith_g1(np.clip(n_l, 0.0, 1.0), alpha2) * v_h / (n_v * cos_h), 0.0)
+    weights = np.where((n_l > 0.0) & (v_h > 0.0), fresnel * _smith_g1(n_v, alpha)
+                       * _smith_g1(np.clip(n_l, 0.0, 1.0), alpha) * v_h / (n_v * cos_h), 0.0)
     return directions, weights
 
 
