@@ -678,7 +678,7 @@ def bake_slab(skin: MadeUpSkin, resolution_name: str | Resolution = "default", *
             "top_albedo": np.stack(top_albedo), "through": np.stack(through),
             "through_mean": np.stack(through_mean), "below": np.stack(below),
             "film_albedo": np.stack(film_albedo), "body_gloss": np.stack(body_gloss)}
-    if support is not None:
+    if support is not None and only_um is not None:
         rows = {name: at_support(table, support[1]) for name, table in rows.items()}
         axis = np.array([float(only_um)])
     return SlabTables(thickness_um=axis, theta_deg=theta_deg, phi_deg=phi_deg, **rows,

@@ -142,13 +142,13 @@ def thickness_support(thickness_um: float, n: int = THICKNESS_NODES,
     reads (two, or one where its weight is all on one node: at a node, or the thick limit) and
     its fractional index among them (0 for one node): what :func:`at_support` needs of the
     rows baked at ``nodes`` to give the axis's tables at that thickness."""
-    low, t = _corners(thickness_index(thickness_um, n, h_min, h_max), n)
-    low, t = int(low), float(t)
+    corner, weight = _corners(thickness_index(thickness_um, n, h_min, h_max), n)
+    low, t = int(corner), float(weight)
     if t == 0.0:
-        return np.array([low]), 0.0
+        return np.array([low], np.intp), 0.0
     if t == 1.0:
-        return np.array([low + 1]), 0.0
-    return np.array([low, low + 1]), t
+        return np.array([low + 1], np.intp), 0.0
+    return np.array([low, low + 1], np.intp), t
 
 
 def at_support(rows: NDArray[np.float64], t: float) -> NDArray[np.float64]:
