@@ -307,11 +307,11 @@ def test_a_thickness_move_is_swapped_in_first_and_measured_after(sphere, monkeyp
 def test_a_shade_step_at_a_thickness_shows_at_preview_first_then_refines(sphere, monkeypatch):
     """With the film at a thickness a shade change rebuilds the group (its absorption is
     baked): with an event loop, a bake the file has not seen goes at preview resolution first
-    and the settings' resolution follows once it is swapped in; a shade whose bake the file
-    has goes straight to it."""
+    (the slab at its thickness alone) and the settings' resolution follows once it is swapped
+    in; a shade whose bake the file has goes straight to it."""
     import bpy
 
-    from makeup_skin_addon import apply, groups, live, nodes
+    from makeup_skin_addon import apply, bakes, groups, live, nodes
 
     material, _ = apply_pipeline(sphere, "LAYERED", resolution="default", film_mode="SLAB",
                                  skin_colour=(0.45, 0.25, 0.15))
@@ -325,6 +325,7 @@ def test_a_shade_step_at_a_thickness_shows_at_preview_first_then_refines(sphere,
     assert live.wait(60.0) and live.poll(bpy.context) == []
     shown = nodes.read_meta(groups.group_of(material).node_tree)
     assert shown["resolution"] == "preview" and shown["key"] != before
+    assert bakes._BAKES.get(shown["key"]).one.slab.one_thickness  # its thickness alone
     assert material.name in live.in_flight()  # the refinement, set off by the swap
     assert live.wait(60.0) and live.poll(bpy.context) == []
     refined = nodes.read_meta(groups.group_of(material).node_tree)
