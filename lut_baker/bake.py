@@ -33,7 +33,7 @@ Functions and types
 - :func:`path3_width_deg` -- the narrowest lobe path 3 goes through (degrees).
 - :func:`inter_reflection_albedo` -- what the inter-reflections add to the albedo.
 - :data:`PAPER_FILM`, :data:`SLAB_RESOLUTION` -- the bake's film modes and the slab tables' grids.
-- :func:`bake_slab` -- the film as a slab at every thickness of the axis
+- :func:`bake_slab` -- the film as a slab at every thickness of the axis, or at one
   (:class:`lut_baker.tables.slab_tables.SlabTables`).
 - :func:`profile_radius` -- where the dipole's R(d) falls to a fraction of its peak (mm).
 - :func:`rgb_view` -- a channel axis of 1 or 3 as 3, without a copy.
@@ -75,7 +75,7 @@ from .numerics.quadrature import (
     panel_interpolation,
     uniform_azimuths,
 )
-from .tables.slab_tables import SlabTables, thickness_nodes
+from .tables.slab_tables import SlabTables, at_support, thickness_nodes, thickness_support
 from .tables.table_set import THETA_OFFSET, Tables, node_cos_azimuths, radius_nodes, theta_nodes
 
 __all__ = [
@@ -488,7 +488,7 @@ def _stage(progress: Progress | None, fraction: float, message: str) -> None:
 
 def bake(skin: MadeUpSkin, resolution_name: str | Resolution = "default", *,
          inter_reflection: bool = False, progress: Progress | None = None,
-         film: str | float = "paper") -> Tables:
+         film: str | float = "paper", one_thickness: bool = False) -> Tables:
     """Bake the tables of one made-up skin (see :mod:`lut_baker.tables.table_set` for their
     meaning).
 
@@ -503,6 +503,9 @@ def bake(skin: MadeUpSkin, resolution_name: str | Resolution = "default", *,
     micrometres: the tables also hold the film as a slab at every thickness of the axis, every
     inter-reflection in (``tables.slab``, :func:`bake_slab`), and ``parameters`` record the
     thickness (``film_thickness_um``) as the lookups' default.
+    ``one_thickness``: with a thickness, the slab's tables at that thickness only (equal to the
+    axis's there, :func:`bake_slab`'s ``only_um``): a preview's, which a Thickness move cannot
+    read (it needs the axis's).
     """
     thickness_um = _film_thickness(film)
     if not isinstance(skin, MadeUpSkin):
@@ -546,8 +549,9 @@ def bake(skin: MadeUpSkin, resolution_name: str | Resolution = "default", *,
 
     slab = None
     if thickness_um is not None:
-        _stage(progress, 0.8, "the film as a slab at every thickness")
-        slab = bake_slab(skin, res)
+        _stage(progress, 0.8, "the film as a slab at its thickness" if one_thickness
+               else "the film as a slab at every thickness")
+        slab = bake_slab(skin, res, only_um=thickness_um if one_thickness else None)
 
     _stage(progress, 0.9, "radial profile")
     radius_mm = radius_nodes(res.n_radius, res.radius_spacing, profile_radius(skin.dipole))
@@ -621,13 +625,20 @@ def _film_thickness(film: str | float) -> float | None:
 
 
 def bake_slab(skin: MadeUpSkin, resolution_name: str | Resolution = "default", *,
-              thicknesses_um: ArrayLike | None = None) -> SlabTables:
+              thicknesses_um: ArrayLike | None = None,
+              only_um: float | None = None) -> SlabTables:
     """The film as a slab over the skin at every thickness of the axis
     (:func:`lut_baker.tables.slab_tables.thickness_nodes`, or ``thicknesses_um``), at the
     skin's absorption: per thickness, the parts of :func:`lut_baker.model.slab_skin.
     slab_skin_parts` computed on the bake's quadrature (Gauss-Legendre panels), interpolated
     to the tables' polar nodes panel by panel (:func:`~lut_baker.numerics.quadrature.
-    panel_interpolation`) and summed as cosine series at the tables' azimuths."""
+    panel_interpolation`) and summed as cosine series at the tables' azimuths.
+
+    ``only_um``: the tables at that thickness only (one entry, what a preview needs): the
+    axis's nodes either side of it baked (:func:`~lut_baker.tables.slab_tables.
+    thickness_support`) and interpolated there as the axis's lookups are
+    (:func:`~lut_baker.tables.slab_tables.at_support`), so that they equal the whole axis's
+    tables at that thickness, for a fifth of its cost."""
     res = resolution(resolution_name)
     grid = hemisphere_panels(res.quad_panels, res.quad_points, res.quad_phi)
     n_theta, n_phi = SLAB_RESOLUTION.get(res.name, SLAB_RESOLUTION["default"])
@@ -638,6 +649,11 @@ def bake_slab(skin: MadeUpSkin, resolution_name: str | Resolution = "default", *
                                    res.quad_panels)
     axis = (thickness_nodes() if thicknesses_um is None
             else np.asarray(thicknesses_um, float))
+    support: tuple[NDArray[np.intp], float] | None = None
+    if only_um is not None:
+        relative_thickness(only_um)  # raises on a negative thickness
+        support = thickness_support(float(only_um), axis.size, float(axis[0]),
+                                    float(axis[-2]))
     absorption = np.broadcast_to(np.asarray(skin.absorption, float), (3,))
     film = foundation_slab(skin.film, skin.film_transmission, grid, absorption)
     share = np.broadcast_to(surface_share(skin.film), (3,))  # k: the surface's share of the gloss
@@ -646,7 +662,7 @@ def bake_slab(skin: MadeUpSkin, resolution_name: str | Resolution = "default", *
     lobe = skin_star(gloss_layer(skin.film), grid)  # eq. 2's gloss, star form, every order
     on_table, top_albedo, through, through_mean, below, film_albedo, body_gloss = (
         [] for _ in range(7))
-    for h in axis:
+    for h in (axis if support is None else axis[support[0]]):
         x = np.inf if np.isinf(h) else relative_thickness(h)
         parts = slab_skin_parts(film, x, skin.skin_reflection, face)
         body_gloss.append(np.broadcast_to(
@@ -658,12 +674,14 @@ def bake_slab(skin: MadeUpSkin, resolution_name: str | Resolution = "default", *
         through_mean.append(np.broadcast_to(parts.through @ (2.0 * grid.weight), (3,)))
         below.append(np.broadcast_to(parts.below, (3,)))
         film_albedo.append(rgb_view(lagrange @ np.asarray(parts.film).T))
-    return SlabTables(thickness_um=axis, theta_deg=theta_deg, phi_deg=phi_deg,
-                      top=_thickness_series(np.stack(on_table), pairs),
-                      top_albedo=np.stack(top_albedo),
-                      through=np.stack(through), through_mean=np.stack(through_mean),
-                      below=np.stack(below), film_albedo=np.stack(film_albedo),
-                      body_gloss=np.stack(body_gloss),
+    rows = {"top": _thickness_series(np.stack(on_table), pairs),
+            "top_albedo": np.stack(top_albedo), "through": np.stack(through),
+            "through_mean": np.stack(through_mean), "below": np.stack(below),
+            "film_albedo": np.stack(film_albedo), "body_gloss": np.stack(body_gloss)}
+    if support is not None and only_um is not None:
+        rows = {name: at_support(table, support[1]) for name, table in rows.items()}
+        axis = np.array([float(only_um)])
+    return SlabTables(thickness_um=axis, theta_deg=theta_deg, phi_deg=phi_deg, **rows,
                       absorption=absorption.copy(), surface_share=share.copy(),
                       theta_spacing=res.theta_spacing, theta_offset=res.theta_offset,
                       phi_spacing=res.phi_spacing)

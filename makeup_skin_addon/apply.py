@@ -245,8 +245,9 @@ def apply_to_object(context: Any, obj: Any, *, resolution: str | None = None,
 
     ``resolution``: of the bake (default the settings').  ``preview_first``: when the file
     has no group of that bake, bake and fit at preview resolution instead (about a quarter of
-    the bake's time, and the first Apply's match with it) and say so in ``report.refine``
-    (the resolution to rebuild at, which the caller does on a worker thread:
+    the bake's time, and the first Apply's match with it; with the film at a thickness the
+    slab's tables at that thickness only, :func:`.bakes.rebake`) and say so in
+    ``report.refine`` (the resolution to rebuild at, which the caller does on a worker thread:
     :func:`.live.refine`); else ``report.refine`` is None.
 
     Over the artist's shader (:func:`.convert.artist_tree`) the skin under the film is read
@@ -286,7 +287,8 @@ def apply_to_object(context: Any, obj: Any, *, resolution: str | None = None,
     with Progress(context) as progress:
         work = Bake(record, tier_choice.forced_method(settings), settings.coverage,
                     settings.absorption, progress,
-                    tiers=tier_choice.fitted_tiers(settings, scene), over=reading is not None)
+                    tiers=tier_choice.fitted_tiers(settings, scene), over=reading is not None,
+                    one_thickness=report.refine is not None)
         group, measured, tier, auto = groups.group_for(material, settings, scene, work, report)
     # 6. The material's surface.
     groups.record_measurement(material, measured, record["key"], auto)

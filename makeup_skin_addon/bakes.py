@@ -23,8 +23,9 @@ worker thread (:mod:`.live`): nothing here touches bpy.
   film as a slab: its thickness in the record; the slab's tables, baked at every thickness,
   shared by the records of every thickness, and a fit at a new thickness moved from the last
   one, :func:`lut_baker.closures.fitting.at_thickness`).
-- :func:`rebake` -- the tables of a record, baked once per session; :func:`remember` -- tables
-  a caller baked itself, kept as the record's.
+- :func:`rebake` -- the tables of a record, baked once per session (a preview's with the film
+  as a slab at its thickness only, if asked, kept apart); :func:`remember` -- tables a caller
+  baked itself, kept as the record's.
 - :func:`baked` -- ``(tables, fit)`` of a record, baked and fitted once per session;
   :func:`cached` -- the same if this session has them, else None (never fits).
 - :func:`measure` -- what a fit measures at a coverage and absorption, as plain data;
@@ -78,12 +79,20 @@ class BakeRecordError(ValueError):
 
 
 class _Entry:
-    """One bake in the cache: its tables (None until baked) and its fits by ``(forced method,
-    over the artist's shader)``."""
+    """One bake in the cache: its tables (None until baked), with the film as a slab its tables
+    at the record's thickness only (``one``: a preview's, :func:`rebake`'s ``one_thickness``;
+    kept apart: never handed out for the tables of the axis) and its fits by ``(forced
+    method, over the artist's shader)`` (the same from either: the tables at one thickness
+    equal the axis's there, :func:`lut_baker.bake.bake_slab`)."""
 
     def __init__(self) -> None:
         self.tables: table_set.Tables | None = None
+        self.one: table_set.Tables | None = None
         self.fits: dict[tuple, closure_fit.ClosureFit] = {}
+
+    def any_tables(self) -> table_set.Tables | None:
+        """The tables of the axis if baked, else those at one thickness, else None."""
+        return self.tables if self.tables is not None else self.one
 
 
 _BAKES = cache.LRUCache(CACHE_SIZE)
@@ -177,9 +186,13 @@ def remember(record: dict, tables: table_set.Tables) -> None:
     _entry(record["key"]).tables = tables
 
 
-def rebake(record: dict, *, progress: Report | None = None) -> table_set.Tables:
+def rebake(record: dict, *, progress: Report | None = None,
+           one_thickness: bool = False) -> table_set.Tables:
     """The tables of a :func:`bake_record`, baked once per session (cached by key);
-    ``progress(fraction, message)``: the bake's, when it runs.
+    ``progress(fraction, message)``: the bake's, when it runs.  ``one_thickness``: with the
+    film as a slab, tables at the record's thickness will do (a preview Apply's: the slab baked
+    there only, :func:`lut_baker.bake.bake`'s ``one_thickness``, unless the axis's are here
+    already); they are kept apart from the axis's, which a Thickness move reads.
 
     Raises
     ------
@@ -204,13 +217,20 @@ def rebake(record: dict, *, progress: Report | None = None) -> table_set.Tables:
         entry.tables = dataclasses.replace(
             slab, parameters={**slab.parameters, "film_thickness_um": float(thickness)})
         return entry.tables
+    one = one_thickness and thickness is not None
+    if one and entry.one is not None:
+        return entry.one
     try:
         skin = params_file.skin_from_dict(record["parameters"])
         tables = bake.bake(skin, record["resolution"], progress=progress,
-                           film="paper" if thickness is None else float(thickness))
+                           film="paper" if thickness is None else float(thickness),
+                           one_thickness=one)
     except (KeyError, TypeError, ValueError):
         raise BakeRecordError("its bake record cannot be re-baked (a parameter is missing or "
                               "unreadable)") from None
+    if one:
+        entry.one = tables
+        return tables
     entry.tables = tables
     if shared is not None:
         _SLABS.put(shared, tables)
@@ -226,26 +246,27 @@ def cached(record: dict, method: str | None = None, *,
     fit = None if entry is None else entry.fits.get((method, bool(over_shader)))
     if fit is None or not set(tiers) <= set(fit.tiers):
         return None
-    return rebake(record), fit
+    tables = entry.any_tables()  # at the fit's thickness either will do
+    return (rebake(record) if tables is None else tables), fit
 
 
 def baked(record: dict, *, method: str | None = None,
           tiers: Iterable[str] = closure_fit.TIERS, over_shader: bool = False,
           errors_at: tuple[float, Sequence[float]] | None = None,
-          bake_progress: Report | None = None, fit_progress: Report | None = None
-          ) -> tuple[table_set.Tables, closure_fit.ClosureFit]:
+          bake_progress: Report | None = None, fit_progress: Report | None = None,
+          one_thickness: bool = False) -> tuple[table_set.Tables, closure_fit.ClosureFit]:
     """``(tables, fit)`` of a bake record (:func:`bake_record`): re-baked (:func:`rebake`) and
     fitted once per session.  ``method``: a subsurface method forced by the user, else None;
     ``tiers``: those the fit must hold (a cached fit without some gets them fitted onto it);
     ``over_shader``: a fit for a group over the artist's shader; ``errors_at``: ``(coverage,
-    absorption)`` at which a new fit measures the tiers (default: the bake's).
+    absorption)`` at which a new fit measures the tiers (default: the bake's);
+    ``one_thickness``: the tables at the record's thickness will do (:func:`rebake`).
 
     Raises
     ------
     BakeRecordError
         If the record cannot be baked (:func:`rebake`).
     """
-    tables = rebake(record, progress=bake_progress)
     fits = _entry(record["key"]).fits
     which = (method, bool(over_shader))
     fit = fits.get(which)
@@ -256,10 +277,12 @@ def baked(record: dict, *, method: str | None = None,
     if fit is None and shared is not None:
         other = _SLAB_FITS.get((shared, skin_key, *which))
         if other is not None and set(tiers) <= set(other.tiers):
+            tables = rebake(record, progress=bake_progress)  # the axis's: the fit moves on it
             fit = _under(fitting.at_thickness(other, tables,
                                               float(record["film_thickness_um"])), record)
             fits[which] = fit
             return tables, fit
+    tables = rebake(record, progress=bake_progress, one_thickness=one_thickness)
     if fit is None or not set(tiers) <= set(fit.tiers):
         fit = _under(fitting.fit_closures(
             tables, tiers=tiers, over_shader=over_shader, onto=fit, subsurface_method=method,
@@ -350,13 +373,17 @@ class Bake:
     can be reused needs none of them): the fit of ``tiers`` for the forced subsurface
     ``method`` (None: the fit's choice), measured at ``coverage`` and ``absorption``, for a
     group over the artist's shader if ``over``.  ``progress``: Apply's (:class:`.progress.
-    Stages`).  Nothing here touches bpy: a worker thread may make them (:mod:`.live`), and
-    the group is built from them on the main thread (:mod:`.groups`)."""
+    Stages`).  ``one_thickness``: with the film as a slab, tables at the record's thickness
+    will do (a preview that a refinement follows: :func:`rebake`).  Nothing here touches bpy:
+    a worker thread may make them (:mod:`.live`), and the group is built from them on the
+    main thread (:mod:`.groups`)."""
 
     def __init__(self, record: dict, method: str | None, coverage: float,
                  absorption: Iterable[float], progress: Stages | None = None, *,
-                 tiers: Iterable[str] = tiers.TIERS, over: bool = False):
+                 tiers: Iterable[str] = tiers.TIERS, over: bool = False,
+                 one_thickness: bool = False):
         self.record, self.method = record, method
+        self.one_thickness = bool(one_thickness)
         self.coverage, self.absorption = float(coverage), [float(a) for a in absorption]
         self.progress = progress
         self.tiers, self.over = tuple(tiers), bool(over)
@@ -379,7 +406,8 @@ class Bake:
                 self.record, method=self.method, tiers=self.tiers, over_shader=self.over,
                 errors_at=(self.coverage, self.absorption),
                 bake_progress=stage(self.progress, 0.0, BAKE_SHARE),
-                fit_progress=stage(self.progress, BAKE_SHARE, MEASURE_SHARE))
+                fit_progress=stage(self.progress, BAKE_SHARE, MEASURE_SHARE),
+                one_thickness=self.one_thickness)
         return self._fitted
 
     def adopt(self, measured: dict | None) -> None:

@@ -19,7 +19,9 @@ swapped in at once, and a rebuild that measures (the tiers' errors, Tier Auto's 
 it once the slider rests (:data:`DEBOUNCE_S`), superseded by the next move.
 
 An Apply at preview resolution is refined the same way (:func:`refine`: the settings'
-resolution computed on a worker, swapped in when ready).
+resolution computed on a worker, swapped in when ready).  A preview that a refinement follows
+(:func:`refine`'s ``then``) bakes the film's slab at its thickness only, as Apply's does
+(:class:`.bakes.Bake`'s ``one_thickness``).
 
 Without an event loop (headless) timers never fire: :func:`flush` does the whole work at once,
 waiting for the rebuilds in flight.  :func:`unregister` removes the timers and stops and joins
@@ -221,8 +223,10 @@ def _prepared(context, name: str, resolution: str) -> _Job | str | None:
     reason = _usable(material)
     if reason is not None:
         return None if reason == "gone" else reason
+    then = _then.get(name)  # a refinement follows: the preview's slab at its thickness will do
     try:
-        return _Job(prepare_rebuild(context, material, resolution, measure=measure))
+        return _Job(prepare_rebuild(context, material, resolution, measure=measure,
+                                    one_thickness=then is not None and then != resolution))
     except (ValueError, RuntimeError) as error:
         return f"Made-up Skin: the preview of {name!r} failed: {error}."
 

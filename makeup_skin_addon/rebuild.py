@@ -85,24 +85,27 @@ def _tier_now(material: Any) -> str | None:
 
 
 def prepare_rebuild(context: Any, material: Any, resolution: str, *,
-                    measure: bool = True) -> Rebuild:
+                    measure: bool = True, one_thickness: bool = False) -> Rebuild:
     """What the rebuild of ``material``'s group at ``resolution`` needs of Blender (main
     thread, a few milliseconds): its settings (:func:`.skin_model.skin_settings`), the tiers
     to fit (:func:`.tier_choice.fitted_tiers`), whether it goes over the artist's shader, and
     with Tier Auto the scene the choice judges in.  Not ``measure``: a rebuild of the tier the
     material has now that measures nothing (:attr:`Rebuild.unmeasured`; measured all the same
-    if it has no group of a tier yet)."""
+    if it has no group of a tier yet).  ``one_thickness``: the slab's tables at the film's
+    thickness will do (a preview a refinement follows: :class:`.bakes.Bake`)."""
     settings = material.makeup_skin
     if not measure:
         tier = settings.tier if settings.tier != "AUTO" else _tier_now(material)
         if tier is not None:
-            rebuild = prepare_rebuild(context, material, resolution)
+            rebuild = prepare_rebuild(context, material, resolution,
+                                      one_thickness=one_thickness)
             rebuild.where, rebuild.unmeasured = None, tier
             return rebuild
     over = settings.over_shader and convert.artist_tree(material) is not None
     bake = {"method": tier_choice.forced_method(settings), "coverage": settings.coverage,
             "absorption": list(settings.absorption),
-            "tiers": tier_choice.fitted_tiers(settings, context.scene), "over": over}
+            "tiers": tier_choice.fitted_tiers(settings, context.scene), "over": over,
+            "one_thickness": one_thickness}
     where = (tier_choice.choice_scene(material, context.scene) if settings.tier == "AUTO"
              else None)
     return Rebuild(material, skin_model.skin_settings(settings), resolution, bake, where)

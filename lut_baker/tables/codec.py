@@ -215,7 +215,11 @@ def sidecar_data(tables: Tables, layout: dict, digest: str, image_name: str) -> 
 def _slab_grids(slab: SlabTables) -> dict:
     """The slab's grids in the sidecar: the thickness axis by its closed form (it ends in
     ``inf``, which JSON does not hold), the angular grid and its spacings, the absorption, the
-    surface's share of the gloss."""
+    surface's share of the gloss.  Tables at one thickness (a preview's) have no axis to
+    write: ValueError."""
+    if slab.one_thickness:
+        raise ValueError("the slab's tables at one thickness are not written (a preview's): "
+                         "bake the whole thickness axis to write them")
     return {"thickness_nodes": int(slab.thickness_um.size),
             "thickness_min_um": float(slab.thickness_um[0]),
             "thickness_max_um": float(slab.thickness_um[-2]),

@@ -30,10 +30,19 @@ fractional index of ``h`` is::
 clamped to ``[0, n - 1]``, and every table is interpolated linearly in ``x`` (and, for the
 angular table, trilinearly in its own angular grid, as :mod:`lut_baker.tables.table_set`).
 
+Tables at one thickness (``thickness_um`` of one entry, what a preview bakes:
+``lut_baker.bake.bake_slab(..., only_um=h)``) hold the rows a lookup at ``h`` reads from the
+axis (:func:`thickness_support`: the nodes either side of ``h`` and its weight between them,
+:func:`at_support`), so that they equal the axis's tables there; they are read at ``h`` only
+(another thickness raises: it needs the axis).
+
 Functions and types
 -------------------
-- :data:`THICKNESS_MIN_UM`, :data:`THICKNESS_MAX_UM`, :data:`THICKNESS_NODES` -- the axis.
+- :data:`THICKNESS_MIN_UM`, :data:`THICKNESS_MAX_UM`, :data:`THICKNESS_NODES` -- the axis;
+  :data:`ONE_THICKNESS_RTOL` -- how close a thickness reads tables at one thickness.
 - :func:`thickness_nodes`, :func:`thickness_index` -- its nodes and the closed-form index.
+- :func:`thickness_support`, :func:`at_support` -- the nodes a lookup at one thickness reads
+  and its rows from theirs (tables at one thickness).
 - :class:`SlabTables` -- the tables, with ``at`` (the 1-D parts at a thickness).
 - :class:`SlabParts` -- the 1-D parts at one thickness; :class:`SlabSlice` -- the 1-D tables
   at one thickness (``SlabTables.sliced``), read at any angles.
@@ -59,14 +68,25 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..model.albedo import bihemispherical
 from ..numerics.geometry import polar_angle_deg
-from .table_set import THETA_OFFSET, Tables, _linear, _trilinear, phi_index, theta_index
+from .table_set import (
+    THETA_OFFSET,
+    Tables,
+    _corners,
+    _linear,
+    _trilinear,
+    phi_index,
+    theta_index,
+)
 
 __all__ = [
     "THICKNESS_MIN_UM",
     "THICKNESS_MAX_UM",
     "THICKNESS_NODES",
+    "ONE_THICKNESS_RTOL",
     "thickness_nodes",
     "thickness_index",
+    "thickness_support",
+    "at_support",
     "SlabTables",
     "SlabParts",
     "SlabSlice",
@@ -90,6 +110,9 @@ THICKNESS_MAX_UM = 300.0
 THICKNESS_NODES = 10
 """Nodes of the axis: 9 log-spaced (a ratio of 2.04) and the thick limit
 (docs/baking.md measures the interpolation error)."""
+ONE_THICKNESS_RTOL = 1e-12
+"""How close a thickness must be to that of tables at one thickness to be read from them (a
+float's round trip through the panel and a record)."""
 
 
 def thickness_nodes(n: int = THICKNESS_NODES, h_min: float = THICKNESS_MIN_UM,
@@ -110,6 +133,32 @@ def thickness_index(thickness_um: ArrayLike, n: int = THICKNESS_NODES,
     finite = np.log(np.minimum(h, h_max) / h_min) / np.log(h_max / h_min) * (n - 2)
     beyond = (n - 2) + (1.0 - h_max / np.maximum(h, h_max))
     return np.clip(np.where(h <= h_max, finite, beyond), 0.0, n - 1.0)
+
+
+def thickness_support(thickness_um: float, n: int = THICKNESS_NODES,
+                      h_min: float = THICKNESS_MIN_UM,
+                      h_max: float = THICKNESS_MAX_UM) -> tuple[NDArray[np.intp], float]:
+    """``(nodes, t)``: the nodes of :func:`thickness_nodes` a lookup at ``thickness_um``
+    reads (two, or one where its weight is all on one node: at a node, or the thick limit) and
+    its fractional index among them (0 for one node): what :func:`at_support` needs of the
+    rows baked at ``nodes`` to give the axis's tables at that thickness."""
+    corner, weight = _corners(thickness_index(thickness_um, n, h_min, h_max), n)
+    low, t = int(corner), float(weight)
+    if t == 0.0:
+        return np.array([low], np.intp), 0.0
+    if t == 1.0:
+        return np.array([low + 1], np.intp), 0.0
+    return np.array([low, low + 1], np.intp), t
+
+
+def at_support(rows: NDArray[np.float64], t: float) -> NDArray[np.float64]:
+    """A table at one thickness from its rows at :func:`thickness_support`'s nodes
+    (``(1 or 2, ...)``): the interpolation :class:`SlabTables`' lookups make (the same
+    operations: equal to them to the last bit), ``(1, ...)``."""
+    rows = np.asarray(rows)
+    if rows.shape[0] == 1:
+        return rows.copy()
+    return _linear(rows, np.asarray(t))[None]
 
 
 class SlabParts(NamedTuple):
@@ -151,7 +200,8 @@ class SlabSlice(NamedTuple):
 class SlabTables:
     """Made-up skin at every thickness (module docstring), at the baked ``absorption`` (3,).
 
-    ``thickness_um`` (K,): the axis (:func:`thickness_nodes`).  Angular grid of its own,
+    ``thickness_um`` (K,): the axis (:func:`thickness_nodes`), or one thickness (K = 1: the
+    tables there only, read at it only; module docstring).  Angular grid of its own,
     ``theta_deg`` (n_theta,) and ``phi_deg`` (n_phi,), laid out as ``theta_spacing``,
     ``theta_offset`` and ``phi_spacing`` say (the closed forms of
     :mod:`lut_baker.tables.table_set`).  ``top`` (K, n_theta, n_theta, n_phi, 3) 1/sr;
@@ -187,13 +237,29 @@ class SlabTables:
             if np.shape(getattr(self, name)) != shape:
                 raise ValueError(f"slab table {name!r} must have shape {shape}, "
                                  f"got {np.shape(getattr(self, name))}")
+        if k == 1:
+            return
         expected = thickness_nodes(k, float(self.thickness_um[0]),
                                    float(self.thickness_um[-2]))
         if not np.allclose(self.thickness_um, expected, rtol=1e-12):
             raise ValueError("thickness_um does not follow its closed form (thickness_nodes)")
 
+    @property
+    def one_thickness(self) -> bool:
+        """Whether these are the tables at one thickness only (module docstring)."""
+        return self.thickness_um.size == 1
+
     def thickness_index(self, thickness_um: ArrayLike) -> NDArray[np.float64]:
-        """Fractional index on the axis (clamped)."""
+        """Fractional index on the axis (clamped); 0 for tables at one thickness, which
+        raise ValueError at any other."""
+        if self.one_thickness:
+            h = np.asarray(thickness_um, float)
+            if not np.all(np.isclose(h, self.thickness_um[0], rtol=ONE_THICKNESS_RTOL,
+                                     atol=0.0)):
+                raise ValueError(f"these slab tables hold the film at "
+                                 f"{float(self.thickness_um[0])} um only: another thickness "
+                                 f"needs the axis's (bake_slab without only_um)")
+            return np.zeros(h.shape)
         return thickness_index(thickness_um, self.thickness_um.size,
                                float(self.thickness_um[0]), float(self.thickness_um[-2]))
 
@@ -203,7 +269,13 @@ class SlabTables:
                            float(self.theta_deg[-1]), self.theta_offset)
 
     def _along(self, table: NDArray[np.float64], thickness_um: float) -> NDArray[np.float64]:
-        """``table[k, ...]`` interpolated linearly at one thickness."""
+        """``table[k, ...]`` interpolated linearly at one thickness (tables at one thickness:
+        their row, read-only)."""
+        if self.one_thickness:
+            self.thickness_index(thickness_um)  # raises at another thickness
+            row = np.asarray(table)[0]
+            row.setflags(write=False)
+            return row
         return _linear(np.asarray(table), np.asarray(self.thickness_index(thickness_um)))
 
     def at(self, thickness_um: float, theta_deg: ArrayLike) -> SlabParts:

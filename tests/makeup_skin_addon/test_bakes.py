@@ -138,3 +138,42 @@ def test_a_slab_fit_is_made_on_the_records_skin(bpy_factory, monkeypatch):
     assert calls == [] and moved.slab.thickness_um == 30.0
     np.testing.assert_array_equal(moved.skin_albedo, tan)
     bakes.clear()
+
+
+def test_a_previews_slab_at_one_thickness_is_kept_apart(bpy_factory, monkeypatch):
+    """``one_thickness`` (an Apply at preview first): the slab is baked at the record's
+    thickness only, kept apart from the axis's: the record's tables of the axis are baked when
+    asked for (and shared with other thicknesses), the fit made on the one thickness is the
+    record's either way (no fit again), and a fit at another thickness on the same skin moves
+    on the axis's tables (baked then), as without the preview."""
+    from lut_baker.closures import fitting
+    from makeup_skin_addon import bakes
+
+    bakes.clear()
+    skin = presets.made_up_skin("light_ivory", "jensen_skin1", absorption=[0.2, 0.4, 0.6])
+    tan = [0.55, 0.27, 0.16]
+    record = bakes.bake_record(skin, "preview", 9.6, None, tan)
+    one, fit = bakes.baked(record, tiers=("PRINCIPLED",), one_thickness=True)
+    assert one.slab.one_thickness and one.slab.thickness_um.tolist() == [9.6]
+    assert bakes.rebake(record, one_thickness=True) is one
+    assert bakes.cached(record, tiers=("PRINCIPLED",)) == (one, fit)
+    with pytest.raises(ValueError, match="only"):
+        one.slab.sliced(30.0)
+    calls = []
+    original = fitting.fit_closures
+    monkeypatch.setattr(fitting, "fit_closures",
+                        lambda *a, **k: (calls.append(1), original(*a, **k))[1])
+    series = bakes.rebake(record)
+    assert series is not one and series.slab.thickness_um.size > 2
+    assert bakes.baked(record, tiers=("PRINCIPLED",)) == (series, fit)
+    assert bakes.rebake(record, one_thickness=True) is series  # the axis's will do
+    other = bakes.bake_record(skin, "preview", 30.0, None, tan)
+    tables, moved = bakes.baked(other, tiers=("PRINCIPLED",), one_thickness=True)
+    assert tables.slab is series.slab and not tables.slab.one_thickness
+    assert calls == [] and moved.slab.thickness_um == 30.0
+    bakes.clear()
+    monkeypatch.undo()
+    bakes.baked(record, tiers=("PRINCIPLED",), one_thickness=True)  # a fit at 9.6 on `one`
+    tables, moved = bakes.baked(other, tiers=("PRINCIPLED",), one_thickness=True)
+    assert not tables.slab.one_thickness and moved.slab.thickness_um == 30.0
+    bakes.clear()

@@ -307,11 +307,11 @@ def test_a_thickness_move_is_swapped_in_first_and_measured_after(sphere, monkeyp
 def test_a_shade_step_at_a_thickness_shows_at_preview_first_then_refines(sphere, monkeypatch):
     """With the film at a thickness a shade change rebuilds the group (its absorption is
     baked): with an event loop, a bake the file has not seen goes at preview resolution first
-    and the settings' resolution follows once it is swapped in; a shade whose bake the file
-    has goes straight to it."""
+    (the slab at its thickness alone) and the settings' resolution follows once it is swapped
+    in; a shade whose bake the file has goes straight to it."""
     import bpy
 
-    from makeup_skin_addon import apply, groups, live, nodes
+    from makeup_skin_addon import apply, bakes, groups, live, nodes
 
     material, _ = apply_pipeline(sphere, "LAYERED", resolution="default", film_mode="SLAB",
                                  skin_colour=(0.45, 0.25, 0.15))
@@ -325,6 +325,7 @@ def test_a_shade_step_at_a_thickness_shows_at_preview_first_then_refines(sphere,
     assert live.wait(60.0) and live.poll(bpy.context) == []
     shown = nodes.read_meta(groups.group_of(material).node_tree)
     assert shown["resolution"] == "preview" and shown["key"] != before
+    assert bakes._BAKES.get(shown["key"]).one.slab.one_thickness  # its thickness alone
     assert material.name in live.in_flight()  # the refinement, set off by the swap
     assert live.wait(60.0) and live.poll(bpy.context) == []
     refined = nodes.read_meta(groups.group_of(material).node_tree)
@@ -337,3 +338,54 @@ def test_a_shade_step_at_a_thickness_shows_at_preview_first_then_refines(sphere,
     back = nodes.read_meta(groups.group_of(material).node_tree)
     assert back["resolution"] == "default" and back["key"] != refined["key"]
     assert list(material.makeup_skin.absorption) == pytest.approx(shade, abs=1e-6)
+
+
+def test_a_preview_first_apply_at_a_thickness_bakes_it_alone(sphere):
+    """With the film at a thickness an Apply at preview first bakes the slab's tables at that
+    thickness only (lut_baker.bake.bake's one_thickness), kept apart from the axis's: its
+    group is the one the axis's tables give (they are equal there).  A Thickness move before
+    the refinement bakes the axis then and gives the film an Apply at preview resolution gives
+    after the same move."""
+    import bpy
+    from support.addon_steps import cold_caches
+
+    from makeup_skin_addon import apply, bakes, groups, live, nodes
+
+    def moved(name, preview_first):
+        material = bpy.data.materials.new(name)
+        sphere.data.materials.clear()
+        sphere.data.materials.append(material)
+        settings = material.makeup_skin
+        settings.tier, settings.film_mode, settings.thickness_um = "LAYERED", "SLAB", 9.6
+        settings.resolution = "default" if preview_first else "preview"
+        cold_caches()
+        material, report = apply.apply_to_object(bpy.context, sphere,
+                                                 preview_first=preview_first)
+        group = groups.group_of(material).node_tree
+        meta = nodes.read_meta(group)
+        entry = bakes._BAKES.get(meta["key"])
+        shown = _fingerprint(group), meta
+        settings.live_update = True
+        settings.thickness_um = 40.0
+        assert material.name in live.pending()
+        live.flush(bpy.context)
+        group = groups.group_of(material).node_tree
+        after = _fingerprint(group), nodes.read_meta(group)
+        bpy.data.materials.remove(material)
+        bpy.data.node_groups.remove(group)
+        return report, entry, shown, after
+
+    report, entry, shown, after = moved("Quick", True)
+    assert report.refine == "default" and shown[1]["resolution"] == "preview"
+    assert entry.tables is None and entry.one.slab.one_thickness
+    assert entry.one.slab.thickness_um.tolist() == [shown[1]["film_thickness_um"]]
+    assert after[1]["film_thickness_um"] == 40.0 and after[1]["resolution"] == "preview"
+    _, series, shown_series, after_series = moved("Series", False)
+    assert series.tables is not None and series.one is None
+    assert series.tables.slab.thickness_um.size > 2
+    for (fingerprint, meta), (expected, expected_meta) in ((shown, shown_series),
+                                                          (after, after_series)):
+        assert fingerprint == expected
+        for key in ("key", "tier", "parameters", "glossy", "measured"):
+            assert meta.get(key) == expected_meta.get(key), key
+    cold_caches()

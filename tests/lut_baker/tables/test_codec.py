@@ -59,3 +59,15 @@ def test_a_sidecar_whose_slab_grid_disagrees_is_refused(slab_baked):
     meta["slab"] = {**meta["slab"], "thickness_nodes": meta["slab"]["thickness_nodes"] + 1}
     with pytest.raises(codec.TableFileError, match="layout does not match"):
         codec.check_layout(meta, "s.json")
+
+
+def test_the_slab_at_one_thickness_is_not_written(slab_baked):
+    """A preview's slab at one thickness has no axis the sidecar could describe: refused."""
+    from lut_baker.model import film_slab
+
+    one = replace(slab_baked, slab=bake.bake_slab(
+        presets.made_up_skin("paper_natural", "jensen_skin1", absorption=[0.1, 0.3, 0.5]),
+        "preview", only_um=film_slab.DEFAULT_THICKNESS_UM))
+    pixels, layout = codec.atlas(one)
+    with pytest.raises(ValueError, match="one thickness"):
+        codec.sidecar_data(one, layout, codec.pixel_hash(pixels), "s.exr")

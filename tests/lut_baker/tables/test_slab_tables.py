@@ -37,6 +37,57 @@ def test_the_thickness_axis():
     assert ST.thickness_index(600.0) == pytest.approx(nodes.size - 1.5)
 
 
+@pytest.fixture(scope="module")
+def preview_axis(skin):
+    return B.bake_slab(skin, "preview")
+
+
+def _parts_at(slab, um, directions):
+    """Every table of ``slab`` read at thickness ``um``: the 1-D parts and ``top`` at
+    ``directions`` ``(wi, wo)``."""
+    return [*slab.sliced(um).tables, slab.top_at(um, *directions)]
+
+
+@pytest.mark.parametrize("um", [0.5, 1.0, 2.0, FS.DEFAULT_THICKNESS_UM,
+                                float(ST.thickness_nodes()[3]), 300.0, 1000.0, np.inf])
+def test_the_tables_at_one_thickness_are_the_axiss_there(skin, preview_axis, um):
+    """``bake_slab(..., only_um=h)`` (a preview's) bakes the axis's nodes either side of h
+    (one at a node, below the axis or at the thick limit) and interpolates them as the
+    lookups do: every table read at h equals the axis's there (measured: to the last bit, the
+    same operations; rtol 1e-12 leaves room for a BLAS that splits the products otherwise),
+    and another thickness is refused."""
+    one = B.bake_slab(skin, "preview", only_um=um)
+    assert one.one_thickness and one.thickness_um.tolist() == [um]
+    nodes, t = ST.thickness_support(um)
+    at_node = um <= ST.THICKNESS_MIN_UM or np.isinf(um) or um in ST.thickness_nodes()
+    assert nodes.size == (1 if at_node else 2) and 0.0 <= t < 1.0
+    rng = np.random.default_rng(3)
+    directions = [w / np.linalg.norm(w, axis=-1, keepdims=True) * np.sign(w[..., 2:])
+                  for w in rng.normal(size=(2, 200, 3))]
+    for got, expected in zip(_parts_at(one, um, directions),
+                             _parts_at(preview_axis, um, directions), strict=True):
+        np.testing.assert_allclose(got, expected, rtol=1e-12, atol=0.0)
+    with pytest.raises(ValueError, match="only"):
+        one.sliced(2.0 * um if np.isfinite(um) else 300.0)
+
+
+def test_a_bake_at_one_thickness_is_the_bake_there(skin, tables):
+    """``bake(..., one_thickness=True)``: the tables of the whole bake, the slab's at its
+    thickness only (equal there, rtol 1e-12 as above), the rest as they were."""
+    one = B.bake(skin, "default", film=FS.DEFAULT_THICKNESS_UM, one_thickness=True)
+    assert one.slab.one_thickness and one.parameters == tables.parameters
+    np.testing.assert_allclose(one.path3_gloss, tables.path3_gloss, rtol=1e-12, atol=0.0)
+    rng = np.random.default_rng(4)
+    directions = [w / np.linalg.norm(w, axis=-1, keepdims=True) * np.sign(w[..., 2:])
+                  for w in rng.normal(size=(2, 200, 3))]
+    np.testing.assert_allclose(ST.slab_reflection(one, *directions),
+                               ST.slab_reflection(tables, *directions), rtol=1e-12, atol=0.0)
+    for got, expected in zip(_parts_at(one.slab, FS.DEFAULT_THICKNESS_UM, directions),
+                             _parts_at(tables.slab, FS.DEFAULT_THICKNESS_UM, directions),
+                             strict=True):
+        np.testing.assert_allclose(got, expected, rtol=1e-12, atol=0.0)
+
+
 def test_the_paper_mode_is_the_tables_as_they_were(skin, tables):
     """The slab is an addition: the paper's parts are the same computation (bit-identical in
     one process), and the paper mode holds no slab."""
