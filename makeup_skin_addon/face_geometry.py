@@ -24,8 +24,9 @@ import numpy as np
 
 __all__ = ["CHUNK", "corner_counts", "face_areas", "face_normals"]
 
-CHUNK = 1 << 16
-"""Faces measured at a time."""
+CHUNK = 1 << 15
+"""Faces measured at a time: their temporaries stay in a core's cache (on the production
+head 15 ms at 2^14-2^15 faces, 20 ms at 2^16, 31 ms all at once)."""
 _TINY = np.float32(1e-35)
 """Blender's threshold on a squared length below which a vector is not normalised."""
 _HALF = np.float32(0.5)
@@ -59,9 +60,11 @@ def _groups(loop_start: np.ndarray, loop_total: np.ndarray,
 
 def _coordinates(positions: np.ndarray, corner_verts: np.ndarray,
                  corners: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """x, y, z of the corners ``corners`` (``(k, n)`` each, float32)."""
-    verts = corner_verts[corners]
-    return positions[:, 0][verts], positions[:, 1][verts], positions[:, 2][verts]
+    """x, y, z of the corners ``corners`` (``(k, n)`` each, float32; taken from the positions
+    flat, which is faster than from their columns' strided views)."""
+    flat = positions.reshape(-1)
+    at = np.take(corner_verts, corners) * 3
+    return np.take(flat, at), np.take(flat, at + 1), np.take(flat, at + 2)
 
 
 def _cross(a: tuple, b: tuple) -> tuple:
