@@ -78,17 +78,20 @@ def _triangle_cross(x: np.ndarray, y: np.ndarray, z: np.ndarray) -> tuple:
                   (x[1] - x[2], y[1] - y[2], z[1] - z[2]))
 
 
+def _newell_term(x: np.ndarray, y: np.ndarray, z: np.ndarray, p: int, c: int) -> tuple:
+    """The edge from corner ``p`` to corner ``c``'s part of a Newell vector."""
+    return ((y[p] - y[c]) * (z[p] + z[c]), (z[p] - z[c]) * (x[p] + x[c]),
+            (x[p] - x[c]) * (y[p] + y[c]))
+
+
 def _newell(x: np.ndarray, y: np.ndarray, z: np.ndarray) -> tuple:
     """A face's Newell vector (twice its area along its normal), its edges summed from the one
     that closes the face, as Blender sums them."""
     k = len(x)
-    total = None
-    for i in range(k):
-        p, c = i - 1 if i else k - 1, i
-        term = ((y[p] - y[c]) * (z[p] + z[c]), (z[p] - z[c]) * (x[p] + x[c]),
-                (x[p] - x[c]) * (y[p] + y[c]))
-        total = term if total is None else tuple(s + t for s, t in zip(total, term,
-                                                                       strict=True))
+    total = _newell_term(x, y, z, k - 1, 0)
+    for i in range(1, k):
+        total = tuple(s + t for s, t in zip(total, _newell_term(x, y, z, i - 1, i),
+                                            strict=True))
     return total
 
 
