@@ -14,6 +14,8 @@ corner count, a chunk of :data:`CHUNK` at a time (the temporaries stay a few MB)
 - :func:`corner_counts` -- each face's corners, from the faces' first corners.
 - :func:`face_areas` -- every face's area (float32, in the mesh's units squared).
 - :func:`face_normals` -- unit normals of given faces (float32).
+- :func:`fan_areas` -- the cumulative areas of faces' fan triangles (where a point falls in a
+  face).
 """
 
 from __future__ import annotations
@@ -22,7 +24,7 @@ from collections.abc import Iterator
 
 import numpy as np
 
-__all__ = ["CHUNK", "corner_counts", "face_areas", "face_normals"]
+__all__ = ["CHUNK", "corner_counts", "face_areas", "face_normals", "fan_areas"]
 
 CHUNK = 1 << 15
 """Faces measured at a time: their temporaries stay in a core's cache (on the production
@@ -136,3 +138,14 @@ def face_normals(positions: np.ndarray, corner_verts: np.ndarray, loop_start: np
         unit[2] = np.where(long, unit[2], _ONE)  # a zero normal is +Z
         normal[rows] = np.stack(unit, axis=1)
     return normal
+
+
+def fan_areas(positions: np.ndarray, corner_verts: np.ndarray, corners: np.ndarray) -> np.ndarray:
+    """The cumulative areas ``(n, k - 2)`` (float32) of the fan triangles from the first corner
+    of ``n`` faces of ``k`` corners (their corners ``corners``, ``(k, n)``): each triangle's
+    ``|(v_j - v_0) x (v_j+1 - v_0)| / 2``, its squares summed in order, then summed along the
+    fan."""
+    x, y, z = _coordinates(positions, corner_verts, corners)
+    cross = _cross((x[1:-1] - x[0], y[1:-1] - y[0], z[1:-1] - z[0]),
+                   (x[2:] - x[0], y[2:] - y[0], z[2:] - z[0]))
+    return np.cumsum(np.sqrt(_squared_length(cross)) * _HALF, axis=0).T

@@ -121,27 +121,21 @@ def sampled_triangles(face_area, loop_start, loop_total, corner_vert, positions,
     return Triangles(face, (first, second, second + 1), weights)
 
 
-def _fan_areas(loops: np.ndarray, corner_vert, positions) -> np.ndarray:
-    """The cumulative areas of the fan triangles from the first corner of faces of ``k``
-    corners (their corners ``loops``, ``(n, k)``): ``(n, k - 2)``."""
-    p = positions[corner_vert[loops]]
-    fan = 0.5 * np.linalg.norm(np.cross(p[:, 1:-1] - p[:, :1], p[:, 2:] - p[:, :1]), axis=-1)
-    return np.cumsum(fan, axis=1)
-
-
 def _fan_partial(faces: np.ndarray, first: np.ndarray, loop_start, loop_total, corner_vert,
                  positions, k: int) -> np.ndarray:
-    """:func:`_fan_areas` of the faces ``faces`` of ``k`` corners that points fell in (their
-    first corners ``first``), one row a point: computed once per face of ``k`` corners when
-    the mesh has fewer of them than there are points (the same numbers, row by row), else per
-    point."""
-    with_k = np.flatnonzero(np.asarray(loop_total) == k)
-    if len(with_k) >= len(faces):
-        return _fan_areas(first[:, None] + np.arange(k), corner_vert, positions)
+    """The cumulative areas of the fan triangles (:func:`.face_geometry.fan_areas`) of the
+    faces ``faces`` of ``k`` corners that points fell in (their first corners ``first``), one
+    row a point: computed once per face of ``k`` corners when the mesh has fewer of them than
+    there are points (the same numbers, row by row), else per point."""
+    with_k = np.asarray(loop_total) == k
+    if np.count_nonzero(with_k) >= len(faces):
+        return face_geometry.fan_areas(positions, corner_vert,
+                                       first[None, :] + np.arange(k)[:, None])
+    with_k = np.flatnonzero(with_k)
     row = np.zeros(len(loop_total), np.int64)
     row[with_k] = np.arange(len(with_k))
-    own = np.asarray(loop_start)[with_k].astype(np.int64)[:, None] + np.arange(k)
-    return _fan_areas(own, corner_vert, positions)[row[faces]]
+    own = np.asarray(loop_start)[with_k].astype(np.int64)[None, :] + np.arange(k)[:, None]
+    return face_geometry.fan_areas(positions, corner_vert, own)[row[faces]]
 
 
 def _interpolated(weights: tuple, values: np.ndarray, corners: tuple, out: np.ndarray) -> None:
