@@ -253,7 +253,7 @@ def _points(obj, layer, area: np.ndarray, faces: int, count: int,
             loop_start: np.ndarray, loop_total: np.ndarray) -> tuple[Points, np.ndarray, int]:
     """``(points, corners, checksum)``: ``count`` points of ``obj``'s faces by ``area``, the
     corners their UVs are read at ((3, count) int32) and those UVs' :func:`_uv_checksum`.  The
-    UV map is read last, the positions freed (the peak is the lower)."""
+    UV map is read last, once the positions are freed (a lower peak)."""
     mesh = obj.data
     # What is returned is allocated before the temporaries: freed, these then leave the top of
     # the heap free and the allocator gives it back.
@@ -334,8 +334,8 @@ class Surface:
 
 def object_points(obj, material, layer, count: int = BUDGET) -> Points:
     """``count`` points of ``obj``'s faces that use ``material``, at the UV map ``layer``
-    (:func:`sampled_triangles`), kept until the mesh, its UVs, slots or transform change.  Faces of
-    other slots do not count."""
+    (:func:`sampled_triangles`), kept until the mesh, its slots or transform change or a UV
+    the points are read at.  Faces of other slots do not count."""
     return Surface(obj, material, layer).points(int(count))
 
 
