@@ -9,7 +9,8 @@ triangle's normal is its edges' cross product divided by its length, a quad's it
 cross product times the length's reciprocal, a larger face's its Newell vector's likewise; a
 zero normal is +Z.  Compiled without fused multiply-adds (Blender's x86-64 builds) Blender gives
 the same floats; with them (arm64) they may differ in the last bits.  Faces are taken by their
-corner count, a chunk of :data:`CHUNK` at a time (the temporaries stay a few MB).
+corner count, a chunk of :data:`CHUNK` at a time (the temporaries stay a few MB); what is kept
+can be given as ``out``, allocated before them (:mod:`.surface_points`).
 
 - :func:`corner_counts` -- each face's corners, from the faces' first corners.
 - :func:`face_areas` -- every face's area (float32, in the mesh's units squared).
@@ -39,7 +40,10 @@ def corner_counts(loop_start: np.ndarray, corners: int) -> np.ndarray:
     """Each face's number of corners (int32), from its first corner ``loop_start`` (the faces'
     corners are consecutive and in face order, as Blender stores them) and the mesh's
     ``corners`` in all."""
-    return np.diff(loop_start, append=np.int32(corners)).astype(np.int32, copy=False)
+    total = np.empty(len(loop_start), np.int32)
+    np.subtract(loop_start[1:], loop_start[:-1], out=total[:-1])
+    total[-1:] = corners - loop_start[-1:]
+    return total
 
 
 def _groups(loop_start: np.ndarray, loop_total: np.ndarray,
@@ -102,11 +106,12 @@ def _squared_length(v: tuple) -> np.ndarray:
 
 
 def face_areas(positions: np.ndarray, corner_verts: np.ndarray, loop_start: np.ndarray,
-               loop_total: np.ndarray) -> np.ndarray:
+               loop_total: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
     """Every face's area (float32, the units of ``positions`` squared) as Blender's
     ``MeshPolygon.area`` gives it: from the vertices' ``positions`` ``(v, 3)`` float32, the
-    corners' vertices ``corner_verts`` and the faces' first corner and corner count."""
-    area = np.empty(len(loop_start), np.float32)
+    corners' vertices ``corner_verts`` and the faces' first corner and corner count; into
+    ``out`` if given (float64: the float32 areas, exactly)."""
+    area = np.empty(len(loop_start), np.float32) if out is None else out
     for rows, corners in _groups(loop_start, loop_total, None):
         x, y, z = _coordinates(positions, corner_verts, corners)
         twice = _triangle_cross(x, y, z) if len(corners) == 3 else _newell(x, y, z)
@@ -115,11 +120,13 @@ def face_areas(positions: np.ndarray, corner_verts: np.ndarray, loop_start: np.n
 
 
 def face_normals(positions: np.ndarray, corner_verts: np.ndarray, loop_start: np.ndarray,
-                 loop_total: np.ndarray, faces: np.ndarray | None = None) -> np.ndarray:
+                 loop_total: np.ndarray, faces: np.ndarray | None = None,
+                 out: np.ndarray | None = None) -> np.ndarray:
     """Unit normals ``(n, 3)`` float32 of the faces ``faces`` (indices; None: every face) as
-    Blender's ``MeshPolygon.normal`` gives them (arguments as :func:`face_areas`)."""
+    Blender's ``MeshPolygon.normal`` gives them (arguments as :func:`face_areas`), into ``out``
+    if given."""
     count = len(loop_start) if faces is None else len(faces)
-    normal = np.empty((count, 3), np.float32)
+    normal = np.empty((count, 3), np.float32) if out is None else out
     for rows, corners in _groups(loop_start, loop_total, faces):
         x, y, z = _coordinates(positions, corner_verts, corners)
         k = len(corners)

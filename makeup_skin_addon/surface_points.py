@@ -229,9 +229,9 @@ def _face_areas(obj, slots: tuple, loop_start: np.ndarray,
     slots counts as the last slot, as Blender draws it).  The areas are Blender's
     (:func:`.face_geometry.face_areas`)."""
     mesh = obj.data
+    area = np.empty(len(loop_start))  # kept: allocated before the temporaries (_points)
     positions, corner_verts = _positions(mesh), _corner_verts(mesh)
-    area = face_geometry.face_areas(positions, corner_verts, loop_start,
-                                    loop_total).astype(float)
+    face_geometry.face_areas(positions, corner_verts, loop_start, loop_total, out=area)
     index = np.minimum(_material_indices(mesh), max(len(obj.material_slots) - 1, 0))
     used = np.isin(index, slots)
     area[~used] = 0.0
@@ -240,7 +240,8 @@ def _face_areas(obj, slots: tuple, loop_start: np.ndarray,
     gram = linear.T @ linear
     scale = np.trace(gram) / 3.0
     if np.allclose(gram, scale * np.eye(3), rtol=0.0, atol=1e-9 * max(scale, 1e-30)):
-        return area * scale, faces  # a rotation and a uniform scale: areas times its square
+        area *= scale  # a rotation and a uniform scale: areas times its square
+        return area, faces
     # Otherwise a face's area grows by |cof(M) n| along its unit normal n, cof(M) = det(M)
     # M^-T, whose columns are the cross products of M's (defined for a flattened M too).
     normal = face_geometry.face_normals(positions, corner_verts, loop_start, loop_total)
@@ -255,17 +256,19 @@ def _points(obj, layer, area: np.ndarray, faces: int, count: int,
     corners their UVs are read at ((3, count) int32) and those UVs' :func:`_uv_checksum`.  The
     UV map is read last, once the positions are freed (a lower peak)."""
     mesh = obj.data
-    # What is returned is allocated before the temporaries: freed, these then leave the top of
-    # the heap free and the allocator gives it back.
+    # What is kept is allocated before the temporaries: freed, these then leave the top of the
+    # heap free (allocated after them, a kept array holds them resident below it).
     uv = np.empty((count, 2), np.float32)
-    position = np.empty((count, 3), np.float32)
+    position, normal = np.empty((count, 3), np.float32), np.empty((count, 3), np.float32)
+    corners = np.empty((3, count), np.int32)
     positions, corner_verts = _positions(mesh), _corner_verts(mesh)
     triangles = sampled_triangles(area, loop_start, loop_total, corner_verts, positions, count)
     triangles.interpolated(positions, position, corner_verts)
-    normal = face_geometry.face_normals(positions, corner_verts, loop_start, loop_total,
-                                        triangles.face)
+    face_geometry.face_normals(positions, corner_verts, loop_start, loop_total, triangles.face,
+                               out=normal)
     del positions, corner_verts
-    corners = np.array(triangles.corners, np.int32)
+    for row, corner in zip(corners, triangles.corners, strict=True):
+        row[:] = corner
     corner_uv = _corner_uvs(layer)
     triangles.interpolated(corner_uv, uv)
     checksum = _uv_checksum(corner_uv, corners)
