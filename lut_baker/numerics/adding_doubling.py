@@ -314,16 +314,24 @@ def passive_generator(generator: SlabGenerator, scale0: NDArray[np.float64], rel
     azimuth), so the absorption becomes ``(1 - relief) max(0, a) >= 0``.  ``relief`` in [0, 1]
     (per leading index, e.g. per channel) lets the directions that absorb give up part of it
     for those that would create light.  ``generator``'s arrays are ``(..., orders, N, N)``
-    with order 0 first; a slab with no negative absorption is returned as it is."""
+    with order 0 first; a slab with no negative absorption is returned as it is, and so is
+    every leading index without any (whatever its ``relief``: a slab that only absorbs, such as
+    a pure absorber, has nothing to give up for)."""
     order0 = SlabGenerator(basis=generator.basis[..., 0, :, :], rates=generator.rates[..., 0, :])
     absorption = absorption_per_direction(order0, scale0)  # (..., N)
-    if not np.any(absorption < 0.0):
+    creates = np.any(absorption < 0.0, axis=-1)  # (...,)
+    if not np.any(creates):
         return generator
-    relief = np.asarray(relief, float)[..., None]
+    relief = np.where(creates, np.asarray(relief, float), 0.0)[..., None]
     change = np.maximum(0.0, -absorption) - relief * np.maximum(0.0, absorption)
     extra = change[..., None, :, None] * np.eye(change.shape[-1])  # (..., 1, N, N)
     p, q = generator_matrices(generator)
-    return generator_from_matrices(p + extra, q + extra)
+    made = generator_from_matrices(p + extra, q + extra)
+    if np.all(creates):
+        return made
+    return SlabGenerator(basis=np.where(creates[..., None, None, None], made.basis,
+                                        generator.basis),
+                         rates=np.where(creates[..., None, None], made.rates, generator.rates))
 
 
 def slab(generator: SlabGenerator, thickness: float

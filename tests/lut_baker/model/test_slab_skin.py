@@ -182,3 +182,19 @@ def test_nothing_in_made_up_skin_retro_reflects(paper, um):
     bare = retro_mirror(SS.slab_skin_parts(film, 0.0, paper.skin_reflection).top)
     for got, want in zip(thin, bare, strict=True):
         assert np.allclose(got[keep], want[keep], rtol=0.05, atol=2e-3)
+
+
+def test_match_skin_out_of_reach_in_some_channels(paper):
+    """A target lighter than the film without pigment in one channel and darker than full
+    absorption in another (the medium skin times (1.2, 1, 0.4) at 1 um): those channels end
+    at A = 0 and 1, clamped, the one between matched."""
+    target = np.array(SKINS["medium"][0]) * [1.2, 1.0, 0.4]
+    skin = paper.skin_reflection
+    albedo = np.array(SKINS["medium"][0]) - bare_gloss(skin)
+    absorption, under, clamped = SS.matching_shade(target, paper.film, paper.film_transmission,
+                                                   skin, albedo, 1.0, GRID)
+    assert absorption[0] == 0.0 and absorption[2] == 1.0
+    assert list(clamped) == [True, False, True]
+    colour = SS.slab_colour(paper.film, paper.film_transmission, skin, under, 1.0, GRID,
+                            absorption)
+    assert abs(colour[1] / target[1] - 1.0) < 1e-9
