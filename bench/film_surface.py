@@ -114,8 +114,8 @@ def main() -> int:
                                                           shade), x, skin_layer, face)
             fixed = SS.parts_albedo(parts, a, grid)[:, 0] / bare_0 - 1.0
             fixed_u = SS.parts_colour(parts, a, grid) / bare_u - 1.0
-            shade_m, under, _ = SS.matching_shade(bare_u, film, base.film_transmission,
-                                                  skin_layer, a, um, grid)
+            shade_m, under, _, _ = SS.matching_shade(bare_u, film, base.film_transmission,
+                                                     skin_layer, a, um, grid)
             matched = SS.slab_skin_parts(SS.foundation_slab(
                 film, base.film_transmission, grid, shade_m), x, skin_layer, face)
             direct = SS.parts_albedo(matched, under, grid)[:, 0]

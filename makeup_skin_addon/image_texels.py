@@ -250,9 +250,12 @@ def read_texels(pixels: np.ndarray, uv: np.ndarray, extension: str = "REPEAT") -
         wrapped = uv
     column = np.clip((wrapped[:, 0] * width).astype(np.int64), 0, width - 1)
     row = np.clip((wrapped[:, 1] * height).astype(np.int64), 0, height - 1)
-    values = pixels[row, column].astype(float)
+    # One gather of whole texels by their flat index (indexing rows and columns apart
+    # gathers several times slower).
+    values = pixels.reshape(height * width, -1).take(row * width + column, axis=0).astype(float)
     if extension == "CLIP":
-        values[np.any((uv < 0.0) | (uv > 1.0), axis=1)] = 0.0
+        outside = (uv < 0.0) | (uv > 1.0)
+        values[outside[:, 0] | outside[:, 1]] = 0.0
     return values
 
 

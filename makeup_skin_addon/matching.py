@@ -187,7 +187,8 @@ class SlabLight:
             self.thickness_um, self.grid, absorption), float).reshape(-1) * np.ones(3)
 
     def solve(self, target, body):
-        """``(A, a, clamped)``: :func:`lut_baker.model.slab_skin.matching_shade`."""
+        """``(A, a, clamped, colour)``: :func:`lut_baker.model.slab_skin.matching_shade` (the
+        covered colour at ``A`` and ``a`` its search's own)."""
         return slab_skin.matching_shade(target, self.skin.film, self.skin.film_transmission,
                                         self.skin.skin_reflection, body, self.thickness_um,
                                         self.grid)
@@ -216,8 +217,7 @@ def _covered(light, settings, absorption, body, under=None) -> np.ndarray:
 
 def _solve(settings, light, target, skin: SkinTarget) -> Shade:
     if isinstance(light, SlabLight):
-        absorption, under, clamped = light.solve(target, skin.body)
-        reached = light.covered(absorption, under)
+        absorption, under, clamped, reached = light.solve(target, skin.body)
         return Shade(np.asarray(absorption, float), np.asarray(clamped, bool),
                      np.asarray(target, float), reached, skin, under=np.asarray(under, float))
     gloss = float(settings.gloss)

@@ -61,13 +61,15 @@ def occupancy(positions: np.ndarray, cells: int = GRID) -> tuple[np.ndarray, np.
     grid of ``cells`` cells along the longest side of their bounding box (padded by two
     cells), its corner ``origin`` and cell ``size`` (metres)."""
     positions = np.asarray(positions, np.float32)
-    low, high = np.min(positions.T, axis=1), np.max(positions.T, axis=1)
+    by_axis = np.ascontiguousarray(positions.T)  # a reduction along rows of 3 is slow
+    low, high = by_axis.min(axis=1), by_axis.max(axis=1)
     size = float(max(high - low)) / cells or 1.0
     origin = low - 2.0 * size
     shape = np.ceil((high - origin) / size).astype(int) + 3
     grid = np.zeros(shape, bool)
-    index = np.floor((positions - origin) / size).astype(int)
-    grid[index[:, 0], index[:, 1], index[:, 2]] = True
+    # Every point lies two cells inside the corner: truncation is the floor.
+    index = ((positions - origin) / size).astype(np.intp)
+    grid.reshape(-1)[(index[:, 0] * shape[1] + index[:, 1]) * shape[2] + index[:, 2]] = True
     return grid, origin, size
 
 
@@ -101,23 +103,23 @@ def unhidden(grid: np.ndarray, origin: np.ndarray, size: float, starts: np.ndarr
     shape = np.array(grid.shape, np.uintp)
     flat = distance.reshape(-1)
     free = np.ones(len(starts), bool)
-    position = ((starts - origin) / size).astype(np.float32)
-    directions = directions.astype(np.float32)
+    # The rays still going, one column each: position (in cells) over direction.
+    state = np.empty((6, len(starts)), np.float32)
+    state[:3] = ((starts - origin) / size).T
+    state[3:] = directions.T
     ray = np.arange(len(starts))
     for _ in range(int(np.ceil(np.linalg.norm(grid.shape) / STEP_CELLS)) + 1):
         # Below 0 wraps to a huge index (unsigned), so one comparison per axis bounds it.
-        x, y, z = np.floor(position).astype(np.intp).view(np.uintp).T
+        x, y, z = np.floor(state[:3]).astype(np.intp).view(np.uintp)
         inside = (x < shape[0]) & (y < shape[1]) & (z < shape[2])
-        clear = np.zeros(len(ray), np.float32)
-        clear[inside] = flat[(x[inside] * shape[1] + y[inside]) * shape[2] + z[inside]]
-        hit = inside & (clear == 0)
-        free[ray[hit]] = False
-        going = inside & ~hit
+        # Outside, the cell is any (clipped): only the inside's are used.
+        clear = flat.take(((x * shape[1] + y) * shape[2] + z).view(np.intp), mode="clip")
+        free[ray[inside & (clear == 0)]] = False
+        going = inside & (clear != 0)
         if not np.any(going):
             break
-        leap = np.maximum(clear[going] - 1.5, STEP_CELLS)[:, None]
-        position, directions, ray = (position[going] + leap * directions[going],
-                                     directions[going], ray[going])
+        state, ray = state[:, going], ray[going]
+        state[:3] += np.maximum(clear[going].astype(np.float32) - 1.5, STEP_CELLS) * state[3:]
     return free
 
 

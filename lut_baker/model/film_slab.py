@@ -79,6 +79,7 @@ from ..numerics.adding_doubling import (
     absorption_per_direction,
     add_layers,
     mirror,
+    passive_family,
     passive_generator,
     slab,
     slab_generator,
@@ -415,15 +416,22 @@ def _measured(film: ReflectionLayer, transmission: TransmissionLayer, grid: Hemi
     return _MEASURED.get_or_compute(key, compute)
 
 
-def _free_film_albedo(generator: SlabGenerator, face: NDArray[np.float64],
-                      scale0: NDArray[np.float64], grid: HemisphereGrid) -> NDArray[np.float64]:
-    """Bihemispherical ``R + T`` (gloss left out) of the free film of unit thickness, order 0."""
-    order0 = SlabGenerator(basis=generator.basis[..., :1, :, :], rates=generator.rates[..., :1, :])
-    stand_in = FilmSlab(grid=grid, generator=order0, absorption=np.zeros(face.shape[0]),
-                        measured_face=face)
-    r, t = free_film_matrices(stand_in, 1.0)
-    return bihemispherical_on_grid(star_albedo(r[:, 0], scale0) + star_albedo(t[:, 0], scale0),
-                                   grid)
+def _free_film_albedo(face: NDArray[np.float64], scale0: NDArray[np.float64],
+                      grid: HemisphereGrid) -> Callable[[SlabGenerator], NDArray[np.float64]]:
+    """``generator -> `` the bihemispherical ``R + T`` (gloss left out) of the free film of unit
+    thickness, order 0 (:func:`free_film_matrices`), its two faces built once."""
+    upper = face_layer(face, 1)
+    lower = Layer(top=upper.bottom, bottom=upper.top, down=upper.down)
+
+    def albedo(generator: SlabGenerator) -> NDArray[np.float64]:
+        order0 = SlabGenerator(basis=generator.basis[..., :1, :, :],
+                               rates=generator.rates[..., :1, :])
+        r, t = slab(order0, 1.0)
+        stack = add_layers(surface_on_body(upper, Layer(top=r, bottom=r, down=t)), lower)
+        return bihemispherical_on_grid(star_albedo(stack.top[:, 0], scale0)
+                                       + star_albedo(stack.down[:, 0], scale0), grid)
+
+    return albedo
 
 
 def _passive(generator: SlabGenerator, target: ArrayLike, face: NDArray[np.float64],
@@ -431,15 +439,20 @@ def _passive(generator: SlabGenerator, target: ArrayLike, face: NDArray[np.float
     """:func:`~lut_baker.numerics.adding_doubling.passive_generator` with the ``relief`` per
     channel (a root on [0, 1], :func:`increasing_root`) at which the free film of unit
     thickness keeps, under uniform light, the measured film's ``R + T`` (``target``): passive,
-    and absorbing what the measured film absorbs."""
+    and absorbing what the measured film absorbs.  The root's generators share their work
+    (:func:`~lut_baker.numerics.adding_doubling.passive_family`)."""
     scale0 = star_scale(grid)[0]
     first = SlabGenerator(basis=generator.basis[..., 0, :, :], rates=generator.rates[..., 0, :])
     if not np.any(absorption_per_direction(first, scale0) < 0.0):
         return generator  # passive already: any relief leaves it as it is
     order0 = SlabGenerator(basis=generator.basis[..., :1, :, :], rates=generator.rates[..., :1, :])
-    relief = increasing_root(
-        lambda r: _free_film_albedo(passive_generator(order0, scale0, r), face, scale0, grid),
-        np.broadcast_to(np.asarray(target, float), (face.shape[0],)), RELIEF_STEPS)
+    family = passive_family(order0, scale0)
+    albedo = _free_film_albedo(face, scale0, grid)
+    relief = increasing_root(lambda r: albedo(family(r)),
+                             np.broadcast_to(np.asarray(target, float), (face.shape[0],)),
+                             RELIEF_STEPS)
+    if generator.rates.shape[-2] == 1:  # order 0 only: the root's family
+        return family(relief)
     return passive_generator(generator, scale0, relief)
 
 

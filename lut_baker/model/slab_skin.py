@@ -41,8 +41,9 @@ Functions and types
 - :func:`parts_albedo`, :func:`parts_colour` -- its directional albedo (gloss included) and its
   colour under uniform light.
 - :func:`slab_colour` -- the colour of a foundation at a thickness on a skin, exactly.
+- :data:`ABSORPTION_POWER`, :func:`absorption_along` -- the variable Match Skin searches in.
 - :func:`matching_absorption` -- the absorption whose made-up skin at a thickness has a
-  target colour (Match Skin).
+  target colour (Match Skin), and the colour it reaches.
 - :func:`matching_skin_albedo` -- the skin albedo under the film that gives a target colour
   (closed form).
 - :func:`matching_shade` -- Match Skin at a thickness: the absorption, and where even full
@@ -83,6 +84,8 @@ __all__ = [
     "parts_albedo",
     "parts_colour",
     "slab_colour",
+    "ABSORPTION_POWER",
+    "absorption_along",
     "matching_absorption",
     "matching_skin_albedo",
     "matching_shade",
@@ -241,21 +244,35 @@ def _relative(thickness_um: float) -> float:
     return np.inf if np.isinf(thickness_um) else relative_thickness(thickness_um)
 
 
+ABSORPTION_POWER = 3
+"""The power of :func:`absorption_along`: with it the made-up skin's colour is nearly linear in
+``s`` (a film's colour falls fast as the first pigment absorbs, then slowly)."""
+
+
+def absorption_along(s: ArrayLike) -> NDArray[np.float64]:
+    """The absorption ``A = 1 - (1 - s)^p`` (``p``: :data:`ABSORPTION_POWER`) at ``s`` in [0, 1]
+    (increasing, 0 and 1 at the ends exactly): the variable Match Skin searches in."""
+    return 1.0 - (1.0 - np.asarray(s, float)) ** ABSORPTION_POWER
+
+
 def matching_absorption(target: ArrayLike, film: ReflectionLayer,
                         transmission: TransmissionLayer, skin: ReflectionLayer,
-                        skin_albedo: ArrayLike, thickness_um: float,
-                        grid: HemisphereGrid) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
-    """``(A, clamped)`` per channel: the foundation's absorption whose made-up skin at
+                        skin_albedo: ArrayLike, thickness_um: float, grid: HemisphereGrid
+                        ) -> tuple[NDArray[np.float64], NDArray[np.bool_], NDArray[np.float64]]:
+    """``(A, clamped, colour)`` per channel: the foundation's absorption whose made-up skin at
     ``thickness_um`` has the colour ``target`` (RGB, under uniform light) on the skin under the
-    film (``skin``'s gloss, diffuse albedo ``skin_albedo``); :func:`slab_colour` falls as
-    ``A`` grows, and a bracketed root finds it (:func:`~lut_baker.model.film_slab.
-    increasing_root`).  A target out of the film's reach gets ``A = 0`` (too light) or 1 (too
-    dark) and ``clamped``."""
+    film (``skin``'s gloss, diffuse albedo ``skin_albedo``), and the colour it has there (the
+    search's own evaluation: :func:`slab_colour` at ``A``).  :func:`slab_colour` falls as ``A``
+    grows, and a bracketed root finds it (:func:`~lut_baker.model.film_slab.increasing_root`)
+    in :func:`absorption_along`'s ``s``, where the colour is nearly linear (at the default
+    thickness 7-8 evaluations where ``A`` itself takes 9-11).  A target out of the film's reach
+    gets ``A = 0`` (too light) or 1 (too dark) and ``clamped``."""
     goal = np.broadcast_to(np.asarray(target, float), (3,))
     albedo = np.broadcast_to(np.asarray(skin_albedo, float), (3,))
     face = face_albedo(film, grid)
 
     known: dict[tuple[float, ...], NDArray[np.float64]] = {}
+    per_channel: dict[tuple[int, float], float] = {}  # the channels are independent
 
     # the ends, asked twice, evaluated once
     def colour(a: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -263,12 +280,18 @@ def matching_absorption(target: ArrayLike, film: ReflectionLayer,
         if key not in known:
             known[key] = slab_colour(film, transmission, skin, albedo, thickness_um, grid, a,
                                      face)
+            per_channel.update({(c, value): float(known[key][c])
+                                for c, value in enumerate(key)})
         return known[key]
 
-    absorption = increasing_root(lambda a: -colour(a), -goal, ROOT_STEPS)
+    along = increasing_root(lambda s: -colour(absorption_along(s)), -goal, ROOT_STEPS)
+    absorption = absorption_along(along)
     too_light = goal > colour(np.zeros(3))
     too_dark = goal < colour(np.ones(3))
-    return absorption, too_light | too_dark
+    keys = [(c, float(value)) for c, value in enumerate(absorption)]
+    reached = (np.array([per_channel[key] for key in keys])
+               if all(key in per_channel for key in keys) else colour(absorption))
+    return absorption, too_light | too_dark, reached
 
 
 def matching_skin_albedo(parts: SlabSkinParts, target: ArrayLike,
@@ -290,16 +313,17 @@ def matching_skin_albedo(parts: SlabSkinParts, target: ArrayLike,
 def matching_shade(target: ArrayLike, film: ReflectionLayer, transmission: TransmissionLayer,
                    skin: ReflectionLayer, skin_albedo: ArrayLike, thickness_um: float,
                    grid: HemisphereGrid) -> tuple[NDArray[np.float64], NDArray[np.float64],
-                                                  NDArray[np.bool_]]:
-    """Match Skin at a thickness: ``(A, a, clamped)`` per channel.  The foundation's
+                                                  NDArray[np.bool_], NDArray[np.float64]]:
+    """Match Skin at a thickness: ``(A, a, clamped, colour)`` per channel.  The foundation's
     absorption ``A`` first (:func:`matching_absorption`: the shade is the foundation's, the skin
     under the film is the artist's); where even ``A = 1`` leaves the made-up skin lighter than
     ``target`` (a sheer film whose surface gloss alone adds more than its pigment can take
     away), the skin's albedo under the film ``a`` is lowered until it matches
     (:func:`matching_skin_albedo`), else ``a`` is ``skin_albedo`` unchanged.  ``clamped``: out of
-    reach of both."""
-    absorption, clamped = matching_absorption(target, film, transmission, skin, skin_albedo,
-                                              thickness_um, grid)
+    reach of both.  ``colour``: the made-up skin's at ``A`` and ``a`` (:func:`slab_colour`),
+    from the search's evaluations."""
+    absorption, clamped, reached = matching_absorption(target, film, transmission, skin,
+                                                       skin_albedo, thickness_um, grid)
     albedo = np.array(np.broadcast_to(np.asarray(skin_albedo, float), (3,)))
     goal = np.broadcast_to(np.asarray(target, float), (3,))
     dark = clamped & (absorption == 1.0)
@@ -309,4 +333,5 @@ def matching_shade(target: ArrayLike, film: ReflectionLayer, transmission: Trans
         under, out = matching_skin_albedo(parts, goal, grid)
         albedo = np.where(dark, under, albedo)
         clamped = np.where(dark, out, clamped)
-    return absorption, albedo, clamped
+        reached = np.where(dark, parts_colour(parts, albedo, grid), reached)
+    return absorption, albedo, clamped, reached

@@ -38,12 +38,14 @@ Functions and types
 - :func:`generator_matrices`, :func:`generator_from_matrices` -- its transport matrices P, Q.
 - :func:`absorption_per_direction` -- the energy the slab's transport equation removes per unit
   thickness from light along each node (order 0).
-- :func:`passive_generator` -- the generator with no negative absorption.
+- :func:`passive_generator` -- the generator with no negative absorption;
+  :func:`passive_family` -- for several reliefs, sharing the work.
 - :func:`slab` -- the slab at any thickness; :func:`thick_slab` -- at infinite thickness.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cached_property
 from typing import NamedTuple
@@ -68,6 +70,7 @@ __all__ = [
     "generator_from_matrices",
     "absorption_per_direction",
     "passive_generator",
+    "passive_family",
     "slab",
     "thick_slab",
 ]
@@ -314,16 +317,38 @@ def passive_generator(generator: SlabGenerator, scale0: NDArray[np.float64], rel
     azimuth), so the absorption becomes ``(1 - relief) max(0, a) >= 0``.  ``relief`` in [0, 1]
     (per leading index, e.g. per channel) lets the directions that absorb give up part of it
     for those that would create light.  ``generator``'s arrays are ``(..., orders, N, N)``
-    with order 0 first; a slab with no negative absorption is returned as it is."""
+    with order 0 first; a slab with no negative absorption is returned as it is, and so is
+    every leading index without any (whatever its ``relief``: a slab that only absorbs, such as
+    a pure absorber, has nothing to give up for).  :func:`passive_family` for several
+    ``relief``."""
+    return passive_family(generator, scale0)(relief)
+
+
+def passive_family(generator: SlabGenerator, scale0: NDArray[np.float64]
+                   ) -> Callable[[ArrayLike], SlabGenerator]:
+    """``relief -> passive_generator(generator, scale0, relief)``, the work that does not
+    depend on ``relief`` (the absorption per direction, the transport matrices) done once."""
     order0 = SlabGenerator(basis=generator.basis[..., 0, :, :], rates=generator.rates[..., 0, :])
     absorption = absorption_per_direction(order0, scale0)  # (..., N)
-    if not np.any(absorption < 0.0):
-        return generator
-    relief = np.asarray(relief, float)[..., None]
-    change = np.maximum(0.0, -absorption) - relief * np.maximum(0.0, absorption)
-    extra = change[..., None, :, None] * np.eye(change.shape[-1])  # (..., 1, N, N)
+    creates = np.any(absorption < 0.0, axis=-1)  # (...,)
+    if not np.any(creates):
+        return lambda relief: generator
     p, q = generator_matrices(generator)
-    return generator_from_matrices(p + extra, q + extra)
+    eye = np.eye(absorption.shape[-1])
+
+    def at(relief: ArrayLike) -> SlabGenerator:
+        share = np.where(creates, np.asarray(relief, float), 0.0)[..., None]
+        change = np.maximum(0.0, -absorption) - share * np.maximum(0.0, absorption)
+        extra = change[..., None, :, None] * eye  # (..., 1, N, N)
+        made = generator_from_matrices(p + extra, q + extra)
+        if np.all(creates):
+            return made
+        return SlabGenerator(basis=np.where(creates[..., None, None, None], made.basis,
+                                            generator.basis),
+                             rates=np.where(creates[..., None, None], made.rates,
+                                            generator.rates))
+
+    return at
 
 
 def slab(generator: SlabGenerator, thickness: float

@@ -268,3 +268,17 @@ def test_the_measured_presets_as_the_slabs_thick_limit(paper):
         moved = np.array(stored[name]["absorption"]) - solved
         assert np.all(moved >= -1e-9) and np.max(moved) < 0.11
         assert list(clamped) == [name == "clarins_105", False, False]
+
+
+@pytest.mark.parametrize("absorption", [[0.0, 1.0, 1.0], [1.0, 0.0, 0.5], [0.0, 0.0, 1.0]])
+def test_each_channel_is_the_film_at_its_own_absorption(paper, absorption):
+    """The channels are independent films, the ends 0 (no pigment absorbs) and 1 (nothing
+    comes back from the body but what crosses it unscattered) included, mixed or not."""
+    mixed = FS.film_slab(paper.film, paper.film_transmission, GRID, absorption=absorption,
+                         orders=1)
+    for c, a in enumerate(absorption):
+        alone = FS.film_slab(paper.film, paper.film_transmission, GRID, absorption=a,
+                             orders=1)
+        for x in (0.01, 1.0 / 15.0, 1.0):
+            for got, want in zip(FS.body(mixed, x), FS.body(alone, x), strict=True):
+                assert np.allclose(got[c], want[0], rtol=0.0, atol=1e-12)

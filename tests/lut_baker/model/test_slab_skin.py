@@ -110,8 +110,9 @@ def test_match_skin_at_sheer_default_and_full(name, paper):
     skin = paper.skin_reflection
     albedo = np.array(target) - bare_gloss(skin)
     for um in (SHEER_UM, FS.DEFAULT_THICKNESS_UM, FULL_UM):
-        absorption, under, clamped = SS.matching_shade(target, film, paper.film_transmission,
-                                                       skin, albedo, um, GRID)
+        absorption, under, clamped, _ = SS.matching_shade(target, film,
+                                                          paper.film_transmission, skin,
+                                                          albedo, um, GRID)
         colour = SS.slab_colour(film, paper.film_transmission, skin, under, um, GRID,
                                 absorption)
         assert np.all(np.abs(colour / np.array(target) - 1.0) < 0.03), (name, um, colour)
@@ -182,3 +183,40 @@ def test_nothing_in_made_up_skin_retro_reflects(paper, um):
     bare = retro_mirror(SS.slab_skin_parts(film, 0.0, paper.skin_reflection).top)
     for got, want in zip(thin, bare, strict=True):
         assert np.allclose(got[keep], want[keep], rtol=0.05, atol=2e-3)
+
+
+def test_match_skin_out_of_reach_in_some_channels(paper):
+    """A target lighter than the film without pigment in one channel and darker than full
+    absorption in another (the medium skin times (1.2, 1, 0.4) at 1 um): those channels end
+    at A = 0 and 1, clamped, the one between matched."""
+    target = np.array(SKINS["medium"][0]) * [1.2, 1.0, 0.4]
+    skin = paper.skin_reflection
+    albedo = np.array(SKINS["medium"][0]) - bare_gloss(skin)
+    absorption, under, clamped, _ = SS.matching_shade(target, paper.film,
+                                                      paper.film_transmission, skin, albedo,
+                                                      1.0, GRID)
+    assert absorption[0] == 0.0 and absorption[2] == 1.0
+    assert list(clamped) == [True, False, True]
+    colour = SS.slab_colour(paper.film, paper.film_transmission, skin, under, 1.0, GRID,
+                            absorption)
+    assert abs(colour[1] / target[1] - 1.0) < 1e-9
+
+
+@pytest.mark.parametrize("um", (1.0, 2.0, FS.DEFAULT_THICKNESS_UM, 50.0))
+@pytest.mark.parametrize("name", list(SKINS))
+def test_the_matched_colour_is_the_slab_colour_at_the_match(name, paper, um):
+    """Match Skin's colour (its search's own evaluations, the skin under the film darkened
+    where it is) is :func:`slab_colour` at the absorption and skin albedo it returns, and the
+    target where nothing is clamped.  The search runs in ``s`` (``A = 1 - (1 - s)^3``), 0 and 1
+    at the ends exactly."""
+    target, foundation = SKINS[name]
+    film = presets.foundation_film(foundation)
+    skin = paper.skin_reflection
+    albedo = np.array(target) - bare_gloss(skin)
+    absorption, under, clamped, colour = SS.matching_shade(target, film,
+                                                           paper.film_transmission, skin,
+                                                           albedo, um, GRID)
+    exact = SS.slab_colour(film, paper.film_transmission, skin, under, um, GRID, absorption)
+    assert np.allclose(colour, exact, rtol=1e-12, atol=0.0)
+    assert np.allclose(colour[~clamped], np.array(target)[~clamped], rtol=1e-9, atol=0.0)
+    assert SS.absorption_along(0.0) == 0.0 and SS.absorption_along(1.0) == 1.0
