@@ -7,10 +7,11 @@ The formulas are Blender's, in float32 and in its order of operations: a triangl
 half its edges' cross product's length, a larger face's half its Newell vector's; a
 triangle's normal is its edges' cross product divided by its length, a quad's its diagonals'
 cross product times the length's reciprocal, a larger face's its Newell vector's likewise; a
-zero normal is +Z.  Compiled without fused multiply-adds (Blender's x86-64 builds) Blender gives
-the same floats; with them (arm64) they may differ in the last bits.  Faces are taken by their
-corner count, a chunk of :data:`CHUNK` at a time (the temporaries stay a few MB); what is kept
-can be given as ``out``, allocated before them (:mod:`.surface_points`).
+zero normal is +Z.  Blender's x86-64 builds, whose baseline has no fused multiply-add, give the
+same floats (4.5 and 5.0 checked, docs/addon.md "Match Skin"); a build that fuses them (arm64)
+may differ in the last bits.  Faces are taken by their corner count, a chunk of :data:`CHUNK`
+at a time (the temporaries stay a few MB); what is kept can be given as ``out``, allocated
+before them (:mod:`.surface_points`).
 
 - :func:`corner_counts` -- each face's corners, from the faces' first corners.
 - :func:`face_areas` -- every face's area (float32, in the mesh's units squared).

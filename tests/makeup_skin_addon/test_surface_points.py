@@ -22,8 +22,9 @@ def test_areas_normals_and_corners_as_blender_gives_them(blank_scene):
     """Triangles, quads and larger faces, bent out of their planes and at sizes from a
     millimetre to a kilometre, and degenerate ones: each face's corner count exactly as
     Blender's, its area and normal within float32 rounding of Blender's (the same formulas in
-    float32, in Blender's order: equal to the last bit on x86-64, where Blender is built
-    without fused multiply-adds; with them a few units in the last place may differ)."""
+    float32, in Blender's order: equal to the last bit on this x86-64 machine, whose Blender
+    fuses no multiply-add; a build that fuses them may differ by a few units in the last place,
+    hence the tolerances, not equality)."""
     import bpy
 
     from makeup_skin_addon import face_geometry, surface_points
