@@ -14,7 +14,8 @@ its own, and only at module level (no import inside a function, no cycle):
    ``skin_nodes`` and ``convert`` (the material converted in place and back).
 4. The session's bakes: ``storage`` (the images the .blend keeps, their hashes), ``bakes`` (a
    bake's key and record, one cache of tables and closure fits, :class:`.bakes.Bake`).
-5. The skin: ``surface_points``, ``image_texels`` and ``skin_sampling`` (an image's mean over a
+5. The skin: ``face_geometry`` (the faces' areas and normals as Blender's),
+   ``surface_points``, ``image_texels`` and ``skin_sampling`` (an image's mean over a
    material's faces), ``sky_visibility`` (what the mesh hides of a uniform sky from its
    skin), ``skin_colour`` (the skin preset's own colour), ``artist_skin`` (the
    skin the artist's shader describes), ``shade`` and ``skin_model`` (the settings as the

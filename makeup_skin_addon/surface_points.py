@@ -4,14 +4,16 @@ skin's mean colour and the artist's shader are read (:mod:`.skin_sampling`).
 A fixed budget of points (:data:`BUDGET` in all) is spread over the faces of the material's
 slots on every mesh object that uses it: stratified along the faces' cumulative area, with a
 fixed seed (:data:`SEED`), so the same mesh gives the same points on every run and machine.
-Only what the points need is read: the faces' areas and material indices, their corners,
-positions and UVs (Blender's attribute arrays, copied whole: not the loop triangles,
-docs/addon.md "Match Skin").  An object's points are cached for the session until its mesh,
-UVs, material slots or transform change (a CRC of the arrays, read again at each call: about
-15 ms on a million-triangle head).
+Only what the points need is read: the faces' first corners and material indices, the
+corners' vertices, the positions and UVs (Blender's attribute arrays, copied whole: not the
+loop triangles nor the faces' own areas and normals, docs/addon.md "Match Skin"); the faces'
+areas and normals are computed from them as Blender computes them (:mod:`.face_geometry`).  An
+object's points are cached for the session until its mesh, material slots or transform change
+or a UV they are read from (a CRC of the arrays and of the UVs at the points' corners, read
+again at each call: 7 ms of CPU on a million-triangle head, 10 ms over the whole UV map).
 
-- :func:`face_points` -- area-weighted, stratified points over given faces and their UVs
-  (numpy only).
+- :func:`sampled_triangles` -- area-weighted, stratified points over given faces
+  (:class:`Triangles`: their faces, triangles and barycentric weights; numpy only).
 - :func:`object_points` -- the points of one object's faces of the material (cached);
   :class:`Surface` -- one object's faces at a UV map, their area read once.
 - :func:`shares` -- the budget split between objects by area.
@@ -27,10 +29,11 @@ from dataclasses import dataclass
 import bpy
 import numpy as np
 
+from . import face_geometry
 from .core import cache
 
-__all__ = ["BUDGET", "SEED", "Points", "Surface", "face_points", "object_points", "shares",
-           "users", "clear_cache"]
+__all__ = ["BUDGET", "SEED", "Points", "Surface", "Triangles", "sampled_triangles",
+           "object_points", "shares", "users", "clear_cache"]
 
 BUDGET = 1 << 16
 """Points in all, split between the objects by area: the mean's standard error is the texture's
@@ -39,9 +42,9 @@ spread over the surface divided by 256 (0.06-0.13% on the production head of doc
 SEED = 20251203
 """The points' seed: the same mesh gives the same points, hence the same mean, everywhere."""
 POINTS_CACHE_SIZE = 128
-"""Objects (per material and UV map) whose points are kept: 8 bytes a point, 0.5 MB per
-material however many objects share it, 64 MB at most; a material on more objects than this is
-read again at each click."""
+"""Objects (per material and UV map) whose points are kept: 44 bytes a point (the UV, position,
+normal and the three corners whose UVs are checked), 2.9 MB per material however many objects
+share it; a material on more objects than this is read again at each click."""
 
 _POINTS = cache.LRUCache(POINTS_CACHE_SIZE)
 
@@ -66,16 +69,34 @@ def users(material) -> list:
             and any(slot.material == material for slot in obj.material_slots)]
 
 
-def face_points(face_area, loop_start, loop_total, corner_vert, positions, corner_uv,
-                count: int, seed: int = SEED, *, with_positions: bool = False):
-    """UVs ((count, 2) float32) of ``count`` points spread over the faces in proportion to
-    ``face_area`` (zero: a face not counted), uniform within each face: stratified along the
-    cumulative area (point i falls in the i-th of ``count`` equal shares, at a random place in
-    it), then a triangle of the face's fan from its first corner by its area (``positions`` of
-    the corners ``corner_vert``), then a uniform point in it, its UV interpolated from the
-    corners' ``corner_uv``.  Faces are given by ``loop_start`` and ``loop_total`` (corners);
-    fans assume convex faces.  ``with_positions``: ``(uv, position (count, 3), face index
-    (count,))``."""
+@dataclass(frozen=True)
+class Triangles:
+    """Where points fell: each point's ``face`` (n,), the corners of its triangle of that face's
+    fan ``corners`` (three (n,) int64: the first corner, then two consecutive ones) and its
+    barycentric ``weights`` there (three (n,) float64)."""
+
+    face: np.ndarray
+    corners: tuple
+    weights: tuple
+
+    def interpolated(self, values: np.ndarray, out: np.ndarray,
+                     corner_index: np.ndarray | None = None) -> np.ndarray:
+        """``out`` ((n, c) float32) filled with ``values`` ((m, c)) interpolated at the points:
+        ``values`` per corner, or per vertex with the corners' vertices ``corner_index``."""
+        corners = self.corners if corner_index is None else tuple(
+            corner_index[c] for c in self.corners)
+        _interpolated(self.weights, values, corners, out)
+        return out
+
+
+def sampled_triangles(face_area, loop_start, loop_total, corner_vert, positions, count: int,
+                      seed: int = SEED) -> Triangles:
+    """``count`` points spread over the faces in proportion to ``face_area`` (zero: a face not
+    counted), uniform within each face (:class:`Triangles`): stratified along the cumulative
+    area (point i falls in the i-th of ``count`` equal shares, at a random place in it), then a
+    triangle of the face's fan from its first corner by its area (``positions`` of the corners
+    ``corner_vert``), then a uniform point in it.  Faces are given by ``loop_start`` and
+    ``loop_total`` (corners); fans assume convex faces."""
     rng = np.random.default_rng(seed)
     draws = rng.random((4, count))
     face_area = np.asarray(face_area, float)
@@ -83,12 +104,9 @@ def face_points(face_area, loop_start, loop_total, corner_vert, positions, corne
     shares = (np.arange(count) + draws[0]) * (cumulative[-1] / count)
     last = np.flatnonzero(face_area > 0.0)[-1]  # a share rounded up to the total lands here
     face = np.minimum(np.searchsorted(cumulative, shares, side="right"), last)
+    del cumulative, shares
     first = np.asarray(loop_start)[face].astype(np.int64)  # the fan's first corner
     corners = np.asarray(loop_total)[face]
-    # What is returned is allocated before the temporaries: freed, these then leave the top of
-    # the heap free and the allocator gives it back (on a million triangles, 38 MB kept else).
-    uv = np.empty((count, 2), np.float32)
-    xyz = np.empty((count, 3), np.float32) if with_positions else None
     second = first + 1  # the fan triangle's second corner (the first triangle's)
     for k in np.flatnonzero(np.bincount(corners)[4:]) + 4:  # faces of more than 3 corners
         pick = np.flatnonzero(corners == k)
@@ -100,36 +118,24 @@ def face_points(face_area, loop_start, loop_total, corner_vert, positions, corne
         second[pick] += below.sum(axis=1)
     root = np.sqrt(draws[2])
     weights = (1.0 - root, root * (1.0 - draws[3]), root * draws[3])
-    triangle = (first, second, second + 1)
-    _interpolated(weights, corner_uv, triangle, uv)
-    if xyz is None:
-        return uv
-    corner_vert = np.asarray(corner_vert)
-    _interpolated(weights, positions, tuple(corner_vert[t] for t in triangle), xyz)
-    return uv, xyz, face
-
-
-def _fan_areas(loops: np.ndarray, corner_vert, positions) -> np.ndarray:
-    """The cumulative areas of the fan triangles from the first corner of faces of ``k``
-    corners (their corners ``loops``, ``(n, k)``): ``(n, k - 2)``."""
-    p = positions[corner_vert[loops]]
-    fan = 0.5 * np.linalg.norm(np.cross(p[:, 1:-1] - p[:, :1], p[:, 2:] - p[:, :1]), axis=-1)
-    return np.cumsum(fan, axis=1)
+    return Triangles(face, (first, second, second + 1), weights)
 
 
 def _fan_partial(faces: np.ndarray, first: np.ndarray, loop_start, loop_total, corner_vert,
                  positions, k: int) -> np.ndarray:
-    """:func:`_fan_areas` of the faces ``faces`` of ``k`` corners that points fell in (their
-    first corners ``first``), one row a point: computed once per face of ``k`` corners when
-    the mesh has fewer of them than there are points (the same numbers, row by row), else per
-    point."""
-    with_k = np.flatnonzero(np.asarray(loop_total) == k)
-    if len(with_k) >= len(faces):
-        return _fan_areas(first[:, None] + np.arange(k), corner_vert, positions)
+    """The cumulative areas of the fan triangles (:func:`.face_geometry.fan_areas`) of the
+    faces ``faces`` of ``k`` corners that points fell in (their first corners ``first``), one
+    row a point: computed once per face of ``k`` corners when the mesh has fewer of them than
+    there are points (the same numbers, row by row), else per point."""
+    with_k = np.asarray(loop_total) == k
+    if np.count_nonzero(with_k) >= len(faces):
+        return face_geometry.fan_areas(positions, corner_vert,
+                                       first[None, :] + np.arange(k)[:, None])
+    with_k = np.flatnonzero(with_k)
     row = np.zeros(len(loop_total), np.int64)
     row[with_k] = np.arange(len(with_k))
-    own = np.asarray(loop_start)[with_k].astype(np.int64)[:, None] + np.arange(k)
-    return _fan_areas(own, corner_vert, positions)[row[faces]]
+    own = np.asarray(loop_start)[with_k].astype(np.int64)[None, :] + np.arange(k)[:, None]
+    return face_geometry.fan_areas(positions, corner_vert, own)[row[faces]]
 
 
 def _interpolated(weights: tuple, values: np.ndarray, corners: tuple, out: np.ndarray) -> None:
@@ -190,25 +196,42 @@ def _linear_part(obj) -> np.ndarray:
 
 
 def _fingerprint(obj, layer, slots: tuple) -> tuple:
-    """What the points of ``obj`` depend on, cheaply: the counts, the UV map's name, the slots,
-    the transform's linear part and a CRC-32 of the positions, corners, material indices and
-    UVs (the arrays copied whole: about 15 ms on a million triangles)."""
+    """What the points of ``obj`` depend on but the UVs, cheaply: the counts, the UV map's name,
+    the slots, the transform's linear part and a CRC-32 of the positions, corners' vertices and
+    material indices (Blender's arrays copied whole, one at a time: 4.5 ms on a million
+    triangles).  The UVs are checked where the points read them (:func:`_uv_checksum`)."""
     mesh = obj.data
     crc = 0
     for read in (_positions, _corner_verts, _material_indices):  # one array at a time
         crc = zlib.crc32(np.ascontiguousarray(read(mesh)).data, crc)
-    crc = zlib.crc32(_corner_uvs(layer).data, crc)
     return (len(mesh.vertices), len(mesh.loops), len(mesh.polygons), layer.name, slots,
             tuple(_linear_part(obj).ravel()), crc)
 
 
-def _face_areas(obj, slots: tuple) -> tuple[np.ndarray, int]:
+def _uv_checksum(corner_uv: np.ndarray, corners: np.ndarray) -> int:
+    """A CRC-32 of the UVs ``corner_uv`` ((m, 2) float32) at the corners ``corners`` (the
+    points' triangles' corners, all of the UV map the points depend on): 65,536 points in
+    0.8 ms, a fifth of the whole map's on a million triangles."""
+    return zlib.crc32(np.take(corner_uv.view(np.uint64).reshape(-1), corners).data)
+
+
+def _loop_starts(mesh) -> tuple[np.ndarray, np.ndarray]:
+    """``(loop_start, loop_total)`` of the faces (int32): their first corners (read a face at a
+    time: Blender keeps no array of them that Python can copy) and their corner counts."""
+    loop_start = _array(mesh.polygons, "loop_start", len(mesh.polygons), np.int32)
+    return loop_start, face_geometry.corner_counts(loop_start, len(mesh.loops))
+
+
+def _face_areas(obj, slots: tuple, loop_start: np.ndarray,
+                loop_total: np.ndarray) -> tuple[np.ndarray, int]:
     """``(areas, faces)``: the world areas (square metres, float64) of ``obj``'s faces, zero
     for faces of other slots, and how many faces the slots have (a material index beyond the
-    slots counts as the last slot, as Blender draws it)."""
+    slots counts as the last slot, as Blender draws it).  The areas are Blender's
+    (:func:`.face_geometry.face_areas`)."""
     mesh = obj.data
-    count = len(mesh.polygons)
-    area = _array(mesh.polygons, "area", count, np.float32).astype(float)
+    area = np.empty(len(loop_start))  # kept: allocated before the temporaries (_points)
+    positions, corner_verts = _positions(mesh), _corner_verts(mesh)
+    face_geometry.face_areas(positions, corner_verts, loop_start, loop_total, out=area)
     index = np.minimum(_material_indices(mesh), max(len(obj.material_slots) - 1, 0))
     used = np.isin(index, slots)
     area[~used] = 0.0
@@ -217,27 +240,54 @@ def _face_areas(obj, slots: tuple) -> tuple[np.ndarray, int]:
     gram = linear.T @ linear
     scale = np.trace(gram) / 3.0
     if np.allclose(gram, scale * np.eye(3), rtol=0.0, atol=1e-9 * max(scale, 1e-30)):
-        return area * scale, faces  # a rotation and a uniform scale: areas times its square
+        area *= scale  # a rotation and a uniform scale: areas times its square
+        return area, faces
     # Otherwise a face's area grows by |cof(M) n| along its unit normal n, cof(M) = det(M)
     # M^-T, whose columns are the cross products of M's (defined for a flattened M too).
-    normal = _array(mesh.polygons, "normal", 3 * count, np.float32).reshape(-1, 3)
+    normal = face_geometry.face_normals(positions, corner_verts, loop_start, loop_total)
     a, b, c = linear.T
     cofactor = np.column_stack([np.cross(b, c), np.cross(c, a), np.cross(a, b)])
     return area * np.linalg.norm(normal @ cofactor.T, axis=1), faces
 
 
-def _points(obj, layer, area: np.ndarray, faces: int, count: int) -> Points:
+def _points(obj, layer, area: np.ndarray, faces: int, count: int,
+            loop_start: np.ndarray, loop_total: np.ndarray) -> tuple[Points, np.ndarray, int]:
+    """``(points, corners, checksum)``: ``count`` points of ``obj``'s faces by ``area``, the
+    corners their UVs are read at ((3, count) int32) and those UVs' :func:`_uv_checksum`.  The
+    UV map is read last, once the positions are freed (a lower peak)."""
     mesh = obj.data
-    loop_start = _array(mesh.polygons, "loop_start", len(mesh.polygons), np.int32)
-    if np.all(np.diff(loop_start) > 0):
-        loop_total = np.diff(loop_start, append=len(mesh.loops))
-    else:
-        loop_total = _array(mesh.polygons, "loop_total", len(mesh.polygons), np.int32)
-    uv, position, face = face_points(area, loop_start, loop_total, _corner_verts(mesh),
-                                     _positions(mesh), _corner_uvs(layer), count,
-                                     with_positions=True)
-    normal = _array(mesh.polygons, "normal", 3 * len(mesh.polygons), np.float32).reshape(-1, 3)
-    return Points(uv, float(area.sum()), faces, position, normal[face])
+    # What is kept is allocated before the temporaries: freed, these then leave the top of the
+    # heap free (allocated after them, a kept array holds them resident below it).
+    uv = np.empty((count, 2), np.float32)
+    position, normal = np.empty((count, 3), np.float32), np.empty((count, 3), np.float32)
+    corners = np.empty((3, count), np.int32)
+    positions, corner_verts = _positions(mesh), _corner_verts(mesh)
+    triangles = sampled_triangles(area, loop_start, loop_total, corner_verts, positions, count)
+    triangles.interpolated(positions, position, corner_verts)
+    face_geometry.face_normals(positions, corner_verts, loop_start, loop_total, triangles.face,
+                               out=normal)
+    del positions, corner_verts
+    for row, corner in zip(corners, triangles.corners, strict=True):
+        row[:] = corner
+    corner_uv = _corner_uvs(layer)
+    triangles.interpolated(corner_uv, uv)
+    checksum = _uv_checksum(corner_uv, corners)
+    return Points(uv, float(area.sum()), faces, position, normal), corners, checksum
+
+
+@dataclass(frozen=True)
+class _Entry:
+    """A cached object's points: the mesh's :func:`_fingerprint`, the corners the points' UVs
+    are read at and those UVs' checksum."""
+
+    fingerprint: tuple
+    corners: np.ndarray
+    uv_checksum: int
+    points: Points
+
+    def matches(self, fingerprint: tuple, layer) -> bool:
+        return (fingerprint == self.fingerprint
+                and _uv_checksum(_corner_uvs(layer), self.corners) == self.uv_checksum)
 
 
 class Surface:
@@ -250,13 +300,20 @@ class Surface:
         self.key = (obj.session_uid, material.session_uid, layer.name)
         self.fingerprint = _fingerprint(obj, layer, self.slots)
         entry = _POINTS.get(self.key)
-        self.cached = entry[1] if entry is not None and entry[0] == self.fingerprint else None
+        self.cached = (entry.points if entry is not None
+                       and entry.matches(self.fingerprint, layer) else None)
+        self._faces: tuple | None = None
         self._areas: tuple[np.ndarray, int] | None = None
+
+    def _loop_starts(self) -> tuple[np.ndarray, np.ndarray]:
+        if self._faces is None:
+            self._faces = _loop_starts(self.obj.data)
+        return self._faces
 
     def areas(self) -> tuple[np.ndarray, int]:
         """``(areas, faces)`` of :func:`_face_areas`, read once."""
         if self._areas is None:
-            self._areas = _face_areas(self.obj, self.slots)
+            self._areas = _face_areas(self.obj, self.slots, *self._loop_starts())
         return self._areas
 
     def area(self) -> float:
@@ -267,18 +324,21 @@ class Surface:
         if self.cached is not None and len(self.cached.uv) == count:
             return self.cached
         areas, faces = self.areas()
-        points = (_points(self.obj, self.layer, areas, faces, count)
-                  if count > 0 and areas.sum() > 0.0
-                  else Points(np.empty((0, 2), np.float32), float(areas.sum()), faces))
-        _POINTS.put(self.key, (self.fingerprint, points))
+        if count > 0 and areas.sum() > 0.0:
+            points, corners, checksum = _points(self.obj, self.layer, areas, faces, count,
+                                                *self._loop_starts())
+        else:
+            points = Points(np.empty((0, 2), np.float32), float(areas.sum()), faces)
+            corners, checksum = np.empty((3, 0), np.int32), 0
+        _POINTS.put(self.key, _Entry(self.fingerprint, corners, checksum, points))
         self.cached = points
         return points
 
 
 def object_points(obj, material, layer, count: int = BUDGET) -> Points:
     """``count`` points of ``obj``'s faces that use ``material``, at the UV map ``layer``
-    (:func:`face_points`), kept until the mesh, its UVs, slots or transform change.  Faces of
-    other slots do not count."""
+    (:func:`sampled_triangles`), kept until the mesh, its slots or transform change or a UV
+    the points are read at.  Faces of other slots do not count."""
     return Surface(obj, material, layer).points(int(count))
 
 
