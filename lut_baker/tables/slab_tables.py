@@ -179,7 +179,7 @@ class SlabParts(NamedTuple):
 class SlabSlice(NamedTuple):
     """The 1-D tables of ``slab`` at one thickness (:meth:`SlabTables.sliced`): ``tables``,
     :class:`SlabParts` on the slab's own angular grid; :meth:`at` reads them at polar
-    angles."""
+    angles, :meth:`film_albedo_at` the film's own albedo alone."""
 
     slab: SlabTables
     thickness_um: float
@@ -194,6 +194,10 @@ class SlabSlice(NamedTuple):
                          through_mean=tables.through_mean, below=tables.below,
                          film_albedo=_linear(tables.film_albedo, x),
                          body_gloss=tables.body_gloss)
+
+    def film_albedo_at(self, theta_deg: ArrayLike) -> NDArray[np.float64]:
+        """:meth:`at`'s ``film_albedo`` alone (the other parts not read), ``(..., 3)``."""
+        return _linear(self.tables.film_albedo, self.slab.theta_index(theta_deg))
 
 
 @dataclass(frozen=True, eq=False)

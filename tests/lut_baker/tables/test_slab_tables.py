@@ -71,6 +71,16 @@ def test_the_tables_at_one_thickness_are_the_axiss_there(skin, preview_axis, um)
         one.sliced(2.0 * um if np.isfinite(um) else 300.0)
 
 
+def test_the_films_albedo_alone_is_the_slices(preview_axis):
+    """SlabSlice.film_albedo_at reads the film's albedo alone as at() reads it (the same
+    interpolation: the same numbers, bit for bit), on and between the grid's angles."""
+    theta = np.concatenate([preview_axis.theta_deg, np.linspace(0.0, 90.0, 37), [12.5]])
+    for um in (0.7, 9.6, 300.0):
+        found = preview_axis.sliced(um)
+        np.testing.assert_array_equal(found.film_albedo_at(theta), found.at(theta).film_albedo)
+        np.testing.assert_array_equal(found.film_albedo_at(33.0), found.at(33.0).film_albedo)
+
+
 def test_a_bake_at_one_thickness_is_the_bake_there(skin, tables):
     """``bake(..., one_thickness=True)``: the tables of the whole bake, the slab's at its
     thickness only (equal there, rtol 1e-12 as above), the rest as they were."""
