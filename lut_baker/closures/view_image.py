@@ -100,6 +100,7 @@ def row_reader(cos_view: ArrayLike, size: int
         row = np.asarray(row, float)
         if row.shape[0] != size:
             raise ValueError(f"a row of {row.shape[0]} texels read as one of {size}")
-        return np.asarray(_Numpy.lerp(t, row[first], row[second]), float)
+        return np.asarray(_Numpy.lerp(t, np.take(row, first, axis=0),
+                                      np.take(row, second, axis=0)), float)
 
     return read

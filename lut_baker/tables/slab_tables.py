@@ -67,6 +67,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..model.albedo import bihemispherical
+from ..model.microfacet import reflection_cosines
 from ..numerics.geometry import polar_angle_deg
 from .table_set import (
     THETA_OFFSET,
@@ -304,9 +305,16 @@ class SlabTables:
     def top_at(self, thickness_um: float, wi: ArrayLike, wo: ArrayLike) -> NDArray[np.float64]:
         """``top`` (1/sr, ``(..., 3)``) at one thickness and unit directions ``(..., 3)``."""
         to_light, to_view = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
-        return _trilinear(self._along(self.top, thickness_um),
-                          self.theta_index(polar_angle_deg(to_light)),
-                          self.theta_index(polar_angle_deg(to_view)),
+        return self._top(thickness_um, to_light, to_view,
+                         self.theta_index(polar_angle_deg(to_light)),
+                         self.theta_index(polar_angle_deg(to_view)))
+
+    def _top(self, thickness_um: float, to_light: NDArray[np.float64],
+             to_view: NDArray[np.float64], x_light: NDArray[np.float64],
+             x_view: NDArray[np.float64]) -> NDArray[np.float64]:
+        """:meth:`top_at` at broadcast directions whose :meth:`theta_index` of their polar
+        angles are ``x_light``, ``x_view``."""
+        return _trilinear(self._along(self.top, thickness_um), x_light, x_view,
                           phi_index(to_light, to_view, self.phi_deg.size, self.phi_spacing))
 
 
@@ -397,11 +405,18 @@ def slab_lookup(tables: Tables, wi: ArrayLike, wo: ArrayLike,
     slab = _slab(tables)
     h = _thickness(tables, thickness_um)
     to_light, to_view = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
-    return SlabLookup(film_gloss=tables.surface_gloss("film_gloss", to_light, to_view),
-                      top=slab.top_at(h, to_light, to_view),
-                      skin_gloss=tables.surface_gloss("skin_gloss", to_light, to_view),
-                      through_i=slab.through_at(h, to_light),
-                      through_o=slab.through_at(h, to_view),
+    # what the lookups share: the surfaces' cosines, the polar angles' indices, t at h
+    cosines = reflection_cosines(to_light, to_view)
+    x_light = slab.theta_index(polar_angle_deg(to_light))
+    x_view = slab.theta_index(polar_angle_deg(to_view))
+    through = slab._along(slab.through, h)
+    return SlabLookup(film_gloss=tables.surface_gloss("film_gloss", to_light, to_view,
+                                                      cosines=cosines),
+                      top=slab._top(h, to_light, to_view, x_light, x_view),
+                      skin_gloss=tables.surface_gloss("skin_gloss", to_light, to_view,
+                                                      cosines=cosines),
+                      through_i=_linear(through, x_light),
+                      through_o=_linear(through, x_view),
                       upper=(to_light[..., 2] >= 0.0) & (to_view[..., 2] >= 0.0),
                       thickness_um=h)
 

@@ -373,10 +373,14 @@ class Tables:
             raise ValueError(f"tables' {SURFACE_GLOSS[name]!r} parameters: {error}") from None
 
     def surface_gloss(self, name: str, wi: NDArray[np.float64],
-                      wo: NDArray[np.float64]) -> NDArray[np.float64]:
+                      wo: NDArray[np.float64], *,
+                      cosines: tuple[NDArray[np.float64], ...] | None = None
+                      ) -> NDArray[np.float64]:
         """Surface gloss ``name`` (:data:`SURFACE_GLOSS`, 1/sr) at unit directions ``(..., 3)``
-        in closed form (eq. 2's specular term), ``(..., 3)``; 0 below the surface."""
-        value = ts_reflection(wi, wo, self.surface_layer(name), check=False)
+        in closed form (eq. 2's specular term), ``(..., 3)``; 0 below the surface.
+        ``cosines``: :func:`lut_baker.model.microfacet.reflection_cosines` of the directions,
+        if already computed (the surfaces share them)."""
+        value = ts_reflection(wi, wo, self.surface_layer(name), check=False, cosines=cosines)
         value = value if np.ndim(value) == np.ndim(wi) else value[..., None]
         return np.broadcast_to(value, value.shape[:-1] + (3,))
 

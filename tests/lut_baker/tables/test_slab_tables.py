@@ -10,6 +10,7 @@ from lut_baker.model import film_slab as FS
 from lut_baker.model import presets
 from lut_baker.model import slab_skin as SS
 from lut_baker.numerics import adding_doubling as AD
+from lut_baker.numerics.geometry import direction
 from lut_baker.numerics.quadrature import hemisphere_panels
 from lut_baker.tables import slab_tables as ST
 
@@ -79,6 +80,22 @@ def test_the_films_albedo_alone_is_the_slices(preview_axis):
         found = preview_axis.sliced(um)
         np.testing.assert_array_equal(found.film_albedo_at(theta), found.at(theta).film_albedo)
         np.testing.assert_array_equal(found.film_albedo_at(33.0), found.at(33.0).film_albedo)
+
+
+def test_the_lookups_share_their_angles(tables):
+    """slab_lookup computes what its lookups share once (the surfaces' cosines, the polar
+    angles' indices): each the same as looked up alone (the same operations: bit for bit)."""
+    rng = np.random.default_rng(2)
+    wi = direction(np.radians(rng.uniform(0.0, 90.0, 50)), rng.uniform(0.0, 6.0, 50))
+    wo = direction(np.radians(rng.uniform(0.0, 90.0, 50)), rng.uniform(0.0, 6.0, 50))
+    slab, um = tables.slab, 20.0
+    found = ST.slab_lookup(tables, wi, wo, um)
+    np.testing.assert_array_equal(found.top, slab.top_at(um, wi, wo))
+    np.testing.assert_array_equal(found.through_i, slab.through_at(um, wi))
+    np.testing.assert_array_equal(found.through_o, slab.through_at(um, wo))
+    for name in ("film_gloss", "skin_gloss"):
+        np.testing.assert_array_equal(getattr(found, name),
+                                      tables.surface_gloss(name, wi, wo))
 
 
 def test_a_bake_at_one_thickness_is_the_bake_there(skin, tables):
