@@ -60,6 +60,7 @@ Functions and types
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import NamedTuple
 
@@ -150,6 +151,17 @@ def thickness_support(thickness_um: float, n: int = THICKNESS_NODES,
     if t == 1.0:
         return np.array([low + 1], np.intp), 0.0
     return np.array([low, low + 1], np.intp), t
+
+
+def _all_close(h: NDArray[np.float64], baked_um: float) -> bool:
+    """Whether every thickness ``h`` is ``baked_um`` within :data:`ONE_THICKNESS_RTOL`
+    (``np.isclose``'s test, a single thickness without numpy's array machinery)."""
+    if h.ndim:
+        return bool(np.all(np.isclose(h, baked_um, rtol=ONE_THICKNESS_RTOL, atol=0.0)))
+    x = float(h)
+    if math.isfinite(x) and math.isfinite(baked_um):
+        return abs(x - baked_um) <= ONE_THICKNESS_RTOL * abs(baked_um)
+    return x == baked_um
 
 
 def at_support(rows: NDArray[np.float64], t: float) -> NDArray[np.float64]:
@@ -259,8 +271,7 @@ class SlabTables:
         raise ValueError at any other."""
         if self.one_thickness:
             h = np.asarray(thickness_um, float)
-            if not np.all(np.isclose(h, self.thickness_um[0], rtol=ONE_THICKNESS_RTOL,
-                                     atol=0.0)):
+            if not _all_close(h, float(self.thickness_um[0])):
                 raise ValueError(f"these slab tables hold the film at "
                                  f"{float(self.thickness_um[0])} um only: another thickness "
                                  f"needs the axis's (bake_slab without only_um)")

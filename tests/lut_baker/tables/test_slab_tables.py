@@ -72,6 +72,19 @@ def test_the_tables_at_one_thickness_are_the_axiss_there(skin, preview_axis, um)
         one.sliced(2.0 * um if np.isfinite(um) else 300.0)
 
 
+def test_one_thickness_is_checked_as_isclose_does():
+    """Tables at one thickness accept a thickness as ``np.isclose`` at ONE_THICKNESS_RTOL
+    decides (a single thickness checked without numpy's array machinery: the same decision,
+    infinities and NaN included)."""
+    rng = np.random.default_rng(4)
+    for baked in (9.6, 0.7, 300.0, np.inf):
+        near = baked * (1.0 + rng.uniform(-3e-12, 3e-12, 50))
+        for h in [*near, baked, np.nextafter(baked, 0.0), np.inf, -np.inf, np.nan, 0.0]:
+            expected = bool(np.isclose(h, baked, rtol=ST.ONE_THICKNESS_RTOL, atol=0.0))
+            assert ST._all_close(np.asarray(h, float), float(baked)) == expected, (baked, h)
+        assert ST._all_close(np.array([baked, baked]), float(baked))
+
+
 def test_the_films_albedo_alone_is_the_slices(preview_axis):
     """SlabSlice.film_albedo_at reads the film's albedo alone as at() reads it (the same
     interpolation: the same numbers, bit for bit), on and between the grid's angles."""
