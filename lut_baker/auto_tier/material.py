@@ -45,7 +45,8 @@ from .measured import by_number, load
 __all__ = ["MaterialTraits", "traits_from_tables", "paper_traits", "profile_mean_radius_mm",
            "gloss_and_skin_shares", "gloss_omission_error", "gloss_omissions",
            "profile_mismatch", "SHARE_LIGHTS_DEG", "TRAITS_COMMAND", "PAPER_TIER_ERRORS",
-           "PAPER_MISMATCH", "PAPER_SKIN_SHARE", "PAPER_GLOSS_SHARE", "PAPER_GLOSS_OMISSION"]
+           "PAPER_MISMATCH", "PAPER_SKIN_SHARE", "PAPER_GLOSS_SHARE", "PAPER_GLOSS_OMISSION",
+           "SPHERE_PX"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -353,6 +354,8 @@ def profile_mismatch(tables: Tables, fit_error: ArrayLike) -> float:
 SHARE_LIGHTS_DEG = (0.0, 45.0, 75.0, 89.0)
 """Light angles (degrees from the view) at which :func:`traits_from_tables` measures the
 shares."""
+SPHERE_PX = 48
+"""Pixels across the spheres :func:`traits_from_tables` measures by default."""
 
 
 def traits_from_tables(tables: Tables, fit: ClosureFit, coverage: float | None = None,
@@ -360,7 +363,7 @@ def traits_from_tables(tables: Tables, fit: ClosureFit, coverage: float | None =
                        lights_deg: Iterable[float] = SHARE_LIGHTS_DEG,
                        method: str | None = None,
                        errors: Mapping[str, TierError] | None = None,
-                       over_shader: bool = False
+                       over_shader: bool = False, sphere_px: int = SPHERE_PX
                        ) -> MaterialTraits:
     """:class:`MaterialTraits` of baked ``tables`` and their
     :class:`lut_baker.closures.closure_fit.ClosureFit` ``fit`` at a coverage and absorption
@@ -369,7 +372,8 @@ def traits_from_tables(tables: Tables, fit: ClosureFit, coverage: float | None =
     ``over_shader``: a fit for a group over the artist's shader (``fit_closures(...,
     over_shader=True)``): the bare skin is the artist's (the tiers' errors and gloss
     omissions leave it as it is) and so is the subsurface closure under the film, radius and
-    method, which spreads light as the artist's skin does: no profile mismatch."""
+    method, which spreads light as the artist's skin does: no profile mismatch.
+    ``sphere_px``: pixels across the spheres the shares and omissions are measured on."""
     w, a = tables.coverage_and_absorption(coverage, absorption)
     errors = tier_errors(fit, tables, w, a, over_shader=over_shader) if errors is None \
         else errors
@@ -379,10 +383,10 @@ def traits_from_tables(tables: Tables, fit: ClosureFit, coverage: float | None =
     for light in lights_deg:  # each sphere's lookups, rows and bare skin made once
         angle = float(light)
         if fit.slab is not None:  # the film as a slab: its own made-up skin and parts
-            sphere = _sphere(tables, angle, w, a, 48, fit)
+            sphere = _sphere(tables, angle, w, a, sphere_px, fit)
             shares[angle] = _slab_shares(tables, fit, sphere, w, targets)
         else:
-            sphere = _sphere(tables, angle, w, a, 48)
+            sphere = _sphere(tables, angle, w, a, sphere_px)
             shares[angle] = _shares(tables, sphere, w, a)
         for tier in fit.tiers:
             omissions[tier][angle] = _omission(tables, fit, tier, sphere, w, a, over_shader)
