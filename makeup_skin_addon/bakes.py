@@ -309,15 +309,22 @@ def _same(a: Iterable[float], b: Iterable[float]) -> bool:
                                     for x, y in zip(a, b, strict=True))
 
 
+PREVIEW_SPHERE_PX = 32
+"""Pixels across the Auto tier's spheres (:func:`lut_baker.auto_tier.traits_from_tables`)
+when the tables are at preview resolution (the settings' resolution: its default, 48)."""
+
+
 def measure(tables: table_set.Tables, fit: closure_fit.ClosureFit, coverage: float,
             absorption: Iterable[float], method: str | None = None, *,
-            with_traits: bool = True, over_shader: bool = False) -> dict:
+            with_traits: bool = True, over_shader: bool = False,
+            resolution: str | None = None) -> dict:
     """What ``fit`` measures at ``coverage`` and ``absorption`` (per channel), of the tiers it
     holds, as plain data: ``{"coverage", "absorption", "method", "errors": {tier: {"rms",
     "albedo"}}, "traits": MaterialTraits.as_dict() or None}`` (the traits, which hold the
     gloss omissions too, only ``with_traits``: the Auto tier's, about 10 ms a tier more).
-    ``over_shader``: ``fit`` is for a group over the artist's shader.  The fit's own errors
-    are reused when it was measured there."""
+    ``over_shader``: ``fit`` is for a group over the artist's shader; ``resolution``: the
+    tables' (at ``"preview"`` the traits' spheres are :data:`PREVIEW_SPHERE_PX` across).  The
+    fit's own errors are reused when it was measured there."""
     coverage = float(coverage)
     absorption = [float(a) for a in absorption]
     errors = fit.errors
@@ -325,9 +332,10 @@ def measure(tables: table_set.Tables, fit: closure_fit.ClosureFit, coverage: flo
     if first is None or not (_same([first.coverage], [coverage])
                              and _same(first.absorption, absorption)):
         errors = tiers.tier_errors(fit, tables, coverage, absorption, over_shader=over_shader)
+    sphere_px = PREVIEW_SPHERE_PX if resolution == "preview" else auto_tier.SPHERE_PX
     traits = auto_tier.traits_from_tables(tables, fit, coverage, absorption, method=method,
-                                          errors=errors, over_shader=over_shader) \
-        if with_traits else None
+                                          errors=errors, over_shader=over_shader,
+                                          sphere_px=sphere_px) if with_traits else None
     return {"coverage": coverage, "absorption": absorption, "method": method,
             "errors": {tier: {"rms": float(e.rms), "albedo": float(e.albedo)}
                        for tier, e in errors.items()},
@@ -422,7 +430,8 @@ class Bake:
             tables, fit = self.fitted()
             measured = measure(tables, fit, self.coverage, self.absorption,
                                self.method or fit.subsurface_method,
-                               with_traits=with_traits, over_shader=self.over)
+                               with_traits=with_traits, over_shader=self.over,
+                               resolution=self.record.get("resolution"))
             self._measured = measured
             report = stage(self.progress, MEASURE_SHARE, 1.0)
             if report is not None:

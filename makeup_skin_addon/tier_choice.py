@@ -208,7 +208,7 @@ def _measurement(meta: dict, coverage: float, absorption, *, may_fit: bool, tier
     if got is None:
         return None
     return bakes.measure(*got, coverage, absorption, method=meta.get("subsurface_method"),
-                        over_shader=over)
+                        over_shader=over, resolution=meta.get("resolution"))
 
 
 def material_traits(material, *, refit: bool = False, may_fit: bool = True, scene=None):

@@ -72,6 +72,7 @@ from .material import (
                          PAPER_SKIN_SHARE,
                          PAPER_TIER_ERRORS,
                          SHARE_LIGHTS_DEG,
+                         SPHERE_PX,
                          TRAITS_COMMAND,
                          MaterialTraits,
                          gloss_and_skin_shares,
@@ -93,6 +94,6 @@ __all__ = [
     "PAPER_MISMATCH", "traits_from_tables", "profile_mean_radius_mm", "gloss_and_skin_shares",
     "gloss_omission_error", "gloss_omissions", "PAPER_GLOSS_OMISSION", "profile_mismatch",
     "blur_kernel", "subsurface_omission_error", "noise", "Prediction", "predict", "Choice",
-    "needs_subsurface", "choose", "TRAITS_COMMAND", "SHARE_LIGHTS_DEG", "COST_COMMAND",
+    "needs_subsurface", "choose", "TRAITS_COMMAND", "SHARE_LIGHTS_DEG", "SPHERE_PX", "COST_COMMAND",
     "EEVEE_COST_COMMAND",
 ]

@@ -13,7 +13,7 @@
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from functools import cached_property, lru_cache
 from typing import Any
 
@@ -45,7 +45,8 @@ from .measured import by_number, load
 __all__ = ["MaterialTraits", "traits_from_tables", "paper_traits", "profile_mean_radius_mm",
            "gloss_and_skin_shares", "gloss_omission_error", "gloss_omissions",
            "profile_mismatch", "SHARE_LIGHTS_DEG", "TRAITS_COMMAND", "PAPER_TIER_ERRORS",
-           "PAPER_MISMATCH", "PAPER_SKIN_SHARE", "PAPER_GLOSS_SHARE", "PAPER_GLOSS_OMISSION"]
+           "PAPER_MISMATCH", "PAPER_SKIN_SHARE", "PAPER_GLOSS_SHARE", "PAPER_GLOSS_OMISSION",
+           "SPHERE_PX"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -162,7 +163,9 @@ class _Sphere:
     once for the total, the bare skin and the shares: with the film as a slab the slab's,
     ``lookup``, :func:`lut_baker.closures.tiers.slab_lookup_of`, and the paper's tables',
     :meth:`lut_baker.tables.table_set.Tables.reflection_parts`, only when asked for) and the
-    tables' radiance ``f cos(theta_i)`` at a coverage and absorption, with its RMS ``norm``."""
+    tables' radiance ``f cos(theta_i)`` at a coverage and absorption, with its RMS ``norm``;
+    each tier's image rows read at the pixels (:meth:`rows_read`) are shared by its replicas
+    there."""
 
     wi: NDArray[np.float64]
     wo: NDArray[np.float64]
@@ -172,12 +175,18 @@ class _Sphere:
     lookup: SlabLookup | None = None
     _parts: ReflectionParts | None = None
     _bare: NDArray[np.float64] | None = None
+    _rows: dict[str, dict[str, NDArray[np.float64]]] = field(default_factory=dict)
 
     @cached_property
     def pairs(self) -> DirectionPairs:
         """The pixels' :class:`lut_baker.closures.cycles.DirectionPairs` (the replicas' lobes
         share their cosines)."""
         return DirectionPairs(self.wi, self.wo)
+
+    def rows_read(self, tier: str) -> dict[str, NDArray[np.float64]]:
+        """Tier ``tier``'s image rows read at the pixels, by name (filled by its replicas:
+        :func:`lut_baker.closures.tiers.tier_replica`'s ``read``)."""
+        return self._rows.setdefault(tier, {})
 
     def parts(self, tables: Tables) -> ReflectionParts:
         """The tables' lookups at the pixels (made once)."""
@@ -290,7 +299,8 @@ def _omission(tables: Tables, fit: ClosureFit, tier: str, sphere: _Sphere, w: fl
         return 0.0
     bare = sphere.bare(tables, a, fit) if over_shader else None
     kept, left_out = (tier_reflection(fit, tables, tier, w, a, gloss, (sphere.wi, sphere.wo),
-                                      over_shader=over_shader, bare=bare, pairs=sphere.pairs)
+                                      over_shader=over_shader, bare=bare, pairs=sphere.pairs,
+                                      read=sphere.rows_read(tier))
                       for gloss in (1.0, 0.0))
     return float(np.sqrt(np.mean(((kept - left_out) * sphere.cos_i) ** 2)) / norm)
 
@@ -319,16 +329,13 @@ def gloss_omissions(tables: Tables, fit: ClosureFit, coverage: float | None = No
     ``lights_deg`` (default :data:`SHARE_LIGHTS_DEG`): ``{tier: {light angle: error}}``."""
     lights = SHARE_LIGHTS_DEG if lights_deg is None else lights_deg
     w, a = tables.coverage_and_absorption(coverage, absorption)
-    spheres = {float(light): _sphere(tables, light, w, a, 48) for light in lights}
-    return _omissions(tables, fit, spheres, w, a, fit.tiers if tiers is None else tiers,
-                      over_shader)
-
-
-def _omissions(tables: Tables, fit: ClosureFit, spheres: Mapping[float, _Sphere], w: float,
-               a: ArrayLike, tiers: Iterable[str], over_shader: bool
-               ) -> dict[str, dict[float, float]]:
-    return {tier: {light: _omission(tables, fit, tier, sphere, w, a, over_shader)
-                   for light, sphere in spheres.items()} for tier in tiers}
+    tiers = tuple(fit.tiers if tiers is None else tiers)
+    out: dict[str, dict[float, float]] = {tier: {} for tier in tiers}
+    for light in lights:
+        sphere = _sphere(tables, light, w, a, 48)
+        for tier in tiers:
+            out[tier][float(light)] = _omission(tables, fit, tier, sphere, w, a, over_shader)
+    return out
 
 
 def profile_mismatch(tables: Tables, fit_error: ArrayLike) -> float:
@@ -347,6 +354,8 @@ def profile_mismatch(tables: Tables, fit_error: ArrayLike) -> float:
 SHARE_LIGHTS_DEG = (0.0, 45.0, 75.0, 89.0)
 """Light angles (degrees from the view) at which :func:`traits_from_tables` measures the
 shares."""
+SPHERE_PX = 48
+"""Pixels across the spheres :func:`traits_from_tables` measures by default."""
 
 
 def traits_from_tables(tables: Tables, fit: ClosureFit, coverage: float | None = None,
@@ -354,7 +363,7 @@ def traits_from_tables(tables: Tables, fit: ClosureFit, coverage: float | None =
                        lights_deg: Iterable[float] = SHARE_LIGHTS_DEG,
                        method: str | None = None,
                        errors: Mapping[str, TierError] | None = None,
-                       over_shader: bool = False
+                       over_shader: bool = False, sphere_px: int = SPHERE_PX
                        ) -> MaterialTraits:
     """:class:`MaterialTraits` of baked ``tables`` and their
     :class:`lut_baker.closures.closure_fit.ClosureFit` ``fit`` at a coverage and absorption
@@ -363,19 +372,24 @@ def traits_from_tables(tables: Tables, fit: ClosureFit, coverage: float | None =
     ``over_shader``: a fit for a group over the artist's shader (``fit_closures(...,
     over_shader=True)``): the bare skin is the artist's (the tiers' errors and gloss
     omissions leave it as it is) and so is the subsurface closure under the film, radius and
-    method, which spreads light as the artist's skin does: no profile mismatch."""
+    method, which spreads light as the artist's skin does: no profile mismatch.
+    ``sphere_px``: pixels across the spheres the shares and omissions are measured on."""
     w, a = tables.coverage_and_absorption(coverage, absorption)
     errors = tier_errors(fit, tables, w, a, over_shader=over_shader) if errors is None \
         else errors
-    if fit.slab is not None:  # the film as a slab: its own made-up skin and parts
-        spheres = {float(angle): _sphere(tables, angle, w, a, 48, fit)
-                   for angle in lights_deg}
-        targets = FitTargets(tables, 2, fit.slab.thickness_um)
-        shares = {angle: _slab_shares(tables, fit, sphere, w, targets)
-                  for angle, sphere in spheres.items()}
-    else:
-        spheres = {float(angle): _sphere(tables, angle, w, a, 48) for angle in lights_deg}
-        shares = {angle: _shares(tables, sphere, w, a) for angle, sphere in spheres.items()}
+    targets = None if fit.slab is None else FitTargets(tables, 2, fit.slab.thickness_um)
+    shares: dict[float, tuple[float, float]] = {}
+    omissions: dict[str, dict[float, float]] = {tier: {} for tier in fit.tiers}
+    for light in lights_deg:  # each sphere's lookups, rows and bare skin made once
+        angle = float(light)
+        if fit.slab is not None:  # the film as a slab: its own made-up skin and parts
+            sphere = _sphere(tables, angle, w, a, sphere_px, fit)
+            shares[angle] = _slab_shares(tables, fit, sphere, w, targets)
+        else:
+            sphere = _sphere(tables, angle, w, a, sphere_px)
+            shares[angle] = _shares(tables, sphere, w, a)
+        for tier in fit.tiers:
+            omissions[tier][angle] = _omission(tables, fit, tier, sphere, w, a, over_shader)
     mismatch = 0.0 if over_shader else profile_mismatch(
         tables, fit.profiles[method or fit.subsurface_method].error)
     return MaterialTraits(
@@ -385,7 +399,7 @@ def traits_from_tables(tables: Tables, fit: ClosureFit, coverage: float | None =
         profile_mismatch=mismatch,
         skin_share={angle: value[1] for angle, value in shares.items()},
         gloss_share={angle: value[0] for angle, value in shares.items()},
-        gloss_omission=_omissions(tables, fit, spheres, w, a, fit.tiers, over_shader),
+        gloss_omission=omissions,
     )
 
 

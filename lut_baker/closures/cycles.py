@@ -51,7 +51,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import cached_property, lru_cache
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -466,13 +466,14 @@ def microfacet_albedos(cos_view: ArrayLike, roughness: float, fresnel: OfCosine,
 def _chunked(cos_view: ArrayLike, roughness: float, fresnel: OfCosine | None,
              distribution: str, n_u: int, n_phi: int,
              both: bool) -> tuple[NDArray[np.float64], ...]:
-    """:func:`_albedo_views` over the views in chunks (:data:`ALBEDO_CHUNK`), reshaped."""
+    """:func:`_albedo_views` over the views in chunks (:data:`ALBEDO_CHUNK`), reshaped; the
+    half vectors (:func:`_half_vectors`) made once for every chunk."""
     views = np.asarray(cos_view, float)
     flat = views.ravel()
     step = max(ALBEDO_CHUNK // (n_u * n_phi), 1)
-    parts = [_albedo_views(flat[k:k + step], roughness, fresnel, distribution, n_u, n_phi,
-                           both) for k in range(0, flat.size, step)] or [
-        _albedo_views(flat, roughness, fresnel, distribution, n_u, n_phi, both)]
+    nodes = _half_vectors(roughness, distribution, n_u, n_phi)
+    parts = [_albedo_views(flat[k:k + step], nodes, fresnel, both)
+             for k in range(0, flat.size, step)] or [_albedo_views(flat, nodes, fresnel, both)]
     out = []
     for index in range(len(parts[0])):
         total = np.concatenate([part[index] for part in parts], axis=0)
@@ -487,13 +488,39 @@ albedo at 64 texels, 393 216 nodes: 14 -> 5 ms); each view's sum is the same to 
 whatever the chunk."""
 
 
-def _albedo_views(views: NDArray[np.float64], roughness: float, fresnel: OfCosine | None,
-                  distribution: str, n_u: int, n_phi: int,
-                  both: bool = False) -> tuple[NDArray[np.float64], ...]:
-    """:func:`microfacet_albedo` at 1-D ``views``: ``((V,),)``, or ``((V, C),)`` for an RGB
-    ``fresnel``; ``both``: the Fresnel-free albedo first, then the one with ``fresnel``."""
-    alpha = np.square(max(float(roughness), ROUGHNESS_EPS))
+@lru_cache(maxsize=8)
+def _albedo_nodes(n_u: int, n_phi: int
+                  ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """``(u (U,), weights (1, U, 1), cos(phi) (1, 1, P))`` of :func:`microfacet_albedo`'s
+    quadrature: ``n_u`` Gauss-Legendre nodes in ``u`` with their weights over ``n_phi``, the
+    cosines of ``n_phi`` midpoints in azimuth over [0, pi] (read-only; the same for every
+    roughness, made once per resolution)."""
     u, w_u = gauss_legendre(n_u)
+    weights = w_u[None, :, None] / n_phi
+    cos_phi = np.cos(midpoint_nodes(n_phi, 0.0, np.pi))[None, None, :]
+    weights.setflags(write=False)
+    cos_phi.setflags(write=False)
+    return u, weights, cos_phi
+
+
+class _HalfVectors(NamedTuple):
+    """:func:`microfacet_albedo`'s microfacet normals at one roughness: ``alpha``, ``hx``
+    ``(1, U, P)`` and ``hz`` ``(1, U, 1)`` (the normals' x and z; the view in x-z), the
+    quadrature's ``weights`` ``(1, U, 1)``, the ``distribution``."""
+
+    alpha: float
+    hx: NDArray[np.float64]
+    hz: NDArray[np.float64]
+    weights: NDArray[np.float64]
+    distribution: str
+
+
+def _half_vectors(roughness: float, distribution: str, n_u: int, n_phi: int) -> _HalfVectors:
+    """:class:`_HalfVectors` of ``distribution`` at ``roughness`` on :func:`_albedo_nodes`:
+    ``tan^2 theta_h = alpha^2 u / (1 - u)`` (GGX), ``-alpha^2 log(1 - u)`` (Beckmann),
+    ``cos theta_h = u^(1/(e+1))`` (Ashikhmin-Shirley)."""
+    alpha = np.square(max(float(roughness), ROUGHNESS_EPS))
+    u, weights, cos_phi = _albedo_nodes(n_u, n_phi)
     if distribution == "GGX":
         tan2 = alpha * alpha * u / (1.0 - u)
     elif distribution == "BECKMANN":
@@ -506,22 +533,29 @@ def _albedo_views(views: NDArray[np.float64], roughness: float, fresnel: OfCosin
                          f"{distribution!r}")
     cos_h = 1.0 / np.sqrt(1.0 + tan2)
     sin_h = np.sqrt(tan2) * cos_h
-    phi = midpoint_nodes(n_phi, 0.0, np.pi)
+    return _HalfVectors(alpha, sin_h[None, :, None] * cos_phi, cos_h[None, :, None], weights,
+                        distribution)
+
+
+def _albedo_views(views: NDArray[np.float64], nodes: _HalfVectors, fresnel: OfCosine | None,
+                  both: bool = False) -> tuple[NDArray[np.float64], ...]:
+    """:func:`microfacet_albedo` at 1-D ``views`` on ``nodes`` (:func:`_half_vectors`):
+    ``((V,),)``, or ``((V, C),)`` for an RGB ``fresnel``; ``both``: the Fresnel-free albedo
+    first, then the one with ``fresnel``."""
+    hx, hz, distribution = nodes.hx, nodes.hz, nodes.distribution
     mu_o = np.clip(views, 1e-6, 1.0)[:, None, None]
     sin_o = np.sqrt(1.0 - mu_o * mu_o)
-    hx = sin_h[None, :, None] * np.cos(phi)[None, None, :]
-    hz = cos_h[None, :, None]
     h_dot_o = hx * sin_o + hz * mu_o
     mu_i = h_dot_o * (2.0 * hz) - mu_o  # 2 h.wo n.h - n.wo (doubling is exact)
     valid = (h_dot_o > 0.0) & (mu_i > 0.0)
     if distribution == "ASHIKHMIN_SHIRLEY":
         value = np.where(valid, mu_i / np.maximum(mu_i, mu_o), 0.0)
     else:
-        g2 = microfacet_shadowing(np.where(valid, mu_i, 1.0), mu_o, alpha, distribution)
+        g2 = microfacet_shadowing(np.where(valid, mu_i, 1.0), mu_o, nodes.alpha, distribution)
         g2 *= h_dot_o  # g2 h.wo / (n.wo n.h), in place (a new full-size array)
         g2 /= mu_o * hz
         value = np.where(valid, g2, 0.0)
-    weights = w_u[None, :, None] / n_phi
+    weights = nodes.weights
     if fresnel is None:
         return (np.sum(value * weights, axis=(1, 2)),)
     weighted = value * weights

@@ -39,7 +39,7 @@ from typing import Any, Protocol
 import numpy as np
 
 from ..model.made_up_skin import combine, coverage_weights, mix_slots
-from .view_image import sample_row
+from .view_image import row_reader
 
 __all__ = ["Algebra", "ShaderAlgebra", "NumpyAlgebra", "TierInputs", "Closure",
            "ViewWeightedClosures", "principled_sockets", "principled_shader",
@@ -84,11 +84,17 @@ class ShaderAlgebra(Algebra, Protocol):
 class NumpyAlgebra:
     """The numpy algebra: scalars are arrays with a trailing axis of 1, colours of 3 (any
     leading shape, broadcast), rows read at ``cos_view`` (``(...,)``) from ``rows`` (name ->
-    ``(size, 3)``) as Blender's Image Texture samples them."""
+    ``(size, 3)``) as Blender's Image Texture samples them (their texels at ``cos_view`` found
+    once per size, :func:`lut_baker.closures.view_image.row_reader`).  ``read``: the rows
+    already read from ``rows`` at ``cos_view`` by name (read-only), which this algebra fills as
+    it reads: algebras of the same rows and view share them."""
 
-    def __init__(self, rows: dict[str, Any] | None = None, cos_view: Any = None) -> None:
+    def __init__(self, rows: dict[str, Any] | None = None, cos_view: Any = None,
+                 read: dict[str, Any] | None = None) -> None:
         self._rows = rows or {}
         self._cos = None if cos_view is None else np.asarray(cos_view, float)
+        self._readers: dict[int, Any] = {}
+        self._read = {} if read is None else read
 
     maximum = staticmethod(np.maximum)
     minimum = staticmethod(np.minimum)
@@ -109,7 +115,15 @@ class NumpyAlgebra:
     def row(self, name: str) -> Any:
         if self._cos is None:
             raise ValueError(f"row {name!r} asked of an algebra without view angles")
-        return sample_row(self._rows[name], self._cos)
+        if name not in self._read:
+            row = np.asarray(self._rows[name], float)
+            size = row.shape[0]
+            if size not in self._readers:
+                self._readers[size] = row_reader(self._cos, size)
+            value = self._readers[size](row)
+            value.setflags(write=False)
+            self._read[name] = value
+        return self._read[name]
 
 
 @dataclass(frozen=True)

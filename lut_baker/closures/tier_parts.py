@@ -30,7 +30,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..numerics.geometry import polar_angle_deg
 from ..numerics.quadrature import trapezoid_weights
-from ..tables.slab_tables import SlabParts, SlabTables, slab_colour
+from ..tables.slab_tables import SlabParts, SlabSlice, SlabTables, slab_colour
 from ..tables.table_set import Tables
 from . import cycles as cc
 from .lobes import (
@@ -136,10 +136,13 @@ class FitTargets:
             raise ValueError("these tables hold the paper's film only")
         return self.slab
 
+    def slab_slice(self) -> SlabSlice:
+        """The slab's 1-D tables at the fit's thickness (made once)."""
+        return self._once("slice", lambda: self.slab_tables().sliced(self.thickness_um))
+
     def slab_parts(self, theta_deg: ArrayLike) -> SlabParts:
         """The slab's 1-D parts at the fit's thickness and polar angles ``theta_deg``."""
-        return self._once("slice", lambda: self.slab_tables().sliced(
-            self.thickness_um)).at(theta_deg)
+        return self.slab_slice().at(theta_deg)
 
     def gloss_weight(self) -> NDArray[np.float64]:
         """The weight of eq. 2's gloss lobe (the tables' ``film_gloss``) the tiers draw as the
@@ -153,9 +156,10 @@ class FitTargets:
         """The film body's directional albedo without its share of the gloss (what its Diffuse
         closure draws), ``(..., 3)`` at ``theta_deg``: the film's own albedo less the body's
         gloss lobe's (slab only)."""
-        parts = self.slab_parts(theta_deg)
+        found = self.slab_slice()
         lobe = self.tables.directional("film_gloss_albedo", theta_deg)
-        return np.maximum(parts.film_albedo - parts.body_gloss * lobe, 0.0)
+        return np.maximum(found.film_albedo_at(theta_deg) - found.tables.body_gloss * lobe,
+                          0.0)
 
     def film_body(self, wi: NDArray[np.float64], wo: NDArray[np.float64],
                   film_gloss: NDArray[np.float64] | None = None) -> NDArray[np.float64]:
@@ -165,7 +169,7 @@ class FitTargets:
         looked up."""
         def albedo(w: NDArray[np.float64]) -> NDArray[np.float64]:
             return self.body_albedo(polar_angle_deg(w))
-        body_gloss = self.slab_parts(0.0).body_gloss
+        body_gloss = self.slab_slice().tables.body_gloss
         gloss = (self.tables.surface_gloss("film_gloss", wi, wo) if film_gloss is None
                  else film_gloss)
         return (albedo(wi) * albedo(wo) / (np.pi * np.maximum(self.film_mean(), 1e-12))

@@ -98,13 +98,15 @@ class NumpyShaders(NumpyAlgebra):
     :class:`lut_baker.closures.cycles.DirectionPairs` shared by the lobes) times its colour,
     Diffuse and Subsurface closures Lambertian, a closure of colour 0 none (it is never
     allocated); a Principled BSDF Cycles' (:func:`lut_baker.closures.cycles.
-    principled_reflection`)."""
+    principled_reflection`).  ``read``: :class:`~lut_baker.closures.tier_formulas.
+    NumpyAlgebra`'s."""
 
     def __init__(self, wi: NDArray[np.float64], wo: NDArray[np.float64],
                  rows: dict[str, Any], lobes: dict[str, LobeFit],
                  glossy: Callable[[cc.DirectionPairs, LobeFit], NDArray[np.float64]],
-                 pairs: cc.DirectionPairs | None = None):
-        super().__init__(rows, wo[..., 2])
+                 pairs: cc.DirectionPairs | None = None,
+                 read: dict[str, Any] | None = None):
+        super().__init__(rows, wo[..., 2], read)
         self.wi, self.wo, self._lobes, self._glossy = wi, wo, lobes, glossy
         self._pairs = cc.DirectionPairs(wi, wo) if pairs is None else pairs
 
@@ -135,19 +137,22 @@ class NumpyShaders(NumpyAlgebra):
 def tier_replica(fit: ClosureFit, tables: Tables, name: str | Tier, coverage: float,
                  absorption: ArrayLike, gloss: float = 1.0,
                  directions: Directions | None = None, *,
-                 pairs: cc.DirectionPairs | None = None) -> NDArray[np.float64]:
+                 pairs: cc.DirectionPairs | None = None,
+                 read: dict[str, Any] | None = None) -> NDArray[np.float64]:
     """Tier ``name``'s (or a :class:`~lut_baker.closures.tier_registry.Tier`'s) BRDF
     ``(..., 3)`` at the angular nodes or at ``directions``
     ``(wi, wo)``: its shader (:attr:`~lut_baker.closures.tier_registry.Tier.shader`) at a
     coverage, absorption and Gloss evaluated by :class:`NumpyShaders`, its image's rows read
     as Blender reads them (linear between texel centres).  ``pairs``: the
     :class:`lut_baker.closures.cycles.DirectionPairs` of ``directions``, if made (their
-    cosines shared by the replicas there)."""
+    cosines shared by the replicas there); ``read``: this tier's rows already read at
+    ``directions``, by name, filled as they are read (shared by its replicas there at other
+    inputs)."""
     found = name if isinstance(name, Tier) else held(fit, name)
     wi, wo = tables.node_directions() if directions is None else directions
     image = found.image(fit)
     rows = {} if image is None else dict(zip(image.rows, image.texels, strict=True))
-    ops = NumpyShaders(wi, wo, rows, found.lobes(fit), found.glossy, pairs)
+    ops = NumpyShaders(wi, wo, rows, found.lobes(fit), found.glossy, pairs, read)
     value = np.asarray(found.shader(fit, _inputs(fit, coverage, absorption, gloss), ops, None))
     shape = np.broadcast_shapes(wi.shape, wo.shape)[:-1] + (3,)
     return value if value.shape == shape else np.broadcast_to(value, shape).copy()
@@ -157,18 +162,20 @@ def tier_reflection(fit: ClosureFit, tables: Tables, name: str, coverage: float,
                     absorption: ArrayLike, gloss: float = 1.0,
                     directions: Directions | None = None, *, over_shader: bool = False,
                     bare: NDArray[np.float64] | None = None,
-                    pairs: cc.DirectionPairs | None = None) -> NDArray[np.float64]:
+                    pairs: cc.DirectionPairs | None = None,
+                    read: dict[str, Any] | None = None) -> NDArray[np.float64]:
     """Tier ``name``'s BRDF ``(..., 3)`` (:func:`tier_replica`) at the angular nodes or at
     ``directions``.  ``over_shader``: the group goes over the artist's shader, which is the
     bare skin (the tables' bare skin stands for it, with the film as a slab on the fit's skin;
     the Gloss input leaves it alone): the tier's covered skin (its replica at coverage 1) and
     that bare skin (``bare``, if already computed at these directions), mixed by coverage as
-    areas.  ``pairs``: as :func:`tier_replica`'s."""
+    areas.  ``pairs``, ``read``: as :func:`tier_replica`'s."""
     if not over_shader:
         return tier_replica(fit, tables, name, coverage, absorption, gloss, directions,
-                            pairs=pairs)
+                            pairs=pairs, read=read)
     wi, wo = tables.node_directions() if directions is None else directions
-    covered = tier_replica(fit, tables, name, 1.0, absorption, gloss, (wi, wo), pairs=pairs)
+    covered = tier_replica(fit, tables, name, 1.0, absorption, gloss, (wi, wo), pairs=pairs,
+                           read=read)
     if bare is None:
         bare = (tables.made_up_reflection(wi, wo, 0.0, absorption) if fit.slab is None
                 else slab_bare(fit, tables, (wi, wo)))

@@ -7,7 +7,8 @@ float image that the node group reads at ``u = cos(theta_o)``: :data:`IMAGE_ROWS
 :func:`texel_pair` and :func:`read_row` read a row at ``u`` as Blender's Linear, EXTEND lookup
 does, written once over an algebra (two Closest lookups at neighbouring texel centres mixed
 linearly: numpy arrays in :func:`sample_row`, node sockets in the add-on's node group, where
-EEVEE's Linear lookup would mix rows through mipmaps).
+EEVEE's Linear lookup would mix rows through mipmaps); :func:`row_reader` reads many rows at
+the same ``u``, its texels found once.
 """
 
 from __future__ import annotations
@@ -19,7 +20,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 __all__ = ["IMAGE_ROWS", "EEVEE_IMAGE_ROWS", "DEFAULT_IMAGE_SIZE", "texel_centres", "texel_pair",
-           "read_row", "sample_row"]
+           "read_row", "sample_row", "row_reader"]
 
 IMAGE_ROWS = ("film_gloss", "path3_gloss", "skin_gloss", "film_transmittance",
             "film_gloss_diffuse")
@@ -80,9 +81,26 @@ def sample_row(row: ArrayLike, cos_view: ArrayLike) -> NDArray[np.float64]:
     [0.  0.5 1.5 3. ]
     """
     row = np.asarray(row, float)
-    size = row.shape[0]
+    return row_reader(cos_view, row.shape[0])(row)
 
-    def texel(u: NDArray[np.float64]) -> NDArray[np.float64]:
-        return row[np.clip(np.floor(u * size).astype(int), 0, size - 1)]
 
-    return np.asarray(read_row(np.asarray(cos_view, float), size, texel, _Numpy), float)
+def row_reader(cos_view: ArrayLike, size: int
+               ) -> Callable[[ArrayLike], NDArray[np.float64]]:
+    """:func:`sample_row` at ``u = cos_view`` for any row of ``size`` texels: the texels and
+    weights of :func:`texel_pair` found once, each row then read by two lookups and a mix (the
+    same operations as :func:`sample_row`: the same numbers).  ``ValueError`` for a row of
+    another size."""
+    def texel(u: NDArray[np.float64]) -> NDArray[np.intp]:
+        return np.clip(np.floor(u * size).astype(int), 0, size - 1)
+
+    u0, u1, t = texel_pair(np.asarray(cos_view, float), size, _Numpy)
+    first, second = texel(u0), texel(u1)
+
+    def read(row: ArrayLike) -> NDArray[np.float64]:
+        row = np.asarray(row, float)
+        if row.shape[0] != size:
+            raise ValueError(f"a row of {row.shape[0]} texels read as one of {size}")
+        return np.asarray(_Numpy.lerp(t, np.take(row, first, axis=0),
+                                      np.take(row, second, axis=0)), float)
+
+    return read

@@ -294,14 +294,20 @@ def ts_transmission_from_cosines(n_dot_h: Cosines, v_dot_h: Cosines, layer: Tran
 # Eqs. 2 and 4 at unit vectors
 # --------------------------------------------------------------------------------------------
 def ts_reflection(wi: ArrayLike, wo: ArrayLike, layer: ReflectionLayer, *,
-                  check: bool = True) -> NDArray[np.float64]:
+                  check: bool = True,
+                  cosines: tuple[NDArray[np.float64], ...] | None = None
+                  ) -> NDArray[np.float64]:
     """:func:`ts_reflection_from_cosines` at unit vectors ``wi``, ``wo`` ``(..., 3)`` (paper
     eq. 2); where either lies below the surface (z < 0) the value is 0.  ``check=False`` skips
-    the direction checks (inner loops that pass unit vectors)."""
-    if check:
-        wi = check_directions("wi", wi)
-        wo = check_directions("wo", wo)
-    n_dot_h, v_dot_h, n_dot_v, n_dot_l = reflection_cosines(wi, wo)
+    the direction checks (inner loops that pass unit vectors); ``cosines``: their
+    :func:`reflection_cosines`, if already computed (layers at the same directions share
+    them; unchecked)."""
+    if cosines is None:
+        if check:
+            wi = check_directions("wi", wi)
+            wo = check_directions("wo", wo)
+        cosines = reflection_cosines(wi, wo)
+    n_dot_h, v_dot_h, n_dot_v, n_dot_l = cosines
     value = ts_reflection_from_cosines(channel_axis(n_dot_h, layer), channel_axis(v_dot_h, layer),
                                        channel_axis(n_dot_v, layer), channel_axis(n_dot_l, layer),
                                        layer)

@@ -16,10 +16,14 @@ Functions
 - :func:`light_direction` -- a distant light at an angle from the view (world frame).
 - :func:`sphere_normals` -- the sphere's normals at the pixel centres, and the disk's mask.
 - :func:`tangent_frame`, :func:`local_directions` -- world directions in each normal's frame.
-- :func:`sphere_directions` -- the local ``wi``, ``wo`` of the lit pixels.
+- :func:`sphere_directions` -- the local ``wi``, ``wo`` of the lit pixels (the sphere's
+  frames made once per resolution, :func:`_sphere_frames`).
 """
 
 from __future__ import annotations
+
+from functools import lru_cache
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -103,10 +107,41 @@ def tangent_frame(normals: np.ndarray) -> tuple[NDArray[np.float64], NDArray[np.
 
 def local_directions(world: np.ndarray, normals: np.ndarray) -> np.ndarray:
     """World unit vectors ``(..., 3)`` in each normal's local frame (normal = +z)."""
-    tangent, bitangent = tangent_frame(normals)
+    return _in_frame(world, *tangent_frame(normals), normals)
+
+
+def _in_frame(world: np.ndarray, tangent: np.ndarray, bitangent: np.ndarray,
+              normals: np.ndarray) -> np.ndarray:
+    """World unit vectors ``(..., 3)`` in the frames ``(tangent, bitangent, normals)``,
+    renormalised."""
     local = np.stack([np.sum(world * tangent, -1), np.sum(world * bitangent, -1),
                       np.sum(world * normals, -1)], axis=-1)
     return local / np.linalg.norm(local, axis=-1, keepdims=True)
+
+
+class _SphereFrames(NamedTuple):
+    """The reference sphere's points inside its disk at one resolution, light aside: the
+    disk's ``mask`` (n, n), the ``normals`` there (P, 3, row-major), their
+    :func:`tangent_frame` and the view ``wo`` in each frame (all read-only)."""
+
+    mask: NDArray[np.bool_]
+    normals: NDArray[np.float64]
+    tangent: NDArray[np.float64]
+    bitangent: NDArray[np.float64]
+    wo: NDArray[np.float64]
+
+
+@lru_cache(maxsize=4)
+def _sphere_frames(resolution: int) -> _SphereFrames:
+    """:class:`_SphereFrames` at ``resolution`` (made once: every light shares them)."""
+    normals, mask = sphere_normals(resolution)
+    points = normals[mask]
+    tangent, bitangent = tangent_frame(points)
+    wo = _in_frame(np.broadcast_to(VIEW, points.shape), tangent, bitangent, points)
+    frames = _SphereFrames(mask, points, tangent, bitangent, wo)
+    for array in frames:
+        array.setflags(write=False)
+    return frames
 
 
 def sphere_directions(resolution: int, light_angle_deg: float
@@ -115,12 +150,11 @@ def sphere_directions(resolution: int, light_angle_deg: float
     distant light ``light_angle_deg`` (degrees) from the view: the pixels whose centre sees a
     lit point of the sphere, and at those points (row-major order) the local unit directions
     to the light and to the camera (normal = +z)."""
-    normals, mask = sphere_normals(resolution)
-    light = light_direction(light_angle_deg)
-    points = normals[mask]
-    wi = local_directions(np.broadcast_to(light, points.shape), points)
-    wo = local_directions(np.broadcast_to(VIEW, points.shape), points)
-    seen = (wi[:, 2] > 0.0) & (wo[:, 2] > 0.0)
-    lit = np.zeros_like(mask)
-    lit[mask] = seen
-    return lit, wi[seen], wo[seen]
+    frames = _sphere_frames(int(resolution))
+    points = frames.normals
+    wi = _in_frame(np.broadcast_to(light_direction(light_angle_deg), points.shape),
+                   frames.tangent, frames.bitangent, points)
+    seen = (wi[:, 2] > 0.0) & (frames.wo[:, 2] > 0.0)
+    lit = np.zeros_like(frames.mask)
+    lit[frames.mask] = seen
+    return lit, wi[seen], frames.wo[seen]

@@ -60,6 +60,7 @@ Functions and types
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import NamedTuple
 
@@ -67,6 +68,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..model.albedo import bihemispherical
+from ..model.microfacet import reflection_cosines
 from ..numerics.geometry import polar_angle_deg
 from .table_set import (
     THETA_OFFSET,
@@ -151,6 +153,17 @@ def thickness_support(thickness_um: float, n: int = THICKNESS_NODES,
     return np.array([low, low + 1], np.intp), t
 
 
+def _all_close(h: NDArray[np.float64], baked_um: float) -> bool:
+    """Whether every thickness ``h`` is ``baked_um`` within :data:`ONE_THICKNESS_RTOL`
+    (``np.isclose``'s test, a single thickness without numpy's array machinery)."""
+    if h.ndim:
+        return bool(np.all(np.isclose(h, baked_um, rtol=ONE_THICKNESS_RTOL, atol=0.0)))
+    x = float(h)
+    if math.isfinite(x) and math.isfinite(baked_um):
+        return abs(x - baked_um) <= ONE_THICKNESS_RTOL * abs(baked_um)
+    return x == baked_um
+
+
 def at_support(rows: NDArray[np.float64], t: float) -> NDArray[np.float64]:
     """A table at one thickness from its rows at :func:`thickness_support`'s nodes
     (``(1 or 2, ...)``): the interpolation :class:`SlabTables`' lookups make (the same
@@ -179,7 +192,7 @@ class SlabParts(NamedTuple):
 class SlabSlice(NamedTuple):
     """The 1-D tables of ``slab`` at one thickness (:meth:`SlabTables.sliced`): ``tables``,
     :class:`SlabParts` on the slab's own angular grid; :meth:`at` reads them at polar
-    angles."""
+    angles, :meth:`film_albedo_at` the film's own albedo alone."""
 
     slab: SlabTables
     thickness_um: float
@@ -194,6 +207,10 @@ class SlabSlice(NamedTuple):
                          through_mean=tables.through_mean, below=tables.below,
                          film_albedo=_linear(tables.film_albedo, x),
                          body_gloss=tables.body_gloss)
+
+    def film_albedo_at(self, theta_deg: ArrayLike) -> NDArray[np.float64]:
+        """:meth:`at`'s ``film_albedo`` alone (the other parts not read), ``(..., 3)``."""
+        return _linear(self.tables.film_albedo, self.slab.theta_index(theta_deg))
 
 
 @dataclass(frozen=True, eq=False)
@@ -254,8 +271,7 @@ class SlabTables:
         raise ValueError at any other."""
         if self.one_thickness:
             h = np.asarray(thickness_um, float)
-            if not np.all(np.isclose(h, self.thickness_um[0], rtol=ONE_THICKNESS_RTOL,
-                                     atol=0.0)):
+            if not _all_close(h, float(self.thickness_um[0])):
                 raise ValueError(f"these slab tables hold the film at "
                                  f"{float(self.thickness_um[0])} um only: another thickness "
                                  f"needs the axis's (bake_slab without only_um)")
@@ -300,9 +316,16 @@ class SlabTables:
     def top_at(self, thickness_um: float, wi: ArrayLike, wo: ArrayLike) -> NDArray[np.float64]:
         """``top`` (1/sr, ``(..., 3)``) at one thickness and unit directions ``(..., 3)``."""
         to_light, to_view = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
-        return _trilinear(self._along(self.top, thickness_um),
-                          self.theta_index(polar_angle_deg(to_light)),
-                          self.theta_index(polar_angle_deg(to_view)),
+        return self._top(thickness_um, to_light, to_view,
+                         self.theta_index(polar_angle_deg(to_light)),
+                         self.theta_index(polar_angle_deg(to_view)))
+
+    def _top(self, thickness_um: float, to_light: NDArray[np.float64],
+             to_view: NDArray[np.float64], x_light: NDArray[np.float64],
+             x_view: NDArray[np.float64]) -> NDArray[np.float64]:
+        """:meth:`top_at` at broadcast directions whose :meth:`theta_index` of their polar
+        angles are ``x_light``, ``x_view``."""
+        return _trilinear(self._along(self.top, thickness_um), x_light, x_view,
                           phi_index(to_light, to_view, self.phi_deg.size, self.phi_spacing))
 
 
@@ -393,11 +416,18 @@ def slab_lookup(tables: Tables, wi: ArrayLike, wo: ArrayLike,
     slab = _slab(tables)
     h = _thickness(tables, thickness_um)
     to_light, to_view = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
-    return SlabLookup(film_gloss=tables.surface_gloss("film_gloss", to_light, to_view),
-                      top=slab.top_at(h, to_light, to_view),
-                      skin_gloss=tables.surface_gloss("skin_gloss", to_light, to_view),
-                      through_i=slab.through_at(h, to_light),
-                      through_o=slab.through_at(h, to_view),
+    # what the lookups share: the surfaces' cosines, the polar angles' indices, t at h
+    cosines = reflection_cosines(to_light, to_view)
+    x_light = slab.theta_index(polar_angle_deg(to_light))
+    x_view = slab.theta_index(polar_angle_deg(to_view))
+    through = slab._along(slab.through, h)
+    return SlabLookup(film_gloss=tables.surface_gloss("film_gloss", to_light, to_view,
+                                                      cosines=cosines),
+                      top=slab._top(h, to_light, to_view, x_light, x_view),
+                      skin_gloss=tables.surface_gloss("skin_gloss", to_light, to_view,
+                                                      cosines=cosines),
+                      through_i=_linear(through, x_light),
+                      through_o=_linear(through, x_view),
                       upper=(to_light[..., 2] >= 0.0) & (to_view[..., 2] >= 0.0),
                       thickness_um=h)
 

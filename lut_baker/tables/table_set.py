@@ -71,6 +71,7 @@ Contents
 from __future__ import annotations
 
 from dataclasses import dataclass, field, fields
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
@@ -368,15 +369,19 @@ class Tables:
             raise ValueError(f"tables need the {SURFACE_GLOSS[name]!r} layer in their "
                              f"parameters for {name!r} (eq. 2 in closed form)")
         try:
-            return ReflectionLayer(**{**layer, "P_d": 0.0})
+            return _specular_layer(tuple(sorted(layer.items())))
         except TypeError as error:
             raise ValueError(f"tables' {SURFACE_GLOSS[name]!r} parameters: {error}") from None
 
     def surface_gloss(self, name: str, wi: NDArray[np.float64],
-                      wo: NDArray[np.float64]) -> NDArray[np.float64]:
+                      wo: NDArray[np.float64], *,
+                      cosines: tuple[NDArray[np.float64], ...] | None = None
+                      ) -> NDArray[np.float64]:
         """Surface gloss ``name`` (:data:`SURFACE_GLOSS`, 1/sr) at unit directions ``(..., 3)``
-        in closed form (eq. 2's specular term), ``(..., 3)``; 0 below the surface."""
-        value = ts_reflection(wi, wo, self.surface_layer(name), check=False)
+        in closed form (eq. 2's specular term), ``(..., 3)``; 0 below the surface.
+        ``cosines``: :func:`lut_baker.model.microfacet.reflection_cosines` of the directions,
+        if already computed (the surfaces share them)."""
+        value = ts_reflection(wi, wo, self.surface_layer(name), check=False, cosines=cosines)
         value = value if np.ndim(value) == np.ndim(wi) else value[..., None]
         return np.broadcast_to(value, value.shape[:-1] + (3,))
 
@@ -537,3 +542,23 @@ class Tables:
                           * self.film_transmittance_integral),
             skin_gloss=self.directional("skin_gloss_albedo", theta_deg),
             skin=np.pi * self.skin_diffuse))
+
+
+def _specular_layer(items: tuple[tuple[str, Any], ...]) -> ReflectionLayer:
+    """A reflection layer of parameters ``items`` with ``P_d = 0`` (eq. 2's specular term);
+    made once per parameter set when they are plain numbers (:func:`_cached_specular_layer`),
+    checked each time otherwise."""
+    try:
+        hash(items)
+    except TypeError:
+        return ReflectionLayer(**{**dict(items), "P_d": 0.0})
+    return _cached_specular_layer(items)
+
+
+@lru_cache(maxsize=16)
+def _cached_specular_layer(items: tuple[tuple[str, Any], ...]) -> ReflectionLayer:
+    """:func:`_specular_layer` made once (its arrays read-only: shared by every lookup)."""
+    layer = ReflectionLayer(**{**dict(items), "P_d": 0.0})
+    for value in (layer.P_d, layer.P_s, layer.n, layer.eta):
+        value.setflags(write=False)
+    return layer

@@ -177,3 +177,29 @@ def test_a_previews_slab_at_one_thickness_is_kept_apart(bpy_factory, monkeypatch
     tables, moved = bakes.baked(other, tiers=("PRINCIPLED",), one_thickness=True)
     assert not tables.slab.one_thickness and moved.slab.thickness_um == 30.0
     bakes.clear()
+
+
+def test_a_preview_measures_the_auto_tiers_spheres_smaller(record, monkeypatch):
+    """At preview resolution the Auto tier's spheres are PREVIEW_SPHERE_PX across, at any
+    other the traits' own size: the shares and gloss omissions within 2% of each other (the
+    preview's are refined later at the settings' resolution), the tiers' errors the same."""
+    from lut_baker import auto_tier
+    from makeup_skin_addon import bakes
+
+    sizes = []
+    original = auto_tier.traits_from_tables
+    monkeypatch.setattr(auto_tier, "traits_from_tables",
+                        lambda *a, **k: (sizes.append(k["sphere_px"]), original(*a, **k))[1])
+    tables, fit = bakes.baked(record)
+    preview = bakes.measure(tables, fit, 0.6, (0.1, 0.2, 0.3), resolution="preview")
+    full = bakes.measure(tables, fit, 0.6, (0.1, 0.2, 0.3), resolution="default")
+    assert sizes == [bakes.PREVIEW_SPHERE_PX, auto_tier.SPHERE_PX]
+    assert bakes.PREVIEW_SPHERE_PX < auto_tier.SPHERE_PX
+    assert preview["errors"] == full["errors"]
+    small, large = preview["traits"], full["traits"]
+    for name in ("gloss_share", "skin_share"):
+        for light, value in large[name].items():
+            assert small[name][light] == pytest.approx(value, rel=0.02), (name, light)
+    for tier, by_light in large["gloss_omission"].items():
+        for light, value in by_light.items():
+            assert small["gloss_omission"][tier][light] == pytest.approx(value, rel=0.02)

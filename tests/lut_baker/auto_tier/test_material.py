@@ -62,6 +62,16 @@ def test_gloss_omission_is_the_tiers_gloss(paper_tables, paper_fit, matte):
         assert traits.gloss_error(tier, 45.0) == traits.gloss_omission[tier][45.0]
 
 
+def test_traits_measure_each_sphere_once(paper_tables, paper_fit):
+    """The traits' gloss omissions, measured with the shares on each sphere in one pass, are
+    gloss_omissions' (the same spheres and replicas: the same numbers, bit for bit)."""
+    traits = auto_tier.traits_from_tables(paper_tables, paper_fit, 0.6, 0.2)
+    assert traits.gloss_omission == auto_tier.gloss_omissions(paper_tables, paper_fit, 0.6, 0.2)
+    assert list(traits.gloss_omission) == list(paper_fit.tiers)
+    assert all(list(by_light) == list(auto_tier.SHARE_LIGHTS_DEG)
+               for by_light in traits.gloss_omission.values())
+
+
 def test_traits_of_a_fit_of_some_tiers(paper_tables, paper_fit):
     """The traits hold the tiers the fit holds (the Auto tier asks only for the engine's),
     those tiers' values as a full fit gives them; over the artist's shader the subsurface

@@ -26,6 +26,23 @@ def test_lobe_albedo_matches_brute_quadrature(distribution, roughness):
     assert np.all(fast <= 1.0 + 1e-9)
 
 
+def test_albedo_nodes_are_shared_and_left_alone(monkeypatch):
+    """The albedo's quadrature nodes are made once per resolution and read-only, so every
+    call, chunk and roughness reads the same nodes: a view's albedo is the same to the last bit
+    alone, among others, in chunks of any size, and before and after other roughnesses
+    (numpy's reductions over a view's own nodes: the same operations)."""
+    first = cc._albedo_nodes(48, 32)
+    assert first is cc._albedo_nodes(48, 32)
+    assert not any(array.flags.writeable for array in first[1:])
+    mu = np.linspace(0.05, 1.0, 20)
+    alone = np.array([cc.microfacet_albedo(m, 0.3) for m in mu])
+    together = cc.microfacet_albedo(mu, 0.3)
+    cc.microfacet_albedo(mu, 0.7, lambda c: cc.dielectric_fresnel(c, 1.4))
+    monkeypatch.setattr(cc, "ALBEDO_CHUNK", 3 * 48 * 32)
+    np.testing.assert_array_equal(cc.microfacet_albedo(mu, 0.3), together)
+    np.testing.assert_array_equal(alone, together)
+
+
 def test_ggx_distribution_is_normalised():
     # Int D(h) cos(theta_h) dw_h = 1 for any alpha.
     theta = np.linspace(0.0, np.pi / 2, 200001)

@@ -101,6 +101,24 @@ def test_replicas_take_any_directions(paper_tables, paper_fit):
         np.testing.assert_allclose(poisoned[0, 1:], batch[0, 1:], rtol=1e-12, err_msg=tier)
 
 
+def test_replicas_share_the_rows_they_read(paper_tables, paper_fit):
+    """A tier's replicas at the same directions and other inputs may share the rows read
+    there (``read``): filled by the first, read-only, and every replica the same as alone
+    (the same arrays: bit for bit)."""
+    wi = direction(np.radians(np.linspace(0.0, 80.0, 12)), 0.5)
+    wo = direction(np.radians(np.linspace(70.0, 5.0, 12)), 0.0)
+    for tier in tiers.TIERS:
+        read: dict = {}
+        for gloss, coverage in ((1.0, 1.0), (0.0, 1.0), (0.5, 0.3)):
+            alone = tiers.tier_replica(paper_fit, paper_tables, tier, coverage, 0.2, gloss,
+                                       (wi, wo))
+            shared = tiers.tier_replica(paper_fit, paper_tables, tier, coverage, 0.2, gloss,
+                                        (wi, wo), read=read)
+            np.testing.assert_array_equal(shared, alone, err_msg=tier)
+        assert all(not row.flags.writeable for row in read.values()), tier
+        assert read or tier != "LAYERED"  # the Layered tier reads its view-angle image
+
+
 def test_over_the_artists_shader_the_bare_skin_is_the_tables(paper_tables, paper_fit):
     """Over the artist's shader a tier's BRDF is its covered skin mixed by coverage with the
     tables' bare skin (the artist's shader stands there): at coverage 0 it is that bare skin,

@@ -27,3 +27,21 @@ def test_sphere_framing():
     np.testing.assert_allclose(wi[:, 2], normals[lit] @ geometry.light_direction(45.0),
                                rtol=1e-12)
     assert np.all(wi[:, 2] > 0.0) and np.all(wo[:, 2] > 0.0)
+
+
+def test_sphere_frames_shared_by_lights():
+    """Every light at one resolution shares the sphere's frames (made once): the directions
+    are those of local_directions at the lit normals (the same operations: equal to the last
+    bit), and a caller's arrays are its own (writing them leaves the next call alone)."""
+    normals, mask = geometry.sphere_normals(20)
+    for light_deg in (0.0, 45.0, 89.0, 120.0):
+        lit, wi, wo = geometry.sphere_directions(20, light_deg)
+        points = normals[lit]
+        light = np.broadcast_to(geometry.light_direction(light_deg), points.shape)
+        # bit for bit: the same numpy operations on the same inputs
+        np.testing.assert_array_equal(wi, geometry.local_directions(light, points))
+        np.testing.assert_array_equal(
+            wo, geometry.local_directions(np.broadcast_to(geometry.VIEW, points.shape), points))
+        lit[...], wi[...], wo[...] = False, 0.0, 0.0
+        again = geometry.sphere_directions(20, light_deg)
+        assert np.any(again[0]) and np.all(again[2][:, 2] > 0.0)

@@ -10,6 +10,7 @@ from lut_baker.model import film_slab as FS
 from lut_baker.model import presets
 from lut_baker.model import slab_skin as SS
 from lut_baker.numerics import adding_doubling as AD
+from lut_baker.numerics.geometry import direction
 from lut_baker.numerics.quadrature import hemisphere_panels
 from lut_baker.tables import slab_tables as ST
 
@@ -69,6 +70,45 @@ def test_the_tables_at_one_thickness_are_the_axiss_there(skin, preview_axis, um)
         np.testing.assert_allclose(got, expected, rtol=1e-12, atol=0.0)
     with pytest.raises(ValueError, match="only"):
         one.sliced(2.0 * um if np.isfinite(um) else 300.0)
+
+
+def test_one_thickness_is_checked_as_isclose_does():
+    """Tables at one thickness accept a thickness as ``np.isclose`` at ONE_THICKNESS_RTOL
+    decides (a single thickness checked without numpy's array machinery: the same decision,
+    infinities and NaN included)."""
+    rng = np.random.default_rng(4)
+    for baked in (9.6, 0.7, 300.0, np.inf):
+        near = baked * (1.0 + rng.uniform(-3e-12, 3e-12, 50))
+        for h in [*near, baked, np.nextafter(baked, 0.0), np.inf, -np.inf, np.nan, 0.0]:
+            expected = bool(np.isclose(h, baked, rtol=ST.ONE_THICKNESS_RTOL, atol=0.0))
+            assert ST._all_close(np.asarray(h, float), float(baked)) == expected, (baked, h)
+        assert ST._all_close(np.array([baked, baked]), float(baked))
+
+
+def test_the_films_albedo_alone_is_the_slices(preview_axis):
+    """SlabSlice.film_albedo_at reads the film's albedo alone as at() reads it (the same
+    interpolation: the same numbers, bit for bit), on and between the grid's angles."""
+    theta = np.concatenate([preview_axis.theta_deg, np.linspace(0.0, 90.0, 37), [12.5]])
+    for um in (0.7, 9.6, 300.0):
+        found = preview_axis.sliced(um)
+        np.testing.assert_array_equal(found.film_albedo_at(theta), found.at(theta).film_albedo)
+        np.testing.assert_array_equal(found.film_albedo_at(33.0), found.at(33.0).film_albedo)
+
+
+def test_the_lookups_share_their_angles(tables):
+    """slab_lookup computes what its lookups share once (the surfaces' cosines, the polar
+    angles' indices): each the same as looked up alone (the same operations: bit for bit)."""
+    rng = np.random.default_rng(2)
+    wi = direction(np.radians(rng.uniform(0.0, 90.0, 50)), rng.uniform(0.0, 6.0, 50))
+    wo = direction(np.radians(rng.uniform(0.0, 90.0, 50)), rng.uniform(0.0, 6.0, 50))
+    slab, um = tables.slab, 20.0
+    found = ST.slab_lookup(tables, wi, wo, um)
+    np.testing.assert_array_equal(found.top, slab.top_at(um, wi, wo))
+    np.testing.assert_array_equal(found.through_i, slab.through_at(um, wi))
+    np.testing.assert_array_equal(found.through_o, slab.through_at(um, wo))
+    for name in ("film_gloss", "skin_gloss"):
+        np.testing.assert_array_equal(getattr(found, name),
+                                      tables.surface_gloss(name, wi, wo))
 
 
 def test_a_bake_at_one_thickness_is_the_bake_there(skin, tables):

@@ -105,3 +105,23 @@ def test_lookups_are_reciprocal(default_tables):
     wo = direction(np.radians(rng.uniform(0, 89, 50)), rng.uniform(0, 2 * np.pi, 50))
     np.testing.assert_allclose(default_tables.made_up_reflection(wi, wo),
                                default_tables.made_up_reflection(wo, wi), rtol=1e-12)
+
+
+def test_a_surface_layer_is_made_once_per_parameter_set(default_tables):
+    """The surface gloss's layer (eq. 2's specular term) is made once for a set of plain
+    parameters and shared, its arrays read-only; other parameters give their own layer, and
+    unreadable ones are refused each time (the tables check their layers when made)."""
+    layer = default_tables.surface_layer("film_gloss")
+    assert layer is default_tables.surface_layer("film_gloss") and float(layer.P_d) == 0.0
+    assert not layer.P_s.flags.writeable
+    film = default_tables.parameters["film"]
+    other = replace(default_tables, parameters={**default_tables.parameters,
+                                                "film": {**film, "n": 2.0 * film["n"]}})
+    assert float(other.surface_layer("film_gloss").n) == 2.0 * film["n"]
+    rgb = replace(default_tables, parameters={**default_tables.parameters,
+                                              "film": {**film, "P_s": [1.0, 2.0, 3.0]}})
+    assert rgb.surface_layer("film_gloss").P_s.tolist() == [1.0, 2.0, 3.0]
+    for _ in range(2):  # not cached: refused each time
+        with pytest.raises(ValueError, match="parameters"):
+            replace(default_tables, parameters={**default_tables.parameters,
+                                                "film": {**film, "colour": 1.0}})
