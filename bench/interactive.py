@@ -30,8 +30,9 @@ Each first Apply is measured two ways, each in its own process: ``full``, what a
 event loop) gets, everything at the settings' resolution (default) before Apply returns; and
 ``preview``, what the Apply button does in Blender (``apply_to_object(...,
 preview_first=True)`` then ``live.refine``): the bake and fit at preview resolution, then the
-settings' resolution on a worker thread.  For ``preview``: Apply's CPU (``time.process_time``:
-every thread) and wall seconds, and the refine's: the worker's wall and CPU seconds (process
+settings' resolution on a worker thread.  For each: Apply's CPU (``time.process_time``:
+every thread), its main thread's (``time.thread_time``) and wall seconds; for ``preview`` also
+the refine's: the worker's wall and CPU seconds (process
 CPU minus the main thread's, ``time.thread_time``) and every main-thread step (``start``:
 setting the worker off; ``poll``: each look at it, every ``checkout.POLL_S`` s as the poll timer
 does; ``swap``: the look that builds the group and installs it), the longest being the worst
@@ -49,7 +50,10 @@ CPU and wall.  A checkout without the worker thread blocks for the whole rebuild
 Every figure also times 3 (``x3``): a machine three times slower.  The measured processes run
 with one BLAS thread (``--blas-threads``): numpy's OpenBLAS threads spin between the bake's
 matrix products, and ``time.process_time`` counts that spinning as CPU (on an idle core up to
-twice the computation; the wall time hardly moves).  Run with the venv's python of the Blender
+twice the computation; the wall time hardly moves).  Blender's own task threads do the same
+around its node-tree updates (each node and link the group's build adds: ``sched_yield`` in
+``perf``), which no setting of an add-on's reaches: the main thread's CPU is printed beside the
+process's.  Run with the venv's python of the Blender
 line to measure (``$(tools/venv.sh)/bin/python``); the machine's load is recorded at the start
 and the end.
 """
@@ -165,14 +169,15 @@ def first_apply(bpy, support, case: str, mode: str) -> dict:
             return {**out, "unavailable": "no worker thread in this checkout"}
         with Clock() as clock:
             material, report = apply_to_object(bpy.context, obj, preview_first=True)
-        out.update(apply_cpu_s=clock.cpu, apply_wall_s=clock.wall, refined=report.refine)
+        out.update(apply_cpu_s=clock.cpu, apply_wall_s=clock.wall, apply_main_s=clock.main,
+                   refined=report.refine)
         if report.refine is not None:
             out["refine"] = swapped_in(bpy, live, material.name, lambda: live.refine(
                 bpy.context, material, report.refine))
     else:
         with Clock() as clock:
             material, _ = apply_to_object(bpy.context, obj)
-        out.update(apply_cpu_s=clock.cpu, apply_wall_s=clock.wall)
+        out.update(apply_cpu_s=clock.cpu, apply_wall_s=clock.wall, apply_main_s=clock.main)
     meta = json.loads(group_of(material).node_tree["makeup_skin_fit"])
     out.update(tier=meta["tier"], resolution=meta["resolution"],
                fitted=sorted(json.loads(material["makeup_skin_errors"])))
@@ -279,7 +284,9 @@ def _apply_line(row: dict) -> str:
     tail = "" if refine is None else (
         f"  refine: worker {refine['worker_cpu_s']:.3f} s CPU / {refine['worker_wall_s']:.3f} s"
         f", worst block {_x3(refine['worst_block_s'])} (swap {refine['swap_s']:.3f})")
-    return (f"{row['case']:<28} {row['mode']:<7} Apply CPU {_x3(row['apply_cpu_s'])} "
+    main = row.get("apply_main_s")
+    main_part = "" if main is None else f" (main thread {main:.3f})"
+    return (f"{row['case']:<28} {row['mode']:<7} Apply CPU {_x3(row['apply_cpu_s'])}{main_part} "
             f"wall {_x3(row['apply_wall_s'])}  {row['tier']} at {row['resolution']}" + tail)
 
 
@@ -299,6 +306,12 @@ def print_report(results: dict) -> None:
             print(f"  {mode}: Apply CPU {min(cpu):.3f}-{max(cpu):.3f} s (median "
                   f"{statistics.median(cpu):.3f}); {over} of {len(cpu)} over "
                   f"{APPLY_GOAL_CPU_S} s")
+            main = [row["apply_main_s"] for row in results["cases"]
+                    if row["mode"] == mode and "apply_main_s" in row]
+            if main:
+                print(f"  {mode}: of it the main thread {min(main):.3f}-{max(main):.3f} s "
+                      f"(median {statistics.median(main):.3f}; the rest Blender's own worker "
+                      f"threads)")
     blocks = [row["refine"]["worst_block_s"] for row in results["cases"] if row.get("refine")]
     if blocks:
         print(f"  refine: worst main-thread block {_x3(max(blocks))}")
