@@ -20,8 +20,8 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
-from functools import lru_cache
-from typing import TypedDict
+from functools import lru_cache, partial
+from typing import TypedDict, TypeVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -32,6 +32,8 @@ from . import eevee
 from .tier_formulas import SPECULAR_IOR
 from .view_grid import ViewGrid
 from .view_image import DEFAULT_IMAGE_SIZE, sample_row, texel_centres
+
+_T = TypeVar("_T")
 
 __all__ = ["LobeFit", "fit_coat", "fit_specular", "fit_glossy", "ROUGHNESS_RANGE",
            "FIT_XTOL", "DISTRIBUTION_MARGIN", "COAT_IOR_RANGE", "SPECULAR_LEVEL_RANGE",
@@ -108,13 +110,13 @@ LobeTimes = Callable[[float], Callable[[float], NDArray[np.float64]]]
 """``lobe_times(roughness)(second)``: the factor per pair a GGX lobe is multiplied by."""
 
 
-def _per_value(compute: Callable[[float], NDArray[np.float64]]
-               ) -> Callable[[float], NDArray[np.float64]]:
+def _per_value(compute: Callable[[float], _T]) -> Callable[[float], _T]:
     """``compute`` remembered by its argument: the scan of :func:`_fit_roughness_and` asks for
-    the same :data:`SECOND_SCAN` values of the second parameter at every roughness."""
-    found: dict[float, NDArray[np.float64]] = {}
+    the same :data:`SECOND_SCAN` values of the second parameter at every roughness, a preview's
+    search (:func:`_searched_distributions`) the samples its scan had."""
+    found: dict[float, _T] = {}
 
-    def once(value: float) -> NDArray[np.float64]:
+    def once(value: float) -> _T:
         value = float(value)
         if value not in found:
             found[value] = compute(value)
@@ -231,6 +233,9 @@ energy compensation's mean albedo from them, :func:`_search_average_albedo`); th
 weights use :data:`FINAL_QUADRATURE` (within 0.1%) at every texel (while searching, the
 grid's own integral: :func:`_search_glossy_albedo`)."""
 FINAL_QUADRATURE: AlbedoQuadrature = {"n_u": 96, "n_phi": 64}
+PREVIEW_QUADRATURE: AlbedoQuadrature = {"n_u": 48, "n_phi": 32}
+"""The Glossy weights' closure albedo in a preview's fit (:func:`fit_glossy`'s ``preview``):
+within 0.5% of :data:`FINAL_QUADRATURE`, a quarter of its cost."""
 
 
 def _texel_albedo(albedo_table: np.ndarray, theta_deg: np.ndarray,
@@ -275,16 +280,17 @@ def glossy_lobe(grid: ViewGrid, roughness: float, closure: str) -> np.ndarray:
 
 
 def glossy_albedo(cos_view: ArrayLike, roughness: float, closure: str, *,
-                  final: bool = True) -> NDArray[np.float64]:
+                  final: bool = True, preview: bool = False) -> NDArray[np.float64]:
     """The albedo of :func:`glossy_lobe`'s closure at view cosines: by quadrature over
-    normals for Cycles' (:data:`FINAL_QUADRATURE`, or :data:`SEARCH_QUADRATURE` while
-    searching), in closed form for EEVEE's."""
+    normals for Cycles' (:data:`FINAL_QUADRATURE`, :data:`PREVIEW_QUADRATURE` for a
+    ``preview``, or :data:`SEARCH_QUADRATURE` while searching), in closed form for EEVEE's."""
     if closure == EEVEE_GLOSSY:
         return eevee.glossy_albedo(cos_view, roughness)
     if not final:
         views = np.ascontiguousarray(cos_view, float)
         return _search_albedo(views.tobytes(), views.shape, float(roughness), closure)
-    return cc.microfacet_albedo(cos_view, roughness, distribution=closure, **FINAL_QUADRATURE)
+    return cc.microfacet_albedo(cos_view, roughness, distribution=closure,
+                                **(PREVIEW_QUADRATURE if preview else FINAL_QUADRATURE))
 
 
 SEARCH_ALBEDOS = 256
@@ -316,9 +322,47 @@ def _search_glossy_albedo(grid: ViewGrid, lobe: NDArray[np.float64], roughness: 
     return grid.view_albedo(lobe)
 
 
+def _chosen_distribution(errors: dict[str, float], closures: tuple[str, ...]) -> str:
+    """The closure of lowest error, unless it beats the first of ``closures`` (GGX) by no
+    more than :data:`DISTRIBUTION_MARGIN` (relative): then the first."""
+    distribution = min(errors, key=lambda d: errors[d])
+    if errors[distribution] >= (1.0 - DISTRIBUTION_MARGIN) * errors[closures[0]]:
+        distribution = closures[0]
+    return distribution
+
+
+def _scanned_error(error_of: Callable[[float], float]) -> float:
+    """The lowest of ``error_of`` over :func:`_minimise_roughness`'s scan (its first
+    :data:`ROUGHNESS_SCAN` samples)."""
+    low, high = np.log(ROUGHNESS_RANGE)
+    return min(float(error_of(float(np.exp(x)))) for x in np.linspace(low, high, ROUGHNESS_SCAN))
+
+
+def _searched_distributions(error_of: Callable[[str, float], float],
+                            closures: tuple[str, ...], preview: bool
+                            ) -> tuple[str, float, dict[str, float]]:
+    """``(distribution, roughness, errors by closure)`` of :func:`fit_glossy`'s search:
+    ``error_of(closure, roughness)`` minimised in roughness for each closure, the
+    distribution chosen by :func:`_chosen_distribution`.  A ``preview`` chooses on the scans
+    (:func:`_scanned_error`) and searches the chosen closure alone (the others' errors are
+    their scans')."""
+    if not preview:
+        searched = {d: _minimise_roughness(partial(error_of, d)) for d in closures}
+        distribution = _chosen_distribution({d: found[1] for d, found in searched.items()},
+                                            closures)
+        return (distribution, searched[distribution][0],
+                {d: found[1] for d, found in searched.items()})
+    functions = {d: _per_value(partial(error_of, d)) for d in closures}
+    errors = {d: _scanned_error(functions[d]) for d in closures}
+    distribution = _chosen_distribution(errors, closures)
+    roughness, errors[distribution] = _minimise_roughness(functions[distribution])
+    return distribution, roughness, errors
+
+
 def fit_glossy(grid: ViewGrid, target: ArrayLike, albedo_table: np.ndarray,
                theta_deg: np.ndarray, size: int = DEFAULT_IMAGE_SIZE, *, companion: bool = False,
-               closures: tuple[str, ...] = cc.GLOSSY_DISTRIBUTIONS) -> LobeFit:
+               closures: tuple[str, ...] = cc.GLOSSY_DISTRIBUTIONS,
+               preview: bool = False) -> LobeFit:
     """Distribution (:data:`lut_baker.closures.cycles.GLOSSY_DISTRIBUTIONS`) and roughness of a
     Glossy BSDF whose view-dependent weight (table albedo / closure albedo, read from a
     ``size``-texel image by ``cos(theta_o)``) best reproduces ``target`` ``(V, A, P[, 3])``;
@@ -334,7 +378,12 @@ def fit_glossy(grid: ViewGrid, target: ArrayLike, albedo_table: np.ndarray,
     distributions (default), or ``(EEVEE_GLOSSY,)`` for the EEVEE tier.  The first of them
     (GGX) is chosen unless another one's error is lower by more than
     :data:`DISTRIBUTION_MARGIN` (relative): a near tie never flips the choice.  The fit's
-    ``distribution`` is the Glossy node's (``GGX`` for EEVEE's closure)."""
+    ``distribution`` is the Glossy node's (``GGX`` for EEVEE's closure).
+
+    ``preview``: a preview's fit, which a refined one soon replaces: the distribution is
+    chosen on the searches' scans and only its roughness searched
+    (:func:`_searched_distributions`), the weights' closure albedo by
+    :data:`PREVIEW_QUADRATURE`."""
     values = np.asarray(target, float)
     values = values if values.ndim == 4 else values[..., None]
     values = values * np.ones(3)
@@ -358,7 +407,7 @@ def fit_glossy(grid: ViewGrid, target: ArrayLike, albedo_table: np.ndarray,
         own integral of the lobe (:func:`_search_glossy_albedo`); the final ones at the
         image's texels, sampled as Blender samples them."""
         shape = glossy_lobe(grid, roughness, distribution)
-        closure = (glossy_albedo(texels, roughness, distribution) if final
+        closure = (glossy_albedo(texels, roughness, distribution, preview=preview) if final
                    else _search_glossy_albedo(grid, shape, roughness, distribution))
         table = tables[final]
         glossy = table / np.maximum(closure, 1e-6)[:, None]
@@ -376,19 +425,13 @@ def fit_glossy(grid: ViewGrid, target: ArrayLike, albedo_table: np.ndarray,
             value = value + rows(diffuse) / np.pi
         return glossy, diffuse, value
 
-    def search(distribution: str) -> tuple[float, float]:
-        return _minimise_roughness(lambda r: error_of(weights(r, distribution, False)[2]))
-
-    searched = {distribution: search(distribution) for distribution in closures}
-    distribution = min(searched, key=lambda d: searched[d][1])
-    if searched[distribution][1] >= (1.0 - DISTRIBUTION_MARGIN) * searched[closures[0]][1]:
-        distribution = closures[0]
-    roughness = searched[distribution][0]
+    distribution, roughness, searched = _searched_distributions(
+        lambda closure, r: error_of(weights(r, closure, False)[2]), closures, preview)
     glossy, diffuse, value = weights(roughness, distribution, True)
     node = "GGX" if distribution == EEVEE_GLOSSY else distribution
     return LobeFit(roughness=roughness, error=error_of(value), weights=glossy,
                    distribution=node, diffuse_weights=diffuse,
-                   searched={("GGX" if name == EEVEE_GLOSSY else name): float(found[1])
+                   searched={("GGX" if name == EEVEE_GLOSSY else name): float(found)
                              for name, found in searched.items()})
 
 

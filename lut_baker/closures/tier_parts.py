@@ -104,7 +104,7 @@ class FitTargets:
     albedo ``a``): the skin the film covers, where a fit is judged and its colour held (the
     artist's mean skin under the film; default the tables' skin, ``pi P_d``).  ``preview``:
     the tables are a preview's, which a refined fit soon replaces: the Glossy lobes are
-    searched on the first of their closures (GGX) alone (:func:`glossy_closures`)."""
+    fitted as a preview's (:func:`~lut_baker.closures.lobes.fit_glossy`'s ``preview``)."""
 
     def __init__(self, tables: Tables, image_size: int,
                  thickness_um: float | None = None,
@@ -410,18 +410,12 @@ def _image(targets: FitTargets, lobes: dict[str, LobeFit],
     return np.stack(stack)
 
 
-def glossy_closures(targets: FitTargets, closures: tuple[str, ...]) -> tuple[str, ...]:
-    """The Glossy closures :func:`fit_glossy` searches for ``targets``: ``closures``, or for a
-    preview's tables the first of them alone (the one chosen on a near tie: GGX)."""
-    return closures[:1] if targets.preview else closures
-
-
 def _glossy(targets: FitTargets, name: str, closures: tuple[str, ...]) -> LobeFit:
     """:func:`fit_glossy` of one gloss part (the film's with its Lambertian companion)."""
     grid, table = targets.target(name)
     return fit_glossy(grid, table, targets.albedo(name), targets.albedo_theta(name),
                       targets.image_size, companion=name == "film_gloss",
-                      closures=glossy_closures(targets, closures))
+                      closures=closures, preview=targets.preview)
 
 
 def _view_weighted_lobes(targets: FitTargets, names: tuple[str, ...],
