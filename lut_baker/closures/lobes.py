@@ -20,8 +20,8 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
-from functools import lru_cache, partial
-from typing import TypedDict, TypeVar
+from functools import lru_cache
+from typing import TypedDict
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -33,11 +33,10 @@ from .tier_formulas import SPECULAR_IOR
 from .view_grid import ViewGrid
 from .view_image import DEFAULT_IMAGE_SIZE, sample_row, texel_centres
 
-_T = TypeVar("_T")
-
 __all__ = ["LobeFit", "fit_coat", "fit_specular", "fit_glossy", "ROUGHNESS_RANGE",
            "FIT_XTOL", "DISTRIBUTION_MARGIN", "COAT_IOR_RANGE", "SPECULAR_LEVEL_RANGE",
-           "SEARCH_QUADRATURE", "FINAL_QUADRATURE", "NO_LOBE_ERROR", "EEVEE_GLOSSY",
+           "SEARCH_QUADRATURE", "FINAL_QUADRATURE", "PREVIEW_QUADRATURE", "PREVIEW_XTOL",
+           "NO_LOBE_ERROR", "EEVEE_GLOSSY",
            "glossy_lobe", "glossy_albedo", "fit_glossy_pair", "PAIR_RATIO", "PAIR_ALBEDO_SLACK",
            "PAIR", "SHARE_RIDGE"]
 
@@ -52,6 +51,10 @@ FIT_XTOL = 1e-7
 """Absolute tolerance of the searches (``log(roughness)``, IOR, level): far below what a render
 shows and far above rounding, so that a fit moves continuously with its data (a 1e-9 change of
 the tables moves it by about 1e-9, never by a search's tolerance)."""
+PREVIEW_XTOL = 1e-4
+"""The searches' tolerance in a preview's fit (``preview``: the tables a preview's, the fit
+soon replaced by a refined one): Levenberg-Marquardt's last steps, each well under 1e-4, are
+left out (a third of its evaluations); the fitted numbers move by about 1e-5."""
 DISTRIBUTION_MARGIN = 0.02
 """A Glossy distribution other than GGX is chosen only when its error is this much (relative)
 lower than GGX's: a near tie keeps GGX, so the choice does not flip with rounding."""
@@ -98,11 +101,17 @@ def _grey(values: ArrayLike) -> NDArray[np.float64]:
     return np.mean(array, axis=-1) if array.ndim == 4 else array
 
 
-def _minimise_roughness(error_of: Callable[[float], float]) -> tuple[float, float]:
+def search_xtol(preview: bool) -> float:
+    """The searches' tolerance: :data:`FIT_XTOL`, or for a preview's fit :data:`PREVIEW_XTOL`."""
+    return PREVIEW_XTOL if preview else FIT_XTOL
+
+
+def _minimise_roughness(error_of: Callable[[float], float],
+                        xtol: float = FIT_XTOL) -> tuple[float, float]:
     """``(roughness, error)``: ``error_of(roughness)`` minimised over :data:`ROUGHNESS_RANGE`,
-    in ``log(roughness)`` (a lobe's width goes as roughness squared)."""
+    in ``log(roughness)`` (a lobe's width goes as roughness squared), to ``xtol``."""
     log_r, error = brent_minimum(lambda x: error_of(float(np.exp(x))),
-                                 *np.log(ROUGHNESS_RANGE), coarse=ROUGHNESS_SCAN, xtol=FIT_XTOL)
+                                 *np.log(ROUGHNESS_RANGE), coarse=ROUGHNESS_SCAN, xtol=xtol)
     return float(np.exp(log_r)), error
 
 
@@ -110,13 +119,13 @@ LobeTimes = Callable[[float], Callable[[float], NDArray[np.float64]]]
 """``lobe_times(roughness)(second)``: the factor per pair a GGX lobe is multiplied by."""
 
 
-def _per_value(compute: Callable[[float], _T]) -> Callable[[float], _T]:
+def _per_value(compute: Callable[[float], NDArray[np.float64]]
+               ) -> Callable[[float], NDArray[np.float64]]:
     """``compute`` remembered by its argument: the scan of :func:`_fit_roughness_and` asks for
-    the same :data:`SECOND_SCAN` values of the second parameter at every roughness, a preview's
-    search (:func:`_searched_distributions`) the samples its scan had."""
-    found: dict[float, _T] = {}
+    the same :data:`SECOND_SCAN` values of the second parameter at every roughness."""
+    found: dict[float, NDArray[np.float64]] = {}
 
-    def once(value: float) -> _T:
+    def once(value: float) -> NDArray[np.float64]:
         value = float(value)
         if value not in found:
             found[value] = compute(value)
@@ -125,12 +134,13 @@ def _per_value(compute: Callable[[float], _T]) -> Callable[[float], _T]:
 
 
 def _fit_roughness_and(grid: ViewGrid, target: ArrayLike, lobe_times: LobeTimes,
-                       second_range: tuple[float, float]) -> tuple[float, float, float]:
+                       second_range: tuple[float, float], xtol: float = FIT_XTOL
+                       ) -> tuple[float, float, float]:
     """``(roughness, second, error)``: a GGX lobe times ``lobe_times(roughness)(second)`` (a
     factor per pair) fitted to ``target`` (channels averaged).  A scan of
     :data:`ROUGHNESS_SCAN` roughnesses by :data:`SECOND_SCAN` values of the second parameter
     finds the start; bounded Levenberg-Marquardt on ``(log(roughness), second)`` converges
-    from it (:func:`lut_baker.numerics.optimise.least_squares`, to :data:`FIT_XTOL`)."""
+    from it (:func:`lut_baker.numerics.optimise.least_squares`, to ``xtol``)."""
     grey = _grey(target)
     root_weight = np.sqrt(grid.weight) * grid.cos_i
     scale = 1.0 / max(float(np.sqrt(np.sum(np.square(root_weight * grey)))), 1e-300)
@@ -152,7 +162,7 @@ def _fit_roughness_and(grid: ViewGrid, target: ArrayLike, lobe_times: LobeTimes,
     low, high = np.log(ROUGHNESS_RANGE)
     x, cost, _ = scanned_least_squares(
         residuals, (np.linspace(low, high, ROUGHNESS_SCAN),
-                    np.linspace(second_range[0], second_range[1], SECOND_SCAN)), xtol=FIT_XTOL)
+                    np.linspace(second_range[0], second_range[1], SECOND_SCAN)), xtol=xtol)
     return float(np.exp(x[0])), float(x[1]), float(np.sqrt(cost))
 
 
@@ -164,12 +174,12 @@ def _search_average_albedo(grid: ViewGrid, albedo: NDArray[np.float64]) -> float
     return float(2.0 * np.mean(albedo * grid.cos_view))
 
 
-def fit_coat(grid: ViewGrid, target: ArrayLike) -> LobeFit:
+def fit_coat(grid: ViewGrid, target: ArrayLike, *, preview: bool = False) -> LobeFit:
     """Coat Roughness and Coat IOR of a GGX coat (weight 1, dielectric Fresnel, Cycles'
     energy compensation) fitted to ``target`` (the film's gloss on ``grid``, ``(V, A, P[, 3])``,
     channels averaged).  ``level`` is the coat's weight per unit coverage: 1, or 0 when the
     film has no gloss (a matte product) or no coat does much better than none
-    (:data:`NO_LOBE_ERROR`)."""
+    (:data:`NO_LOBE_ERROR`).  ``preview``: searched to :data:`PREVIEW_XTOL`."""
     if not np.any(np.asarray(target, float)):
         return LobeFit(roughness=ROUGHNESS_RANGE[1], ior=COAT_IOR_RANGE[0], level=0.0,
                        error=0.0)
@@ -184,7 +194,8 @@ def fit_coat(grid: ViewGrid, target: ArrayLike) -> LobeFit:
             return fresnel(ior) * scale[:, None, None]
         return factor
 
-    roughness, ior, error = _fit_roughness_and(grid, target, lobe_times, COAT_IOR_RANGE)
+    roughness, ior, error = _fit_roughness_and(grid, target, lobe_times, COAT_IOR_RANGE,
+                                               search_xtol(preview))
     if error >= NO_LOBE_ERROR:
         return LobeFit(roughness=roughness, ior=ior, level=0.0, error=1.0)
     return LobeFit(roughness=roughness, ior=ior, level=1.0, error=error)
@@ -199,11 +210,11 @@ def _specular_fresnel(cos_hi: NDArray[np.float64], level: float) -> NDArray[np.f
 
 
 def fit_specular(grid: ViewGrid, target: ArrayLike,
-                 attenuation: ArrayLike | None = None) -> LobeFit:
+                 attenuation: ArrayLike | None = None, *, preview: bool = False) -> LobeFit:
     """Roughness and Specular IOR Level (at IOR :data:`SPECULAR_IOR`) of the Principled
     specular fitted to ``target`` ``(V, A, P[, 3])`` (channels averaged).  ``attenuation``:
     the factor the layers above apply to it per view ``(V,)`` (the coat's ``1 - E_coat``), or
-    None."""
+    None.  ``preview``: searched to :data:`PREVIEW_XTOL`."""
     scale: float | NDArray[np.float64] = (1.0 if attenuation is None
                                           else np.asarray(attenuation, float)[:, None, None])
 
@@ -213,7 +224,7 @@ def fit_specular(grid: ViewGrid, target: ArrayLike,
         return fresnel
 
     roughness, level, error = _fit_roughness_and(grid, target, lobe_times,
-                                                 SPECULAR_LEVEL_RANGE)
+                                                 SPECULAR_LEVEL_RANGE, search_xtol(preview))
     if error >= NO_LOBE_ERROR:  # no lobe does much better than none: leave it to the diffuse
         return LobeFit(roughness=roughness, ior=SPECULAR_IOR, level=0.0, error=1.0)
     return LobeFit(roughness=roughness, ior=SPECULAR_IOR, level=level, error=error)
@@ -322,43 +333,6 @@ def _search_glossy_albedo(grid: ViewGrid, lobe: NDArray[np.float64], roughness: 
     return grid.view_albedo(lobe)
 
 
-def _chosen_distribution(errors: dict[str, float], closures: tuple[str, ...]) -> str:
-    """The closure of lowest error, unless it beats the first of ``closures`` (GGX) by no
-    more than :data:`DISTRIBUTION_MARGIN` (relative): then the first."""
-    distribution = min(errors, key=lambda d: errors[d])
-    if errors[distribution] >= (1.0 - DISTRIBUTION_MARGIN) * errors[closures[0]]:
-        distribution = closures[0]
-    return distribution
-
-
-def _scanned_error(error_of: Callable[[float], float]) -> float:
-    """The lowest of ``error_of`` over :func:`_minimise_roughness`'s scan (its first
-    :data:`ROUGHNESS_SCAN` samples)."""
-    low, high = np.log(ROUGHNESS_RANGE)
-    return min(float(error_of(float(np.exp(x)))) for x in np.linspace(low, high, ROUGHNESS_SCAN))
-
-
-def _searched_distributions(error_of: Callable[[str, float], float],
-                            closures: tuple[str, ...], preview: bool
-                            ) -> tuple[str, float, dict[str, float]]:
-    """``(distribution, roughness, errors by closure)`` of :func:`fit_glossy`'s search:
-    ``error_of(closure, roughness)`` minimised in roughness for each closure, the
-    distribution chosen by :func:`_chosen_distribution`.  A ``preview`` chooses on the scans
-    (:func:`_scanned_error`) and searches the chosen closure alone (the others' errors are
-    their scans')."""
-    if not preview:
-        searched = {d: _minimise_roughness(partial(error_of, d)) for d in closures}
-        distribution = _chosen_distribution({d: found[1] for d, found in searched.items()},
-                                            closures)
-        return (distribution, searched[distribution][0],
-                {d: found[1] for d, found in searched.items()})
-    functions = {d: _per_value(partial(error_of, d)) for d in closures}
-    errors = {d: _scanned_error(functions[d]) for d in closures}
-    distribution = _chosen_distribution(errors, closures)
-    roughness, errors[distribution] = _minimise_roughness(functions[distribution])
-    return distribution, roughness, errors
-
-
 def fit_glossy(grid: ViewGrid, target: ArrayLike, albedo_table: np.ndarray,
                theta_deg: np.ndarray, size: int = DEFAULT_IMAGE_SIZE, *, companion: bool = False,
                closures: tuple[str, ...] = cc.GLOSSY_DISTRIBUTIONS,
@@ -380,10 +354,8 @@ def fit_glossy(grid: ViewGrid, target: ArrayLike, albedo_table: np.ndarray,
     :data:`DISTRIBUTION_MARGIN` (relative): a near tie never flips the choice.  The fit's
     ``distribution`` is the Glossy node's (``GGX`` for EEVEE's closure).
 
-    ``preview``: a preview's fit, which a refined one soon replaces: the distribution is
-    chosen on the searches' scans and only its roughness searched
-    (:func:`_searched_distributions`), the weights' closure albedo by
-    :data:`PREVIEW_QUADRATURE`."""
+    ``preview``: a preview's fit, soon replaced by a refined one: searched to
+    :data:`PREVIEW_XTOL`, the weights' closure albedo by :data:`PREVIEW_QUADRATURE`."""
     values = np.asarray(target, float)
     values = values if values.ndim == 4 else values[..., None]
     values = values * np.ones(3)
@@ -425,13 +397,20 @@ def fit_glossy(grid: ViewGrid, target: ArrayLike, albedo_table: np.ndarray,
             value = value + rows(diffuse) / np.pi
         return glossy, diffuse, value
 
-    distribution, roughness, searched = _searched_distributions(
-        lambda closure, r: error_of(weights(r, closure, False)[2]), closures, preview)
+    def search(distribution: str) -> tuple[float, float]:
+        return _minimise_roughness(lambda r: error_of(weights(r, distribution, False)[2]),
+                                   search_xtol(preview))
+
+    searched = {distribution: search(distribution) for distribution in closures}
+    distribution = min(searched, key=lambda d: searched[d][1])
+    if searched[distribution][1] >= (1.0 - DISTRIBUTION_MARGIN) * searched[closures[0]][1]:
+        distribution = closures[0]
+    roughness = searched[distribution][0]
     glossy, diffuse, value = weights(roughness, distribution, True)
     node = "GGX" if distribution == EEVEE_GLOSSY else distribution
     return LobeFit(roughness=roughness, error=error_of(value), weights=glossy,
                    distribution=node, diffuse_weights=diffuse,
-                   searched={("GGX" if name == EEVEE_GLOSSY else name): float(found)
+                   searched={("GGX" if name == EEVEE_GLOSSY else name): float(found[1])
                              for name, found in searched.items()})
 
 
