@@ -120,9 +120,10 @@ def fit_closures(tables: Tables, *, tiers: Iterable[str] | None = None,
     tiers are judged (the fit's Skin Color) and, with the film as a slab, the PRINCIPLED
     tier's colour held (:func:`~lut_baker.closures.tier_parts.held_gloss_to_diffuse`);
     default the tables' skin, ``pi P_d`` (a fit ``onto`` keeps its own).  ``preview``: the
-    tables are a preview's, soon replaced by a refined fit: the lobes are searched to a looser
-    tolerance (:data:`~lut_baker.closures.lobes.PREVIEW_XTOL`) and the Glossy weights' closure
-    albedo by a coarser quadrature (:data:`~lut_baker.closures.lobes.PREVIEW_QUADRATURE`).
+    tables are a preview's, soon replaced by a refined fit: the Glossy weights' closure albedo
+    by a coarser quadrature (:data:`~lut_baker.closures.lobes.PREVIEW_QUADRATURE`; every
+    search to the same tolerance as at any resolution, so that the fit moves continuously with
+    its data).
     ``progress(fraction, message)``: called as the fit advances (fraction 0..1).
 
     The film's gloss is fitted on a grid sized by its own lobe, the skin's gloss and path 3 on

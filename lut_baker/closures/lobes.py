@@ -35,8 +35,8 @@ from .view_image import DEFAULT_IMAGE_SIZE, sample_row, texel_centres
 
 __all__ = ["LobeFit", "fit_coat", "fit_specular", "fit_glossy", "ROUGHNESS_RANGE",
            "FIT_XTOL", "DISTRIBUTION_MARGIN", "COAT_IOR_RANGE", "SPECULAR_LEVEL_RANGE",
-           "SEARCH_QUADRATURE", "FINAL_QUADRATURE", "PREVIEW_QUADRATURE", "PREVIEW_XTOL",
-           "NO_LOBE_ERROR", "EEVEE_GLOSSY",
+           "SEARCH_QUADRATURE", "FINAL_QUADRATURE", "PREVIEW_QUADRATURE", "NO_LOBE_ERROR",
+           "EEVEE_GLOSSY",
            "glossy_lobe", "glossy_albedo", "fit_glossy_pair", "PAIR_RATIO", "PAIR_ALBEDO_SLACK",
            "PAIR", "SHARE_RIDGE"]
 
@@ -51,10 +51,6 @@ FIT_XTOL = 1e-7
 """Absolute tolerance of the searches (``log(roughness)``, IOR, level): far below what a render
 shows and far above rounding, so that a fit moves continuously with its data (a 1e-9 change of
 the tables moves it by about 1e-9, never by a search's tolerance)."""
-PREVIEW_XTOL = 1e-4
-"""The searches' tolerance in a preview's fit (``preview``: the tables a preview's, the fit
-soon replaced by a refined one): Levenberg-Marquardt's last steps, each well under 1e-4, are
-left out (a third of its evaluations); the fitted numbers move by about 1e-5."""
 DISTRIBUTION_MARGIN = 0.02
 """A Glossy distribution other than GGX is chosen only when its error is this much (relative)
 lower than GGX's: a near tie keeps GGX, so the choice does not flip with rounding."""
@@ -101,17 +97,11 @@ def _grey(values: ArrayLike) -> NDArray[np.float64]:
     return np.mean(array, axis=-1) if array.ndim == 4 else array
 
 
-def search_xtol(preview: bool) -> float:
-    """The searches' tolerance: :data:`FIT_XTOL`, or for a preview's fit :data:`PREVIEW_XTOL`."""
-    return PREVIEW_XTOL if preview else FIT_XTOL
-
-
-def _minimise_roughness(error_of: Callable[[float], float],
-                        xtol: float = FIT_XTOL) -> tuple[float, float]:
+def _minimise_roughness(error_of: Callable[[float], float]) -> tuple[float, float]:
     """``(roughness, error)``: ``error_of(roughness)`` minimised over :data:`ROUGHNESS_RANGE`,
-    in ``log(roughness)`` (a lobe's width goes as roughness squared), to ``xtol``."""
+    in ``log(roughness)`` (a lobe's width goes as roughness squared)."""
     log_r, error = brent_minimum(lambda x: error_of(float(np.exp(x))),
-                                 *np.log(ROUGHNESS_RANGE), coarse=ROUGHNESS_SCAN, xtol=xtol)
+                                 *np.log(ROUGHNESS_RANGE), coarse=ROUGHNESS_SCAN, xtol=FIT_XTOL)
     return float(np.exp(log_r)), error
 
 
@@ -134,13 +124,12 @@ def _per_value(compute: Callable[[float], NDArray[np.float64]]
 
 
 def _fit_roughness_and(grid: ViewGrid, target: ArrayLike, lobe_times: LobeTimes,
-                       second_range: tuple[float, float], xtol: float = FIT_XTOL
-                       ) -> tuple[float, float, float]:
+                       second_range: tuple[float, float]) -> tuple[float, float, float]:
     """``(roughness, second, error)``: a GGX lobe times ``lobe_times(roughness)(second)`` (a
     factor per pair) fitted to ``target`` (channels averaged).  A scan of
     :data:`ROUGHNESS_SCAN` roughnesses by :data:`SECOND_SCAN` values of the second parameter
     finds the start; bounded Levenberg-Marquardt on ``(log(roughness), second)`` converges
-    from it (:func:`lut_baker.numerics.optimise.least_squares`, to ``xtol``)."""
+    from it (:func:`lut_baker.numerics.optimise.least_squares`, to :data:`FIT_XTOL`)."""
     grey = _grey(target)
     root_weight = np.sqrt(grid.weight) * grid.cos_i
     scale = 1.0 / max(float(np.sqrt(np.sum(np.square(root_weight * grey)))), 1e-300)
@@ -162,7 +151,7 @@ def _fit_roughness_and(grid: ViewGrid, target: ArrayLike, lobe_times: LobeTimes,
     low, high = np.log(ROUGHNESS_RANGE)
     x, cost, _ = scanned_least_squares(
         residuals, (np.linspace(low, high, ROUGHNESS_SCAN),
-                    np.linspace(second_range[0], second_range[1], SECOND_SCAN)), xtol=xtol)
+                    np.linspace(second_range[0], second_range[1], SECOND_SCAN)), xtol=FIT_XTOL)
     return float(np.exp(x[0])), float(x[1]), float(np.sqrt(cost))
 
 
@@ -174,12 +163,12 @@ def _search_average_albedo(grid: ViewGrid, albedo: NDArray[np.float64]) -> float
     return float(2.0 * np.mean(albedo * grid.cos_view))
 
 
-def fit_coat(grid: ViewGrid, target: ArrayLike, *, preview: bool = False) -> LobeFit:
+def fit_coat(grid: ViewGrid, target: ArrayLike) -> LobeFit:
     """Coat Roughness and Coat IOR of a GGX coat (weight 1, dielectric Fresnel, Cycles'
     energy compensation) fitted to ``target`` (the film's gloss on ``grid``, ``(V, A, P[, 3])``,
     channels averaged).  ``level`` is the coat's weight per unit coverage: 1, or 0 when the
     film has no gloss (a matte product) or no coat does much better than none
-    (:data:`NO_LOBE_ERROR`).  ``preview``: searched to :data:`PREVIEW_XTOL`."""
+    (:data:`NO_LOBE_ERROR`)."""
     if not np.any(np.asarray(target, float)):
         return LobeFit(roughness=ROUGHNESS_RANGE[1], ior=COAT_IOR_RANGE[0], level=0.0,
                        error=0.0)
@@ -194,8 +183,7 @@ def fit_coat(grid: ViewGrid, target: ArrayLike, *, preview: bool = False) -> Lob
             return fresnel(ior) * scale[:, None, None]
         return factor
 
-    roughness, ior, error = _fit_roughness_and(grid, target, lobe_times, COAT_IOR_RANGE,
-                                               search_xtol(preview))
+    roughness, ior, error = _fit_roughness_and(grid, target, lobe_times, COAT_IOR_RANGE)
     if error >= NO_LOBE_ERROR:
         return LobeFit(roughness=roughness, ior=ior, level=0.0, error=1.0)
     return LobeFit(roughness=roughness, ior=ior, level=1.0, error=error)
@@ -210,11 +198,11 @@ def _specular_fresnel(cos_hi: NDArray[np.float64], level: float) -> NDArray[np.f
 
 
 def fit_specular(grid: ViewGrid, target: ArrayLike,
-                 attenuation: ArrayLike | None = None, *, preview: bool = False) -> LobeFit:
+                 attenuation: ArrayLike | None = None) -> LobeFit:
     """Roughness and Specular IOR Level (at IOR :data:`SPECULAR_IOR`) of the Principled
     specular fitted to ``target`` ``(V, A, P[, 3])`` (channels averaged).  ``attenuation``:
     the factor the layers above apply to it per view ``(V,)`` (the coat's ``1 - E_coat``), or
-    None.  ``preview``: searched to :data:`PREVIEW_XTOL`."""
+    None."""
     scale: float | NDArray[np.float64] = (1.0 if attenuation is None
                                           else np.asarray(attenuation, float)[:, None, None])
 
@@ -224,7 +212,7 @@ def fit_specular(grid: ViewGrid, target: ArrayLike,
         return fresnel
 
     roughness, level, error = _fit_roughness_and(grid, target, lobe_times,
-                                                 SPECULAR_LEVEL_RANGE, search_xtol(preview))
+                                                 SPECULAR_LEVEL_RANGE)
     if error >= NO_LOBE_ERROR:  # no lobe does much better than none: leave it to the diffuse
         return LobeFit(roughness=roughness, ior=SPECULAR_IOR, level=0.0, error=1.0)
     return LobeFit(roughness=roughness, ior=SPECULAR_IOR, level=level, error=error)
@@ -354,8 +342,9 @@ def fit_glossy(grid: ViewGrid, target: ArrayLike, albedo_table: np.ndarray,
     :data:`DISTRIBUTION_MARGIN` (relative): a near tie never flips the choice.  The fit's
     ``distribution`` is the Glossy node's (``GGX`` for EEVEE's closure).
 
-    ``preview``: a preview's fit, soon replaced by a refined one: searched to
-    :data:`PREVIEW_XTOL`, the weights' closure albedo by :data:`PREVIEW_QUADRATURE`."""
+    ``preview``: a preview's fit, soon replaced by a refined one: the weights' closure albedo
+    by :data:`PREVIEW_QUADRATURE` (the searches to :data:`FIT_XTOL` as every fit's, so that a
+    preview's fit too moves continuously with its data)."""
     values = np.asarray(target, float)
     values = values if values.ndim == 4 else values[..., None]
     values = values * np.ones(3)
@@ -398,8 +387,7 @@ def fit_glossy(grid: ViewGrid, target: ArrayLike, albedo_table: np.ndarray,
         return glossy, diffuse, value
 
     def search(distribution: str) -> tuple[float, float]:
-        return _minimise_roughness(lambda r: error_of(weights(r, distribution, False)[2]),
-                                   search_xtol(preview))
+        return _minimise_roughness(lambda r: error_of(weights(r, distribution, False)[2]))
 
     searched = {distribution: search(distribution) for distribution in closures}
     distribution = min(searched, key=lambda d: searched[d][1])

@@ -103,10 +103,9 @@ class FitTargets:
     ``thickness_um``: another thickness than the baked one.  ``skin_albedo`` (RGB, diffuse
     albedo ``a``): the skin the film covers, where a fit is judged and its colour held (the
     artist's mean skin under the film; default the tables' skin, ``pi P_d``).  ``preview``:
-    the tables are a preview's, which a refined fit soon replaces: the lobes are fitted as a
-    preview's (the ``preview`` of :func:`~lut_baker.closures.lobes.fit_glossy`,
-    :func:`~lut_baker.closures.lobes.fit_coat` and :func:`~lut_baker.closures.lobes.
-    fit_specular`: coarser tolerances and quadrature)."""
+    the tables are a preview's, which a refined fit soon replaces: the Glossy lobes' weights
+    by a coarser closure albedo (the ``preview`` of :func:`~lut_baker.closures.lobes.
+    fit_glossy`)."""
 
     def __init__(self, tables: Tables, image_size: int,
                  thickness_um: float | None = None,
@@ -288,19 +287,17 @@ def principled_parts(targets: FitTargets, over_shader: bool) -> dict[str, Any]:
     mean layering albedos and what the base colour carries of the gloss the lobes miss."""
     film_grid, film_gloss = targets.coat_target()
     skin_grid, path3 = targets.target("path3_gloss")
-    coat = fit_coat(film_grid, film_gloss, preview=targets.preview)
+    coat = fit_coat(film_grid, film_gloss)
     coat_ior = coat.ior
     if coat_ior is None:
         raise AssertionError("fit_coat gives an IOR")
     e_coat = cc.coat_view_terms(skin_grid.cos_view, coat.roughness, coat_ior)[1]
-    specular_film = fit_specular(skin_grid, path3, attenuation=1.0 - e_coat,
-                                 preview=targets.preview)
+    specular_film = fit_specular(skin_grid, path3, attenuation=1.0 - e_coat)
     if over_shader:
         specular_bare = LobeFit(roughness=specular_film.roughness, ior=SPECULAR_IOR,
                                 level=0.0, error=1.0)
     else:
-        specular_bare = fit_specular(skin_grid, targets.target("skin_gloss")[1],
-                                     preview=targets.preview)
+        specular_bare = fit_specular(skin_grid, targets.target("skin_gloss")[1])
         # The node group mixes the two roughnesses by coverage: a dropped lobe (level 0) takes
         # the other's, so that mixing never sharpens the remaining lobe.
         if specular_film.level == 0.0:

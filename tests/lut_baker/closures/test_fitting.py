@@ -15,10 +15,9 @@ from lut_baker.model import presets
 
 
 def test_a_preview_fit_is_the_full_fit_to_a_preview_tolerance(paper_tables, paper_fit):
-    """A preview's fit (searches to PREVIEW_XTOL, the Glossy weights' albedo by a coarser
-    quadrature) chooses the same distributions and lobes as the full fit of the same tables,
-    within 1e-3, and its tiers err as much within 1% (``paper_fit`` is the full fit: a fit is
-    a preview's only when asked)."""
+    """A preview's fit (the Glossy weights' albedo by a coarser quadrature) chooses the same
+    distributions and lobes as the full fit of the same tables, within 1e-3, and its tiers err
+    as much within 1% (``paper_fit`` is the full fit: a fit is a preview's only when asked)."""
     preview = fitting.fit_closures(paper_tables, preview=True)
     for name, lobe in paper_fit.glossy.items():
         fast = preview.glossy[name]
