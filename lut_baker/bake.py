@@ -128,7 +128,9 @@ class Resolution:
     ``n_radius`` distances with ``radius_spacing`` (closed forms in
     :mod:`lut_baker.tables.table_set`). Quadrature of the path-3 integrals: ``quad_panels``
     Gauss-Legendre panels of ``quad_points`` nodes in polar angle, ``quad_phi`` (odd) azimuth
-    samples.  The gloss albedos (:func:`gloss_albedos`) need no grid of their own.
+    samples.  The gloss albedos (:func:`gloss_albedos`) need no grid of their own: their
+    half-vector quadrature is at ``gloss_level`` (:func:`lut_baker.model.albedo.
+    specular_albedo`'s ``level``; a preview's -1, half the nodes each way).
     """
 
     name: str
@@ -143,6 +145,7 @@ class Resolution:
     phi_spacing: str = "half_vector"
     radius_spacing: str = "quadratic"
     theta_max_deg: float = 89.0
+    gloss_level: int = 0
 
     def for_lobe(self, width_deg: float) -> Resolution:
         """This resolution scaled for a lobe of 1/e half-width ``width_deg`` (degrees):
@@ -179,7 +182,7 @@ def scaled_count(count: int, scale: float) -> int:
 
 RESOLUTIONS = {
     "preview": Resolution("preview", n_theta=48, n_phi=33, n_radius=128,
-                          quad_panels=2, quad_points=6, quad_phi=17),
+                          quad_panels=2, quad_points=6, quad_phi=17, gloss_level=-1),
     "default": Resolution("default", n_theta=96, n_phi=65, n_radius=320,
                           quad_panels=3, quad_points=10, quad_phi=33),
     "high": Resolution("high", n_theta=112, n_phi=97, n_radius=512,
@@ -381,14 +384,16 @@ class _NodePairs:
         return out
 
 
-def gloss_albedos(layers: Sequence[ReflectionLayer], theta_deg: ArrayLike) -> list[np.ndarray]:
+def gloss_albedos(layers: Sequence[ReflectionLayer], theta_deg: ArrayLike, *,
+                  level: int = 0) -> list[np.ndarray]:
     """Directional albedos ``Int P_s D G F_r cos(theta_o) dwo`` (eq. 2's specular part
     integrated) of each reflecting layer at incidences ``theta_deg``: ``(n_theta, 3)`` each.
 
     The integral runs over the half vector (:func:`lut_baker.model.albedo.specular_albedo`),
     in panels sized by the layer's own lobe (1/n degrees), so that a lobe of any width is
-    resolved at the same cost; the Fresnel term from :func:`fresnel_interpolated`."""
-    return [rgb_view(specular_albedo(np.asarray(theta_deg, float), layer,
+    resolved at the same cost; the Fresnel term from :func:`fresnel_interpolated`.
+    ``level``: the quadrature's (:func:`lut_baker.model.albedo.specular_albedo`)."""
+    return [rgb_view(specular_albedo(np.asarray(theta_deg, float), layer, level=level,
                                      fresnel=fresnel_interpolated)) for layer in layers]
 
 
@@ -534,7 +539,8 @@ def bake(skin: MadeUpSkin, resolution_name: str | Resolution = "default", *,
                                       np.atleast_1d(skin.dipole.eta))
     inner_t = order0_integral(kernels(film_transmission, grid.theta, grid.theta, grid.n_phi)[0],
                               grid)
-    albedos = gloss_albedos((skin.film, skin.skin_reflection), theta_deg)
+    albedos = gloss_albedos((skin.film, skin.skin_reflection), theta_deg,
+                            level=res.gloss_level)
 
     extra = None
     if inter_reflection:

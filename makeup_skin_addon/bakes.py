@@ -260,7 +260,9 @@ def baked(record: dict, *, method: str | None = None,
     ``tiers``: those the fit must hold (a cached fit without some gets them fitted onto it);
     ``over_shader``: a fit for a group over the artist's shader; ``errors_at``: ``(coverage,
     absorption)`` at which a new fit measures the tiers (default: the bake's);
-    ``one_thickness``: the tables at the record's thickness will do (:func:`rebake`).
+    ``one_thickness``: the tables at the record's thickness will do (:func:`rebake`).  A
+    preview's tables are fitted as a preview (:func:`lut_baker.closures.fitting.
+    fit_closures`'s ``preview``: the refine replaces the fit).
 
     Raises
     ------
@@ -286,7 +288,8 @@ def baked(record: dict, *, method: str | None = None,
     if fit is None or not set(tiers) <= set(fit.tiers):
         fit = _under(fitting.fit_closures(
             tables, tiers=tiers, over_shader=over_shader, onto=fit, subsurface_method=method,
-            errors_at=errors_at, skin_albedo=skin, progress=fit_progress), record)
+            errors_at=errors_at, skin_albedo=skin, preview=record["resolution"] == "preview",
+            progress=fit_progress), record)
         fits[which] = fit
         if shared is not None:
             _SLAB_FITS.put((shared, skin_key, *which), fit)

@@ -105,7 +105,7 @@ def fit_closures(tables: Tables, *, tiers: Iterable[str] | None = None,
                  over_shader: bool = False, onto: ClosureFit | None = None,
                  image_size: int = DEFAULT_IMAGE_SIZE, subsurface_method: str | None = None,
                  errors_at: tuple[float, Any] | None = None,
-                 skin_albedo: Any = None,
+                 skin_albedo: Any = None, preview: bool = False,
                  progress: Callable[..., object] | None = None) -> ClosureFit:
     """Fit the ``tiers`` (default: all of :data:`TIERS`) to ``tables`` and measure their
     errors at ``errors_at`` = ``(coverage, absorption)`` (default: those the tables were baked
@@ -119,7 +119,11 @@ def fit_closures(tables: Tables, *, tiers: Iterable[str] | None = None,
     (RGB): the skin the film covers (the artist's mean skin under the film), at which the
     tiers are judged (the fit's Skin Color) and, with the film as a slab, the PRINCIPLED
     tier's colour held (:func:`~lut_baker.closures.tier_parts.held_gloss_to_diffuse`);
-    default the tables' skin, ``pi P_d`` (a fit ``onto`` keeps its own).
+    default the tables' skin, ``pi P_d`` (a fit ``onto`` keeps its own).  ``preview``: the
+    tables are a preview's, soon replaced by a refined fit: the Glossy weights' closure albedo
+    by a coarser quadrature (:data:`~lut_baker.closures.lobes.PREVIEW_QUADRATURE`; every
+    search to the same tolerance as at any resolution, so that the fit moves continuously with
+    its data).
     ``progress(fraction, message)``: called as the fit advances (fraction 0..1).
 
     The film's gloss is fitted on a grid sized by its own lobe, the skin's gloss and path 3 on
@@ -129,7 +133,8 @@ def fit_closures(tables: Tables, *, tiers: Iterable[str] | None = None,
     asked = _checked_tiers(TIERS if tiers is None else tiers)
     wanted = asked if onto is None else tuple(t for t in asked if t.name not in onto.tiers)
     targets = FitTargets(tables, image_size,
-                         skin_albedo=onto.skin_albedo if onto is not None else skin_albedo)
+                         skin_albedo=onto.skin_albedo if onto is not None else skin_albedo,
+                         preview=preview)
     parts: dict[str, Any] = {}
     total = sum(t.fit_share for t in wanted) or 1.0
     done = 0.0

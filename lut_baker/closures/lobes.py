@@ -35,7 +35,8 @@ from .view_image import DEFAULT_IMAGE_SIZE, sample_row, texel_centres
 
 __all__ = ["LobeFit", "fit_coat", "fit_specular", "fit_glossy", "ROUGHNESS_RANGE",
            "FIT_XTOL", "DISTRIBUTION_MARGIN", "COAT_IOR_RANGE", "SPECULAR_LEVEL_RANGE",
-           "SEARCH_QUADRATURE", "FINAL_QUADRATURE", "NO_LOBE_ERROR", "EEVEE_GLOSSY",
+           "SEARCH_QUADRATURE", "FINAL_QUADRATURE", "PREVIEW_QUADRATURE", "NO_LOBE_ERROR",
+           "EEVEE_GLOSSY",
            "glossy_lobe", "glossy_albedo", "fit_glossy_pair", "PAIR_RATIO", "PAIR_ALBEDO_SLACK",
            "PAIR", "SHARE_RIDGE"]
 
@@ -231,6 +232,9 @@ energy compensation's mean albedo from them, :func:`_search_average_albedo`); th
 weights use :data:`FINAL_QUADRATURE` (within 0.1%) at every texel (while searching, the
 grid's own integral: :func:`_search_glossy_albedo`)."""
 FINAL_QUADRATURE: AlbedoQuadrature = {"n_u": 96, "n_phi": 64}
+PREVIEW_QUADRATURE: AlbedoQuadrature = {"n_u": 48, "n_phi": 32}
+"""The Glossy weights' closure albedo in a preview's fit (:func:`fit_glossy`'s ``preview``):
+within 0.5% of :data:`FINAL_QUADRATURE`, a quarter of its cost."""
 
 
 def _texel_albedo(albedo_table: np.ndarray, theta_deg: np.ndarray,
@@ -275,16 +279,17 @@ def glossy_lobe(grid: ViewGrid, roughness: float, closure: str) -> np.ndarray:
 
 
 def glossy_albedo(cos_view: ArrayLike, roughness: float, closure: str, *,
-                  final: bool = True) -> NDArray[np.float64]:
+                  final: bool = True, preview: bool = False) -> NDArray[np.float64]:
     """The albedo of :func:`glossy_lobe`'s closure at view cosines: by quadrature over
-    normals for Cycles' (:data:`FINAL_QUADRATURE`, or :data:`SEARCH_QUADRATURE` while
-    searching), in closed form for EEVEE's."""
+    normals for Cycles' (:data:`FINAL_QUADRATURE`, :data:`PREVIEW_QUADRATURE` for a
+    ``preview``, or :data:`SEARCH_QUADRATURE` while searching), in closed form for EEVEE's."""
     if closure == EEVEE_GLOSSY:
         return eevee.glossy_albedo(cos_view, roughness)
     if not final:
         views = np.ascontiguousarray(cos_view, float)
         return _search_albedo(views.tobytes(), views.shape, float(roughness), closure)
-    return cc.microfacet_albedo(cos_view, roughness, distribution=closure, **FINAL_QUADRATURE)
+    return cc.microfacet_albedo(cos_view, roughness, distribution=closure,
+                                **(PREVIEW_QUADRATURE if preview else FINAL_QUADRATURE))
 
 
 SEARCH_ALBEDOS = 256
@@ -318,7 +323,8 @@ def _search_glossy_albedo(grid: ViewGrid, lobe: NDArray[np.float64], roughness: 
 
 def fit_glossy(grid: ViewGrid, target: ArrayLike, albedo_table: np.ndarray,
                theta_deg: np.ndarray, size: int = DEFAULT_IMAGE_SIZE, *, companion: bool = False,
-               closures: tuple[str, ...] = cc.GLOSSY_DISTRIBUTIONS) -> LobeFit:
+               closures: tuple[str, ...] = cc.GLOSSY_DISTRIBUTIONS,
+               preview: bool = False) -> LobeFit:
     """Distribution (:data:`lut_baker.closures.cycles.GLOSSY_DISTRIBUTIONS`) and roughness of a
     Glossy BSDF whose view-dependent weight (table albedo / closure albedo, read from a
     ``size``-texel image by ``cos(theta_o)``) best reproduces ``target`` ``(V, A, P[, 3])``;
@@ -334,7 +340,11 @@ def fit_glossy(grid: ViewGrid, target: ArrayLike, albedo_table: np.ndarray,
     distributions (default), or ``(EEVEE_GLOSSY,)`` for the EEVEE tier.  The first of them
     (GGX) is chosen unless another one's error is lower by more than
     :data:`DISTRIBUTION_MARGIN` (relative): a near tie never flips the choice.  The fit's
-    ``distribution`` is the Glossy node's (``GGX`` for EEVEE's closure)."""
+    ``distribution`` is the Glossy node's (``GGX`` for EEVEE's closure).
+
+    ``preview``: a preview's fit, soon replaced by a refined one: the weights' closure albedo
+    by :data:`PREVIEW_QUADRATURE` (the searches to :data:`FIT_XTOL` as every fit's, so that a
+    preview's fit too moves continuously with its data)."""
     values = np.asarray(target, float)
     values = values if values.ndim == 4 else values[..., None]
     values = values * np.ones(3)
@@ -358,7 +368,7 @@ def fit_glossy(grid: ViewGrid, target: ArrayLike, albedo_table: np.ndarray,
         own integral of the lobe (:func:`_search_glossy_albedo`); the final ones at the
         image's texels, sampled as Blender samples them."""
         shape = glossy_lobe(grid, roughness, distribution)
-        closure = (glossy_albedo(texels, roughness, distribution) if final
+        closure = (glossy_albedo(texels, roughness, distribution, preview=preview) if final
                    else _search_glossy_albedo(grid, shape, roughness, distribution))
         table = tables[final]
         glossy = table / np.maximum(closure, 1e-6)[:, None]

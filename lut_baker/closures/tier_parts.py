@@ -102,12 +102,16 @@ class FitTargets:
     are the slab's ``t`` and the film's body has rows of its own (``film_body``).
     ``thickness_um``: another thickness than the baked one.  ``skin_albedo`` (RGB, diffuse
     albedo ``a``): the skin the film covers, where a fit is judged and its colour held (the
-    artist's mean skin under the film; default the tables' skin, ``pi P_d``)."""
+    artist's mean skin under the film; default the tables' skin, ``pi P_d``).  ``preview``:
+    the tables are a preview's, which a refined fit soon replaces: the Glossy lobes' weights
+    by a coarser closure albedo (the ``preview`` of :func:`~lut_baker.closures.lobes.
+    fit_glossy`)."""
 
     def __init__(self, tables: Tables, image_size: int,
                  thickness_um: float | None = None,
-                 skin_albedo: ArrayLike | None = None) -> None:
+                 skin_albedo: ArrayLike | None = None, *, preview: bool = False) -> None:
         self.tables, self.image_size = tables, image_size
+        self.preview = bool(preview)
         self.theta_deg = np.asarray(tables.theta_deg, float)
         self.skin_albedo: NDArray[np.float64] = np.array(np.broadcast_to(np.asarray(
             np.pi * np.asarray(tables.skin_diffuse, float) if skin_albedo is None
@@ -411,8 +415,8 @@ def _glossy(targets: FitTargets, name: str, closures: tuple[str, ...]) -> LobeFi
     """:func:`fit_glossy` of one gloss part (the film's with its Lambertian companion)."""
     grid, table = targets.target(name)
     return fit_glossy(grid, table, targets.albedo(name), targets.albedo_theta(name),
-                      targets.image_size,
-                      companion=name == "film_gloss", closures=closures)
+                      targets.image_size, companion=name == "film_gloss",
+                      closures=closures, preview=targets.preview)
 
 
 def _view_weighted_lobes(targets: FitTargets, names: tuple[str, ...],

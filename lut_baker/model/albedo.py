@@ -167,12 +167,13 @@ def specular_albedo(theta_i_deg: ArrayLike, layer: ReflectionLayer, *, level: in
     (:func:`lut_baker.numerics.quadrature.mirror_quadrature`, panels sized by the lobe): the
     same cost for a lobe of any width.  ``fresnel``: :func:`fresnel_reflectance` or an
     accelerator of it.  Shape ``theta.shape + (C,)`` (C the layer's channels, 1 for a scalar
-    layer)."""
+    layer).  ``level``: each level up doubles both node counts, level -1 halves them (a
+    preview's: within 0.3% of level 0 up to 85 degrees, 1% at 89)."""
     theta = np.radians(np.asarray(theta_i_deg, float))
-    scale = 2**int(level)
+    scale = 2.0**int(level)
     quad = mirror_quadrature(theta.ravel(), 1.0 / float(np.max(layer.n)),
-                             alpha_points=SPECULAR_POINTS[0] * scale,
-                             phi_points=SPECULAR_POINTS[1] * scale)
+                             alpha_points=int(SPECULAR_POINTS[0] * scale),
+                             phi_points=int(SPECULAR_POINTS[1] * scale))
     cos_o = quad.cos_other
     values = ts_specular_from_cosines(quad.cos_h[..., None], quad.cos_dh[..., None],
                                       cos_o[..., None], quad.cos_fixed[..., None], layer.P_s,

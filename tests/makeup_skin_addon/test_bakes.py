@@ -35,6 +35,30 @@ def test_a_record_is_baked_and_fitted_once(record, monkeypatch):
     assert bakes.cached(record, "RANDOM_WALK") is None  # a forced method is another fit
 
 
+def test_only_a_preview_record_is_fitted_as_a_preview(record, monkeypatch):
+    """The preview's shortcuts (lut_baker.closures.fitting.fit_closures's ``preview``) are
+    taken for a record at preview resolution only, never at the settings' resolution."""
+    from lut_baker.closures import fitting
+    from makeup_skin_addon import bakes
+
+    bakes.clear()
+    tables = bakes.rebake(record)
+    asked = {}
+    original = fitting.fit_closures
+
+    def spy(*args, **kwargs):
+        asked[kwargs["preview"]] = asked.get(kwargs["preview"], 0) + 1
+        return original(*args, **kwargs)
+
+    monkeypatch.setattr(fitting, "fit_closures", spy)
+    monkeypatch.setattr(bakes, "rebake", lambda *args, **kwargs: tables)  # no bake at default
+    skin = presets.made_up_skin("light_ivory", "jensen_skin1")
+    for resolution in ("preview", "default", "high"):
+        bakes.baked(bakes.bake_record(skin, resolution), tiers=("LAYERED",))
+    assert asked == {True: 1, False: 2}
+    bakes.clear()
+
+
 def test_a_measurement_is_found_at_its_own_coverage_and_absorption(record):
     from makeup_skin_addon import bakes
 

@@ -42,8 +42,9 @@ def test_match_skin_and_the_steps(sphere):
 def test_the_bare_skins_gloss_needs_no_bake(addon):
     """With the film at a thickness the bare skin's gloss comes from its own layer
     (``bare_light``, no tables baked): within 2e-4 of what the paper film's tables give at each
-    resolution (their directional table interpolated), at either end of Skin Roughness, and
-    its film parts weigh nothing at coverage 0."""
+    resolution (their directional table interpolated), at either end of Skin Roughness, the
+    bare colour within 1e-5 (5e-5 against a preview's tables, whose gloss albedos take half
+    the quadrature's nodes), and its film parts weigh nothing at coverage 0."""
     import bpy
 
     from makeup_skin_addon import matching
@@ -59,7 +60,8 @@ def test_the_bare_skins_gloss_needs_no_bake(addon):
             baked = matching.light_for(settings, resolution=resolution)
             np.testing.assert_allclose(bare.skin_gloss, baked.skin_gloss, rtol=2e-4)
             np.testing.assert_allclose(uniform_light.bare_colour(bare, skin, 0.7),
-                                       uniform_light.bare_colour(baked, skin, 0.7), rtol=1e-5)
+                                       uniform_light.bare_colour(baked, skin, 0.7),
+                                       rtol=5e-5 if resolution == "preview" else 1e-5)
 
 
 def test_the_first_apply_matches_the_skin(head):

@@ -69,9 +69,16 @@ def case_tables(name: str, resolution: str = "preview"):
 
 @lru_cache(maxsize=8)
 def case_fit(name: str, resolution: str = "preview"):
-    """``(skin, tables, closure fit)`` of a case (kept: a fit takes 1-14 s)."""
+    """``(skin, tables, closure fit)`` of a case (kept: a fit takes 1-14 s), fitted as the
+    add-on fits tables of that resolution (:func:`shipped_fit`)."""
     skin, tables = case_tables(name, resolution)
-    return skin, tables, fitting.fit_closures(tables)
+    return skin, tables, shipped_fit(tables, resolution)
+
+
+def shipped_fit(tables, resolution: str = "preview"):
+    """The closure fit the add-on makes of ``tables`` baked at ``resolution``: a preview's at
+    preview resolution (``makeup_skin_addon.bakes``), the full one otherwise."""
+    return fitting.fit_closures(tables, preview=resolution == "preview")
 
 
 def criterion(name: str) -> str:
@@ -101,9 +108,9 @@ def fit_movement(name: str, seeds=(0, 1), resolution: str = "preview", *, rel: f
         if via_bake:
             moved = bake.bake(perturbed(skin, rel, seed), resolution)
             _worst(worst, movement(tables, moved, "tables"))
-            _worst(worst, movement(fit, fitting.fit_closures(moved), "fit"))
+            _worst(worst, movement(fit, shipped_fit(moved, resolution), "fit"))
         if via_tables:
-            refit = fitting.fit_closures(perturbed(tables, rel, 1000 + seed))
+            refit = shipped_fit(perturbed(tables, rel, 1000 + seed), resolution)
             _worst(worst, movement(fit, refit, "fit_of_tables"))
     return worst
 
@@ -222,7 +229,7 @@ def decision_margins(tables, skin=None) -> dict:
     """
     margins: dict = {}
     with recorded_searches() as recorder:
-        fit = fitting.fit_closures(tables)
+        fit = shipped_fit(tables)
     for lobe, found in fit.glossy.items():
         margins[f"distribution/{lobe}"] = distribution_margin(found)
     # One EEVEE lobe or two for the film gloss: GGX against lobes.PAIR in its searched errors.

@@ -14,6 +14,24 @@ from lut_baker.closures.view_grid import lobe_widths_deg, view_grid
 from lut_baker.model import presets
 
 
+def test_a_preview_fit_is_the_full_fit_to_a_preview_tolerance(paper_tables, paper_fit):
+    """A preview's fit (the Glossy weights' albedo by a coarser quadrature) chooses the same
+    distributions and lobes as the full fit of the same tables, within 1e-3, and its tiers err
+    as much within 1% (``paper_fit`` is the full fit: a fit is a preview's only when asked)."""
+    preview = fitting.fit_closures(paper_tables, preview=True)
+    for name, lobe in paper_fit.glossy.items():
+        fast = preview.glossy[name]
+        assert fast.distribution == lobe.distribution
+        assert fast.roughness == pytest.approx(lobe.roughness, rel=1e-3)
+        np.testing.assert_allclose(fast.weights, lobe.weights, rtol=1e-2)
+    for name in ("coat", "specular_film", "specular_bare"):
+        fast, full = getattr(preview, name), getattr(paper_fit, name)
+        assert fast.roughness == pytest.approx(full.roughness, rel=1e-3)
+        assert fast.level == pytest.approx(full.level, rel=1e-3)
+    for tier, error in paper_fit.errors.items():
+        assert preview.errors[tier].rms == pytest.approx(error.rms, rel=1e-2)
+
+
 def test_paper_fit_parameters_are_in_blender_ranges(paper_fit):
     assert lobes.ROUGHNESS_RANGE[0] <= paper_fit.coat.roughness <= 1.0
     assert 1.0 < paper_fit.coat.ior <= lobes.COAT_IOR_RANGE[1]
