@@ -167,12 +167,15 @@ class Shade:
 class SlabLight:
     """The settings' made-up skin with the film at a thickness under uniform light: the
     model's layers (``skin``, with ``foundation``'s film if given), the thickness and the
-    bake's quadrature at ``resolution`` (the slab is derived on it, docs/baking.md)."""
+    bake's quadrature at ``resolution`` (the slab is derived on it, docs/baking.md): the
+    named one refined for a narrow skin gloss as the bake refines it
+    (:meth:`lut_baker.bake.Resolution.for_lobe`), so that the colour matched is the tables'."""
 
     def __init__(self, settings, foundation: str | None = None, resolution: str | None = None):
         self.skin = skin_model.skin_from_settings(settings, foundation)
         self.thickness_um = float(skin_model.film_of(settings))
-        res = bake.resolution(resolution or settings.resolution)
+        res = bake.resolution(resolution or settings.resolution).for_lobe(
+            bake.path3_width_deg(self.skin))
         self.grid = quadrature.hemisphere_panels(res.quad_panels, res.quad_points,
                                                  res.quad_phi)
         self.film_gloss = uniform_light_gloss(self.skin, self.grid)
