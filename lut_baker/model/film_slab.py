@@ -420,16 +420,15 @@ def _free_film_albedo(face: NDArray[np.float64], scale0: NDArray[np.float64],
                       grid: HemisphereGrid) -> Callable[[SlabGenerator], NDArray[np.float64]]:
     """``generator -> `` the bihemispherical ``R + T`` (gloss left out) of the free film of unit
     thickness, order 0 (:func:`free_film_matrices`), its two faces built once."""
-    upper = face_layer(face, 1)
-    lower = Layer(top=upper.bottom, bottom=upper.top, down=upper.down)
+    faces = _free_film_faces(face, 1)
 
     def albedo(generator: SlabGenerator) -> NDArray[np.float64]:
         order0 = SlabGenerator(basis=generator.basis[..., :1, :, :],
                                rates=generator.rates[..., :1, :])
         r, t = slab(order0, 1.0)
-        stack = add_layers(surface_on_body(upper, Layer(top=r, bottom=r, down=t)), lower)
-        return bihemispherical_on_grid(star_albedo(stack.top[:, 0], scale0)
-                                       + star_albedo(stack.down[:, 0], scale0), grid)
+        top, down = _free_film(faces, Layer(top=r, bottom=r, down=t))
+        return bihemispherical_on_grid(star_albedo(top[:, 0], scale0)
+                                       + star_albedo(down[:, 0], scale0), grid)
 
     return albedo
 
@@ -592,9 +591,22 @@ def free_film_matrices(film: FilmSlab, thickness: float, face: ArrayLike | None 
     reflection without the top surface's gloss and its transmission, star form.  ``face``: the
     surfaces' ``a_g`` ``(C, N)`` (default: the measured film's)."""
     face = film.measured_face if face is None else np.asarray(face, float)
-    upper = face_layer(face, film.orders)
-    lower = Layer(top=upper.bottom, bottom=upper.top, down=upper.down)
-    stack = add_layers(surface_on_body(upper, _body_layer(film, thickness)), lower)
+    return _free_film(_free_film_faces(face, film.orders), _body_layer(film, thickness))
+
+
+def _free_film_faces(face: ArrayLike, orders: int) -> tuple[Layer, Layer]:
+    """The free film's upper and lower surfaces (:func:`face_layer`; the lower one the upper
+    turned over)."""
+    upper = face_layer(face, orders)
+    return upper, Layer(top=upper.bottom, bottom=upper.top, down=upper.down)
+
+
+def _free_film(faces: tuple[Layer, Layer], body_layer: Layer
+               ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """``(R, T)`` of the surfaces ``faces`` (:func:`_free_film_faces`) either side of
+    ``body_layer``: :func:`free_film_matrices` of a body."""
+    upper, lower = faces
+    stack = add_layers(surface_on_body(upper, body_layer), lower)
     return stack.top, stack.down
 
 
