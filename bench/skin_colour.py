@@ -30,8 +30,9 @@ Parts, each in fresh Blender processes (so the first call is truly cold), this c
 - ``operators`` -- end to end on the head with the add-on registered: ``bpy.ops.makeup_skin.
   match_skin()`` (the first: the colour cold, the session's uniform-light tables baked),
   ``shade_step(direction="LIGHTER")``, ``shade_step(direction="DARKER")``, Match Skin again;
-  and, in another process, a first Apply at the defaults
-  (:func:`makeup_skin_addon.apply.apply_to_object`: the match, then the bake and fit).  Each
+  and, in another process, a first Apply at the defaults as the button makes it in a window
+  (``bpy.ops.makeup_skin.apply()``: the match, then the bake and fit at preview resolution,
+  refined on a worker and swapped in).  Each
   with the part spent in reading the skin's colour (over the artist's shader
   ``artist_skin.read_material``; an older checkout's ``skin_sampling.surface_mean`` or
   ``shade.image_mean``) and, for Apply, in the match (``matching.first_shade``, or
@@ -330,7 +331,7 @@ def operators_worker(cache: Path, repo: Path, which: str) -> dict:
                   ("darker", lambda: bpy.ops.makeup_skin.shade_step(direction="DARKER")),
                   ("match_skin again", lambda: bpy.ops.makeup_skin.match_skin())]
                  if which == "match" else
-                 [("first apply", lambda: apply_to_object(bpy.context, head))])
+                 [("first apply", lambda: bpy.ops.makeup_skin.apply())])  # the button's
         out = {}
         for name, run in steps:
             spent.clear()
