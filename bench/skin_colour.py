@@ -37,7 +37,10 @@ Parts, each in fresh Blender processes (so the first call is truly cold), this c
   ``artist_skin.read_material``; an older checkout's ``skin_sampling.surface_mean`` or
   ``shade.image_mean``) and, for Apply, in the match (``matching.first_shade``, or
   ``shade.first_shade``).  Match Skin waits for Apply: the head is applied first and the
-  colour's caches emptied, as in a made-up file opened anew.  The clicks are measured as in
+  colour's caches in memory emptied, as in a made-up file opened anew on the machine that
+  made it up (the reduced image kept on disk, ``image_store``, as the installed extension
+  keeps it: each process has a new, empty folder, so the first Apply decodes the texture).
+  The clicks are measured as in
   Blender with a window: with the film at a thickness (the default Film) a shade change
   rebuilds the group, whose absorption is baked, on a worker thread; the step is the click
   (what the interface waits for), and the rebuild is then polled as the add-on's timer does
@@ -94,9 +97,10 @@ SAMPLING_ROWS = {"cold": "the colour, cold (the first click)", "warm": "again (w
                  "mesh edit": "after a mesh edit (a vertex in 20 moved)",
                  "image file edit": "after the image file changed (reloaded)",
                  "image painted": "after a paint stroke in Blender (unsaved)"}
-OPERATOR_ROWS = {"match_skin": "Match Skin, the first", "lighter": "Lighter",
+OPERATOR_ROWS = {"match_skin": "Match Skin, the first (the file opened anew)", "lighter": "Lighter",
                  "darker": "Darker", "match_skin again": "Match Skin again",
-                 "first apply": "first Apply (bake and fit included)"}
+                 "first apply": "first Apply (bake and fit included; the texture never "
+                                "read before)"}
 
 
 # -- the production head ------------------------------------------------------------------------
@@ -295,6 +299,11 @@ def operators_worker(cache: Path, repo: Path, which: str) -> dict:
     from makeup_skin_addon import shade
 
     apply_to_object = addon_attribute("apply_to_object")
+    if importlib.util.find_spec("makeup_skin_addon.image_store") is not None:
+        # As installed: reduced images kept in the extension's folder (new and empty here).
+        from makeup_skin_addon import image_store
+
+        image_store.set_directory(tempfile.mkdtemp(prefix="bench_store_"))
 
     spent: dict = {}
     over_shader = importlib.util.find_spec("makeup_skin_addon.artist_skin") is not None
@@ -323,7 +332,8 @@ def operators_worker(cache: Path, repo: Path, which: str) -> dict:
         material.makeup_skin.live_update = False
         if which == "match" and over_shader:
             # Match Skin waits for Apply (greyed out before): Apply, then forget the colour
-            # read (a made-up file opened anew: the first Match Skin reads it cold).
+            # read in memory (a made-up file opened anew: its mesh read cold, its texture
+            # from the store the Apply filled).
             apply_to_object(bpy.context, head)
             skin_sampling.clear_cache()
         steps = ([("match_skin", lambda: bpy.ops.makeup_skin.match_skin()),

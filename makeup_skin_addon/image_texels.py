@@ -25,6 +25,7 @@ from typing import Any
 import bpy
 import numpy as np
 
+from . import image_store
 from .core import cache
 from .progress import report
 
@@ -186,9 +187,22 @@ def reduced_image(image, size: int = IMAGE_SIZE) -> ReducedImage:
     each time: nothing cheap tells a second paint stroke from the first)."""
     reduced = _cached_image(image, size)
     if reduced is None:
-        report(0.0, f"Reading image {image.name!r}")
-        reduced = _read(image, size)
+        reduced = _stored_or_read(image, size)
         _IMAGES.put((image.session_uid, size), (_image_fingerprint(image), reduced))
+    return reduced
+
+
+def _stored_or_read(image, size: int) -> ReducedImage:
+    """``image`` reduced, from :mod:`.image_store` when an earlier session kept it, else read
+    (and kept there when it is a file image)."""
+    name = image_store.key(image, size)
+    stored = image_store.load(name) if name is not None else None
+    if stored is not None:
+        return ReducedImage(*stored)
+    report(0.0, f"Reading image {image.name!r}")
+    reduced = _read(image, size)
+    if name is not None and reduced.pixels is not None:
+        image_store.save(name, reduced.pixels, reduced.note)
     return reduced
 
 

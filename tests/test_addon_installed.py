@@ -86,6 +86,10 @@ def test_apply_from_the_installed_extension(installed, tmp_path):
     apply = sys.modules[installed["module"] + ".makeup_skin_addon.apply"]
     assert Path(apply.__file__).is_relative_to(installed["repo_dir"])
     assert apply.check_material(bpy.context, material)[0]  # re-bakes to its recorded hash
+    # Reduced images are kept in the extension's own user folder.
+    store = sys.modules[installed["module"] + ".makeup_skin_addon.image_store"]
+    assert store.directory() == Path(bpy.utils.extension_path_user(
+        installed["module"], path="reduced_images"))
 
     sphere_scene.light_and_camera(scene, 0.03, light_deg=0.0)
     sphere_scene.cycles_settings(scene, size=32, samples=8)
