@@ -340,7 +340,9 @@ class MatteSlab:
     (``flakes``) and their GGX roughness (``flake_alpha``) or, if ``cone_spread_deg > 0``,
     their normals on a cone (:func:`cone_distribution`: ``cone_deg`` from the vertical, spread
     ``cone_spread_deg``), the flakes' own single-scattering albedo (``flake_albedo``; None:
-    ``albedo``), the surface's index ``eta`` (1: no surface) and GGX roughness ``alpha``."""
+    ``albedo``), the surface's index ``eta`` (1: no surface), its GGX roughness ``alpha`` and
+    the fraction of the area it covers (``coverage``; the rest is the bare medium, in patches
+    wider than the light's path in the medium: :func:`matte_slab_kernel`)."""
 
     albedo: np.ndarray
     g1: float = 0.0
@@ -353,6 +355,7 @@ class MatteSlab:
     flake_albedo: np.ndarray | None = None
     eta: float = 1.0
     alpha: float = 0.3
+    coverage: float = 1.0
 
 
 def medium_generator(grid: HemisphereGrid, model: MatteSlab):
@@ -398,12 +401,19 @@ def medium_reflection(grid: HemisphereGrid, model: MatteSlab) -> np.ndarray:
 def matte_slab_kernel(grid: HemisphereGrid, model: MatteSlab, tir_points: int = 8):
     """``(kernel, a_g)``: the light the medium returns (through the surface, if ``eta > 1``) as
     a kernel per channel and order on ``grid`` (1/sr, ``(C, orders, N, N)``; the surface's own
-    reflection, :func:`ggx_reflection`, is added in closed form where it is read) and the
-    surface's directional albedo at the nodes ``(N,)`` (zeros without a surface)."""
+    reflection, :func:`ggx_reflection` times ``model.coverage``, is added in closed form where
+    it is read) and the surface's directional albedo at the nodes times its coverage ``(N,)``
+    (zeros without a surface).  A partial surface (``coverage`` < 1) is patches of surface and
+    of bare medium each wide enough that light leaves by the patch it entered: the two
+    reflections weighted by their areas."""
     scale = AD.star_scale(grid)
     if not model.eta > 1.0:
         return AD.from_star(medium_reflection(grid, model), scale), np.zeros(grid.theta.size)
     inside = refracted_grid(grid, model.eta, tir_points)
     body = medium_reflection(inside, model)
     a_g = ggx_albedo(np.cos(grid.theta), model.alpha, model.eta)
-    return AD.from_star(under_surface(body, a_g), scale), a_g
+    star = under_surface(body, a_g)
+    w = float(model.coverage)
+    if w < 1.0:
+        star = w * star + (1.0 - w) * medium_reflection(grid, model)
+    return AD.from_star(star, scale), w * a_g

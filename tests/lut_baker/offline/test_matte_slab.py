@@ -131,6 +131,8 @@ MODELS = [
               cone_spread_deg=20.0, flake_albedo=np.array([0.95, 0.85, 0.7])),
     MatteSlab(albedo=np.array([0.98, 0.9, 0.6]), g1=0.1, flakes=0.4, cone_deg=30.0,
               cone_spread_deg=15.0, eta=1.4, alpha=0.5),
+    MatteSlab(albedo=np.array([0.98, 0.9, 0.6]), g1=0.3, flakes=0.4, cone_deg=40.0,
+              cone_spread_deg=20.0, eta=1.5, alpha=0.3, coverage=0.3),
 ]
 
 
@@ -153,3 +155,20 @@ def test_no_surface_is_the_limit_of_a_vanishing_one():
     k_faint, a_g = matte_slab_kernel(GRID, faint)
     assert np.max(a_g) < 1e-6
     np.testing.assert_allclose(k_faint, k_bare, atol=1e-2 * np.max(np.abs(k_bare)))
+
+
+def test_partial_surface_is_its_patches_by_area():
+    # Surface over 30% of the area, bare medium elsewhere: each patch's light by its area, the
+    # ends of the range the bare medium and the whole surface.
+    medium = {"albedo": np.array([0.95, 0.7]), "g1": 0.5, "flakes": 0.3, "cone_deg": 40.0,
+              "cone_spread_deg": 20.0}
+    k_bare, _ = matte_slab_kernel(GRID, MatteSlab(**medium))
+    k_full, a_full = matte_slab_kernel(GRID, MatteSlab(**medium, eta=1.5, alpha=0.3))
+    k_part, a_part = matte_slab_kernel(GRID, MatteSlab(**medium, eta=1.5, alpha=0.3,
+                                                       coverage=0.3))
+    np.testing.assert_allclose(k_part, 0.3 * k_full + 0.7 * k_bare, rtol=1e-10, atol=1e-14)
+    np.testing.assert_allclose(a_part, 0.3 * a_full, rtol=1e-12)
+    k_none, a_none = matte_slab_kernel(GRID, MatteSlab(**medium, eta=1.5, alpha=0.3,
+                                                       coverage=0.0))
+    np.testing.assert_allclose(k_none, k_bare, rtol=1e-10, atol=1e-14)
+    assert np.all(a_none == 0.0)
