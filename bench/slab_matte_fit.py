@@ -28,7 +28,9 @@ infinitely thick medium with a single-scattering albedo per channel in one of th
   added); ``cone_surface_15`` the same with eta held at a binder's 1.5 (8 parameters);
 - ``cone_partial_15``: ``cone_surface_15`` with the surface over a fraction of the area (the
   coverage), the bare medium elsewhere (9 parameters: a powder whose particles the binder does
-  not all wet),
+  not all wet);
+- ``cone_flat``: ``cone`` with a share of the flakes lying flat (normals about the vertical,
+  their own spread; 9 parameters: Lanza et al.'s 103 has its flakes near the vertical),
 
 read in the plane of incidence by a bicubic spline over the grid's polar nodes (the surface's
 own reflection in closed form).  Physical bounds: |g| <= 0.95, 1.01 <= eta <= 2, 0.05 <= alpha
@@ -115,9 +117,13 @@ FORMS = {
                         ((-4.0, 4.0), LOGIT, LOGIT, LOG_SPREAD, LOG_ALPHA, LOGIT),
                         ((-0.2, 1.0, 0.3, np.log(20.0), np.log(0.3), -1.0),
                          (0.3, 0.0, -1.0, np.log(30.0), np.log(0.6), 0.0))),
+    "cone_flat": (("g", "flakes", "cone", "spread", "flat", "flat_spread"),
+                  ((-4.0, 4.0), LOGIT, LOGIT, LOG_SPREAD, LOGIT, LOG_SPREAD),
+                  ((-0.2, 1.0, 0.3, np.log(20.0), -1.0, np.log(15.0)),
+                   (0.3, 0.0, -1.0, np.log(30.0), 0.0, np.log(30.0)))),
 }
 CONE_FORMS = ("cone", "cone_flakes", "cone_tinted", "cone_slab", "cone_surface",
-              "cone_surface_15", "cone_partial_15")
+              "cone_surface_15", "cone_partial_15", "cone_flat")
 BINDER_ETA = 1.5
 """The surface's index in ``cone_surface_15``: a binder's (oils, silicones: about 1.4-1.5)."""
 ALBEDO_LOGIT_MAX = {"cone_tinted": float(np.log(0.995 / 0.005))}
@@ -152,6 +158,8 @@ def unpack(form: str, p) -> MatteSlab:
         first = 6 if form == "cone_slab" else 4
         kw.update(flakes=_sigmoid(p[first]), cone_deg=90.0 * _sigmoid(p[first + 1]),
                   cone_spread_deg=np.exp(p[first + 2]))
+    if form == "cone_flat":
+        kw.update(flat=_sigmoid(p[7]), flat_spread_deg=np.exp(p[8]))
     if form == "cone_tinted":
         kw.update(flake_albedo=_sigmoid(p[7:10]))
     return MatteSlab(**kw)
@@ -164,7 +172,8 @@ def physical(form: str, p) -> np.ndarray:
     values = {"g1": m.g1, "g2": m.g2, "weight": m.weight, "g": m.g1, "eta": m.eta,
               "alpha": m.alpha, "flakes": m.flakes, "flake_alpha": m.flake_alpha,
               "cone": m.cone_deg, "spread": m.cone_spread_deg, "flake_r": tint[0],
-              "flake_g": tint[1], "flake_b": tint[2], "coverage": m.coverage}
+              "flake_g": tint[1], "flake_b": tint[2], "coverage": m.coverage,
+              "flat": m.flat, "flat_spread": m.flat_spread_deg}
     return np.array([*m.albedo, *(values[k] for k in FORMS[form][0])])
 
 
@@ -276,11 +285,15 @@ def main(argv=None) -> int:
             names = ("albedo_r", "albedo_g", "albedo_b", *FORMS[form][0])
             bound = [n for n, b in zip(names, at_bound, strict=True) if b]
             print(f"{name} {form}: fit {100 * rms:.1f}% rms, {100 * worst:.1f}% worst; fitted on "
-                  f"{fitted} predicting {held}: {100 * held_rms:.1f}% rms, "
+                  f"{fitted} predicting {held}: {100 * held_rms:.2f}% rms, "
                   f"{100 * held_worst:.1f}% worst ({time.perf_counter() - clock:.0f} s)")
             values = physical(form, p)
             print("  " + ", ".join(f"{n} {v:.4f}" for n, v in zip(names, values, strict=True)))
             if args.held_starts:
+                on = relative_error(in_plane(grid, unpack(form, q), ti[rows], to[rows]),
+                                    rgb[rows])[0]
+                print(f"  held-out fit from the optimum on every incidence: {100 * on:.1f}% on "
+                      f"the fitted incidences, predicting {100 * held_rms:.1f}%")
                 _held_from_starts(grid, form, (ti, to, rgb), rows, args.starts)
             verdict = "determined" if change < DETERMINED and not bound else "NOT determined"
             print(f"  data x (1 + {PERTURBATION:g} u): parameters move by {change:.2e} (condition "

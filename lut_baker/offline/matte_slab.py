@@ -339,7 +339,8 @@ class MatteSlab:
     (``weight``), the fraction of the extinction seen from above that is due to flakes
     (``flakes``) and their GGX roughness (``flake_alpha``) or, if ``cone_spread_deg > 0``,
     their normals on a cone (:func:`cone_distribution`: ``cone_deg`` from the vertical, spread
-    ``cone_spread_deg``), the flakes' own single-scattering albedo (``flake_albedo``; None:
+    ``cone_spread_deg``; a share ``flat`` of them lying flat instead, their normals about the
+    vertical with the spread ``flat_spread_deg``), the flakes' own single-scattering albedo (``flake_albedo``; None:
     ``albedo``), the surface's index ``eta`` (1: no surface), its GGX roughness ``alpha`` and
     the fraction of the area it covers (``coverage``; the rest is the bare medium, in patches
     wider than the light's path in the medium: :func:`matte_slab_kernel`)."""
@@ -352,6 +353,8 @@ class MatteSlab:
     flake_alpha: float = 0.5
     cone_deg: float = 0.0
     cone_spread_deg: float = 0.0
+    flat: float = 0.0
+    flat_spread_deg: float = 20.0
     flake_albedo: np.ndarray | None = None
     eta: float = 1.0
     alpha: float = 0.3
@@ -371,7 +374,11 @@ def medium_generator(grid: HemisphereGrid, model: MatteSlab):
         mu = np.cos(grid.theta)
         if model.cone_spread_deg > 0.0:
             def distribution(cos_h):
-                return cone_distribution(cos_h, model.cone_deg, model.cone_spread_deg)
+                tilted = cone_distribution(cos_h, model.cone_deg, model.cone_spread_deg)
+                if model.flat <= 0.0:
+                    return tilted
+                flat = cone_distribution(cos_h, 0.0, model.flat_spread_deg)
+                return (1.0 - model.flat) * tilted + model.flat * flat
 
             flake_forward, flake_back = kernel_orders(grid, distribution)
             flake_area = projected_area(mu, distribution)

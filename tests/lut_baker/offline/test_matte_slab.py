@@ -118,6 +118,19 @@ def test_white_furnace_with_flakes_on_a_cone(cone, spread):
     assert np.all(np.concatenate(totals[2:]) < 0.9)
 
 
+def test_white_furnace_with_flat_and_tilted_flakes():
+    # Flakes on a cone with a share lying flat: a conservative finite slab still returns what
+    # it receives (the mixture of two normalised distributions is normalised).
+    scale0 = AD.star_scale(GRID)[0]
+    model = MatteSlab(albedo=np.array([1.0]), g1=0.3, flakes=0.8, cone_deg=45.0,
+                      cone_spread_deg=15.0, flat=0.4, flat_spread_deg=20.0)
+    for thickness in (1.0, 4.0):
+        r, t = AD.slab(medium_generator(GRID, model), thickness)
+        total = AD.star_albedo(r[:, 0], scale0) + AD.star_albedo(t[:, 0], scale0)
+        assert np.all(total <= 1.0 + 2e-3)
+        np.testing.assert_allclose(total, 1.0, atol=2e-2)
+
+
 def test_phase_function_is_normalised():
     np.testing.assert_allclose(_scattered(*phase_orders(GRID, 0.6, -0.3, 0.7)), 1.0, rtol=2e-3)
 
