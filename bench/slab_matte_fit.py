@@ -29,6 +29,8 @@ infinitely thick medium with a single-scattering albedo per channel in one of th
 - ``cone_partial_15``: ``cone_surface_15`` with the surface over a fraction of the area (the
   coverage), the bare medium elsewhere (9 parameters: a powder whose particles the binder does
   not all wet);
+- ``cone_patches_15``: ``cone_partial_15`` with two kinds of surface patch, each its
+  roughness and coverage (11 parameters: a heavier-tailed gloss than one GGX lobe);
 - ``cone_flat``: ``cone`` with a share of the flakes lying flat (normals about the vertical,
   their own spread; 9 parameters: Lanza et al.'s 103 has its flakes near the vertical),
 
@@ -117,13 +119,19 @@ FORMS = {
                         ((-4.0, 4.0), LOGIT, LOGIT, LOG_SPREAD, LOG_ALPHA, LOGIT),
                         ((-0.2, 1.0, 0.3, np.log(20.0), np.log(0.3), -1.0),
                          (0.3, 0.0, -1.0, np.log(30.0), np.log(0.6), 0.0))),
+    "cone_patches_15": (("g", "flakes", "cone", "spread", "alpha", "coverage", "alpha2",
+                         "coverage2"),
+                        ((-4.0, 4.0), LOGIT, LOGIT, LOG_SPREAD, LOG_ALPHA, LOGIT, LOG_ALPHA,
+                         LOGIT),
+                        ((-0.2, 1.0, 0.3, np.log(20.0), np.log(0.15), -3.0, np.log(0.6), 0.0),
+                         (0.3, 0.0, -1.0, np.log(30.0), np.log(0.2), -1.0, np.log(0.8), 0.0))),
     "cone_flat": (("g", "flakes", "cone", "spread", "flat", "flat_spread"),
                   ((-4.0, 4.0), LOGIT, LOGIT, LOG_SPREAD, LOGIT, LOG_SPREAD),
                   ((-0.2, 1.0, 0.3, np.log(20.0), -1.0, np.log(15.0)),
                    (0.3, 0.0, -1.0, np.log(30.0), 0.0, np.log(30.0)))),
 }
 CONE_FORMS = ("cone", "cone_flakes", "cone_tinted", "cone_slab", "cone_surface",
-              "cone_surface_15", "cone_partial_15", "cone_flat")
+              "cone_surface_15", "cone_partial_15", "cone_patches_15", "cone_flat")
 BINDER_ETA = 1.5
 """The surface's index in ``cone_surface_15``: a binder's (oils, silicones: about 1.4-1.5)."""
 ALBEDO_LOGIT_MAX = {"cone_tinted": float(np.log(0.995 / 0.005))}
@@ -150,6 +158,11 @@ def unpack(form: str, p) -> MatteSlab:
         kw.update(eta=BINDER_ETA, alpha=np.exp(p[-1]))
     elif form == "cone_partial_15":
         kw.update(eta=BINDER_ETA, alpha=np.exp(p[-2]), coverage=_sigmoid(p[-1]))
+    elif form == "cone_patches_15":
+        # Both kinds share the coverage _sigmoid(p[8]), split by _sigmoid(p[10]).
+        total, split = _sigmoid(p[8]), _sigmoid(p[10])
+        kw.update(eta=BINDER_ETA, alpha=np.exp(p[7]), coverage=total * split,
+                  alpha2=np.exp(p[9]), coverage2=total * (1.0 - split))
     if form == "flakes_surface":
         kw.update(flakes=_sigmoid(p[4]), flake_alpha=np.exp(p[5]))
     if form == "cone_flakes":
@@ -173,7 +186,8 @@ def physical(form: str, p) -> np.ndarray:
               "alpha": m.alpha, "flakes": m.flakes, "flake_alpha": m.flake_alpha,
               "cone": m.cone_deg, "spread": m.cone_spread_deg, "flake_r": tint[0],
               "flake_g": tint[1], "flake_b": tint[2], "coverage": m.coverage,
-              "flat": m.flat, "flat_spread": m.flat_spread_deg}
+              "flat": m.flat, "flat_spread": m.flat_spread_deg,
+              "alpha2": m.alpha2, "coverage2": m.coverage2}
     return np.array([*m.albedo, *(values[k] for k in FORMS[form][0])])
 
 
@@ -191,10 +205,10 @@ def in_plane(grid, model: MatteSlab, theta_i, theta_o) -> np.ndarray:
                  .ev(theta_i, np.abs(theta_o)) for phi in (np.pi, 0.0)]
         out[:, c] = np.pi * np.where(theta_o >= 0.0, sides[0], sides[1])
     if model.eta > 1.0:
-        out += np.pi * model.coverage * ggx_reflection(np.cos(np.radians(theta_i)),
-                                      np.cos(np.radians(np.abs(theta_o))),
-                                      np.where(theta_o >= 0.0, -1.0, 1.0), model.alpha,
-                                      model.eta)[:, None]
+        for alpha, coverage in model.surface_patches():
+            out += np.pi * coverage * ggx_reflection(
+                np.cos(np.radians(theta_i)), np.cos(np.radians(np.abs(theta_o))),
+                np.where(theta_o >= 0.0, -1.0, 1.0), alpha, model.eta)[:, None]
     return out
 
 

@@ -343,7 +343,8 @@ class MatteSlab:
     vertical with the spread ``flat_spread_deg``), the flakes' own single-scattering albedo (``flake_albedo``; None:
     ``albedo``), the surface's index ``eta`` (1: no surface), its GGX roughness ``alpha`` and
     the fraction of the area it covers (``coverage``; the rest is the bare medium, in patches
-    wider than the light's path in the medium: :func:`matte_slab_kernel`)."""
+    wider than the light's path in the medium: :func:`matte_slab_kernel`), and optionally a
+    second kind of surface patch, roughness ``alpha2`` over ``coverage2`` of the area."""
 
     albedo: np.ndarray
     g1: float = 0.0
@@ -359,6 +360,17 @@ class MatteSlab:
     eta: float = 1.0
     alpha: float = 0.3
     coverage: float = 1.0
+    alpha2: float = 0.3
+    coverage2: float = 0.0
+
+    def surface_patches(self) -> list[tuple[float, float]]:
+        """``(alpha, coverage)`` of each kind of surface patch: ``alpha`` over ``coverage`` and,
+        if ``coverage2 > 0``, a second roughness ``alpha2`` over ``coverage2`` (the bare medium
+        over the rest)."""
+        patches = [(float(self.alpha), float(self.coverage))]
+        if self.coverage2 > 0.0:
+            patches.append((float(self.alpha2), float(self.coverage2)))
+        return patches
 
 
 def medium_generator(grid: HemisphereGrid, model: MatteSlab):
@@ -408,19 +420,24 @@ def medium_reflection(grid: HemisphereGrid, model: MatteSlab) -> np.ndarray:
 def matte_slab_kernel(grid: HemisphereGrid, model: MatteSlab, tir_points: int = 8):
     """``(kernel, a_g)``: the light the medium returns (through the surface, if ``eta > 1``) as
     a kernel per channel and order on ``grid`` (1/sr, ``(C, orders, N, N)``; the surface's own
-    reflection, :func:`ggx_reflection` times ``model.coverage``, is added in closed form where
-    it is read) and the surface's directional albedo at the nodes times its coverage ``(N,)``
-    (zeros without a surface).  A partial surface (``coverage`` < 1) is patches of surface and
-    of bare medium each wide enough that light leaves by the patch it entered: the two
-    reflections weighted by their areas."""
+    reflection, :func:`ggx_reflection` times each patch's coverage, is added in closed form
+    where it is read) and the surface's directional albedo at the nodes, each patch's by its
+    coverage ``(N,)`` (zeros without a surface).  A partial surface (coverages below 1,
+    :meth:`MatteSlab.surface_patches`) is patches of surface and of bare medium each wide
+    enough that light leaves by the patch it entered: their reflections weighted by their
+    areas."""
     scale = AD.star_scale(grid)
     if not model.eta > 1.0:
         return AD.from_star(medium_reflection(grid, model), scale), np.zeros(grid.theta.size)
     inside = refracted_grid(grid, model.eta, tir_points)
     body = medium_reflection(inside, model)
-    a_g = ggx_albedo(np.cos(grid.theta), model.alpha, model.eta)
-    star = under_surface(body, a_g)
-    w = float(model.coverage)
-    if w < 1.0:
-        star = w * star + (1.0 - w) * medium_reflection(grid, model)
-    return AD.from_star(star, scale), w * a_g
+    star = 0.0
+    a_g = np.zeros(grid.theta.size)
+    for alpha, w in model.surface_patches():
+        patch = ggx_albedo(np.cos(grid.theta), alpha, model.eta)
+        star = star + w * under_surface(body, patch)
+        a_g = a_g + w * patch
+    bare = 1.0 - sum(w for _, w in model.surface_patches())
+    if bare > 0.0:
+        star = star + bare * medium_reflection(grid, model)
+    return AD.from_star(star, scale), a_g

@@ -146,6 +146,9 @@ MODELS = [
               cone_spread_deg=15.0, eta=1.4, alpha=0.5),
     MatteSlab(albedo=np.array([0.98, 0.9, 0.6]), g1=0.3, flakes=0.4, cone_deg=40.0,
               cone_spread_deg=20.0, eta=1.5, alpha=0.3, coverage=0.3),
+    MatteSlab(albedo=np.array([0.98, 0.9, 0.6]), g1=0.3, flakes=0.4, cone_deg=40.0,
+              cone_spread_deg=20.0, eta=1.5, alpha=0.1, coverage=0.2, alpha2=0.7,
+              coverage2=0.6),
 ]
 
 
@@ -185,3 +188,10 @@ def test_partial_surface_is_its_patches_by_area():
                                                        coverage=0.0))
     np.testing.assert_allclose(k_none, k_bare, rtol=1e-10, atol=1e-14)
     assert np.all(a_none == 0.0)
+    # Two kinds of patch (roughness 0.3 over 30%, 0.8 over 50%), bare medium over 20%.
+    k_rough, a_rough = matte_slab_kernel(GRID, MatteSlab(**medium, eta=1.5, alpha=0.8))
+    k_two, a_two = matte_slab_kernel(GRID, MatteSlab(**medium, eta=1.5, alpha=0.3,
+                                                     coverage=0.3, alpha2=0.8, coverage2=0.5))
+    np.testing.assert_allclose(k_two, 0.3 * k_full + 0.5 * k_rough + 0.2 * k_bare, rtol=1e-10,
+                               atol=1e-14)
+    np.testing.assert_allclose(a_two, 0.3 * a_full + 0.5 * a_rough, rtol=1e-12)
