@@ -259,8 +259,8 @@ def _held_from_starts(grid, form, data, rows, starts: int) -> None:
         on = relative_error(in_plane(grid, model, ti[rows], to[rows]), rgb[rows])[0]
         off = relative_error(in_plane(grid, model, ti[~rows], to[~rows]), rgb[~rows])[0]
         values = ", ".join(f"{v:.4f}" for v in physical(form, q))
-        print(f"  held-out fit from start {k}: {100 * on:.1f}% on the fitted incidences, "
-              f"predicting {100 * off:.1f}% ({values})", flush=True)
+        print(f"  held-out fit from start {k}: {100 * on:.2f}% on the fitted incidences, "
+              f"predicting {100 * off:.2f}% ({values})", flush=True)
 
 
 def main(argv=None) -> int:
@@ -306,8 +306,8 @@ def main(argv=None) -> int:
             if args.held_starts:
                 on = relative_error(in_plane(grid, unpack(form, q), ti[rows], to[rows]),
                                     rgb[rows])[0]
-                print(f"  held-out fit from the optimum on every incidence: {100 * on:.1f}% on "
-                      f"the fitted incidences, predicting {100 * held_rms:.1f}%")
+                print(f"  held-out fit from the optimum on every incidence: {100 * on:.2f}% on "
+                      f"the fitted incidences, predicting {100 * held_rms:.2f}%")
                 _held_from_starts(grid, form, (ti, to, rgb), rows, args.starts)
             verdict = "determined" if change < DETERMINED and not bound else "NOT determined"
             print(f"  data x (1 + {PERTURBATION:g} u): parameters move by {change:.2e} (condition "
