@@ -35,16 +35,17 @@ infinitely thick medium with a single-scattering albedo per channel in one of th
   their own spread; 9 parameters: Lanza et al.'s 103 has its flakes near the vertical),
 
 read in the plane of incidence by a bicubic spline over the grid's polar nodes (the surface's
-own reflection in closed form).  Physical bounds: |g| <= 0.95, 1.01 <= eta <= 2, 0.05 <= alpha
-<= 1, 0.2 <= flake alpha <= 1, 0 <= cone <= 90 degrees, 5 <= spread <= 60 degrees (a
-narrower cone is finer than the default grid resolves).  It prints the relative error
-(model/measured - 1) on every incidence and, fitted on alternate incidences, on the others
-(as lut_baker/offline/foundations.py does for eq. 2; that fit starts from the optimum on every
-incidence, and ``--held-starts`` also starts it from the form's own starts); then the check that the fit is
-determined by its data: refitted from its optimum to the measurements moved by 1e-9
-(relative, random signs), the largest change of a parameter to first order (< 1e-6 passes;
+own reflection in closed form). Physical bounds: |g| <= 0.95, 1.01 <= eta <= 2, 0.05 <= alpha
+<= 1, 0.2 <= flake alpha <= 1, 0 <= cone <= 90 degrees, 5 <= spread <= 60 degrees (a narrower
+cone is finer than the default grid resolves), a surface's coverage 3e-4 from 0 and 1 (logits
+within 8). It prints the relative error (model/measured -
+1) on every incidence and, fitted on alternate incidences, on the others (as
+lut_baker/offline/foundations.py does for eq. 2; that fit starts from the optimum on every
+incidence, and ``--held-starts`` also starts it from the form's own starts); then the check
+that the fit is determined by its data: refitted from its optimum to the measurements moved by
+1e-9 (relative, random signs), the largest change of a parameter to first order (< 1e-6 passes;
 :func:`data_response`) and whether a parameter sits at its bound (then it is not determined
-either).  About 1-6 minutes per product and form on one core at the default grid.
+either). About 1-6 minutes per product and form on one core at the default grid.
 """
 
 from __future__ import annotations

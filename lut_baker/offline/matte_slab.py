@@ -335,12 +335,12 @@ def under_surface(body: np.ndarray, surface_albedo: np.ndarray) -> np.ndarray:
 @dataclass(frozen=True, eq=False)
 class MatteSlab:
     """The model's parameters: ``albedo`` (single scattering, RGB, shared by the two kinds of
-    particle), the spheres' phase function ``g1``, ``g2`` and the weight of ``g1``
-    (``weight``), the fraction of the extinction seen from above that is due to flakes
-    (``flakes``) and their GGX roughness (``flake_alpha``) or, if ``cone_spread_deg > 0``,
-    their normals on a cone (:func:`cone_distribution`: ``cone_deg`` from the vertical, spread
-    ``cone_spread_deg``; a share ``flat`` of them lying flat instead, their normals about the
-    vertical with the spread ``flat_spread_deg``), the flakes' own single-scattering albedo (``flake_albedo``; None:
+    particle), the spheres' phase function ``g1``, ``g2`` and the weight of ``g1`` (``weight``),
+    the fraction of the extinction seen from above that is due to flakes (``flakes``) and their
+    GGX roughness (``flake_alpha``) or, if ``cone_spread_deg > 0``, their normals on a cone
+    (:func:`cone_distribution`: ``cone_deg`` from the vertical, spread ``cone_spread_deg``; a
+    share ``flat`` of them lying flat instead, their normals about the vertical with the spread
+    ``flat_spread_deg``), the flakes' own single-scattering albedo (``flake_albedo``; None:
     ``albedo``), the surface's index ``eta`` (1: no surface), its GGX roughness ``alpha`` and
     the fraction of the area it covers (``coverage``; the rest is the bare medium, in patches
     wider than the light's path in the medium: :func:`matte_slab_kernel`), and optionally a
