@@ -431,13 +431,11 @@ def matte_slab_kernel(grid: HemisphereGrid, model: MatteSlab, tir_points: int = 
         return AD.from_star(medium_reflection(grid, model), scale), np.zeros(grid.theta.size)
     inside = refracted_grid(grid, model.eta, tir_points)
     body = medium_reflection(inside, model)
-    star = 0.0
-    a_g = np.zeros(grid.theta.size)
-    for alpha, w in model.surface_patches():
-        patch = ggx_albedo(np.cos(grid.theta), alpha, model.eta)
-        star = star + w * under_surface(body, patch)
-        a_g = a_g + w * patch
-    bare = 1.0 - sum(w for _, w in model.surface_patches())
+    patches = model.surface_patches()
+    albedos = [ggx_albedo(np.cos(grid.theta), alpha, model.eta) for alpha, _ in patches]
+    star = sum(w * under_surface(body, a) for (_, w), a in zip(patches, albedos, strict=True))
+    a_g = sum(w * a for (_, w), a in zip(patches, albedos, strict=True))
+    bare = 1.0 - sum(w for _, w in patches)
     if bare > 0.0:
         star = star + bare * medium_reflection(grid, model)
-    return AD.from_star(star, scale), a_g
+    return AD.from_star(np.asarray(star), scale), np.asarray(a_g)
