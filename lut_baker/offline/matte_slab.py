@@ -54,7 +54,7 @@ Functions
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -344,7 +344,9 @@ class MatteSlab:
     ``albedo``), the surface's index ``eta`` (1: no surface), its GGX roughness ``alpha`` and
     the fraction of the area it covers (``coverage``; the rest is the bare medium, in patches
     wider than the light's path in the medium: :func:`matte_slab_kernel`), and optionally a
-    second kind of surface patch, roughness ``alpha2`` over ``coverage2`` of the area."""
+    second kind of surface patch, roughness ``alpha2`` over ``coverage2`` of the area; a top
+    layer of the medium ``top_thickness`` thick absorbing ``top_absorption`` times as much
+    (:func:`medium_reflection`)."""
 
     albedo: np.ndarray
     g1: float = 0.0
@@ -362,6 +364,8 @@ class MatteSlab:
     coverage: float = 1.0
     alpha2: float = 0.3
     coverage2: float = 0.0
+    top_thickness: float = 0.0
+    top_absorption: float = 1.0
 
     def surface_patches(self) -> list[tuple[float, float]]:
         """``(alpha, coverage)`` of each kind of surface patch: ``alpha`` over ``coverage`` and,
@@ -413,8 +417,20 @@ def medium_generator(grid: HemisphereGrid, model: MatteSlab):
 
 def medium_reflection(grid: HemisphereGrid, model: MatteSlab) -> np.ndarray:
     """The thick medium's reflection (star form on ``grid``): :func:`medium_generator`'s
-    infinite-thickness limit."""
-    return AD.thick_slab(medium_generator(grid, model))
+    infinite-thickness limit, under a top layer of the same particles absorbing
+    ``model.top_absorption`` times as much (single-scattering albedo ``1 - k (1 - albedo)``),
+    ``model.top_thickness`` thick (units of the spheres' extinction), if that is > 0."""
+    thick = AD.thick_slab(medium_generator(grid, model))
+    if not model.top_thickness > 0.0:
+        return thick
+    top_albedo = 1.0 - model.top_absorption * (1.0 - np.asarray(model.albedo, float))
+    top = replace(model, albedo=top_albedo, top_thickness=0.0)
+    r, t = AD.slab(medium_generator(grid, top), model.top_thickness)
+    # The medium is even in the vertical (HG and two-sided flakes): the top layer reflects the
+    # same from below; nothing leaves the thick medium downward.
+    return AD.add_layers(AD.Layer(top=r, bottom=r, down=t),
+                         AD.Layer(top=thick, bottom=thick, down=np.zeros_like(thick)),
+                         symmetric=True).top
 
 
 def matte_slab_kernel(grid: HemisphereGrid, model: MatteSlab, tir_points: int = 8):

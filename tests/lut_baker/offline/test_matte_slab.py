@@ -18,6 +18,7 @@ from lut_baker.offline.matte_slab import (
     kernel_orders,
     matte_slab_kernel,
     medium_generator,
+    medium_reflection,
     phase_orders,
     projected_area,
     refracted_grid,
@@ -195,3 +196,20 @@ def test_partial_surface_is_its_patches_by_area():
     np.testing.assert_allclose(k_two, 0.3 * k_full + 0.5 * k_rough + 0.2 * k_bare, rtol=1e-10,
                                atol=1e-14)
     np.testing.assert_allclose(a_two, 0.3 * a_full + 0.5 * a_rough, rtol=1e-12)
+
+
+def test_top_layer_of_the_medium():
+    # A top layer absorbing as the medium does is the medium; a very thick one is its own thick
+    # medium; a less absorbing one reflects more.
+    medium = {"albedo": np.array([0.98, 0.9]), "g1": 0.5, "flakes": 0.4, "cone_deg": 40.0,
+              "cone_spread_deg": 20.0}
+    plain = medium_reflection(GRID, MatteSlab(**medium))
+    same = medium_reflection(GRID, MatteSlab(**medium, top_thickness=3.0, top_absorption=1.0))
+    np.testing.assert_allclose(same, plain, atol=1e-12)
+    deep = medium_reflection(GRID, MatteSlab(**medium, top_thickness=200.0, top_absorption=0.3))
+    whiter = medium_reflection(GRID, MatteSlab(**{**medium, "albedo": 1.0 - 0.3 * (
+        1.0 - medium["albedo"])}))
+    np.testing.assert_allclose(deep, whiter, atol=1e-12)
+    scale0 = AD.star_scale(GRID)[0]
+    thin = medium_reflection(GRID, MatteSlab(**medium, top_thickness=2.0, top_absorption=0.3))
+    assert np.all(AD.star_albedo(thin[:, 0], scale0) > AD.star_albedo(plain[:, 0], scale0))
