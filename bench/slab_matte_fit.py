@@ -3,7 +3,7 @@ held-out errors, and whether the data determine the parameters (docs/model.md, "
 products as a slab under a surface"; docs/foundations/README.md).
 
     python bench/slab_matte_fit.py [--products NAME ...] [--forms FORM ...]
-                                   [--grid PANELS POINTS N_PHI] [--starts K]
+                                   [--grid PANELS POINTS N_PHI] [--starts K] [--held-starts]
 
 For Clarins 103 and 108 (data/lanza2024, matte; eq. 2 fits them with P_d alone at 19.4% and
 19.5% rms, 23.1% and 19.0% held out) this fits, by adding (lut_baker.offline.matte_slab), an
@@ -25,18 +25,30 @@ infinitely thick medium with a single-scattering albedo per channel in one of th
   give their flakes and their spheres each an albedo (the spheres' at most 0.995);
 - ``cone_slab``: spheres with two HG lobes and the flakes on a cone (9 parameters);
 - ``cone_surface``: ``cone`` under the rough dielectric surface (9 parameters: eta, alpha
-  added); ``cone_surface_15`` the same with eta held at a binder's 1.5 (8 parameters),
+  added); ``cone_surface_15`` the same with eta held at a binder's 1.5 (8 parameters);
+- ``cone_partial_15``: ``cone_surface_15`` with the surface over a fraction of the area (the
+  coverage), the bare medium elsewhere (9 parameters: a powder whose particles the binder does
+  not all wet);
+- ``cone_patches_15``: ``cone_partial_15`` with two kinds of surface patch, each its
+  roughness and coverage (11 parameters: a heavier-tailed gloss than one GGX lobe);
+- ``cone_top``: ``cone`` under a top layer of the same particles absorbing differently (9
+  parameters: its thickness and its absorption relative to the medium's, 0.01-100 and
+  0.02-50);
+- ``cone_flat``: ``cone`` with a share of the flakes lying flat (normals about the vertical,
+  their own spread; 9 parameters: Lanza et al.'s 103 has its flakes near the vertical),
 
 read in the plane of incidence by a bicubic spline over the grid's polar nodes (the surface's
-own reflection in closed form).  Physical bounds: |g| <= 0.95, 1.01 <= eta <= 2, 0.05 <= alpha
-<= 1, 0.2 <= flake alpha <= 1, 0 <= cone <= 90 degrees, 5 <= spread <= 60 degrees (a
-narrower cone is finer than the default grid resolves).  It prints the relative error
-(model/measured - 1) on every incidence and, fitted on alternate incidences, on the others
-(as lut_baker/offline/foundations.py does for eq. 2); then the check that the fit is
-determined by its data: refitted from its optimum to the measurements moved by 1e-9
-(relative, random signs), the largest change of a parameter to first order (< 1e-6 passes;
+own reflection in closed form). Physical bounds: |g| <= 0.95, 1.01 <= eta <= 2, 0.05 <= alpha
+<= 1, 0.2 <= flake alpha <= 1, 0 <= cone <= 90 degrees, 5 <= spread <= 60 degrees (a narrower
+cone is finer than the default grid resolves), a surface's coverage 3e-4 from 0 and 1 (logits
+within 8). It prints the relative error (model/measured -
+1) on every incidence and, fitted on alternate incidences, on the others (as
+lut_baker/offline/foundations.py does for eq. 2; that fit starts from the optimum on every
+incidence, and ``--held-starts`` also starts it from the form's own starts); then the check
+that the fit is determined by its data: refitted from its optimum to the measurements moved by
+1e-9 (relative, random signs), the largest change of a parameter to first order (< 1e-6 passes;
 :func:`data_response`) and whether a parameter sits at its bound (then it is not determined
-either).  About 1-6 minutes per product and form on one core at the default grid.
+either). About 1-6 minutes per product and form on one core at the default grid.
 """
 
 from __future__ import annotations
@@ -107,9 +119,29 @@ FORMS = {
                         ((-4.0, 4.0), LOGIT, LOGIT, LOG_SPREAD, LOG_ALPHA),
                         ((-0.2, 1.0, 0.3, np.log(20.0), np.log(0.3)),
                          (0.3, 0.0, -1.0, np.log(30.0), np.log(0.6)))),
+    "cone_partial_15": (("g", "flakes", "cone", "spread", "alpha", "coverage"),
+                        ((-4.0, 4.0), LOGIT, LOGIT, LOG_SPREAD, LOG_ALPHA, LOGIT),
+                        ((-0.2, 1.0, 0.3, np.log(20.0), np.log(0.3), -1.0),
+                         (0.3, 0.0, -1.0, np.log(30.0), np.log(0.6), 0.0))),
+    "cone_patches_15": (("g", "flakes", "cone", "spread", "alpha", "coverage", "alpha2",
+                         "coverage2"),
+                        ((-4.0, 4.0), LOGIT, LOGIT, LOG_SPREAD, LOG_ALPHA, LOGIT, LOG_ALPHA,
+                         LOGIT),
+                        ((-0.2, 1.0, 0.3, np.log(20.0), np.log(0.15), -3.0, np.log(0.6), 0.0),
+                         (0.3, 0.0, -1.0, np.log(30.0), np.log(0.2), -1.0, np.log(0.8), 0.0))),
+    "cone_top": (("g", "flakes", "cone", "spread", "top_thickness", "top_absorption"),
+                 ((-4.0, 4.0), LOGIT, LOGIT, LOG_SPREAD, (np.log(0.01), np.log(100.0)),
+                  (np.log(0.02), np.log(50.0))),
+                 ((-0.2, 1.0, 0.3, np.log(20.0), 0.0, np.log(0.3)),
+                  (0.3, 0.0, -1.0, np.log(30.0), np.log(3.0), np.log(3.0)))),
+    "cone_flat": (("g", "flakes", "cone", "spread", "flat", "flat_spread"),
+                  ((-4.0, 4.0), LOGIT, LOGIT, LOG_SPREAD, LOGIT, LOG_SPREAD),
+                  ((-0.2, 1.0, 0.3, np.log(20.0), -1.0, np.log(15.0)),
+                   (0.3, 0.0, -1.0, np.log(30.0), 0.0, np.log(30.0)))),
 }
 CONE_FORMS = ("cone", "cone_flakes", "cone_tinted", "cone_slab", "cone_surface",
-              "cone_surface_15")
+              "cone_surface_15", "cone_partial_15", "cone_patches_15", "cone_flat",
+              "cone_top")
 BINDER_ETA = 1.5
 """The surface's index in ``cone_surface_15``: a binder's (oils, silicones: about 1.4-1.5)."""
 ALBEDO_LOGIT_MAX = {"cone_tinted": float(np.log(0.995 / 0.005))}
@@ -134,6 +166,13 @@ def unpack(form: str, p) -> MatteSlab:
         kw.update(eta=1.0 + np.exp(p[-2]), alpha=np.exp(p[-1]))
     elif form == "cone_surface_15":
         kw.update(eta=BINDER_ETA, alpha=np.exp(p[-1]))
+    elif form == "cone_partial_15":
+        kw.update(eta=BINDER_ETA, alpha=np.exp(p[-2]), coverage=_sigmoid(p[-1]))
+    elif form == "cone_patches_15":
+        # Both kinds share the coverage _sigmoid(p[8]), split by _sigmoid(p[10]).
+        total, split = _sigmoid(p[8]), _sigmoid(p[10])
+        kw.update(eta=BINDER_ETA, alpha=np.exp(p[7]), coverage=total * split,
+                  alpha2=np.exp(p[9]), coverage2=total * (1.0 - split))
     if form == "flakes_surface":
         kw.update(flakes=_sigmoid(p[4]), flake_alpha=np.exp(p[5]))
     if form == "cone_flakes":
@@ -142,6 +181,10 @@ def unpack(form: str, p) -> MatteSlab:
         first = 6 if form == "cone_slab" else 4
         kw.update(flakes=_sigmoid(p[first]), cone_deg=90.0 * _sigmoid(p[first + 1]),
                   cone_spread_deg=np.exp(p[first + 2]))
+    if form == "cone_top":
+        kw.update(top_thickness=np.exp(p[7]), top_absorption=np.exp(p[8]))
+    if form == "cone_flat":
+        kw.update(flat=_sigmoid(p[7]), flat_spread_deg=np.exp(p[8]))
     if form == "cone_tinted":
         kw.update(flake_albedo=_sigmoid(p[7:10]))
     return MatteSlab(**kw)
@@ -154,7 +197,10 @@ def physical(form: str, p) -> np.ndarray:
     values = {"g1": m.g1, "g2": m.g2, "weight": m.weight, "g": m.g1, "eta": m.eta,
               "alpha": m.alpha, "flakes": m.flakes, "flake_alpha": m.flake_alpha,
               "cone": m.cone_deg, "spread": m.cone_spread_deg, "flake_r": tint[0],
-              "flake_g": tint[1], "flake_b": tint[2]}
+              "flake_g": tint[1], "flake_b": tint[2], "coverage": m.coverage,
+              "flat": m.flat, "flat_spread": m.flat_spread_deg,
+              "alpha2": m.alpha2, "coverage2": m.coverage2, "top_thickness": m.top_thickness,
+              "top_absorption": m.top_absorption}
     return np.array([*m.albedo, *(values[k] for k in FORMS[form][0])])
 
 
@@ -172,10 +218,10 @@ def in_plane(grid, model: MatteSlab, theta_i, theta_o) -> np.ndarray:
                  .ev(theta_i, np.abs(theta_o)) for phi in (np.pi, 0.0)]
         out[:, c] = np.pi * np.where(theta_o >= 0.0, sides[0], sides[1])
     if model.eta > 1.0:
-        out += np.pi * ggx_reflection(np.cos(np.radians(theta_i)),
-                                      np.cos(np.radians(np.abs(theta_o))),
-                                      np.where(theta_o >= 0.0, -1.0, 1.0), model.alpha,
-                                      model.eta)[:, None]
+        for alpha, coverage in model.surface_patches():
+            out += np.pi * coverage * ggx_reflection(
+                np.cos(np.radians(theta_i)), np.cos(np.radians(np.abs(theta_o))),
+                np.where(theta_o >= 0.0, -1.0, 1.0), alpha, model.eta)[:, None]
     return out
 
 
@@ -215,6 +261,21 @@ def data_response(grid, form, theta_i, theta_o, rgb, p, seed: int = 0):
     return change, float(np.linalg.cond(jac))
 
 
+def _held_from_starts(grid, form, data, rows, starts: int) -> None:
+    """Print the fit on the alternate incidences ``rows`` started from the form's own starts
+    (not from the optimum on every incidence): its rms on the fitted rows and on the others."""
+    ti, to, rgb = data
+    for k, start in enumerate(FORMS[form][2][:starts]):
+        q, _ = fit(grid, form, ti[rows], to[rows], rgb[rows], np.array([3.0, 2.0, 1.0, *start]))
+        q, _ = fit(grid, form, ti[rows], to[rows], rgb[rows], q, tight=True)
+        model = unpack(form, q)
+        on = relative_error(in_plane(grid, model, ti[rows], to[rows]), rgb[rows])[0]
+        off = relative_error(in_plane(grid, model, ti[~rows], to[~rows]), rgb[~rows])[0]
+        values = ", ".join(f"{v:.4f}" for v in physical(form, q))
+        print(f"  held-out fit from start {k}: {100 * on:.2f}% on the fitted incidences, "
+              f"predicting {100 * off:.2f}% ({values})", flush=True)
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--products", nargs="+", default=["clarins_103", "clarins_108"])
@@ -222,6 +283,8 @@ def main(argv=None) -> int:
     parser.add_argument("--grid", type=int, nargs=3, default=(4, 8, 65),
                         metavar=("PANELS", "POINTS", "N_PHI"))
     parser.add_argument("--starts", type=int, default=2)
+    parser.add_argument("--held-starts", action="store_true",
+                        help="also fit the alternate incidences from the form's own starts")
     args = parser.parse_args(argv)
     grid = hemisphere_panels(*args.grid)
     np.seterr(all="ignore")
@@ -249,10 +312,16 @@ def main(argv=None) -> int:
             names = ("albedo_r", "albedo_g", "albedo_b", *FORMS[form][0])
             bound = [n for n, b in zip(names, at_bound, strict=True) if b]
             print(f"{name} {form}: fit {100 * rms:.1f}% rms, {100 * worst:.1f}% worst; fitted on "
-                  f"{fitted} predicting {held}: {100 * held_rms:.1f}% rms, "
+                  f"{fitted} predicting {held}: {100 * held_rms:.2f}% rms, "
                   f"{100 * held_worst:.1f}% worst ({time.perf_counter() - clock:.0f} s)")
             values = physical(form, p)
             print("  " + ", ".join(f"{n} {v:.4f}" for n, v in zip(names, values, strict=True)))
+            if args.held_starts:
+                on = relative_error(in_plane(grid, unpack(form, q), ti[rows], to[rows]),
+                                    rgb[rows])[0]
+                print(f"  held-out fit from the optimum on every incidence: {100 * on:.2f}% on "
+                      f"the fitted incidences, predicting {100 * held_rms:.2f}%")
+                _held_from_starts(grid, form, (ti, to, rgb), rows, args.starts)
             verdict = "determined" if change < DETERMINED and not bound else "NOT determined"
             print(f"  data x (1 + {PERTURBATION:g} u): parameters move by {change:.2e} (condition "
                   f"{condition:.1e}); at a bound: "

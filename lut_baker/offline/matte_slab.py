@@ -54,7 +54,7 @@ Functions
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -335,12 +335,18 @@ def under_surface(body: np.ndarray, surface_albedo: np.ndarray) -> np.ndarray:
 @dataclass(frozen=True, eq=False)
 class MatteSlab:
     """The model's parameters: ``albedo`` (single scattering, RGB, shared by the two kinds of
-    particle), the spheres' phase function ``g1``, ``g2`` and the weight of ``g1``
-    (``weight``), the fraction of the extinction seen from above that is due to flakes
-    (``flakes``) and their GGX roughness (``flake_alpha``) or, if ``cone_spread_deg > 0``,
-    their normals on a cone (:func:`cone_distribution`: ``cone_deg`` from the vertical, spread
-    ``cone_spread_deg``), the flakes' own single-scattering albedo (``flake_albedo``; None:
-    ``albedo``), the surface's index ``eta`` (1: no surface) and GGX roughness ``alpha``."""
+    particle), the spheres' phase function ``g1``, ``g2`` and the weight of ``g1`` (``weight``),
+    the fraction of the extinction seen from above that is due to flakes (``flakes``) and their
+    GGX roughness (``flake_alpha``) or, if ``cone_spread_deg > 0``, their normals on a cone
+    (:func:`cone_distribution`: ``cone_deg`` from the vertical, spread ``cone_spread_deg``; a
+    share ``flat`` of them lying flat instead, their normals about the vertical with the spread
+    ``flat_spread_deg``), the flakes' own single-scattering albedo (``flake_albedo``; None:
+    ``albedo``), the surface's index ``eta`` (1: no surface), its GGX roughness ``alpha`` and
+    the fraction of the area it covers (``coverage``; the rest is the bare medium, in patches
+    wider than the light's path in the medium: :func:`matte_slab_kernel`), and optionally a
+    second kind of surface patch, roughness ``alpha2`` over ``coverage2`` of the area; a top
+    layer of the medium ``top_thickness`` thick absorbing ``top_absorption`` times as much
+    (:func:`medium_reflection`)."""
 
     albedo: np.ndarray
     g1: float = 0.0
@@ -350,9 +356,25 @@ class MatteSlab:
     flake_alpha: float = 0.5
     cone_deg: float = 0.0
     cone_spread_deg: float = 0.0
+    flat: float = 0.0
+    flat_spread_deg: float = 20.0
     flake_albedo: np.ndarray | None = None
     eta: float = 1.0
     alpha: float = 0.3
+    coverage: float = 1.0
+    alpha2: float = 0.3
+    coverage2: float = 0.0
+    top_thickness: float = 0.0
+    top_absorption: float = 1.0
+
+    def surface_patches(self) -> list[tuple[float, float]]:
+        """``(alpha, coverage)`` of each kind of surface patch: ``alpha`` over ``coverage`` and,
+        if ``coverage2 > 0``, a second roughness ``alpha2`` over ``coverage2`` (the bare medium
+        over the rest)."""
+        patches = [(float(self.alpha), float(self.coverage))]
+        if self.coverage2 > 0.0:
+            patches.append((float(self.alpha2), float(self.coverage2)))
+        return patches
 
 
 def medium_generator(grid: HemisphereGrid, model: MatteSlab):
@@ -368,7 +390,11 @@ def medium_generator(grid: HemisphereGrid, model: MatteSlab):
         mu = np.cos(grid.theta)
         if model.cone_spread_deg > 0.0:
             def distribution(cos_h):
-                return cone_distribution(cos_h, model.cone_deg, model.cone_spread_deg)
+                tilted = cone_distribution(cos_h, model.cone_deg, model.cone_spread_deg)
+                if model.flat <= 0.0:
+                    return tilted
+                flat = cone_distribution(cos_h, 0.0, model.flat_spread_deg)
+                return (1.0 - model.flat) * tilted + model.flat * flat
 
             flake_forward, flake_back = kernel_orders(grid, distribution)
             flake_area = projected_area(mu, distribution)
@@ -391,19 +417,41 @@ def medium_generator(grid: HemisphereGrid, model: MatteSlab):
 
 def medium_reflection(grid: HemisphereGrid, model: MatteSlab) -> np.ndarray:
     """The thick medium's reflection (star form on ``grid``): :func:`medium_generator`'s
-    infinite-thickness limit."""
-    return AD.thick_slab(medium_generator(grid, model))
+    infinite-thickness limit, under a top layer of the same particles absorbing
+    ``model.top_absorption`` times as much (single-scattering albedo ``1 - k (1 - albedo)``),
+    ``model.top_thickness`` thick (units of the spheres' extinction), if that is > 0."""
+    thick = AD.thick_slab(medium_generator(grid, model))
+    if not model.top_thickness > 0.0:
+        return thick
+    top_albedo = 1.0 - model.top_absorption * (1.0 - np.asarray(model.albedo, float))
+    top = replace(model, albedo=top_albedo, top_thickness=0.0)
+    r, t = AD.slab(medium_generator(grid, top), model.top_thickness)
+    # The medium is even in the vertical (HG and two-sided flakes): the top layer reflects the
+    # same from below; nothing leaves the thick medium downward.
+    return AD.add_layers(AD.Layer(top=r, bottom=r, down=t),
+                         AD.Layer(top=thick, bottom=thick, down=np.zeros_like(thick)),
+                         symmetric=True).top
 
 
 def matte_slab_kernel(grid: HemisphereGrid, model: MatteSlab, tir_points: int = 8):
     """``(kernel, a_g)``: the light the medium returns (through the surface, if ``eta > 1``) as
     a kernel per channel and order on ``grid`` (1/sr, ``(C, orders, N, N)``; the surface's own
-    reflection, :func:`ggx_reflection`, is added in closed form where it is read) and the
-    surface's directional albedo at the nodes ``(N,)`` (zeros without a surface)."""
+    reflection, :func:`ggx_reflection` times each patch's coverage, is added in closed form
+    where it is read) and the surface's directional albedo at the nodes, each patch's by its
+    coverage ``(N,)`` (zeros without a surface).  A partial surface (coverages below 1,
+    :meth:`MatteSlab.surface_patches`) is patches of surface and of bare medium each wide
+    enough that light leaves by the patch it entered: their reflections weighted by their
+    areas."""
     scale = AD.star_scale(grid)
     if not model.eta > 1.0:
         return AD.from_star(medium_reflection(grid, model), scale), np.zeros(grid.theta.size)
     inside = refracted_grid(grid, model.eta, tir_points)
     body = medium_reflection(inside, model)
-    a_g = ggx_albedo(np.cos(grid.theta), model.alpha, model.eta)
-    return AD.from_star(under_surface(body, a_g), scale), a_g
+    patches = model.surface_patches()
+    albedos = [ggx_albedo(np.cos(grid.theta), alpha, model.eta) for alpha, _ in patches]
+    star = sum(w * under_surface(body, a) for (_, w), a in zip(patches, albedos, strict=True))
+    a_g = sum(w * a for (_, w), a in zip(patches, albedos, strict=True))
+    bare = 1.0 - sum(w for _, w in patches)
+    if bare > 0.0:
+        star = star + bare * medium_reflection(grid, model)
+    return AD.from_star(np.asarray(star), scale), np.asarray(a_g)

@@ -18,6 +18,7 @@ from lut_baker.offline.matte_slab import (
     kernel_orders,
     matte_slab_kernel,
     medium_generator,
+    medium_reflection,
     phase_orders,
     projected_area,
     refracted_grid,
@@ -118,6 +119,19 @@ def test_white_furnace_with_flakes_on_a_cone(cone, spread):
     assert np.all(np.concatenate(totals[2:]) < 0.9)
 
 
+def test_white_furnace_with_flat_and_tilted_flakes():
+    # Flakes on a cone with a share lying flat: a conservative finite slab still returns what
+    # it receives (the mixture of two normalised distributions is normalised).
+    scale0 = AD.star_scale(GRID)[0]
+    model = MatteSlab(albedo=np.array([1.0]), g1=0.3, flakes=0.8, cone_deg=45.0,
+                      cone_spread_deg=15.0, flat=0.4, flat_spread_deg=20.0)
+    for thickness in (1.0, 4.0):
+        r, t = AD.slab(medium_generator(GRID, model), thickness)
+        total = AD.star_albedo(r[:, 0], scale0) + AD.star_albedo(t[:, 0], scale0)
+        assert np.all(total <= 1.0 + 2e-3)
+        np.testing.assert_allclose(total, 1.0, atol=2e-2)
+
+
 def test_phase_function_is_normalised():
     np.testing.assert_allclose(_scattered(*phase_orders(GRID, 0.6, -0.3, 0.7)), 1.0, rtol=2e-3)
 
@@ -131,6 +145,11 @@ MODELS = [
               cone_spread_deg=20.0, flake_albedo=np.array([0.95, 0.85, 0.7])),
     MatteSlab(albedo=np.array([0.98, 0.9, 0.6]), g1=0.1, flakes=0.4, cone_deg=30.0,
               cone_spread_deg=15.0, eta=1.4, alpha=0.5),
+    MatteSlab(albedo=np.array([0.98, 0.9, 0.6]), g1=0.3, flakes=0.4, cone_deg=40.0,
+              cone_spread_deg=20.0, eta=1.5, alpha=0.3, coverage=0.3),
+    MatteSlab(albedo=np.array([0.98, 0.9, 0.6]), g1=0.3, flakes=0.4, cone_deg=40.0,
+              cone_spread_deg=20.0, eta=1.5, alpha=0.1, coverage=0.2, alpha2=0.7,
+              coverage2=0.6),
 ]
 
 
@@ -153,3 +172,44 @@ def test_no_surface_is_the_limit_of_a_vanishing_one():
     k_faint, a_g = matte_slab_kernel(GRID, faint)
     assert np.max(a_g) < 1e-6
     np.testing.assert_allclose(k_faint, k_bare, atol=1e-2 * np.max(np.abs(k_bare)))
+
+
+def test_partial_surface_is_its_patches_by_area():
+    # Surface over 30% of the area, bare medium elsewhere: each patch's light by its area, the
+    # ends of the range the bare medium and the whole surface.
+    medium = {"albedo": np.array([0.95, 0.7]), "g1": 0.5, "flakes": 0.3, "cone_deg": 40.0,
+              "cone_spread_deg": 20.0}
+    k_bare, _ = matte_slab_kernel(GRID, MatteSlab(**medium))
+    k_full, a_full = matte_slab_kernel(GRID, MatteSlab(**medium, eta=1.5, alpha=0.3))
+    k_part, a_part = matte_slab_kernel(GRID, MatteSlab(**medium, eta=1.5, alpha=0.3,
+                                                       coverage=0.3))
+    np.testing.assert_allclose(k_part, 0.3 * k_full + 0.7 * k_bare, rtol=1e-10, atol=1e-14)
+    np.testing.assert_allclose(a_part, 0.3 * a_full, rtol=1e-12)
+    k_none, a_none = matte_slab_kernel(GRID, MatteSlab(**medium, eta=1.5, alpha=0.3,
+                                                       coverage=0.0))
+    np.testing.assert_allclose(k_none, k_bare, rtol=1e-10, atol=1e-14)
+    assert np.all(a_none == 0.0)
+    # Two kinds of patch (roughness 0.3 over 30%, 0.8 over 50%), bare medium over 20%.
+    k_rough, a_rough = matte_slab_kernel(GRID, MatteSlab(**medium, eta=1.5, alpha=0.8))
+    k_two, a_two = matte_slab_kernel(GRID, MatteSlab(**medium, eta=1.5, alpha=0.3,
+                                                     coverage=0.3, alpha2=0.8, coverage2=0.5))
+    np.testing.assert_allclose(k_two, 0.3 * k_full + 0.5 * k_rough + 0.2 * k_bare, rtol=1e-10,
+                               atol=1e-14)
+    np.testing.assert_allclose(a_two, 0.3 * a_full + 0.5 * a_rough, rtol=1e-12)
+
+
+def test_top_layer_of_the_medium():
+    # A top layer absorbing as the medium does is the medium; a very thick one is its own thick
+    # medium; a less absorbing one reflects more.
+    medium = {"albedo": np.array([0.98, 0.9]), "g1": 0.5, "flakes": 0.4, "cone_deg": 40.0,
+              "cone_spread_deg": 20.0}
+    plain = medium_reflection(GRID, MatteSlab(**medium))
+    same = medium_reflection(GRID, MatteSlab(**medium, top_thickness=3.0, top_absorption=1.0))
+    np.testing.assert_allclose(same, plain, atol=1e-12)
+    deep = medium_reflection(GRID, MatteSlab(**medium, top_thickness=200.0, top_absorption=0.3))
+    whiter = medium_reflection(GRID, MatteSlab(**{**medium, "albedo": 1.0 - 0.3 * (
+        1.0 - medium["albedo"])}))
+    np.testing.assert_allclose(deep, whiter, atol=1e-12)
+    scale0 = AD.star_scale(GRID)[0]
+    thin = medium_reflection(GRID, MatteSlab(**medium, top_thickness=2.0, top_absorption=0.3))
+    assert np.all(AD.star_albedo(thin[:, 0], scale0) > AD.star_albedo(plain[:, 0], scale0))
