@@ -3,9 +3,10 @@ texture again for the first Match Skin (decoding a 4096 px PNG is 0.3-0.4 s and 
 reading it back from here a few milliseconds and 3 MB).
 
 An entry is the reduced image of :mod:`.image_texels` (its pixels and its note) under a key that
-changes whenever the pixels could: the file's absolute path, date and size, the colour space and
-alpha mode it is read with, the reduction's size, Blender's version and :data:`FORMAT`.  Only
-images read from a file on disk are kept (not packed, generated or painted and unsaved).  The
+changes whenever the pixels could: the file's absolute path, date and size (a packed image's:
+its bytes' SHA-256), the colour space and alpha mode it is read with, the reduction's size,
+Blender's version and :data:`FORMAT`.  Only file images are kept, on disk or packed (not
+generated ones, nor one painted and unsaved).  The
 entries live in the extension's own user folder (``bpy.utils.extension_path_user``, removed
 with the extension), at most :data:`MAX_ENTRIES` (the least recently used go first), each
 written whole or not at all; an entry that cannot be read is a miss.  Run from a source
@@ -61,17 +62,31 @@ def directory() -> Path | None:
 
 def key(image, size: int) -> str | None:
     """The key of ``image`` reduced to ``size`` (hex digest), or None when it is not kept: not
-    a file image on disk, packed, or with unsaved changes."""
-    if image.source != "FILE" or image.packed_files or image.is_dirty:
+    a file image (on disk, or packed in the .blend), or with unsaved changes."""
+    if image.source != "FILE" or image.is_dirty:
         return None
+    content = _content(image)
+    if content is None:
+        return None
+    parts = (FORMAT, tuple(bpy.app.version), content, image.colorspace_settings.name,
+             image.alpha_mode, size)
+    return hashlib.sha256(repr(parts).encode()).hexdigest()
+
+
+def _content(image) -> tuple | None:
+    """What identifies the bytes an image is decoded from: a packed image's SHA-256 (about 18
+    ms for a 7.6 MB PNG, against some 0.35 s to decode it), a file's real path, date and size;
+    None when there is neither (no file, or a packed image of several files)."""
+    if image.packed_files:
+        if len(image.packed_files) != 1:
+            return None
+        return ("packed", hashlib.sha256(image.packed_file.data).hexdigest())
     path = bpy.path.abspath(image.filepath, library=image.library)
     try:
         info = os.stat(path)
     except OSError:
         return None
-    parts = (FORMAT, tuple(bpy.app.version), os.path.realpath(path), info.st_mtime_ns,
-             info.st_size, image.colorspace_settings.name, image.alpha_mode, size)
-    return hashlib.sha256(repr(parts).encode()).hexdigest()
+    return ("file", os.path.realpath(path), info.st_mtime_ns, info.st_size)
 
 
 def _entry(name: str) -> Path | None:

@@ -76,8 +76,9 @@ def test_a_file_image_is_not_decoded_again_in_a_later_session(store, tmp_path, m
 
 
 def test_the_key_follows_what_the_pixels_depend_on(store, tmp_path):
-    """Another colour space, reduction size or file gives another key; an image that is not a
-    file on disk (generated, packed, painted and not saved) has none."""
+    """Another colour space, reduction size or file gives another key, a packed image its
+    bytes' (the same bytes packed twice, one key); an image that is not a file image
+    (generated, painted and not saved) has none."""
     import bpy
 
     from makeup_skin_addon import image_store
@@ -92,9 +93,32 @@ def test_the_key_follows_what_the_pixels_depend_on(store, tmp_path):
     assert image_store.key(image, 512) != key
     assert image_store.key(bpy.data.images.new("Generated", 4, 4), 512) is None
     other.pack()
-    assert image_store.key(other, 512) is None
+    packed = image_store.key(other, 512)
+    assert packed is not None and packed != key
+    again = _png(bpy, tmp_path / "again.png", _codes(1))  # the same bytes, elsewhere
+    again.pack()
+    assert image_store.key(again, 512) == packed
+    third = _png(bpy, tmp_path / "third.png", _codes(4))  # other bytes
+    third.pack()
+    assert image_store.key(third, 512) not in (None, packed)
     image.pixels[0] = 0.5
     assert image.is_dirty and image_store.key(image, 512) is None
+
+
+def test_a_packed_image_is_not_decoded_again_in_a_later_session(store, tmp_path,
+                                                                monkeypatch):
+    import bpy
+
+    from makeup_skin_addon import image_texels
+
+    image = _png(bpy, tmp_path / "skin.png", _codes(5))
+    image.pack()
+    os.remove(tmp_path / "skin.png")  # only the packed bytes are left
+    first = image_texels.reduced_image(image).pixels
+    assert first is not None
+    _session_ends()
+    monkeypatch.setattr(image_texels, "_read", lambda *args: pytest.fail("decoded again"))
+    np.testing.assert_array_equal(image_texels.reduced_image(image).pixels, first)
 
 
 def test_the_store_is_bounded_and_skips_what_it_cannot_read(store, tmp_path, monkeypatch):
