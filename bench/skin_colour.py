@@ -32,7 +32,8 @@ Parts, each in fresh Blender processes (so the first call is truly cold), this c
   ``shade_step(direction="LIGHTER")``, ``shade_step(direction="DARKER")``, Match Skin again;
   and, in another process, a first Apply at the defaults as the button makes it in a window
   (``bpy.ops.makeup_skin.apply()``: the match, then the bake and fit at preview resolution,
-  refined on a worker and swapped in).  Each
+  refined on a worker and swapped in), and in a third the same with the texture read in an
+  earlier session (kept on disk by the add-on's image store, the mesh read cold).  Each
   with the part spent in reading the skin's colour (over the artist's shader
   ``artist_skin.read_material``; an older checkout's ``skin_sampling.surface_mean`` or
   ``shade.image_mean``) and, for Apply, in the match (``matching.first_shade``, or
@@ -100,7 +101,12 @@ SAMPLING_ROWS = {"cold": "the colour, cold (the first click)", "warm": "again (w
 OPERATOR_ROWS = {"match_skin": "Match Skin, the first (the file opened anew)", "lighter": "Lighter",
                  "darker": "Darker", "match_skin again": "Match Skin again",
                  "first apply": "first Apply (bake and fit included; the texture never "
-                                "read before)"}
+                                "read before)",
+                 "first apply, texture known": "first Apply (the same; the texture read in an "
+                                               "earlier session)"}
+FIRST_APPLY = {"apply": "first apply", "apply_known": "first apply, texture known"}
+"""The operators part's first Apply by worker: the texture never read on the machine, or read
+in an earlier session (kept on disk by the add-on's image store)."""
 
 
 # -- the production head ------------------------------------------------------------------------
@@ -336,12 +342,20 @@ def operators_worker(cache: Path, repo: Path, which: str) -> dict:
             # from the store the Apply filled).
             apply_to_object(bpy.context, head)
             skin_sampling.clear_cache()
+        if which == "apply_known" and importlib.util.find_spec(
+                "makeup_skin_addon.image_store") is not None:
+            # The texture read in an earlier session on this machine: kept on disk, not in
+            # memory (the mesh read cold).
+            from makeup_skin_addon import image_texels, skin_sampling
+
+            image_texels.reduced_image(material.node_tree.nodes["Albedo"].image)
+            skin_sampling.clear_cache()
         steps = ([("match_skin", lambda: bpy.ops.makeup_skin.match_skin()),
                   ("lighter", lambda: bpy.ops.makeup_skin.shade_step(direction="LIGHTER")),
                   ("darker", lambda: bpy.ops.makeup_skin.shade_step(direction="DARKER")),
                   ("match_skin again", lambda: bpy.ops.makeup_skin.match_skin())]
                  if which == "match" else
-                 [("first apply", lambda: bpy.ops.makeup_skin.apply())])  # the button's
+                 [(FIRST_APPLY[which], lambda: bpy.ops.makeup_skin.apply())])  # the button's
         out = {}
         for name, run in steps:
             spent.clear()
@@ -386,7 +400,7 @@ def worker_main(args) -> int:
 # -- the runner ---------------------------------------------------------------------------------
 
 def _run(args, worker: str) -> dict:
-    repo = args.repo if worker in ("match", "apply") else OWN_ROOT
+    repo = args.repo if worker in ("match", *FIRST_APPLY) else OWN_ROOT
     command = [sys.executable, str(HERE), "--worker", worker, "--cache", str(args.cache),
                "--repo", str(repo)]
     result = subprocess.run(command, capture_output=True, text=True, check=False)
@@ -405,12 +419,12 @@ def _verdict(figures: dict, factor: float = 1.0) -> str:
 
 
 def _row(name: str, figures: dict, extra: str = "") -> str:
-    return (f"  {name:<18} {figures['wall_s']:8.3f} {figures['cpu_s']:8.3f} "
+    return (f"  {name:<28} {figures['wall_s']:8.3f} {figures['cpu_s']:8.3f} "
             f"{figures['mb']:8.1f} {SLOWER * figures['wall_s']:8.3f}  "
             f"{_verdict(figures):<6} {_verdict(figures, SLOWER):<6}{extra}")
 
 
-HEADER = (f"  {'step':<18} {'wall s':>8} {'CPU s':>8} {'MB added':>8} {'wall x3':>8}  "
+HEADER = (f"  {'step':<28} {'wall s':>8} {'CPU s':>8} {'MB added':>8} {'wall x3':>8}  "
           f"{'target':<6} {'x3':<6}")
 
 
@@ -516,7 +530,8 @@ def main(argv=None) -> int:
         results["accuracy"] = _run(args, "accuracy")
         print_accuracy(results["accuracy"])
     if "operators" in args.parts:
-        results["operators"] = {**_run(args, "match"), **_run(args, "apply")}
+        results["operators"] = {**_run(args, "match"), **_run(args, "apply"),
+                                **_run(args, "apply_known")}
         print_operators(results["operators"])
     results["load_after"] = machine_load()
     print(f"\nload after {results['load_after']} (MB: {MB:.0e} bytes)")
