@@ -109,10 +109,15 @@ def test_uninstall_leaves_nothing(installed):
     import bpy
 
     prefs = bpy.context.preferences
+    store = sys.modules[installed["module"] + ".makeup_skin_addon.image_store"]
+    store.save("entry", np.zeros((2, 2, 3), np.float32), "")  # a reduced image kept
+    kept = store.directory()
+    assert (kept / "entry.npz").is_file()
     repo_index = next(i for i, repo in enumerate(prefs.extensions.repos)
                       if repo.module == REPO_MODULE)
     assert bpy.ops.extensions.package_uninstall(repo_index=repo_index,
                                                 pkg_id=installed["pkg_id"]) == {"FINISHED"}
+    assert not kept.exists()  # the extension's user folder goes with it
     assert installed["module"] not in prefs.addons
     assert not hasattr(bpy.types.Material, "makeup_skin")
     assert [n for n in dir(bpy.types) if n.startswith(("MAKEUPSKIN", "MAKEUP_SKIN"))] == []
