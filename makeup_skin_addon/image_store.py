@@ -6,10 +6,10 @@ An entry is the reduced image of :mod:`.image_texels` (its pixels and its note) 
 changes whenever the pixels could: the file's absolute path, date and size (a packed image's:
 its bytes' SHA-256), the colour space and alpha mode it is read with, the reduction's size,
 Blender's version and :data:`FORMAT`.  Only file images are kept, on disk or packed (not
-generated ones, nor one painted and unsaved).  The
-entries live in the extension's own user folder (``bpy.utils.extension_path_user``, removed
-with the extension), at most :data:`MAX_ENTRIES` (the least recently used go first), each
-written whole or not at all; an entry that cannot be read is a miss.  Run from a source
+generated ones, nor one painted and unsaved).  The entries live in the extension's own user
+folder (``bpy.utils.extension_path_user``, removed with the extension), at most
+:data:`MAX_ENTRIES` (the least recently used go first), each written whole or not at all; an
+entry that cannot be read is a miss.  Run from a source
 checkout (no extension folder) nothing is kept unless :func:`set_directory` names a folder.
 
 - :func:`key` -- an image's key, or None when it is not kept.
@@ -23,6 +23,7 @@ import contextlib
 import hashlib
 import os
 import tempfile
+import zipfile
 from pathlib import Path
 
 import bpy
@@ -102,7 +103,7 @@ def load(name: str) -> tuple[np.ndarray, str] | None:
     try:
         with np.load(path, allow_pickle=False) as entry:
             pixels, note = entry["pixels"], str(entry["note"])
-    except (OSError, ValueError, KeyError, EOFError):
+    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile):
         return None
     if pixels.dtype != np.float32 or pixels.ndim != 3 or pixels.shape[2] != 3:
         return None

@@ -134,6 +134,9 @@ def test_the_store_is_bounded_and_skips_what_it_cannot_read(store, tmp_path, mon
     assert image_store.load("a") is None
     loaded, note = image_store.load("b")
     np.testing.assert_array_equal(loaded, pixels + 1)
+    whole = (store / "c.npz").read_bytes()
+    (store / "c.npz").write_bytes(whole[: len(whole) // 2])  # cut short
+    assert image_store.load("c") is None
     (store / "b.npz").write_bytes(b"not an entry")
     assert image_store.load("b") is None
     assert not list(store.glob("*.partial"))
