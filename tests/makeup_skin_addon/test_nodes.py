@@ -61,11 +61,12 @@ def test_unlinked_normals_in_eevee(head, tmp_path):
 
 @pytest.mark.slow  # renders compared
 def test_every_closure_reads_a_normal_input(head, tmp_path):
-    from makeup_skin_addon import nodes
+    from makeup_skin_addon import group_parts, nodes
 
     for tier in ("LAYERED", "PRINCIPLED", "EEVEE"):
         group = group_node(apply_operator(head, tier)).node_tree
-        closures = [n for n in group.nodes if n.type.startswith(("BSDF", "SUBSURFACE"))]
+        closures = [n for n in group_parts.nodes_of(group)
+                    if n.type.startswith(("BSDF", "SUBSURFACE"))]
         assert closures
         for closure in closures:
             sources = {link.from_socket.name for name in ("Normal", "Coat Normal")
@@ -118,12 +119,14 @@ def test_skin_colour_texture_matches_a_bake_at_that_albedo(addon, blank_scene, t
 
 
 def test_forced_subsurface_method_gets_its_own_group(sphere):
+    from makeup_skin_addon import group_parts
+
     material, _ = apply_pipeline(sphere, "PRINCIPLED")
     auto = material.node_tree.nodes["Made-up Skin"].node_tree
     material, _ = apply_pipeline(sphere, "PRINCIPLED", subsurface_method="RANDOM_WALK_SKIN")
     group = material.node_tree.nodes["Made-up Skin"].node_tree
     assert group != auto and " RW Skin " in group.name
-    principled = next(n for n in group.nodes if n.type == "BSDF_PRINCIPLED")
+    principled = next(n for n in group_parts.nodes_of(group) if n.type == "BSDF_PRINCIPLED")
     assert principled.subsurface_method == "RANDOM_WALK_SKIN"
     meta = json.loads(group["makeup_skin_fit"])
     radius = meta["profiles"]["RANDOM_WALK_SKIN"]["radius_mm"]

@@ -39,7 +39,7 @@ def test_save_reload_renders_the_same_and_keeps_only_what_the_render_reads(spher
 def test_altered_lookup_image_is_found_and_rebuilt(sphere, tmp_path):
     import bpy
 
-    from makeup_skin_addon import apply
+    from makeup_skin_addon import apply, group_parts
 
     material, _ = apply_pipeline(sphere, "LAYERED")
     before = render(tmp_path, "before")
@@ -54,7 +54,7 @@ def test_altered_lookup_image_is_found_and_rebuilt(sphere, tmp_path):
     assert bpy.ops.makeup_skin.check_tables() == {"FINISHED"}
     assert len(view_images()) == 1 and apply.check_material(bpy.context, material)[0]
     group = material.node_tree.nodes["Made-up Skin"].node_tree
-    textures = [n for n in group.nodes if n.type == "TEX_IMAGE"]
+    textures = [n for n in group_parts.nodes_of(group) if n.type == "TEX_IMAGE"]
     assert textures and all(n.image == view_images()[0] for n in textures)
 
 
