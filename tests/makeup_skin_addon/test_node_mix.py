@@ -128,35 +128,63 @@ def _emission(tree, target_input):
     return emission
 
 
-def _principled_probe(group, name):
-    """A copy of the PRINCIPLED ``group`` whose output is the Principled input ``name``."""
-    from makeup_skin_addon import nodes
+def _copy(group, name):
+    """A copy of ``group`` with copies of the parts it is built as, so that a probe's edits
+    stay in the probe."""
+    from makeup_skin_addon import group_parts
 
     probe = group.copy()
-    probe.name = f"probe {name}"
-    bsdf = next(node for node in probe.nodes if node.type == "BSDF_PRINCIPLED")
-    emission = _emission(probe, nodes.socket(bsdf.inputs, name))
+    probe.name = name
+    for holder in probe.nodes:
+        if holder.type == "GROUP" and holder.node_tree in group_parts.parts_of(group):
+            holder.node_tree = holder.node_tree.copy()
+    return probe
+
+
+def _to_output(probe, shader):
+    """Link the shader output socket ``shader`` (of the probe or of one of its parts) to the
+    probe's Group Output."""
     output = next(node for node in probe.nodes if node.type == "GROUP_OUTPUT")
-    probe.nodes.remove(bsdf)
-    probe.links.new(emission.outputs[0], output.inputs["Shader"])
+    part = shader.id_data
+    if part != probe:
+        item = part.interface.new_socket("probe", in_out="OUTPUT",
+                                         socket_type="NodeSocketShader")
+        inner = next(node for node in part.nodes if node.type == "GROUP_OUTPUT")
+        part.links.new(shader, next(s for s in inner.inputs if s.identifier == item.identifier))
+        holder = next(node for node in probe.nodes if node.type == "GROUP"
+                      and node.node_tree == part)
+        shader = next(s for s in holder.outputs if s.identifier == item.identifier)
+    probe.links.new(shader, output.inputs["Shader"])
+
+
+def _principled_probe(group, name):
+    """A copy of the PRINCIPLED ``group`` whose output is the Principled input ``name``."""
+    from makeup_skin_addon import group_parts, nodes
+
+    probe = _copy(group, f"probe {name}")
+    bsdf = next(node for node in group_parts.nodes_of(probe)
+                if node.type == "BSDF_PRINCIPLED")
+    emission = _emission(bsdf.id_data, nodes.socket(bsdf.inputs, name))
+    bsdf.id_data.nodes.remove(bsdf)
+    _to_output(probe, emission.outputs[0])
     return probe
 
 
 def _layered_probe(group, label):
     """A copy of the LAYERED ``group`` in which the closure labelled ``label`` is an Emission
     of its colour, in its place, and every other closure is gone."""
-    from makeup_skin_addon import nodes
+    from makeup_skin_addon import group_parts, nodes
 
-    probe = group.copy()
-    probe.name = f"probe {label}"
-    closures = [node for node in probe.nodes if node.type in CLOSURES]
+    probe = _copy(group, f"probe {label}")
+    closures = [node for node in group_parts.nodes_of(probe) if node.type in CLOSURES]
     assert label in {node.label for node in closures}
     for node in closures:
+        tree = node.id_data
         if node.label == label:
-            emission = _emission(probe, nodes.socket(node.inputs, "Color"))
+            emission = _emission(tree, nodes.socket(node.inputs, "Color"))
             for link in list(node.outputs[0].links):
-                probe.links.new(emission.outputs[0], link.to_socket)
-        probe.nodes.remove(node)
+                tree.links.new(emission.outputs[0], link.to_socket)
+        tree.nodes.remove(node)
     return probe
 
 
@@ -164,16 +192,16 @@ def _weight_probe(group, label):
     """A copy of the LAYERED ``group`` in which the Mix Shader weighting the closure
     labelled ``label`` is an Emission of its factor, in its place, and every closure is
     gone: the pixel is the weight times the coverage mix above it."""
-    from makeup_skin_addon import nodes
+    from makeup_skin_addon import group_parts, nodes
 
-    probe = group.copy()
-    probe.name = f"probe {label} weight"
-    mix = next(node for node in probe.nodes if node.label == f"{label} (weight)")
-    emission = _emission(probe, nodes.socket(mix.inputs, "Fac"))
+    probe = _copy(group, f"probe {label} weight")
+    mix = next(node for node in group_parts.nodes_of(probe)
+               if node.label == f"{label} (weight)")
+    emission = _emission(mix.id_data, nodes.socket(mix.inputs, "Fac"))
     for link in list(mix.outputs[0].links):
-        probe.links.new(emission.outputs[0], link.to_socket)
-    for node in [n for n in probe.nodes if n.type in CLOSURES] + [mix]:
-        probe.nodes.remove(node)
+        mix.id_data.links.new(emission.outputs[0], link.to_socket)
+    for node in [n for n in group_parts.nodes_of(probe) if n.type in CLOSURES] + [mix]:
+        node.id_data.nodes.remove(node)
     return probe
 
 
