@@ -279,8 +279,22 @@ class Parts:
         """The group's socket ``outer`` as a socket inside the part ``tree``."""
         part, holder, inputs, _ = self._parts[self._of[tree.as_pointer()]]
         item = self._item(part, outer.name, outer.type, "INPUT")
+        hidden = self._hidden(outer)
+        if item.hide_value != hidden:
+            item.hide_value = hidden
         connect(outer, socket(holder.inputs, item.identifier))
         return socket(inputs.outputs, item.identifier)
+
+    def _hidden(self, outer) -> bool:
+        """Whether ``outer`` is one of the group's inputs whose value is hidden: unlinked, the
+        engines then take what it feeds as unlinked too (a BSDF's Normal: the shading
+        normal), so the part's socket that carries it on is hidden as well."""
+        if outer.node.bl_idname != "NodeGroupInput":
+            return False
+        item = next((item for item in self.tree.interface.items_tree
+                     if item.item_type == "SOCKET" and item.in_out == "INPUT"
+                     and item.identifier == outer.identifier), None)
+        return bool(item is not None and item.hide_value)
 
     def _item(self, part, name: str, carried: str, in_out: str):
         """``part``'s interface socket ``name`` for a socket of type ``carried``, taken again

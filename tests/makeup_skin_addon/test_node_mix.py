@@ -31,6 +31,7 @@ import dataclasses
 
 import numpy as np
 import pytest
+from support import group_probes
 
 from lut_baker.bake import bake
 from lut_baker.closures import fitting as cf
@@ -128,45 +129,16 @@ def _emission(tree, target_input):
     return emission
 
 
-def _copy(group, name):
-    """A copy of ``group`` with copies of the parts it is built as, so that a probe's edits
-    stay in the probe."""
-    from makeup_skin_addon import group_parts
-
-    probe = group.copy()
-    probe.name = name
-    for holder in probe.nodes:
-        if holder.type == "GROUP" and holder.node_tree in group_parts.parts_of(group):
-            holder.node_tree = holder.node_tree.copy()
-    return probe
-
-
-def _to_output(probe, shader):
-    """Link the shader output socket ``shader`` (of the probe or of one of its parts) to the
-    probe's Group Output."""
-    output = next(node for node in probe.nodes if node.type == "GROUP_OUTPUT")
-    part = shader.id_data
-    if part != probe:
-        item = part.interface.new_socket("probe", in_out="OUTPUT",
-                                         socket_type="NodeSocketShader")
-        inner = next(node for node in part.nodes if node.type == "GROUP_OUTPUT")
-        part.links.new(shader, next(s for s in inner.inputs if s.identifier == item.identifier))
-        holder = next(node for node in probe.nodes if node.type == "GROUP"
-                      and node.node_tree == part)
-        shader = next(s for s in holder.outputs if s.identifier == item.identifier)
-    probe.links.new(shader, output.inputs["Shader"])
-
-
 def _principled_probe(group, name):
     """A copy of the PRINCIPLED ``group`` whose output is the Principled input ``name``."""
     from makeup_skin_addon import group_parts, nodes
 
-    probe = _copy(group, f"probe {name}")
+    probe = group_probes.copy_with_parts(group, f"probe {name}")
     bsdf = next(node for node in group_parts.nodes_of(probe)
                 if node.type == "BSDF_PRINCIPLED")
     emission = _emission(bsdf.id_data, nodes.socket(bsdf.inputs, name))
     bsdf.id_data.nodes.remove(bsdf)
-    _to_output(probe, emission.outputs[0])
+    group_probes.to_output(probe, emission.outputs[0])
     return probe
 
 
@@ -175,7 +147,7 @@ def _layered_probe(group, label):
     of its colour, in its place, and every other closure is gone."""
     from makeup_skin_addon import group_parts, nodes
 
-    probe = _copy(group, f"probe {label}")
+    probe = group_probes.copy_with_parts(group, f"probe {label}")
     closures = [node for node in group_parts.nodes_of(probe) if node.type in CLOSURES]
     assert label in {node.label for node in closures}
     for node in closures:
@@ -194,7 +166,7 @@ def _weight_probe(group, label):
     gone: the pixel is the weight times the coverage mix above it."""
     from makeup_skin_addon import group_parts, nodes
 
-    probe = _copy(group, f"probe {label} weight")
+    probe = group_probes.copy_with_parts(group, f"probe {label} weight")
     mix = next(node for node in group_parts.nodes_of(probe)
                if node.label == f"{label} (weight)")
     emission = _emission(mix.id_data, nodes.socket(mix.inputs, "Fac"))
