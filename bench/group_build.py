@@ -11,9 +11,9 @@ as many times again with its bpy calls counted and timed by kind (``nodes.new``,
 setting, a socket's value, ``links.new``), in the fastest of those, the rest being the group's
 interface, its image and record, the Python side (the tier's formulas, socket lookups) and
 the timing's own clock reads (about a microsecond each, two a call); and each kind
-alone on a copy of the group (every
+alone on a copy of the group's largest tree (the group's own, or its largest part: every
 change made through Python runs Blender's node-tree update, ``BKE_main_ensure_invariants``,
-over the whole tree).
+over the whole tree, in parallel above 32 nodes).
 """
 
 from __future__ import annotations

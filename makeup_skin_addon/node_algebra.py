@@ -46,10 +46,10 @@ class Builder:
     """Adds nodes to a tree and links them; values may be sockets, :class:`NodeValue` or
     constants.
 
-    Every setting, value and link set through the Python API updates the whole tree (about
-    half a microsecond a node, the tree's nodes at the time), so only what differs from a
-    new node's own is set, and the new nodes are laid out in one call by :meth:`finish`
-    (their places matter to no render).
+    Every setting, value and link set through the Python API updates the whole tree (a cost
+    that grows with the tree's nodes at the time, and jumps above 32 nodes: ``parts``), so
+    only what differs from a new node's own is set, and the new nodes are laid out in one
+    call by :meth:`finish` (their places matter to no render).
 
     ``parts``: the tree is built as nested groups of at most :data:`PART_NODES` nodes
     (:class:`Parts`), which keeps that update from going parallel, several times dearer.
