@@ -43,7 +43,7 @@ from dataclasses import dataclass, field
 
 import bpy
 
-from . import artist_shader, node_copy, skin_nodes
+from . import artist_shader, group_parts, node_copy, skin_nodes
 from .keys import (
     BASE_STRENGTH_KEY,
     FILM_NORMAL_NODE,
@@ -257,8 +257,7 @@ def _remove_unused(group) -> list[str]:
         images = [entry.get("name") for entry in json.loads(group[FIT_KEY]).get("images", [])]
     except (TypeError, ValueError, AttributeError):
         images = []
-    removed = [group.name]
-    bpy.data.node_groups.remove(group)
+    removed = group_parts.remove_group(group)
     for name in images:
         image = bpy.data.images.get(name or "")
         if image is not None and image.name.startswith(VIEW_IMAGE_PREFIX) and image.users == 0:

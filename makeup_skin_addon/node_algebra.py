@@ -20,8 +20,10 @@ from __future__ import annotations
 import bpy
 import numpy as np
 
-__all__ = ["Builder", "Mismatch", "NodeValue", "NodeAlgebra", "NodeShaders", "socket",
-           "value_of"]
+from .group_parts import PART_KEY
+
+__all__ = ["Builder", "Mismatch", "Parts", "PART_NODES", "NodeValue", "NodeAlgebra",
+           "NodeShaders", "socket", "value_of"]
 
 
 def socket(sockets, identifier: str):
@@ -44,45 +46,68 @@ class Builder:
     """Adds nodes to a tree and links them; values may be sockets, :class:`NodeValue` or
     constants.
 
-    Every setting, value and link set through the Python API updates the whole tree (about
-    half a microsecond a node, the tree's nodes at the time), so only what differs from a
-    new node's own is set, and the new nodes are laid out in one call by :meth:`finish`
-    (their places matter to no render).
+    Every setting, value and link set through the Python API updates the whole tree (a cost
+    that grows with the tree's nodes at the time, and jumps above 32 nodes: ``parts``), so
+    only what differs from a new node's own is set, and the new nodes are laid out in one
+    call by :meth:`finish` (their places matter to no render).
+
+    ``parts``: the tree is built as nested groups of at most :data:`PART_NODES` nodes
+    (:class:`Parts`), which keeps that update from going parallel, several times dearer.
 
     ``reuse``: the tree holds what an earlier build of the same structure added, in the same
     order (a group rebuilt from a new fit of the same tier): its nodes are taken in turn
-    instead of added, and only the settings, values and links that differ are set, which
-    costs a fraction of adding them (a live update's group swap on the main thread).  Every
-    input the build feeds is fed again, so a node taken for another of its type ends up as a
-    new one would.  A node of another type or label, or nodes or links left over
-    (:meth:`finish`), raise :class:`Mismatch`: the caller then clears the tree and builds
-    anew."""
+    instead of added (with ``parts``, the Group Input and Output from the tree and the rest
+    from its parts, in order), and only the settings, values and links that differ are set,
+    which costs a fraction of adding them (a live update's group swap on the main thread).
+    Every input the build feeds is fed again, so a node taken for another of its type ends
+    up as a new one would.  A node of another type or label, or nodes, links or part sockets
+    left over (:meth:`finish`), raise :class:`Mismatch`: the caller then clears the tree and
+    builds anew."""
 
-    def __init__(self, tree, *, reuse: bool = False):
+    def __init__(self, tree, *, reuse: bool = False, parts: bool = False):
         self.tree = tree
         self.count = 0
-        self._old = list(tree.nodes) if reuse else None
-        # The tree's links by their input (a socket's own ``links`` walks every link).
-        self._into = {link.to_socket.as_pointer(): link for link in tree.links} if reuse \
-            else {}
+        self._parts = Parts(tree, reuse=reuse) if parts else None
+        trees = [tree, *self._parts.trees()] if self._parts is not None else [tree]
+        self._pools: dict | None = None
+        if reuse:
+            self._pools = ({"outer": [n for n in tree.nodes if n.bl_idname in Parts.OUTER],
+                            "inner": [n for part in self._parts.trees() for n in part.nodes
+                                      if n.bl_idname not in Parts.OUTER]}
+                           if self._parts is not None else {"all": list(tree.nodes)})
+        self._taken: dict = {}
+        # The trees' links by their input (a socket's own ``links`` walks every link).
+        self._into = {link.to_socket.as_pointer(): link for part in trees
+                      for link in part.links} if reuse else {}
         self._links = 0
 
     def node(self, kind: str, label: str = "", **props):
-        if self._old is not None:
+        if self._pools is not None:
             return self._reused(kind, label, props)
-        node = self.tree.nodes.new(kind)
+        tree = self._parts.tree_for(kind) if self._parts is not None else self.tree
+        node = tree.nodes.new(kind)
         self.count += 1
         if label:
             node.label = label
         _set(node, props)
         return node
 
+    def _pool(self, kind: str) -> str:
+        if self._parts is None:
+            return "all"
+        return "outer" if kind in Parts.OUTER else "inner"
+
     def _reused(self, kind: str, label: str, props: dict):
-        """The next node of the tree, if it is of the type and label :meth:`node` would add
-        (its settings set where they differ: an operation, a distribution, an image)."""
-        if self._old is None or self.count >= len(self._old):
+        """The next node of the tree (or of its parts), if it is of the type and label
+        :meth:`node` would add (its settings set where they differ: an operation, a
+        distribution, an image)."""
+        assert self._pools is not None
+        pool = self._pool(kind)
+        taken = self._taken.get(pool, 0)
+        if taken >= len(self._pools[pool]):
             raise Mismatch("more nodes than the tree holds")
-        node = self._old[self.count]
+        node = self._pools[pool][taken]
+        self._taken[pool] = taken + 1
         self.count += 1
         if node.bl_idname != SAME_NODE.get(kind, kind) or node.label != label:
             raise Mismatch(f"{node.bl_idname} {node.label!r} where {kind} {label!r} goes")
@@ -90,23 +115,37 @@ class Builder:
         return node
 
     def link(self, source, target) -> None:
-        """Link output ``source`` into input ``target`` (reusing: unless it is linked so)."""
-        if self._old is None:
-            self.tree.links.new(source, target)
+        """Link output ``source`` into input ``target`` (reusing: unless it is linked so),
+        through the parts' sockets when they are in two trees."""
+        if self._parts is not None:
+            source = self._parts.route(source, target.id_data, self._connect)
+        self._connect(source, target)
+
+    def _connect(self, source, target) -> None:
+        """Link two sockets of one tree (reusing: unless they are linked so)."""
+        if self._pools is None:
+            target.id_data.links.new(source, target)
             return
         self._links += 1
         key = target.as_pointer()
         old = self._into.get(key)
         if old is not None and old.from_socket.as_pointer() == source.as_pointer():
             return
-        self._into[key] = self.tree.links.new(source, target)
+        self._into[key] = target.id_data.links.new(source, target)
 
     def finish(self) -> None:
         """Adding: lay the new nodes out (columns of ten, in the order they were added).
-        Reusing: :class:`Mismatch` unless every node and link of the tree was taken."""
-        if self._old is None:
-            _lay_out(self.tree.nodes, self.count)
-        elif self.count != len(self._old) or self._links != len(self.tree.links):
+        Reusing: :class:`Mismatch` unless every node, link and part socket was taken."""
+        trees = [self.tree, *self._parts.trees()] if self._parts is not None else [self.tree]
+        if self._pools is None:
+            for tree in trees:
+                _lay_out(tree.nodes, len(tree.nodes) if tree is not self.tree or
+                         self._parts is not None else self.count)
+            return
+        left = any(self._taken.get(pool, 0) != len(nodes) for pool, nodes in
+                   self._pools.items())
+        if left or self._links != sum(len(tree.links) for tree in trees) or (
+                self._parts is not None and not self._parts.all_sockets_taken()):
             raise Mismatch("the tree holds nodes or links this build does not add")
 
     def feed(self, target, value):
@@ -126,10 +165,10 @@ class Builder:
             new = float(np.ravel(value)[0])
         else:
             new = tuple(map(float, value))
-        if self._old is not None:
+        if self._pools is not None:
             link = self._into.pop(target.as_pointer(), None)
             if link is not None:
-                self.tree.links.remove(link)
+                target.id_data.links.remove(link)
         old = target.default_value
         if (tuple(old) if isinstance(new, tuple) else old) != new:
             target.default_value = new
@@ -153,6 +192,131 @@ class Builder:
         self.feed(socket(node.inputs, "A_Vector"), a)
         self.feed(socket(node.inputs, "B_Vector"), b)
         return socket(node.outputs, "Result_Vector")
+
+
+PART_NODES = 30
+"""Nodes a part holds at most, its Group Input and Output included (:class:`Parts`)."""
+_INTERFACE_TYPES = {"VALUE": "NodeSocketFloat", "VECTOR": "NodeSocketVector",
+                    "RGBA": "NodeSocketColor", "SHADER": "NodeSocketShader"}
+
+
+class Parts:
+    """A group built as parts: node groups of at most :data:`PART_NODES` nodes nested in it,
+    filled in turn, a value crossing from one tree to another through the parts' sockets
+    (each crossing made once).  Every change
+    made through Python runs Blender's node-tree update over the whole tree, and above 32
+    nodes that update works in parallel, several times dearer on a free core (docs/addon.md,
+    "A first Apply, timed"); parts keep every tree under it.  The group's own Group Input and
+    Output stay in it, beside the parts' group nodes.  ``reuse``: the parts the group holds
+    are taken again, their sockets found by name."""
+
+    OUTER = ("NodeGroupInput", "NodeGroupOutput")
+
+    def __init__(self, tree, *, reuse: bool = False):
+        self.tree = tree
+        self._parts: list = []  # (part tree, its group node, its Group Input, Group Output)
+        self._of: dict = {}  # part tree pointer -> index
+        self._routes: dict = {}  # (socket pointer, tree pointer) -> the socket there
+        self._reuse = reuse
+        self._used: set = set()  # the sockets' (part pointer, identifier) taken, reusing
+        if reuse:
+            for holder in (n for n in tree.nodes if n.type == "GROUP" and
+                           n.node_tree is not None and PART_KEY in n.node_tree):
+                self._remember(holder.node_tree, holder)
+
+    def trees(self) -> list:
+        return [part[0] for part in self._parts]
+
+    def tree_for(self, kind: str):
+        """The tree a new node of ``kind`` goes into: the group for its Group Input and
+        Output, else the last part (a new one when it is full)."""
+        if kind in self.OUTER:
+            return self.tree
+        if not self._parts or len(self._parts[-1][0].nodes) >= PART_NODES:
+            part = bpy.data.node_groups.new(f"{self.tree.name} part {len(self._parts) + 1}",
+                                            "ShaderNodeTree")
+            part[PART_KEY] = True
+            part.nodes.new("NodeGroupInput")
+            part.nodes.new("NodeGroupOutput")
+            holder = self.tree.nodes.new("ShaderNodeGroup")
+            holder.node_tree = part
+            self._remember(part, holder)
+        return self._parts[-1][0]
+
+    def _remember(self, part, holder) -> None:
+        io = {node.bl_idname: node for node in part.nodes if node.bl_idname in self.OUTER}
+        self._of[part.as_pointer()] = len(self._parts)
+        self._parts.append((part, holder, io.get("NodeGroupInput"), io.get("NodeGroupOutput")))
+
+    def route(self, source, tree, connect):
+        """``source`` (an output socket of any tree of the group) as a socket of ``tree``:
+        itself, or through the sockets of the part it leaves and of the part it enters,
+        linked by ``connect(source, target)``."""
+        if source.id_data == tree:
+            return source
+        key = (source.as_pointer(), tree.as_pointer())
+        if key not in self._routes:
+            outer = self._left(source, connect)
+            self._routes[key] = outer if tree == self.tree else self._entered(outer, tree,
+                                                                             connect)
+        return self._routes[key]
+
+    def _left(self, source, connect):
+        """``source`` as a socket of the group: its part's group node's output for it."""
+        if source.id_data == self.tree:
+            return source
+        key = (source.as_pointer(), self.tree.as_pointer())
+        if key not in self._routes:
+            index = self._of[source.id_data.as_pointer()]
+            part, holder, _, outputs = self._parts[index]
+            item = self._item(part, f"part {index + 1} {source.node.name} {source.identifier}",
+                              source.type, "OUTPUT")
+            connect(source, socket(outputs.inputs, item.identifier))
+            self._routes[key] = socket(holder.outputs, item.identifier)
+        return self._routes[key]
+
+    def _entered(self, outer, tree, connect):
+        """The group's socket ``outer`` as a socket inside the part ``tree``."""
+        part, holder, inputs, _ = self._parts[self._of[tree.as_pointer()]]
+        item = self._item(part, outer.name, outer.type, "INPUT")
+        hidden = self._hidden(outer)
+        if item.hide_value != hidden:
+            item.hide_value = hidden
+        connect(outer, socket(holder.inputs, item.identifier))
+        return socket(inputs.outputs, item.identifier)
+
+    def _hidden(self, outer) -> bool:
+        """Whether ``outer`` is one of the group's inputs whose value is hidden: unlinked, the
+        engines then take what it feeds as unlinked too (a BSDF's Normal: the shading
+        normal), so the part's socket that carries it on is hidden as well."""
+        if outer.node.bl_idname != "NodeGroupInput":
+            return False
+        item = next((item for item in self.tree.interface.items_tree
+                     if item.item_type == "SOCKET" and item.in_out == "INPUT"
+                     and item.identifier == outer.identifier), None)
+        return bool(item is not None and item.hide_value)
+
+    def _item(self, part, name: str, carried: str, in_out: str):
+        """``part``'s interface socket ``name`` for a socket of type ``carried``, taken again
+        when reusing and there, else added.  A value leaving a part is named after its part,
+        node and socket; one entering a part after the group's socket that carries it (the
+        group's input, or the part's output it left by)."""
+        kind = _INTERFACE_TYPES[carried]
+        if self._reuse:
+            for item in part.interface.items_tree:
+                if (item.item_type == "SOCKET" and item.name == name and item.in_out == in_out
+                        and item.socket_type == kind):
+                    self._used.add((part.as_pointer(), item.identifier))
+                    return item
+        item = part.interface.new_socket(name, in_out=in_out, socket_type=kind)
+        self._used.add((part.as_pointer(), item.identifier))
+        return item
+
+    def all_sockets_taken(self) -> bool:
+        """Reusing: whether every socket of every part was taken again."""
+        return all((part.as_pointer(), item.identifier) in self._used
+                   for part in self.trees() for item in part.interface.items_tree
+                   if item.item_type == "SOCKET")
 
 
 def _set(node, props: dict) -> None:

@@ -50,6 +50,7 @@ import numpy as np
 
 from . import keys, storage
 from .core import tier_formulas, tier_registry, view_image
+from .group_parts import parts_of, remove_parts
 from .keys import FIT_KEY, LEGACY_TABLES_REF, view_image_name
 from .node_algebra import Builder, Mismatch, NodeAlgebra, NodeShaders, NodeValue, socket
 
@@ -291,15 +292,17 @@ def _emit(group, emit, reuse: bool) -> None:
     same tier and kind: the same structure, new values; :class:`.node_algebra.Builder`), or
     on a cleared group (at once, or when the structure turns out to differ)."""
     if reuse:
-        build = Builder(group, reuse=True)
+        build = Builder(group, reuse=True, parts=True)
         try:
             emit(build)
             build.finish()
             return
         except Mismatch:
             pass
+    old = parts_of(group)
     group.nodes.clear()
-    build = Builder(group)
+    remove_parts(old)
+    build = Builder(group, parts=True)
     emit(build)
     build.finish()
 

@@ -73,7 +73,8 @@ def test_roughness_moves_the_gloss_live_and_a_picked_colour_at_once(sphere):
 
 
 def _fingerprint(group):
-    """Every node of ``group`` in order (type, label, operation or distribution, image name),
+    """Every node of ``group`` and its parts in order (type, label, operation or distribution,
+    image name),
     the values of its unlinked inputs (rounded far below a render's precision) and its
     links: two groups of the same fingerprint render alike."""
     def value(item):
@@ -85,16 +86,20 @@ def _fingerprint(group):
         except TypeError:
             return round(float(data), 9)
 
-    index = {node.name: i for i, node in enumerate(group.nodes)}
+    from makeup_skin_addon import group_parts
+
+    trees = [group, *group_parts.parts_of(group)]
+    every = group_parts.nodes_of(group)
+    index = {node.as_pointer(): i for i, node in enumerate(every)}
     nodes = [(node.bl_idname, node.label, getattr(node, "operation", None),
               getattr(node, "distribution", None),
               getattr(getattr(node, "image", None), "name", None),
               tuple((item.identifier, value(item)) for item in node.inputs
                     if not item.is_linked and item.enabled))
-             for node in group.nodes]
-    links = sorted((index[link.from_node.name], link.from_socket.identifier,
-                    index[link.to_node.name], link.to_socket.identifier)
-                   for link in group.links)
+             for node in every]
+    links = sorted((index[link.from_node.as_pointer()], link.from_socket.identifier,
+                    index[link.to_node.as_pointer()], link.to_socket.identifier)
+                   for tree in trees for link in tree.links)
     return nodes, links
 
 

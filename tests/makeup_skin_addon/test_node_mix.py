@@ -31,6 +31,7 @@ import dataclasses
 
 import numpy as np
 import pytest
+from support import group_probes
 
 from lut_baker.bake import bake
 from lut_baker.closures import fitting as cf
@@ -130,33 +131,32 @@ def _emission(tree, target_input):
 
 def _principled_probe(group, name):
     """A copy of the PRINCIPLED ``group`` whose output is the Principled input ``name``."""
-    from makeup_skin_addon import nodes
+    from makeup_skin_addon import group_parts, nodes
 
-    probe = group.copy()
-    probe.name = f"probe {name}"
-    bsdf = next(node for node in probe.nodes if node.type == "BSDF_PRINCIPLED")
-    emission = _emission(probe, nodes.socket(bsdf.inputs, name))
-    output = next(node for node in probe.nodes if node.type == "GROUP_OUTPUT")
-    probe.nodes.remove(bsdf)
-    probe.links.new(emission.outputs[0], output.inputs["Shader"])
+    probe = group_probes.copy_with_parts(group, f"probe {name}")
+    bsdf = next(node for node in group_parts.nodes_of(probe)
+                if node.type == "BSDF_PRINCIPLED")
+    emission = _emission(bsdf.id_data, nodes.socket(bsdf.inputs, name))
+    bsdf.id_data.nodes.remove(bsdf)
+    group_probes.to_output(probe, emission.outputs[0])
     return probe
 
 
 def _layered_probe(group, label):
     """A copy of the LAYERED ``group`` in which the closure labelled ``label`` is an Emission
     of its colour, in its place, and every other closure is gone."""
-    from makeup_skin_addon import nodes
+    from makeup_skin_addon import group_parts, nodes
 
-    probe = group.copy()
-    probe.name = f"probe {label}"
-    closures = [node for node in probe.nodes if node.type in CLOSURES]
+    probe = group_probes.copy_with_parts(group, f"probe {label}")
+    closures = [node for node in group_parts.nodes_of(probe) if node.type in CLOSURES]
     assert label in {node.label for node in closures}
     for node in closures:
+        tree = node.id_data
         if node.label == label:
-            emission = _emission(probe, nodes.socket(node.inputs, "Color"))
+            emission = _emission(tree, nodes.socket(node.inputs, "Color"))
             for link in list(node.outputs[0].links):
-                probe.links.new(emission.outputs[0], link.to_socket)
-        probe.nodes.remove(node)
+                tree.links.new(emission.outputs[0], link.to_socket)
+        tree.nodes.remove(node)
     return probe
 
 
@@ -164,16 +164,16 @@ def _weight_probe(group, label):
     """A copy of the LAYERED ``group`` in which the Mix Shader weighting the closure
     labelled ``label`` is an Emission of its factor, in its place, and every closure is
     gone: the pixel is the weight times the coverage mix above it."""
-    from makeup_skin_addon import nodes
+    from makeup_skin_addon import group_parts, nodes
 
-    probe = group.copy()
-    probe.name = f"probe {label} weight"
-    mix = next(node for node in probe.nodes if node.label == f"{label} (weight)")
-    emission = _emission(probe, nodes.socket(mix.inputs, "Fac"))
+    probe = group_probes.copy_with_parts(group, f"probe {label} weight")
+    mix = next(node for node in group_parts.nodes_of(probe)
+               if node.label == f"{label} (weight)")
+    emission = _emission(mix.id_data, nodes.socket(mix.inputs, "Fac"))
     for link in list(mix.outputs[0].links):
-        probe.links.new(emission.outputs[0], link.to_socket)
-    for node in [n for n in probe.nodes if n.type in CLOSURES] + [mix]:
-        probe.nodes.remove(node)
+        mix.id_data.links.new(emission.outputs[0], link.to_socket)
+    for node in [n for n in group_parts.nodes_of(probe) if n.type in CLOSURES] + [mix]:
+        node.id_data.nodes.remove(node)
     return probe
 
 

@@ -8,7 +8,7 @@ import json
 
 import numpy as np
 import pytest
-from support import sphere_scene
+from support import group_probes, sphere_scene
 from support.addon_steps import HEAD_PX, apply_operator, apply_pipeline, group_node, render
 
 
@@ -61,11 +61,12 @@ def test_unlinked_normals_in_eevee(head, tmp_path):
 
 @pytest.mark.slow  # renders compared
 def test_every_closure_reads_a_normal_input(head, tmp_path):
-    from makeup_skin_addon import nodes
+    from makeup_skin_addon import group_parts, nodes
 
     for tier in ("LAYERED", "PRINCIPLED", "EEVEE"):
         group = group_node(apply_operator(head, tier)).node_tree
-        closures = [n for n in group.nodes if n.type.startswith(("BSDF", "SUBSURFACE"))]
+        closures = [n for n in group_parts.nodes_of(group)
+                    if n.type.startswith(("BSDF", "SUBSURFACE"))]
         assert closures
         for closure in closures:
             sources = {link.from_socket.name for name in ("Normal", "Coat Normal")
@@ -118,12 +119,14 @@ def test_skin_colour_texture_matches_a_bake_at_that_albedo(addon, blank_scene, t
 
 
 def test_forced_subsurface_method_gets_its_own_group(sphere):
+    from makeup_skin_addon import group_parts
+
     material, _ = apply_pipeline(sphere, "PRINCIPLED")
     auto = material.node_tree.nodes["Made-up Skin"].node_tree
     material, _ = apply_pipeline(sphere, "PRINCIPLED", subsurface_method="RANDOM_WALK_SKIN")
     group = material.node_tree.nodes["Made-up Skin"].node_tree
     assert group != auto and " RW Skin " in group.name
-    principled = next(n for n in group.nodes if n.type == "BSDF_PRINCIPLED")
+    principled = next(n for n in group_parts.nodes_of(group) if n.type == "BSDF_PRINCIPLED")
     assert principled.subsurface_method == "RANDOM_WALK_SKIN"
     meta = json.loads(group["makeup_skin_fit"])
     radius = meta["profiles"]["RANDOM_WALK_SKIN"]["radius_mm"]
@@ -154,25 +157,28 @@ def _row_probe(group, row: str, linear: bool):
     """A copy of ``group`` whose output is an Emission of its view-angle row ``row``: read as
     the group reads it (two Closest texels mixed) or, ``linear``, by one Linear lookup at
     ``u = cos(theta_o)`` (what the Layered tier did before)."""
-    probe = group.copy()
-    emission = probe.nodes.new("ShaderNodeEmission")
+    from makeup_skin_addon import group_parts
+
+    probe = group_probes.copy_with_parts(group, f"row probe {row} {linear}")
+    every = group_parts.nodes_of(probe)
     if linear:
-        cos = next(n for n in probe.nodes if n.label == "cos theta_o (film)").outputs[0]
-        texture = next(n for n in probe.nodes if n.type == "TEX_IMAGE" and n.label == row)
-        coordinate = probe.nodes.new("ShaderNodeCombineXYZ")
-        probe.links.new(cos, coordinate.inputs["X"])
-        coordinate.inputs["Y"].default_value = texture.inputs["Vector"].links[0].from_node \
-            .inputs["Y"].default_value
-        lookup = probe.nodes.new("ShaderNodeTexImage")
+        cos = next(n for n in every if n.label == "cos theta_o (film)").outputs[0]
+        texture = next(n for n in every if n.type == "TEX_IMAGE" and n.label == row)
+        texel = next(n for n in every if n.label == f"row {row}, texel 0")  # its coordinate
+        tree = cos.id_data
+        coordinate = tree.nodes.new("ShaderNodeCombineXYZ")
+        tree.links.new(cos, coordinate.inputs["X"])
+        coordinate.inputs["Y"].default_value = texel.inputs["Y"].default_value
+        lookup = tree.nodes.new("ShaderNodeTexImage")
         lookup.image, lookup.interpolation, lookup.extension = texture.image, "Linear", "EXTEND"
-        probe.links.new(coordinate.outputs[0], lookup.inputs["Vector"])
-        probe.links.new(lookup.outputs["Color"], emission.inputs["Color"])
+        tree.links.new(coordinate.outputs[0], lookup.inputs["Vector"])
+        colour = lookup.outputs["Color"]
     else:
-        mixed = next(n for n in probe.nodes if n.label == f"row {row}")
-        probe.links.new(next(s for s in mixed.outputs if s.enabled and s.is_linked),
-                        emission.inputs["Color"])
-    output = next(n for n in probe.nodes if n.type == "GROUP_OUTPUT")
-    probe.links.new(emission.outputs[0], output.inputs["Shader"])
+        mixed = next(n for n in every if n.label == f"row {row}")
+        colour = next(s for s in mixed.outputs if s.enabled and s.is_linked)
+    emission = colour.id_data.nodes.new("ShaderNodeEmission")
+    colour.id_data.links.new(colour, emission.inputs["Color"])
+    group_probes.to_output(probe, emission.outputs[0])
     return probe
 
 

@@ -39,7 +39,7 @@ def test_save_reload_renders_the_same_and_keeps_only_what_the_render_reads(spher
 def test_altered_lookup_image_is_found_and_rebuilt(sphere, tmp_path):
     import bpy
 
-    from makeup_skin_addon import apply
+    from makeup_skin_addon import apply, group_parts
 
     material, _ = apply_pipeline(sphere, "LAYERED")
     before = render(tmp_path, "before")
@@ -54,7 +54,7 @@ def test_altered_lookup_image_is_found_and_rebuilt(sphere, tmp_path):
     assert bpy.ops.makeup_skin.check_tables() == {"FINISHED"}
     assert len(view_images()) == 1 and apply.check_material(bpy.context, material)[0]
     group = material.node_tree.nodes["Made-up Skin"].node_tree
-    textures = [n for n in group.nodes if n.type == "TEX_IMAGE"]
+    textures = [n for n in group_parts.nodes_of(group) if n.type == "TEX_IMAGE"]
     assert textures and all(n.image == view_images()[0] for n in textures)
 
 
@@ -121,8 +121,9 @@ def test_whole_walk_reopened_without_the_addon_renders_the_same(head, tmp_path):
 def test_apply_adds_little_to_the_file(head, tmp_path):
     """The .blend keeps the bake's record and the view-angle image (5.7 kB), not the tables:
     Apply adds a few hundred kilobytes per skin, not the 21.6 MB of tables it used to pack.
-    The groups' nodes are most of it: 91 in the Layered group, 54 before its view-angle rows
-    were each read from two Closest texels (EEVEE's Linear filter mixes the rows)."""
+    The groups' nodes are most of it: 107 in the Layered group, 54 before its view-angle rows
+    were each read from two Closest texels (EEVEE's Linear filter mixes the rows), and the
+    sockets by which values cross between the parts it is built as (node_algebra.Parts)."""
     import bpy
 
     def saved_size(name):
@@ -134,7 +135,9 @@ def test_apply_adds_little_to_the_file(head, tmp_path):
     before = saved_size("before")
     apply_operator(head)
     apply_operator(other, "LAYERED", skin="jensen_skin1")  # two skins: two groups, two images
-    assert saved_size("after") - before < 1e6  # measured 773 kB on 5.0.1 (2 x 237 kB before)
+    # Measured on 5.0.1: 773 kB in one tree each (2 x 237 kB before the two texels), 1.1 MB
+    # as parts (their 46 sockets and 31 crossing links per Layered group).
+    assert saved_size("after") - before < 1.5e6
     assert len([image for image in bpy.data.images if image.name.startswith("MakeupSkin")]) == 2
 
 

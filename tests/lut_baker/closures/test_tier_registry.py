@@ -107,7 +107,7 @@ def test_a_toy_tier_is_in_the_panel_and_renders_as_its_replica(bpy_factory, prev
     """The toy tier is an item of the Tier setting, Apply's path builds its group with no
     other file edited, Cycles renders it as its replica; unregistered, it is no item and the
     built-in tiers render as before."""
-    from makeup_skin_addon import groups, nodes, properties
+    from makeup_skin_addon import group_parts, groups, nodes, properties
 
     bpy = bpy_factory
     sphere = bench_scene.sphere_scene(size=SIZE, samples=SAMPLES, radius_mm=10.0)
@@ -136,6 +136,6 @@ def test_a_toy_tier_is_in_the_panel_and_renders_as_its_replica(bpy_factory, prev
             assert error < RENDER_BOUND
             tree = group.node_tree
             bpy.data.materials.remove(material)
-            bpy.data.node_groups.remove(tree)
+            group_parts.remove_group(tree)
         assert TOY not in [item[0] for item in properties.tier_items()]
         assert not [g for g in bpy.data.node_groups if "Toy Diffuse" in g.name]

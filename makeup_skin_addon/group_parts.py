@@ -1,0 +1,47 @@
+"""The nested groups a made-up skin group is built as (:class:`.node_algebra.Parts`): how they
+are told apart from any other group, and removed with the group.
+
+- :data:`PART_KEY` -- the custom property that marks a part.
+- :func:`parts_of` -- the parts nested in a group.
+- :func:`remove_parts` -- remove those nothing uses any more; :func:`remove_group` -- a group
+  with its parts.
+- :func:`nodes_of` -- the nodes of a group and of its parts.
+"""
+
+from __future__ import annotations
+
+import bpy
+
+__all__ = ["PART_KEY", "parts_of", "remove_parts", "remove_group", "nodes_of"]
+
+PART_KEY = "makeup_skin_part"
+"""A part's custom property: it marks the add-on's nested groups."""
+
+
+def parts_of(tree) -> list:
+    """The part groups nested in ``tree``, in the order they were made."""
+    return [node.node_tree for node in tree.nodes if node.type == "GROUP"
+            and node.node_tree is not None and PART_KEY in node.node_tree]
+
+
+def remove_parts(parts) -> None:
+    """Remove the part groups ``parts`` that nothing uses any more."""
+    for part in parts:
+        if part.users == 0:
+            bpy.data.node_groups.remove(part)
+
+
+def remove_group(tree) -> list[str]:
+    """Remove the group ``tree`` and the parts nested in it that nothing else uses; the names
+    removed."""
+    parts = parts_of(tree)
+    removed = [tree.name]
+    bpy.data.node_groups.remove(tree)
+    removed += [part.name for part in parts if part.users == 0]
+    remove_parts(parts)
+    return removed
+
+
+def nodes_of(tree) -> list:
+    """The nodes of ``tree`` and of the parts nested in it."""
+    return [*tree.nodes, *(node for part in parts_of(tree) for node in part.nodes)]
