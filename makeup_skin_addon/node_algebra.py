@@ -206,7 +206,8 @@ class Parts:
     (each crossing made once).  Every change
     made through Python runs Blender's node-tree update over the whole tree, and above 32
     nodes that update works in parallel, several times dearer on a free core (docs/addon.md,
-    "A first Apply, timed"); parts keep every tree under it.  The group's own Group Input and
+    "Not done"); parts keep every tree under it.  A part is named after its group with a
+    leading '.', so that Blender's Add > Group menu leaves it out.  The group's own Group Input and
     Output stay in it, beside the parts' group nodes.  ``reuse``: the parts the group holds
     are taken again, their sockets found by name."""
 
@@ -233,7 +234,8 @@ class Parts:
         if kind in self.OUTER:
             return self.tree
         if not self._parts or len(self._parts[-1][0].nodes) >= PART_NODES:
-            part = bpy.data.node_groups.new(f"{self.tree.name} part {len(self._parts) + 1}",
+            # A leading '.': Blender's Add > Group menu leaves the parts out.
+            part = bpy.data.node_groups.new(f".{self.tree.name} part {len(self._parts) + 1}",
                                             "ShaderNodeTree")
             part[PART_KEY] = True
             part.nodes.new("NodeGroupInput")

@@ -22,6 +22,7 @@ def test_no_tree_of_the_group_is_over_the_part_size(sphere):
     parts = group_parts.parts_of(group)
     assert len(parts) > 1  # the Layered group needs several
     assert all(len(tree.nodes) <= node_algebra.PART_NODES for tree in (group, *parts))
+    assert all(part.name.startswith(".") for part in parts)  # out of the Add > Group menu
     assert len(group_parts.nodes_of(group)) == len(group.nodes) + sum(
         len(part.nodes) for part in parts)
 
