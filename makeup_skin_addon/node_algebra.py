@@ -203,13 +203,13 @@ _INTERFACE_TYPES = {"VALUE": "NodeSocketFloat", "VECTOR": "NodeSocketVector",
 class Parts:
     """A group built as parts: node groups of at most :data:`PART_NODES` nodes nested in it,
     filled in turn, a value crossing from one tree to another through the parts' sockets
-    (each crossing made once).  Every change
-    made through Python runs Blender's node-tree update over the whole tree, and above 32
-    nodes that update works in parallel, several times dearer on a free core (docs/addon.md,
-    "Not done"); parts keep every tree under it.  A part is named after its group with a
-    leading '.', so that Blender's Add > Group menu leaves it out.  The group's own Group Input and
-    Output stay in it, beside the parts' group nodes.  ``reuse``: the parts the group holds
-    are taken again, their sockets found by name."""
+    (each crossing made once).  Every change made through Python runs Blender's node-tree
+    update over the whole tree, and above 32 nodes that update works in parallel, several
+    times dearer on a free core (docs/addon.md, "Not done"); parts keep every tree under it.
+    A part is named after its group with a leading '.', so that Blender's Add > Group menu
+    leaves it out.  The group's own Group Input and Output stay in it, beside the parts'
+    group nodes.  ``reuse``: the parts the group holds are taken again, their sockets found
+    by name."""
 
     OUTER = ("NodeGroupInput", "NodeGroupOutput")
 
