@@ -279,9 +279,13 @@ def _slab_shares(tables: Tables, fit: ClosureFit, sphere: _Sphere, w: float,
     return float(np.sqrt(np.mean(gloss**2)) / norm), float(np.sqrt(np.mean(skin**2)) / norm)
 
 
+SPHERE_PX = 48
+"""Pixels across the spheres the shares and gloss omissions are measured on by default."""
+
+
 def gloss_and_skin_shares(tables: Tables, light_deg: float, coverage: float | None = None,
                           absorption: ArrayLike | None = None, *,
-                          resolution: int = 48) -> tuple[float, float]:
+                          resolution: int = SPHERE_PX) -> tuple[float, float]:
     """``(gloss share, skin share)`` of a sphere's image under one distant light
     ``light_deg`` from the view (orthographic, the reference's framing): relative RMS over
     the lit pixels of the gloss lobes' radiance (film, path-3 and skin gloss at the coverage
@@ -307,7 +311,7 @@ def _omission(tables: Tables, fit: ClosureFit, tier: str, sphere: _Sphere, w: fl
 
 def gloss_omission_error(tables: Tables, fit: ClosureFit, tier: str, light_deg: float,
                          coverage: float | None = None, absorption: ArrayLike | None = None,
-                         *, resolution: int = 48,
+                         *, resolution: int = SPHERE_PX,
                          over_shader: bool = False) -> float:
     """Relative RMS change of a sphere's image (orthographic, one distant light ``light_deg``
     from the view, the lit pixels) when ``tier``'s Gloss input goes from 1 to 0: the tier's
@@ -332,7 +336,7 @@ def gloss_omissions(tables: Tables, fit: ClosureFit, coverage: float | None = No
     tiers = tuple(fit.tiers if tiers is None else tiers)
     out: dict[str, dict[float, float]] = {tier: {} for tier in tiers}
     for light in lights:
-        sphere = _sphere(tables, light, w, a, 48)
+        sphere = _sphere(tables, light, w, a, SPHERE_PX)
         for tier in tiers:
             out[tier][float(light)] = _omission(tables, fit, tier, sphere, w, a, over_shader)
     return out
@@ -354,8 +358,6 @@ def profile_mismatch(tables: Tables, fit_error: ArrayLike) -> float:
 SHARE_LIGHTS_DEG = (0.0, 45.0, 75.0, 89.0)
 """Light angles (degrees from the view) at which :func:`traits_from_tables` measures the
 shares."""
-SPHERE_PX = 48
-"""Pixels across the spheres :func:`traits_from_tables` measures by default."""
 
 
 def traits_from_tables(tables: Tables, fit: ClosureFit, coverage: float | None = None,
