@@ -32,7 +32,6 @@ KINDS = ("nodes.new", "setting", "value", "links.new")
 _clock = time.process_time
 
 
-
 class _Timed:
     """A tree's ``nodes`` or ``links`` whose ``new`` is timed into ``spent[kind]``."""
 
@@ -108,12 +107,6 @@ def _timed_build(modules, args: tuple, kwargs: dict, group) -> tuple[float, Coun
         algebra._set, algebra.Builder.feed, nodes.Builder = plain_set, plain_feed, plain_builder
 
 
-def _parts(group) -> list:
-    """The parts ``group`` is built as (none before the add-on built groups as parts)."""
-    return [node.node_tree for node in group.nodes if node.type == "GROUP"
-            and node.node_tree is not None and "makeup_skin_part" in node.node_tree]
-
-
 def _alone(bpy, group, repeats: int = 20) -> dict:
     """Microseconds of CPU per call of each kind, on a copy of ``group`` (its size)."""
     tree = group.copy()
@@ -149,8 +142,8 @@ def main() -> None:
     load = machine_load()
     bpy, *support = _setup(options.repo.resolve())
     apply_to_object = addon_attribute("apply_to_object")
-    modules = (sys.modules[apply_to_object.__module__.rsplit(".", 1)[0] + ".nodes"],
-               sys.modules[apply_to_object.__module__.rsplit(".", 1)[0] + ".node_algebra"])
+    package = apply_to_object.__module__.rsplit(".", 1)[0]
+    modules = (sys.modules[f"{package}.nodes"], sys.modules[f"{package}.node_algebra"])
     nodes = modules[0]
     caught: list = []
     plain = nodes.build_group
@@ -171,7 +164,9 @@ def main() -> None:
             group = bpy.data.node_groups.new("by kind", "ShaderNodeTree")
             timed.append(_timed_build(modules, args, kwargs, group))
         total, spent, counts = min(timed, key=lambda run: run[0])
-        trees = [group, *_parts(group)]
+        # The checkout's parts (none before the add-on built groups as parts).
+        parts = sys.modules.get(f"{package}.group_parts")
+        trees = [group, *(parts.parts_of(group) if parts is not None else ())]
         results = {
             "case": options.case, "nodes": sum(len(tree.nodes) for tree in trees),
             "links": sum(len(tree.links) for tree in trees), "trees": len(trees),

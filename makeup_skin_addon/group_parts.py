@@ -24,22 +24,21 @@ def parts_of(tree) -> list:
             and node.node_tree is not None and PART_KEY in node.node_tree]
 
 
-def remove_parts(parts) -> None:
-    """Remove the part groups ``parts`` that nothing uses any more."""
-    for part in parts:
-        if part.users == 0:
-            bpy.data.node_groups.remove(part)
+def remove_parts(parts) -> list[str]:
+    """Remove the part groups ``parts`` that nothing uses any more; their names."""
+    unused = [part for part in parts if part.users == 0]
+    names = [part.name for part in unused]
+    for part in unused:
+        bpy.data.node_groups.remove(part)
+    return names
 
 
 def remove_group(tree) -> list[str]:
     """Remove the group ``tree`` and the parts nested in it that nothing else uses; the names
     removed."""
-    parts = parts_of(tree)
-    removed = [tree.name]
+    parts, name = parts_of(tree), tree.name
     bpy.data.node_groups.remove(tree)
-    removed += [part.name for part in parts if part.users == 0]
-    remove_parts(parts)
-    return removed
+    return [name, *remove_parts(parts)]
 
 
 def nodes_of(tree) -> list:

@@ -68,7 +68,6 @@ class Builder:
         self.tree = tree
         self.count = 0
         self._parts = Parts(tree, reuse=reuse) if parts else None
-        trees = [tree, *self._parts.trees()] if self._parts is not None else [tree]
         self._pools: dict | None = None
         if reuse:
             self._pools = ({"outer": [n for n in tree.nodes if n.bl_idname in Parts.OUTER],
@@ -77,9 +76,13 @@ class Builder:
                            if self._parts is not None else {"all": list(tree.nodes)})
         self._taken: dict = {}
         # The trees' links by their input (a socket's own ``links`` walks every link).
-        self._into = {link.to_socket.as_pointer(): link for part in trees
+        self._into = {link.to_socket.as_pointer(): link for part in self._trees()
                       for link in part.links} if reuse else {}
         self._links = 0
+
+    def _trees(self) -> list:
+        """The tree and, built as parts, its parts."""
+        return [self.tree, *(self._parts.trees() if self._parts is not None else ())]
 
     def node(self, kind: str, label: str = "", **props):
         if self._pools is not None:
@@ -136,11 +139,10 @@ class Builder:
     def finish(self) -> None:
         """Adding: lay the new nodes out (columns of ten, in the order they were added).
         Reusing: :class:`Mismatch` unless every node, link and part socket was taken."""
-        trees = [self.tree, *self._parts.trees()] if self._parts is not None else [self.tree]
+        trees = self._trees()
         if self._pools is None:
-            for tree in trees:
-                _lay_out(tree.nodes, len(tree.nodes) if tree is not self.tree or
-                         self._parts is not None else self.count)
+            for tree in trees:  # a part's nodes are all new
+                _lay_out(tree.nodes, self.count if self._parts is None else len(tree.nodes))
             return
         left = any(self._taken.get(pool, 0) != len(nodes) for pool, nodes in
                    self._pools.items())
