@@ -18,7 +18,8 @@ Parts, each in fresh Blender processes (so the first call is truly cold), this c
 - ``sampling`` -- :func:`makeup_skin_addon.skin_sampling.surface_mean` on the head: the cold
   first call, a warm repeat (median of 5), after a mesh edit (a vertex in twenty moved), after
   the image file was rewritten and reloaded, after a paint stroke in Blender (unsaved: the image
-  is read whole).  Per step: wall seconds, CPU seconds (the process's, every thread), the memory
+  is read whole), and again with nothing painted since (read whole, its checksum unchanged).
+  Per step: wall seconds, CPU seconds (the process's, every thread), the memory
   added (the resident set's high-water mark, VmHWM reset before the step through
   /proc/self/clear_refs, minus the resident set before it: tracemalloc misses C allocations).
 - ``accuracy`` -- the mean against the exact full-resolution one
@@ -48,8 +49,10 @@ Parts, each in fresh Blender processes (so the first call is truly cold), this c
   (``checkout.swapped_in``): when the material shows the new shade, the worker's CPU and the
   main thread's longest block.
 
-Every time is also printed times 3 (a machine three times slower), against the target: Match
-Skin, Lighter, Darker and the first Apply's match at most 0.2 s and 100 MB on this head.  The
+Every time is also printed times 3 (a machine three times slower), against the targets: Match
+Skin, Lighter, Darker and the first Apply's match (the colour read and the shade solved) at
+most 0.2 s and 100 MB on this head (the MB are the whole step's); the whole first Apply at
+most 0.3 s of CPU here and 1 s three times slower.  The
 machine's load is printed: runs vary with it.  ``--write-docs`` puts the table of the sampling
 and the operators into docs/addon.md ("Match Skin").
 
@@ -90,14 +93,23 @@ LEVELS = 5
 WARM_REPEATS = 5
 TARGET_S = 0.2
 TARGET_MB = 100.0
+APPLY_CPU_S = 0.3
+APPLY_SLOWER_S = 1.0
+"""The first Apply's own targets, on top of its match's (``TARGET_S``, ``TARGET_MB``): at most
+0.3 s of CPU here and 1 s on a machine three times slower."""
 SLOWER = 3.0
 PARTS = ("sampling", "accuracy", "operators")
+IDLE_S = 0.0
+"""Seconds of nothing before each step (``--idle``), as an artist's clicks come: memory the
+process freed may have gone back to the system by then (a virtual machine's free-page
+reporting, the kernel's huge pages) and costs more to take again."""
 DOC = OWN_ROOT / "docs" / "addon.md"
 BEGIN, END = "<!-- skin-colour:begin -->", "<!-- skin-colour:end -->"
 SAMPLING_ROWS = {"cold": "the colour, cold (the first click)", "warm": "again (warm)",
                  "mesh edit": "after a mesh edit (a vertex in 20 moved)",
                  "image file edit": "after the image file changed (reloaded)",
-                 "image painted": "after a paint stroke in Blender (unsaved)"}
+                 "image painted": "after a paint stroke in Blender (unsaved)",
+                 "image painted, again": "again, nothing painted since (its pixels checked)"}
 OPERATOR_ROWS = {"match_skin": "Match Skin, the first (the file opened anew)", "lighter": "Lighter",
                  "darker": "Darker", "match_skin again": "Match Skin again",
                  "first apply": "first Apply (bake and fit included; the texture never "
@@ -164,9 +176,11 @@ def _open(cache: Path, repo: Path):
 
 
 class _Step:
-    """Wall and CPU seconds and the memory added (:class:`checkout.Memory`) of a step."""
+    """Wall and CPU seconds and the memory added (:class:`checkout.Memory`) of a step, after
+    :data:`IDLE_S` seconds of nothing (``--idle``)."""
 
     def __enter__(self):
+        time.sleep(IDLE_S)
         self.memory = Memory().__enter__()
         self.wall, self.cpu = time.perf_counter(), time.process_time()
         return self
@@ -263,6 +277,9 @@ def sampling_worker(cache: Path, repo: Path) -> dict:
     with _Step() as step:
         mean()
     out["image painted"] = step.figures(image_s=spent["reduced_image"])
+    with _Step() as step:
+        mean()
+    out["image painted, again"] = step.figures(image_s=spent["reduced_image"])
     os.remove(working)
     out["images after"] = sorted(image.name for image in bpy.data.images)
     return out
@@ -402,7 +419,7 @@ def worker_main(args) -> int:
 def _run(args, worker: str) -> dict:
     repo = args.repo if worker in ("match", *FIRST_APPLY) else OWN_ROOT
     command = [sys.executable, str(HERE), "--worker", worker, "--cache", str(args.cache),
-               "--repo", str(repo)]
+               "--repo", str(repo), "--idle", str(args.idle)]
     result = subprocess.run(command, capture_output=True, text=True, check=False)
     line = next((line for line in reversed(result.stdout.splitlines())
                  if line.startswith("RESULT ")), None)
@@ -412,26 +429,43 @@ def _run(args, worker: str) -> dict:
     return json.loads(line[len("RESULT "):]) if line else {}
 
 
-def _verdict(figures: dict, factor: float = 1.0) -> str:
-    """Whether a step meets the target (0.2 s, 100 MB), its time times ``factor``."""
-    met = factor * figures["wall_s"] <= TARGET_S and figures["mb"] <= TARGET_MB
-    return "met" if met else "missed"
+def _met(ok: bool) -> str:
+    return "met" if ok else "missed"
+
+
+def _verdicts(figures: dict) -> tuple[str, str]:
+    """Whether a step meets its targets here and on a machine three times slower: a click at
+    most 0.2 s and 100 MB; a first Apply's match (the colour read and the shade solved) the
+    same, and the whole Apply at most 0.3 s of CPU (1 s three times slower)."""
+    if figures.get("match_s") is None:
+        small = figures["mb"] <= TARGET_MB
+        return (_met(figures["wall_s"] <= TARGET_S and small),
+                _met(SLOWER * figures["wall_s"] <= TARGET_S and small))
+    match = figures["sampling_s"] + figures["match_s"]
+    whole = figures["cpu_s"]
+    small = figures["mb"] <= TARGET_MB
+    here = (f"match {_met(match <= TARGET_S and small)}, "
+            f"Apply {_met(whole <= APPLY_CPU_S)}")
+    slower = (f"match {_met(SLOWER * match <= TARGET_S and small)}, "
+              f"Apply {_met(SLOWER * whole <= APPLY_SLOWER_S)}")
+    return here, slower
 
 
 def _row(name: str, figures: dict, extra: str = "") -> str:
+    here, slower = _verdicts(figures)
     return (f"  {name:<28} {figures['wall_s']:8.3f} {figures['cpu_s']:8.3f} "
             f"{figures['mb']:8.1f} {SLOWER * figures['wall_s']:8.3f}  "
-            f"{_verdict(figures):<6} {_verdict(figures, SLOWER):<6}{extra}")
+            f"{here} | {slower} |{extra}")
 
 
 HEADER = (f"  {'step':<28} {'wall s':>8} {'CPU s':>8} {'MB added':>8} {'wall x3':>8}  "
-          f"{'target':<6} {'x3':<6}")
+          f"target | x3 |")
 
 
 def print_sampling(figures: dict) -> None:
     print("\nskin_sampling.surface_mean on the head (image s: the part reading the image)")
     print(HEADER + " image s")
-    for name in ("cold", "warm", "mesh edit", "image file edit", "image painted"):
+    for name in SAMPLING_ROWS:
         print(_row(name, figures[name], f" {figures[name]['image_s']:.3f}"))
     cold = figures["cold"]
     print(f"  mean {', '.join(f'{c:.5f}' for c in cold['rgb'])} +- "
@@ -482,14 +516,14 @@ def _shown(figures: dict) -> str:
 
 def markdown(results: dict) -> str:
     """The sampling's and the operators' figures as the table of docs/addon.md."""
-    lines = ["| step | wall s | CPU s | MB added | 0.2 s, 100 MB | wall s x 3 | 0.2 s x 3 | "
+    lines = ["| step | wall s | CPU s | MB added | target | wall s x 3 | target x 3 | "
              "colour sampling s |", "|---|---|---|---|---|---|---|---|"]
 
     def row(label, figures, part):
+        here, slower = _verdicts(figures)
         lines.append(f"| {label} | {figures['wall_s']:.3f} | {figures['cpu_s']:.3f} | "
-                     f"{figures['mb']:.0f} | {_verdict(figures)} | "
-                     f"{SLOWER * figures['wall_s']:.2f} | {_verdict(figures, SLOWER)} | "
-                     f"{part} |")
+                     f"{figures['mb']:.0f} | {here} | {SLOWER * figures['wall_s']:.2f} | "
+                     f"{slower} | {part} |")
 
     for name, label in SAMPLING_ROWS.items():
         figures = results["sampling"][name]
@@ -512,10 +546,14 @@ def main(argv=None) -> int:
     parser.add_argument("--json", type=Path)
     parser.add_argument("--write-docs", action="store_true",
                         help="put the sampling's and the operators' table into docs/addon.md")
+    parser.add_argument("--idle", type=float, default=0.0,
+                        help="seconds of nothing before each step, as an artist clicks")
     parser.add_argument("--worker", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     args.cache = args.cache.resolve()
     args.repo = args.repo.resolve()
+    global IDLE_S
+    IDLE_S = args.idle
     if args.worker:
         return worker_main(args)
     if args.rebuild or not (args.cache / "head.blend").exists():

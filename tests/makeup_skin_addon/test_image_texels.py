@@ -1,6 +1,7 @@
 """An image as its texture node reads it, box-filtered (makeup_skin_addon.image_texels): kept
-until the image changes (a file rewritten and reloaded, its colour space, unsaved edits read at
-every call), and its texels read at UVs as the texture's extension wraps them."""
+until the image changes (a file rewritten and reloaded, its colour space, unsaved edits: their
+pixels checked at every call), and its texels read at UVs as the texture's extension wraps
+them."""
 
 import numpy as np
 from support.two_faces import RIGHT_BYTES, exact_two_faces, linear
@@ -9,7 +10,8 @@ from support.two_faces import RIGHT_BYTES, exact_two_faces, linear
 def test_the_cache_is_kept_until_the_image_changes(two_faces, tmp_path):
     """An image from a file is read once (the same reduced pixels twice); written again and
     reloaded, or its colour space changed, it is read again; an image edited in Blender
-    (unsaved) is read at every call, with its edits."""
+    (unsaved) is read at every call, with its edits, and reduced again only when they changed
+    its pixels."""
     import bpy
 
     from makeup_skin_addon import image_texels, skin_sampling
@@ -50,6 +52,17 @@ def test_the_cache_is_kept_until_the_image_changes(two_faces, tmp_path):
         assert image.is_dirty
         np.testing.assert_allclose(skin_sampling.surface_mean(image, skin).rgb,
                                    (grey + 3 * linear(np.full(3, value))) / 4, atol=2e-5)
+        painted = image_texels.reduced_image(image)
+        image.pixels.foreach_set(pixels.ravel())  # the same pixels painted again
+        assert image_texels.reduced_image(image) is painted
+    pixels[0, 0, 0] = 0.9  # one texel's red
+    image.pixels.foreach_set(pixels.ravel())
+    changed = image_texels.reduced_image(image)
+    assert changed is not painted and not np.array_equal(changed.pixels, painted.pixels)
+    image.save()  # saved: read from its file again, the same pixels
+    assert not image.is_dirty
+    np.testing.assert_allclose(image_texels.reduced_image(image).pixels, changed.pixels,
+                               atol=1e-6)
 
 
 def test_texels_wrap_as_the_texture_extension_does(addon):
