@@ -34,6 +34,9 @@ infinitely thick medium with a single-scattering albedo per channel in one of th
 - ``cone_top``: ``cone`` under a top layer of the same particles absorbing differently (9
   parameters: its thickness and its absorption relative to the medium's, 0.01-100 and
   0.02-50);
+- ``cone_finite``: ``cone`` of a finite optical thickness over a black base (8 parameters: the
+  thickness, 0.1-200 units of extinction; Lanza et al.'s layer over a black base, its
+  thickness free);
 - ``cone_flat``: ``cone`` with a share of the flakes lying flat (normals about the vertical,
   their own spread; 9 parameters: Lanza et al.'s 103 has its flakes near the vertical),
 
@@ -134,6 +137,10 @@ FORMS = {
                   (np.log(0.02), np.log(50.0))),
                  ((-0.2, 1.0, 0.3, np.log(20.0), 0.0, np.log(0.3)),
                   (0.3, 0.0, -1.0, np.log(30.0), np.log(3.0), np.log(3.0)))),
+    "cone_finite": (("g", "flakes", "cone", "spread", "thickness"),
+                    ((-4.0, 4.0), LOGIT, LOGIT, LOG_SPREAD, (np.log(0.1), np.log(200.0))),
+                    ((-0.2, 1.0, 0.3, np.log(20.0), np.log(3.0)),
+                     (0.3, 0.0, -1.0, np.log(30.0), np.log(20.0)))),
     "cone_flat": (("g", "flakes", "cone", "spread", "flat", "flat_spread"),
                   ((-4.0, 4.0), LOGIT, LOGIT, LOG_SPREAD, LOGIT, LOG_SPREAD),
                   ((-0.2, 1.0, 0.3, np.log(20.0), -1.0, np.log(15.0)),
@@ -141,7 +148,7 @@ FORMS = {
 }
 CONE_FORMS = ("cone", "cone_flakes", "cone_tinted", "cone_slab", "cone_surface",
               "cone_surface_15", "cone_partial_15", "cone_patches_15", "cone_flat",
-              "cone_top")
+              "cone_top", "cone_finite")
 BINDER_ETA = 1.5
 """The surface's index in ``cone_surface_15``: a binder's (oils, silicones: about 1.4-1.5)."""
 ALBEDO_LOGIT_MAX = {"cone_tinted": float(np.log(0.995 / 0.005))}
@@ -183,6 +190,8 @@ def unpack(form: str, p) -> MatteSlab:
                   cone_spread_deg=np.exp(p[first + 2]))
     if form == "cone_top":
         kw.update(top_thickness=np.exp(p[7]), top_absorption=np.exp(p[8]))
+    if form == "cone_finite":
+        kw.update(thickness=np.exp(p[7]))
     if form == "cone_flat":
         kw.update(flat=_sigmoid(p[7]), flat_spread_deg=np.exp(p[8]))
     if form == "cone_tinted":
@@ -200,7 +209,7 @@ def physical(form: str, p) -> np.ndarray:
               "flake_g": tint[1], "flake_b": tint[2], "coverage": m.coverage,
               "flat": m.flat, "flat_spread": m.flat_spread_deg,
               "alpha2": m.alpha2, "coverage2": m.coverage2, "top_thickness": m.top_thickness,
-              "top_absorption": m.top_absorption}
+              "top_absorption": m.top_absorption, "thickness": m.thickness}
     return np.array([*m.albedo, *(values[k] for k in FORMS[form][0])])
 
 

@@ -346,7 +346,8 @@ class MatteSlab:
     wider than the light's path in the medium: :func:`matte_slab_kernel`), and optionally a
     second kind of surface patch, roughness ``alpha2`` over ``coverage2`` of the area; a top
     layer of the medium ``top_thickness`` thick absorbing ``top_absorption`` times as much
-    (:func:`medium_reflection`)."""
+    (:func:`medium_reflection`); the medium ``thickness`` thick over a black base (0: infinitely
+    thick; a drawdown thin enough that light reaches what it is drawn on)."""
 
     albedo: np.ndarray
     g1: float = 0.0
@@ -366,6 +367,7 @@ class MatteSlab:
     coverage2: float = 0.0
     top_thickness: float = 0.0
     top_absorption: float = 1.0
+    thickness: float = 0.0
 
     def surface_patches(self) -> list[tuple[float, float]]:
         """``(alpha, coverage)`` of each kind of surface patch: ``alpha`` over ``coverage`` and,
@@ -419,7 +421,11 @@ def medium_reflection(grid: HemisphereGrid, model: MatteSlab) -> np.ndarray:
     """The thick medium's reflection (star form on ``grid``): :func:`medium_generator`'s
     infinite-thickness limit, under a top layer of the same particles absorbing
     ``model.top_absorption`` times as much (single-scattering albedo ``1 - k (1 - albedo)``),
-    ``model.top_thickness`` thick (units of the spheres' extinction), if that is > 0."""
+    ``model.top_thickness`` thick (units of the spheres' extinction), if that is > 0; or, if
+    ``model.thickness`` > 0, the medium that thick over a black base (nothing returns from
+    below it)."""
+    if model.thickness > 0.0:
+        return AD.slab(medium_generator(grid, model), model.thickness)[0]
     thick = AD.thick_slab(medium_generator(grid, model))
     if not model.top_thickness > 0.0:
         return thick

@@ -213,3 +213,22 @@ def test_top_layer_of_the_medium():
     scale0 = AD.star_scale(GRID)[0]
     thin = medium_reflection(GRID, MatteSlab(**medium, top_thickness=2.0, top_absorption=0.3))
     assert np.all(AD.star_albedo(thin[:, 0], scale0) > AD.star_albedo(plain[:, 0], scale0))
+
+
+def test_the_medium_over_a_black_base():
+    # Very thick, it is the thick medium; thinner, it reflects less at every incidence, and
+    # less the more nearly normal the light (its path to the black base is shorter); with no
+    # thickness there is nothing to reflect.
+    medium = {"albedo": np.array([0.98, 0.9]), "g1": 0.5, "flakes": 0.4, "cone_deg": 40.0,
+              "cone_spread_deg": 20.0}
+    plain = medium_reflection(GRID, MatteSlab(**medium))
+    deep = medium_reflection(GRID, MatteSlab(**medium, thickness=400.0))
+    np.testing.assert_allclose(deep, plain, atol=1e-9)
+    scale0 = AD.star_scale(GRID)[0]
+    thick_albedo = AD.star_albedo(plain[:, 0], scale0)
+    thin_albedo = AD.star_albedo(
+        medium_reflection(GRID, MatteSlab(**medium, thickness=2.0))[:, 0], scale0)
+    assert np.all(thin_albedo < thick_albedo)
+    lost = 1.0 - thin_albedo / thick_albedo  # the share the black base takes, by incidence
+    mu = np.cos(GRID.theta)
+    assert np.all(lost[..., np.argmax(mu)] > lost[..., np.argmin(mu)])
