@@ -35,7 +35,7 @@ from dataclasses import dataclass, field
 import bpy
 import numpy as np
 
-from . import artist_shader, convert, skin_sampling, sky_visibility, surface_values
+from . import artist_shader, convert, pages, skin_sampling, sky_visibility, surface_values
 from .artist_shader import Leaf, Source, source
 from .core import principled_albedo
 
@@ -250,6 +250,7 @@ def render_engine(scene) -> str:
     return "CYCLES" if engine == "CYCLES" else "EEVEE"
 
 
+@pages.ordinary()
 def read_material(material, scene=None, progress=None) -> SkinReading | None:
     """:func:`read_skin` of ``material``'s artist shader (:func:`.convert.artist_tree`) over
     its surface (:func:`.skin_sampling.surface_samples`, cached per mesh and image) as the

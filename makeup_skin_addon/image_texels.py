@@ -19,7 +19,6 @@ is read whole at each call and reduced again only when its CRC-32 changed.
 from __future__ import annotations
 
 import contextlib
-import mmap
 import os
 import zlib
 from dataclasses import dataclass
@@ -28,7 +27,7 @@ from typing import Any
 import bpy
 import numpy as np
 
-from . import image_store
+from . import image_store, pages
 from .core import cache
 from .progress import report
 
@@ -142,19 +141,9 @@ def _float_buffer(image) -> np.ndarray | None:
     width, height = image.size
     if width * height == 0:
         return None
-    values = _mapped_float32(width * height * image.channels)
+    values = np.empty(width * height * image.channels, np.float32)
     image.pixels.foreach_get(values)
     return values.reshape(height, width, -1)
-
-
-def _mapped_float32(count: int) -> np.ndarray:
-    """An array of ``count`` float32 in memory mapped for it alone (freed with it), not
-    numpy's: numpy asks Linux for huge pages for arrays of 4 MB and more, and the first touch of
-    those can stall where the kernel must first find or take back whole huge pages (in a
-    virtual machine that gave its free memory back to the host: 1.9-2.2 s for a 4096 px
-    image's 268 MB after a few seconds idle, measured, against 0.19 s mapped here)."""
-    private = {"flags": mmap.MAP_PRIVATE} if hasattr(mmap, "MAP_PRIVATE") else {}
-    return np.frombuffer(mmap.mmap(-1, 4 * count, **private), np.float32)
 
 
 def _reduced_buffer(image, pixels: np.ndarray, size: int) -> ReducedImage:
@@ -210,6 +199,7 @@ def _image_fingerprint(image) -> tuple:
             image.alpha_mode, generated, image.is_dirty)
 
 
+@pages.ordinary()
 def reduced_image(image, size: int = IMAGE_SIZE) -> ReducedImage:
     """``image`` as its texture node reads it (linear), box-filtered down to at most ``size``
     texels across; kept until the image changes (an image with unsaved changes: until its

@@ -23,7 +23,7 @@ from typing import Any
 import bpy
 import numpy as np
 
-from . import image_texels, surface_points
+from . import image_texels, pages, surface_points
 from .progress import Report, report, reporting
 
 __all__ = ["SurfaceMean", "surface_mean", "SurfaceSamples", "surface_samples", "clear_cache"]
@@ -57,6 +57,7 @@ def _missing_uv(obj, uv_map: str, reader: str) -> str:
         f"{obj.name!r} has no UV map{by}"
 
 
+@pages.ordinary()
 def surface_mean(image: Any, material: Any, *, uv_map: str = "", extension: str = "REPEAT",
                  reader: str = "", budget: int = surface_points.BUDGET,
                  size: int = image_texels.IMAGE_SIZE) -> SurfaceMean:

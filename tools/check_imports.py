@@ -52,7 +52,7 @@ LAYERS: dict[str, list[tuple[str, ...]]] = {
         ("makeup_skin_addon.keys",),
         ("makeup_skin_addon.package",),
         ("makeup_skin_addon.core",),
-        ("makeup_skin_addon.progress",),
+        ("makeup_skin_addon.progress", "makeup_skin_addon.pages"),
         ("makeup_skin_addon.group_parts",),
         ("makeup_skin_addon.artist_shader",),
         ("makeup_skin_addon.node_maths",),

@@ -1,0 +1,29 @@
+"""numpy's huge-page request turned off for a block and set back after
+(makeup_skin_addon.pages)."""
+
+import pytest
+
+
+def test_the_block_turns_huge_pages_off_and_sets_them_back():
+    from makeup_skin_addon import pages
+
+    switch = pages._switch()
+    if switch is None:
+        pytest.skip("this numpy has no huge-page switch")
+    before = switch(True)
+    try:
+        with pages.ordinary():
+            assert switch(False) is False  # off inside (the switch returns what it replaced)
+        assert switch(True) is True  # set back as it was
+        with pytest.raises(ValueError), pages.ordinary():
+            raise ValueError
+        assert switch(True) is True  # set back after an error too
+
+        @pages.ordinary()
+        def inside():
+            return switch(False)
+
+        assert inside() is False and inside() is False  # a decorator: each call its block
+        assert switch(True) is True
+    finally:
+        switch(before)
