@@ -444,25 +444,34 @@ def _face_minimum(gram: np.ndarray, right: np.ndarray,
     the best feasible one), so that ``f`` follows the data continuously.  On a face the
     optimum is ``G^-1 r`` plus, with the sum held, the multiple of ``G^-1 1`` that meets it."""
     views, count = right.shape
-    if total is None:
-        best_cost, shares = np.zeros(views), np.zeros((views, count))  # f = 0 is feasible
-    else:
-        best_cost, shares = np.full(views, np.inf), np.zeros((views, count))
-    for mask in range(1, 2 ** count):
-        face = np.flatnonzero([(mask >> k) & 1 for k in range(count)])
-        both = np.stack([right[:, face], np.ones((views, face.size))], axis=-1)
-        solved = _spd_solve(gram[:, face][:, :, face], both)
+    faces = [np.flatnonzero([(mask >> k) & 1 for k in range(count)])
+             for mask in range(1, 2 ** count)]
+    # Every face's optimum, the faces of one size solved together (their views stacked).
+    candidates = np.zeros((len(faces), views, count))
+    for size in range(1, count + 1):
+        group = [i for i, face in enumerate(faces) if face.size == size]
+        grams = np.concatenate([gram[:, faces[i]][:, :, faces[i]] for i in group])
+        both = np.concatenate([np.stack([right[:, faces[i]], np.ones((views, size))], axis=-1)
+                               for i in group])
+        solved = _spd_solve(grams, both).reshape(len(group), views, size, 2)
         solution = solved[..., 0]
         if total is not None:
             ones = solved[..., 1]
-            solution = solution + ((np.asarray(total, float) - solution.sum(axis=1))
-                                   / ones.sum(axis=1))[:, None] * ones
-        f = np.zeros((views, count))
-        f[:, face] = solution
-        cost = np.einsum("vk,vkj,vj->v", f, gram, f) - 2.0 * np.einsum("vk,vk->v", right, f)
-        better = np.all(solution >= 0.0, axis=1) & (cost < best_cost)
-        best_cost = np.where(better, cost, best_cost)
-        shares = np.where(better[:, None], f, shares)
+            solution = solution + ((np.asarray(total, float) - solution.sum(axis=-1))
+                                   / ones.sum(axis=-1))[..., None] * ones
+        for j, i in enumerate(group):
+            candidates[i][:, faces[i]] = solution[j]
+    cost = (np.einsum("fvk,vkj,fvj->fv", candidates, gram, candidates)
+            - 2.0 * np.einsum("vk,fvk->fv", right, candidates))
+    feasible = np.all(candidates >= 0.0, axis=-1) & ~np.isnan(cost)
+    ranked = np.where(feasible, cost, np.inf)
+    if total is None:  # f = 0 is feasible, at cost 0
+        ranked = np.concatenate([np.zeros((1, views)), ranked])
+        candidates = np.concatenate([np.zeros((1, views, count)), candidates])
+    # The first face, in the order above, of the least cost (a tie keeps the earlier one).
+    best = np.argmin(ranked, axis=0)
+    shares = candidates[best, np.arange(views)]
+    shares[~np.isfinite(ranked[best, np.arange(views)])] = 0.0  # no feasible face
     return shares
 
 
