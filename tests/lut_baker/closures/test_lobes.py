@@ -154,3 +154,31 @@ def test_fit_glossy_pair_of_no_gloss_is_empty():
                                           theta)
     assert not np.any(first.weights) and not np.any(first.diffuse_weights)
     assert not np.any(second.weights)
+
+
+def test_the_share_problem_meets_its_optimality_conditions():
+    """The non-negative shares minimising ``f G f - 2 r f`` per view, free or with their sum
+    held, meet the Karush-Kuhn-Tucker conditions: the gradient ``2 (G f - r)`` vanishes (or,
+    with the sum held, equals one multiplier) on every share above 0 and is no lower on the
+    shares at 0; on random problems of two and three shares with every kind of active set."""
+    rng = np.random.default_rng(7)
+    for count in (2, 3):
+        basis = rng.normal(size=(400, count, count + 2))
+        gram = np.einsum("vka,vja->vkj", basis, basis) + 1e-3 * np.eye(count)
+        right = rng.normal(size=(400, count))
+        for total in (None, rng.uniform(0.5, 1.5, 400)):
+            shares = lobes._face_minimum(gram, right, total)
+            gradient = 2.0 * (np.einsum("vkj,vj->vk", gram, shares) - right)
+            active = shares > 0.0
+            if total is None:
+                multiplier = np.zeros(400)
+            else:
+                np.testing.assert_allclose(shares.sum(axis=1), total, rtol=1e-12)
+                multiplier = np.nanmean(np.where(active, gradient, np.nan), axis=1)
+            # the gradient less the multiplier, relative to the gradient's size
+            excess = (gradient - multiplier[:, None]) / (1.0 + np.abs(gradient).max(
+                axis=1, keepdims=True))
+            assert np.all(shares >= 0.0)
+            assert np.all(np.abs(excess[active]) < 1e-9)
+            assert np.all(excess[~active] > -1e-9)
+            assert len({tuple(row) for row in active}) >= count + 1  # several active sets
