@@ -16,6 +16,7 @@ turned off for the block on the interface's thread and set back as it was after.
 from __future__ import annotations
 
 import contextlib
+import threading
 from collections.abc import Callable, Iterator
 
 import numpy as np
@@ -37,9 +38,10 @@ def _switch() -> Callable[[bool], bool] | None:
 @contextlib.contextmanager
 def ordinary() -> Iterator[None]:
     """A block whose new numpy arrays use ordinary pages (no huge-page request); the setting
-    set back as it was after, whatever happens."""
+    set back as it was after, whatever happens.  On the interface's thread only: a worker's
+    block is left as it is (two threads setting one switch back could leave it off)."""
     switch = _switch()
-    if switch is None:
+    if switch is None or threading.current_thread() is not threading.main_thread():
         yield
         return
     before = switch(False)

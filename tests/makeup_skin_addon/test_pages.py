@@ -1,6 +1,8 @@
 """numpy's huge-page request turned off for a block and set back after
 (makeup_skin_addon.pages)."""
 
+import threading
+
 import pytest
 
 
@@ -24,6 +26,12 @@ def test_the_block_turns_huge_pages_off_and_sets_them_back():
             return switch(False)
 
         assert inside() is False and inside() is False  # a decorator: each call its block
+        assert switch(True) is True
+        seen = []
+        worker = threading.Thread(target=lambda: seen.append(inside()))
+        worker.start()
+        worker.join()
+        assert seen == [True]  # a worker thread's block leaves the switch alone
         assert switch(True) is True
     finally:
         switch(before)
