@@ -21,10 +21,12 @@ def test_the_block_turns_huge_pages_off_and_sets_them_back():
             raise ValueError
         assert switch(True) is True  # set back after an error too
 
-        @pages.ordinary()
-        def inside():
-            return switch(False)
+        def setting():  # the switch's setting, read by setting it and back
+            value = switch(False)
+            switch(value)
+            return value
 
+        inside = pages.ordinary()(setting)
         assert inside() is False and inside() is False  # a decorator: each call its block
         assert switch(True) is True
         seen = []
