@@ -3,6 +3,7 @@ and the operators that use it end to end (a benchmark, not a test).
 
     python bench/skin_colour.py [--repo CHECKOUT] [--cache DIR] [--rebuild] [--json FILE]
                                 [--parts sampling accuracy operators] [--write-docs]
+                                [--idle SECONDS]
 
 The head (built once into ``--cache``, default bench/results/skin_colour_cache/, not committed;
 ``--rebuild`` builds it again): the textured head of tests/support/character.py (Suzanne, its
