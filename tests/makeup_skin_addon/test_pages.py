@@ -6,7 +6,7 @@ import threading
 import pytest
 
 
-def test_the_block_turns_huge_pages_off_and_sets_them_back():
+def test_the_block_turns_huge_pages_off_and_sets_them_back(addon):
     from makeup_skin_addon import pages
 
     switch = pages._switch()
