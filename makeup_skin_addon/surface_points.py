@@ -195,15 +195,36 @@ def _linear_part(obj) -> np.ndarray:
     return np.array(obj.matrix_world, float)[:3, :3]
 
 
-def _fingerprint(obj, layer, slots: tuple) -> tuple:
+class _MeshArrays:
+    """A mesh's arrays for one read of its faces, each copied out of Blender once: the
+    fingerprint, the areas and the points all need the positions and the corners' vertices
+    (read three times, a cold read of a million triangles took 13 ms more)."""
+
+    def __init__(self, mesh):
+        self.mesh = mesh
+        self._arrays: dict = {}
+
+    def get(self, read) -> np.ndarray:
+        """``read(mesh)`` (:func:`_positions`, :func:`_corner_verts`,
+        :func:`_material_indices`), read at the first call."""
+        if read not in self._arrays:
+            self._arrays[read] = read(self.mesh)
+        return self._arrays[read]
+
+    def release(self) -> None:
+        """Let the arrays go (read again if asked for)."""
+        self._arrays.clear()
+
+
+def _fingerprint(obj, layer, slots: tuple, arrays: _MeshArrays) -> tuple:
     """What the points of ``obj`` depend on but the UVs, cheaply: the counts, the UV map's name,
     the slots, the transform's linear part and a CRC-32 of the positions, corners' vertices and
-    material indices (Blender's arrays copied whole, one at a time: 4.5 ms on a million
-    triangles).  The UVs are checked where the points read them (:func:`_uv_checksum`)."""
+    material indices (Blender's arrays copied whole: 4.5 ms on a million triangles).  The UVs
+    are checked where the points read them (:func:`_uv_checksum`)."""
     mesh = obj.data
     crc = 0
-    for read in (_positions, _corner_verts, _material_indices):  # one array at a time
-        crc = zlib.crc32(np.ascontiguousarray(read(mesh)).data, crc)
+    for read in (_positions, _corner_verts, _material_indices):
+        crc = zlib.crc32(np.ascontiguousarray(arrays.get(read)).data, crc)
     return (len(mesh.vertices), len(mesh.loops), len(mesh.polygons), layer.name, slots,
             tuple(_linear_part(obj).ravel()), crc)
 
@@ -216,23 +237,36 @@ def _uv_checksum(corner_uv: np.ndarray, corners: np.ndarray) -> int:
 
 
 def _loop_starts(mesh) -> tuple[np.ndarray, np.ndarray]:
-    """``(loop_start, loop_total)`` of the faces (int32): their first corners (read a face at a
-    time: Blender keeps no array of them that Python can copy) and their corner counts."""
-    loop_start = _array(mesh.polygons, "loop_start", len(mesh.polygons), np.int32)
-    return loop_start, face_geometry.corner_counts(loop_start, len(mesh.loops))
+    """``(loop_start, loop_total)`` of the faces (int32): their first corners and their corner
+    counts.  Blender keeps no array of the first corners that Python can copy (read a face at
+    a time: 15 ms on a million triangles), but it does of its triangles' faces: a face of
+    ``n`` corners has ``n - 2`` triangles, in face order, so a face's first corner is its
+    first triangle's index plus twice its own (5-10 ms).  Read a face at a time where the
+    triangles do not add up so."""
+    faces, corners = len(mesh.polygons), len(mesh.loops)
+    triangles = _array(mesh.loop_triangle_polygons, "value",
+                       len(mesh.loop_triangle_polygons), np.int32)
+    first = np.flatnonzero(triangles[1:] != triangles[:-1]) + 1  # faces 1.. their first
+    if faces > 0 and len(triangles) == corners - 2 * faces and len(first) == faces - 1:
+        loop_start = np.empty(faces, np.int32)
+        loop_start[0] = 0
+        loop_start[1:] = first
+        loop_start += 2 * np.arange(faces, dtype=np.int32)
+    else:
+        loop_start = _array(mesh.polygons, "loop_start", faces, np.int32)
+    return loop_start, face_geometry.corner_counts(loop_start, corners)
 
 
-def _face_areas(obj, slots: tuple, loop_start: np.ndarray,
-                loop_total: np.ndarray) -> tuple[np.ndarray, int]:
+def _face_areas(obj, slots: tuple, loop_start: np.ndarray, loop_total: np.ndarray,
+                arrays: _MeshArrays) -> tuple[np.ndarray, int]:
     """``(areas, faces)``: the world areas (square metres, float64) of ``obj``'s faces, zero
     for faces of other slots, and how many faces the slots have (a material index beyond the
     slots counts as the last slot, as Blender draws it).  The areas are Blender's
     (:func:`.face_geometry.face_areas`)."""
-    mesh = obj.data
     area = np.empty(len(loop_start))  # kept: allocated before the temporaries (_points)
-    positions, corner_verts = _positions(mesh), _corner_verts(mesh)
+    positions, corner_verts = arrays.get(_positions), arrays.get(_corner_verts)
     face_geometry.face_areas(positions, corner_verts, loop_start, loop_total, out=area)
-    index = np.minimum(_material_indices(mesh), max(len(obj.material_slots) - 1, 0))
+    index = np.minimum(arrays.get(_material_indices), max(len(obj.material_slots) - 1, 0))
     used = np.isin(index, slots)
     area[~used] = 0.0
     faces = int(np.count_nonzero(used))
@@ -250,23 +284,23 @@ def _face_areas(obj, slots: tuple, loop_start: np.ndarray,
     return area * np.linalg.norm(normal @ cofactor.T, axis=1), faces
 
 
-def _points(obj, layer, area: np.ndarray, faces: int, count: int,
-            loop_start: np.ndarray, loop_total: np.ndarray) -> tuple[Points, np.ndarray, int]:
-    """``(points, corners, checksum)``: ``count`` points of ``obj``'s faces by ``area``, the
-    corners their UVs are read at ((3, count) int32) and those UVs' :func:`_uv_checksum`.  The
-    UV map is read last, once the positions are freed (a lower peak)."""
-    mesh = obj.data
+def _points(layer, area: np.ndarray, faces: int, count: int, loop_start: np.ndarray,
+            loop_total: np.ndarray, arrays: _MeshArrays) -> tuple[Points, np.ndarray, int]:
+    """``(points, corners, checksum)``: ``count`` points of the faces by ``area``, the corners
+    their UVs are read at ((3, count) int32) and those UVs' :func:`_uv_checksum`.  The UV map
+    is read last, once the mesh's arrays are let go (a lower peak)."""
     # What is kept is allocated before the temporaries: freed, these then leave the top of the
     # heap free (allocated after them, a kept array holds them resident below it).
     uv = np.empty((count, 2), np.float32)
     position, normal = np.empty((count, 3), np.float32), np.empty((count, 3), np.float32)
     corners = np.empty((3, count), np.int32)
-    positions, corner_verts = _positions(mesh), _corner_verts(mesh)
+    positions, corner_verts = arrays.get(_positions), arrays.get(_corner_verts)
     triangles = sampled_triangles(area, loop_start, loop_total, corner_verts, positions, count)
     triangles.interpolated(positions, position, corner_verts)
     face_geometry.face_normals(positions, corner_verts, loop_start, loop_total, triangles.face,
                                out=normal)
     del positions, corner_verts
+    arrays.release()
     for row, corner in zip(corners, triangles.corners, strict=True):
         row[:] = corner
     corner_uv = _corner_uvs(layer)
@@ -298,10 +332,13 @@ class Surface:
         self.obj, self.layer = obj, layer
         self.slots = _slots(obj, material)
         self.key = (obj.session_uid, material.session_uid, layer.name)
-        self.fingerprint = _fingerprint(obj, layer, self.slots)
+        self._arrays = _MeshArrays(obj.data)
+        self.fingerprint = _fingerprint(obj, layer, self.slots, self._arrays)
         entry = _POINTS.get(self.key)
         self.cached = (entry.points if entry is not None
                        and entry.matches(self.fingerprint, layer) else None)
+        if self.cached is not None:
+            self._arrays.release()
         self._faces: tuple | None = None
         self._areas: tuple[np.ndarray, int] | None = None
 
@@ -313,7 +350,7 @@ class Surface:
     def areas(self) -> tuple[np.ndarray, int]:
         """``(areas, faces)`` of :func:`_face_areas`, read once."""
         if self._areas is None:
-            self._areas = _face_areas(self.obj, self.slots, *self._loop_starts())
+            self._areas = _face_areas(self.obj, self.slots, *self._loop_starts(), self._arrays)
         return self._areas
 
     def area(self) -> float:
@@ -325,11 +362,12 @@ class Surface:
             return self.cached
         areas, faces = self.areas()
         if count > 0 and areas.sum() > 0.0:
-            points, corners, checksum = _points(self.obj, self.layer, areas, faces, count,
-                                                *self._loop_starts())
+            points, corners, checksum = _points(self.layer, areas, faces, count,
+                                                *self._loop_starts(), self._arrays)
         else:
             points = Points(np.empty((0, 2), np.float32), float(areas.sum()), faces)
             corners, checksum = np.empty((3, 0), np.int32), 0
+        self._arrays.release()
         _POINTS.put(self.key, _Entry(self.fingerprint, corners, checksum, points))
         self.cached = points
         return points

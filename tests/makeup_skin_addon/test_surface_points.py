@@ -20,11 +20,12 @@ def _blender_faces(mesh):
 
 def test_areas_normals_and_corners_as_blender_gives_them(blank_scene):
     """Triangles, quads and larger faces, bent out of their planes and at sizes from a
-    millimetre to a kilometre, and degenerate ones: each face's corner count exactly as
-    Blender's, its area and normal within float32 rounding of Blender's (the same formulas in
-    float32, in Blender's order: equal to the last bit on this x86-64 machine, whose Blender
-    fuses no multiply-add; a build that fuses them may differ by a few units in the last place,
-    hence the tolerances, not equality)."""
+    millimetre to a kilometre, and degenerate ones: each face's first corner (found from
+    Blender's triangles) and corner count exactly as Blender's, its area and normal within
+    float32 rounding of Blender's (the same formulas in float32, in Blender's order: equal to
+    the last bit on this x86-64 machine, whose Blender fuses no multiply-add; a build that
+    fuses them may differ by a few units in the last place, hence the tolerances, not
+    equality)."""
     import bpy
 
     from makeup_skin_addon import face_geometry, surface_points
@@ -50,7 +51,10 @@ def test_areas_normals_and_corners_as_blender_gives_them(blank_scene):
     meshes.append(degenerate)
     for mesh in meshes:
         area, normal, total = _blender_faces(mesh)
-        loop_start, loop_total = surface_points._loop_starts(mesh)
+        loop_start, loop_total = surface_points._loop_starts(mesh)  # from the triangles
+        first = np.empty(len(mesh.polygons), np.int32)
+        mesh.polygons.foreach_get("loop_start", first)
+        np.testing.assert_array_equal(loop_start, first)
         np.testing.assert_array_equal(loop_total, total)
         positions = surface_points._positions(mesh)
         corner_verts = surface_points._corner_verts(mesh)
@@ -65,6 +69,8 @@ def test_areas_normals_and_corners_as_blender_gives_them(blank_scene):
             face_geometry.face_normals(positions, corner_verts, loop_start, loop_total, some),
             normal[some], rtol=0.0, atol=1e-6)
     assert len(np.unique(np.concatenate([_blender_faces(m)[2] for m in meshes]))) >= 4
+    empty = bpy.data.meshes.new("Empty")  # no faces: nothing to read
+    assert all(len(a) == 0 for a in surface_points._loop_starts(empty))
 
 
 def test_the_cache_follows_every_change(two_faces):
