@@ -244,9 +244,9 @@ def _loop_starts(mesh) -> tuple[np.ndarray, np.ndarray]:
     first triangle's index plus twice its own (5-10 ms).  Read a face at a time where the
     triangles do not add up so."""
     faces, corners = len(mesh.polygons), len(mesh.loops)
-    of_triangles = getattr(mesh, "loop_triangle_polygons", ())  # Blender 3.6 on
-    triangles = _array(of_triangles, "value", len(of_triangles), np.int32) if len(
-        of_triangles) else np.empty(0, np.int32)
+    of_triangles = getattr(mesh, "loop_triangle_polygons", None)  # Blender 3.6 on
+    triangles = (np.empty(0, np.int32) if of_triangles is None else
+                 _array(of_triangles, "value", len(of_triangles), np.int32))
     first = np.flatnonzero(triangles[1:] != triangles[:-1]) + 1  # faces 1.. their first
     if faces > 0 and len(triangles) == corners - 2 * faces and len(first) == faces - 1:
         loop_start = np.empty(faces, np.int32)
