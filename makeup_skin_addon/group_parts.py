@@ -2,7 +2,8 @@
 are told apart from any other group, and removed with the group.
 
 - :data:`PART_KEY` -- the custom property that marks a part.
-- :func:`parts_of` -- the parts nested in a group.
+- :func:`part_holders` -- the group nodes holding them; :func:`parts_of` -- the parts nested in
+  a group.
 - :func:`remove_parts` -- remove those nothing uses any more; :func:`remove_group` -- a group
   with its parts.
 - :func:`nodes_of` -- the nodes of a group and of its parts.
@@ -12,16 +13,21 @@ from __future__ import annotations
 
 import bpy
 
-__all__ = ["PART_KEY", "parts_of", "remove_parts", "remove_group", "nodes_of"]
+__all__ = ["PART_KEY", "part_holders", "parts_of", "remove_parts", "remove_group", "nodes_of"]
 
 PART_KEY = "makeup_skin_part"
 """A part's custom property: it marks the add-on's nested groups."""
 
 
+def part_holders(tree) -> list:
+    """The group nodes of ``tree`` that hold its parts, in the order they were made."""
+    return [node for node in tree.nodes if node.type == "GROUP"
+            and node.node_tree is not None and PART_KEY in node.node_tree]
+
+
 def parts_of(tree) -> list:
     """The part groups nested in ``tree``, in the order they were made."""
-    return [node.node_tree for node in tree.nodes if node.type == "GROUP"
-            and node.node_tree is not None and PART_KEY in node.node_tree]
+    return [node.node_tree for node in part_holders(tree)]
 
 
 def remove_parts(parts) -> list[str]:

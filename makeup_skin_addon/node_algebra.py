@@ -20,7 +20,7 @@ from __future__ import annotations
 import bpy
 import numpy as np
 
-from .group_parts import PART_KEY
+from .group_parts import PART_KEY, part_holders
 
 __all__ = ["Builder", "Mismatch", "Parts", "PART_NODES", "NodeValue", "NodeAlgebra",
            "NodeShaders", "socket", "value_of"]
@@ -223,8 +223,7 @@ class Parts:
         self._reuse = reuse
         self._used: set = set()  # the sockets' (part pointer, identifier) taken, reusing
         if reuse:
-            for holder in (n for n in tree.nodes if n.type == "GROUP" and
-                           n.node_tree is not None and PART_KEY in n.node_tree):
+            for holder in part_holders(tree):
                 self._remember(holder.node_tree, holder)
 
     def trees(self) -> list:
