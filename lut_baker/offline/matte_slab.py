@@ -418,24 +418,24 @@ def medium_generator(grid: HemisphereGrid, model: MatteSlab):
 
 
 def medium_reflection(grid: HemisphereGrid, model: MatteSlab) -> np.ndarray:
-    """The thick medium's reflection (star form on ``grid``): :func:`medium_generator`'s
-    infinite-thickness limit, under a top layer of the same particles absorbing
+    """The medium's reflection (star form on ``grid``): :func:`medium_generator`'s
+    infinite-thickness limit or, if ``model.thickness`` > 0, the medium that thick over a black
+    base (nothing returns from below it); under a top layer of the same particles absorbing
     ``model.top_absorption`` times as much (single-scattering albedo ``1 - k (1 - albedo)``),
-    ``model.top_thickness`` thick (units of the spheres' extinction), if that is > 0; or, if
-    ``model.thickness`` > 0, the medium that thick over a black base (nothing returns from
-    below it)."""
-    if model.thickness > 0.0:
-        return AD.slab(medium_generator(grid, model), model.thickness)[0]
-    thick = AD.thick_slab(medium_generator(grid, model))
+    ``model.top_thickness`` thick (units of the spheres' extinction), if that is > 0."""
+    generator = medium_generator(grid, model)
+    body = (AD.slab(generator, model.thickness)[0] if model.thickness > 0.0
+            else AD.thick_slab(generator))
     if not model.top_thickness > 0.0:
-        return thick
+        return body
     top_albedo = 1.0 - model.top_absorption * (1.0 - np.asarray(model.albedo, float))
     top = replace(model, albedo=top_albedo, top_thickness=0.0)
     r, t = AD.slab(medium_generator(grid, top), model.top_thickness)
     # The medium is even in the vertical (HG and two-sided flakes): the top layer reflects the
-    # same from below; nothing leaves the thick medium downward.
+    # same from below; only the body's reflection from above counts beneath it (what leaves it
+    # downward is lost, into the thick medium or the black base).
     return AD.add_layers(AD.Layer(top=r, bottom=r, down=t),
-                         AD.Layer(top=thick, bottom=thick, down=np.zeros_like(thick)),
+                         AD.Layer(top=body, bottom=body, down=np.zeros_like(body)),
                          symmetric=True).top
 
 

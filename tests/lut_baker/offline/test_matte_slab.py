@@ -232,3 +232,14 @@ def test_the_medium_over_a_black_base():
     lost = 1.0 - thin_albedo / thick_albedo  # the share the black base takes, by incidence
     mu = np.cos(GRID.theta)
     assert np.all(lost[..., np.argmax(mu)] > lost[..., np.argmin(mu)])
+
+
+def test_a_top_layer_over_the_finite_medium():
+    # A top layer absorbing as the medium does, over the medium at a finite thickness, is the
+    # medium as thick as both over the black base.
+    medium = {"albedo": np.array([0.98, 0.9]), "g1": 0.5, "flakes": 0.4, "cone_deg": 40.0,
+              "cone_spread_deg": 20.0}
+    layered = medium_reflection(GRID, MatteSlab(**medium, thickness=2.0, top_thickness=1.5,
+                                                top_absorption=1.0))
+    whole = medium_reflection(GRID, MatteSlab(**medium, thickness=3.5))
+    np.testing.assert_allclose(layered, whole, atol=1e-10)
