@@ -438,13 +438,12 @@ def _verdicts(figures: dict) -> tuple[str, str]:
     """Whether a step meets its targets here and on a machine three times slower: a click at
     most 0.2 s and 100 MB; a first Apply's match (the colour read and the shade solved) the
     same, and the whole Apply at most 0.3 s of CPU (1 s three times slower)."""
+    small = figures["mb"] <= TARGET_MB
     if figures.get("match_s") is None:
-        small = figures["mb"] <= TARGET_MB
         return (_met(figures["wall_s"] <= TARGET_S and small),
                 _met(SLOWER * figures["wall_s"] <= TARGET_S and small))
     match = figures["sampling_s"] + figures["match_s"]
     whole = figures["cpu_s"]
-    small = figures["mb"] <= TARGET_MB
     here = (f"match {_met(match <= TARGET_S and small)}, "
             f"Apply {_met(whole <= APPLY_CPU_S)}")
     slower = (f"match {_met(SLOWER * match <= TARGET_S and small)}, "
