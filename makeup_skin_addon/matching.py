@@ -185,9 +185,9 @@ class SlabLight:
         ``under`` under the film, if given)."""
         if under is not None:
             body = np.asarray(body, float) * np.asarray(under, float)
-        return np.asarray(slab_skin.slab_colour(
+        return slab_skin.channel_colours(
             self.skin.film, self.skin.film_transmission, self.skin.skin_reflection, body,
-            self.thickness_um, self.grid, absorption), float).reshape(-1) * np.ones(3)
+            self.thickness_um, self.grid, absorption)
 
     def solve(self, target, body):
         """``(A, a, clamped, colour)``: :func:`lut_baker.model.slab_skin.matching_shade` (the
@@ -221,12 +221,22 @@ def _covered(light, settings, absorption, body, under=None) -> np.ndarray:
 def _solve(settings, light, target, skin: SkinTarget) -> Shade:
     if isinstance(light, SlabLight):
         absorption, under, clamped, reached = light.solve(target, skin.body)
-        return Shade(np.asarray(absorption, float), np.asarray(clamped, bool),
-                     np.asarray(target, float), reached, skin, under=np.asarray(under, float))
+        result = Shade(np.asarray(absorption, float), np.asarray(clamped, bool),
+                       np.asarray(target, float), reached, skin, under=np.asarray(under, float))
+        # The colour reached by the shade as the settings keep it (single precision): what
+        # the panel's shade renders, and what the next step finds kept as its current colour.
+        result.reached = light.covered(_as_kept(result.absorption), skin.body,
+                                       _as_kept(result.skin_under()))
+        return result
     gloss = float(settings.gloss)
     absorption, clamped = uniform_light.matching_absorption(light, target, skin.body, gloss)
     reached = uniform_light.covered_colour(light, absorption, skin.body, gloss)
     return Shade(absorption, clamped, np.asarray(target, float), reached, skin)
+
+
+def _as_kept(values) -> np.ndarray:
+    """``values`` as a float vector property keeps them: single precision."""
+    return np.asarray(values, np.float32).astype(float)
 
 
 def _reach_sentences(shade_: Shade, light, gloss: float) -> list[str]:
@@ -312,6 +322,9 @@ def matched(material, foundation: str | None = None, skin: SkinTarget | None = N
         skin = skin_target(material, resolution=resolution, light=None if isinstance(
             light, SlabLight) else light)
     target, seen = seen_target(skin, *_film_gloss(settings, light, foundation))
+    # aimed at as the settings keep it (Shade Base), so that steps back to it find this
+    # search again (kept per channel, slab_skin.channel_colours)
+    target = _as_kept(target)
     result = _solve(settings, light, target, skin)
     result.base = result.target
     result.sentences.append(

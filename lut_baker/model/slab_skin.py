@@ -41,6 +41,7 @@ Functions and types
 - :func:`parts_albedo`, :func:`parts_colour` -- its directional albedo (gloss included) and its
   colour under uniform light.
 - :func:`slab_colour` -- the colour of a foundation at a thickness on a skin, exactly.
+- :func:`channel_colours` -- the same for three channels, each channel kept for the session.
 - :data:`ABSORPTION_POWER`, :func:`absorption_along` -- the variable Match Skin searches in.
 - :func:`matching_absorption` -- the absorption whose made-up skin at a thickness has a
   target colour (Match Skin), and the colour it reaches.
@@ -58,6 +59,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..numerics.adding_doubling import Layer, star_albedo, star_scale
+from ..numerics.cache import LRUCache
 from ..numerics.quadrature import HemisphereGrid
 from .film_slab import (
     ROOT_STEPS,
@@ -84,6 +86,8 @@ __all__ = [
     "parts_albedo",
     "parts_colour",
     "slab_colour",
+    "channel_colours",
+    "COLOURS_CACHE_SIZE",
     "ABSORPTION_POWER",
     "absorption_along",
     "matching_absorption",
@@ -244,6 +248,38 @@ def _relative(thickness_um: float) -> float:
     return np.inf if np.isinf(thickness_um) else relative_thickness(thickness_um)
 
 
+COLOURS_CACHE_SIZE = 4096
+"""Channels' colours :func:`channel_colours` keeps (a search evaluates at most
+``ROOT_STEPS + 2`` colours of three channels)."""
+
+_COLOURS = LRUCache(COLOURS_CACHE_SIZE)
+
+
+def channel_colours(film: ReflectionLayer, transmission: TransmissionLayer,
+                    skin: ReflectionLayer, skin_albedo: ArrayLike, thickness_um: float,
+                    grid: HemisphereGrid, absorption: ArrayLike,
+                    face: ArrayLike | None = None) -> NDArray[np.float64]:
+    """:func:`slab_colour` of three channels (``skin_albedo`` and ``absorption`` scalars or
+    RGB), ``(3,)``, each channel kept for the session under its own inputs.  The channels are
+    independent (a channel's colour is the same to the bit whatever the others are), so a
+    channel evaluated in one search is found by the next: Lighter then Darker retrace the
+    search that found the shade they return to, and the current shade's colour is its own
+    search's last evaluation of each channel."""
+    albedo = np.broadcast_to(np.asarray(skin_albedo, float), (3,))
+    a = np.broadcast_to(np.asarray(absorption, float), (3,))
+    common = (repr(film.as_dict()), repr(transmission.as_dict()), repr(skin.as_dict()),
+              float(thickness_um), grid.theta.tobytes(), grid.weight.tobytes(), grid.n_phi)
+    keys = [(common, c, float(albedo[c]), float(a[c])) for c in range(3)]
+    kept = [_COLOURS.get(key) for key in keys]
+    if all(value is not None for value in kept):
+        return np.array(kept)
+    colour = np.broadcast_to(slab_colour(film, transmission, skin, albedo, thickness_um, grid,
+                                         a, face), (3,))
+    for key, value in zip(keys, colour, strict=True):
+        _COLOURS.put(key, float(value))
+    return np.array(colour, float)
+
+
 ABSORPTION_POWER = 3
 """The power of :func:`absorption_along`: with it the made-up skin's colour is nearly linear in
 ``s`` (a film's colour falls fast as the first pigment absorbs, then slowly)."""
@@ -268,30 +304,19 @@ def matching_absorption(target: ArrayLike, film: ReflectionLayer,
     thickness 7-8 evaluations where ``A`` itself takes 9-11).  A target out of the film's reach
     gets ``A = 0`` (too light) or 1 (too dark) and ``clamped``."""
     goal = np.broadcast_to(np.asarray(target, float), (3,))
-    albedo = np.broadcast_to(np.asarray(skin_albedo, float), (3,))
     face = face_albedo(film, grid)
 
-    known: dict[tuple[float, ...], NDArray[np.float64]] = {}
-    per_channel: dict[tuple[int, float], float] = {}  # the channels are independent
-
-    # the ends, asked twice, evaluated once
     def colour(a: NDArray[np.float64]) -> NDArray[np.float64]:
-        key = tuple(np.broadcast_to(np.asarray(a, float), (3,)).tolist())
-        if key not in known:
-            known[key] = slab_colour(film, transmission, skin, albedo, thickness_um, grid, a,
-                                     face)
-            per_channel.update({(c, value): float(known[key][c])
-                                for c, value in enumerate(key)})
-        return known[key]
+        # kept per channel: the ends, asked twice, are evaluated once, and the root's own
+        # channels give the colour reached
+        return channel_colours(film, transmission, skin, skin_albedo, thickness_um, grid, a,
+                               face)
 
     along = increasing_root(lambda s: -colour(absorption_along(s)), -goal, ROOT_STEPS)
     absorption = absorption_along(along)
     too_light = goal > colour(np.zeros(3))
     too_dark = goal < colour(np.ones(3))
-    keys = [(c, float(value)) for c, value in enumerate(absorption)]
-    reached = (np.array([per_channel[key] for key in keys])
-               if all(key in per_channel for key in keys) else colour(absorption))
-    return absorption, too_light | too_dark, reached
+    return absorption, too_light | too_dark, colour(absorption)
 
 
 def matching_skin_albedo(parts: SlabSkinParts, target: ArrayLike,

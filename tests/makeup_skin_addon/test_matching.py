@@ -318,15 +318,17 @@ FAIR = (0.83, 0.52, 0.39)
 """The lighter (fair) skin tone of tests/support/character.py (sRGB 0.92, 0.75, 0.66), linear."""
 
 
-def test_match_skin_at_a_thickness(sphere):
+def test_match_skin_at_a_thickness(sphere, monkeypatch):
     """With the film at a thickness (the default Film), Match Skin solves the foundation's
     absorption on the slab's exact colour (every inter-reflection): the covered skin has the
     bare skin's colour under uniform light (the skin under the film darkened only where full
     absorption is not enough: not on this skin; at 9.6 and 50 um its red is 0.06% and 0.7%
     beyond the film's reach, and the note says so); the group is rebuilt with the absorption
-    baked in (its record keeps the thickness); Lighter then Darker gives the shade back."""
+    baked in (its record keeps the thickness); Lighter then Darker gives the shade back, the
+    Darker click evaluating no colour on the slab (it retraces the match's search, kept)."""
     import bpy
 
+    from lut_baker.model import slab_skin
     from makeup_skin_addon import matching, nodes
 
     material, _ = apply_pipeline(sphere, "LAYERED", skin_colour=FAIR, film_mode="SLAB")
@@ -350,7 +352,12 @@ def test_match_skin_at_a_thickness(sphere):
         assert meta.get("skin_under", [1.0] * 3) == pytest.approx(list(under), abs=1e-7)
     start = np.array(settings.absorption)
     assert bpy.ops.makeup_skin.shade_step(direction="LIGHTER") == {"FINISHED"}
+    evaluated = []
+    exact = slab_skin.slab_colour
+    monkeypatch.setattr(slab_skin, "slab_colour",
+                        lambda *args, **kwargs: evaluated.append(args) or exact(*args, **kwargs))
     assert bpy.ops.makeup_skin.shade_step(direction="DARKER") == {"FINISHED"}
+    assert evaluated == []
     np.testing.assert_allclose(settings.absorption, start, atol=1e-6)
 
 

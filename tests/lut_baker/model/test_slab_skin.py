@@ -220,3 +220,30 @@ def test_the_matched_colour_is_the_slab_colour_at_the_match(name, paper, um):
     assert np.allclose(colour, exact, rtol=1e-12, atol=0.0)
     assert np.allclose(colour[~clamped], np.array(target)[~clamped], rtol=1e-9, atol=0.0)
     assert SS.absorption_along(0.0) == 0.0 and SS.absorption_along(1.0) == 1.0
+
+
+def test_colours_are_kept_channel_by_channel(paper, monkeypatch):
+    """:func:`channel_colours` keeps each channel under its own inputs: a channel kept from
+    one evaluation is what a fresh evaluation with other channels beside it gives (to
+    rounding), and a search asked again evaluates nothing (Lighter then Darker retrace the
+    search of the shade they return to)."""
+    film = presets.foundation_film("paper_natural")
+    args = (film, paper.film_transmission, paper.skin_reflection, (0.5, 0.3, 0.2),
+            FS.DEFAULT_THICKNESS_UM, GRID)
+    SS._COLOURS.clear()
+    SS.channel_colours(*args, (0.1, 0.4, 0.7))
+    SS.channel_colours(*args, (0.2, 0.5, 0.8))
+    evaluated = []
+    exact = SS.slab_colour
+    monkeypatch.setattr(SS, "slab_colour",
+                        lambda *a, **k: evaluated.append(a) or exact(*a, **k))
+    mixed = SS.channel_colours(*args, (0.1, 0.5, 0.7))
+    assert evaluated == []
+    np.testing.assert_allclose(mixed, exact(*args, (0.1, 0.5, 0.7)), rtol=1e-14, atol=0.0)
+    target = (0.45, 0.25, 0.15)
+    first = SS.matching_absorption(target, *args)
+    searched = len(evaluated)
+    again = SS.matching_absorption(target, *args)
+    assert searched > 0 and len(evaluated) == searched
+    for one, other in zip(first, again, strict=True):
+        np.testing.assert_allclose(one, other, rtol=1e-14, atol=0.0)
