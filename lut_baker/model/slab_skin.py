@@ -271,13 +271,17 @@ def channel_colours(film: ReflectionLayer, transmission: TransmissionLayer,
               float(thickness_um), grid.theta.tobytes(), grid.weight.tobytes(), grid.n_phi)
     keys = [(common, c, float(albedo[c]), float(a[c])) for c in range(3)]
     kept = [_COLOURS.get(key) for key in keys]
-    if all(value is not None for value in kept):
-        return np.array(kept)
-    colour = np.broadcast_to(slab_colour(film, transmission, skin, albedo, thickness_um, grid,
-                                         a, face), (3,))
-    for key, value in zip(keys, colour, strict=True):
-        _COLOURS.put(key, float(value))
-    return np.array(colour, float)
+    missing = [c for c in range(3) if kept[c] is None]
+    if missing:
+        # A kept channel is evaluated as a missing one (its own inputs may cost more: a film
+        # absorbing little has its passivity solved for) and its result left aside.
+        pick = [c if kept[c] is None else missing[0] for c in range(3)]
+        colour = np.broadcast_to(slab_colour(film, transmission, skin, albedo[pick],
+                                             thickness_um, grid, a[pick], face), (3,))
+        for c in missing:
+            kept[c] = float(colour[c])
+            _COLOURS.put(keys[c], kept[c])
+    return np.array(kept, float)
 
 
 ABSORPTION_POWER = 3

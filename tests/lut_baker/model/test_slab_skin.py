@@ -240,7 +240,14 @@ def test_colours_are_kept_channel_by_channel(paper, monkeypatch):
     mixed = SS.channel_colours(*args, (0.1, 0.5, 0.7))
     assert evaluated == []
     np.testing.assert_allclose(mixed, exact(*args, (0.1, 0.5, 0.7)), rtol=1e-14, atol=0.0)
+    # Red at A = 0 (a film absorbing nothing: its passivity is solved for, the slow case),
+    # then kept: the next evaluation takes green and blue alone.
+    SS.channel_colours(*args, (0.0, 0.6, 0.9))
+    part = SS.channel_colours(*args, (0.0, 0.61, 0.91))
+    assert len(evaluated) == 2 and np.all(np.asarray(evaluated[1][6]) > 0.0)
+    np.testing.assert_allclose(part, exact(*args, (0.0, 0.61, 0.91)), rtol=1e-14, atol=0.0)
     target = (0.45, 0.25, 0.15)
+    del evaluated[:]
     first = SS.matching_absorption(target, *args)
     searched = len(evaluated)
     again = SS.matching_absorption(target, *args)
