@@ -360,6 +360,7 @@ def operators_worker(cache: Path, repo: Path, which: str) -> dict:
             # from the store the Apply filled).
             apply_to_object(bpy.context, head)
             skin_sampling.clear_cache()
+            _forget_slab_colours()
         if which == "apply_known" and importlib.util.find_spec(
                 "makeup_skin_addon.image_store") is not None:
             # The texture read in an earlier session on this machine: kept on disk, not in
@@ -368,6 +369,7 @@ def operators_worker(cache: Path, repo: Path, which: str) -> dict:
 
             image_texels.reduced_image(material.node_tree.nodes["Albedo"].image)
             skin_sampling.clear_cache()
+            _forget_slab_colours()
         steps = ([("match_skin", lambda: bpy.ops.makeup_skin.match_skin()),
                   ("lighter", lambda: bpy.ops.makeup_skin.shade_step(direction="LIGHTER")),
                   ("darker", lambda: bpy.ops.makeup_skin.shade_step(direction="DARKER")),
@@ -398,6 +400,14 @@ def operators_worker(cache: Path, repo: Path, which: str) -> dict:
     finally:
         makeup_skin_addon.unregister()
     return out
+
+
+def _forget_slab_colours() -> None:
+    """Forget the slab's colours kept in memory (a session of its own: the file opened anew),
+    where the checkout keeps them."""
+    slab_skin = importlib.import_module("lut_baker.model.slab_skin")
+    if hasattr(slab_skin, "_COLOURS"):
+        slab_skin._COLOURS.clear()
 
 
 WORKERS = {"sampling": sampling_worker, "accuracy": accuracy_worker}
