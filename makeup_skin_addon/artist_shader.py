@@ -23,6 +23,9 @@ the film does not cover, not followed under it).
 - :func:`leaves` -- the leaves of a tree with their shares (the Mix Shaders' factors along the
   way, a linked factor counted by a caller-given mean).
 - :func:`is_untouched_default` -- a Principled BSDF exactly as Blender creates it.
+- :func:`render_output`, :func:`surface_output` -- the Material Output the scene's engine
+  renders (its own, else the one for all engines); :func:`other_outputs` -- those another
+  engine renders instead; :func:`engines_rendering` -- the engines an output is for.
 """
 
 from __future__ import annotations
@@ -34,7 +37,9 @@ from typing import Any
 import bpy
 
 __all__ = ["Source", "Leaf", "Mix", "Add", "Shader", "SKIN_TYPES", "GLOSS_TYPES", "read",
-           "behind", "source", "leaves", "is_untouched_default", "surface_output"]
+           "behind", "source", "leaves", "is_untouched_default", "surface_output",
+           "render_output", "other_outputs", "engines_rendering", "scene_engine",
+           "ENGINE_TARGETS", "TARGET_NAMES"]
 
 SKIN_TYPES = ("BSDF_PRINCIPLED", "BSDF_DIFFUSE", "SUBSURFACE_SCATTERING")
 """Node types with a body colour: a skin under the film."""
@@ -98,13 +103,50 @@ class Add:
 Shader = Leaf | Mix | Add
 
 
-def surface_output(material):
-    """The Material Output whose Surface renders (the active one for all engines, else
-    Cycles'), or None."""
+ENGINE_TARGETS = {"CYCLES": "CYCLES", "BLENDER_EEVEE": "EEVEE", "BLENDER_EEVEE_NEXT": "EEVEE"}
+"""A render engine's Material Output target (Blender's own; other engines read the output for
+all)."""
+TARGET_NAMES = {"CYCLES": "Cycles", "EEVEE": "EEVEE"}
+"""The engines that render an output of their own target, as the report names them."""
+
+
+def scene_engine() -> str:
+    """The current scene's render engine ("" without a scene)."""
+    scene = getattr(bpy.context, "scene", None)
+    return scene.render.engine if scene is not None else ""
+
+
+def render_output(tree, engine: str | None = None):
+    """The Material Output of ``tree`` whose Surface ``engine`` renders (default the scene's):
+    the engine's own output if the tree has one, else the one for all engines, else any
+    other (Blender's choice, ``get_output_node``); None when there is none."""
+    target = ENGINE_TARGETS.get(scene_engine() if engine is None else engine, "ALL")
+    return (tree.get_output_node(target) or tree.get_output_node("ALL")
+            or tree.get_output_node("CYCLES") or tree.get_output_node("EEVEE"))
+
+
+def surface_output(material, engine: str | None = None):
+    """The Material Output of ``material`` whose Surface ``engine`` renders
+    (:func:`render_output`), or None."""
     tree = material.node_tree if material is not None else None
-    if tree is None:
-        return None
-    return tree.get_output_node("ALL") or tree.get_output_node("CYCLES")
+    return render_output(tree, engine) if tree is not None else None
+
+
+def engines_rendering(tree, output) -> list[str]:
+    """The engines (:data:`TARGET_NAMES`) that render ``output`` of ``tree``."""
+    return [name for target, name in TARGET_NAMES.items()
+            if tree.get_output_node(target) == output]
+
+
+def other_outputs(tree, output) -> list[tuple[str, Any]]:
+    """``[(target, node)]``: the outputs of ``tree`` with a surface that an engine renders
+    instead of ``output`` (an output for that engine alone; target "CYCLES" or "EEVEE")."""
+    others = []
+    for target in TARGET_NAMES:
+        node = tree.get_output_node(target)
+        if node is not None and node != output and node.inputs["Surface"].is_linked:
+            others.append((target, node))
+    return others
 
 
 def _active_group_output(tree):

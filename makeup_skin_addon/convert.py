@@ -114,9 +114,9 @@ def linked_library(datablock, kind: str) -> str | None:
 
 
 def material_output(tree):
-    """The Material Output node the render uses (the active one for all engines, else
-    Cycles'); a new one if the tree has none."""
-    output = tree.get_output_node("ALL") or tree.get_output_node("CYCLES")
+    """The Material Output node the scene's engine renders
+    (:func:`.artist_shader.render_output`); a new one if the tree has none."""
+    output = artist_shader.render_output(tree)
     if output is None:
         output = tree.nodes.new("ShaderNodeOutputMaterial")
         output.location = (400.0, 0.0)
@@ -207,7 +207,7 @@ def install(material, group, *, over_shader: bool, reading=None, film_strength: 
             json.loads(material[RECORD_KEY]).get("version") != RECORD_VERSION and over_shader:
         revert(material, remove_unused=False)  # an earlier add-on's conversion: again, over
         node = None
-    output = material_output(tree)
+    output = _recorded_output(material) if node is not None else material_output(tree)
     surface = output.inputs["Surface"]
     installed = Installed(over_shader=over_shader)
     if node is None:
@@ -240,7 +240,32 @@ def install(material, group, *, over_shader: bool, reading=None, film_strength: 
         installed.carried += carried.carried
         installed.film_normal = carried.film_normal
         installed.missing = carried.missing
+    for target, other in artist_shader.other_outputs(tree, output):
+        installed.missing.append(_other_output_sentence(tree, target, other, output))
     return installed
+
+
+def _other_output_sentence(tree, target: str, other, output) -> str:
+    engine = artist_shader.TARGET_NAMES[target]
+    preview = " (and so does the viewport's Material Preview)" if target == "EEVEE" else ""
+    made_up = " and ".join(artist_shader.engines_rendering(tree, output)) or "no engine"
+    return (f"the output {other.name!r}, which {engine} renders{preview}: it keeps its own "
+            f"shader, without the film, which went over {output.name!r}, the one {made_up} "
+            f"renders (to make up the other instead: Revert, set the scene's engine to "
+            f"{engine}, Apply)")
+
+
+def _recorded_output(material):
+    """The Material Output a converted material's group feeds (its record's; else the one
+    the scene's engine renders): a later Apply in another engine's scene keeps to it."""
+    try:
+        name = json.loads(material[RECORD_KEY]).get("output") if RECORD_KEY in material \
+            else None
+    except (TypeError, ValueError):
+        name = None
+    output = material.node_tree.nodes.get(name or "")
+    return output if output is not None and output.type == "OUTPUT_MATERIAL" \
+        else material_output(material.node_tree)
 
 
 def can_revert(material) -> bool:
@@ -290,7 +315,7 @@ def revert(material, *, remove_unused: bool = True) -> str:
     if record.get("node") and shader is None:
         raise ValueError(f"material {material.name!r}: its previous surface "
                          f"{record['node']!r} was deleted; nothing was changed")
-    output = tree.nodes.get(record.get("output") or "") or material_output(tree)
+    output = _recorded_output(material)
     node = group_node(material)
     group = node.node_tree
     frame = tree.nodes.get(FRAME_NAME)

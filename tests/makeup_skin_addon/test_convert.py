@@ -217,6 +217,48 @@ def test_blenders_untouched_default_shader_is_no_skin_of_the_artists(addon, blan
     assert not principled.outputs[0].is_linked and principled.parent is not None
 
 
+def _eevee() -> str:
+    import bpy
+
+    return "BLENDER_EEVEE" if bpy.app.version >= (5, 0, 0) else "BLENDER_EEVEE_NEXT"
+
+
+def test_an_output_for_each_engine_the_scenes_is_made_up_the_other_kept(head):
+    """A material with an output for Cycles (the textured Principled) and one for EEVEE alone
+    (a Diffuse BSDF): Apply in an EEVEE scene goes over EEVEE's output, the Cycles output keeps
+    its shader and the report warns, naming it; Apply again in a Cycles scene keeps to the
+    output it made up (the Cycles output's link untouched); Revert gives the tree back."""
+    import bpy
+
+    material = head.active_material
+    tree = material.node_tree
+    cycles = tree.get_output_node("ALL")
+    cycles.target = "CYCLES"
+    principled = cycles.inputs["Surface"].links[0].from_node
+    eevee = tree.nodes.new("ShaderNodeOutputMaterial")
+    eevee.target = "EEVEE"
+    diffuse = tree.nodes.new("ShaderNodeBsdfDiffuse")
+    diffuse.inputs["Color"].default_value = (0.6, 0.35, 0.25, 1.0)
+    tree.links.new(diffuse.outputs[0], eevee.inputs["Surface"])
+    before = tree_state(material)
+    bpy.context.scene.render.engine = _eevee()
+    _, report = apply_pipeline(head, tier="LAYERED")
+    group = group_node(material)
+    assert eevee.inputs["Surface"].links[0].from_node == group
+    assert group.inputs["Skin Shader"].links[0].from_node == diffuse
+    assert cycles.inputs["Surface"].links[0].from_node == principled
+    assert any(repr(cycles.name) in w and "Cycles renders" in w for w in report.warnings), \
+        report.warnings
+    bpy.context.scene.render.engine = "CYCLES"
+    _, report = apply_pipeline(head, tier="LAYERED")
+    assert eevee.inputs["Surface"].links[0].from_node == group
+    assert cycles.inputs["Surface"].links[0].from_node == principled
+    assert any(repr(cycles.name) in w and "the one EEVEE renders" in w
+               for w in report.warnings), report.warnings
+    assert bpy.ops.makeup_skin.revert() == {"FINISHED"}
+    assert tree_state(material) == before
+
+
 def _apply_without_material(obj):
     import bpy
 
