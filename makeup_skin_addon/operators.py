@@ -6,14 +6,15 @@ a function of a lower module (:mod:`.apply`, :mod:`.tier_choice`, :mod:`.live`,
 
 A button Blender greys out says why in its tooltip: every ``poll`` that can refuse gives its
 reason with ``poll_message_set`` (:func:`_allowed`; the reasons: :func:`_object_reason`,
-:func:`_material_reason`, :func:`_linked_reason`, :func:`_revert_reason`)."""
+:func:`_material_reason`, :func:`_linked_reason`, :func:`_revert_reason`,
+:func:`_edit_reason`)."""
 
 from __future__ import annotations
 
 import bpy
 from bl_operators.presets import AddPresetBase
 
-from . import apply, convert, groups, live, matching, skin_model, tier_choice
+from . import apply, convert, groups, live, matching, skin_model, skin_sampling, tier_choice
 from .keys import OPERATOR_PREFIX, PRESET_SUBDIR, SETTINGS_ATTRIBUTE
 from .progress import progress_bar
 from .properties import RESOLUTION_ITEMS
@@ -70,6 +71,13 @@ def _linked_reason(obj, material) -> str | None:
     return None
 
 
+def _edit_reason(obj) -> str | None:
+    """Why the skin of ``obj``'s material cannot be read now: its mesh is in Edit Mode."""
+    if obj is None or obj.type != "MESH" or obj.mode != "EDIT":
+        return None
+    return f"{skin_sampling.in_edit_mode(obj)}: leave Edit Mode (Tab) to read the skin"
+
+
 def _made_up_reason(material) -> str | None:
     """Why a shade cannot be set on ``material``: it is not made up yet.  The first Apply
     matches the skin itself (choosing a matte film when the skin is darker than the default
@@ -90,9 +98,9 @@ def _revert_reason(material) -> str | None:
 
 
 class MAKEUPSKIN_OT_apply(bpy.types.Operator):
-    """Bake and fit the made-up skin and make it the surface of the active object's material,
-    converted in place: the previous surface shader is kept, framed and disconnected, and its
-    albedo and normal links are carried over"""
+    """Bake and fit the made-up skin and lay it over the active object's material, converted
+    in place: its own surface shader stays, the bare skin where the film does not cover, and
+    gives the skin under the film its color, normal and subsurface"""
 
     bl_idname = f"{OPERATOR_PREFIX}.apply"
     bl_label = "Apply Made-up Skin"
@@ -108,7 +116,8 @@ class MAKEUPSKIN_OT_apply(bpy.types.Operator):
     @classmethod
     def poll(cls, context):
         obj = context.active_object
-        return _allowed(cls, _object_reason(obj) or _linked_reason(obj, obj.active_material))
+        return _allowed(cls, _object_reason(obj) or _edit_reason(obj)
+                        or _linked_reason(obj, obj.active_material))
 
     def execute(self, context):
         obj = context.active_object
@@ -251,7 +260,7 @@ class _ShadePoll:
         reason = _material_reason(obj, "Apply first")
         if reason is None:
             reason = (_linked_reason(None, obj.active_material)
-                      or _made_up_reason(obj.active_material))
+                      or _made_up_reason(obj.active_material) or _edit_reason(obj))
         return _allowed(cls, reason)
 
 
@@ -287,8 +296,9 @@ def _set_shade(operator, context, solve) -> set:
 
 
 class MAKEUPSKIN_OT_match_skin(_ShadePoll, bpy.types.Operator):
-    """Set the shade so that the made-up skin has the skin's own color at any coverage: Skin
-    Color's value, or the mean of the image feeding it over the faces that use the material"""
+    """Set the shade so that the made-up skin has the color of the skin before Apply at any
+    coverage: the artist's shader under uniform light, its textures averaged over the faces
+    that use the material (Skin Color's value without one)"""
 
     bl_idname = f"{OPERATOR_PREFIX}.match_skin"
     bl_label = "Match Skin"

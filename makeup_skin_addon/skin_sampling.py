@@ -26,7 +26,8 @@ import numpy as np
 from . import image_texels, pages, surface_points
 from .progress import Report, report, reporting
 
-__all__ = ["SurfaceMean", "surface_mean", "SurfaceSamples", "surface_samples", "clear_cache"]
+__all__ = ["SurfaceMean", "surface_mean", "SurfaceSamples", "surface_samples", "in_edit_mode",
+           "clear_cache"]
 
 
 @dataclass
@@ -51,6 +52,13 @@ def _uv_layer(mesh, uv_map: str):
     return next((layer for layer in mesh.uv_layers if layer.active_render), None)
 
 
+def in_edit_mode(obj) -> str:
+    """Why an object in Edit Mode is not read (else ""): Blender gives Python none of a mesh's
+    UVs (nor its attributes) while it is edited, even after ``update_from_editmode``."""
+    return (f"{obj.name!r} is in Edit Mode, where Blender gives Python no UVs"
+            if obj.mode == "EDIT" else "")
+
+
 def _missing_uv(obj, uv_map: str, reader: str) -> str:
     by = f" (read by {reader!r})" if reader else ""
     return f"{obj.name!r} has no UV map {uv_map!r}{by}" if uv_map else \
@@ -73,11 +81,9 @@ def surface_mean(image: Any, material: Any, *, uv_map: str = "", extension: str 
         return SurfaceMean(None, None, 0, problem=f"no mesh object uses {material.name!r}")
     notes, missing, readable = [], [], []
     for obj in objects:
-        if obj.mode == "EDIT":
-            obj.update_from_editmode()  # the mesh as it is being edited
-        layer = _uv_layer(obj.data, uv_map)
+        layer = None if in_edit_mode(obj) else _uv_layer(obj.data, uv_map)
         if layer is None:
-            missing.append(_missing_uv(obj, uv_map, reader))
+            missing.append(in_edit_mode(obj) or _missing_uv(obj, uv_map, reader))
         else:
             readable.append((obj, layer))
     if not readable:
@@ -135,9 +141,6 @@ class SurfaceSamples:
         self.scene = scene
         self.camera = scene.camera if scene is not None else None
         self.objects = surface_points.users(material)
-        for obj in self.objects:
-            if obj.mode == "EDIT":
-                obj.update_from_editmode()
         self._uv: dict = {}
         self.budget = budget
         self.count = 0
@@ -159,9 +162,9 @@ class SurfaceSamples:
             return self._uv[name]
         surfaces, missing = [], []
         for obj in self.objects:
-            layer = _uv_layer(obj.data, name)
+            layer = None if in_edit_mode(obj) else _uv_layer(obj.data, name)
             if layer is None:
-                missing.append(_missing_uv(obj, name, reader))
+                missing.append(in_edit_mode(obj) or _missing_uv(obj, name, reader))
             else:
                 surfaces.append(surface_points.Surface(obj, self.material, layer))
         counts = surface_points.shares([surface.area() for surface in surfaces], self.budget)

@@ -131,7 +131,8 @@ def _linked(tmp_path, material, mesh):
 def test_every_greyed_out_button_says_why(sphere, tmp_path):
     """Each operator's poll refuses with the reason in the tooltip (``poll_message_set``): no
     active object, an object that is not a mesh, no material, a material not made up (Match
-    Skin, the steps, Revert), nothing to revert, data linked from a library."""
+    Skin, the steps, Revert), a mesh in Edit Mode (what reads the skin), nothing to revert,
+    data linked from a library."""
     import bpy
 
     from makeup_skin_addon import convert
@@ -171,6 +172,15 @@ def test_every_greyed_out_button_says_why(sphere, tmp_path):
     assert reasons["apply"] is reasons["add_preset"] is None
 
     material, _ = apply_pipeline(sphere)
+    assert set(_reasons().values()) == {None}
+    view_layer.objects.active = sphere
+    bpy.ops.object.mode_set(mode="EDIT")  # the mesh's UVs are Blender's alone there
+    reasons = _reasons()
+    assert reasons["apply"] == reasons["match_skin"] == reasons["shade_step"] == (
+        "'Sphere' is in Edit Mode, where Blender gives Python no UVs: leave Edit Mode (Tab) "
+        "to read the skin")
+    assert reasons["fit_to_scene"] is reasons["revert"] is None
+    bpy.ops.object.mode_set(mode="OBJECT")
     assert set(_reasons().values()) == {None}
     record = material.pop(RECORD_KEY)
     assert _reasons()["revert"] == ("Material 'Skin' has no record of its surface before "

@@ -111,9 +111,11 @@ def _source(material):
 def test_messages(two_faces):
     """Why there is no mean, in the words of Skin Color's source: a UV map the texture reads
     that the mesh lacks (named), a mesh without UVs, a material no face uses, no object, an
-    image whose file is missing; an object without the UV map beside one with it is left out
-    and said so."""
+    image whose file is missing; an object without the UV map (or in Edit Mode) beside one
+    with it is left out and said so."""
     import bpy
+
+    from makeup_skin_addon import skin_sampling
 
     obj, skin, texture = two_faces
     uv_node = skin.node_tree.nodes.new("ShaderNodeUVMap")
@@ -127,6 +129,19 @@ def test_messages(two_faces):
     bare.data.uv_layers.remove(bare.data.uv_layers[0])
     assert f"; 'Bare' has no UV map (read by {texture.name!r}): left out" in _source(skin)
     bpy.data.objects.remove(bare)
+    editing = build_two_faces(skin)  # in Edit Mode Blender gives Python none of its UVs
+    editing.name = "Editing"
+    for other in bpy.context.selected_objects:
+        other.select_set(False)
+    editing.select_set(True)
+    bpy.context.view_layer.objects.active = editing
+    bpy.ops.object.mode_set(mode="EDIT")
+    left_out = "'Editing' is in Edit Mode, where Blender gives Python no UVs: left out"
+    assert f"; {left_out}" in _source(skin)
+    mean = skin_sampling.surface_mean(texture.image, skin, reader=texture.name)
+    assert mean.objects == ("Two Faces",) and left_out in mean.notes
+    bpy.ops.object.mode_set(mode="OBJECT")
+    bpy.data.objects.remove(editing)
     for polygon in obj.data.polygons:
         polygon.material_index = 1
     assert _source(skin) == (f"{SOURCE}; no face uses 'Skin': the shader's inputs are read at "
