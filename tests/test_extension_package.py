@@ -49,6 +49,17 @@ def extension_zip(extension_tool, tmp_path_factory):
     return build_extension.build(REPO_ROOT, tmp_path_factory.mktemp("dist"))
 
 
+def test_the_oldest_blender_allowed_is_the_oldest_tested():
+    """The manifest's ``blender_version_min`` is the oldest Blender line the tests run on
+    (``requirements/bpy<line>.txt``, tools/test.sh): an older one is not known to work."""
+    lines = []
+    for path in (REPO_ROOT / "requirements").glob("bpy*.txt"):
+        pins = [line for line in path.read_text().splitlines() if line.startswith("bpy==")]
+        lines.append(tuple(int(part) for part in pins[0].removeprefix("bpy==").split(".")[:2]))
+    minimum = build_extension.manifest(REPO_ROOT)["blender_version_min"]
+    assert tuple(int(part) for part in minimum.split(".")[:2]) == min(lines), (minimum, lines)
+
+
 def test_manifest_validates(extension_tool):
     output = build_extension.validate(REPO_ROOT)
     assert "Success" in output
