@@ -47,6 +47,7 @@ from . import (
     skin_model,
     skin_sampling,
     storage,
+    surface_values,
     tier_choice,
 )
 from .bakes import Bake
@@ -156,6 +157,10 @@ def _first_match(context: Any, material: Any, reading: Any, resolution: str,
             settings.film_roughness = shade.foundation_roughness(film)
     matching.assign(settings, result, "MATCH")
     report += result.sentences
+    for note in reading.notes if reading is not None else ():
+        if surface_values.assumed(note):
+            report.warn(f"Not followed by the match: {note} (the shade is matched as if so; "
+                        f"the made-up skin renders the shader as it is)")
 
 
 def _record(settings: Any, resolution: str) -> dict:

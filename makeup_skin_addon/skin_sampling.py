@@ -23,7 +23,7 @@ from typing import Any
 import bpy
 import numpy as np
 
-from . import image_texels, pages, surface_points
+from . import image_texels, mesh_attributes, pages, surface_points
 from .progress import Report, report, reporting
 
 __all__ = ["SurfaceMean", "surface_mean", "SurfaceSamples", "surface_samples", "in_edit_mode",
@@ -142,6 +142,7 @@ class SurfaceSamples:
         self.camera = scene.camera if scene is not None else None
         self.objects = surface_points.users(material)
         self._uv: dict = {}
+        self._attributes: dict = {}
         self.budget = budget
         self.count = 0
         self.weights: np.ndarray | None = None
@@ -208,6 +209,30 @@ class SurfaceSamples:
             self._note(f"UV map {name!r} read at its mean (not every object has it)")
         self._uv[name] = uv
         return uv
+
+    def attribute(self, name: str, reader: str = "") -> tuple[np.ndarray, bool]:
+        """``((count, 4) values, colour)``: the mesh attribute ``name`` ("": the colour
+        attribute to render) at the points, as an Attribute or Color Attribute node reads it
+        (:func:`.mesh_attributes.at_points`), and whether it holds colours; an object without
+        it gives 0, as Blender renders it, and is noted."""
+        if name in self._attributes:
+            return self._attributes[name]
+        if self.weights is None:
+            self.uv("")  # the points, the same at every UV map
+        parts, colour = [], False
+        for obj, points in self.picked:
+            found = mesh_attributes.at_points(obj, name, points)
+            if found.values is None:
+                self._note(f"{found.problem} (read by {reader!r}): taken as 0")
+                parts.append(np.zeros((len(points.uv), 4)))
+            else:
+                parts.append(found.values)
+                colour = colour or found.colour
+        values = np.concatenate(parts) if parts else np.zeros((1, 4))
+        if len(values) != self.count:
+            values = np.broadcast_to(values.mean(axis=0), (self.count, 4))
+        self._attributes[name] = (values, colour)
+        return values, colour
 
     def image(self, image, uv: np.ndarray, extension: str) -> np.ndarray:
         """``(count, 4)`` linear RGBA of ``image`` at ``uv`` (alpha 1)."""

@@ -18,13 +18,14 @@ again at each call: 7 ms of CPU on a million-triangle head, 10 ms over the whole
   :class:`Surface` -- one object's faces at a UV map, their area read once.
 - :func:`shares` -- the budget split between objects by area.
 - :func:`users` -- the mesh objects whose slots hold a material.
+- :func:`corner_verts`, :func:`corner_faces` -- each corner's vertex and face.
 - :func:`clear_cache` -- forget the cached points.
 """
 
 from __future__ import annotations
 
 import zlib
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import bpy
 import numpy as np
@@ -33,7 +34,7 @@ from . import face_geometry
 from .core import cache
 
 __all__ = ["BUDGET", "SEED", "Points", "Surface", "Triangles", "sampled_triangles",
-           "object_points", "shares", "users", "clear_cache"]
+           "object_points", "shares", "users", "corner_verts", "corner_faces", "clear_cache"]
 
 BUDGET = 1 << 16
 """Points in all, split between the objects by area: the mean's standard error is the texture's
@@ -42,9 +43,9 @@ spread over the surface divided by 256 (0.06-0.13% on the production head of doc
 SEED = 20251203
 """The points' seed: the same mesh gives the same points, hence the same mean, everywhere."""
 POINTS_CACHE_SIZE = 128
-"""Objects (per material and UV map) whose points are kept: 44 bytes a point (the UV, position,
-normal and the three corners whose UVs are checked), 2.9 MB per material however many objects
-share it; a material on more objects than this is read again at each click."""
+"""Objects (per material and UV map) whose points are kept: 56 bytes a point (the UV, position,
+normal, the three corners of its triangle and its weights there), 3.7 MB per material however
+many objects share it; a material on more objects than this is read again at each click."""
 
 _POINTS = cache.LRUCache(POINTS_CACHE_SIZE)
 
@@ -54,13 +55,26 @@ class Points:
     """Points on one object's faces of a material: their UVs ``uv`` ((n, 2) float32, in the UV
     map read), the faces' world area ``area`` (square metres) and how many faces ``faces``;
     ``position`` and ``normal`` ((n, 3) float32, the object's own space: the point and its
-    face's normal), or None."""
+    face's normal), or None; ``corners`` and ``weights`` ((3, n) int32 and float32): the
+    corners of each point's triangle and its barycentric weights there (what a corner's or a
+    vertex's attribute is interpolated by, :meth:`interpolated`)."""
 
     uv: np.ndarray
     area: float
     faces: int
     position: np.ndarray | None = None
     normal: np.ndarray | None = None
+    corners: np.ndarray = field(default_factory=lambda: np.empty((3, 0), np.int32))
+    weights: np.ndarray = field(default_factory=lambda: np.empty((3, 0), np.float32))
+
+    def interpolated(self, values: np.ndarray, corner_index: np.ndarray | None = None
+                     ) -> np.ndarray:
+        """``values`` ((m, c): per corner, or per vertex with the corners' vertices
+        ``corner_index``) at the points, ``(n, c)`` float32."""
+        out = np.empty((len(self.uv), values.shape[1]), np.float32)
+        corners = tuple(self.corners if corner_index is None else corner_index[self.corners])
+        _interpolated(tuple(self.weights.astype(float)), values, corners, out)
+        return out
 
 
 def users(material) -> list:
@@ -175,6 +189,17 @@ def _corner_verts(mesh) -> np.ndarray:
     count = len(mesh.loops)
     return _attribute(mesh, ".corner_vert", lambda: _array(mesh.loops, "vertex_index", count,
                                                            np.int32), "value", 1, np.int32)
+
+
+def corner_verts(mesh) -> np.ndarray:
+    """The vertex of each of ``mesh``'s corners ((corners,) int32)."""
+    return _corner_verts(mesh)
+
+
+def corner_faces(mesh) -> np.ndarray:
+    """The face of each of ``mesh``'s corners ((corners,) int64)."""
+    loop_start, loop_total = _loop_starts(mesh)
+    return np.repeat(np.arange(len(loop_start)), loop_total)
 
 
 def _material_indices(mesh) -> np.ndarray:
@@ -294,7 +319,7 @@ def _points(layer, area: np.ndarray, faces: int, count: int, loop_start: np.ndar
     # heap free (allocated after them, a kept array holds them resident below it).
     uv = np.empty((count, 2), np.float32)
     position, normal = np.empty((count, 3), np.float32), np.empty((count, 3), np.float32)
-    corners = np.empty((3, count), np.int32)
+    corners, weights = np.empty((3, count), np.int32), np.empty((3, count), np.float32)
     positions, corner_verts = arrays.get(_positions), arrays.get(_corner_verts)
     triangles = sampled_triangles(area, loop_start, loop_total, corner_verts, positions, count)
     triangles.interpolated(positions, position, corner_verts)
@@ -304,10 +329,13 @@ def _points(layer, area: np.ndarray, faces: int, count: int, loop_start: np.ndar
     arrays.release()
     for row, corner in zip(corners, triangles.corners, strict=True):
         row[:] = corner
+    for row, weight in zip(weights, triangles.weights, strict=True):
+        row[:] = weight
     corner_uv = _corner_uvs(layer)
     triangles.interpolated(corner_uv, uv)
     checksum = _uv_checksum(corner_uv, corners)
-    return Points(uv, float(area.sum()), faces, position, normal), corners, checksum
+    return (Points(uv, float(area.sum()), faces, position, normal, corners, weights), corners,
+            checksum)
 
 
 @dataclass(frozen=True)

@@ -9,15 +9,19 @@ nodes compute them, for the nodes a skin's colour is commonly built from: Image 
 UV map, a UV Map, Texture Coordinate's UV or a Mapping node before it), RGB and Value, Mix (any
 data type; the usual blend modes), the older MixRGB, Math, Vector Math, Invert, Gamma,
 Hue/Saturation/Value, Brightness/Contrast, Separate and Combine Color (RGB) and XYZ, Clamp, Map
-Range (linear), Color Ramp (linear and constant), reroutes and node groups.  A node it cannot
-evaluate (a procedural texture, an attribute) gives a neutral 0.5 and a note saying so.
+Range (linear), Color Ramp (linear and constant), Color Attribute and Attribute (of the
+geometry: vertex colours and other mesh attributes, :mod:`.mesh_attributes`), reroutes and node
+groups.  A node it cannot evaluate (a procedural texture, an object's attribute) gives a
+neutral 0.5 and a note saying so.
 
 Values are arrays with a leading axis of the sample count (or 1 for a constant) and a trailing
 axis of 3 (colours and vectors) or 1 (floats).
 
-- :class:`Samples` -- what evaluation needs of the surface: UVs by map, image lookups.
+- :class:`Samples` -- what evaluation needs of the surface: UVs by map, image lookups, mesh
+  attributes.
 - :func:`values` -- an input's values at the samples (:class:`.artist_shader.Source`).
 - :func:`mean` -- their mean (RGB or a float).
+- :func:`assumed` -- whether a note says a value was assumed, not read.
 
 What the colour and math nodes compute is written in :mod:`.node_maths`.
 """
@@ -32,10 +36,18 @@ import numpy as np
 from . import node_maths
 from .artist_shader import Source, source
 
-__all__ = ["Samples", "values", "mean", "NEUTRAL"]
+__all__ = ["Samples", "values", "mean", "assumed", "NEUTRAL", "ASSUMED"]
 
 NEUTRAL = 0.5
 """What a node that cannot be evaluated gives (a procedural texture's mean, about)."""
+ASSUMED = (": taken as ", "read at UV (0, 0)")
+"""What the notes of a value assumed, not read, say (a node not evaluated, an attribute or a
+UV map missing): :func:`assumed`."""
+
+
+def assumed(note: str) -> bool:
+    """Whether a note of the evaluation says a value was assumed, not read from the shader."""
+    return any(words in note for words in ASSUMED)
 
 
 class Samples(Protocol):
@@ -49,6 +61,10 @@ class Samples(Protocol):
 
     def image(self, image, uv: np.ndarray, extension: str) -> np.ndarray:
         """``(count, 4)`` linear RGBA of ``image`` at ``uv``, as an Image Texture reads it."""
+
+    def attribute(self, name: str, reader: str = "") -> tuple[np.ndarray, bool]:
+        """``((count, 4) values, colour)``: the mesh attribute ``name`` ("": the colour
+        attribute to render) as an Attribute node reads it, and whether it holds colours."""
 
 
 def _colour(value) -> np.ndarray:
@@ -134,6 +150,22 @@ class _Evaluator:
     def uv(self, node, name: str) -> np.ndarray:
         uv = self.samples.uv(name, self.readers[-1] if self.readers else node.name)
         return np.concatenate([uv, np.zeros((len(uv), 1))], axis=1)
+
+    # -- attributes -----------------------------------------------------------------------
+    def node_vertex_color(self, node, socket, groups):
+        values, _ = self.samples.attribute(node.layer_name, node.name)
+        return values[:, 3:4] if socket.identifier == "Alpha" else values[:, :3]
+
+    def node_attribute(self, node, socket, groups):
+        if node.attribute_type != "GEOMETRY":
+            return self.note(node, f"Attribute of the {node.attribute_type.lower()}")
+        values, colour = self.samples.attribute(node.attribute_name, node.name)
+        if socket.identifier == "Alpha":
+            return values[:, 3:4]
+        if socket.identifier == "Fac":  # a colour's or a vector's mean, as Cycles gives it
+            # (its name is "Factor" from Blender 5.0 on)
+            return values[:, :3].mean(axis=1, keepdims=True)
+        return values[:, :3]
 
     def node_group(self, node, socket, groups):
         tree = node.node_tree

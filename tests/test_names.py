@@ -10,10 +10,11 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 BLENDER_SOCKETS = {"base_color", "base_color_for_body", "skin_color"}
 """Identifiers that name a Blender socket: Base Color, Skin Color."""
-BLENDER_API = {"color", "color_mode", "node_separate_color", "node_combine_color"}
+BLENDER_API = {"color", "color_mode", "node_separate_color", "node_combine_color",
+               "node_vertex_color"}
 """Identifiers that are Blender's: attributes the add-on sets on Blender's data (a colour
 ramp's ``color_mode``, its elements' ``color``) and the handlers named after the node types
-they evaluate (``SEPARATE_COLOR``, ``COMBINE_COLOR``)."""
+they evaluate (``SEPARATE_COLOR``, ``COMBINE_COLOR``, ``VERTEX_COLOR``)."""
 
 
 def _defined_names(tree: ast.AST) -> set[str]:

@@ -64,6 +64,7 @@ LAYERS: dict[str, list[tuple[str, ...]]] = {
         ("makeup_skin_addon.bakes",),
         ("makeup_skin_addon.face_geometry",),
         ("makeup_skin_addon.surface_points",),
+        ("makeup_skin_addon.mesh_attributes",),
         ("makeup_skin_addon.image_store",),
         ("makeup_skin_addon.image_texels",),
         ("makeup_skin_addon.skin_sampling",),

@@ -191,6 +191,24 @@ def test_a_shader_without_skin_is_kept_and_named(head):
     assert any("no skin BSDF" in w and "skin preset" in w for w in report.warnings)
 
 
+def test_what_the_match_cannot_evaluate_is_a_warning(head):
+    """A Noise Texture mixed into the Base Color: the render follows it (linked), the match
+    takes it as 0.5, and the report warns so (counted with what was not carried over)."""
+    material = head.active_material
+    tree = material.node_tree
+    principled = tree.nodes["Principled BSDF"]
+    noise = tree.nodes.new("ShaderNodeTexNoise")
+    mix = tree.nodes.new("ShaderNodeMix")
+    mix.data_type = "RGBA"
+    tree.links.new(principled.inputs["Base Color"].links[0].from_socket, mix.inputs[6])
+    tree.links.new(noise.outputs["Color"], mix.inputs[7])
+    tree.links.new(mix.outputs[2], principled.inputs["Base Color"])
+    _, report = apply_pipeline(head, tier="LAYERED")
+    assert [w for w in report.warnings if w.startswith("Not followed by the match")] == [
+        f"Not followed by the match: {noise.name!r} (Noise Texture) is not evaluated: taken as "
+        f"0.5 (the shade is matched as if so; the made-up skin renders the shader as it is)"]
+
+
 def test_an_object_without_material_gets_one_and_is_told(addon, blank_scene):
     import bpy
 

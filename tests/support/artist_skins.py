@@ -9,7 +9,8 @@ Roughness 0.45.
 
 - :data:`KINDS` -- the kinds, by name, with a line saying what each is.
 - :func:`artist_material` -- a new material of one kind.
-- :func:`head_with` -- the textured head with a material of one kind.
+- :func:`head_with` -- the textured head with a material of one kind;
+  :func:`vertex_colours` -- a mesh's colour attribute, the skin tone blotched per vertex.
 - :func:`uniform_white` -- the scene lit by a uniform white world and nothing else, framed by
   the portrait camera: the light under which a surface shows its albedo.
 - :func:`face_mean` -- the object's mean colour in a render (its pixels weighted by alpha).
@@ -22,8 +23,8 @@ import numpy as np
 
 from support import character
 
-__all__ = ["KINDS", "artist_material", "head_with", "uniform_white", "face_mean", "blurred",
-           "SKIN_VALUES"]
+__all__ = ["KINDS", "artist_material", "head_with", "vertex_colours", "uniform_white",
+           "face_mean", "blurred", "SKIN_VALUES"]
 
 KINDS = {
     "principled": "a Principled BSDF fed by the albedo texture and the pore normal map",
@@ -32,6 +33,8 @@ KINDS = {
     "dark_value": "a Principled BSDF whose Base Color is a value, dark (0.36, 0.14, 0.08)",
     "pale_value": "a Principled BSDF whose Base Color is a value, pale (0.70, 0.50, 0.40)",
     "two_principled": "two Principled skins behind a Mix Shader whose factor is a texture",
+    "vertex_colour": "a Principled BSDF whose Base Color is the mesh's colour attribute "
+                     "(vertex colours: the skin tone, blotched vertex by vertex)",
 }
 """The artist's materials the tests render, by kind."""
 SKIN_VALUES = {"Subsurface Weight": 1.0, "Subsurface Radius": (1.0, 0.2, 0.1),
@@ -127,10 +130,15 @@ def artist_material(kind: str, name: str | None = None):
         node.node_tree = _skin_group()
         node.location = (800, 300)
         surface = node.outputs[0]
-    elif kind in BASE_VALUES:
-        bsdf = _principled(tree, (300, 300), {**SKIN_VALUES, "Base Color": BASE_VALUES[kind]})
+    elif kind in BASE_VALUES or kind == "vertex_colour":
+        bsdf = _principled(tree, (300, 300), {**SKIN_VALUES,
+                                              "Base Color": BASE_VALUES.get(kind, (0.5,) * 3)})
         _, normal = _textures(tree, 300, 300)
         links.new(normal, bsdf.inputs["Normal"])
+        if kind == "vertex_colour":
+            colours = tree.nodes.new("ShaderNodeVertexColor")  # the render colour attribute
+            colours.location = (0, 500)
+            links.new(colours.outputs["Color"], bsdf.inputs["Base Color"])
         surface = bsdf.outputs[0]
     else:  # two_principled
         first = _textured_skin(tree)
@@ -167,7 +175,24 @@ def head_with(kind: str, name: str = "Head"):
     own = obj.data.materials[0]
     obj.data.materials[0] = artist_material(kind)
     bpy.data.materials.remove(own)
+    if kind == "vertex_colour":
+        vertex_colours(obj.data)
     return obj
+
+
+def vertex_colours(mesh, seed: int = 0, spread: float = 0.15):
+    """A colour attribute ``Skin`` on ``mesh``'s vertices (float, the one to render): the
+    skin tone (:data:`support.character.SKIN_SRGB`, linear) times ``1 + spread u`` per vertex
+    and channel, ``u`` uniform in [-1, 1] from ``seed``; returns the attribute."""
+    rng = np.random.default_rng(seed)
+    tone = np.where(np.array(character.SKIN_SRGB) <= 0.04045, np.array(character.SKIN_SRGB)
+                    / 12.92, ((np.array(character.SKIN_SRGB) + 0.055) / 1.055) ** 2.4)
+    rgb = tone * (1.0 + spread * rng.uniform(-1.0, 1.0, (len(mesh.vertices), 3)))
+    rgba = np.concatenate([rgb, np.ones((len(rgb), 1))], axis=1).astype(np.float32)
+    attribute = mesh.color_attributes.new("Skin", "FLOAT_COLOR", "POINT")
+    attribute.data.foreach_set("color", rgba.ravel())
+    mesh.color_attributes.render_color_index = mesh.color_attributes.find("Skin")
+    return attribute
 
 
 def uniform_white(scene, obj, *, size: int = 128, samples: int = 64, seed: int = 0) -> None:
