@@ -12,6 +12,7 @@ is read whole at each call and reduced again only when its CRC-32 changed.
   (cached, :class:`ReducedImage`); :func:`is_cached` -- whether it is.
 - :func:`box_factor`, :func:`box_reduce` -- the filter in numpy; :func:`srgb_to_linear` -- the
   sRGB curve; :func:`srgb_codes_to_linear` -- the same on a byte image's codes, by table.
+- :func:`finite_texels` -- a reduced image's texels that are not finite replaced.
 - :func:`read_texels` -- a reduced image at UVs, wrapped as the texture's extension says.
 - :func:`clear_cache` -- forget the reduced images.
 """
@@ -32,8 +33,8 @@ from .core import cache
 from .progress import report
 
 __all__ = ["IMAGE_SIZE", "ReducedImage", "reduced_image", "is_cached", "box_factor",
-           "box_reduce", "srgb_to_linear", "srgb_codes_to_linear", "read_texels",
-           "clear_cache"]
+           "box_reduce", "srgb_to_linear", "srgb_codes_to_linear", "finite_texels",
+           "read_texels", "clear_cache"]
 
 IMAGE_SIZE = 512
 """The longest side, in texels, the image is box-filtered down to before it is read."""
@@ -225,7 +226,7 @@ def _painted(image, size: int) -> ReducedImage:
     if entry is not None and entry[0] == fingerprint:
         return entry[1]
     report(0.0, f"Reading image {image.name!r}")
-    reduced = _tiled_noted(image, _reduced_buffer(image, pixels, size))
+    reduced = _finished(image, _reduced_buffer(image, pixels, size))
     _IMAGES.put((image.session_uid, size), (fingerprint, reduced))
     return reduced
 
@@ -257,15 +258,37 @@ def _cached_image(image: Any, size: int) -> ReducedImage | None:
 
 
 def _read(image, size: int) -> ReducedImage:
-    return _tiled_noted(image, _read_pixels(image, size))
+    return _finished(image, _read_pixels(image, size))
 
 
-def _tiled_noted(image, reduced: ReducedImage) -> ReducedImage:
-    """``reduced`` with a note when ``image`` is tiled (its first tile stands for all)."""
-    if image.source == "TILED" and reduced.pixels is not None:
-        tiled = f"image {image.name!r} is tiled: its first tile was read for every UV"
-        return ReducedImage(reduced.pixels, "; ".join(n for n in (reduced.note, tiled) if n))
-    return reduced
+def _finished(image, reduced: ReducedImage) -> ReducedImage:
+    """``reduced`` as it is kept: its texels made finite (:func:`finite_texels`), with a note
+    saying so, and one when ``image`` is tiled (its first tile stands for all)."""
+    if reduced.pixels is None:
+        return reduced
+    pixels, bad = finite_texels(reduced.pixels)
+    notes = [reduced.note]
+    if bad:
+        notes.append(f"image {image.name!r} is not finite in {bad} of its {len(pixels[0])} x "
+                     f"{len(pixels)} reduced texels (NaN or infinite texels): taken as the "
+                     f"mean of the others")
+    if image.source == "TILED":
+        notes.append(f"image {image.name!r} is tiled: its first tile was read for every UV")
+    return ReducedImage(pixels, "; ".join(n for n in notes if n))
+
+
+def finite_texels(pixels: np.ndarray) -> tuple[np.ndarray, int]:
+    """``(pixels, count)``: ``pixels`` ((h, w, 3)) with each texel that is not finite in some
+    channel (a NaN or an infinity in the image, spread by the box filter) replaced by the
+    mean of the finite ones (0 without any), and how many there were."""
+    bad = ~np.all(np.isfinite(pixels), axis=-1)
+    count = int(np.count_nonzero(bad))
+    if count == 0:
+        return pixels, 0
+    fixed = np.array(pixels)
+    good = fixed[~bad]
+    fixed[bad] = good.mean(axis=0) if len(good) else 0.0
+    return fixed, count
 
 
 def _loaded_small(image, size: int) -> bool:

@@ -121,6 +121,30 @@ def test_the_box_filter_averages_whole_and_partial_boxes(addon):
     np.testing.assert_allclose(cut[0, 0], whole[0, 0], rtol=1e-6)
 
 
+def test_texels_that_are_not_finite_are_the_others_mean_and_said(addon, blank_scene):
+    """A float image with NaN and infinite texels (a bad bake): its reduced image is finite,
+    those texels the mean of the others, and its note says how many (a note of a value
+    assumed: the first Apply warns)."""
+    import bpy
+
+    from makeup_skin_addon import image_texels, surface_values
+
+    pixels = np.ones((64, 64, 4), np.float32) * np.float32([0.5, 0.3, 0.2, 1.0])
+    pixels[10:12, 10:12, :3] = np.nan
+    pixels[30, 30, 1] = np.inf
+    image = bpy.data.images.new("Bad Bake", 64, 64, float_buffer=True)
+    image.pixels.foreach_set(pixels.ravel())
+    reduced = image_texels.reduced_image(image)
+    assert np.all(np.isfinite(reduced.pixels))
+    np.testing.assert_allclose(reduced.pixels, np.broadcast_to([0.5, 0.3, 0.2], (64, 64, 3)),
+                               rtol=1e-4)  # a float32 mean of some 4000 texels
+    assert reduced.note == ("image 'Bad Bake' is not finite in 5 of its 64 x 64 reduced texels "
+                            "(NaN or infinite texels): taken as the mean of the others")
+    assert surface_values.assumed(reduced.note)
+    fixed, count = image_texels.finite_texels(np.full((2, 2, 3), np.nan))
+    assert count == 4 and np.all(fixed == 0.0)
+
+
 def test_a_small_image_loaded_already_reads_as_its_file_does(addon, tmp_path):
     """An image file at most 512 px across that Blender has loaded is read from memory (no
     copy decoding its file again): the same reduced pixels as the same file not yet loaded,
