@@ -303,6 +303,10 @@ def _loaded_small(image, size: int) -> bool:
 def _read_pixels(image, size: int) -> ReducedImage:
     if image.source == "VIEWER":
         return ReducedImage(None, problem=f"image {image.name!r} is a render result")
+    if image.source in {"SEQUENCE", "MOVIE"}:
+        kind = "an image sequence" if image.source == "SEQUENCE" else "a movie"
+        return ReducedImage(None, problem=f"image {image.name!r} is {kind}: its frames are "
+                                          f"not read")
     if image.source == "GENERATED" or _loaded_small(image, size):
         return _whole(image, size)
     reduced = _scaled_copy(image, size)

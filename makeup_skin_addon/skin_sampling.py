@@ -23,7 +23,7 @@ from typing import Any
 import bpy
 import numpy as np
 
-from . import image_texels, mesh_attributes, pages, surface_points
+from . import image_texels, mesh_attributes, pages, surface_points, surface_values
 from .progress import Report, report, reporting
 
 __all__ = ["SurfaceMean", "surface_mean", "SurfaceSamples", "surface_samples", "in_edit_mode",
@@ -237,9 +237,9 @@ class SurfaceSamples:
     def image(self, image, uv: np.ndarray, extension: str) -> np.ndarray:
         """``(count, 4)`` linear RGBA of ``image`` at ``uv`` (alpha 1)."""
         reduced = image_texels.reduced_image(image)
-        if reduced.pixels is None:
-            self._note(reduced.problem)
-            return np.zeros((len(uv), 4))
+        if reduced.pixels is None:  # neither black nor Blender's magenta: a neutral guess
+            self._note(f"{reduced.problem}: taken as {surface_values.NEUTRAL:g}")
+            return np.full((len(uv), 4), surface_values.NEUTRAL)
         self._note(reduced.note)
         rgb = image_texels.read_texels(reduced.pixels, uv, extension)
         return np.concatenate([rgb, np.ones((len(rgb), 1))], axis=1)

@@ -111,8 +111,9 @@ def _source(material):
 def test_messages(two_faces):
     """Why there is no mean, in the words of Skin Color's source: a UV map the texture reads
     that the mesh lacks (named), a mesh without UVs, a material no face uses, no object, an
-    image whose file is missing; an object without the UV map (or in Edit Mode) beside one
-    with it is left out and said so."""
+    image whose file is missing or whose frames are not read (taken as 0.5, neither black nor
+    Blender's magenta); an object without the UV map (or in Edit Mode) beside one with it is
+    left out and said so."""
     import bpy
 
     from makeup_skin_addon import skin_sampling
@@ -161,7 +162,10 @@ def test_messages(two_faces):
     missing.filepath = "//gone.png"
     texture.image = missing
     assert _source(skin) == (f"{SOURCE} over the 3 faces that use it; image 'Gone' has no "
-                             f"pixels (its file '//gone.png' is missing)")
+                             f"pixels (its file '//gone.png' is missing): taken as 0.5")
+    missing.source = "SEQUENCE"  # frames are not read (it said the file was missing)
+    assert _source(skin) == (f"{SOURCE} over the 3 faces that use it; image 'Gone' is an "
+                             f"image sequence: its frames are not read: taken as 0.5")
 
 
 def test_with_a_camera_the_points_count_by_what_it_sees(two_faces):
