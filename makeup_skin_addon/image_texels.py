@@ -10,6 +10,8 @@ is read whole at each call and reduced again only when its CRC-32 changed.
 
 - :func:`reduced_image` -- an image box-filtered to at most :data:`IMAGE_SIZE`, linear
   (cached, :class:`ReducedImage`); :func:`is_cached` -- whether it is.
+- :func:`reduced_tiles`, :func:`tile_files` -- a tiled (UDIM) image's tiles, each reduced
+  from its file.
 - :func:`box_factor`, :func:`box_reduce` -- the filter in numpy; :func:`srgb_to_linear` -- the
   sRGB curve; :func:`srgb_codes_to_linear` -- the same on a byte image's codes, by table.
 - :func:`finite_texels` -- a reduced image's texels that are not finite replaced.
@@ -32,7 +34,8 @@ from . import image_store, pages
 from .core import cache
 from .progress import report
 
-__all__ = ["IMAGE_SIZE", "ReducedImage", "reduced_image", "is_cached", "box_factor",
+__all__ = ["IMAGE_SIZE", "ReducedImage", "reduced_image", "reduced_tiles", "tile_files",
+           "is_cached", "box_factor",
            "box_reduce", "srgb_to_linear", "srgb_codes_to_linear", "finite_texels",
            "read_texels", "clear_cache"]
 
@@ -40,8 +43,9 @@ IMAGE_SIZE = 512
 """The longest side, in texels, the image is box-filtered down to before it is read."""
 LINEAR_SPACES = frozenset({"Linear Rec.709", "scene_linear", "Non-Color"})
 """Colour spaces whose values a texture node reads as they are (Blender's scene linear)."""
-IMAGES_CACHE_SIZE = 4
-"""Reduced images kept (3 MB each at :data:`IMAGE_SIZE`)."""
+IMAGES_CACHE_SIZE = 8
+"""Reduced images (or tiles of one) kept (3 MB each at :data:`IMAGE_SIZE`); beyond them, a
+file image is read again from its store on disk (:mod:`.image_store`)."""
 
 _IMAGES = cache.LRUCache(IMAGES_CACHE_SIZE)
 
@@ -245,6 +249,53 @@ def _stored_or_read(image, size: int) -> ReducedImage:
     return reduced
 
 
+def tile_files(image) -> dict[int, str]:
+    """The file of each tile of a tiled (UDIM) image, by tile number (absolute paths: its
+    path's ``<UDIM>`` or ``<UVTILE>`` token replaced), or {} when its tiles are not files
+    (packed, generated)."""
+    if image.source != "TILED" or image.packed_files:
+        return {}
+    path = bpy.path.abspath(image.filepath, library=image.library)
+    if "<UDIM>" not in path and "<UVTILE>" not in path:
+        return {}
+    return {tile.number: path.replace("<UDIM>", str(tile.number)).replace(
+        "<UVTILE>", f"u{(tile.number - 1001) % 10 + 1}_v{(tile.number - 1001) // 10 + 1}")
+        for tile in image.tiles}
+
+
+@pages.ordinary()
+def reduced_tiles(image, size: int = IMAGE_SIZE) -> dict[int, ReducedImage]:
+    """The tiles of a tiled image whose tiles are files (:func:`tile_files`), each reduced as
+    a file image of its own (kept in memory until its file changes, and on disk between
+    sessions), by tile number; {} when its tiles are not files."""
+    return {number: _tile(image, path, size) for number, path in tile_files(image).items()}
+
+
+def _tile(image, path: str, size: int) -> ReducedImage:
+    stat = None
+    with contextlib.suppress(OSError):
+        info = os.stat(path)
+        stat = (info.st_mtime_ns, info.st_size)
+    key = (image.session_uid, size, path)
+    fingerprint = (stat, image.colorspace_settings.name, image.alpha_mode)
+    entry = _IMAGES.get(key)
+    if entry is not None and entry[0] == fingerprint:
+        return entry[1]
+    if stat is None:
+        reduced = ReducedImage(None, problem=f"image {image.name!r} has no file {path!r} for "
+                                             f"a tile")
+    else:
+        tile = bpy.data.images.load(path, check_existing=False)  # its own, removed at once
+        try:
+            tile.colorspace_settings.name = image.colorspace_settings.name
+            tile.alpha_mode = image.alpha_mode
+            reduced = _stored_or_read(tile, size)
+        finally:
+            bpy.data.images.remove(tile)
+    _IMAGES.put(key, (fingerprint, reduced))
+    return reduced
+
+
 def is_cached(image: Any, size: int = IMAGE_SIZE) -> bool:
     """Whether :func:`reduced_image` has ``image`` at ``size`` and it has not changed since."""
     return _cached_image(image, size) is not None
@@ -272,8 +323,9 @@ def _finished(image, reduced: ReducedImage) -> ReducedImage:
         notes.append(f"image {image.name!r} is not finite in {bad} of its {len(pixels[0])} x "
                      f"{len(pixels)} reduced texels (NaN or infinite texels): taken as the "
                      f"mean of the others")
-    if image.source == "TILED":
-        notes.append(f"image {image.name!r} is tiled: its first tile was read for every UV")
+    if image.source == "TILED":  # its tiles are not files (else read by reduced_tiles)
+        notes.append(f"image {image.name!r} is tiled, its tiles not files: taken as its first "
+                     f"tile at every UV")
     return ReducedImage(pixels, "; ".join(n for n in notes if n))
 
 

@@ -235,14 +235,42 @@ class SurfaceSamples:
         return values, colour
 
     def image(self, image, uv: np.ndarray, extension: str) -> np.ndarray:
-        """``(count, 4)`` linear RGBA of ``image`` at ``uv`` (alpha 1)."""
-        reduced = image_texels.reduced_image(image)
-        if reduced.pixels is None:  # neither black nor Blender's magenta: a neutral guess
-            self._note(f"{reduced.problem}: taken as {surface_values.NEUTRAL:g}")
-            return np.full((len(uv), 4), surface_values.NEUTRAL)
-        self._note(reduced.note)
-        rgb = image_texels.read_texels(reduced.pixels, uv, extension)
+        """``(count, 4)`` linear RGBA of ``image`` at ``uv`` (alpha 1); a tiled (UDIM) image's
+        tiles each at the UVs that fall in it (:meth:`_tiles`)."""
+        tiles = image_texels.reduced_tiles(image) if image.source == "TILED" else {}
+        if tiles:
+            rgb = self._tiles(image, tiles, uv)
+        else:
+            rgb = self._texels(image_texels.reduced_image(image), uv, extension)
         return np.concatenate([rgb, np.ones((len(rgb), 1))], axis=1)
+
+    def _texels(self, reduced, uv: np.ndarray, extension: str) -> np.ndarray:
+        """``(n, 3)``: ``reduced`` (:class:`.image_texels.ReducedImage`) at ``uv``; without
+        pixels, neither black nor Blender's magenta but a neutral guess, noted."""
+        if reduced.pixels is None:
+            self._note(f"{reduced.problem}: taken as {surface_values.NEUTRAL:g}")
+            return np.full((len(uv), 3), surface_values.NEUTRAL)
+        self._note(reduced.note)
+        return image_texels.read_texels(reduced.pixels, uv, extension)
+
+    def _tiles(self, image, tiles: dict, uv: np.ndarray) -> np.ndarray:
+        """``(n, 3)``: each UV read in the tile it falls in (tile ``1001 + u + 10 v`` of the
+        whole parts, at the fractional parts); a UV outside every tile (Blender renders it
+        without the image) taken as neutral, noted."""
+        whole = np.floor(uv)
+        number = 1001 + whole[:, 0] + 10 * whole[:, 1]
+        inside = (whole[:, 0] >= 0) & (whole[:, 0] < 10) & (whole[:, 1] >= 0)
+        rgb = np.full((len(uv), 3), surface_values.NEUTRAL)
+        for tile, reduced in tiles.items():
+            at = inside & (number == tile)
+            if np.any(at):
+                rgb[at] = self._texels(reduced, uv[at] - whole[at], "REPEAT")
+        outside = ~inside | ~np.isin(number, list(tiles))
+        if np.any(outside):
+            self._note(f"{np.count_nonzero(outside) / len(uv):.1%} of the points fall outside "
+                       f"the tiles of image {image.name!r}: taken as "
+                       f"{surface_values.NEUTRAL:g}")
+        return rgb
 
 
 def _seen(obj, points: surface_points.Points, camera, scene) -> np.ndarray:

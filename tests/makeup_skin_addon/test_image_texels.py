@@ -4,7 +4,7 @@ pixels checked at every call), and its texels read at UVs as the texture's exten
 them."""
 
 import numpy as np
-from support.two_faces import RIGHT_BYTES, exact_two_faces, linear
+from support.two_faces import LEFT_BYTES, RIGHT_BYTES, exact_two_faces, linear
 
 
 def test_the_cache_is_kept_until_the_image_changes(two_faces, tmp_path):
@@ -171,3 +171,70 @@ def test_a_small_image_loaded_already_reads_as_its_file_does(addon, tmp_path):
         read[loaded] = image_texels.reduced_image(image).pixels
     assert np.array_equal(read[True], read[False])
     np.testing.assert_allclose(read[True], linear(codes[..., :3] / 255), rtol=1e-6, atol=1e-9)
+
+
+def _tile_files(tmp_path, colours: dict) -> str:
+    """8-bit PNG tiles ``skin.<number>.png`` of one colour each (bytes): the first's path."""
+    import bpy
+
+    for number, colour in colours.items():
+        image = bpy.data.images.new(f"tile {number}", 8, 8)
+        pixels = np.ones((8, 8, 4), np.float32)
+        pixels[..., :3] = np.asarray(colour) / 255.0
+        image.pixels.foreach_set(pixels.ravel())
+        image.filepath_raw = str(tmp_path / f"skin.{number}.png")
+        image.file_format = "PNG"
+        image.save()
+        bpy.data.images.remove(image)
+    return str(tmp_path / f"skin.{min(colours)}.png")
+
+
+def test_a_tiled_image_is_read_tile_by_tile(two_faces, tmp_path):
+    """A UDIM image whose tiles are files: each UV is read in the tile it falls in (the
+    standing face's in 1001, the lying face's moved to 1002: the mean is the faces' by area,
+    1:3); UVs outside every tile are taken as 0.5 and said so; the tiles' files named from
+    the path's token."""
+    import bpy
+
+    from makeup_skin_addon import image_texels, skin_sampling
+
+    obj, skin, texture = two_faces
+    first = _tile_files(tmp_path, {1001: LEFT_BYTES, 1002: RIGHT_BYTES})
+    image = bpy.data.images.load(first)
+    image.source = "TILED"  # Blender finds 1002 beside it
+    texture.image = image
+    assert sorted(image_texels.tile_files(image)) == [1001, 1002]
+    layer = obj.data.uv_layers[0]
+    uv = np.array([d.uv[:] for d in layer.data])
+    uv[4:8] = uv[0:4] + (1.0, 0.0)  # the lying face's corners into tile 1002
+    layer.data.foreach_set("uv", uv.ravel())
+
+    def mean():
+        samples = skin_sampling.surface_samples(skin)
+        values = samples.image(image, samples.uv(""), "REPEAT")[:, :3]
+        return np.average(values, axis=0, weights=samples.weights), samples.notes
+
+    rgb, notes = mean()
+    np.testing.assert_allclose(rgb, exact_two_faces(1.0, 3.0), atol=2e-5)
+    assert notes == []
+    uv[4:8] = uv[0:4] + (2.0, 0.0)  # tile 1003: none
+    layer.data.foreach_set("uv", uv.ravel())
+    rgb, notes = mean()
+    np.testing.assert_allclose(rgb, (linear(np.asarray(LEFT_BYTES) / 255) + 3 * 0.5) / 4,
+                               atol=2e-5)
+    assert any(note.endswith(f"fall outside the tiles of image {image.name!r}: taken as 0.5")
+               for note in notes), notes
+
+
+def test_the_files_of_uv_tiles(addon):
+    from types import SimpleNamespace
+
+    from makeup_skin_addon import image_texels
+
+    image = SimpleNamespace(source="TILED", packed_files=[], library=None,
+                            filepath="/textures/skin.<UVTILE>.exr",
+                            tiles=[SimpleNamespace(number=n) for n in (1001, 1012)])
+    assert image_texels.tile_files(image) == {1001: "/textures/skin.u1_v1.exr",
+                                              1012: "/textures/skin.u2_v2.exr"}
+    image.packed_files = ["packed"]  # packed tiles are not files
+    assert image_texels.tile_files(image) == {}
