@@ -9,7 +9,7 @@ nodes compute them, for the nodes a skin's colour is commonly built from: Image 
 UV map, a UV Map, Texture Coordinate's UV or a Mapping node before it), RGB and Value, Mix (any
 data type; the usual blend modes), the older MixRGB, Math, Vector Math, Invert, Gamma,
 Hue/Saturation/Value, Brightness/Contrast, Separate and Combine Color (RGB) and XYZ, Clamp, Map
-Range (linear), Color Ramp (linear and constant), Color Attribute and Attribute (of the
+Range (linear), Color Ramp (linear and constant), RGB Curves, Color Attribute and Attribute (of the
 geometry: vertex colours and other mesh attributes, :mod:`.mesh_attributes`), reroutes and node
 groups.  A node it cannot evaluate (a procedural texture, an object's attribute) gives a
 neutral 0.5 and a note saying so.
@@ -91,6 +91,22 @@ def _float(value) -> np.ndarray:
 
 def _as(kind: str, value) -> np.ndarray:
     return _float(value) if kind == "VALUE" else _colour(value)
+
+
+CURVE_NODES = 1025
+"""Values a curve of an RGB Curves node is tabulated at (over the values it is given, 0 to 1
+at least; read between them linearly: within about 1e-5 of the curve)."""
+
+
+def _curve(mapping, curve, values: np.ndarray) -> np.ndarray:
+    """``curve`` (of the CurveMapping ``mapping``, as Blender evaluates it) at ``values``:
+    tabulated at :data:`CURVE_NODES` values from the least to the largest (Blender's own
+    evaluation, a value at a time) and read between them."""
+    values = np.asarray(values, float)
+    low, high = min(0.0, float(values.min())), max(1.0, float(values.max()))
+    nodes = np.linspace(low, high, CURVE_NODES)
+    table = np.array([mapping.evaluate(curve, float(x)) for x in nodes])
+    return np.interp(values, nodes, table)
 
 
 class _Evaluator:
@@ -276,6 +292,16 @@ class _Evaluator:
         v = v * value[:, 0]
         shifted = node_maths.hsv_to_rgb(h, s, v)
         return colour + t * (shifted - colour)
+
+    def node_curve_rgb(self, node, socket, groups):
+        colour = self.input(node, "Color", groups)
+        t = self.input(node, "Fac", groups, "VALUE")
+        mapping = node.mapping
+        combined = mapping.curves[3]  # the C curve, applied before each channel's own
+        curved = np.column_stack([
+            _curve(mapping, mapping.curves[c], _curve(mapping, combined, colour[:, c]))
+            for c in range(3)])
+        return colour + t * (curved - colour)
 
     def node_valtorgb(self, node, socket, groups):
         t = np.clip(self.input(node, "Fac", groups, "VALUE")[:, 0], 0.0, 1.0)

@@ -131,3 +131,50 @@ def test_what_cannot_be_evaluated_is_half_and_said(tree):
     np.testing.assert_allclose(surface_values.mean(_source_of(colour), Points(), notes),
                                (0.5, 0.5, 0.5))
     assert notes == [f"{noise.name!r} (Noise Texture) is not evaluated: taken as 0.5"]
+
+
+def test_rgb_curves_as_cycles_renders_them(addon, blank_scene, tmp_path):
+    """An RGB Curves node (its C curve bent, then a channel's own; Factor 0.8) on a constant
+    colour feeding an Emission seen flat by an orthographic camera: Cycles renders the value
+    the evaluation gives, within 1e-3 (the curves' own tables)."""
+    import bpy
+    from support.addon_steps import render
+
+    from makeup_skin_addon import surface_values
+
+    scene = blank_scene
+    scene.render.engine = "CYCLES"
+    scene.cycles.samples = 1
+    scene.cycles.use_denoising = False
+    scene.render.resolution_x = scene.render.resolution_y = 4
+    scene.view_settings.view_transform = "Standard"
+    scene.view_settings.look = "None"
+    bpy.ops.mesh.primitive_plane_add(size=40.0)  # fills the frame
+    plane = bpy.context.active_object
+    material = bpy.data.materials.new("Curved")
+    if material.node_tree is None:  # 4.5: a new material has no tree
+        material.use_nodes = True
+    plane.data.materials.append(material)
+    tree = material.node_tree
+    emission = tree.nodes.new("ShaderNodeEmission")
+    tree.links.new(emission.outputs[0], tree.get_output_node("ALL").inputs["Surface"])
+    curves = tree.nodes.new("ShaderNodeRGBCurve")
+    curves.inputs["Color"].default_value = (0.2, 0.5, 0.8, 1.0)
+    next(s for s in curves.inputs if s.identifier == "Fac").default_value = 0.8
+    mapping = curves.mapping
+    mapping.curves[3].points.new(0.5, 0.75)  # C
+    mapping.curves[0].points.new(0.3, 0.1)  # R
+    mapping.curves[2].points.new(0.6, 0.9)  # B
+    mapping.update()
+    tree.links.new(curves.outputs["Color"], emission.inputs["Color"])
+    camera = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
+    camera.data.type = "ORTHO"
+    camera.location = (0.0, 0.0, 2.0)
+    scene.collection.objects.link(camera)
+    scene.camera = camera
+    rendered = render(tmp_path, "curves").reshape(-1, 3).mean(axis=0)
+    notes = []
+    evaluated = surface_values.mean(_source_of(emission.inputs["Color"]), Points(), notes)
+    assert notes == []
+    np.testing.assert_allclose(evaluated, rendered, atol=1e-3)
+    assert not np.allclose(evaluated, (0.2, 0.5, 0.8), atol=0.05)  # the curves did bend it
