@@ -11,6 +11,8 @@ The points are area-weighted and stratified on the faces of the material's slots
   covers, what was said about it, or why there is none.
 - :func:`surface_samples` -- the points for evaluating the artist's shader
   (:class:`SurfaceSamples`), counted by what the camera sees.
+- :func:`rendered_users` -- the objects read: those that use the material and render in the
+  scene; :func:`in_edit_mode` -- why an object in Edit Mode is not.
 - :func:`clear_cache` -- forget the points and the reduced images (the add-on's unregister
   calls it).
 """
@@ -27,7 +29,7 @@ from . import image_texels, mesh_attributes, pages, surface_points, surface_valu
 from .progress import Report, report, reporting
 
 __all__ = ["SurfaceMean", "surface_mean", "SurfaceSamples", "surface_samples", "in_edit_mode",
-           "clear_cache"]
+           "rendered_users", "clear_cache"]
 
 
 @dataclass
@@ -50,6 +52,23 @@ def _uv_layer(mesh, uv_map: str):
     if uv_map:
         return mesh.uv_layers.get(uv_map)
     return next((layer for layer in mesh.uv_layers if layer.active_render), None)
+
+
+def rendered_users(material, scene=None) -> tuple[list, list[str]]:
+    """``(objects, notes)``: the mesh objects that use ``material`` and render in ``scene``
+    (default the current one: linked into it and not disabled in renders), the others left
+    out and said so; when none renders, every object that uses it, and a note saying so."""
+    users = surface_points.users(material)
+    scene = scene if scene is not None else getattr(bpy.context, "scene", None)
+    if scene is None or not users:
+        return users, []
+    rendered = [obj for obj in users
+                if not obj.hide_render and scene.objects.get(obj.name) == obj]
+    if not rendered:
+        return users, [f"no object in scene {scene.name!r} renders {material.name!r}: every "
+                       f"object that uses it counts"]
+    return rendered, [f"{obj.name!r} does not render in scene {scene.name!r}: left out"
+                      for obj in users if obj not in rendered]
 
 
 def in_edit_mode(obj) -> str:
@@ -76,10 +95,10 @@ def surface_mean(image: Any, material: Any, *, uv_map: str = "", extension: str 
     with the texture's ``extension``.  ``reader``: the texture node's name, for the messages.
     An object without that UV map is left out (said in ``notes``); with no face left, ``rgb``
     is None and ``problem`` says why."""
-    objects = surface_points.users(material)
+    objects, notes = rendered_users(material)
     if not objects:
         return SurfaceMean(None, None, 0, problem=f"no mesh object uses {material.name!r}")
-    notes, missing, readable = [], [], []
+    missing, readable = [], []
     for obj in objects:
         layer = None if in_edit_mode(obj) else _uv_layer(obj.data, uv_map)
         if layer is None:
@@ -140,13 +159,12 @@ class SurfaceSamples:
         self.material = material
         self.scene = scene
         self.camera = scene.camera if scene is not None else None
-        self.objects = surface_points.users(material)
+        self.objects, self.notes = rendered_users(material, scene)
         self._uv: dict = {}
         self._attributes: dict = {}
         self.budget = budget
         self.count = 0
         self.weights: np.ndarray | None = None
-        self.notes: list[str] = []
         self.faces = 0
         self.seen_by = ""
         self.picked: list = []

@@ -196,3 +196,40 @@ def test_with_a_camera_the_points_count_by_what_it_sees(two_faces):
     np.testing.assert_allclose(away.leaves[0].base, everywhere, atol=1e-6)
     assert any("sees none of it" in note for note in away.notes)
 
+
+
+def test_only_the_objects_that_render_count(two_faces):
+    """A copy of the mesh disabled in renders and one in another scene, their UVs in another
+    band of the image: left out of the mean, and said so (the match's too); with nothing in
+    the scene rendering the material, every object that uses it counts, and that is said."""
+    import bpy
+
+    from makeup_skin_addon import skin_sampling
+
+    obj, skin, texture = two_faces
+    alone = skin_sampling.surface_mean(texture.image, skin).rgb
+
+    def copy(name):
+        other = build_two_faces(skin)
+        other.name = name
+        layer = other.data.uv_layers[0]
+        uv = np.array([d.uv[:] for d in layer.data])
+        uv[:8, 0] = uv[8:, 0].mean()  # the skin faces read the third band
+        layer.data.foreach_set("uv", uv.ravel())
+        return other
+
+    copy("Hidden").hide_render = True
+    elsewhere = copy("Elsewhere")
+    bpy.context.scene.collection.objects.unlink(elsewhere)
+    bpy.data.scenes.new("Other").collection.objects.link(elsewhere)
+    scene = bpy.context.scene.name
+    mean = skin_sampling.surface_mean(texture.image, skin)
+    np.testing.assert_allclose(mean.rgb, alone, atol=1e-9)
+    left_out = [f"'Hidden' does not render in scene {scene!r}: left out",
+                f"'Elsewhere' does not render in scene {scene!r}: left out"]
+    assert mean.objects == ("Two Faces",) and all(n in mean.notes for n in left_out)
+    assert all(n in _source(skin) for n in left_out)
+    obj.hide_render = True
+    mean = skin_sampling.surface_mean(texture.image, skin)
+    assert len(mean.objects) == 3 and (f"no object in scene {scene!r} renders 'Skin': every "
+                                       f"object that uses it counts") in mean.notes
