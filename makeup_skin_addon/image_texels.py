@@ -14,7 +14,8 @@ is read whole at each call and reduced again only when its CRC-32 changed.
   from its file.
 - :func:`box_factor`, :func:`box_reduce` -- the filter in numpy; :func:`srgb_to_linear` -- the
   sRGB curve; :func:`srgb_codes_to_linear` -- the same on a byte image's codes, by table.
-- :func:`finite_texels` -- a reduced image's texels that are not finite replaced.
+- :func:`finite_values` -- a reduced image's texels (or any values) that are not finite
+  replaced.
 - :func:`read_texels` -- a reduced image at UVs, wrapped as the texture's extension says.
 - :func:`clear_cache` -- forget the reduced images.
 """
@@ -36,7 +37,7 @@ from .progress import report
 
 __all__ = ["IMAGE_SIZE", "ReducedImage", "reduced_image", "reduced_tiles", "tile_files",
            "is_cached", "box_factor",
-           "box_reduce", "srgb_to_linear", "srgb_codes_to_linear", "finite_texels",
+           "box_reduce", "srgb_to_linear", "srgb_codes_to_linear", "finite_values",
            "read_texels", "clear_cache"]
 
 IMAGE_SIZE = 512
@@ -313,11 +314,11 @@ def _read(image, size: int) -> ReducedImage:
 
 
 def _finished(image, reduced: ReducedImage) -> ReducedImage:
-    """``reduced`` as it is kept: its texels made finite (:func:`finite_texels`), with a note
+    """``reduced`` as it is kept: its texels made finite (:func:`finite_values`), with a note
     saying so, and one when ``image`` is tiled (its first tile stands for all)."""
     if reduced.pixels is None:
         return reduced
-    pixels, bad = finite_texels(reduced.pixels)
+    pixels, bad = finite_values(reduced.pixels)
     notes = [reduced.note]
     if bad:
         notes.append(f"image {image.name!r} is not finite in {bad} of its {len(pixels[0])} x "
@@ -329,10 +330,11 @@ def _finished(image, reduced: ReducedImage) -> ReducedImage:
     return ReducedImage(pixels, "; ".join(n for n in notes if n))
 
 
-def finite_texels(pixels: np.ndarray) -> tuple[np.ndarray, int]:
-    """``(pixels, count)``: ``pixels`` ((h, w, 3)) with each texel that is not finite in some
-    channel (a NaN or an infinity in the image, spread by the box filter) replaced by the
-    mean of the finite ones (0 without any), and how many there were."""
+def finite_values(pixels: np.ndarray) -> tuple[np.ndarray, int]:
+    """``(pixels, count)``: ``pixels`` (``(..., c)``: a reduced image's texels, or any values
+    by row) with each one that is not finite in some channel (a NaN or an infinity in the
+    image, spread by the box filter) replaced by the mean of the finite ones (0 without any),
+    and how many there were."""
     bad = ~np.all(np.isfinite(pixels), axis=-1)
     count = int(np.count_nonzero(bad))
     if count == 0:

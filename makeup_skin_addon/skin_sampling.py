@@ -246,7 +246,11 @@ class SurfaceSamples:
             else:
                 parts.append(found.values)
                 colour = colour or found.colour
-        values = np.concatenate(parts) if parts else np.zeros((1, 4))
+        values, bad = image_texels.finite_values(np.concatenate(parts) if parts
+                                                 else np.zeros((1, 4)))
+        if bad:
+            self._note(f"attribute {name!r} (read by {reader!r}) is not finite at {bad} points: "
+                       f"taken as the mean of the others")
         if len(values) != self.count:
             values = np.broadcast_to(values.mean(axis=0), (self.count, 4))
         self._attributes[name] = (values, colour)

@@ -141,7 +141,7 @@ def test_texels_that_are_not_finite_are_the_others_mean_and_said(addon, blank_sc
     assert reduced.note == ("image 'Bad Bake' is not finite in 5 of its 64 x 64 reduced texels "
                             "(NaN or infinite texels): taken as the mean of the others")
     assert surface_values.assumed(reduced.note)
-    fixed, count = image_texels.finite_texels(np.full((2, 2, 3), np.nan))
+    fixed, count = image_texels.finite_values(np.full((2, 2, 3), np.nan))
     assert count == 4 and np.all(fixed == 0.0)
 
 

@@ -130,3 +130,24 @@ def test_a_vertex_coloured_skin_is_read_as_it_renders(faces):
         tree.links.new(socket, principled.inputs["Roughness"])
         assert surface_values.mean(source(principled.inputs["Roughness"], ()), samples, notes,
                                    "VALUE") == pytest.approx(expected, rel=1e-6)
+
+
+def test_a_colour_attribute_that_is_not_finite_is_the_others_mean(faces):
+    """A NaN vertex colour (a script's slip): the points it reaches take the mean of the
+    others, and the note says how many (a value assumed: the first Apply warns)."""
+    from makeup_skin_addon import skin_sampling, surface_values
+
+    obj, skin, _ = faces
+    mesh = obj.data
+    colours = np.tile(np.float32([0.6, 0.4, 0.3, 1.0]), (len(mesh.vertices), 1))
+    colours[0] = np.nan
+    mesh.color_attributes.new("Skin", "FLOAT_COLOR", "POINT").data.foreach_set(
+        "color", colours.ravel())
+    samples = skin_sampling.surface_samples(skin)
+    values, _ = samples.attribute("Skin", "Color Attribute")
+    assert np.all(np.isfinite(values))
+    np.testing.assert_allclose(values, np.tile([0.6, 0.4, 0.3, 1.0], (len(values), 1)),
+                               rtol=1e-6)
+    note = next(n for n in samples.notes if n.startswith("attribute 'Skin'"))
+    assert note.endswith("points: taken as the mean of the others")
+    assert surface_values.assumed(note)
