@@ -11,6 +11,8 @@ The points are area-weighted and stratified on the faces of the material's slots
   covers, what was said about it, or why there is none.
 - :func:`surface_samples` -- the points for evaluating the artist's shader
   (:class:`SurfaceSamples`), counted by what the camera sees.
+- :func:`image_rgb` -- an image at UVs as its texture node reads it, a UDIM image tile by
+  tile.
 - :func:`rendered_users` -- the objects read: those that use the material and render in the
   scene; :func:`in_edit_mode` -- why an object in Edit Mode is not.
 - :func:`clear_cache` -- forget the points and the reduced images (the add-on's unregister
@@ -19,6 +21,7 @@ The points are area-weighted and stratified on the faces of the material's slots
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -28,8 +31,8 @@ import numpy as np
 from . import image_texels, mesh_attributes, pages, surface_points, surface_values
 from .progress import Report, report, reporting
 
-__all__ = ["SurfaceMean", "surface_mean", "SurfaceSamples", "surface_samples", "in_edit_mode",
-           "rendered_users", "clear_cache"]
+__all__ = ["SurfaceMean", "surface_mean", "SurfaceSamples", "surface_samples", "image_rgb",
+           "in_edit_mode", "rendered_users", "clear_cache"]
 
 
 @dataclass
@@ -109,9 +112,12 @@ def surface_mean(image: Any, material: Any, *, uv_map: str = "", extension: str 
         return SurfaceMean(None, None, 0, problem="; ".join(missing))
     notes += [f"{text}: left out" for text in missing]
     slow = not image_texels.is_cached(image, size)
-    reduced = image_texels.reduced_image(image, size)  # first: its decoder's peak is the call's
-    if reduced.pixels is None:
-        return SurfaceMean(None, None, 0, notes=notes, problem=reduced.problem)
+    reduced = None  # a UDIM image whose tiles are files is read tile by tile (image_rgb)
+    if not image_texels.tile_files(image):
+        # read first: its decoder's peak is the call's
+        reduced = image_texels.reduced_image(image, size)
+        if reduced.pixels is None:
+            return SurfaceMean(None, None, 0, notes=notes, problem=reduced.problem)
     surfaces = [surface_points.Surface(obj, material, layer) for obj, layer in readable]
     cold = [surface for surface in surfaces if surface.cached is None]
     for step, surface in enumerate(cold):
@@ -128,17 +134,21 @@ def surface_mean(image: Any, material: Any, *, uv_map: str = "", extension: str 
         return SurfaceMean(None, None, faces, notes=notes, problem=why)
     total = sum(points.area for _, points in picked)
     rgb, variance = np.zeros(3), np.zeros(3)
+    said: list[str] = []
+
+    def say(sentence: str) -> None:
+        if sentence not in said:
+            said.append(sentence)
+
     for _, points in picked:
-        values = image_texels.read_texels(reduced.pixels, points.uv, extension)
+        values = image_rgb(image, points.uv, extension, say, reduced)
         share = points.area / total
         rgb += share * values.mean(axis=0)
         variance += share ** 2 * values.var(axis=0) / len(values)
     if slow or cold:
         report(1.0, "")
-    if reduced.note:
-        notes.insert(0, reduced.note)
     return SurfaceMean(rgb, np.sqrt(variance), faces, tuple(obj.name for obj, _ in picked),
-                       notes)
+                       said + notes)
 
 
 
@@ -257,42 +267,49 @@ class SurfaceSamples:
         return values, colour
 
     def image(self, image, uv: np.ndarray, extension: str) -> np.ndarray:
-        """``(count, 4)`` linear RGBA of ``image`` at ``uv`` (alpha 1); a tiled (UDIM) image's
-        tiles each at the UVs that fall in it (:meth:`_tiles`)."""
-        tiles = image_texels.reduced_tiles(image) if image.source == "TILED" else {}
-        if tiles:
-            rgb = self._tiles(image, tiles, uv)
-        else:
-            rgb = self._texels(image_texels.reduced_image(image), uv, extension)
+        """``(count, 4)`` linear RGBA of ``image`` at ``uv`` (alpha 1): :func:`image_rgb`."""
+        rgb = image_rgb(image, uv, extension, self._note)
         return np.concatenate([rgb, np.ones((len(rgb), 1))], axis=1)
 
-    def _texels(self, reduced, uv: np.ndarray, extension: str) -> np.ndarray:
-        """``(n, 3)``: ``reduced`` (:class:`.image_texels.ReducedImage`) at ``uv``; without
-        pixels, neither black nor Blender's magenta but a neutral guess, noted."""
-        if reduced.pixels is None:
-            self._note(f"{reduced.problem}: taken as {surface_values.NEUTRAL:g}")
-            return np.full((len(uv), 3), surface_values.NEUTRAL)
-        self._note(reduced.note)
-        return image_texels.read_texels(reduced.pixels, uv, extension)
 
-    def _tiles(self, image, tiles: dict, uv: np.ndarray) -> np.ndarray:
-        """``(n, 3)``: each UV read in the tile it falls in (tile ``1001 + u + 10 v`` of the
-        whole parts, at the fractional parts); a UV outside every tile (Blender renders it
-        without the image) taken as neutral, noted."""
-        whole = np.floor(uv)
-        number = 1001 + whole[:, 0] + 10 * whole[:, 1]
-        inside = (whole[:, 0] >= 0) & (whole[:, 0] < 10) & (whole[:, 1] >= 0)
-        rgb = np.full((len(uv), 3), surface_values.NEUTRAL)
-        for tile, reduced in tiles.items():
-            at = inside & (number == tile)
-            if np.any(at):
-                rgb[at] = self._texels(reduced, uv[at] - whole[at], "REPEAT")
-        outside = ~inside | ~np.isin(number, list(tiles))
-        if np.any(outside):
-            self._note(f"{np.count_nonzero(outside) / len(uv):.1%} of the points fall outside "
-                       f"the tiles of image {image.name!r}: taken as "
-                       f"{surface_values.NEUTRAL:g}")
-        return rgb
+def image_rgb(image, uv: np.ndarray, extension: str, note: Callable[[str], None],
+              reduced: image_texels.ReducedImage | None = None) -> np.ndarray:
+    """``(n, 3)`` linear RGB of ``image`` at ``uv`` as its texture node reads it (the reduced
+    image, :mod:`.image_texels`, or ``reduced`` if read already); a tiled (UDIM) image whose
+    tiles are files read tile by tile (:func:`_tiles`); what was assumed said by ``note``
+    (without pixels, neither black nor Blender's magenta but a neutral guess)."""
+    tiles = image_texels.reduced_tiles(image) if image.source == "TILED" else {}
+    if tiles:
+        return _tiles(image, tiles, uv, note)
+    return _texels(reduced or image_texels.reduced_image(image), uv, extension, note)
+
+
+def _texels(reduced, uv: np.ndarray, extension: str, note) -> np.ndarray:
+    if reduced.pixels is None:
+        note(f"{reduced.problem}: taken as {surface_values.NEUTRAL:g}")
+        return np.full((len(uv), 3), surface_values.NEUTRAL)
+    if reduced.note:
+        note(reduced.note)
+    return image_texels.read_texels(reduced.pixels, uv, extension)
+
+
+def _tiles(image, tiles: dict, uv: np.ndarray, note) -> np.ndarray:
+    """``(n, 3)``: each UV read in the tile it falls in (tile ``1001 + u + 10 v`` of the
+    whole parts, at the fractional parts); a UV outside every tile (Blender renders it
+    without the image) taken as neutral, noted."""
+    whole = np.floor(uv)
+    number = 1001 + whole[:, 0] + 10 * whole[:, 1]
+    inside = (whole[:, 0] >= 0) & (whole[:, 0] < 10) & (whole[:, 1] >= 0)
+    rgb = np.full((len(uv), 3), surface_values.NEUTRAL)
+    for tile, reduced in tiles.items():
+        at = inside & (number == tile)
+        if np.any(at):
+            rgb[at] = _texels(reduced, uv[at] - whole[at], "REPEAT", note)
+    outside = ~inside | ~np.isin(number, list(tiles))
+    if np.any(outside):
+        note(f"{np.count_nonzero(outside) / len(uv):.1%} of the points fall outside the tiles "
+             f"of image {image.name!r}: taken as {surface_values.NEUTRAL:g}")
+    return rgb
 
 
 def _seen(obj, points: surface_points.Points, camera, scene) -> np.ndarray:

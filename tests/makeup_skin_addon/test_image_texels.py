@@ -192,8 +192,8 @@ def _tile_files(tmp_path, colours: dict) -> str:
 def test_a_tiled_image_is_read_tile_by_tile(two_faces, tmp_path):
     """A UDIM image whose tiles are files: each UV is read in the tile it falls in (the
     standing face's in 1001, the lying face's moved to 1002: the mean is the faces' by area,
-    1:3); UVs outside every tile are taken as 0.5 and said so; the tiles' files named from
-    the path's token."""
+    1:3), by the artist's shader's points and by Skin Color's mean alike; UVs outside every
+    tile are taken as 0.5 and said so."""
     import bpy
 
     from makeup_skin_addon import image_texels, skin_sampling
@@ -217,6 +217,8 @@ def test_a_tiled_image_is_read_tile_by_tile(two_faces, tmp_path):
     rgb, notes = mean()
     np.testing.assert_allclose(rgb, exact_two_faces(1.0, 3.0), atol=2e-5)
     assert notes == []
+    skin_colour = skin_sampling.surface_mean(image, skin)  # the skin preset's path, the same
+    np.testing.assert_allclose(skin_colour.rgb, exact_two_faces(1.0, 3.0), atol=2e-5)
     uv[4:8] = uv[0:4] + (2.0, 0.0)  # tile 1003: none
     layer.data.foreach_set("uv", uv.ravel())
     rgb, notes = mean()
