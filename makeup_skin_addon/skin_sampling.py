@@ -14,7 +14,7 @@ The points are area-weighted and stratified on the faces of the material's slots
 - :func:`image_rgb` -- an image at UVs as its texture node reads it, a UDIM image tile by
   tile.
 - :func:`rendered_users` -- the objects read: those that use the material and render in the
-  scene; :func:`in_edit_mode` -- why an object in Edit Mode is not.
+  scene (:func:`rendering`); :func:`in_edit_mode` -- why an object in Edit Mode is not.
 - :func:`clear_cache` -- forget the points and the reduced images (the add-on's unregister
   calls it).
 """
@@ -32,7 +32,7 @@ from . import image_texels, mesh_attributes, pages, surface_points, surface_valu
 from .progress import Report, report, reporting
 
 __all__ = ["SurfaceMean", "surface_mean", "SurfaceSamples", "surface_samples", "image_rgb",
-           "in_edit_mode", "rendered_users", "clear_cache"]
+           "in_edit_mode", "rendered_users", "rendering", "clear_cache"]
 
 
 @dataclass
@@ -57,16 +57,36 @@ def _uv_layer(mesh, uv_map: str):
     return next((layer for layer in mesh.uv_layers if layer.active_render), None)
 
 
+def rendering(scene) -> set:
+    """The objects ``scene`` renders (their ``session_uid``): in a collection of a view layer
+    it renders, not excluded there, no collection on the way disabled in renders, the object
+    itself not disabled in renders."""
+    out: set = set()
+
+    def walk(layer_collection) -> None:
+        if layer_collection.exclude or layer_collection.collection.hide_render:
+            return
+        out.update(obj.session_uid for obj in layer_collection.collection.objects
+                   if not obj.hide_render)
+        for child in layer_collection.children:
+            walk(child)
+
+    for view_layer in scene.view_layers:
+        if view_layer.use:
+            walk(view_layer.layer_collection)
+    return out
+
+
 def rendered_users(material, scene=None) -> tuple[list, list[str]]:
     """``(objects, notes)``: the mesh objects that use ``material`` and render in ``scene``
-    (default the current one: linked into it and not disabled in renders), the others left
-    out and said so; when none renders, every object that uses it, and a note saying so."""
+    (default the current one, :func:`rendering`), the others left out and said so; when none
+    renders, every object that uses it, and a note saying so."""
     users = surface_points.users(material)
     scene = scene if scene is not None else getattr(bpy.context, "scene", None)
     if scene is None or not users:
         return users, []
-    rendered = [obj for obj in users
-                if not obj.hide_render and scene.objects.get(obj.name) == obj]
+    renders = rendering(scene)
+    rendered = [obj for obj in users if obj.session_uid in renders]
     if not rendered:
         return users, [f"no object in scene {scene.name!r} renders {material.name!r}: every "
                        f"object that uses it counts"]

@@ -199,9 +199,10 @@ def test_with_a_camera_the_points_count_by_what_it_sees(two_faces):
 
 
 def test_only_the_objects_that_render_count(two_faces):
-    """A copy of the mesh disabled in renders and one in another scene, their UVs in another
-    band of the image: left out of the mean, and said so (the match's too); with nothing in
-    the scene rendering the material, every object that uses it counts, and that is said."""
+    """Copies of the mesh disabled in renders, in another scene, in a collection disabled in
+    renders or excluded from the view layer, their UVs in another band of the image: left out
+    of the mean, and said so (the match's too); with nothing in the scene rendering the
+    material, every object that uses it counts, and that is said."""
     import bpy
 
     from makeup_skin_addon import skin_sampling
@@ -229,7 +230,21 @@ def test_only_the_objects_that_render_count(two_faces):
                 f"'Elsewhere' does not render in scene {scene!r}: left out"]
     assert mean.objects == ("Two Faces",) and all(n in mean.notes for n in left_out)
     assert all(n in _source(skin) for n in left_out)
+    # A collection disabled in renders, and one excluded from the view layer, hide theirs.
+    for name, switch in (("Off", "hide_render"), ("Excluded", "exclude")):
+        other = copy(name)
+        collection = bpy.data.collections.new(name)
+        bpy.context.scene.collection.children.link(collection)
+        bpy.context.scene.collection.objects.unlink(other)
+        collection.objects.link(other)
+        if switch == "hide_render":
+            collection.hide_render = True
+        else:
+            bpy.context.view_layer.layer_collection.children[name].exclude = True
+        mean = skin_sampling.surface_mean(texture.image, skin)
+        np.testing.assert_allclose(mean.rgb, alone, atol=1e-9)
+        assert f"{name!r} does not render in scene {scene!r}: left out" in mean.notes
     obj.hide_render = True
     mean = skin_sampling.surface_mean(texture.image, skin)
-    assert len(mean.objects) == 3 and (f"no object in scene {scene!r} renders 'Skin': every "
+    assert len(mean.objects) == 5 and (f"no object in scene {scene!r} renders 'Skin': every "
                                        f"object that uses it counts") in mean.notes
