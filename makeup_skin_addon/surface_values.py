@@ -9,10 +9,12 @@ nodes compute them, for the nodes a skin's colour is commonly built from: Image 
 UV map, a UV Map, Texture Coordinate's UV or a Mapping node before it), RGB and Value, Mix (any
 data type; the usual blend modes), the older MixRGB, Math, Vector Math, Invert, Gamma,
 Hue/Saturation/Value, Brightness/Contrast, Separate and Combine Color (RGB) and XYZ, Clamp, Map
-Range (linear), Color Ramp (linear and constant), RGB Curves, Color Attribute and Attribute (of the
-geometry: vertex colours and other mesh attributes, :mod:`.mesh_attributes`), reroutes and node
-groups.  A node it cannot evaluate (a procedural texture, an object's attribute) gives a
-neutral 0.5 and a note saying so.
+Range (linear), Color Ramp (linear and constant), RGB Curves, Color Attribute and Attribute (of
+the geometry: vertex colours and other mesh attributes, :mod:`.mesh_attributes`), Fresnel and
+Layer Weight (their averages under uniform light, over the directions the surface is seen
+from: a Mix Shader's factor for a sheen or a rim), reroutes and node groups.  A node it
+cannot evaluate (a procedural texture, an object's attribute) gives a neutral 0.5 and a note
+saying so.
 
 Values are arrays with a leading axis of the sample count (or 1 for a constant) and a trailing
 axis of 3 (colours and vectors) or 1 (floats).
@@ -35,6 +37,7 @@ import numpy as np
 
 from . import node_maths
 from .artist_shader import Source, source
+from .core import film_slab
 
 __all__ = ["Samples", "values", "mean", "assumed", "NEUTRAL", "ASSUMED"]
 
@@ -91,6 +94,16 @@ def _float(value) -> np.ndarray:
 
 def _as(kind: str, value) -> np.ndarray:
     return _float(value) if kind == "VALUE" else _colour(value)
+
+
+def _fresnel_average(ior: np.ndarray) -> np.ndarray:
+    """``(n, 1)``: a Fresnel factor of index ``ior`` ((n, 1)) averaged over the directions a
+    surface is seen from under uniform light (cosine-weighted,
+    :func:`lut_baker.model.film_slab.interface_albedo`): what it weighs a Mix Shader's two
+    shaders by in the colour under uniform light."""
+    values, inverse = np.unique(np.maximum(np.asarray(ior, float), 1.0), return_inverse=True)
+    averages = np.array([film_slab.interface_albedo(float(value)) for value in values])
+    return averages[inverse].reshape(np.shape(ior))
 
 
 CURVE_NODES = 1025
@@ -302,6 +315,19 @@ class _Evaluator:
             _curve(mapping, mapping.curves[c], _curve(mapping, combined, colour[:, c]))
             for c in range(3)])
         return colour + t * (curved - colour)
+
+    # -- view-dependent factors, averaged under uniform light -------------------------------
+    def node_fresnel(self, node, socket, groups):
+        return _fresnel_average(self.input(node, "IOR", groups, "VALUE"))
+
+    def node_layer_weight(self, node, socket, groups):
+        blend = np.clip(self.input(node, "Blend", groups, "VALUE"), 0.0, 1.0 - 1e-5)
+        if socket.identifier == "Fresnel":  # Cycles: eta 1 / (1 - blend)
+            return _fresnel_average(1.0 / np.maximum(1.0 - blend, 1e-5))
+        # Facing: 1 - |cos|^b (b = 2 blend below 0.5, 0.5 / (1 - blend) above), whose average
+        # over 2 cos dcos is 1 - 2 / (b + 2)
+        power = np.where(blend < 0.5, 2.0 * blend, 0.5 / (1.0 - blend))
+        return 1.0 - 2.0 / (power + 2.0)
 
     def node_valtorgb(self, node, socket, groups):
         t = np.clip(self.input(node, "Fac", groups, "VALUE")[:, 0], 0.0, 1.0)

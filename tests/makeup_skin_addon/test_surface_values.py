@@ -178,3 +178,62 @@ def test_rgb_curves_as_cycles_renders_them(addon, blank_scene, tmp_path):
     assert notes == []
     np.testing.assert_allclose(evaluated, rendered, atol=1e-3)
     assert not np.allclose(evaluated, (0.2, 0.5, 0.8), atol=0.05)  # the curves did bend it
+
+
+def test_fresnel_and_layer_weight_as_their_average_over_a_sphere(addon, blank_scene, tmp_path):
+    """Fresnel and Layer Weight feeding a Mix Shader's factor count by their average under
+    uniform light, over the directions the surface is seen from: what Cycles renders of them
+    as an emission over a smooth sphere seen orthographically (a disc whose area is spread as
+    2 cos dcos; its edge pixels counted by their coverage), within 1%."""
+    import bpy
+    from support.addon_steps import render
+
+    from makeup_skin_addon import surface_values
+
+    scene = blank_scene
+    scene.render.engine = "CYCLES"
+    scene.cycles.samples = 16
+    scene.cycles.use_denoising = False
+    scene.render.resolution_x = scene.render.resolution_y = 96
+    scene.render.film_transparent = True
+    scene.view_settings.view_transform = "Standard"
+    scene.view_settings.look = "None"
+    bpy.ops.mesh.primitive_uv_sphere_add(radius=1.0, segments=128, ring_count=64)
+    sphere = bpy.context.active_object
+    bpy.ops.object.shade_smooth()
+    material = bpy.data.materials.new("Factor")
+    if material.node_tree is None:  # 4.5: a new material has no tree
+        material.use_nodes = True
+    sphere.data.materials.append(material)
+    tree = material.node_tree
+    emission = tree.nodes.new("ShaderNodeEmission")
+    tree.links.new(emission.outputs[0], tree.get_output_node("ALL").inputs["Surface"])
+    camera = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
+    camera.data.type, camera.data.ortho_scale = "ORTHO", 2.2
+    camera.location = (0.0, 0.0, 5.0)
+    scene.collection.objects.link(camera)
+    scene.camera = camera
+    fresnel = tree.nodes.new("ShaderNodeFresnel")
+    fresnel.inputs["IOR"].default_value = 1.45
+    weight = tree.nodes.new("ShaderNodeLayerWeight")
+    for output, blend in (("Fresnel", 0.6), ("Facing", 0.3), ("Facing", 0.8)):
+        weight.inputs["Blend"].default_value = blend
+        tree.links.new(next(s for s in weight.outputs if s.identifier == output),
+                       emission.inputs["Color"])
+        _check_disc(tmp_path, render, surface_values, emission, f"{output} {blend}")
+    tree.links.new(fresnel.outputs[0], emission.inputs["Color"])
+    _check_disc(tmp_path, render, surface_values, emission, "Fresnel node")
+
+
+def _check_disc(tmp_path, render, surface_values, emission, name):
+    from support import sphere_scene
+
+    path = tmp_path / f"{name}.exr"
+    render(tmp_path, name)
+    pixels = sphere_scene.image_pixels(str(path))
+    rendered = pixels[..., 0].sum() / pixels[..., 3].sum()  # premultiplied: edges by coverage
+    notes = []
+    evaluated = surface_values.mean(_source_of(emission.inputs["Color"]), Points(), notes,
+                                    "VALUE")
+    assert notes == [], name
+    assert evaluated == pytest.approx(rendered, rel=0.01), name
