@@ -133,6 +133,33 @@ def test_what_cannot_be_evaluated_is_half_and_said(tree):
     assert notes == [f"{noise.name!r} (Noise Texture) is not evaluated: taken as 0.5"]
 
 
+def _emission_seen_flat(scene, obj, *, size: int, samples: int, ortho_scale: float):
+    """``obj`` given a material whose surface is an Emission, seen by an orthographic camera
+    from +Z in Cycles (``size`` px square, ``samples``, the Standard view: a pixel is the
+    emission's value): ``(the material's tree, the Emission node)``."""
+    import bpy
+
+    scene.render.engine = "CYCLES"
+    scene.cycles.samples = samples
+    scene.cycles.use_denoising = False
+    scene.render.resolution_x = scene.render.resolution_y = size
+    scene.view_settings.view_transform = "Standard"
+    scene.view_settings.look = "None"
+    material = bpy.data.materials.new("Seen Flat")
+    if material.node_tree is None:  # 4.5: a new material has no tree
+        material.use_nodes = True
+    obj.data.materials.append(material)
+    tree = material.node_tree
+    emission = tree.nodes.new("ShaderNodeEmission")
+    tree.links.new(emission.outputs[0], tree.get_output_node("ALL").inputs["Surface"])
+    camera = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
+    camera.data.type, camera.data.ortho_scale = "ORTHO", ortho_scale
+    camera.location = (0.0, 0.0, 5.0)
+    scene.collection.objects.link(camera)
+    scene.camera = camera
+    return tree, emission
+
+
 def test_rgb_curves_as_cycles_renders_them(addon, blank_scene, tmp_path):
     """An RGB Curves node (its C curve bent, then a channel's own; Factor 0.8) on a constant
     colour feeding an Emission seen flat by an orthographic camera: Cycles renders the value
@@ -142,22 +169,9 @@ def test_rgb_curves_as_cycles_renders_them(addon, blank_scene, tmp_path):
 
     from makeup_skin_addon import surface_values
 
-    scene = blank_scene
-    scene.render.engine = "CYCLES"
-    scene.cycles.samples = 1
-    scene.cycles.use_denoising = False
-    scene.render.resolution_x = scene.render.resolution_y = 4
-    scene.view_settings.view_transform = "Standard"
-    scene.view_settings.look = "None"
     bpy.ops.mesh.primitive_plane_add(size=40.0)  # fills the frame
-    plane = bpy.context.active_object
-    material = bpy.data.materials.new("Curved")
-    if material.node_tree is None:  # 4.5: a new material has no tree
-        material.use_nodes = True
-    plane.data.materials.append(material)
-    tree = material.node_tree
-    emission = tree.nodes.new("ShaderNodeEmission")
-    tree.links.new(emission.outputs[0], tree.get_output_node("ALL").inputs["Surface"])
+    tree, emission = _emission_seen_flat(blank_scene, bpy.context.active_object, size=4,
+                                         samples=1, ortho_scale=6.0)
     curves = tree.nodes.new("ShaderNodeRGBCurve")
     curves.inputs["Color"].default_value = (0.2, 0.5, 0.8, 1.0)
     next(s for s in curves.inputs if s.identifier == "Fac").default_value = 0.8
@@ -167,11 +181,6 @@ def test_rgb_curves_as_cycles_renders_them(addon, blank_scene, tmp_path):
     mapping.curves[2].points.new(0.6, 0.9)  # B
     mapping.update()
     tree.links.new(curves.outputs["Color"], emission.inputs["Color"])
-    camera = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
-    camera.data.type = "ORTHO"
-    camera.location = (0.0, 0.0, 2.0)
-    scene.collection.objects.link(camera)
-    scene.camera = camera
     rendered = render(tmp_path, "curves").reshape(-1, 3).mean(axis=0)
     notes = []
     evaluated = surface_values.mean(_source_of(emission.inputs["Color"]), Points(), notes)
@@ -186,33 +195,12 @@ def test_fresnel_and_layer_weight_as_their_average_over_a_sphere(addon, blank_sc
     as an emission over a smooth sphere seen orthographically (a disc whose area is spread as
     2 cos dcos; its edge pixels counted by their coverage), within 1%."""
     import bpy
-    from support.addon_steps import render
 
-    from makeup_skin_addon import surface_values
-
-    scene = blank_scene
-    scene.render.engine = "CYCLES"
-    scene.cycles.samples = 16
-    scene.cycles.use_denoising = False
-    scene.render.resolution_x = scene.render.resolution_y = 96
-    scene.render.film_transparent = True
-    scene.view_settings.view_transform = "Standard"
-    scene.view_settings.look = "None"
     bpy.ops.mesh.primitive_uv_sphere_add(radius=1.0, segments=128, ring_count=64)
-    sphere = bpy.context.active_object
     bpy.ops.object.shade_smooth()
-    material = bpy.data.materials.new("Factor")
-    if material.node_tree is None:  # 4.5: a new material has no tree
-        material.use_nodes = True
-    sphere.data.materials.append(material)
-    tree = material.node_tree
-    emission = tree.nodes.new("ShaderNodeEmission")
-    tree.links.new(emission.outputs[0], tree.get_output_node("ALL").inputs["Surface"])
-    camera = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
-    camera.data.type, camera.data.ortho_scale = "ORTHO", 2.2
-    camera.location = (0.0, 0.0, 5.0)
-    scene.collection.objects.link(camera)
-    scene.camera = camera
+    blank_scene.render.film_transparent = True
+    tree, emission = _emission_seen_flat(blank_scene, bpy.context.active_object, size=96,
+                                         samples=16, ortho_scale=2.2)
     fresnel = tree.nodes.new("ShaderNodeFresnel")
     fresnel.inputs["IOR"].default_value = 1.45
     weight = tree.nodes.new("ShaderNodeLayerWeight")
@@ -220,13 +208,17 @@ def test_fresnel_and_layer_weight_as_their_average_over_a_sphere(addon, blank_sc
         weight.inputs["Blend"].default_value = blend
         tree.links.new(next(s for s in weight.outputs if s.identifier == output),
                        emission.inputs["Color"])
-        _check_disc(tmp_path, render, surface_values, emission, f"{output} {blend}")
+        _check_disc(tmp_path, emission, f"{output} {blend}")
     tree.links.new(fresnel.outputs[0], emission.inputs["Color"])
-    _check_disc(tmp_path, render, surface_values, emission, "Fresnel node")
+    _check_disc(tmp_path, emission, "Fresnel node")
 
 
-def _check_disc(tmp_path, render, surface_values, emission, name):
+def _check_disc(tmp_path, emission, name):
+    """The render's mean over the disc (by coverage) is the evaluation's, within 1%."""
     from support import sphere_scene
+    from support.addon_steps import render
+
+    from makeup_skin_addon import surface_values
 
     path = tmp_path / f"{name}.exr"
     render(tmp_path, name)
