@@ -128,10 +128,13 @@ class _Evaluator:
         self.memo: dict = {}
         self.readers: list[str] = []  # the image textures whose coordinates are evaluated
 
-    def note(self, node, what: str) -> np.ndarray:
-        sentence = f"{node.name!r} ({what}) is not evaluated: taken as {NEUTRAL:g}"
+    def say(self, sentence: str) -> None:
+        """Add ``sentence`` to the notes, once."""
         if sentence not in self.notes:
             self.notes.append(sentence)
+
+    def note(self, node, what: str) -> np.ndarray:
+        self.say(f"{node.name!r} ({what}) is not evaluated: taken as {NEUTRAL:g}")
         return np.full((1, 3), NEUTRAL)
 
     def input(self, node, key, groups, kind: str = "RGBA") -> np.ndarray:
@@ -220,7 +223,11 @@ class _Evaluator:
         if uv.shape[0] != self.samples.count:
             uv = np.broadcast_to(uv, (self.samples.count, 2))
         rgba = self.samples.image(node.image, uv, node.extension)
-        return rgba[:, 3:4] if socket.name == "Alpha" else rgba[:, :3]
+        if socket.identifier == "Alpha" and node.image.alpha_mode != "NONE":
+            # the reduced images keep colour only
+            self.say(f"{node.name!r}'s Alpha (of image {node.image.name!r}) is not read: "
+                     f"taken as 1")
+        return rgba[:, 3:4] if socket.identifier == "Alpha" else rgba[:, :3]
 
     def node_mapping(self, node, socket, groups):
         vector = self.input(node, "Vector", groups, "VECTOR")

@@ -133,6 +133,28 @@ def test_what_cannot_be_evaluated_is_half_and_said(tree):
     assert notes == [f"{noise.name!r} (Noise Texture) is not evaluated: taken as 0.5"]
 
 
+def test_an_images_alpha_is_said_to_be_taken_as_1(tree):
+    """A texture's Alpha (a mask in the albedo's alpha mixing two skins): the reduced images
+    keep colour only, so it is 1, and the note says so (a value assumed: the first Apply
+    warns); an image without alpha says nothing."""
+    import bpy
+
+    from makeup_skin_addon import surface_values
+
+    group, colour = tree
+    texture = group.nodes.new("ShaderNodeTexImage")
+    texture.image = bpy.data.images.new("Masked", 3, 1, alpha=True)
+    group.links.new(texture.outputs["Alpha"], colour)
+    notes = []
+    assert surface_values.mean(_source_of(colour), Points(), notes, "VALUE") == 1.0
+    assert notes == ["'Image Texture''s Alpha (of image 'Masked') is not read: taken as 1"]
+    assert surface_values.assumed(notes[0])
+    texture.image.alpha_mode = "NONE"
+    notes = []
+    surface_values.mean(_source_of(colour), Points(), notes, "VALUE")
+    assert notes == []
+
+
 def _emission_seen_flat(scene, obj, *, size: int, samples: int, ortho_scale: float):
     """``obj`` given a material whose surface is an Emission, seen by an orthographic camera
     from +Z in Cycles (``size`` px square, ``samples``, the Standard view: a pixel is the
