@@ -203,11 +203,13 @@ def install(material, group, *, over_shader: bool, reading=None, film_strength: 
         material.use_nodes = True
     tree = material.node_tree
     node = group_node(material)
-    if node is not None and material.get(RECORD_KEY) and \
-            json.loads(material[RECORD_KEY]).get("version") != RECORD_VERSION and over_shader:
+    record = (json.loads(material[RECORD_KEY]) if node is not None and material.get(RECORD_KEY)
+              else None)
+    if record is not None and record.get("version") != RECORD_VERSION and over_shader:
         revert(material, remove_unused=False)  # an earlier add-on's conversion: again, over
-        node = None
-    output = _recorded_output(material) if node is not None else material_output(tree)
+        node = record = None
+    output = (_recorded_output(tree, record.get("output")) if record is not None
+              else material_output(tree))
     surface = output.inputs["Surface"]
     installed = Installed(over_shader=over_shader)
     if node is None:
@@ -255,17 +257,12 @@ def _other_output_sentence(tree, target: str, other, output) -> str:
             f"{engine}, Apply)")
 
 
-def _recorded_output(material):
-    """The Material Output a converted material's group feeds (its record's; else the one
-    the scene's engine renders): a later Apply in another engine's scene keeps to it."""
-    try:
-        name = json.loads(material[RECORD_KEY]).get("output") if RECORD_KEY in material \
-            else None
-    except (TypeError, ValueError):
-        name = None
-    output = material.node_tree.nodes.get(name or "")
+def _recorded_output(tree, name: str | None):
+    """The Material Output a converted material's group feeds, ``name`` in its record (else
+    the one the scene's engine renders): a later Apply in another engine's scene keeps to it."""
+    output = tree.nodes.get(name or "")
     return output if output is not None and output.type == "OUTPUT_MATERIAL" \
-        else material_output(material.node_tree)
+        else material_output(tree)
 
 
 def can_revert(material) -> bool:
@@ -315,7 +312,7 @@ def revert(material, *, remove_unused: bool = True) -> str:
     if record.get("node") and shader is None:
         raise ValueError(f"material {material.name!r}: its previous surface "
                          f"{record['node']!r} was deleted; nothing was changed")
-    output = _recorded_output(material)
+    output = _recorded_output(tree, record.get("output"))
     node = group_node(material)
     group = node.node_tree
     frame = tree.nodes.get(FRAME_NAME)

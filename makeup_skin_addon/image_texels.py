@@ -22,7 +22,6 @@ is read whole at each call and reduced again only when its CRC-32 changed.
 
 from __future__ import annotations
 
-import contextlib
 import os
 import zlib
 from dataclasses import dataclass
@@ -194,9 +193,7 @@ def _image_fingerprint(image) -> tuple:
     size), packed data, colour space, generated settings, alpha."""
     stat = None
     if image.source in {"FILE", "SEQUENCE", "MOVIE", "TILED"} and not image.packed_files:
-        with contextlib.suppress(OSError):
-            info = os.stat(bpy.path.abspath(image.filepath, library=image.library))
-            stat = (info.st_mtime_ns, info.st_size)
+        stat = _file_stamp(bpy.path.abspath(image.filepath, library=image.library))
     packed = tuple((p.packed_file.size, p.packed_file.as_pointer()) for p in image.packed_files)
     generated = ((image.generated_width, image.generated_height, image.generated_type,
                   tuple(image.generated_color), image.use_generated_float)
@@ -272,11 +269,17 @@ def reduced_tiles(image, size: int = IMAGE_SIZE) -> dict[int, ReducedImage]:
     return {number: _tile(image, path, size) for number, path in tile_files(image).items()}
 
 
-def _tile(image, path: str, size: int) -> ReducedImage:
-    stat = None
-    with contextlib.suppress(OSError):
+def _file_stamp(path: str) -> tuple[int, int] | None:
+    """A file's ``(date in ns, size)``, None when it cannot be read."""
+    try:
         info = os.stat(path)
-        stat = (info.st_mtime_ns, info.st_size)
+    except OSError:
+        return None
+    return info.st_mtime_ns, info.st_size
+
+
+def _tile(image, path: str, size: int) -> ReducedImage:
+    stat = _file_stamp(path)
     key = (image.session_uid, size, path)
     fingerprint = (stat, image.colorspace_settings.name, image.alpha_mode)
     entry = _IMAGES.get(key)
