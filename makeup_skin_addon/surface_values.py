@@ -317,10 +317,10 @@ class _Evaluator:
         colour = self.input(node, "Color", groups)
         t = self.input(node, "Fac", groups, "VALUE")
         mapping = node.mapping
-        combined = mapping.curves[3]  # the C curve, applied before each channel's own
-        curved = np.column_stack([
-            _curve(mapping, mapping.curves[c], _curve(mapping, combined, colour[:, c]))
-            for c in range(3)])
+        # the C curve (one table over every channel's values), then each channel's own
+        combined = _curve(mapping, mapping.curves[3], colour)
+        curved = np.column_stack([_curve(mapping, mapping.curves[c], combined[:, c])
+                                  for c in range(3)])
         return colour + t * (curved - colour)
 
     # -- view-dependent factors, averaged under uniform light -------------------------------
